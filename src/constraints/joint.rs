@@ -1,0 +1,270 @@
+//! Joint constraint equations built from two primitives (Haug 1989, Nikravesh 1988):
+//!
+//! - spherical: `d = r_j + A_j s_j − r_i − A_i s_i = 0` (3 rows);
+//! - dot-1: `a_iᵀ b_j = 0` for body vectors `a_i = A_i a'`, `b_j = A_j b'`;
+//! - dot-2: `a_iᵀ d = 0`.
+//!
+//! With `x, y, z` the axes of the joint frames `J` on parent `i` and child `j`:
+//! revolute = spherical + `z_i·x_j, z_i·y_j`; prismatic = `z_i·x_j, z_i·y_j, y_i·x_j, d·x_i,
+//! d·y_i`; cylindrical = `z_i·x_j, z_i·y_j, d·x_i, d·y_i`; fixed = spherical + `z_i·x_j,
+//! z_i·y_j, y_i·x_j`; universal = spherical + `z_i·x_j`; planar = `z_i·x_j, z_i·y_j, d·z_i`;
+//! screw = cylindrical + `d·z_i − h θ`; distance = `d·d − L²`; point-on-line = `d·x_i, d·y_i`.
+//!
+//! Joint coordinates: `θ = atan2(y_i·x_j, x_i·x_j)` about z, `d·z_i` along z; universal
+//! `θ₂ = atan2(z_i·y_j, z_i·z_j)`; planar `x = d·x_i, y = d·y_i`.
+//!
+//! ## References
+//! - E. J. Haug, *Computer-Aided Kinematics and Dynamics of Mechanical Systems* (1989), ch. 3.
+
+use crate::jet::{Pair, Scalar, Vec3Jet};
+use crate::model::{Joint, JointKind};
+use nalgebra::Vector3;
+
+/// Joint-frame points and axes of both sides.
+struct Frames {
+    d: Vec3Jet,
+    x: [Vec3Jet; 2],
+    y: [Vec3Jet; 2],
+    z: [Vec3Jet; 2],
+}
+
+fn frames(joint: &Joint, pair: &Pair) -> Frames {
+    let mut pts = Vec::with_capacity(2);
+    let mut x = Vec::with_capacity(2);
+    let mut y = Vec::with_capacity(2);
+    let mut z = Vec::with_capacity(2);
+    for k in 0..2 {
+        let f = &joint.body_from_joint[k];
+        pts.push(pair.point(k, &f.translation.vector));
+        x.push(pair.vector(k, &(f.rotation * Vector3::x())));
+        y.push(pair.vector(k, &(f.rotation * Vector3::y())));
+        z.push(pair.vector(k, &(f.rotation * Vector3::z())));
+    }
+    Frames {
+        d: pts[1].sub(&pts[0]),
+        x: [x[0], x[1]],
+        y: [y[0], y[1]],
+        z: [z[0], z[1]],
+    }
+}
+
+fn component(pair: &Pair, d: &Vec3Jet, k: usize) -> Scalar {
+    let mut e = Vector3::zeros();
+    e[k] = 1.0;
+    let mut g = crate::jet::LVec::zeros();
+    for i in 0..crate::jet::NL {
+        g[i] = d.j[(k, i)];
+    }
+    let h = if pair.hess {
+        d.contract(&e)
+    } else {
+        crate::jet::LMat::zeros()
+    };
+    Scalar { v: d.v[k], g, h }
+}
+
+fn angle(pair: &Pair, f: &Frames) -> Scalar {
+    let s = pair.dot(&f.y[0], &f.x[1]);
+    let c = pair.dot(&f.x[0], &f.x[1]);
+    pair.atan2(&s, &c)
+}
+
+/// Number of constraint rows of a joint (0 for merged and floating joints).
+pub(crate) fn row_count(joint: &Joint) -> usize {
+    if joint.merged {
+        return 0;
+    }
+    match joint.kind {
+        JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic => 5,
+        JointKind::Fixed => 6,
+        JointKind::Floating => 0,
+        JointKind::Planar => 3,
+        JointKind::Spherical => 3,
+        JointKind::Universal | JointKind::Cylindrical => 4,
+        JointKind::Screw { .. } => 5,
+        JointKind::Distance { .. } => 1,
+        JointKind::PointOnLine => 2,
+    }
+}
+
+/// Names of the constraint rows of a joint, in row order.
+pub(crate) fn row_names(joint: &Joint) -> &'static [&'static str] {
+    const POS: [&str; 3] = ["pos_x", "pos_y", "pos_z"];
+    if joint.merged {
+        return &[];
+    }
+    match joint.kind {
+        JointKind::Revolute | JointKind::Continuous => {
+            &["pos_x", "pos_y", "pos_z", "axis_x", "axis_y"]
+        }
+        JointKind::Prismatic => &["axis_x", "axis_y", "twist", "slide_x", "slide_y"],
+        JointKind::Fixed => &["pos_x", "pos_y", "pos_z", "axis_x", "axis_y", "twist"],
+        JointKind::Floating => &[],
+        JointKind::Planar => &["normal_x", "normal_y", "plane"],
+        JointKind::Spherical => &POS,
+        JointKind::Universal => &["pos_x", "pos_y", "pos_z", "cross"],
+        JointKind::Cylindrical => &["axis_x", "axis_y", "slide_x", "slide_y"],
+        JointKind::Screw { .. } => &["axis_x", "axis_y", "slide_x", "slide_y", "thread"],
+        JointKind::Distance { .. } => &["length"],
+        JointKind::PointOnLine => &["line_x", "line_y"],
+    }
+}
+
+/// Evaluates the constraint rows of a joint into `out` (cleared first).
+pub(crate) fn rows(joint: &Joint, pair: &Pair, out: &mut Vec<Scalar>) {
+    out.clear();
+    if joint.merged || joint.kind == JointKind::Floating {
+        return;
+    }
+    let f = frames(joint, pair);
+    let spherical = |out: &mut Vec<Scalar>| {
+        for k in 0..3 {
+            out.push(component(pair, &f.d, k));
+        }
+    };
+    let parallel = |out: &mut Vec<Scalar>| {
+        out.push(pair.dot(&f.z[0], &f.x[1]));
+        out.push(pair.dot(&f.z[0], &f.y[1]));
+    };
+    let on_axis = |out: &mut Vec<Scalar>| {
+        out.push(pair.dot(&f.x[0], &f.d));
+        out.push(pair.dot(&f.y[0], &f.d));
+    };
+    match joint.kind {
+        JointKind::Revolute | JointKind::Continuous => {
+            spherical(out);
+            parallel(out);
+        }
+        JointKind::Prismatic => {
+            parallel(out);
+            out.push(pair.dot(&f.y[0], &f.x[1]));
+            on_axis(out);
+        }
+        JointKind::Fixed => {
+            spherical(out);
+            parallel(out);
+            out.push(pair.dot(&f.y[0], &f.x[1]));
+        }
+        JointKind::Planar => {
+            parallel(out);
+            out.push(pair.dot(&f.z[0], &f.d));
+        }
+        JointKind::Spherical => spherical(out),
+        JointKind::Universal => {
+            spherical(out);
+            out.push(pair.dot(&f.z[0], &f.x[1]));
+        }
+        JointKind::Cylindrical => {
+            parallel(out);
+            on_axis(out);
+        }
+        JointKind::Screw { pitch } => {
+            parallel(out);
+            on_axis(out);
+            let t = angle(pair, &f).scale(-pitch);
+            out.push(pair.dot(&f.z[0], &f.d).add(&t));
+        }
+        JointKind::Distance { length } => out.push(pair.dot(&f.d, &f.d).minus(length * length)),
+        JointKind::PointOnLine => on_axis(out),
+        JointKind::Floating => {}
+    }
+}
+
+/// Scalar joint coordinate `dof` (see the module docs), or `None` if the joint has none.
+pub(crate) fn coordinate(joint: &Joint, pair: &Pair, dof: usize) -> Option<Scalar> {
+    let f = frames(joint, pair);
+    match (joint.kind, dof) {
+        (JointKind::Revolute | JointKind::Continuous | JointKind::Screw { .. }, 0) => {
+            Some(angle(pair, &f))
+        }
+        (JointKind::Prismatic, 0) => Some(pair.dot(&f.z[0], &f.d)),
+        (JointKind::Cylindrical, 0) => Some(angle(pair, &f)),
+        (JointKind::Cylindrical, 1) => Some(pair.dot(&f.z[0], &f.d)),
+        (JointKind::Universal, 0) => Some(angle(pair, &f)),
+        (JointKind::Universal, 1) => {
+            let s = pair.dot(&f.z[0], &f.y[1]);
+            let c = pair.dot(&f.z[0], &f.z[1]);
+            Some(pair.atan2(&s, &c))
+        }
+        (JointKind::Planar, 0) => Some(pair.dot(&f.x[0], &f.d)),
+        (JointKind::Planar, 1) => Some(pair.dot(&f.y[0], &f.d)),
+        (JointKind::Planar, 2) => Some(angle(pair, &f)),
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::jet::testing::{check_scalar, sample_pair};
+    use crate::model::BodyId;
+    use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+
+    fn joint(kind: JointKind) -> Joint {
+        let f0 = Isometry3::from_parts(
+            Translation3::new(0.1, 0.2, -0.3),
+            UnitQuaternion::from_euler_angles(0.3, -0.2, 0.9),
+        );
+        let f1 = Isometry3::from_parts(
+            Translation3::new(-0.2, 0.05, 0.4),
+            UnitQuaternion::from_euler_angles(-0.5, 0.4, 0.1),
+        );
+        Joint {
+            name: "j".into(),
+            kind,
+            parent_link: "a".into(),
+            child_link: "b".into(),
+            bodies: [Some(BodyId(0)), Some(BodyId(1))],
+            body_from_joint: [f0, f1],
+            tree: false,
+            merged: false,
+            limits: None,
+        }
+    }
+
+    const KINDS: [JointKind; 11] = [
+        JointKind::Revolute,
+        JointKind::Continuous,
+        JointKind::Prismatic,
+        JointKind::Fixed,
+        JointKind::Planar,
+        JointKind::Spherical,
+        JointKind::Universal,
+        JointKind::Cylindrical,
+        JointKind::Screw { pitch: 0.01 },
+        JointKind::Distance { length: 0.7 },
+        JointKind::PointOnLine,
+    ];
+
+    #[test]
+    fn every_row_jacobian_and_hessian_match_finite_differences() {
+        for kind in KINDS {
+            let j = joint(kind);
+            for seed in 0..3 {
+                let pair = sample_pair(seed);
+                let mut out = Vec::new();
+                rows(&j, &pair, &mut out);
+                assert_eq!(out.len(), row_count(&j));
+                assert_eq!(row_names(&j).len(), row_count(&j));
+                for r in 0..out.len() {
+                    check_scalar(
+                        &pair,
+                        &|q| {
+                            let mut o = Vec::new();
+                            rows(&j, q, &mut o);
+                            o[r]
+                        },
+                        &format!("{} row {}", kind.name(), row_names(&j)[r]),
+                    );
+                }
+                for dof in 0..kind.scalar_coordinates() {
+                    check_scalar(
+                        &pair,
+                        &|q| coordinate(&j, q, dof).unwrap(),
+                        &format!("{} coordinate {dof}", kind.name()),
+                    );
+                }
+            }
+        }
+    }
+}

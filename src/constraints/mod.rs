@@ -1,0 +1,234 @@
+//! The constraint equations `Φ(q) = 0`, their Jacobian `Φ_q` (assembled as sparse triplets)
+//! and the weighted Hessian `Σ_k w_k ∇²Φ_k`.
+//!
+//! Rows come in blocks: the equations of each joint ([`joint`]), one Euler-parameter
+//! normalization `p_iᵀ p_i − 1 = 0` per body, locks `θ(q) − θ̄ = 0` and mimic couplings
+//! `θ_a(q) − m θ_b(q) − c = 0`.
+
+pub(crate) mod joint;
+
+use crate::jet::{pair_of, scatter, Scalar};
+use crate::model::{BodyId, JointId, Model};
+use nalgebra::{DMatrix, DVector};
+
+/// A sparse matrix in triplet (coordinate) form.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Triplets {
+    pub(crate) rows: usize,
+    pub(crate) cols: usize,
+    pub(crate) entries: Vec<(usize, usize, f64)>,
+}
+
+impl Triplets {
+    /// Dense copy (duplicates summed).
+    pub(crate) fn to_dense(&self) -> DMatrix<f64> {
+        let mut m = DMatrix::zeros(self.rows, self.cols);
+        for &(i, j, v) in &self.entries {
+            m[(i, j)] += v;
+        }
+        m
+    }
+}
+
+/// What a block of rows expresses.
+#[derive(Clone, Debug)]
+pub(crate) enum BlockKind {
+    /// The equations of a joint.
+    Joint(JointId),
+    /// `pᵀp − 1` of a body.
+    Normalization(BodyId),
+    /// A held joint coordinate.
+    Lock {
+        joint: JointId,
+        dof: usize,
+        value: f64,
+    },
+    /// A mimic coupling (index into `Model::mimics`).
+    Mimic(usize),
+}
+
+/// A block of consecutive rows.
+#[derive(Clone, Debug)]
+pub(crate) struct Block {
+    pub(crate) kind: BlockKind,
+    pub(crate) first: usize,
+}
+
+/// The full set of constraint rows of a model, with locks resolved to values.
+#[derive(Clone, Debug)]
+pub(crate) struct Constraints {
+    pub(crate) blocks: Vec<Block>,
+    len: usize,
+    names: Vec<String>,
+}
+
+impl Constraints {
+    /// Builds the rows of `model` plus the locks `(joint, dof, value)`.
+    pub(crate) fn new(model: &Model, locks: &[(JointId, usize, f64)]) -> Self {
+        let mut blocks = Vec::new();
+        let mut names = Vec::new();
+        let mut len = 0;
+        let mut push = |kind: BlockKind, count: usize, blocks: &mut Vec<Block>| {
+            blocks.push(Block { kind, first: len });
+            len += count;
+        };
+        for (i, j) in model.joints.iter().enumerate() {
+            let count = joint::row_count(j);
+            if count > 0 {
+                push(BlockKind::Joint(JointId(i)), count, &mut blocks);
+                names.extend(
+                    joint::row_names(j)
+                        .iter()
+                        .map(|r| format!("{}.{}", j.name, r)),
+                );
+            }
+        }
+        for (i, b) in model.bodies.iter().enumerate() {
+            push(BlockKind::Normalization(BodyId(i)), 1, &mut blocks);
+            names.push(format!("{}.normalization", b.name));
+        }
+        for &(joint, dof, value) in locks {
+            push(BlockKind::Lock { joint, dof, value }, 1, &mut blocks);
+            names.push(format!("{}.lock[{dof}]", model.joints[joint.0].name));
+        }
+        for (i, m) in model.mimics.iter().enumerate() {
+            push(BlockKind::Mimic(i), 1, &mut blocks);
+            names.push(format!("{}.mimic", model.joints[m.joint.0].name));
+        }
+        Constraints { blocks, len, names }
+    }
+
+    /// Number of rows `m`.
+    pub(crate) fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Name of row `i` (`joint.row`, `body.normalization`, `joint.lock[dof]`, `joint.mimic`).
+    pub(crate) fn row_name(&self, i: usize) -> &str {
+        &self.names[i]
+    }
+
+    /// Evaluates each block's rows as local jets and hands them to `visit(row, bodies, jet,
+    /// coefficient)`; normalization rows are handled by the callers directly.
+    fn for_each_row(
+        &self,
+        model: &Model,
+        q: &DVector<f64>,
+        hess: bool,
+        mut visit: impl FnMut(usize, &[Option<BodyId>; 2], &Scalar, f64),
+        mut normalization: impl FnMut(usize, BodyId),
+    ) {
+        let mut buf = Vec::with_capacity(6);
+        for block in &self.blocks {
+            match &block.kind {
+                BlockKind::Joint(id) => {
+                    let j = &model.joints[id.0];
+                    let pair = pair_of(&j.bodies, q, hess);
+                    joint::rows(j, &pair, &mut buf);
+                    for (k, s) in buf.iter().enumerate() {
+                        visit(block.first + k, &j.bodies, s, 1.0);
+                    }
+                }
+                BlockKind::Normalization(b) => normalization(block.first, *b),
+                BlockKind::Lock {
+                    joint: id,
+                    dof,
+                    value,
+                } => {
+                    let j = &model.joints[id.0];
+                    let pair = pair_of(&j.bodies, q, hess);
+                    if let Some(s) = joint::coordinate(j, &pair, *dof) {
+                        visit(block.first, &j.bodies, &s.minus(*value), 1.0);
+                    }
+                }
+                BlockKind::Mimic(i) => {
+                    let m = &model.mimics[*i];
+                    let ja = &model.joints[m.joint.0];
+                    let jb = &model.joints[m.reference.0];
+                    let pa = pair_of(&ja.bodies, q, hess);
+                    let pb = pair_of(&jb.bodies, q, hess);
+                    if let (Some(a), Some(b)) =
+                        (joint::coordinate(ja, &pa, 0), joint::coordinate(jb, &pb, 0))
+                    {
+                        visit(block.first, &ja.bodies, &a.minus(m.offset), 1.0);
+                        visit(block.first, &jb.bodies, &b, -m.multiplier);
+                    }
+                }
+            }
+        }
+    }
+
+    /// `Φ(q)` into `phi`, and `Φ_q` into `jac` when given.
+    pub(crate) fn evaluate(
+        &self,
+        model: &Model,
+        q: &DVector<f64>,
+        phi: &mut DVector<f64>,
+        mut jac: Option<&mut Triplets>,
+    ) {
+        phi.fill(0.0);
+        if let Some(t) = jac.as_deref_mut() {
+            t.rows = self.len;
+            t.cols = q.len();
+            t.entries.clear();
+        }
+        let jac_cell = std::cell::RefCell::new(jac);
+        let phi_cell = std::cell::RefCell::new(phi);
+        self.for_each_row(
+            model,
+            q,
+            false,
+            |row, bodies, s, c| {
+                phi_cell.borrow_mut()[row] += c * s.v;
+                if let Some(t) = jac_cell.borrow_mut().as_deref_mut() {
+                    for i in 0..crate::jet::NL {
+                        if let Some(gi) = crate::jet::global_index(bodies, i) {
+                            if s.g[i] != 0.0 {
+                                t.entries.push((row, gi, c * s.g[i]));
+                            }
+                        }
+                    }
+                }
+            },
+            |row, b| {
+                let i = 7 * b.0 + 3;
+                let p = q.rows(i, 4);
+                phi_cell.borrow_mut()[row] = p.dot(&p) - 1.0;
+                if let Some(t) = jac_cell.borrow_mut().as_deref_mut() {
+                    for k in 0..4 {
+                        t.entries.push((row, i + k, 2.0 * q[i + k]));
+                    }
+                }
+            },
+        );
+    }
+
+    /// Adds `Σ_k w_k ∇²Φ_k(q)` to `h`.
+    pub(crate) fn add_hessian(
+        &self,
+        model: &Model,
+        q: &DVector<f64>,
+        w: &DVector<f64>,
+        h: &mut DMatrix<f64>,
+    ) {
+        let mut g = DVector::zeros(q.len());
+        let h_cell = std::cell::RefCell::new(h);
+        self.for_each_row(
+            model,
+            q,
+            true,
+            |row, bodies, s, c| {
+                if w[row] != 0.0 {
+                    scatter(bodies, s, c * w[row], &mut g, Some(*h_cell.borrow_mut()));
+                }
+            },
+            |row, b| {
+                let i = 7 * b.0 + 3;
+                let mut h = h_cell.borrow_mut();
+                for k in 0..4 {
+                    h[(i + k, i + k)] += 2.0 * w[row];
+                }
+            },
+        );
+    }
+}

@@ -1,0 +1,133 @@
+//! Potential energy `V(q)` and its derivatives; the generalized force is `g = −V_qᵀ`.
+//!
+//! `V = V_gravity + V_springs + V_joint_springs − W_loads − W_efforts` with
+//! - gravity `−Σ_i m_i gᵀ (r_i + A_i c_i)` (zero at the world origin),
+//! - translational springs `∫₀^{L−L₀} F(δ) dδ`, `L = ‖r_Pj − r_Pi‖`,
+//! - joint springs `∫₀^{θ−θ_ref} F(δ) dδ`,
+//! - dead loads `W = fᵀ r_P`, joint efforts `W = τ θ`.
+
+pub(crate) mod law;
+
+use crate::constraints::joint;
+use crate::jet::{pair_of, scatter, Pair, Scalar, Vec3Jet};
+use crate::model::{BodyId, JointKind, Model, SpringMode};
+use nalgebra::{DMatrix, DVector, Vector3};
+
+/// Potential energy split by source [J].
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Energy {
+    /// Total `V` [J].
+    pub total: f64,
+    /// Gravity [J].
+    pub gravity: f64,
+    /// Translational springs [J].
+    pub springs: f64,
+    /// Joint springs [J].
+    pub joint_springs: f64,
+    /// Minus the work of dead loads and joint efforts [J].
+    pub loads: f64,
+}
+
+/// `wᵀ f` for a constant `w`.
+fn weighted(pair: &Pair, f: &Vec3Jet, w: &Vector3<f64>) -> Scalar {
+    let h = if pair.hess {
+        f.contract(w)
+    } else {
+        crate::jet::LMat::zeros()
+    };
+    Scalar {
+        v: w.dot(&f.v),
+        g: f.j.transpose() * w,
+        h,
+    }
+}
+
+/// Whether coordinate `dof` of a joint of this kind is an angle (wrapped into (−π, π]).
+pub(crate) fn is_angle(kind: JointKind, dof: usize) -> bool {
+    matches!(
+        (kind, dof),
+        (
+            JointKind::Revolute | JointKind::Continuous | JointKind::Screw { .. },
+            0
+        ) | (JointKind::Cylindrical, 0)
+            | (JointKind::Universal, _)
+            | (JointKind::Planar, 2)
+    )
+}
+
+/// Evaluates `V(q)`; adds `V_q` to `grad` and, when given, `V_qq` to `hess`. Returns `None`
+/// where `V` is undefined (a force table with `extrapolate="error"` left its range).
+pub(crate) fn potential(
+    model: &Model,
+    q: &DVector<f64>,
+    grad: &mut DVector<f64>,
+    mut hess: Option<&mut DMatrix<f64>>,
+) -> Option<Energy> {
+    let want_h = hess.is_some();
+    let mut e = Energy::default();
+    let mut add = |bodies: &[Option<BodyId>; 2], s: &Scalar, c: f64, slot: &mut f64| {
+        *slot += c * s.v;
+        scatter(bodies, s, c, grad, hess.as_deref_mut());
+    };
+    for (i, b) in model.bodies.iter().enumerate() {
+        if b.gravity_mass == 0.0 {
+            continue;
+        }
+        let bodies = [Some(BodyId(i)), None];
+        let pair = pair_of(&bodies, q, want_h);
+        let p = pair.point(0, &b.gravity_com);
+        let s = weighted(&pair, &p, &(-b.gravity_mass * model.gravity));
+        add(&bodies, &s, 1.0, &mut e.gravity);
+    }
+    for l in &model.loads {
+        let bodies = [Some(l.body), None];
+        let pair = pair_of(&bodies, q, want_h);
+        let p = pair.point(0, &l.point);
+        add(
+            &bodies,
+            &weighted(&pair, &p, &(-l.force)),
+            1.0,
+            &mut e.loads,
+        );
+    }
+    for s in &model.springs {
+        let bodies = [s.ends[0].body, s.ends[1].body];
+        let pair = pair_of(&bodies, q, want_h);
+        let d = pair
+            .point(1, &s.ends[1].point)
+            .sub(&pair.point(0, &s.ends[0].point));
+        let l2 = pair.dot(&d, &d);
+        let l = l2.v.sqrt();
+        let (u, f, k) = law::evaluate(&s.law, s.mode, l - s.free_length)?;
+        if l < 1e-12 {
+            e.springs += u;
+            continue;
+        }
+        let len = l2.compose(l, 0.5 / l, -0.25 / (l * l * l));
+        add(&bodies, &len.compose(u, f, k), 1.0, &mut e.springs);
+    }
+    for js in &model.joint_springs {
+        let j = &model.joints[js.joint.0];
+        let pair = pair_of(&j.bodies, q, want_h);
+        let theta = joint::coordinate(j, &pair, js.dof)?;
+        let mut delta = theta.v - js.reference;
+        if is_angle(j.kind, js.dof) {
+            delta = crate::math::wrap_angle(delta);
+        }
+        let (u, f, k) = law::evaluate(&js.law, SpringMode::Both, delta)?;
+        add(
+            &j.bodies,
+            &theta.compose(u, f, k),
+            1.0,
+            &mut e.joint_springs,
+        );
+    }
+    for ef in &model.efforts {
+        let j = &model.joints[ef.joint.0];
+        let pair = pair_of(&j.bodies, q, want_h);
+        let theta = joint::coordinate(j, &pair, ef.dof)?;
+        add(&j.bodies, &theta, -ef.value, &mut e.loads);
+    }
+    e.total = e.gravity + e.springs + e.joint_springs + e.loads;
+    Some(e)
+}

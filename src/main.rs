@@ -1,0 +1,268 @@
+//! The `restpose` command line.
+
+use anyhow::{bail, Context};
+use clap::{Parser, Subcommand, ValueEnum};
+use restpose::export::json::AnalysisResult;
+use restpose::urdf::{load_file, ImportOptions};
+use restpose::{Method, Options};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Exit code when the solve did not converge.
+const EXIT_NOT_CONVERGED: u8 = 3;
+/// Exit code for invalid input.
+const EXIT_INPUT: u8 = 1;
+
+#[derive(Parser)]
+#[command(
+    name = "restpose",
+    version,
+    about = "Static equilibrium (rest pose) of URDF mechanisms"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Solve for the stable rest pose and print a summary.
+    Analyze(AnalyzeArgs),
+    /// Write a generated benchmark mechanism (URDF) to standard output.
+    Generate {
+        /// Family.
+        #[arg(value_enum)]
+        family: Family,
+        /// Number of links (chain) or loops (ladder).
+        #[arg(long, default_value_t = 20)]
+        size: usize,
+    },
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Family {
+    /// N-link spatial pendulum chain with joint springs (alternating joint axes).
+    Chain,
+    /// N-link planar chain (all axes parallel) with joint springs.
+    PlanarChain,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum MethodArg {
+    Newton,
+    Bfgs,
+    Dfp,
+}
+
+#[derive(clap::Args)]
+struct AnalyzeArgs {
+    /// URDF file.
+    file: PathBuf,
+    /// Write the result JSON here (written even when the solve does not converge).
+    #[arg(long, value_name = "OUT.json")]
+    json: Option<PathBuf>,
+    /// Gravity [m/s²] when the file has no <mech:gravity>.
+    #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_hyphen_values = true)]
+    gravity: Option<Vec<f64>>,
+    /// Hold a joint coordinate: JOINT=VALUE or JOINT[DOF]=VALUE (repeatable).
+    #[arg(long, value_name = "JOINT=VALUE")]
+    lock: Vec<String>,
+    /// Initial guess of a joint coordinate: JOINT=VALUE or JOINT[DOF]=VALUE (repeatable).
+    #[arg(long, value_name = "JOINT=VALUE")]
+    initial: Vec<String>,
+    /// Maximum minimizer iterations.
+    #[arg(long, default_value_t = 200)]
+    max_iterations: usize,
+    /// Tolerance on the scaled reduced gradient [J].
+    #[arg(long, default_value_t = 1e-8)]
+    tolerance: f64,
+    /// Tolerance on the constraint residual ‖Φ‖∞.
+    #[arg(long, default_value_t = 1e-10)]
+    constraint_tolerance: f64,
+    /// Minimizer.
+    #[arg(long, value_enum, default_value = "newton")]
+    method: MethodArg,
+    /// Leave the root link free instead of welding it to the world.
+    #[arg(long)]
+    floating_base: bool,
+    /// Stop at an unstable stationary point instead of leaving it.
+    #[arg(long)]
+    allow_unstable: bool,
+    /// Print only errors.
+    #[arg(long, short)]
+    quiet: bool,
+    /// Also list ignored foreign elements.
+    #[arg(long, short)]
+    verbose: bool,
+}
+
+fn coord(s: &str, what: &str) -> anyhow::Result<(String, usize, f64)> {
+    let (name, value) = s
+        .split_once('=')
+        .with_context(|| format!("--{what} {s}: expected JOINT=VALUE"))?;
+    let value: f64 = value
+        .trim()
+        .parse()
+        .with_context(|| format!("--{what} {s}: `{value}` is not a number"))?;
+    if !value.is_finite() {
+        bail!("--{what} {s}: value must be finite");
+    }
+    let (name, dof) = match name.split_once('[') {
+        Some((n, rest)) => {
+            let d = rest
+                .trim_end_matches(']')
+                .parse()
+                .with_context(|| format!("--{what} {s}: bad [DOF]"))?;
+            (n, d)
+        }
+        None => (name, 0),
+    };
+    Ok((name.to_string(), dof, value))
+}
+
+fn analyze(a: &AnalyzeArgs) -> anyhow::Result<u8> {
+    let mut opts = ImportOptions {
+        floating_base: a.floating_base,
+        ..Default::default()
+    };
+    if let Some(g) = &a.gravity {
+        opts.gravity = nalgebra::Vector3::new(g[0], g[1], g[2]);
+    }
+    for l in &a.lock {
+        let (n, d, v) = coord(l, "lock")?;
+        opts.locks.push((n, d, Some(v)));
+    }
+    for l in &a.initial {
+        opts.initial.push(coord(l, "initial")?);
+    }
+    let loaded = load_file(&a.file, &opts)?;
+    if !a.quiet {
+        for w in &loaded.warnings {
+            eprintln!("warning: {w}");
+        }
+        if a.verbose {
+            for i in &loaded.ignored {
+                eprintln!("ignored: {}:{i}", a.file.display());
+            }
+        }
+    }
+    let options = Options {
+        method: match a.method {
+            MethodArg::Newton => Method::Newton,
+            MethodArg::Bfgs => Method::Bfgs,
+            MethodArg::Dfp => Method::Dfp,
+        },
+        gradient_tolerance: a.tolerance,
+        constraint_tolerance: a.constraint_tolerance,
+        max_iterations: a.max_iterations,
+        allow_unstable: a.allow_unstable,
+        ..Default::default()
+    };
+    let model = &loaded.model;
+    let (state, report) = restpose::solve(model, &options)?;
+    let result = AnalysisResult::new(model, &state, &report);
+    if let Some(path) = &a.json {
+        restpose::export::write_atomic(path, result.to_json().as_bytes())?;
+    }
+    if !a.quiet {
+        print_summary(&result);
+    }
+    if !result.converged {
+        eprintln!(
+            "error: {}: did not converge ({}) after {} iterations; ‖∂V/∂v‖∞ = {:.3e}, ‖Φ‖∞ = {:.3e}, corrector failures {}, step halvings {}, re-partitions {}",
+            a.file.display(),
+            result.termination,
+            result.iterations,
+            result.diagnostics.gradient_norm,
+            result.diagnostics.constraint_residual,
+            result.diagnostics.corrector_failures,
+            result.diagnostics.step_halvings,
+            result.diagnostics.repartitions
+        );
+        return Ok(EXIT_NOT_CONVERGED);
+    }
+    Ok(0)
+}
+
+fn print_summary(r: &AnalysisResult) {
+    println!("robot `{}`", r.robot);
+    println!(
+        "  bodies {}, coordinates {}, constraint rows {} ({} redundant), degrees of freedom {}",
+        r.bodies,
+        r.coordinates,
+        r.constraints,
+        r.redundant_constraints.len(),
+        r.dof
+    );
+    if !r.redundant_constraints.is_empty() {
+        println!(
+            "  redundant constraints: {}",
+            r.redundant_constraints.join(", ")
+        );
+    }
+    println!(
+        "  independent coordinates: {}",
+        r.independent_coordinates.join(", ")
+    );
+    println!();
+    println!("  iteration   potential energy [J]   ‖∂V/∂v‖∞ [J]");
+    for h in &r.history {
+        println!(
+            "  {:>9}   {:>20.9}   {:>12.3e}",
+            h.iteration, h.potential_energy, h.gradient_norm
+        );
+    }
+    println!();
+    println!(
+        "  {}: {} iterations, V = {:.9} J",
+        r.termination, r.iterations, r.potential_energy
+    );
+    if let Some(s) = &r.stability {
+        let eig: Vec<String> = s.eigenvalues.iter().map(|e| format!("{e:.4e}")).collect();
+        println!(
+            "  stability: {} (smallest reduced-Hessian eigenvalues {})",
+            s.verdict,
+            eig.join(", ")
+        );
+    }
+    println!();
+    println!("  joint                          type          position");
+    for (name, j) in &r.joints {
+        let p: Vec<String> = j.position.iter().map(|v| format!("{v:.9}")).collect();
+        println!("  {:<30} {:<13} [{}]", name, j.kind, p.join(", "));
+    }
+    if !r.reactions.is_empty() {
+        println!();
+        println!("  reaction on child at joint origin (world)   force [N]                          torque [N m]");
+        for (name, re) in &r.reactions {
+            let f = re.force_world;
+            let t = re.torque_world;
+            println!(
+                "  {:<30} [{:>10.4}, {:>10.4}, {:>10.4}]   [{:>10.4}, {:>10.4}, {:>10.4}]",
+                name, f[0], f[1], f[2], t[0], t[1], t[2]
+            );
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let out = match &cli.command {
+        Command::Analyze(a) => analyze(a),
+        Command::Generate { family, size } => {
+            let text = match family {
+                Family::Chain => restpose::generate::chain(*size, false),
+                Family::PlanarChain => restpose::generate::chain(*size, true),
+            };
+            print!("{text}");
+            Ok(0)
+        }
+    };
+    match out {
+        Ok(code) => ExitCode::from(code),
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(EXIT_INPUT)
+        }
+    }
+}

@@ -1,0 +1,145 @@
+//! Euler-parameter helpers: the rotation matrix `A(p)`, its derivative `B(p, a)`, and the
+//! only conversions between nalgebra quaternions and Euler parameters.
+//!
+//! For `p = [e0, e1, e2, e3]`, `e = [e1, e2, e3]`, restpose uses the homogeneous quadratic form
+//!
+//! `A(p) = (e0² − eᵀe) I + 2 e eᵀ + 2 e0 ẽ`
+//!
+//! which equals the paper's `(2 e0² − 1) I + 2 (e eᵀ + e0 ẽ)` whenever `pᵀp = 1`. Off the unit
+//! sphere (inside the Newton corrector, where normalization is only a constraint row) the
+//! homogeneous form keeps `A(p) a` an exact quadratic in `p`, so that
+//!
+//! `B(p, a) = ∂(A(p) a)/∂p = 2 [ (e0 I + ẽ) a ,  e aᵀ − (e0 I + ẽ) ã ]`
+//!
+//! is linear in `p` and the Hessian of `(A(p) a)_k` is the constant matrix whose row `m` is
+//! row `k` of `B(e_m, a)` (`e_m` the m-th unit 4-vector).
+//!
+//! Conventions: `e0 = q.w, e1 = q.i, e2 = q.j, e3 = q.k`.
+//!
+//! ## References
+//! - P. E. Nikravesh, *Computer-Aided Analysis of Mechanical Systems*, Prentice Hall (1988), ch. 6.
+
+use nalgebra::{Matrix3, Matrix3x4, Quaternion, UnitQuaternion, Vector3, Vector4};
+
+/// Skew-symmetric matrix `ã` with `ã b = a × b`.
+pub fn skew(a: &Vector3<f64>) -> Matrix3<f64> {
+    Matrix3::new(0.0, -a.z, a.y, a.z, 0.0, -a.x, -a.y, a.x, 0.0)
+}
+
+/// Rotation matrix `A(p)` of (not necessarily unit) Euler parameters, homogeneous form.
+pub fn rotation(p: &Vector4<f64>) -> Matrix3<f64> {
+    let e0 = p[0];
+    let e = Vector3::new(p[1], p[2], p[3]);
+    Matrix3::identity() * (e0 * e0 - e.dot(&e)) + 2.0 * e * e.transpose() + 2.0 * e0 * skew(&e)
+}
+
+/// `B(p, a) = ∂(A(p) a)/∂p`, a 3 × 4 matrix linear in `p`.
+pub fn b_matrix(p: &Vector4<f64>, a: &Vector3<f64>) -> Matrix3x4<f64> {
+    let e0 = p[0];
+    let e = Vector3::new(p[1], p[2], p[3]);
+    let m = Matrix3::identity() * e0 + skew(&e);
+    let c0 = 2.0 * m * a;
+    let rest = 2.0 * (e * a.transpose() - m * skew(a));
+    let mut b = Matrix3x4::zeros();
+    b.set_column(0, &c0);
+    b.fixed_view_mut::<3, 3>(0, 1).copy_from(&rest);
+    b
+}
+
+/// Euler parameters `[e0, e1, e2, e3]` of a unit quaternion.
+pub fn euler_parameters(q: &UnitQuaternion<f64>) -> Vector4<f64> {
+    Vector4::new(q.w, q.i, q.j, q.k)
+}
+
+/// Unit quaternion of Euler parameters (normalized; the identity if `p` is zero).
+pub fn unit_quaternion(p: &Vector4<f64>) -> UnitQuaternion<f64> {
+    let q = Quaternion::new(p[0], p[1], p[2], p[3]);
+    if q.norm() > 0.0 {
+        UnitQuaternion::from_quaternion(q)
+    } else {
+        UnitQuaternion::identity()
+    }
+}
+
+/// Rotation taking the z axis onto the unit vector `axis` by the shortest arc (a half turn
+/// about x when `axis = −z`).
+pub fn align_z(axis: &Vector3<f64>) -> UnitQuaternion<f64> {
+    UnitQuaternion::rotation_between(&Vector3::z(), axis).unwrap_or_else(|| {
+        UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI)
+    })
+}
+
+/// Wraps an angle into (−π, π].
+pub fn wrap_angle(a: f64) -> f64 {
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let mut w = a % two_pi;
+    if w <= -std::f64::consts::PI {
+        w += two_pi;
+    } else if w > std::f64::consts::PI {
+        w -= two_pi;
+    }
+    w
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn arb_p() -> impl Strategy<Value = Vector4<f64>> {
+        (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64)
+            .prop_map(|(a, b, c, d)| Vector4::new(a, b, c, d))
+    }
+
+    proptest! {
+        #[test]
+        fn rotation_matches_nalgebra_on_unit_sphere(p in arb_p()) {
+            prop_assume!(p.norm() > 0.1);
+            let p = p.normalize();
+            let a = rotation(&p);
+            let r = unit_quaternion(&p).to_rotation_matrix();
+            prop_assert!((a - r.matrix()).norm() < 1e-12);
+        }
+
+        #[test]
+        fn b_is_exact_derivative(p in arb_p(), a in (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64)) {
+            let a = Vector3::new(a.0, a.1, a.2);
+            let b = b_matrix(&p, &a);
+            let h = 1e-6;
+            for m in 0..4 {
+                let mut pp = p;
+                pp[m] += h;
+                let mut pm = p;
+                pm[m] -= h;
+                let fd = (rotation(&pp) * a - rotation(&pm) * a) / (2.0 * h);
+                prop_assert!((fd - b.column(m)).norm() < 1e-8);
+            }
+        }
+
+        #[test]
+        fn q_and_minus_q_same_rotation(p in arb_p()) {
+            prop_assert!((rotation(&p) - rotation(&(-p))).norm() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn align_z_maps_z_to_axis() {
+        for axis in [
+            Vector3::x(),
+            Vector3::y(),
+            Vector3::z(),
+            -Vector3::z(),
+            Vector3::new(1.0, 2.0, -3.0).normalize(),
+        ] {
+            let r = align_z(&axis);
+            assert!((r * Vector3::z() - axis).norm() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn wrap_angle_range() {
+        assert!((wrap_angle(3.0 * std::f64::consts::PI) - std::f64::consts::PI).abs() < 1e-12);
+        assert!((wrap_angle(-0.5) + 0.5).abs() < 1e-15);
+        assert!((wrap_angle(7.0) - (7.0 - 2.0 * std::f64::consts::PI)).abs() < 1e-12);
+    }
+}

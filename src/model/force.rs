@@ -1,0 +1,133 @@
+//! Force elements: springs, loads, efforts; and the coordinate-level inputs locks, mimics
+//! and initial guesses.
+
+use super::{BodyId, JointId};
+use nalgebra::Vector3;
+
+/// Which sign of force a spring can carry.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SpringMode {
+    /// Tension and compression.
+    Both,
+    /// Tension only (a cable).
+    Tension,
+    /// Compression only (a bump stop).
+    Compression,
+}
+
+/// Force (or torque) as a function of deflection `δ`, positive in tension.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ForceLaw {
+    /// `F = preload + k δ`.
+    Linear {
+        /// Stiffness [N/m or N m/rad].
+        stiffness: f64,
+        /// Force at zero deflection [N or N m].
+        preload: f64,
+    },
+    /// Piecewise-linear table of `(δ, F)` rows, `δ` strictly increasing.
+    Table {
+        /// `(deflection, force)` rows.
+        points: Vec<(f64, f64)>,
+        /// Beyond the table: continue the end slopes (`true`) or hold the end forces (`false`).
+        extrapolate_linear: bool,
+        /// Beyond the table the law is undefined (`extrapolate="error"`).
+        bounded: bool,
+    },
+}
+
+/// One end of a translational spring.
+#[derive(Clone, Debug)]
+pub struct SpringEnd {
+    /// The body (`None` = world).
+    pub body: Option<BodyId>,
+    /// Attachment point in the body frame (world frame for the world) [m].
+    pub point: Vector3<f64>,
+}
+
+/// Point-to-point translational spring: potential `∫₀^{L−L₀} F(δ) dδ`.
+#[derive(Clone, Debug)]
+pub struct Spring {
+    /// Spring name.
+    pub name: String,
+    /// The two ends.
+    pub ends: [SpringEnd; 2],
+    /// Free length `L₀` [m].
+    pub free_length: f64,
+    /// Force law.
+    pub law: ForceLaw,
+    /// Tension/compression mode.
+    pub mode: SpringMode,
+}
+
+/// Spring on a joint coordinate: potential `∫₀^{θ−θ_ref} F(δ) dδ`.
+#[derive(Clone, Debug)]
+pub struct JointSpring {
+    /// Joint.
+    pub joint: JointId,
+    /// Coordinate index of the joint.
+    pub dof: usize,
+    /// Reference value [rad or m].
+    pub reference: f64,
+    /// Force law.
+    pub law: ForceLaw,
+}
+
+/// Constant dead force at a body point: potential `−fᵀ r_P`.
+#[derive(Clone, Debug)]
+pub struct Load {
+    /// Load name.
+    pub name: String,
+    /// The body.
+    pub body: BodyId,
+    /// Application point in the body frame [m].
+    pub point: Vector3<f64>,
+    /// Force in the world frame [N].
+    pub force: Vector3<f64>,
+}
+
+/// Constant generalized force on a joint coordinate: potential `−τ θ`.
+#[derive(Clone, Debug)]
+pub struct Effort {
+    /// Joint.
+    pub joint: JointId,
+    /// Coordinate index.
+    pub dof: usize,
+    /// Torque [N m] or force [N].
+    pub value: f64,
+}
+
+/// Held joint coordinate: constraint `θ − value = 0`.
+#[derive(Clone, Debug)]
+pub struct Lock {
+    /// Joint.
+    pub joint: JointId,
+    /// Coordinate index.
+    pub dof: usize,
+    /// Held value [rad or m]; `None` = the initial-guess value.
+    pub value: Option<f64>,
+}
+
+/// Linear coupling `θ = multiplier θ_ref + offset`.
+#[derive(Clone, Debug)]
+pub struct Mimic {
+    /// The mimicking joint.
+    pub joint: JointId,
+    /// The mimicked joint.
+    pub reference: JointId,
+    /// Multiplier.
+    pub multiplier: f64,
+    /// Offset [rad or m].
+    pub offset: f64,
+}
+
+/// Initial guess of a joint coordinate.
+#[derive(Clone, Debug)]
+pub struct Initial {
+    /// Joint.
+    pub joint: JointId,
+    /// Coordinate index.
+    pub dof: usize,
+    /// Value [rad or m].
+    pub value: f64,
+}

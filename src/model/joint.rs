@@ -1,0 +1,106 @@
+//! Joints: a kind and a joint frame `J` on each side.
+//!
+//! The frame `J` has its z axis along the joint axis (for a universal joint x is the second
+//! axis; for a planar joint z is the plane normal). At zero displacement the two `J` frames
+//! coincide; the relative motion of the child's `J` in the parent's `J` is
+//! `Rz(θ)` (revolute), `Tz(d)` (prismatic), `Rz(θ) Tz(d)` (cylindrical),
+//! `Rz(θ₁) Rx(θ₂)` (universal), `T(x, y, 0) Rz(θ)` (planar), `Rz(θ) Tz(h θ)` (screw).
+
+use super::BodyId;
+use nalgebra::Isometry3;
+
+/// Index of a joint in [`crate::Model::joints`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct JointId(pub usize);
+
+/// Joint type.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum JointKind {
+    /// Rotation about z, limited.
+    Revolute,
+    /// Rotation about z, unlimited.
+    Continuous,
+    /// Translation along z.
+    Prismatic,
+    /// No relative motion.
+    Fixed,
+    /// Six degrees of freedom, no constraint.
+    Floating,
+    /// Translation in the x-y plane and rotation about z.
+    Planar,
+    /// Rotation about a common point.
+    Spherical,
+    /// Rotation about z of the parent and x of the child.
+    Universal,
+    /// Rotation about and translation along z.
+    Cylindrical,
+    /// Rotation about z coupled to translation along z: `d = pitch θ`.
+    Screw {
+        /// Pitch [m/rad].
+        pitch: f64,
+    },
+    /// The two joint origins stay `length` apart (massless rod).
+    Distance {
+        /// Rod length [m].
+        length: f64,
+    },
+    /// The child's joint origin stays on the parent's z line.
+    PointOnLine,
+}
+
+impl JointKind {
+    /// The type name used in URDF and in the result JSON.
+    pub fn name(&self) -> &'static str {
+        match self {
+            JointKind::Revolute => "revolute",
+            JointKind::Continuous => "continuous",
+            JointKind::Prismatic => "prismatic",
+            JointKind::Fixed => "fixed",
+            JointKind::Floating => "floating",
+            JointKind::Planar => "planar",
+            JointKind::Spherical => "spherical",
+            JointKind::Universal => "universal",
+            JointKind::Cylindrical => "cylindrical",
+            JointKind::Screw { .. } => "screw",
+            JointKind::Distance { .. } => "distance",
+            JointKind::PointOnLine => "point_on_line",
+        }
+    }
+
+    /// Number of scalar joint coordinates that springs, efforts, locks and initial values can
+    /// address (`dof` index).
+    pub fn scalar_coordinates(&self) -> usize {
+        match self {
+            JointKind::Revolute
+            | JointKind::Continuous
+            | JointKind::Prismatic
+            | JointKind::Screw { .. } => 1,
+            JointKind::Universal | JointKind::Cylindrical => 2,
+            JointKind::Planar => 3,
+            _ => 0,
+        }
+    }
+}
+
+/// A joint between a parent and a child body.
+#[derive(Clone, Debug)]
+pub struct Joint {
+    /// Joint name.
+    pub name: String,
+    /// Joint type.
+    pub kind: JointKind,
+    /// Parent link name.
+    pub parent_link: String,
+    /// Child link name.
+    pub child_link: String,
+    /// Parent and child bodies (`None` = world).
+    pub bodies: [Option<BodyId>; 2],
+    /// Joint frame `J` in the parent body frame and in the child body frame.
+    pub body_from_joint: [Isometry3<f64>; 2],
+    /// A spanning-tree edge (`true`) or a loop closure (`false`).
+    pub tree: bool,
+    /// A fixed joint welded into one body (adds no constraint).
+    pub merged: bool,
+    /// Position limits `[lower, upper]` of the first coordinate, if any.
+    pub limits: Option<[f64; 2]>,
+}

@@ -1,0 +1,80 @@
+//! The immutable mechanism model: rigid bodies, the links they carry, joints, forces.
+//!
+//! Each moving body `i` has 7 Cartesian coordinates `q_i = [r_i; p_i]` (body-frame origin in
+//! the world, Euler parameters). Links welded by URDF `fixed` joints share one body; every
+//! link keeps its own `body_from_link` transform so that its pose can be reported. The world
+//! (ground) is not a body: joints and forces refer to it with `None`.
+
+mod body;
+mod force;
+mod joint;
+
+pub use body::{Body, BodyId, Link};
+pub use force::{
+    Effort, ForceLaw, Initial, JointSpring, Load, Lock, Mimic, Spring, SpringEnd, SpringMode,
+};
+pub use joint::{Joint, JointId, JointKind};
+
+use nalgebra::Vector3;
+
+/// A validated mechanism (built by the URDF importer); immutable once built.
+#[derive(Clone, Debug)]
+pub struct Model {
+    /// Robot name from `<robot name>`.
+    pub name: String,
+    /// Moving rigid bodies (7 coordinates each).
+    pub bodies: Vec<Body>,
+    /// Every URDF link, with the body carrying it.
+    pub links: Vec<Link>,
+    /// Every joint: URDF joints (fixed ones merged into bodies included) and loop joints.
+    pub joints: Vec<Joint>,
+    /// Translational point-to-point springs.
+    pub springs: Vec<Spring>,
+    /// Springs on joint coordinates.
+    pub joint_springs: Vec<JointSpring>,
+    /// Constant dead loads.
+    pub loads: Vec<Load>,
+    /// Constant generalized forces on joint coordinates.
+    pub efforts: Vec<Effort>,
+    /// Held joint coordinates.
+    pub locks: Vec<Lock>,
+    /// Linear couplings between joint coordinates.
+    pub mimics: Vec<Mimic>,
+    /// Initial guesses of joint coordinates.
+    pub initial: Vec<Initial>,
+    /// Gravity in the world frame [m/s²].
+    pub gravity: Vector3<f64>,
+    /// Characteristic length of the mechanism [m], used to scale position coordinates.
+    pub length_scale: f64,
+}
+
+impl Model {
+    /// Number of Cartesian coordinates `n = 7 b`.
+    pub fn coordinate_count(&self) -> usize {
+        7 * self.bodies.len()
+    }
+
+    /// Looks a joint up by name.
+    pub fn joint_id(&self, name: &str) -> Option<JointId> {
+        self.joints.iter().position(|j| j.name == name).map(JointId)
+    }
+
+    /// Looks a link up by name.
+    pub fn link(&self, name: &str) -> Option<&Link> {
+        self.links.iter().find(|l| l.name == name)
+    }
+
+    /// The joint with this id.
+    pub fn joint(&self, id: JointId) -> &Joint {
+        &self.joints[id.0]
+    }
+
+    /// Name of the coordinate `i` of the state vector, as `body.x` … `body.e3`.
+    pub fn coordinate_name(&self, i: usize) -> String {
+        const C: [&str; 7] = ["x", "y", "z", "e0", "e1", "e2", "e3"];
+        match self.bodies.get(i / 7) {
+            Some(b) => format!("{}.{}", b.name, C[i % 7]),
+            None => format!("q{i}"),
+        }
+    }
+}

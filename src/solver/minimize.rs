@@ -1,0 +1,267 @@
+//! Unconstrained minimization of `f(v̂) = V(u(v̂), v̂)` over the scaled independent coordinates.
+//!
+//! Each iteration picks a direction `d` (Newton: `−Ĥ⁻¹ ∇f` with the eigenvalues of the exact
+//! reduced Hessian replaced by their magnitudes, floored; BFGS / DFP: `−B ∇f` with the inverse
+//! update), caps `‖d‖∞` at `max_step`, and backtracks from `α = 1` until the Armijo condition
+//! `f(v̂ + α d) ≤ f + 10⁻⁴ α ∇fᵀ d` holds. A trial point starts from the first-order prediction
+//! `q + α Z d` and is brought back onto `Φ = 0` by the Newton corrector; if the corrector fails
+//! the step is halved (paper step (f)). When no step is found, the coordinates are
+//! re-partitioned once at the current point. At a stationary point with a negative reduced
+//! Hessian eigenvalue (a saddle or maximum) the search leaves along its eigenvector, unless
+//! `allow_unstable` is set.
+//!
+//! ## References
+//! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §3.1, §3.4, §6.1.
+//! - R. Fletcher, M. J. D. Powell, A rapidly convergent descent method for minimization,
+//!   *Computer Journal* 6 (1963) 163–168.
+
+use super::options::{Method, Options};
+use super::partition::Partition;
+use super::report::{Diagnostics, Iterate, Termination};
+use super::system::{Eval, System};
+use nalgebra::{DMatrix, DVector, SymmetricEigen};
+
+/// Outcome of the minimization.
+pub(crate) struct Outcome {
+    pub(crate) q: DVector<f64>,
+    pub(crate) part: Partition,
+    pub(crate) eval: Eval,
+    pub(crate) termination: Termination,
+    pub(crate) history: Vec<Iterate>,
+    pub(crate) diagnostics: Diagnostics,
+}
+
+/// Eigenvalue tolerance for the stability verdict.
+pub(crate) fn eigen_tolerance(eig: &DVector<f64>) -> f64 {
+    1e-8 * eig.amax().max(1.0)
+}
+
+fn quasi_newton_update(
+    method: Method,
+    b: &mut DMatrix<f64>,
+    s: &DVector<f64>,
+    y: &DVector<f64>,
+    first: bool,
+) {
+    let ys = y.dot(s);
+    if ys <= 1e-14 * s.norm() * y.norm() || ys <= 0.0 {
+        return;
+    }
+    if first {
+        let n = b.nrows();
+        *b = DMatrix::identity(n, n) * (ys / y.dot(y));
+    }
+    match method {
+        Method::Bfgs => {
+            let rho = 1.0 / ys;
+            let by = &*b * y;
+            let yby = y.dot(&by);
+            // (I − ρ s yᵀ) B (I − ρ y sᵀ) + ρ s sᵀ, expanded.
+            *b += (s * s.transpose()) * (rho * rho * yby + rho)
+                - (&by * s.transpose() + s * by.transpose()) * rho;
+        }
+        Method::Dfp => {
+            let by = &*b * y;
+            let yby = y.dot(&by);
+            *b += s * s.transpose() / ys - &by * by.transpose() / yby;
+        }
+        Method::Newton => {}
+    }
+}
+
+pub(crate) fn minimize(
+    sys: &mut System,
+    mut q: DVector<f64>,
+    mut part: Partition,
+    options: &Options,
+) -> Option<Outcome> {
+    let mut diag = Diagnostics::default();
+    let mut eval = sys.evaluate(&q, &part)?;
+    diag.function_evaluations += 1;
+    let mut history = Vec::new();
+    let mut dof = part.independent.len();
+    let mut binv = DMatrix::identity(dof, dof);
+    let mut first_update = true;
+    let mut just_repartitioned = false;
+    let mut termination = Termination::MaxIterations;
+    let mut iteration = 0;
+    loop {
+        let f = eval.energy.total;
+        let gnorm = eval.grad_v.amax();
+        if history.last().map(|h: &Iterate| h.iteration) != Some(iteration) {
+            history.push(Iterate {
+                iteration,
+                potential_energy: f,
+                gradient_norm: gnorm,
+            });
+        }
+        let mut negative_curvature = None;
+        let hessian = if options.method == Method::Newton || gnorm <= options.gradient_tolerance {
+            Some(sys.reduced_hessian(&q, &part, &eval))
+        } else {
+            None
+        };
+        let eig = hessian
+            .as_ref()
+            .filter(|_| dof > 0)
+            .map(|h| SymmetricEigen::new(h.clone()));
+        if gnorm <= options.gradient_tolerance {
+            match &eig {
+                Some(e) if !options.allow_unstable => {
+                    let tol = eigen_tolerance(&e.eigenvalues);
+                    let (imin, lmin) =
+                        e.eigenvalues
+                            .iter()
+                            .enumerate()
+                            .fold(
+                                (0, f64::INFINITY),
+                                |a, (i, &l)| if l < a.1 { (i, l) } else { a },
+                            );
+                    if lmin < -tol {
+                        negative_curvature = Some(e.eigenvectors.column(imin).into_owned());
+                    } else {
+                        termination = Termination::Converged;
+                        break;
+                    }
+                }
+                _ => {
+                    termination = Termination::Converged;
+                    break;
+                }
+            }
+        }
+        if iteration >= options.max_iterations {
+            break;
+        }
+        let g = &eval.grad_v;
+        let mut d = if let Some(nc) = negative_curvature {
+            diag.negative_curvature_steps += 1;
+            let s = if nc.dot(g) > 0.0 { -1.0 } else { 1.0 };
+            let scale = s * options.max_step / nc.amax().max(1e-300);
+            nc * scale
+        } else {
+            match (&eig, options.method) {
+                (Some(e), Method::Newton) => {
+                    let floor = 1e-8 * e.eigenvalues.amax().max(1e-12);
+                    let mut d = DVector::zeros(dof);
+                    for i in 0..dof {
+                        let v = e.eigenvectors.column(i);
+                        d -= v * (v.dot(g) / e.eigenvalues[i].abs().max(floor));
+                    }
+                    d
+                }
+                _ => -(&binv * g),
+            }
+        };
+        if d.dot(g) > 0.0 {
+            d = -g.clone();
+            binv = DMatrix::identity(dof, dof);
+            first_update = true;
+        }
+        let dmax = d.amax();
+        if dmax > options.max_step {
+            d *= options.max_step / dmax;
+        }
+        let slope = g.dot(&d);
+        // Backtracking line search.
+        let mut alpha = 1.0;
+        let mut accepted = None;
+        for _ in 0..40 {
+            let mut qt = &q + sys.tangent_step(&part, &eval, &(&d * alpha));
+            if sys
+                .correct(
+                    &mut qt,
+                    &part,
+                    options.constraint_tolerance,
+                    options.max_corrector_iterations,
+                )
+                .is_err()
+            {
+                diag.corrector_failures += 1;
+                diag.step_halvings += 1;
+                alpha *= 0.5;
+                continue;
+            }
+            let Some(et) = sys.evaluate(&qt, &part) else {
+                diag.step_halvings += 1;
+                alpha *= 0.5;
+                continue;
+            };
+            diag.function_evaluations += 1;
+            let ft = et.energy.total;
+            let roundoff = 1e-13 * (1.0 + f.abs());
+            let armijo = ft <= f + 1e-4 * alpha * slope;
+            let flat = (ft - f).abs() <= roundoff && et.grad_v.amax() < gnorm;
+            if ft.is_finite() && (armijo || flat) {
+                accepted = Some((qt, et, alpha));
+                break;
+            }
+            // Quadratic interpolation of f along d, safeguarded.
+            let denom = 2.0 * (ft - f - slope * alpha);
+            let next = if denom > 0.0 {
+                -slope * alpha * alpha / denom
+            } else {
+                0.5 * alpha
+            };
+            alpha = next.clamp(0.1 * alpha, 0.5 * alpha);
+            diag.step_halvings += 1;
+        }
+        match accepted {
+            Some((qt, et, alpha)) => {
+                let s = &d * alpha;
+                let y = &et.grad_v - &eval.grad_v;
+                quasi_newton_update(options.method, &mut binv, &s, &y, first_update);
+                first_update = false;
+                q = qt;
+                eval = et;
+                iteration += 1;
+                just_repartitioned = false;
+                if eval.energy.total < -1e15
+                    || (0..q.len()).any(|i| i % 7 < 3 && q[i].abs() > 1e6 * sys.model.length_scale)
+                {
+                    termination = Termination::Unbounded;
+                    history.push(Iterate {
+                        iteration,
+                        potential_energy: eval.energy.total,
+                        gradient_norm: eval.grad_v.amax(),
+                    });
+                    break;
+                }
+                // Re-partition when Φ_u becomes ill-conditioned.
+                let u = eval.lu.u();
+                let diag_u = u.diagonal().abs();
+                if diag_u.len() > 0 && diag_u.min() < 1e-8 * diag_u.max() {
+                    part = sys.partition(&q);
+                    diag.repartitions += 1;
+                    eval = sys.evaluate(&q, &part)?;
+                    dof = part.independent.len();
+                    binv = DMatrix::identity(dof, dof);
+                    first_update = true;
+                }
+            }
+            None if !just_repartitioned => {
+                part = sys.partition(&q);
+                diag.repartitions += 1;
+                eval = sys.evaluate(&q, &part)?;
+                dof = part.independent.len();
+                binv = DMatrix::identity(dof, dof);
+                first_update = true;
+                just_repartitioned = true;
+            }
+            None => {
+                termination = Termination::LineSearchFailed;
+                break;
+            }
+        }
+    }
+    diag.gradient_norm = eval.grad_v.amax();
+    diag.constraint_residual = sys.residual(&q).amax();
+    Some(Outcome {
+        q,
+        part,
+        eval,
+        termination,
+        history,
+        diagnostics: diag,
+    })
+}

@@ -1,0 +1,155 @@
+//! Static equilibrium by generalized coordinate partitioning: minimize `V(q)` subject to
+//! `Φ(q) = 0` (paper eq. 27).
+//!
+//! 1. Initial state by forward kinematics with the initial joint values; loop joints are closed
+//!    by a damped Newton iteration that holds the joints given initial values where it can
+//!    ([`assemble`]).
+//! 2. Partition `q = [u; v]` by full pivoting of `Φ_q` ([`partition`]).
+//! 3. Minimize `f(v) = V(u(v), v)` ([`minimize`]), with the corrector keeping `Φ = 0`.
+//! 4. Stability from the eigenvalues of the reduced Hessian; reactions from the multipliers
+//!    `μ` (`V_qᵀ = Φ_qᵀ μ`).
+//!
+//! ## References
+//! - P. E. Nikravesh, O. K. Srinivasan, Generalized co-ordinate partitioning in static
+//!   equilibrium analysis of large-scale mechanical systems, *Int. J. Numer. Meth. Eng.* 21
+//!   (1985) 451–464 (`shared/paper/`).
+
+mod assemble;
+mod minimize;
+mod options;
+pub(crate) mod partition;
+mod reactions;
+mod report;
+mod system;
+
+pub use options::{Method, Options};
+pub use report::{Diagnostics, Iterate, Reaction, Report, Stability, Termination};
+
+use crate::constraints::Constraints;
+use crate::error::{Error, Result};
+use crate::model::{JointId, Model};
+use crate::state::{JointValues, State};
+use nalgebra::SymmetricEigen;
+use system::System;
+
+/// Initial guess: forward kinematics with every joint at its `mech:initial` / `--initial`
+/// value (0 otherwise). Loop joints are not yet closed.
+pub fn initial_state(model: &Model) -> State {
+    State::from_joint_values(model, &initial_values(model))
+}
+
+fn initial_values(model: &Model) -> JointValues {
+    let mut values = JointValues::new();
+    for i in &model.initial {
+        let j = &model.joints[i.joint.0];
+        let v = values
+            .entry(j.name.clone())
+            .or_insert_with(|| vec![0.0; j.kind.scalar_coordinates()]);
+        if i.dof < v.len() {
+            v[i.dof] = i.value;
+        }
+    }
+    values
+}
+
+/// Locks resolved to values: the given value, else the initial value, else 0.
+fn lock_values(model: &Model) -> Vec<(JointId, usize, f64)> {
+    model
+        .locks
+        .iter()
+        .map(|l| {
+            let init = model
+                .initial
+                .iter()
+                .find(|i| i.joint == l.joint && i.dof == l.dof)
+                .map_or(0.0, |i| i.value);
+            (l.joint, l.dof, l.value.unwrap_or(init))
+        })
+        .collect()
+}
+
+/// Finds the stable static equilibrium of `model` from its initial guess.
+///
+/// # Errors
+/// [`Error::Assembly`] if the loops cannot be closed from the initial guess,
+/// [`Error::Inconsistent`] for contradictory redundant constraints, [`Error::Undefined`] if
+/// the energy cannot be evaluated at the start. Not converging is not an error: see
+/// [`Report::termination`].
+///
+/// # Example
+/// ```
+/// let loaded = restpose::urdf::load_file("robots/pendulum.urdf", &Default::default()).unwrap();
+/// let (state, report) = restpose::solve(&loaded.model, &Default::default()).unwrap();
+/// assert!(report.converged());
+/// assert!((report.energy.total + 18.686957).abs() < 1e-6);
+/// # let _ = state;
+/// ```
+pub fn solve(model: &Model, options: &Options) -> Result<(State, Report)> {
+    let start = initial_state(model);
+    solve_from(model, start, options)
+}
+
+/// Like [`solve`], from a given (not necessarily assembled) state.
+///
+/// # Errors
+/// As [`solve`].
+pub fn solve_from(model: &Model, start: State, options: &Options) -> Result<(State, Report)> {
+    let locks = lock_values(model);
+    let q = assemble::assemble(model, start.q, &locks, options)?;
+    let mut sys = System::new(model, Constraints::new(model, &locks));
+    let part = sys.partition(&q);
+    let out = minimize::minimize(&mut sys, q, part, options).ok_or_else(|| {
+        Error::Undefined(
+            "a force table with extrapolate=\"error\" is out of range, or Φ_u is singular".into(),
+        )
+    })?;
+    let state = State { q: out.q.clone() };
+    let dof = out.part.independent.len();
+    let stability = if dof > 0 {
+        let h = sys.reduced_hessian(&out.q, &out.part, &out.eval);
+        let eig = SymmetricEigen::new(h).eigenvalues;
+        let tol = minimize::eigen_tolerance(&eig);
+        let mut vals: Vec<f64> = eig.iter().copied().collect();
+        vals.sort_by(f64::total_cmp);
+        let verdict = if vals[0] < -tol {
+            "unstable"
+        } else if vals[0] <= tol {
+            "neutral"
+        } else {
+            "stable"
+        };
+        vals.truncate(6);
+        Some(Stability {
+            verdict: verdict.into(),
+            tolerance: tol,
+            eigenvalues: vals,
+        })
+    } else {
+        None
+    };
+    let reactions = reactions::reactions(&sys, &out.q, &out.part, &out.eval);
+    let report = Report {
+        termination: out.termination,
+        iterations: out.history.last().map_or(0, |h| h.iteration),
+        energy: out.eval.energy,
+        dof,
+        history: out.history,
+        independent_coordinates: out
+            .part
+            .independent
+            .iter()
+            .map(|&i| model.coordinate_name(i))
+            .collect(),
+        redundant_constraints: out
+            .part
+            .redundant
+            .iter()
+            .map(|&r| sys.cons.row_name(r).to_string())
+            .collect(),
+        stability,
+        reactions,
+        diagnostics: out.diagnostics,
+        sizes: [model.bodies.len(), model.coordinate_count(), sys.cons.len()],
+    };
+    Ok((state, report))
+}

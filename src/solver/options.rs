@@ -1,0 +1,51 @@
+//! Solver options, with their defaults.
+
+/// Minimization method in the independent coordinates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// Newton's method with the exact reduced Hessian (modified to be positive definite away
+    /// from the minimum) and a backtracking line search.
+    #[default]
+    Newton,
+    /// BFGS quasi-Newton (inverse-Hessian update) with a backtracking line search.
+    Bfgs,
+    /// Davidon–Fletcher–Powell quasi-Newton, the paper's minimizer.
+    Dfp,
+}
+
+/// Options of [`crate::solve`].
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// Minimization method (default: Newton).
+    pub method: Method,
+    /// Convergence tolerance on the reduced gradient `‖∂V/∂v‖∞` in scaled coordinates [J]
+    /// (default: 1e-8).
+    pub gradient_tolerance: f64,
+    /// Newton corrector tolerance on `‖Φ‖∞` [m or 1] (default: 1e-10).
+    pub constraint_tolerance: f64,
+    /// Maximum minimizer iterations (default: 200).
+    pub max_iterations: usize,
+    /// Maximum Newton iterations of the corrector per trial point (default: 25).
+    pub max_corrector_iterations: usize,
+    /// Largest change of a scaled independent coordinate per iteration (default: 0.3; about
+    /// 35° for an Euler parameter, 0.3 L for a position).
+    pub max_step: f64,
+    /// Stop at a stationary point even if it is unstable (default: false: leave saddles and
+    /// maxima along the direction of negative curvature).
+    pub allow_unstable: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            method: Method::Newton,
+            gradient_tolerance: 1e-8,
+            constraint_tolerance: 1e-10,
+            max_iterations: 200,
+            max_corrector_iterations: 25,
+            max_step: 0.3,
+            allow_unstable: false,
+        }
+    }
+}

@@ -1,0 +1,108 @@
+//! Coordinate partitioning by Gaussian elimination with full pivoting of `Φ_q` (paper §3).
+//!
+//! Columns are first scaled (`Φ_q S`, `S = diag(L … , 1 …)`: position columns by the
+//! characteristic length `L`, Euler-parameter columns by 1) so that the choice does not depend
+//! on the length unit. At step `k` the entry of largest magnitude in the remaining block is the
+//! pivot; its column becomes a dependent coordinate `u_k` and its row an independent row. The
+//! elimination stops when the largest remaining entry is below `tol · max|Φ_q S|`: the number
+//! of steps is the rank `r`, the unpivoted rows are redundant, the unpivoted columns are the
+//! independent coordinates `v` (`n − r` degrees of freedom).
+
+use nalgebra::DMatrix;
+
+/// Result of a partition.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Partition {
+    /// Dependent coordinates `u` (pivot columns), in pivot order.
+    pub(crate) dependent: Vec<usize>,
+    /// Independent coordinates `v`, ascending.
+    pub(crate) independent: Vec<usize>,
+    /// Independent constraint rows (pivot rows), in pivot order.
+    pub(crate) rows: Vec<usize>,
+    /// Redundant constraint rows, ascending.
+    pub(crate) redundant: Vec<usize>,
+}
+
+/// Relative rank tolerance of the full-pivoting elimination.
+pub(crate) const RANK_TOLERANCE: f64 = 1e-9;
+
+/// Partitions the (dense) Jacobian `jac` with column scales `scale`.
+pub(crate) fn partition(jac: &DMatrix<f64>, scale: &[f64]) -> Partition {
+    let (m, n) = jac.shape();
+    let mut a = jac.clone();
+    for j in 0..n {
+        a.column_mut(j).scale_mut(scale[j]);
+    }
+    let mut row_perm: Vec<usize> = (0..m).collect();
+    let mut col_perm: Vec<usize> = (0..n).collect();
+    let amax = a.amax();
+    let mut rank = 0;
+    for k in 0..m.min(n) {
+        let mut best = (k, k, 0.0);
+        for jj in k..n {
+            let c = col_perm[jj];
+            for ii in k..m {
+                let v = a[(row_perm[ii], c)].abs();
+                if v > best.2 {
+                    best = (ii, jj, v);
+                }
+            }
+        }
+        if best.2 <= RANK_TOLERANCE * amax || best.2 == 0.0 {
+            break;
+        }
+        row_perm.swap(k, best.0);
+        col_perm.swap(k, best.1);
+        let (pr, pc) = (row_perm[k], col_perm[k]);
+        let piv = a[(pr, pc)];
+        for ii in k + 1..m {
+            let r = row_perm[ii];
+            let f = a[(r, pc)] / piv;
+            if f != 0.0 {
+                for jj in k..n {
+                    let c = col_perm[jj];
+                    a[(r, c)] -= f * a[(pr, c)];
+                }
+            }
+        }
+        rank = k + 1;
+    }
+    let mut independent = col_perm[rank..].to_vec();
+    independent.sort_unstable();
+    let mut redundant = row_perm[rank..].to_vec();
+    redundant.sort_unstable();
+    Partition {
+        dependent: col_perm[..rank].to_vec(),
+        independent,
+        rows: row_perm[..rank].to_vec(),
+        redundant,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn detects_rank_and_redundant_row() {
+        // Row 2 = row 0 + row 1.
+        let j = DMatrix::from_row_slice(
+            3,
+            4,
+            &[1.0, 2.0, 0.0, 0.0, 0.0, 1.0, 3.0, 0.0, 1.0, 3.0, 3.0, 0.0],
+        );
+        let p = partition(&j, &[1.0; 4]);
+        assert_eq!(p.dependent.len(), 2);
+        assert_eq!(p.redundant.len(), 1);
+        assert_eq!(p.independent.len(), 2);
+        assert!(p.independent.contains(&3));
+    }
+
+    #[test]
+    fn full_pivot_picks_largest() {
+        let j = DMatrix::from_row_slice(1, 3, &[0.1, -5.0, 2.0]);
+        let p = partition(&j, &[1.0; 3]);
+        assert_eq!(p.dependent, vec![1]);
+        assert_eq!(p.independent, vec![0, 2]);
+    }
+}

@@ -1,0 +1,118 @@
+//! What a solve returns besides the final state.
+
+use crate::forces::Energy;
+
+/// Why the minimizer stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Termination {
+    /// Reduced gradient and constraint residual below tolerance.
+    Converged,
+    /// `max_iterations` reached.
+    MaxIterations,
+    /// No acceptable step even after step halving and re-partitioning.
+    LineSearchFailed,
+    /// The energy decreases without bound (for example a prismatic joint along gravity with
+    /// no spring or limit).
+    Unbounded,
+}
+
+impl Termination {
+    /// The snake-case name used in the JSON.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Termination::Converged => "converged",
+            Termination::MaxIterations => "max_iterations",
+            Termination::LineSearchFailed => "line_search_failed",
+            Termination::Unbounded => "unbounded",
+        }
+    }
+}
+
+/// One accepted iterate.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Iterate {
+    /// Iteration number (0 = the assembled initial guess).
+    pub iteration: usize,
+    /// Potential energy [J].
+    pub potential_energy: f64,
+    /// `‖∂V/∂v‖∞` in scaled coordinates [J].
+    pub gradient_norm: f64,
+}
+
+/// Stability of the equilibrium from the eigenvalues of the reduced Hessian.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Stability {
+    /// `stable` (all eigenvalues > tolerance), `unstable` (one < −tolerance) or `neutral`.
+    pub verdict: String,
+    /// Eigenvalue tolerance used: `1e-8 · max(1, max |λ|)` [J].
+    pub tolerance: f64,
+    /// Smallest eigenvalues of the scaled reduced Hessian, ascending (at most 6) [J].
+    pub eigenvalues: Vec<f64>,
+}
+
+/// Counters of what the solver had to do.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Diagnostics {
+    /// Potential evaluations (trial points that assembled).
+    pub function_evaluations: usize,
+    /// Trial points where the Newton corrector failed.
+    pub corrector_failures: usize,
+    /// Step halvings in line searches.
+    pub step_halvings: usize,
+    /// Re-partitions after the first.
+    pub repartitions: usize,
+    /// Steps taken along a direction of negative curvature (leaving a saddle or maximum).
+    pub negative_curvature_steps: usize,
+    /// Final `‖∂V/∂v‖∞` [J].
+    pub gradient_norm: f64,
+    /// Final `‖Φ‖∞`.
+    pub constraint_residual: f64,
+}
+
+/// Reaction of a joint on its child link at the joint origin.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Reaction {
+    /// Force in the world frame [N].
+    pub force_world: [f64; 3],
+    /// Torque about the joint origin, world frame [N m].
+    pub torque_world: [f64; 3],
+    /// Force in the joint frame (parent side) [N].
+    pub force_joint: [f64; 3],
+    /// Torque in the joint frame (parent side) [N m].
+    pub torque_joint: [f64; 3],
+}
+
+/// The solve's report.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Report {
+    /// Why it stopped.
+    pub termination: Termination,
+    /// Minimizer iterations.
+    pub iterations: usize,
+    /// Energy at the final state [J].
+    pub energy: Energy,
+    /// Degrees of freedom `n − rank(Φ_q)`.
+    pub dof: usize,
+    /// Iteration history (iteration 0 = start).
+    pub history: Vec<Iterate>,
+    /// Names of the independent coordinates of the final partition.
+    pub independent_coordinates: Vec<String>,
+    /// Names of the constraint rows found redundant.
+    pub redundant_constraints: Vec<String>,
+    /// Stability verdict at the final state.
+    pub stability: Option<Stability>,
+    /// Reactions of every joint with constraint rows, by joint name.
+    pub reactions: Vec<(String, Reaction)>,
+    /// Counters.
+    pub diagnostics: Diagnostics,
+    /// Number of bodies, coordinates and constraint rows.
+    pub sizes: [usize; 3],
+}
+
+impl Report {
+    /// Whether the solve converged.
+    pub fn converged(&self) -> bool {
+        self.termination == Termination::Converged
+    }
+}

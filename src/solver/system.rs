@@ -1,0 +1,236 @@
+//! Evaluation of the partitioned problem at a configuration: the corrector, the reduced
+//! gradient and the reduced Hessian.
+//!
+//! With `q = [u; v]`, `Φ_q = [Φ_u Φ_v]` (independent rows only) and `H = −Φ_u⁻¹ Φ_v`:
+//! - corrector: Newton on `Φ(u; v) = 0` for fixed `v`: `Φ_u δu = −Φ`;
+//! - multipliers: `Φ_uᵀ μ = V_uᵀ`, so that `V_qᵀ = Φ_qᵀ μ` at equilibrium;
+//! - reduced gradient (eq. 37): `∂V/∂v = V_v + V_u H = V_v − Φ_vᵀ μ`;
+//! - reduced Hessian: `Zᵀ (V_qq − Σ_k μ_k Φ_k,qq) Z`, `Z = [H; I]`, exact at feasible points.
+//!
+//! Independent coordinates are scaled, `v = S v̂` (positions by the characteristic length), and
+//! gradients and Hessians are reported in the scaled coordinates `v̂`.
+
+use super::partition::{partition, Partition};
+use crate::constraints::{Constraints, Triplets};
+use crate::forces::{potential, Energy};
+use crate::model::Model;
+use nalgebra::{DMatrix, DVector, LU};
+
+/// The model, its constraint rows and scratch space.
+pub(crate) struct System<'a> {
+    pub(crate) model: &'a Model,
+    pub(crate) cons: Constraints,
+    /// Column scale per coordinate (`L` for positions, 1 for Euler parameters).
+    pub(crate) scale: Vec<f64>,
+    phi: DVector<f64>,
+    jac: Triplets,
+}
+
+/// Quantities at a feasible configuration under a partition.
+pub(crate) struct Eval {
+    pub(crate) energy: Energy,
+    /// Multipliers of the independent rows (in `Partition::rows` order).
+    pub(crate) mu: DVector<f64>,
+    /// Reduced gradient in scaled coordinates.
+    pub(crate) grad_v: DVector<f64>,
+    pub(crate) lu: LU<f64, nalgebra::Dyn, nalgebra::Dyn>,
+    pub(crate) phi_v: DMatrix<f64>,
+}
+
+/// Why the corrector gave up.
+#[derive(Debug)]
+pub(crate) struct CorrectorFailure;
+
+impl<'a> System<'a> {
+    pub(crate) fn new(model: &'a Model, cons: Constraints) -> Self {
+        let n = model.coordinate_count();
+        let l = model.length_scale;
+        let scale = (0..n).map(|i| if i % 7 < 3 { l } else { 1.0 }).collect();
+        System {
+            model,
+            phi: DVector::zeros(cons.len()),
+            jac: Triplets::default(),
+            cons,
+            scale,
+        }
+    }
+
+    /// `Φ(q)`.
+    pub(crate) fn residual(&mut self, q: &DVector<f64>) -> &DVector<f64> {
+        self.cons.evaluate(self.model, q, &mut self.phi, None);
+        &self.phi
+    }
+
+    /// Dense `Φ_q(q)` (and `Φ(q)` into the scratch).
+    pub(crate) fn jacobian(&mut self, q: &DVector<f64>) -> DMatrix<f64> {
+        self.cons
+            .evaluate(self.model, q, &mut self.phi, Some(&mut self.jac));
+        self.jac.to_dense()
+    }
+
+    /// Partition at `q`.
+    pub(crate) fn partition(&mut self, q: &DVector<f64>) -> Partition {
+        let j = self.jacobian(q);
+        partition(&j, &self.scale)
+    }
+
+    /// Newton corrector: solves the independent rows for `u` with `v` fixed; returns the number
+    /// of iterations. Also fails if the redundant rows are not satisfied at the end.
+    pub(crate) fn correct(
+        &mut self,
+        q: &mut DVector<f64>,
+        part: &Partition,
+        tol: f64,
+        max_iterations: usize,
+    ) -> Result<usize, CorrectorFailure> {
+        let r = part.rows.len();
+        let mut first = f64::INFINITY;
+        for it in 0..=max_iterations {
+            let j = self.jacobian(q);
+            let res = part
+                .rows
+                .iter()
+                .map(|&i| self.phi[i].abs())
+                .fold(0.0, f64::max);
+            if !res.is_finite() {
+                return Err(CorrectorFailure);
+            }
+            if res <= tol {
+                let all = self.phi.amax();
+                return if all <= tol.max(1e-8) {
+                    Ok(it)
+                } else {
+                    Err(CorrectorFailure)
+                };
+            }
+            if it == 0 {
+                first = res;
+            } else if res > 1e3 * first.max(tol) {
+                return Err(CorrectorFailure);
+            }
+            if it == max_iterations {
+                break;
+            }
+            let phi_u = DMatrix::from_fn(r, r, |a, b| j[(part.rows[a], part.dependent[b])]);
+            let rhs = DVector::from_fn(r, |a, _| -self.phi[part.rows[a]]);
+            let Some(du) = phi_u.lu().solve(&rhs) else {
+                return Err(CorrectorFailure);
+            };
+            for (k, &c) in part.dependent.iter().enumerate() {
+                q[c] += du[k];
+            }
+        }
+        Err(CorrectorFailure)
+    }
+
+    /// Energy, multipliers and reduced gradient at a feasible `q`; `None` where the energy is
+    /// undefined or `Φ_u` is singular.
+    pub(crate) fn evaluate(&mut self, q: &DVector<f64>, part: &Partition) -> Option<Eval> {
+        let j = self.jacobian(q);
+        let mut grad_q = DVector::zeros(q.len());
+        let energy = potential(self.model, q, &mut grad_q, None)?;
+        let r = part.rows.len();
+        let dof = part.independent.len();
+        let phi_u = DMatrix::from_fn(r, r, |a, b| j[(part.rows[a], part.dependent[b])]);
+        let phi_v = DMatrix::from_fn(r, dof, |a, b| j[(part.rows[a], part.independent[b])]);
+        let v_u = DVector::from_fn(r, |a, _| grad_q[part.dependent[a]]);
+        let mu = if r > 0 {
+            phi_u.transpose().lu().solve(&v_u)?
+        } else {
+            DVector::zeros(0)
+        };
+        let lu = phi_u.lu();
+        let mut grad_v =
+            DVector::from_fn(dof, |b, _| grad_q[part.independent[b]]) - phi_v.transpose() * &mu;
+        for (b, &c) in part.independent.iter().enumerate() {
+            grad_v[b] *= self.scale[c];
+        }
+        Some(Eval {
+            energy,
+            mu,
+            grad_v,
+            lu,
+            phi_v,
+        })
+    }
+
+    /// `Z δv̂` for a step `δv̂` in scaled independent coordinates: the first-order change of all
+    /// coordinates.
+    pub(crate) fn tangent_step(
+        &self,
+        part: &Partition,
+        eval: &Eval,
+        dv: &DVector<f64>,
+    ) -> DVector<f64> {
+        let n = self.model.coordinate_count();
+        let mut dq = DVector::zeros(n);
+        let mut dvu = dv.clone();
+        for (b, &c) in part.independent.iter().enumerate() {
+            dvu[b] *= self.scale[c];
+            dq[c] = dvu[b];
+        }
+        if !part.rows.is_empty() {
+            let rhs = -(&eval.phi_v * dvu);
+            if let Some(du) = eval.lu.solve(&rhs) {
+                for (k, &c) in part.dependent.iter().enumerate() {
+                    dq[c] = du[k];
+                }
+            }
+        }
+        dq
+    }
+
+    /// The null-space basis `Z = [H; I] S` (n × dof) at `eval`.
+    pub(crate) fn null_basis(&self, part: &Partition, eval: &Eval) -> DMatrix<f64> {
+        let n = self.model.coordinate_count();
+        let dof = part.independent.len();
+        let mut z = DMatrix::zeros(n, dof);
+        let h = if part.rows.is_empty() {
+            DMatrix::zeros(0, dof)
+        } else {
+            eval.lu
+                .solve(&(-&eval.phi_v))
+                .unwrap_or_else(|| DMatrix::zeros(part.rows.len(), dof))
+        };
+        for b in 0..dof {
+            let s = self.scale[part.independent[b]];
+            z[(part.independent[b], b)] = s;
+            for (k, &c) in part.dependent.iter().enumerate() {
+                z[(c, b)] = h[(k, b)] * s;
+            }
+        }
+        z
+    }
+
+    /// The Hessian of the Lagrangian `W = V_qq − Σ μ_k Φ_k,qq` at `q`.
+    pub(crate) fn lagrangian_hessian(
+        &self,
+        q: &DVector<f64>,
+        part: &Partition,
+        eval: &Eval,
+    ) -> DMatrix<f64> {
+        let n = q.len();
+        let mut w = DMatrix::zeros(n, n);
+        let mut g = DVector::zeros(n);
+        let _ = potential(self.model, q, &mut g, Some(&mut w));
+        let mut weights = DVector::zeros(self.cons.len());
+        for (k, &row) in part.rows.iter().enumerate() {
+            weights[row] = -eval.mu[k];
+        }
+        self.cons.add_hessian(self.model, q, &weights, &mut w);
+        w
+    }
+
+    /// The reduced Hessian `Zᵀ W Z` in scaled coordinates.
+    pub(crate) fn reduced_hessian(
+        &self,
+        q: &DVector<f64>,
+        part: &Partition,
+        eval: &Eval,
+    ) -> DMatrix<f64> {
+        let z = self.null_basis(part, eval);
+        let w = self.lagrangian_hessian(q, part, eval);
+        let hr = z.transpose() * w * &z;
+        (&hr + hr.transpose()) * 0.5
+    }
+}

@@ -1,0 +1,465 @@
+//! The `mech:` extension elements (`urn:urdf-mech:1`) and URDF `<mimic>`.
+//!
+//! Loop joints are read first (they can be named by the other elements); then gravity,
+//! springs, joint springs, loads, efforts, locks and initial values. Command-line locks and
+//! initial values override the file's.
+
+use super::import::{joint_axes, Builder};
+use super::xml::{child, Source};
+use super::ImportOptions;
+use crate::error::Result;
+use crate::model::{
+    Effort, ForceLaw, Initial, Joint, JointId, JointKind, JointSpring, Load, Lock, Mimic, Spring,
+    SpringEnd, SpringMode,
+};
+use nalgebra::{Isometry3, Vector3};
+use roxmltree::Node;
+
+const KNOWN: [&str; 10] = [
+    "gravity",
+    "link_gravity",
+    "loop_joint",
+    "spring",
+    "joint_spring",
+    "force",
+    "joint_effort",
+    "lock",
+    "initial",
+    "frame",
+];
+
+fn loop_kind(src: &Source, node: Node) -> Result<JointKind> {
+    let ty = src.req(node, "type")?;
+    Ok(match ty {
+        "fixed" => JointKind::Fixed,
+        "revolute" => JointKind::Revolute,
+        "continuous" => JointKind::Continuous,
+        "prismatic" => JointKind::Prismatic,
+        "cylindrical" => JointKind::Cylindrical,
+        "universal" => JointKind::Universal,
+        "spherical" | "ball" => JointKind::Spherical,
+        "planar" => JointKind::Planar,
+        "screw" => JointKind::Screw {
+            pitch: src.f64_or(node, "pitch", 0.0)?,
+        },
+        "distance" => JointKind::Distance {
+            length: src.f64_opt(node, "length")?.ok_or_else(|| {
+                src.error(
+                    node,
+                    format!("{}: a distance joint needs `length`", src.describe(node)),
+                )
+            })?,
+        },
+        "point_on_line" => JointKind::PointOnLine,
+        other => {
+            return Err(src.error(
+                node,
+                format!("{} has an unknown type \"{other}\"", src.describe(node)),
+            ))
+        }
+    })
+}
+
+fn loop_joint(src: &Source, node: Node, b: &Builder) -> Result<Joint> {
+    let name = src.req(node, "name")?.to_string();
+    let kind = loop_kind(src, node)?;
+    let side = |tag: &str| -> Result<(String, Option<crate::model::BodyId>, Isometry3<f64>)> {
+        let c = child(node, tag).ok_or_else(|| {
+            src.error(node, format!("loop joint `{name}` has no <{tag}> element"))
+        })?;
+        let (body, bfl) = b.link_ref(src, c, "link")?;
+        Ok((src.req(c, "link")?.to_string(), body, bfl))
+    };
+    let (pl, pb, pf) = side("parent")?;
+    let (cl, cb, cf) = side("child")?;
+    if let Some(co) = child(node, "child_origin") {
+        if co.attribute("auto").is_some() {
+            return Err(src.error(
+                co,
+                format!(
+                    "loop joint `{name}`: <child_origin auto> is not supported yet; give xyz/rpy"
+                ),
+            ));
+        }
+    }
+    let origin = src.frame(child(node, "origin"))?;
+    let child_origin = src.frame(child(node, "child_origin"))?;
+    let axis = src.axis(child(node, "axis"), node, Vector3::x())?;
+    let axis2 = src.axis(child(node, "axis2"), node, Vector3::y())?;
+    if kind == JointKind::Universal && axis.cross(&axis2).norm() < 1e-9 {
+        return Err(src.error(node, format!("universal joint `{name}` has parallel axes")));
+    }
+    let rot = Isometry3::from_parts(Default::default(), joint_axes(kind, axis, axis2));
+    let limits = match child(node, "limit") {
+        Some(l) => Some([src.f64_or(l, "lower", 0.0)?, src.f64_or(l, "upper", 0.0)?]),
+        None => None,
+    };
+    if pb == cb {
+        return Err(src.error(node, format!("loop joint `{name}` joins body `{pl}` to itself (links `{pl}` and `{cl}` are welded)")));
+    }
+    Ok(Joint {
+        name,
+        kind,
+        parent_link: pl,
+        child_link: cl,
+        bodies: [pb, cb],
+        body_from_joint: [pf * origin * rot, cf * child_origin * rot],
+        tree: false,
+        merged: false,
+        limits,
+    })
+}
+
+fn force_law(src: &Source, node: Node, what: &str) -> Result<ForceLaw> {
+    let stiffness = src.f64_opt(node, "stiffness")?;
+    let preload = src.f64_or(node, "preload", 0.0)?;
+    match (child(node, "force_deflection"), stiffness) {
+        (Some(fd), None) => {
+            let extrapolate = fd.attribute("extrapolate").unwrap_or("linear");
+            let (extrapolate_linear, bounded) = match extrapolate {
+                "linear" => (true, false),
+                "clamp" => (false, false),
+                "error" => (false, true),
+                other => {
+                    return Err(src.error(
+                        fd,
+                        format!("{what}: extrapolate=\"{other}\" is not linear, clamp or error"),
+                    ))
+                }
+            };
+            if let Some(i) = fd.attribute("interpolation") {
+                if i != "linear" {
+                    return Err(src.error(
+                        fd,
+                        format!("{what}: interpolation=\"{i}\" is not supported (only linear)"),
+                    ));
+                }
+            }
+            let mut points = Vec::new();
+            for p in fd
+                .children()
+                .filter(|c| c.is_element() && c.tag_name().name() == "point")
+            {
+                let d = src
+                    .f64_opt(p, "deflection")?
+                    .ok_or_else(|| src.error(p, format!("{what}: <point> needs `deflection`")))?;
+                let f = src
+                    .f64_opt(p, "force")?
+                    .ok_or_else(|| src.error(p, format!("{what}: <point> needs `force`")))?;
+                if let Some(&(last, _)) = points.last() {
+                    if d <= last {
+                        return Err(src.error(
+                            p,
+                            format!(
+                                "{what}: deflections must increase strictly ({d} after {last})"
+                            ),
+                        ));
+                    }
+                }
+                points.push((d, f + preload));
+            }
+            if points.len() < 2 {
+                return Err(src.error(
+                    fd,
+                    format!("{what}: <force_deflection> needs at least two <point> rows"),
+                ));
+            }
+            Ok(ForceLaw::Table {
+                points,
+                extrapolate_linear,
+                bounded,
+            })
+        }
+        (Some(fd), Some(_)) => Err(src.error(
+            fd,
+            format!("{what}: give either `stiffness` or <force_deflection>, not both"),
+        )),
+        (None, Some(k)) => Ok(ForceLaw::Linear {
+            stiffness: k,
+            preload,
+        }),
+        (None, None) => Err(src.error(
+            node,
+            format!("{what} needs `stiffness` or <force_deflection>"),
+        )),
+    }
+}
+
+/// A joint coordinate named by `joint` and `dof` attributes.
+fn joint_coord(src: &Source, node: Node, b: &Builder) -> Result<(JointId, usize)> {
+    let name = src.req(node, "joint")?;
+    let id = b.model.joint_id(name).ok_or_else(|| {
+        src.error(
+            node,
+            format!("{} refers to an unknown joint `{name}`", src.describe(node)),
+        )
+    })?;
+    let dof = src.f64_or(node, "dof", 0.0)?;
+    let kind = b.model.joints[id.0].kind;
+    let n = kind.scalar_coordinates();
+    if dof < 0.0 || dof.fract() != 0.0 || dof as usize >= n {
+        return Err(src.error(
+            node,
+            format!("{}: joint `{name}` ({}) has {n} addressable coordinate(s); dof {dof} is out of range", src.describe(node), kind.name()),
+        ));
+    }
+    Ok((id, dof as usize))
+}
+
+pub(super) fn read(
+    src: &Source,
+    ext: &[Node],
+    urdf_joints: &[(String, Node)],
+    b: &mut Builder,
+    options: &ImportOptions,
+) -> Result<()> {
+    for &n in ext {
+        let tag = n.tag_name().name();
+        if !KNOWN.contains(&tag) {
+            return Err(src.error(
+                n,
+                format!("unknown element <mech:{tag}> (known: {})", KNOWN.join(", ")),
+            ));
+        }
+        if tag == "frame" {
+            return Err(src.error(n, "<mech:frame> is not supported yet"));
+        }
+    }
+    for &n in ext.iter().filter(|n| n.tag_name().name() == "loop_joint") {
+        let j = loop_joint(src, n, b)?;
+        if b.model.joint_id(&j.name).is_some() {
+            return Err(src.error(n, format!("duplicate joint name `{}`", j.name)));
+        }
+        b.model.joints.push(j);
+    }
+    // URDF mimic.
+    for (name, node) in urdf_joints {
+        if let Some(m) = child(*node, "mimic") {
+            let target = src.req(m, "joint")?;
+            let id = b
+                .model
+                .joint_id(name)
+                .ok_or_else(|| src.error(m, "mimic on an unknown joint"))?;
+            let reference = b.model.joint_id(target).ok_or_else(|| {
+                src.error(
+                    m,
+                    format!("joint `{name}` mimics an unknown joint `{target}`"),
+                )
+            })?;
+            for (jid, role) in [(id, "mimicking"), (reference, "mimicked")] {
+                if b.model.joints[jid.0].kind.scalar_coordinates() == 0 {
+                    return Err(src.error(
+                        m,
+                        format!(
+                            "{role} joint `{}` has no scalar coordinate",
+                            b.model.joints[jid.0].name
+                        ),
+                    ));
+                }
+            }
+            b.model.mimics.push(Mimic {
+                joint: id,
+                reference,
+                multiplier: src.f64_or(m, "multiplier", 1.0)?,
+                offset: src.f64_or(m, "offset", 0.0)?,
+            });
+        }
+    }
+    // Mimic cycles.
+    for start in 0..b.model.mimics.len() {
+        let mut cur = b.model.mimics[start].reference;
+        for _ in 0..=b.model.mimics.len() {
+            if cur == b.model.mimics[start].joint {
+                let (name, node) = &urdf_joints[b.model.mimics[start].joint.0];
+                let m = child(*node, "mimic").unwrap_or(*node);
+                return Err(src.error(m, format!("mimic cycle through joint `{name}`")));
+            }
+            match b.model.mimics.iter().find(|m| m.joint == cur) {
+                Some(m) => cur = m.reference,
+                None => break,
+            }
+        }
+    }
+    let mut locks: Vec<Lock> = Vec::new();
+    let mut initial: Vec<Initial> = Vec::new();
+    for &n in ext {
+        let what = src.describe(n);
+        match n.tag_name().name() {
+            "gravity" => {
+                b.model.gravity = src
+                    .vec3_opt(n, "xyz")?
+                    .ok_or_else(|| src.error(n, "<mech:gravity> needs `xyz`"))?;
+                b.gravity_set = true;
+            }
+            "link_gravity" => {
+                let name = src.req(n, "link")?;
+                let i = *b.link_index.get(name).ok_or_else(|| {
+                    src.error(
+                        n,
+                        format!("<mech:link_gravity> refers to an unknown link `{name}`"),
+                    )
+                })?;
+                if n.attribute("enabled")
+                    .is_some_and(|v| v == "false" || v == "0")
+                {
+                    b.no_gravity.push(i);
+                }
+            }
+            "spring" => {
+                let name = src.req(n, "name")?.to_string();
+                let ends: Vec<Node> = n
+                    .children()
+                    .filter(|c| c.is_element() && c.tag_name().name() == "end")
+                    .collect();
+                if ends.len() != 2 {
+                    return Err(src.error(
+                        n,
+                        format!(
+                            "spring `{name}` needs exactly two <end> elements, found {}",
+                            ends.len()
+                        ),
+                    ));
+                }
+                let mut se = Vec::new();
+                for e in ends {
+                    let (body, bfl) = b.link_ref(src, e, "link")?;
+                    let p =
+                        bfl * nalgebra::Point3::from(src.vec3_or(e, "xyz", Vector3::zeros())?);
+                    se.push(SpringEnd {
+                        body,
+                        point: p.coords,
+                    });
+                }
+                let free_length = src
+                    .f64_opt(n, "free_length")?
+                    .ok_or_else(|| src.error(n, format!("spring `{name}` needs `free_length`")))?;
+                if free_length < 0.0 {
+                    return Err(src.error(
+                        n,
+                        format!("spring `{name}` has a negative free length {free_length} m"),
+                    ));
+                }
+                let mode = match n.attribute("mode").unwrap_or("both") {
+                    "both" => SpringMode::Both,
+                    "tension" => SpringMode::Tension,
+                    "compression" => SpringMode::Compression,
+                    other => return Err(src.error(
+                        n,
+                        format!(
+                            "spring `{name}`: mode=\"{other}\" is not both, tension or compression"
+                        ),
+                    )),
+                };
+                let law = force_law(src, n, &format!("spring `{name}`"))?;
+                let ends = [se[0].clone(), se[1].clone()];
+                b.model.springs.push(Spring {
+                    name,
+                    ends,
+                    free_length,
+                    law,
+                    mode,
+                });
+            }
+            "joint_spring" => {
+                let (joint, dof) = joint_coord(src, n, b)?;
+                let law = force_law(src, n, &what)?;
+                let reference = src.f64_or(n, "reference", 0.0)?;
+                b.model.joint_springs.push(JointSpring {
+                    joint,
+                    dof,
+                    reference,
+                    law,
+                });
+            }
+            "force" => {
+                let name = src.req(n, "name")?.to_string();
+                if n.attribute("frame").is_some_and(|f| f != "world") {
+                    return Err(src.error(n, format!(
+                        "force `{name}`: frame=\"{}\" makes a follower load, which has no potential energy; restpose minimizes energy and accepts only world-frame (dead) loads",
+                        n.attribute("frame").unwrap_or_default()
+                    )));
+                }
+                let torque = src.vec3_or(n, "torque", Vector3::zeros())?;
+                if torque != Vector3::zeros() {
+                    return Err(src.error(n, format!(
+                        "force `{name}`: a constant world-frame torque on a body that rotates in 3-D does path-dependent work (no potential energy); use <mech:joint_effort> for a torque about a joint axis, or a pair of forces"
+                    )));
+                }
+                let (body, bfl) = b.link_ref(src, n, "link")?;
+                let point =
+                    bfl * nalgebra::Point3::from(src.vec3_or(n, "xyz", Vector3::zeros())?);
+                let force = src.vec3_or(n, "force", Vector3::zeros())?;
+                if let Some(body) = body {
+                    b.model.loads.push(Load {
+                        name,
+                        body,
+                        point: point.coords,
+                        force,
+                    });
+                }
+            }
+            "joint_effort" => {
+                let (joint, dof) = joint_coord(src, n, b)?;
+                let value = src
+                    .f64_opt(n, "value")?
+                    .ok_or_else(|| src.error(n, format!("{what} needs `value`")))?;
+                b.model.efforts.push(Effort { joint, dof, value });
+            }
+            "lock" => {
+                let (joint, dof) = joint_coord(src, n, b)?;
+                locks.push(Lock {
+                    joint,
+                    dof,
+                    value: src.f64_opt(n, "value")?,
+                });
+            }
+            "initial" => {
+                let (joint, dof) = joint_coord(src, n, b)?;
+                let value = src
+                    .f64_opt(n, "value")?
+                    .ok_or_else(|| src.error(n, format!("{what} needs `value`")))?;
+                initial.push(Initial { joint, dof, value });
+            }
+            _ => {}
+        }
+    }
+    if !b.gravity_set {
+        b.model.gravity = options.gravity;
+    }
+    let resolve = |name: &str, dof: usize, what: &str| -> Result<JointId> {
+        let id = b.model.joint_id(name).ok_or_else(|| {
+            crate::error::Error::Option(format!(
+                "{what} `{name}`: the model has no joint of that name"
+            ))
+        })?;
+        let n = b.model.joints[id.0].kind.scalar_coordinates();
+        if dof >= n {
+            return Err(crate::error::Error::Option(format!(
+                "{what} `{name}`: joint is {} with {n} addressable coordinate(s), dof {dof} is out of range",
+                b.model.joints[id.0].kind.name()
+            )));
+        }
+        Ok(id)
+    };
+    for (name, dof, value) in &options.locks {
+        let id = resolve(name, *dof, "--lock")?;
+        locks.retain(|l| !(l.joint == id && l.dof == *dof));
+        locks.push(Lock {
+            joint: id,
+            dof: *dof,
+            value: *value,
+        });
+    }
+    for (name, dof, value) in &options.initial {
+        let id = resolve(name, *dof, "--initial")?;
+        initial.retain(|l| !(l.joint == id && l.dof == *dof));
+        initial.push(Initial {
+            joint: id,
+            dof: *dof,
+            value: *value,
+        });
+    }
+    b.model.locks = locks;
+    b.model.initial = initial;
+    Ok(())
+}

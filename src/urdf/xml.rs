@@ -1,0 +1,166 @@
+//! XML reading helpers that turn every problem into an [`Error::Input`] naming the file,
+//! line, column and element.
+
+use crate::error::{Error, Result};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+use roxmltree::Node;
+
+/// The namespace URI of restpose's extension elements.
+pub(crate) const MECH_NS: &str = "urn:urdf-mech:1";
+
+/// Source document with its file name, for error positions.
+pub(crate) struct Source<'a> {
+    pub(crate) file: &'a str,
+    pub(crate) doc: &'a roxmltree::Document<'a>,
+}
+
+impl Source<'_> {
+    /// An input error at `node`.
+    pub(crate) fn error(&self, node: Node, message: impl Into<String>) -> Error {
+        let pos = self.doc.text_pos_at(node.range().start);
+        Error::Input {
+            file: self.file.to_string(),
+            line: pos.row,
+            col: pos.col,
+            message: message.into(),
+        }
+    }
+
+    /// Short description of an element for messages: ``joint `elbow` `` or `<origin>`.
+    pub(crate) fn describe(&self, node: Node) -> String {
+        let tag = node.tag_name().name();
+        match node.attribute("name") {
+            Some(n) => format!("{tag} `{n}`"),
+            None => format!("<{tag}>"),
+        }
+    }
+
+    /// A required attribute.
+    pub(crate) fn req<'n>(&self, node: Node<'n, 'n>, attr: &str) -> Result<&'n str> {
+        node.attribute(attr).ok_or_else(|| {
+            self.error(
+                node,
+                format!("{} is missing the attribute `{attr}`", self.describe(node)),
+            )
+        })
+    }
+
+    /// An optional finite number.
+    pub(crate) fn f64_opt(&self, node: Node, attr: &str) -> Result<Option<f64>> {
+        match node.attribute(attr) {
+            None => Ok(None),
+            Some(s) => parse_f64(s).map(Some).ok_or_else(|| {
+                self.error(
+                    node,
+                    format!(
+                        "{}: attribute `{attr}` = \"{s}\" is not a finite number",
+                        self.describe(node)
+                    ),
+                )
+            }),
+        }
+    }
+
+    /// A number with a default.
+    pub(crate) fn f64_or(&self, node: Node, attr: &str, default: f64) -> Result<f64> {
+        Ok(self.f64_opt(node, attr)?.unwrap_or(default))
+    }
+
+    /// An optional list of exactly `N` finite numbers.
+    pub(crate) fn array_opt<const N: usize>(
+        &self,
+        node: Node,
+        attr: &str,
+    ) -> Result<Option<[f64; N]>> {
+        let Some(s) = node.attribute(attr) else {
+            return Ok(None);
+        };
+        let vals: Option<Vec<f64>> = s.split_whitespace().map(parse_f64).collect();
+        match vals {
+            Some(v) if v.len() == N => {
+                let mut out = [0.0; N];
+                out.copy_from_slice(&v);
+                Ok(Some(out))
+            }
+            _ => Err(self.error(
+                node,
+                format!(
+                    "{}: attribute `{attr}` = \"{s}\" must be {N} finite numbers",
+                    self.describe(node)
+                ),
+            )),
+        }
+    }
+
+    /// An optional 3-vector.
+    pub(crate) fn vec3_opt(&self, node: Node, attr: &str) -> Result<Option<Vector3<f64>>> {
+        Ok(self.array_opt::<3>(node, attr)?.map(Vector3::from))
+    }
+
+    /// A 3-vector with a default.
+    pub(crate) fn vec3_or(
+        &self,
+        node: Node,
+        attr: &str,
+        default: Vector3<f64>,
+    ) -> Result<Vector3<f64>> {
+        Ok(self.vec3_opt(node, attr)?.unwrap_or(default))
+    }
+
+    /// A frame from `xyz` with `rpy` or `quat_xyzw` (URDF 1.1) on `node` (identity if absent).
+    pub(crate) fn frame(&self, node: Option<Node>) -> Result<Isometry3<f64>> {
+        let Some(node) = node else {
+            return Ok(Isometry3::identity());
+        };
+        let xyz = self.vec3_or(node, "xyz", Vector3::zeros())?;
+        let rot = if let Some(q) = self.array_opt::<4>(node, "quat_xyzw")? {
+            let quat = nalgebra::Quaternion::new(q[3], q[0], q[1], q[2]);
+            if quat.norm() == 0.0 {
+                return Err(self.error(
+                    node,
+                    format!("{}: `quat_xyzw` is zero", self.describe(node)),
+                ));
+            }
+            UnitQuaternion::from_quaternion(quat)
+        } else {
+            let rpy = self.vec3_or(node, "rpy", Vector3::zeros())?;
+            UnitQuaternion::from_euler_angles(rpy.x, rpy.y, rpy.z)
+        };
+        Ok(Isometry3::from_parts(Translation3::from(xyz), rot))
+    }
+
+    /// A unit axis from attribute `xyz` of `node` (default when absent); a zero axis is an error.
+    pub(crate) fn axis(
+        &self,
+        node: Option<Node>,
+        owner: Node,
+        default: Vector3<f64>,
+    ) -> Result<Vector3<f64>> {
+        let Some(node) = node else { return Ok(default) };
+        let a = self.vec3_or(node, "xyz", default)?;
+        let n = a.norm();
+        if n < 1e-12 {
+            return Err(self.error(
+                node,
+                format!("{} has a zero-length axis", self.describe(owner)),
+            ));
+        }
+        Ok(a / n)
+    }
+}
+
+/// Parses a finite number.
+pub(crate) fn parse_f64(s: &str) -> Option<f64> {
+    s.trim().parse::<f64>().ok().filter(|v| v.is_finite())
+}
+
+/// First child element with this local name.
+pub(crate) fn child<'a>(node: Node<'a, 'a>, name: &str) -> Option<Node<'a, 'a>> {
+    node.children()
+        .find(|c| c.is_element() && c.tag_name().name() == name)
+}
+
+/// Whether the element is in the `mech` namespace.
+pub(crate) fn is_mech(node: Node) -> bool {
+    node.tag_name().namespace() == Some(MECH_NS)
+}

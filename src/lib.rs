@@ -35,6 +35,7 @@ pub mod model;
 pub mod solver;
 pub mod state;
 pub mod urdf;
+pub mod verify;
 
 pub use error::{Error, Result};
 pub use model::Model;

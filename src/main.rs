@@ -33,7 +33,7 @@ enum Command {
         /// Family.
         #[arg(value_enum)]
         family: Family,
-        /// Number of links (chain) or loops (ladder).
+        /// Number of links.
         #[arg(long, default_value_t = 20)]
         size: usize,
     },

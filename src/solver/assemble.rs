@@ -76,6 +76,17 @@ pub(crate) fn assemble(
             }
         }
     }
+    project(model, q, locks, options)
+}
+
+/// Damped Newton onto `Φ = 0` with the given locks only.
+pub(crate) fn project(
+    model: &Model,
+    q: DVector<f64>,
+    locks: &[(JointId, usize, f64)],
+    options: &Options,
+) -> Result<DVector<f64>> {
+    let tol = options.constraint_tolerance;
     let mut sys = System::new(model, Constraints::new(model, locks));
     match newton(&mut sys, q, tol) {
         Ok(qa) => Ok(qa),

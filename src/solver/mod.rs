@@ -53,7 +53,7 @@ fn initial_values(model: &Model) -> JointValues {
 }
 
 /// Locks resolved to values: the given value, else the initial value, else 0.
-fn lock_values(model: &Model) -> Vec<(JointId, usize, f64)> {
+pub(crate) fn lock_values(model: &Model) -> Vec<(JointId, usize, f64)> {
     model
         .locks
         .iter()
@@ -66,6 +66,11 @@ fn lock_values(model: &Model) -> Vec<(JointId, usize, f64)> {
             (l.joint, l.dof, l.value.unwrap_or(init))
         })
         .collect()
+}
+
+/// Closes the constraints from `q` without the initial-value holds (see [`assemble`]).
+pub(crate) fn assemble_only(model: &Model, q: nalgebra::DVector<f64>, locks: &[(JointId, usize, f64)]) -> Result<nalgebra::DVector<f64>> {
+    assemble::project(model, q, locks, &Options::default())
 }
 
 /// Finds the stable static equilibrium of `model` from its initial guess.

@@ -1,0 +1,58 @@
+//! Shared helpers of the integration tests.
+#![allow(dead_code)]
+
+use restpose::state::State;
+use restpose::urdf::{load_file, load_str, ImportOptions};
+use restpose::{Model, Options, Report};
+
+/// Loads `robots/NAME.urdf`.
+pub(crate) fn robot(name: &str) -> Model {
+    let path = format!("{}/robots/{name}.urdf", env!("CARGO_MANIFEST_DIR"));
+    load_file(&path, &ImportOptions::default()).unwrap_or_else(|e| panic!("{e}")).model
+}
+
+/// Loads URDF text.
+pub(crate) fn model_from(text: &str) -> Model {
+    load_str(text, "test.urdf", &ImportOptions::default()).unwrap_or_else(|e| panic!("{e}")).model
+}
+
+/// Solves with default options and asserts convergence.
+pub(crate) fn solve(model: &Model) -> (State, Report) {
+    let (s, r) = restpose::solve(model, &Options::default()).unwrap_or_else(|e| panic!("{e}"));
+    assert!(r.converged(), "{} did not converge: {:?}", model.name, r.termination);
+    (s, r)
+}
+
+/// Joint coordinate by name.
+pub(crate) fn joint(model: &Model, state: &State, name: &str) -> Vec<f64> {
+    state.joint_values(model).into_iter().find(|(n, _)| n == name).map(|(_, v)| v).unwrap()
+}
+
+/// Independent equilibrium checks: constraints hold, the projected gradient vanishes, and no
+/// small feasible perturbation (random joint displacements, then re-assembly) lowers the
+/// energy.
+pub(crate) fn assert_verified_minimum(model: &Model, state: &State) {
+    let b = restpose::verify::balance(model, state).unwrap();
+    assert!(b.constraint_residual < 1e-10, "{}: ‖Φ‖∞ = {:e}", model.name, b.constraint_residual);
+    assert!(b.projected_gradient < 1e-6, "{}: projected gradient {:e}", model.name, b.projected_gradient);
+    let v0 = b.potential_energy;
+    let mut seed = 12345u64;
+    let mut rnd = || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    };
+    for trial in 0..20 {
+        let mut q = state.q.clone();
+        for i in 0..q.len() {
+            q[i] += 1e-4 * rnd();
+        }
+        let perturbed = restpose::verify::assemble(model, &State { q }).unwrap();
+        let moved = (&perturbed.q - &state.q).amax();
+        let v = restpose::verify::potential_energy(model, &perturbed).unwrap();
+        assert!(
+            v >= v0 - 1e-12 * (1.0 + v0.abs()),
+            "{}: trial {trial}: a feasible perturbation of size {moved:e} lowers the energy from {v0} to {v}",
+            model.name
+        );
+    }
+}

@@ -1,0 +1,127 @@
+//! Every robot in `robots/` converges to a verified stable equilibrium.
+mod common;
+use approx::assert_abs_diff_eq;
+use common::*;
+use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+
+#[test]
+fn every_robot_loads_and_solves_to_a_verified_minimum() {
+    let dir = format!("{}/robots", env!("CARGO_MANIFEST_DIR"));
+    let mut count = 0;
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().and_then(|e| e.to_str()) != Some("urdf") {
+            continue;
+        }
+        let name = path.file_stem().unwrap().to_str().unwrap().to_string();
+        let m = robot(&name);
+        let (s, r) = solve(&m);
+        assert_eq!(r.stability.as_ref().map(|s| s.verdict.as_str()), Some("stable"), "{name}");
+        assert_verified_minimum(&m, &s);
+        count += 1;
+    }
+    assert!(count >= 4);
+}
+
+#[test]
+fn slider_crank_reports_redundant_rows_and_one_dof() {
+    let m = robot("slider_crank");
+    let (s, r) = solve(&m);
+    assert_eq!(r.dof, 1);
+    // A planar loop of four joints in 3-D: three out-of-plane rows are redundant.
+    assert_eq!(r.redundant_constraints.len(), 3, "{:?}", r.redundant_constraints);
+    // The loop is closed: the slider's pin and the rod's end coincide.
+    let rod_end = s.link_pose(&m, "rod").unwrap() * Point3::new(0.3, 0.0, 0.0);
+    let slider = s.link_pose(&m, "slider").unwrap() * Point3::origin();
+    assert!((rod_end - slider).norm() < 1e-10);
+    // The slider stays on its line y = 0, z = 0.
+    assert_abs_diff_eq!(slider.y, 0.0, epsilon = 1e-10);
+    assert_abs_diff_eq!(slider.z, 0.0, epsilon = 1e-10);
+}
+
+#[test]
+fn spatial_four_bar_has_one_dof_and_closes() {
+    let m = robot("four_bar_spatial");
+    let (s, r) = solve(&m);
+    assert_eq!(r.dof, 1);
+    assert!(r.redundant_constraints.is_empty());
+    let a = s.link_pose(&m, "coupler").unwrap() * Point3::new(0.4272, 0.0, 0.0);
+    let b = s.link_pose(&m, "rocker").unwrap() * Point3::new(0.15, 0.0, 0.0);
+    assert!((a - b).norm() < 1e-10);
+}
+
+/// Independent check of the 20-link spatial chain: its potential energy as a function of the
+/// joint angles, computed here by forward kinematics in joint coordinates, is stationary at
+/// restpose's joint angles, and its Hessian there is positive definite.
+#[test]
+fn chain_matches_minimal_coordinate_energy() {
+    let n = 20;
+    let m = robot("chain20");
+    let (s, r) = solve(&m);
+    assert_eq!(r.dof, n);
+    let theta: Vec<f64> = (0..n).map(|i| joint(&m, &s, &format!("joint{i}"))[0]).collect();
+    let energy = |th: &[f64]| {
+        let mut pose = Isometry3::identity();
+        let mut v = 0.0;
+        for i in 0..n {
+            let axis = if i % 2 == 0 { Vector3::y_axis() } else { Vector3::z_axis() };
+            let x = if i == 0 { 0.0 } else { 0.2 };
+            pose = pose * Translation3::new(x, 0.0, 0.0) * UnitQuaternion::from_axis_angle(&axis, th[i]);
+            let com = pose * Point3::new(0.1, 0.0, 0.0);
+            v += 9.81 * com.z; // m = 1 kg
+            let k = 10.0 * ((n - i) * (n - i)) as f64;
+            v += 0.5 * k * th[i] * th[i];
+        }
+        v
+    };
+    assert_abs_diff_eq!(energy(&theta), r.energy.total, epsilon = 1e-9);
+    let h = 1e-6;
+    for i in 0..n {
+        let mut tp = theta.clone();
+        let mut tm = theta.clone();
+        tp[i] += h;
+        tm[i] -= h;
+        let g = (energy(&tp) - energy(&tm)) / (2.0 * h);
+        assert!(g.abs() < 1e-6, "∂V/∂θ{i} = {g}");
+    }
+    // Hessian by central differences: positive definite.
+    let hh = 1e-4;
+    let hess = nalgebra::DMatrix::from_fn(n, n, |i, j| {
+        let f = |a: f64, b: f64| {
+            let mut t = theta.clone();
+            t[i] += a;
+            t[j] += b;
+            energy(&t)
+        };
+        (f(hh, hh) - f(hh, -hh) - f(-hh, hh) + f(-hh, -hh)) / (4.0 * hh * hh)
+    });
+    let eig = nalgebra::SymmetricEigen::new(hess).eigenvalues;
+    assert!(eig.min() > 0.0, "minimal-coordinate Hessian not positive definite: {}", eig.min());
+}
+
+/// Generated planar chain: closed-form balance k_i θ_i = Σ_{j ≥ i} torque of link j's weight.
+#[test]
+fn planar_chain_joint_torques_balance_by_hand() {
+    let n = 8;
+    let m = model_from(&restpose::generate::chain(n, true));
+    let (s, _) = solve(&m);
+    let theta: Vec<f64> = (0..n).map(|i| joint(&m, &s, &format!("joint{i}"))[0]).collect();
+    // Joint i at x_i; link j's centre of mass at c_j (in the x-z plane).
+    let mut pts = Vec::new();
+    let mut ang: f64 = 0.0;
+    let mut p = nalgebra::Vector2::new(0.0, 0.0);
+    for i in 0..n {
+        if i > 0 {
+            p += nalgebra::Vector2::new(ang.cos(), -ang.sin()) * 0.2;
+        }
+        ang += theta[i];
+        let c = p + nalgebra::Vector2::new(ang.cos(), -ang.sin()) * 0.1;
+        pts.push((p, c));
+    }
+    for i in 0..n {
+        let k = 10.0 * ((n - i) * (n - i)) as f64;
+        // Gravity (−z) torque about +y at joint i of links j ≥ i: (c − p)_x · m g.
+        let t: f64 = (i..n).map(|j| (pts[j].1.x - pts[i].0.x) * 9.81).sum();
+        assert_abs_diff_eq!(k * theta[i], t, epsilon = 1e-8);
+    }
+}

@@ -2,7 +2,8 @@
 //!
 //! `chain(n, planar)`: `n` slender links (0.2 m, 1 kg, centre of mass at mid-length along x)
 //! hanging from the world in a line along x, joined by revolute joints with torsional springs
-//! `k = 2 n` N m/rad (stiff enough to hold the chain up). Joint axes alternate between y and z
+//! `k_i = 10 (n − i)²` N m/rad on joint `i` (about ten times the gravity torque per radian of
+//! the links it carries, so the chain sags about 0.1 rad per joint). Joint axes alternate between y and z
 //! (spatial chain), or are all y (planar chain, gravity in its plane). Gravity `0 0 −9.81`.
 
 use std::fmt::Write;

@@ -12,9 +12,9 @@ use std::path::Path;
 /// # Errors
 /// [`Error::Io`] if the folder is not writable.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let io = |source| Error::Io {
+    let io = |cause| Error::Io {
         path: path.display().to_string(),
-        source,
+        cause,
     };
     let dir = path
         .parent()

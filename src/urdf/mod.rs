@@ -57,9 +57,9 @@ pub struct Loaded {
 /// not a valid restpose URDF.
 pub fn load_file(path: impl AsRef<Path>, options: &ImportOptions) -> Result<Loaded> {
     let path = path.as_ref();
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+    let text = std::fs::read_to_string(path).map_err(|cause| Error::Io {
         path: path.display().to_string(),
-        source,
+        cause,
     })?;
     load_str(&text, &path.display().to_string(), options)
 }

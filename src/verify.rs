@@ -68,7 +68,12 @@ pub fn balance(model: &Model, state: &State) -> Result<Balance> {
             proj = proj.max(eig.eigenvectors.column(k).dot(&g).abs());
         }
     }
-    Ok(Balance { constraint_residual: phi.amax(), projected_gradient: proj, potential_energy: e.total, dof })
+    Ok(Balance {
+        constraint_residual: phi.amax(),
+        projected_gradient: proj,
+        potential_energy: e.total,
+        dof,
+    })
 }
 
 /// Brings `state` onto `Φ = 0` by a damped Newton iteration that changes the dependent

@@ -51,7 +51,14 @@ fn pendulum_matches_bisection_of_the_closed_form() {
 fn quasi_newton_methods_agree() {
     let m = robot("pendulum");
     for method in [Method::Bfgs, Method::Dfp] {
-        let (s, r) = restpose::solve(&m, &Options { method, ..Default::default() }).unwrap();
+        let (s, r) = restpose::solve(
+            &m,
+            &Options {
+                method,
+                ..Default::default()
+            },
+        )
+        .unwrap();
         assert!(r.converged(), "{method:?}: {:?}", r.termination);
         assert_abs_diff_eq!(joint(&m, &s, "pivot")[0], -1.381577, epsilon = 1e-6);
         assert_abs_diff_eq!(r.energy.total, -18.686957, epsilon = 1e-6);

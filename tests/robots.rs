@@ -16,7 +16,11 @@ fn every_robot_loads_and_solves_to_a_verified_minimum() {
         let name = path.file_stem().unwrap().to_str().unwrap().to_string();
         let m = robot(&name);
         let (s, r) = solve(&m);
-        assert_eq!(r.stability.as_ref().map(|s| s.verdict.as_str()), Some("stable"), "{name}");
+        assert_eq!(
+            r.stability.as_ref().map(|s| s.verdict.as_str()),
+            Some("stable"),
+            "{name}"
+        );
         assert_verified_minimum(&m, &s);
         count += 1;
     }
@@ -29,7 +33,12 @@ fn slider_crank_reports_redundant_rows_and_one_dof() {
     let (s, r) = solve(&m);
     assert_eq!(r.dof, 1);
     // A planar loop of four joints in 3-D: three out-of-plane rows are redundant.
-    assert_eq!(r.redundant_constraints.len(), 3, "{:?}", r.redundant_constraints);
+    assert_eq!(
+        r.redundant_constraints.len(),
+        3,
+        "{:?}",
+        r.redundant_constraints
+    );
     // The loop is closed: the slider's pin and the rod's end coincide.
     let rod_end = s.link_pose(&m, "rod").unwrap() * Point3::new(0.3, 0.0, 0.0);
     let slider = s.link_pose(&m, "slider").unwrap() * Point3::origin();
@@ -59,14 +68,22 @@ fn chain_matches_minimal_coordinate_energy() {
     let m = robot("chain20");
     let (s, r) = solve(&m);
     assert_eq!(r.dof, n);
-    let theta: Vec<f64> = (0..n).map(|i| joint(&m, &s, &format!("joint{i}"))[0]).collect();
+    let theta: Vec<f64> = (0..n)
+        .map(|i| joint(&m, &s, &format!("joint{i}"))[0])
+        .collect();
     let energy = |th: &[f64]| {
         let mut pose = Isometry3::identity();
         let mut v = 0.0;
         for i in 0..n {
-            let axis = if i % 2 == 0 { Vector3::y_axis() } else { Vector3::z_axis() };
+            let axis = if i % 2 == 0 {
+                Vector3::y_axis()
+            } else {
+                Vector3::z_axis()
+            };
             let x = if i == 0 { 0.0 } else { 0.2 };
-            pose = pose * Translation3::new(x, 0.0, 0.0) * UnitQuaternion::from_axis_angle(&axis, th[i]);
+            pose = pose
+                * Translation3::new(x, 0.0, 0.0)
+                * UnitQuaternion::from_axis_angle(&axis, th[i]);
             let com = pose * Point3::new(0.1, 0.0, 0.0);
             v += 9.81 * com.z; // m = 1 kg
             let k = 10.0 * ((n - i) * (n - i)) as f64;
@@ -96,7 +113,11 @@ fn chain_matches_minimal_coordinate_energy() {
         (f(hh, hh) - f(hh, -hh) - f(-hh, hh) + f(-hh, -hh)) / (4.0 * hh * hh)
     });
     let eig = nalgebra::SymmetricEigen::new(hess).eigenvalues;
-    assert!(eig.min() > 0.0, "minimal-coordinate Hessian not positive definite: {}", eig.min());
+    assert!(
+        eig.min() > 0.0,
+        "minimal-coordinate Hessian not positive definite: {}",
+        eig.min()
+    );
 }
 
 /// Generated planar chain: closed-form balance k_i θ_i = Σ_{j ≥ i} torque of link j's weight.
@@ -105,7 +126,9 @@ fn planar_chain_joint_torques_balance_by_hand() {
     let n = 8;
     let m = model_from(&restpose::generate::chain(n, true));
     let (s, _) = solve(&m);
-    let theta: Vec<f64> = (0..n).map(|i| joint(&m, &s, &format!("joint{i}"))[0]).collect();
+    let theta: Vec<f64> = (0..n)
+        .map(|i| joint(&m, &s, &format!("joint{i}"))[0])
+        .collect();
     // Joint i at x_i; link j's centre of mass at c_j (in the x-z plane).
     let mut pts = Vec::new();
     let mut ang: f64 = 0.0;

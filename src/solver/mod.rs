@@ -69,7 +69,11 @@ pub(crate) fn lock_values(model: &Model) -> Vec<(JointId, usize, f64)> {
 }
 
 /// Closes the constraints from `q` without the initial-value holds (see [`assemble`]).
-pub(crate) fn assemble_only(model: &Model, q: nalgebra::DVector<f64>, locks: &[(JointId, usize, f64)]) -> Result<nalgebra::DVector<f64>> {
+pub(crate) fn assemble_only(
+    model: &Model,
+    q: nalgebra::DVector<f64>,
+    locks: &[(JointId, usize, f64)],
+) -> Result<nalgebra::DVector<f64>> {
     assemble::project(model, q, locks, &Options::default())
 }
 

@@ -234,3 +234,168 @@ impl<'a> System<'a> {
         (&hr + hr.transpose()) * 0.5
     }
 }
+
+#[cfg(test)]
+mod tests {
+    //! The assembled global derivatives against central differences, on real robots at
+    //! random (non-assembled, non-unit) configurations.
+    use super::*;
+    use crate::urdf::{load_str, ImportOptions};
+
+    fn models() -> Vec<Model> {
+        [
+            include_str!("../../robots/pendulum.urdf"),
+            include_str!("../../robots/slider_crank.urdf"),
+            include_str!("../../robots/four_bar_spatial.urdf"),
+        ]
+        .iter()
+        .map(|t| {
+            load_str(t, "robot.urdf", &ImportOptions::default())
+                .unwrap()
+                .model
+        })
+        .collect()
+    }
+
+    fn random_q(n: usize, seed: u64) -> DVector<f64> {
+        let mut s = seed;
+        DVector::from_fn(n, |i, _| {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let r = ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0;
+            if i % 7 == 3 {
+                1.0 + 0.2 * r
+            } else {
+                0.3 * r
+            }
+        })
+    }
+
+    #[test]
+    fn potential_gradient_and_hessian_match_finite_differences() {
+        for model in models() {
+            let n = model.coordinate_count();
+            let q = random_q(n, 7);
+            let mut g = DVector::zeros(n);
+            let mut h = DMatrix::zeros(n, n);
+            potential(&model, &q, &mut g, Some(&mut h)).unwrap();
+            let step = 1e-6;
+            for i in 0..n {
+                let mut qp = q.clone();
+                let mut qm = q.clone();
+                qp[i] += step;
+                qm[i] -= step;
+                let (mut gp, mut gm) = (DVector::zeros(n), DVector::zeros(n));
+                let vp = potential(&model, &qp, &mut gp, None).unwrap().total;
+                let vm = potential(&model, &qm, &mut gm, None).unwrap().total;
+                let fd = (vp - vm) / (2.0 * step);
+                assert!(
+                    (fd - g[i]).abs() < 1e-6 * (1.0 + g[i].abs()),
+                    "{}: V_q[{i}] {} vs {fd}",
+                    model.name,
+                    g[i]
+                );
+                for j in 0..n {
+                    let fdh = (gp[j] - gm[j]) / (2.0 * step);
+                    assert!(
+                        (fdh - h[(j, i)]).abs() < 1e-5 * (1.0 + h[(j, i)].abs()),
+                        "{}: V_qq[{j},{i}] {} vs {fdh}",
+                        model.name,
+                        h[(j, i)]
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn constraint_jacobian_and_weighted_hessian_match_finite_differences() {
+        for model in models() {
+            let n = model.coordinate_count();
+            let sys_cons = Constraints::new(&model, &[(crate::model::JointId(0), 0, 0.3)]);
+            let mut sys = System::new(&model, sys_cons);
+            let m = sys.cons.len();
+            let q = random_q(n, 11);
+            let j = sys.jacobian(&q);
+            let w = DVector::from_fn(m, |i, _| ((i * 37 % 11) as f64 - 5.0) * 0.1);
+            let mut h = DMatrix::zeros(n, n);
+            sys.cons.add_hessian(&model, &q, &w, &mut h);
+            let step = 1e-6;
+            for i in 0..n {
+                let mut qp = q.clone();
+                let mut qm = q.clone();
+                qp[i] += step;
+                qm[i] -= step;
+                let jp = sys.jacobian(&qp);
+                let php = sys.phi.clone();
+                let jm = sys.jacobian(&qm);
+                let phm = sys.phi.clone();
+                for r in 0..m {
+                    let fd = (php[r] - phm[r]) / (2.0 * step);
+                    assert!(
+                        (fd - j[(r, i)]).abs() < 1e-6 * (1.0 + fd.abs()),
+                        "{}: Φ_q[{},{i}] ({}) {} vs {fd}",
+                        model.name,
+                        r,
+                        sys.cons.row_name(r),
+                        j[(r, i)]
+                    );
+                }
+                let gp = jp.transpose() * &w;
+                let gm = jm.transpose() * &w;
+                for k in 0..n {
+                    let fd = (gp[k] - gm[k]) / (2.0 * step);
+                    assert!(
+                        (fd - h[(k, i)]).abs() < 1e-5 * (1.0 + fd.abs()),
+                        "{}: (wᵀΦ)_qq[{k},{i}] {} vs {fd}",
+                        model.name,
+                        h[(k, i)]
+                    );
+                }
+            }
+        }
+    }
+
+    /// The reduced gradient equals the derivative of f(v) = V(u(v), v) along each independent
+    /// coordinate (finite differences through the corrector), and the reduced Hessian the
+    /// derivative of the reduced gradient.
+    #[test]
+    fn reduced_gradient_and_hessian_match_differences_through_the_corrector() {
+        for model in models() {
+            let q0 = crate::solver::initial_state(&model).q;
+            let q = crate::solver::assemble_only(&model, q0, &[]).unwrap();
+            let mut sys = System::new(&model, Constraints::new(&model, &[]));
+            let part = sys.partition(&q);
+            let e = sys.evaluate(&q, &part).unwrap();
+            let hr = sys.reduced_hessian(&q, &part, &e);
+            let step = 1e-5;
+            for (b, &c) in part.independent.iter().enumerate() {
+                let at = |sign: f64, sys: &mut System| {
+                    let mut qq = q.clone();
+                    qq[c] += sign * step * sys.scale[c];
+                    sys.correct(&mut qq, &part, 1e-13, 50).unwrap();
+                    sys.evaluate(&qq, &part).unwrap()
+                };
+                let ep = at(1.0, &mut sys);
+                let em = at(-1.0, &mut sys);
+                let fd = (ep.energy.total - em.energy.total) / (2.0 * step);
+                assert!(
+                    (fd - e.grad_v[b]).abs() < 1e-6 * (1.0 + fd.abs()),
+                    "{}: ∂f/∂v[{b}] {} vs {fd}",
+                    model.name,
+                    e.grad_v[b]
+                );
+                for a in 0..part.independent.len() {
+                    let fdh = (ep.grad_v[a] - em.grad_v[a]) / (2.0 * step);
+                    assert!(
+                        (fdh - hr[(a, b)]).abs() < 1e-5 * (1.0 + fdh.abs()),
+                        "{}: reduced Hessian [{a},{b}] {} vs {fdh}",
+                        model.name,
+                        hr[(a, b)]
+                    );
+                }
+            }
+        }
+    }
+}

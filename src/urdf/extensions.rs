@@ -343,12 +343,14 @@ pub(super) fn read(
                     "both" => SpringMode::Both,
                     "tension" => SpringMode::Tension,
                     "compression" => SpringMode::Compression,
-                    other => return Err(src.error(
-                        n,
-                        format!(
+                    other => {
+                        return Err(src.error(
+                            n,
+                            format!(
                             "spring `{name}`: mode=\"{other}\" is not both, tension or compression"
                         ),
-                    )),
+                        ))
+                    }
                 };
                 let law = force_law(src, n, &format!("spring `{name}`"))?;
                 let ends = [se[0].clone(), se[1].clone()];

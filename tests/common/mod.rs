@@ -8,24 +8,38 @@ use restpose::{Model, Options, Report};
 /// Loads `robots/NAME.urdf`.
 pub(crate) fn robot(name: &str) -> Model {
     let path = format!("{}/robots/{name}.urdf", env!("CARGO_MANIFEST_DIR"));
-    load_file(&path, &ImportOptions::default()).unwrap_or_else(|e| panic!("{e}")).model
+    load_file(&path, &ImportOptions::default())
+        .unwrap_or_else(|e| panic!("{e}"))
+        .model
 }
 
 /// Loads URDF text.
 pub(crate) fn model_from(text: &str) -> Model {
-    load_str(text, "test.urdf", &ImportOptions::default()).unwrap_or_else(|e| panic!("{e}")).model
+    load_str(text, "test.urdf", &ImportOptions::default())
+        .unwrap_or_else(|e| panic!("{e}"))
+        .model
 }
 
 /// Solves with default options and asserts convergence.
 pub(crate) fn solve(model: &Model) -> (State, Report) {
     let (s, r) = restpose::solve(model, &Options::default()).unwrap_or_else(|e| panic!("{e}"));
-    assert!(r.converged(), "{} did not converge: {:?}", model.name, r.termination);
+    assert!(
+        r.converged(),
+        "{} did not converge: {:?}",
+        model.name,
+        r.termination
+    );
     (s, r)
 }
 
 /// Joint coordinate by name.
 pub(crate) fn joint(model: &Model, state: &State, name: &str) -> Vec<f64> {
-    state.joint_values(model).into_iter().find(|(n, _)| n == name).map(|(_, v)| v).unwrap()
+    state
+        .joint_values(model)
+        .into_iter()
+        .find(|(n, _)| n == name)
+        .map(|(_, v)| v)
+        .unwrap()
 }
 
 /// Independent equilibrium checks: constraints hold, the projected gradient vanishes, and no
@@ -33,12 +47,24 @@ pub(crate) fn joint(model: &Model, state: &State, name: &str) -> Vec<f64> {
 /// energy.
 pub(crate) fn assert_verified_minimum(model: &Model, state: &State) {
     let b = restpose::verify::balance(model, state).unwrap();
-    assert!(b.constraint_residual < 1e-10, "{}: ‖Φ‖∞ = {:e}", model.name, b.constraint_residual);
-    assert!(b.projected_gradient < 1e-6, "{}: projected gradient {:e}", model.name, b.projected_gradient);
+    assert!(
+        b.constraint_residual < 1e-10,
+        "{}: ‖Φ‖∞ = {:e}",
+        model.name,
+        b.constraint_residual
+    );
+    assert!(
+        b.projected_gradient < 1e-6,
+        "{}: projected gradient {:e}",
+        model.name,
+        b.projected_gradient
+    );
     let v0 = b.potential_energy;
     let mut seed = 12345u64;
     let mut rnd = || {
-        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
     };
     for trial in 0..20 {

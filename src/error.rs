@@ -33,12 +33,12 @@ pub enum Error {
     Option(String),
     /// The loop joints could not be closed from the initial guess.
     #[error(
-        "cannot assemble the mechanism from the initial guess: constraint `{row}` still violated \
-         by {residual:.3e} after {iterations} Newton iterations (check the loop geometry or give \
-         `mech:initial` values near an assembled pose)"
+        "cannot assemble the mechanism from the initial guess: constraint `{row}` is violated \
+         by {residual:.3e} and {iterations} damped Newton iterations could not close it (check \
+         the loop geometry or give `mech:initial` values near an assembled pose)"
     )]
     Assembly {
-        /// Largest remaining residual.
+        /// Residual of that row \[m or 1\].
         residual: f64,
         /// Name of the most violated constraint row.
         row: String,
@@ -61,5 +61,5 @@ pub enum Error {
     Undefined(String),
 }
 
-/// Result with [`Error`].
+/// Result with [`enum@Error`].
 pub type Result<T> = std::result::Result<T, Error>;

@@ -61,19 +61,19 @@ struct AnalyzeArgs {
     /// Write the result JSON here (written even when the solve does not converge).
     #[arg(long, value_name = "OUT.json")]
     json: Option<PathBuf>,
-    /// Gravity [m/s²] when the file has no <mech:gravity>.
+    /// Gravity \[m/s²\] when the file has no <mech:gravity>.
     #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_hyphen_values = true)]
     gravity: Option<Vec<f64>>,
-    /// Hold a joint coordinate: JOINT=VALUE or JOINT[DOF]=VALUE (repeatable).
+    /// Hold a joint coordinate: JOINT=VALUE or JOINT\[DOF\]=VALUE (repeatable).
     #[arg(long, value_name = "JOINT=VALUE")]
     lock: Vec<String>,
-    /// Initial guess of a joint coordinate: JOINT=VALUE or JOINT[DOF]=VALUE (repeatable).
+    /// Initial guess of a joint coordinate: JOINT=VALUE or JOINT\[DOF\]=VALUE (repeatable).
     #[arg(long, value_name = "JOINT=VALUE")]
     initial: Vec<String>,
     /// Maximum minimizer iterations.
     #[arg(long, default_value_t = 200)]
     max_iterations: usize,
-    /// Tolerance on the scaled reduced gradient [J].
+    /// Tolerance on the scaled reduced gradient \[J\].
     #[arg(long, default_value_t = 1e-8)]
     tolerance: f64,
     /// Tolerance on the constraint residual ‖Φ‖∞.

@@ -17,16 +17,16 @@ use nalgebra::DVector;
 pub struct Balance {
     /// `‖Φ‖∞` over all constraint rows (locks included).
     pub constraint_residual: f64,
-    /// `‖Nᵀ S ∇V‖∞` [J]: the gradient of the energy along feasible motions, in coordinates
+    /// `‖Nᵀ S ∇V‖∞` \[J\]: the gradient of the energy along feasible motions, in coordinates
     /// scaled like the solver's (positions by the characteristic length).
     pub projected_gradient: f64,
-    /// Potential energy [J].
+    /// Potential energy \[J\].
     pub potential_energy: f64,
     /// Degrees of freedom from the rank of `Φ_q` (singular values below 1e-6 of the largest count as zero).
     pub dof: usize,
 }
 
-/// Potential energy of a state [J], `None` where a force table is out of its range.
+/// Potential energy of a state \[J\], `None` where a force table is out of its range.
 pub fn potential_energy(model: &Model, state: &State) -> Option<f64> {
     let mut g = DVector::zeros(state.q.len());
     potential(model, &state.q, &mut g, None).map(|e| e.total)

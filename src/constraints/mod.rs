@@ -1,7 +1,7 @@
 //! The constraint equations `Φ(q) = 0`, their Jacobian `Φ_q` (assembled as sparse triplets)
 //! and the weighted Hessian `Σ_k w_k ∇²Φ_k`.
 //!
-//! Rows come in blocks: the equations of each joint ([`joint`]), one Euler-parameter
+//! Rows come in blocks: the equations of each joint (module `joint`), one Euler-parameter
 //! normalization `p_iᵀ p_i − 1 = 0` per body, locks `θ(q) − θ̄ = 0` and mimic couplings
 //! `θ_a(q) − m θ_b(q) − c = 0`.
 

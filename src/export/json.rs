@@ -13,14 +13,14 @@ pub struct JointResult {
     /// Joint type name.
     #[serde(rename = "type")]
     pub kind: String,
-    /// Coordinates [rad or m]; quaternion `wxyz` for spherical joints; `[]` for fixed joints.
+    /// Coordinates \[rad or m\]; quaternion `wxyz` for spherical joints; `[]` for fixed joints.
     pub position: Vec<f64>,
 }
 
 /// A link frame in the world.
 #[derive(Clone, Debug, Serialize)]
 pub struct LinkResult {
-    /// Origin of the link frame [m].
+    /// Origin of the link frame \[m\].
     pub position: [f64; 3],
     /// Orientation as a unit quaternion `[w, x, y, z]`.
     pub orientation_wxyz: [f64; 4],
@@ -37,7 +37,7 @@ pub struct AnalysisResult {
     pub termination: String,
     /// Minimizer iterations.
     pub iterations: usize,
-    /// Potential energy [J].
+    /// Potential energy \[J\].
     pub potential_energy: f64,
     /// Degrees of freedom.
     pub dof: usize,
@@ -56,7 +56,7 @@ pub struct AnalysisResult {
     pub redundant_constraints: Vec<String>,
     /// Independent coordinates of the final partition.
     pub independent_coordinates: Vec<String>,
-    /// Energy by source [J].
+    /// Energy by source \[J\].
     pub energy: Energy,
     /// Solver counters.
     pub diagnostics: Diagnostics,

@@ -13,18 +13,18 @@ use crate::jet::{pair_of, scatter, Pair, Scalar, Vec3Jet};
 use crate::model::{BodyId, JointKind, Model, SpringMode};
 use nalgebra::{DMatrix, DVector, Vector3};
 
-/// Potential energy split by source [J].
+/// Potential energy split by source \[J\].
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct Energy {
-    /// Total `V` [J].
+    /// Total `V` \[J\].
     pub total: f64,
-    /// Gravity [J].
+    /// Gravity \[J\].
     pub gravity: f64,
-    /// Translational springs [J].
+    /// Translational springs \[J\].
     pub springs: f64,
-    /// Joint springs [J].
+    /// Joint springs \[J\].
     pub joint_springs: f64,
-    /// Minus the work of dead loads and joint efforts [J].
+    /// Minus the work of dead loads and joint efforts \[J\].
     pub loads: f64,
 }
 

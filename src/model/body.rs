@@ -11,15 +11,15 @@ pub struct BodyId(pub usize);
 pub struct Body {
     /// Name of the link whose frame is the body frame.
     pub name: String,
-    /// Total mass [kg].
+    /// Total mass \[kg\].
     pub mass: f64,
-    /// Centre of mass in the body frame [m].
+    /// Centre of mass in the body frame \[m\].
     pub com: Vector3<f64>,
-    /// Inertia about the centre of mass, body-frame axes [kg m²].
+    /// Inertia about the centre of mass, body-frame axes \[kg m²\].
     pub inertia: Matrix3<f64>,
-    /// Mass subject to gravity [kg] (links can be excluded with `mech:link_gravity`).
+    /// Mass subject to gravity \[kg\] (links can be excluded with `mech:link_gravity`).
     pub gravity_mass: f64,
-    /// Centre of the mass subject to gravity, body frame [m].
+    /// Centre of the mass subject to gravity, body frame \[m\].
     pub gravity_com: Vector3<f64>,
 }
 

@@ -20,9 +20,9 @@ pub enum SpringMode {
 pub enum ForceLaw {
     /// `F = preload + k δ`.
     Linear {
-        /// Stiffness [N/m or N m/rad].
+        /// Stiffness \[N/m or N m/rad\].
         stiffness: f64,
-        /// Force at zero deflection [N or N m].
+        /// Force at zero deflection \[N or N m\].
         preload: f64,
     },
     /// Piecewise-linear table of `(δ, F)` rows, `δ` strictly increasing.
@@ -41,7 +41,7 @@ pub enum ForceLaw {
 pub struct SpringEnd {
     /// The body (`None` = world).
     pub body: Option<BodyId>,
-    /// Attachment point in the body frame (world frame for the world) [m].
+    /// Attachment point in the body frame (world frame for the world) \[m\].
     pub point: Vector3<f64>,
 }
 
@@ -52,7 +52,7 @@ pub struct Spring {
     pub name: String,
     /// The two ends.
     pub ends: [SpringEnd; 2],
-    /// Free length `L₀` [m].
+    /// Free length `L₀` \[m\].
     pub free_length: f64,
     /// Force law.
     pub law: ForceLaw,
@@ -67,7 +67,7 @@ pub struct JointSpring {
     pub joint: JointId,
     /// Coordinate index of the joint.
     pub dof: usize,
-    /// Reference value [rad or m].
+    /// Reference value \[rad or m\].
     pub reference: f64,
     /// Force law.
     pub law: ForceLaw,
@@ -80,9 +80,9 @@ pub struct Load {
     pub name: String,
     /// The body.
     pub body: BodyId,
-    /// Application point in the body frame [m].
+    /// Application point in the body frame \[m\].
     pub point: Vector3<f64>,
-    /// Force in the world frame [N].
+    /// Force in the world frame \[N\].
     pub force: Vector3<f64>,
 }
 
@@ -93,7 +93,7 @@ pub struct Effort {
     pub joint: JointId,
     /// Coordinate index.
     pub dof: usize,
-    /// Torque [N m] or force [N].
+    /// Torque \[N m\] or force \[N\].
     pub value: f64,
 }
 
@@ -104,7 +104,7 @@ pub struct Lock {
     pub joint: JointId,
     /// Coordinate index.
     pub dof: usize,
-    /// Held value [rad or m]; `None` = the initial-guess value.
+    /// Held value \[rad or m\]; `None` = the initial-guess value.
     pub value: Option<f64>,
 }
 
@@ -117,7 +117,7 @@ pub struct Mimic {
     pub reference: JointId,
     /// Multiplier.
     pub multiplier: f64,
-    /// Offset [rad or m].
+    /// Offset \[rad or m\].
     pub offset: f64,
 }
 
@@ -128,6 +128,6 @@ pub struct Initial {
     pub joint: JointId,
     /// Coordinate index.
     pub dof: usize,
-    /// Value [rad or m].
+    /// Value \[rad or m\].
     pub value: f64,
 }

@@ -36,12 +36,12 @@ pub enum JointKind {
     Cylindrical,
     /// Rotation about z coupled to translation along z: `d = pitch θ`.
     Screw {
-        /// Pitch [m/rad].
+        /// Pitch \[m/rad\].
         pitch: f64,
     },
     /// The two joint origins stay `length` apart (massless rod).
     Distance {
-        /// Rod length [m].
+        /// Rod length \[m\].
         length: f64,
     },
     /// The child's joint origin stays on the parent's z line.

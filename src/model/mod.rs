@@ -42,9 +42,9 @@ pub struct Model {
     pub mimics: Vec<Mimic>,
     /// Initial guesses of joint coordinates.
     pub initial: Vec<Initial>,
-    /// Gravity in the world frame [m/s²].
+    /// Gravity in the world frame \[m/s²\].
     pub gravity: Vector3<f64>,
-    /// Characteristic length of the mechanism [m], used to scale position coordinates.
+    /// Characteristic length of the mechanism \[m\], used to scale position coordinates.
     pub length_scale: f64,
 }
 

@@ -33,19 +33,20 @@ fn newton(
             return Err((res, phi.iamax(), it));
         };
         let mut alpha = 1.0;
-        loop {
+        let mut improved = false;
+        while alpha >= 1e-4 {
             let mut qt = q.clone();
             for (k, &c) in part.dependent.iter().enumerate() {
                 qt[c] += alpha * du[k];
             }
-            let rt = sys.residual(&qt).amax();
-            if rt < res || alpha < 1e-4 {
+            if sys.residual(&qt).amax() < res {
                 q = qt;
+                improved = true;
                 break;
             }
             alpha *= 0.5;
         }
-        if alpha < 1e-4 && sys.residual(&q).amax() >= res {
+        if !improved {
             return Err((res, phi.iamax(), it));
         }
     }
@@ -88,14 +89,25 @@ pub(crate) fn project(
 ) -> Result<DVector<f64>> {
     let tol = options.constraint_tolerance;
     let mut sys = System::new(model, Constraints::new(model, locks));
+    let q0 = q.clone();
     match newton(&mut sys, q, tol) {
         Ok(qa) => Ok(qa),
         Err((residual, row, iterations)) => {
-            let part_rows = sys.cons.row_name(row).to_string();
-            // A violated row that is redundant with a satisfied set means inconsistency.
+            // Name the worst joint row rather than a normalization row, which only reflects
+            // how the Newton steps distorted the Euler parameters.
+            let phi = sys.residual(&q0).clone();
+            let worst = (0..phi.len())
+                .filter(|&r| !sys.cons.row_name(r).ends_with(".normalization"))
+                .max_by(|&a, &b| phi[a].abs().total_cmp(&phi[b].abs()))
+                .filter(|&r| phi[r].abs() > tol)
+                .unwrap_or(row);
             Err(Error::Assembly {
-                residual,
-                row: part_rows,
+                residual: if worst == row {
+                    residual
+                } else {
+                    phi[worst].abs()
+                },
+                row: sys.cons.row_name(worst).to_string(),
                 iterations,
             })
         }

@@ -85,6 +85,7 @@ pub(crate) fn minimize(
     let mut just_repartitioned = false;
     let mut termination = Termination::MaxIterations;
     let mut iteration = 0;
+    let mut linear_steps = 0;
     loop {
         let f = eval.energy.total;
         let gnorm = eval.grad_v.amax();
@@ -159,7 +160,8 @@ pub(crate) fn minimize(
             first_update = true;
         }
         let dmax = d.amax();
-        if dmax > options.max_step {
+        let capped = dmax > options.max_step;
+        if capped {
             d *= options.max_step / dmax;
         }
         let slope = g.dot(&d);
@@ -210,13 +212,21 @@ pub(crate) fn minimize(
             Some((qt, et, alpha)) => {
                 let s = &d * alpha;
                 let y = &et.grad_v - &eval.grad_v;
+                // Full capped steps that leave the gradient unchanged: the energy falls
+                // linearly along a direction of zero curvature.
+                if capped && alpha == 1.0 && y.amax() <= 1e-9 * gnorm {
+                    linear_steps += 1;
+                } else {
+                    linear_steps = 0;
+                }
                 quasi_newton_update(options.method, &mut binv, &s, &y, first_update);
                 first_update = false;
                 q = qt;
                 eval = et;
                 iteration += 1;
                 just_repartitioned = false;
-                if eval.energy.total < -1e15
+                if linear_steps >= 5
+                    || eval.energy.total < -1e15
                     || (0..q.len()).any(|i| i % 7 < 3 && q[i].abs() > 1e6 * sys.model.length_scale)
                 {
                     termination = Termination::Unbounded;
@@ -230,7 +240,7 @@ pub(crate) fn minimize(
                 // Re-partition when Φ_u becomes ill-conditioned.
                 let u = eval.lu.u();
                 let diag_u = u.diagonal().abs();
-                if diag_u.len() > 0 && diag_u.min() < 1e-8 * diag_u.max() {
+                if !diag_u.is_empty() && diag_u.min() < 1e-8 * diag_u.max() {
                     part = sys.partition(&q);
                     diag.repartitions += 1;
                     eval = sys.evaluate(&q, &part)?;

@@ -3,9 +3,9 @@
 //!
 //! 1. Initial state by forward kinematics with the initial joint values; loop joints are closed
 //!    by a damped Newton iteration that holds the joints given initial values where it can
-//!    ([`assemble`]).
-//! 2. Partition `q = [u; v]` by full pivoting of `Φ_q` ([`partition`]).
-//! 3. Minimize `f(v) = V(u(v), v)` ([`minimize`]), with the corrector keeping `Φ = 0`.
+//!    (module `assemble`).
+//! 2. Partition `q = [u; v]` by full pivoting of `Φ_q` (module `partition`).
+//! 3. Minimize `f(v) = V(u(v), v)` (module `minimize`), with the corrector keeping `Φ = 0`.
 //! 4. Stability from the eigenvalues of the reduced Hessian; reactions from the multipliers
 //!    `μ` (`V_qᵀ = Φ_qᵀ μ`).
 //!
@@ -68,7 +68,7 @@ pub(crate) fn lock_values(model: &Model) -> Vec<(JointId, usize, f64)> {
         .collect()
 }
 
-/// Closes the constraints from `q` without the initial-value holds (see [`assemble`]).
+/// Closes the constraints from `q` without the initial-value holds (see module `assemble`).
 pub(crate) fn assemble_only(
     model: &Model,
     q: nalgebra::DVector<f64>,

@@ -19,10 +19,10 @@ pub enum Method {
 pub struct Options {
     /// Minimization method (default: Newton).
     pub method: Method,
-    /// Convergence tolerance on the reduced gradient `‖∂V/∂v‖∞` in scaled coordinates [J]
+    /// Convergence tolerance on the reduced gradient `‖∂V/∂v‖∞` in scaled coordinates \[J\]
     /// (default: 1e-8).
     pub gradient_tolerance: f64,
-    /// Newton corrector tolerance on `‖Φ‖∞` [m or 1] (default: 1e-10).
+    /// Newton corrector tolerance on `‖Φ‖∞` \[m or 1\] (default: 1e-10).
     pub constraint_tolerance: f64,
     /// Maximum minimizer iterations (default: 200).
     pub max_iterations: usize,

@@ -34,9 +34,9 @@ impl Termination {
 pub struct Iterate {
     /// Iteration number (0 = the assembled initial guess).
     pub iteration: usize,
-    /// Potential energy [J].
+    /// Potential energy \[J\].
     pub potential_energy: f64,
-    /// `‖∂V/∂v‖∞` in scaled coordinates [J].
+    /// `‖∂V/∂v‖∞` in scaled coordinates \[J\].
     pub gradient_norm: f64,
 }
 
@@ -45,9 +45,9 @@ pub struct Iterate {
 pub struct Stability {
     /// `stable` (all eigenvalues > tolerance), `unstable` (one < −tolerance) or `neutral`.
     pub verdict: String,
-    /// Eigenvalue tolerance used: `1e-8 · max(1, max |λ|)` [J].
+    /// Eigenvalue tolerance used: `1e-8 · max(1, max |λ|)` \[J\].
     pub tolerance: f64,
-    /// Smallest eigenvalues of the scaled reduced Hessian, ascending (at most 6) [J].
+    /// Smallest eigenvalues of the scaled reduced Hessian, ascending (at most 6) \[J\].
     pub eigenvalues: Vec<f64>,
 }
 
@@ -64,7 +64,7 @@ pub struct Diagnostics {
     pub repartitions: usize,
     /// Steps taken along a direction of negative curvature (leaving a saddle or maximum).
     pub negative_curvature_steps: usize,
-    /// Final `‖∂V/∂v‖∞` [J].
+    /// Final `‖∂V/∂v‖∞` \[J\].
     pub gradient_norm: f64,
     /// Final `‖Φ‖∞`.
     pub constraint_residual: f64,
@@ -73,13 +73,13 @@ pub struct Diagnostics {
 /// Reaction of a joint on its child link at the joint origin.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Reaction {
-    /// Force in the world frame [N].
+    /// Force in the world frame \[N\].
     pub force_world: [f64; 3],
-    /// Torque about the joint origin, world frame [N m].
+    /// Torque about the joint origin, world frame \[N m\].
     pub torque_world: [f64; 3],
-    /// Force in the joint frame (parent side) [N].
+    /// Force in the joint frame (parent side) \[N\].
     pub force_joint: [f64; 3],
-    /// Torque in the joint frame (parent side) [N m].
+    /// Torque in the joint frame (parent side) \[N m\].
     pub torque_joint: [f64; 3],
 }
 
@@ -90,7 +90,7 @@ pub struct Report {
     pub termination: Termination,
     /// Minimizer iterations.
     pub iterations: usize,
-    /// Energy at the final state [J].
+    /// Energy at the final state \[J\].
     pub energy: Energy,
     /// Degrees of freedom `n − rank(Φ_q)`.
     pub dof: usize,

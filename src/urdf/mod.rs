@@ -18,7 +18,7 @@ use std::path::Path;
 /// Options of the importer (the CLI maps its flags onto these).
 #[derive(Clone, Debug)]
 pub struct ImportOptions {
-    /// Gravity used when the file has no `mech:gravity` [m/s²] (default `0 0 −9.81`).
+    /// Gravity used when the file has no `mech:gravity` \[m/s²\] (default `0 0 −9.81`).
     pub gravity: Vector3<f64>,
     /// Leave the root link free (6 degrees of freedom) instead of welding it to the world.
     pub floating_base: bool,

@@ -31,7 +31,16 @@ impl Source<'_> {
         let tag = node.tag_name().name();
         match node.attribute("name") {
             Some(n) => format!("{tag} `{n}`"),
-            None => format!("<{tag}>"),
+            None => match node
+                .ancestors()
+                .skip(1)
+                .find(|a| a.attribute("name").is_some())
+            {
+                Some(a) if a.tag_name().name() != "robot" => {
+                    format!("<{tag}> of {}", self.describe(a))
+                }
+                _ => format!("<{tag}>"),
+            },
         }
     }
 

@@ -1,0 +1,169 @@
+//! The command line: exit codes, the JSON contract, atomic output.
+use std::process::Command;
+
+fn restpose() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_restpose"))
+}
+
+fn robot(name: &str) -> String {
+    format!("{}/robots/{name}.urdf", env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn analyze_writes_the_documented_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r.json");
+    let st = restpose()
+        .args(["analyze", &robot("slider_crank"), "--quiet", "--json"])
+        .arg(&out)
+        .status()
+        .unwrap();
+    assert_eq!(st.code(), Some(0));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    for key in [
+        "robot",
+        "converged",
+        "termination",
+        "iterations",
+        "potential_energy",
+        "dof",
+        "history",
+        "joints",
+        "links",
+        "stability",
+        "reactions",
+        "redundant_constraints",
+        "independent_coordinates",
+    ] {
+        assert!(v.get(key).is_some(), "missing `{key}`");
+    }
+    assert_eq!(v["converged"], true);
+    assert_eq!(v["termination"], "converged");
+    assert_eq!(v["dof"], 1);
+    assert_eq!(v["joints"]["slide"]["type"], "prismatic");
+    assert_eq!(
+        v["joints"]["wrist_pin"]["position"]
+            .as_array()
+            .unwrap()
+            .len(),
+        1
+    );
+    assert_eq!(
+        v["links"]["rod"]["orientation_wxyz"]
+            .as_array()
+            .unwrap()
+            .len(),
+        4
+    );
+    let h = v["history"].as_array().unwrap();
+    assert_eq!(h[0]["iteration"], 0);
+    assert!(h[0]["gradient_norm"].as_f64().unwrap() > 0.0);
+    assert_eq!(v["stability"]["verdict"], "stable");
+    assert!(v["reactions"]["wrist_pin"]["force_world"].is_array());
+}
+
+#[test]
+fn not_converged_exits_3_and_still_writes_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r.json");
+    let o = restpose()
+        .args([
+            "analyze",
+            &robot("pendulum"),
+            "--max-iterations",
+            "1",
+            "--json",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(3));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("did not converge"));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    assert_eq!(v["converged"], false);
+    assert_eq!(v["termination"], "max_iterations");
+}
+
+#[test]
+fn bad_input_exits_1_with_position_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.urdf");
+    std::fs::write(
+        &bad,
+        "<robot name=\"r\">\n<link name=\"a\"/>\n<link name=\"a\"/>\n</robot>",
+    )
+    .unwrap();
+    let out = dir.path().join("r.json");
+    let o = restpose()
+        .arg("analyze")
+        .arg(&bad)
+        .arg("--json")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("bad.urdf:3:1: duplicate link name `a`"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        1,
+        "no temporary files left"
+    );
+}
+
+#[test]
+fn options_lock_initial_gravity() {
+    let o = restpose()
+        .args([
+            "analyze",
+            &robot("pendulum"),
+            "--lock",
+            "pivot=-0.5",
+            "--gravity",
+            "0",
+            "0",
+            "-9.81",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("[-0.500000000]"), "{text}");
+    let o = restpose()
+        .args(["analyze", &robot("pendulum"), "--initial", "pivot=oops"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let o = restpose()
+        .args(["analyze", &robot("pendulum"), "--method", "simplex"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+}
+
+#[test]
+fn same_input_same_json_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |name: &str| {
+        let out = dir.path().join(name);
+        let st = restpose()
+            .args(["analyze", &robot("four_bar_spatial"), "--quiet", "--json"])
+            .arg(&out)
+            .status()
+            .unwrap();
+        assert!(st.success());
+        std::fs::read(out).unwrap()
+    };
+    assert_eq!(run("a.json"), run("b.json"));
+}

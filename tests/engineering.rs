@@ -1,0 +1,151 @@
+//! Stability, reactions, locks, units and unbounded energy.
+mod common;
+use approx::assert_abs_diff_eq;
+use common::*;
+use restpose::urdf::{load_str, ImportOptions};
+use restpose::Options;
+
+const BAR: &str = r#"<robot name="bar" xmlns:mech="urn:urdf-mech:1">
+  <link name="world"/>
+  <link name="bar"><inertial><origin xyz="SCALE 0 0"/><mass value="2"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.6" iyz="0" izz="0.6"/></inertial></link>
+  <joint name="pivot" type="continuous"><parent link="world"/><child link="bar"/><axis xyz="0 0 1"/></joint>
+  <mech:gravity xyz="0 -GRAV 0"/>
+  EXTRA
+</robot>"#;
+
+fn bar(scale: f64, extra: &str) -> String {
+    BAR.replace("SCALE", &scale.to_string())
+        .replace("GRAV", &(9.81 * scale).to_string())
+        .replace("EXTRA", extra)
+}
+
+/// Started exactly upright (a maximum, zero gradient), the pendulum leaves along the negative
+/// curvature and ends hanging down; with `allow_unstable` it stays and says `unstable`.
+#[test]
+fn inverted_start_ends_at_the_stable_equilibrium() {
+    let m = model_from(&bar(
+        1.0,
+        r#"<mech:initial joint="pivot" value="1.5707963267948966"/>"#,
+    ));
+    let (s, r) = solve(&m);
+    assert_abs_diff_eq!(
+        joint(&m, &s, "pivot")[0],
+        -std::f64::consts::FRAC_PI_2,
+        epsilon = 1e-8
+    );
+    assert_eq!(r.stability.unwrap().verdict, "stable");
+    assert!(r.diagnostics.negative_curvature_steps >= 1);
+
+    let opts = Options {
+        allow_unstable: true,
+        ..Default::default()
+    };
+    let (s, r) = restpose::solve(&m, &opts).unwrap();
+    assert!(r.converged());
+    assert_abs_diff_eq!(
+        joint(&m, &s, "pivot")[0],
+        std::f64::consts::FRAC_PI_2,
+        epsilon = 1e-12
+    );
+    assert_eq!(r.stability.unwrap().verdict, "unstable");
+}
+
+/// A locked joint holds the gravity torque: m g x_com, by hand.
+#[test]
+fn lock_holding_torque_equals_gravity_torque() {
+    let angle: f64 = -0.4;
+    let m = model_from(&bar(
+        1.0,
+        &format!(r#"<mech:lock joint="pivot" value="{angle}"/>"#),
+    ));
+    let (s, r) = solve(&m);
+    assert_eq!(r.dof, 0);
+    assert_abs_diff_eq!(joint(&m, &s, "pivot")[0], angle, epsilon = 1e-12);
+    let (_, re) = r.reactions.iter().find(|(n, _)| n == "pivot").unwrap();
+    // Gravity torque about +z of the weight (0, −19.62) at (cos a, sin a): −19.62 cos a; the
+    // joint holds it with the opposite torque.
+    assert_abs_diff_eq!(re.torque_world[2], 19.62 * angle.cos(), epsilon = 1e-9);
+    assert_abs_diff_eq!(re.force_world[1], 19.62, epsilon = 1e-9);
+}
+
+/// Same mechanism in metres and in millimetres (lengths and gravity × 1000, masses and
+/// stiffnesses in consistent units unchanged): same angle, same partition, same iterations,
+/// energy × 10⁶.
+#[test]
+fn metres_and_millimetres_agree() {
+    let spring = |s: f64| {
+        format!(
+            r#"<mech:spring name="k" stiffness="30" free_length="{}"><end link="bar" xyz="{} 0 0"/><end link="world" xyz="{} {} 0"/></mech:spring>
+               <mech:initial joint="pivot" value="-0.3"/>"#,
+            0.5 * s,
+            2.0 * s,
+            -s,
+            -2.0 * s
+        )
+    };
+    let m1 = model_from(&bar(1.0, &spring(1.0)));
+    let m2 = model_from(&bar(1000.0, &spring(1000.0)));
+    let (s1, r1) = solve(&m1);
+    let (s2, r2) = restpose::solve(
+        &m2,
+        &Options {
+            gradient_tolerance: 1e-2,
+            constraint_tolerance: 1e-7,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert!(r2.converged());
+    assert_abs_diff_eq!(
+        joint(&m1, &s1, "pivot")[0],
+        joint(&m2, &s2, "pivot")[0],
+        epsilon = 1e-8
+    );
+    assert_eq!(r1.independent_coordinates, r2.independent_coordinates);
+    assert_eq!(r1.iterations, r2.iterations);
+    assert_abs_diff_eq!(r2.energy.total / 1e6, r1.energy.total, epsilon = 1e-8);
+}
+
+/// A prismatic joint along gravity with nothing holding it: reported, not iterated forever.
+#[test]
+fn unbounded_energy_is_detected() {
+    let text = r#"<robot name="drop" xmlns:mech="urn:urdf-mech:1"><link name="world"/>
+      <link name="box"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+      <joint name="slide" type="prismatic"><parent link="world"/><child link="box"/><axis xyz="0 0 1"/></joint></robot>"#;
+    let m = model_from(text);
+    let (_, r) = restpose::solve(&m, &Options::default()).unwrap();
+    assert_eq!(r.termination, restpose::Termination::Unbounded);
+}
+
+/// The spring's energy at the slider-crank's equilibrium, by hand from the link poses, is
+/// part of the reported total, and the breakdown sums to it.
+#[test]
+fn energy_breakdown_sums_and_spring_energy_by_hand() {
+    let m = robot("slider_crank");
+    let (s, r) = solve(&m);
+    let e = r.energy;
+    assert_abs_diff_eq!(
+        e.gravity + e.springs + e.joint_springs + e.loads,
+        e.total,
+        epsilon = 1e-12
+    );
+    let slider = s.link_pose(&m, "slider").unwrap().translation.vector;
+    let l = (nalgebra::Vector3::new(0.6, 0.0, 0.0) - slider).norm();
+    assert_abs_diff_eq!(e.springs, 0.5 * 500.0 * (l - 0.15).powi(2), epsilon = 1e-12);
+    let crank = joint(&m, &s, "crank_joint")[0];
+    assert_abs_diff_eq!(e.joint_springs, 0.5 * 2.0 * crank * crank, epsilon = 1e-12);
+    // Load −20 N along x on the slider: minus its work.
+    assert_abs_diff_eq!(e.loads, 20.0 * slider.x, epsilon = 1e-12);
+}
+
+#[test]
+fn cli_lock_overrides_and_unknown_joint_is_an_error() {
+    let text = bar(1.0, "");
+    let opts = ImportOptions {
+        locks: vec![("nope".into(), 0, Some(0.0))],
+        ..Default::default()
+    };
+    let err = load_str(&text, "t.urdf", &opts).unwrap_err().to_string();
+    assert!(err.contains("nope"), "{err}");
+}

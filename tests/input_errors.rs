@@ -1,0 +1,80 @@
+//! Bad input gets an error naming the file, line, column and element; never a panic.
+use restpose::urdf::{load_str, ImportOptions};
+
+fn err(text: &str) -> String {
+    match load_str(text, "bad.urdf", &ImportOptions::default()) {
+        Ok(_) => panic!("accepted bad input:\n{text}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+const HEAD: &str = "<robot name=\"r\" xmlns:mech=\"urn:urdf-mech:1\">\n<link name=\"world\"/>\n<link name=\"a\"/>\n";
+
+fn with(body: &str) -> String {
+    format!("{HEAD}{body}\n</robot>")
+}
+
+const J: &str = r#"<joint name="j" type="revolute"><parent link="world"/><child link="a"/><axis xyz="0 0 1"/></joint>"#;
+
+#[test]
+fn each_error_names_file_line_and_element() {
+    let cases: Vec<(String, &str, &str)> = vec![
+        (with(r#"<joint name="j" type="revolute"><parent link="world"/><child link="nope"/></joint>"#), "bad.urdf:4:", "unknown child link `nope`"),
+        (with(&format!("{J}\n<link name=\"a\"/>")), "bad.urdf:5:", "duplicate link name `a`"),
+        (with("<link name=\"b\"/>"), "bad.urdf:3:", "second root link `a`"),
+        (with(r#"<joint name="j" type="revolute"><parent link="world"/><child link="a"/><axis xyz="0 0 0"/></joint>"#), "bad.urdf:4:", "joint `j` has a zero-length axis"),
+        (with(&format!("{J}\n<link name=\"b\"><inertial><mass value=\"-1\"/></inertial></link>")), "bad.urdf:5:", "negative mass"),
+        (with(r#"<joint name="j" type="revolute"><parent link="world"/><child link="a"/><origin xyz="0 zero 0"/></joint>"#), "bad.urdf:4:", "<origin> of joint `j`: attribute `xyz` = \"0 zero 0\" must be 3 finite numbers"),
+        (with(&format!("{J}\n<mech:spinner/>")), "bad.urdf:5:", "unknown element <mech:spinner>"),
+        (with(&format!("{J}\n<mech:joint_spring joint=\"elbow\" stiffness=\"1\"/>")), "bad.urdf:5:", "unknown joint `elbow`"),
+        (with(&format!("{J}\n<mech:force name=\"f\" link=\"a\" torque=\"0 0 1\"/>")), "bad.urdf:5:", "torque"),
+        (with(&format!("{J}\n<mech:force name=\"f\" link=\"a\" force=\"1 0 0\" frame=\"link\"/>")), "bad.urdf:5:", "follower"),
+        (with(&format!("{J}\n<xacro:macro name=\"m\"/>")), "bad.urdf:5:", "xacro"),
+        (with("<joint name=\"j\" type=\"hinge\"><parent link=\"world\"/><child link=\"a\"/></joint>"), "bad.urdf:4:", "unknown type \"hinge\""),
+        (format!("{HEAD}<joint name=\"j\""), "bad.urdf:", "not well-formed XML"),
+        (with(&format!("{J}\n<mech:spring name=\"s\" stiffness=\"1\" free_length=\"1\"><end link=\"a\"/></mech:spring>")), "bad.urdf:5:", "exactly two <end>"),
+        (
+            with(&format!("{J}\n<link name=\"b\"/><link name=\"c\"/>\n<joint name=\"k\" type=\"revolute\"><parent link=\"a\"/><child link=\"b\"/><mimic joint=\"m\"/></joint>\n<joint name=\"m\" type=\"revolute\"><parent link=\"a\"/><child link=\"c\"/><mimic joint=\"k\"/></joint>")),
+            "bad.urdf:",
+            "mimic cycle",
+        ),
+    ];
+    for (text, at, what) in cases {
+        let e = err(&text);
+        assert!(e.starts_with(at), "expected position {at} in: {e}");
+        assert!(e.contains(what), "expected `{what}` in: {e}");
+    }
+}
+
+#[test]
+fn loop_that_cannot_close_is_reported() {
+    let text = r#"<robot name="r" xmlns:mech="urn:urdf-mech:1"><link name="world"/>
+      <link name="a"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+      <joint name="j" type="revolute"><parent link="world"/><child link="a"/><axis xyz="0 0 1"/></joint>
+      <mech:loop_joint name="far" type="spherical"><parent link="a"/><origin xyz="1 0 0"/><child link="world"/><child_origin xyz="5 0 0"/></mech:loop_joint>
+    </robot>"#;
+    let m = load_str(text, "t.urdf", &ImportOptions::default())
+        .unwrap()
+        .model;
+    let e = restpose::solve(&m, &Default::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("cannot assemble") && e.contains("far."), "{e}");
+}
+
+#[test]
+fn undeclared_prefix_is_repaired_with_a_warning() {
+    let text = format!("<robot name=\"r\">\n<link name=\"world\"/><link name=\"a\"/>{J}<mech:gravity xyz=\"0 0 -1\"/></robot>");
+    let l = load_str(&text, "t.urdf", &ImportOptions::default()).unwrap();
+    assert!(l.warnings.iter().any(|w| w.contains("mech")));
+    assert_eq!(l.model.gravity.z, -1.0);
+}
+
+#[test]
+fn foreign_elements_are_ignored_and_listed() {
+    let text = with(&format!(
+        "{J}\n<transmission name=\"t\"/><gazebo/><sensor name=\"s\"/>"
+    ));
+    let l = load_str(&text, "t.urdf", &ImportOptions::default()).unwrap();
+    assert_eq!(l.ignored.len(), 1, "{:?}", l.ignored);
+}

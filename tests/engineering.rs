@@ -149,3 +149,54 @@ fn cli_lock_overrides_and_unknown_joint_is_an_error() {
     let err = load_str(&text, "t.urdf", &opts).unwrap_err().to_string();
     assert!(err.contains("nope"), "{err}");
 }
+
+/// Links welded by fixed joints share one body but keep their own reported poses; a floating
+/// base held by springs finds its rest pose.
+#[test]
+fn merged_fixed_links_report_their_poses_and_floating_base_solves() {
+    let text = r#"<robot name="flange" xmlns:mech="urn:urdf-mech:1">
+      <link name="base"/>
+      <link name="arm"><inertial><origin xyz="0.5 0 0"/><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+      <link name="tool"><inertial><mass value="0.5"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+      <link name="tip"/>
+      <joint name="shoulder" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 1 0"/></joint>
+      <joint name="flange" type="fixed"><parent link="arm"/><child link="tool"/><origin xyz="1 0 0" rpy="0 0 1.5707963267948966"/></joint>
+      <joint name="tcp" type="fixed"><parent link="tool"/><child link="tip"/><origin xyz="0.1 0 0"/></joint>
+      <mech:joint_spring joint="shoulder" stiffness="50"/>
+    </robot>"#;
+    let m = model_from(text);
+    assert_eq!(m.bodies.len(), 1, "arm, tool and tip are one body");
+    let (s, r) = solve(&m);
+    assert_eq!(r.dof, 1);
+    let th = joint(&m, &s, "shoulder")[0];
+    // Balance: 50 θ = g (1·0.5 cos θ + 0.5·1 cos θ) about +y (weight along −z).
+    assert_abs_diff_eq!(50.0 * th, 9.81 * (0.5 + 0.5) * th.cos(), epsilon = 1e-9);
+    let tip = s.link_pose(&m, "tip").unwrap();
+    // tip = Ry(θ) · (1, 0.1, 0) (the flange turns the tool by 90° about z).
+    assert_abs_diff_eq!(tip.translation.x, th.cos(), epsilon = 1e-12);
+    assert_abs_diff_eq!(tip.translation.y, 0.1, epsilon = 1e-12);
+    assert_abs_diff_eq!(tip.translation.z, -th.sin(), epsilon = 1e-12);
+    assert_verified_minimum(&m, &s);
+
+    let hung = r#"<robot name="hung" xmlns:mech="urn:urdf-mech:1">
+      <link name="box"><inertial><mass value="2"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+      <mech:spring name="a" stiffness="400" free_length="1"><end link="box" xyz="0.1 0 0"/><end link="world" xyz="0.1 0 2"/></mech:spring>
+      <mech:spring name="b" stiffness="400" free_length="1"><end link="box" xyz="-0.05 0.08660254037844387 0"/><end link="world" xyz="-0.05 0.08660254037844387 2"/></mech:spring>
+      <mech:spring name="c" stiffness="400" free_length="1"><end link="box" xyz="-0.05 -0.08660254037844387 0"/><end link="world" xyz="-0.05 -0.08660254037844387 2"/></mech:spring>
+    </robot>"#;
+    let opts = restpose::urdf::ImportOptions {
+        floating_base: true,
+        ..Default::default()
+    };
+    let m = restpose::urdf::load_str(hung, "h.urdf", &opts)
+        .unwrap()
+        .model;
+    assert_eq!(m.bodies.len(), 1);
+    let (s, r) = solve(&m);
+    assert_eq!(r.dof, 6);
+    // Three parallel springs of 400 N/m, 120° apart around the centre of mass, carry 2 kg
+    // equally: stretch 2·9.81/1200 below z = 1.
+    let z = s.link_pose(&m, "box").unwrap().translation.z;
+    assert_abs_diff_eq!(z, 1.0 - 2.0 * 9.81 / 1200.0, epsilon = 1e-9);
+    assert_verified_minimum(&m, &s);
+}

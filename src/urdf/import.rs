@@ -35,7 +35,8 @@ pub(super) struct Builder {
 }
 
 impl Builder {
-    /// Body and `body_from_link` of a link named in `node`'s attribute `attr`.
+    /// Body and `body_from_link` of a link named in `node`'s attribute `attr`; `world` names
+    /// the fixed world frame even when the file declares no such link.
     pub(super) fn link_ref(
         &self,
         src: &Source,
@@ -43,6 +44,9 @@ impl Builder {
         attr: &str,
     ) -> Result<(Option<BodyId>, Isometry3<f64>)> {
         let name = src.req(node, attr)?;
+        if name == "world" && !self.link_index.contains_key(name) {
+            return Ok((None, Isometry3::identity()));
+        }
         let i = self.link_index.get(name).ok_or_else(|| {
             src.error(
                 node,

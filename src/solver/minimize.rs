@@ -159,10 +159,23 @@ pub(crate) fn minimize(
             binv = DMatrix::identity(dof, dof);
             first_update = true;
         }
-        let dmax = d.amax();
-        let capped = dmax > options.max_step;
+        // Step limit on the motion of the whole mechanism, not on v alone: every body's Euler
+        // parameters change by at most `max_step` (about 2·max_step rad of rotation) and its
+        // origin by at most 10·max_step characteristic lengths.
+        let dq = sys.tangent_step(&part, &eval, &d);
+        let l = sys.model.length_scale;
+        let (mut rot, mut pos) = (0.0f64, 0.0f64);
+        for (i, x) in dq.iter().enumerate() {
+            if i % 7 < 3 {
+                pos = pos.max(x.abs() / l);
+            } else {
+                rot = rot.max(x.abs());
+            }
+        }
+        let factor = (options.max_step / rot.max(1e-300)).min(10.0 * options.max_step / pos.max(1e-300));
+        let capped = factor < 1.0;
         if capped {
-            d *= options.max_step / dmax;
+            d *= factor;
         }
         let slope = g.dot(&d);
         // Backtracking line search.

@@ -28,8 +28,9 @@ pub struct Options {
     pub max_iterations: usize,
     /// Maximum Newton iterations of the corrector per trial point (default: 25).
     pub max_corrector_iterations: usize,
-    /// Largest change of a scaled independent coordinate per iteration (default: 0.3; about
-    /// 35° for an Euler parameter, 0.3 L for a position).
+    /// Step limit per iteration (default: 0.3): the largest change of any body's Euler
+    /// parameters (0.3 is about 35° of rotation); body origins move at most ten times this in
+    /// characteristic lengths.
     pub max_step: f64,
     /// Stop at a stationary point even if it is unstable (default: false: leave saddles and
     /// maxima along the direction of negative curvature).

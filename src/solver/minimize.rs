@@ -172,7 +172,8 @@ pub(crate) fn minimize(
                 rot = rot.max(x.abs());
             }
         }
-        let factor = (options.max_step / rot.max(1e-300)).min(10.0 * options.max_step / pos.max(1e-300));
+        let factor =
+            (options.max_step / rot.max(1e-300)).min(10.0 * options.max_step / pos.max(1e-300));
         let capped = factor < 1.0;
         if capped {
             d *= factor;

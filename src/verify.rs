@@ -44,8 +44,7 @@ pub fn balance(model: &Model, state: &State) -> Result<Balance> {
     let mut jac = crate::constraints::Triplets::default();
     cons.evaluate(model, &state.q, &mut phi, Some(&mut jac));
     let n = state.q.len();
-    let l = model.length_scale;
-    let scale: Vec<f64> = (0..n).map(|i| if i % 7 < 3 { l } else { 1.0 }).collect();
+    let scale = crate::solver::system::coordinate_scale(model);
     let mut j = jac.to_dense();
     for c in 0..n {
         j.column_mut(c).scale_mut(scale[c]);

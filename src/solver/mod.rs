@@ -20,7 +20,7 @@ mod options;
 pub(crate) mod partition;
 mod reactions;
 mod report;
-mod system;
+pub(crate) mod system;
 
 pub use options::{Method, Options};
 pub use report::{Diagnostics, Iterate, Reaction, Report, Stability, Termination};

@@ -37,15 +37,22 @@ pub(crate) struct Eval {
     pub(crate) phi_v: DMatrix<f64>,
 }
 
+/// Column scale per coordinate: the characteristic length for positions, 1 for Euler
+/// parameters.
+pub(crate) fn coordinate_scale(model: &Model) -> Vec<f64> {
+    let l = model.length_scale;
+    (0..model.coordinate_count())
+        .map(|i| if i % 7 < 3 { l } else { 1.0 })
+        .collect()
+}
+
 /// Why the corrector gave up.
 #[derive(Debug)]
 pub(crate) struct CorrectorFailure;
 
 impl<'a> System<'a> {
     pub(crate) fn new(model: &'a Model, cons: Constraints) -> Self {
-        let n = model.coordinate_count();
-        let l = model.length_scale;
-        let scale = (0..n).map(|i| if i % 7 < 3 { l } else { 1.0 }).collect();
+        let scale = coordinate_scale(model);
         System {
             model,
             phi: DVector::zeros(cons.len()),

@@ -54,6 +54,12 @@ pub(crate) struct Block {
     pub(crate) first: usize,
 }
 
+/// One contribution to a row: `c f` for a local jet `f` of a body pair, or a normalization row.
+enum Term<'a> {
+    Jet(&'a [Option<BodyId>; 2], &'a Scalar, f64),
+    Normalization(BodyId),
+}
+
 /// The full set of constraint rows of a model, with locks resolved to values.
 #[derive(Clone, Debug)]
 pub(crate) struct Constraints {
@@ -108,15 +114,13 @@ impl Constraints {
         &self.names[i]
     }
 
-    /// Evaluates each block's rows as local jets and hands them to `visit(row, bodies, jet,
-    /// coefficient)`; normalization rows are handled by the callers directly.
+    /// Evaluates each block's rows and hands them to `visit(row, term)`.
     fn for_each_row(
         &self,
         model: &Model,
         q: &DVector<f64>,
         hess: bool,
-        mut visit: impl FnMut(usize, &[Option<BodyId>; 2], &Scalar, f64),
-        mut normalization: impl FnMut(usize, BodyId),
+        mut visit: impl FnMut(usize, Term),
     ) {
         let mut buf = Vec::with_capacity(6);
         for block in &self.blocks {
@@ -126,10 +130,10 @@ impl Constraints {
                     let pair = pair_of(&j.bodies, q, hess);
                     joint::rows(j, &pair, &mut buf);
                     for (k, s) in buf.iter().enumerate() {
-                        visit(block.first + k, &j.bodies, s, 1.0);
+                        visit(block.first + k, Term::Jet(&j.bodies, s, 1.0));
                     }
                 }
-                BlockKind::Normalization(b) => normalization(block.first, *b),
+                BlockKind::Normalization(b) => visit(block.first, Term::Normalization(*b)),
                 BlockKind::Lock {
                     joint: id,
                     dof,
@@ -138,7 +142,7 @@ impl Constraints {
                     let j = &model.joints[id.0];
                     let pair = pair_of(&j.bodies, q, hess);
                     if let Some(s) = joint::coordinate(j, &pair, *dof) {
-                        visit(block.first, &j.bodies, &s.minus(*value), 1.0);
+                        visit(block.first, Term::Jet(&j.bodies, &s.minus(*value), 1.0));
                     }
                 }
                 BlockKind::Mimic(i) => {
@@ -150,8 +154,8 @@ impl Constraints {
                     if let (Some(a), Some(b)) =
                         (joint::coordinate(ja, &pa, 0), joint::coordinate(jb, &pb, 0))
                     {
-                        visit(block.first, &ja.bodies, &a.minus(m.offset), 1.0);
-                        visit(block.first, &jb.bodies, &b, -m.multiplier);
+                        visit(block.first, Term::Jet(&ja.bodies, &a.minus(m.offset), 1.0));
+                        visit(block.first, Term::Jet(&jb.bodies, &b, -m.multiplier));
                     }
                 }
             }
@@ -172,15 +176,10 @@ impl Constraints {
             t.cols = q.len();
             t.entries.clear();
         }
-        let jac_cell = std::cell::RefCell::new(jac);
-        let phi_cell = std::cell::RefCell::new(phi);
-        self.for_each_row(
-            model,
-            q,
-            false,
-            |row, bodies, s, c| {
-                phi_cell.borrow_mut()[row] += c * s.v;
-                if let Some(t) = jac_cell.borrow_mut().as_deref_mut() {
+        self.for_each_row(model, q, false, |row, term| match term {
+            Term::Jet(bodies, s, c) => {
+                phi[row] += c * s.v;
+                if let Some(t) = jac.as_deref_mut() {
                     for i in 0..crate::jet::NL {
                         if let Some(gi) = crate::jet::global_index(bodies, i) {
                             if s.g[i] != 0.0 {
@@ -189,18 +188,18 @@ impl Constraints {
                         }
                     }
                 }
-            },
-            |row, b| {
+            }
+            Term::Normalization(b) => {
                 let i = 7 * b.0 + 3;
                 let p = q.rows(i, 4);
-                phi_cell.borrow_mut()[row] = p.dot(&p) - 1.0;
-                if let Some(t) = jac_cell.borrow_mut().as_deref_mut() {
+                phi[row] = p.dot(&p) - 1.0;
+                if let Some(t) = jac.as_deref_mut() {
                     for k in 0..4 {
                         t.entries.push((row, i + k, 2.0 * q[i + k]));
                     }
                 }
-            },
-        );
+            }
+        });
     }
 
     /// Adds `Σ_k w_k ∇²Φ_k(q)` to `h`.
@@ -212,23 +211,18 @@ impl Constraints {
         h: &mut DMatrix<f64>,
     ) {
         let mut g = DVector::zeros(q.len());
-        let h_cell = std::cell::RefCell::new(h);
-        self.for_each_row(
-            model,
-            q,
-            true,
-            |row, bodies, s, c| {
+        self.for_each_row(model, q, true, |row, term| match term {
+            Term::Jet(bodies, s, c) => {
                 if w[row] != 0.0 {
-                    scatter(bodies, s, c * w[row], &mut g, Some(*h_cell.borrow_mut()));
+                    scatter(bodies, s, c * w[row], &mut g, Some(&mut *h));
                 }
-            },
-            |row, b| {
+            }
+            Term::Normalization(b) => {
                 let i = 7 * b.0 + 3;
-                let mut h = h_cell.borrow_mut();
                 for k in 0..4 {
                     h[(i + k, i + k)] += 2.0 * w[row];
                 }
-            },
-        );
+            }
+        });
     }
 }

@@ -20,7 +20,7 @@ fn newton(
     const MAX: usize = 100;
     for it in 0..MAX {
         let j = sys.jacobian(&q);
-        let phi = sys.residual(&q).clone();
+        let phi = sys.phi().clone();
         let res = phi.amax();
         if res <= tol {
             return Ok(q);

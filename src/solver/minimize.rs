@@ -25,6 +25,8 @@ use nalgebra::{DMatrix, DVector, SymmetricEigen};
 pub(crate) struct Outcome {
     pub(crate) q: DVector<f64>,
     pub(crate) part: Partition,
+    /// Reduced-Hessian eigenvalues at `q`, when the convergence test computed them.
+    pub(crate) eigenvalues: Option<DVector<f64>>,
     pub(crate) eval: Eval,
     pub(crate) termination: Termination,
     pub(crate) history: Vec<Iterate>,
@@ -86,6 +88,7 @@ pub(crate) fn minimize(
     let mut termination = Termination::MaxIterations;
     let mut iteration = 0;
     let mut linear_steps = 0;
+    let mut eigenvalues = None;
     loop {
         let f = eval.energy.total;
         let gnorm = eval.grad_v.amax();
@@ -97,15 +100,9 @@ pub(crate) fn minimize(
             });
         }
         let mut negative_curvature = None;
-        let hessian = if options.method == Method::Newton || gnorm <= options.gradient_tolerance {
-            Some(sys.reduced_hessian(&q, &part, &eval))
-        } else {
-            None
-        };
-        let eig = hessian
-            .as_ref()
-            .filter(|_| dof > 0)
-            .map(|h| SymmetricEigen::new(h.clone()));
+        let eig = (dof > 0
+            && (options.method == Method::Newton || gnorm <= options.gradient_tolerance))
+            .then(|| SymmetricEigen::new(sys.reduced_hessian(&q, &part, &eval)));
         if gnorm <= options.gradient_tolerance {
             match &eig {
                 Some(e) if !options.allow_unstable => {
@@ -121,11 +118,13 @@ pub(crate) fn minimize(
                     if lmin < -tol {
                         negative_curvature = Some(e.eigenvectors.column(imin).into_owned());
                     } else {
+                        eigenvalues = Some(e.eigenvalues.clone());
                         termination = Termination::Converged;
                         break;
                     }
                 }
                 _ => {
+                    eigenvalues = eig.as_ref().map(|e| e.eigenvalues.clone());
                     termination = Termination::Converged;
                     break;
                 }
@@ -162,7 +161,7 @@ pub(crate) fn minimize(
         // Step limit on the motion of the whole mechanism, not on v alone: every body's Euler
         // parameters change by at most `max_step` (about 2·max_step rad of rotation) and its
         // origin by at most 10·max_step characteristic lengths.
-        let dq = sys.tangent_step(&part, &eval, &d);
+        let mut dq = sys.tangent_step(&part, &eval, &d);
         let l = sys.model.length_scale;
         let (mut rot, mut pos) = (0.0f64, 0.0f64);
         for (i, x) in dq.iter().enumerate() {
@@ -177,13 +176,14 @@ pub(crate) fn minimize(
         let capped = factor < 1.0;
         if capped {
             d *= factor;
+            dq *= factor;
         }
         let slope = g.dot(&d);
         // Backtracking line search.
         let mut alpha = 1.0;
         let mut accepted = None;
         for _ in 0..40 {
-            let mut qt = &q + sys.tangent_step(&part, &eval, &(&d * alpha));
+            let mut qt = &q + &dq * alpha;
             if sys
                 .correct(
                     &mut qt,
@@ -283,6 +283,7 @@ pub(crate) fn minimize(
     Some(Outcome {
         q,
         part,
+        eigenvalues,
         eval,
         termination,
         history,

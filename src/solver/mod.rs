@@ -115,8 +115,9 @@ pub fn solve_from(model: &Model, start: State, options: &Options) -> Result<(Sta
     let state = State { q: out.q.clone() };
     let dof = out.part.independent.len();
     let stability = if dof > 0 {
-        let h = sys.reduced_hessian(&out.q, &out.part, &out.eval);
-        let eig = SymmetricEigen::new(h).eigenvalues;
+        let eig = out.eigenvalues.clone().unwrap_or_else(|| {
+            SymmetricEigen::new(sys.reduced_hessian(&out.q, &out.part, &out.eval)).eigenvalues
+        });
         let tol = minimize::eigen_tolerance(&eig);
         let mut vals: Vec<f64> = eig.iter().copied().collect();
         vals.sort_by(f64::total_cmp);

@@ -46,6 +46,17 @@ pub(crate) fn coordinate_scale(model: &Model) -> Vec<f64> {
         .collect()
 }
 
+/// Solves `Aᵀ x = b` with the factors `P A = L U` of `A`: `Uᵀ y = b`, `Lᵀ z = y`, `x = Pᵀ z`.
+fn solve_transpose(
+    lu: &LU<f64, nalgebra::Dyn, nalgebra::Dyn>,
+    b: DVector<f64>,
+) -> Option<DVector<f64>> {
+    let y = lu.u().tr_solve_upper_triangular(&b)?;
+    let mut z = lu.l().tr_solve_lower_triangular(&y)?;
+    lu.p().inv_permute_rows(&mut z);
+    Some(z)
+}
+
 /// Why the corrector gave up.
 #[derive(Debug)]
 pub(crate) struct CorrectorFailure;
@@ -65,6 +76,11 @@ impl<'a> System<'a> {
     /// `Φ(q)`.
     pub(crate) fn residual(&mut self, q: &DVector<f64>) -> &DVector<f64> {
         self.cons.evaluate(self.model, q, &mut self.phi, None);
+        &self.phi
+    }
+
+    /// `Φ` at the point of the last [`System::jacobian`] or [`System::residual`] call.
+    pub(crate) fn phi(&self) -> &DVector<f64> {
         &self.phi
     }
 
@@ -141,12 +157,12 @@ impl<'a> System<'a> {
         let phi_u = DMatrix::from_fn(r, r, |a, b| j[(part.rows[a], part.dependent[b])]);
         let phi_v = DMatrix::from_fn(r, dof, |a, b| j[(part.rows[a], part.independent[b])]);
         let v_u = DVector::from_fn(r, |a, _| grad_q[part.dependent[a]]);
+        let lu = phi_u.lu();
         let mu = if r > 0 {
-            phi_u.transpose().lu().solve(&v_u)?
+            solve_transpose(&lu, v_u)?
         } else {
             DVector::zeros(0)
         };
-        let lu = phi_u.lu();
         let mut grad_v =
             DVector::from_fn(dof, |b, _| grad_q[part.independent[b]]) - phi_v.transpose() * &mu;
         for (b, &c) in part.independent.iter().enumerate() {
@@ -249,6 +265,15 @@ mod tests {
     use super::*;
     use crate::urdf::{load_str, ImportOptions};
 
+    /// Analytic value against a central difference, relative to `1 + |value|`.
+    fn assert_fd(analytic: f64, fd: f64, tol: f64, what: impl Fn() -> String) {
+        assert!(
+            (fd - analytic).abs() < tol * (1.0 + analytic.abs().min(fd.abs())),
+            "{}",
+            what()
+        );
+    }
+
     fn models() -> Vec<Model> {
         [
             include_str!("../../robots/pendulum.urdf"),
@@ -297,20 +322,14 @@ mod tests {
                 let vp = potential(&model, &qp, &mut gp, None).unwrap().total;
                 let vm = potential(&model, &qm, &mut gm, None).unwrap().total;
                 let fd = (vp - vm) / (2.0 * step);
-                assert!(
-                    (fd - g[i]).abs() < 1e-6 * (1.0 + g[i].abs()),
-                    "{}: V_q[{i}] {} vs {fd}",
-                    model.name,
-                    g[i]
-                );
+                assert_fd(g[i], fd, 1e-6, || {
+                    format!("{}: V_q[{i}] {} vs {fd}", model.name, g[i])
+                });
                 for j in 0..n {
                     let fdh = (gp[j] - gm[j]) / (2.0 * step);
-                    assert!(
-                        (fdh - h[(j, i)]).abs() < 1e-5 * (1.0 + h[(j, i)].abs()),
-                        "{}: V_qq[{j},{i}] {} vs {fdh}",
-                        model.name,
-                        h[(j, i)]
-                    );
+                    assert_fd(h[(j, i)], fdh, 1e-5, || {
+                        format!("{}: V_qq[{j},{i}] {} vs {fdh}", model.name, h[(j, i)])
+                    });
                 }
             }
         }
@@ -340,25 +359,23 @@ mod tests {
                 let phm = sys.phi.clone();
                 for r in 0..m {
                     let fd = (php[r] - phm[r]) / (2.0 * step);
-                    assert!(
-                        (fd - j[(r, i)]).abs() < 1e-6 * (1.0 + fd.abs()),
-                        "{}: Φ_q[{},{i}] ({}) {} vs {fd}",
-                        model.name,
-                        r,
-                        sys.cons.row_name(r),
-                        j[(r, i)]
-                    );
+                    assert_fd(j[(r, i)], fd, 1e-6, || {
+                        format!(
+                            "{}: Φ_q[{},{i}] ({}) {} vs {fd}",
+                            model.name,
+                            r,
+                            sys.cons.row_name(r),
+                            j[(r, i)]
+                        )
+                    });
                 }
                 let gp = jp.transpose() * &w;
                 let gm = jm.transpose() * &w;
                 for k in 0..n {
                     let fd = (gp[k] - gm[k]) / (2.0 * step);
-                    assert!(
-                        (fd - h[(k, i)]).abs() < 1e-5 * (1.0 + fd.abs()),
-                        "{}: (wᵀΦ)_qq[{k},{i}] {} vs {fd}",
-                        model.name,
-                        h[(k, i)]
-                    );
+                    assert_fd(h[(k, i)], fd, 1e-5, || {
+                        format!("{}: (wᵀΦ)_qq[{k},{i}] {} vs {fd}", model.name, h[(k, i)])
+                    });
                 }
             }
         }
@@ -387,20 +404,18 @@ mod tests {
                 let ep = at(1.0, &mut sys);
                 let em = at(-1.0, &mut sys);
                 let fd = (ep.energy.total - em.energy.total) / (2.0 * step);
-                assert!(
-                    (fd - e.grad_v[b]).abs() < 1e-6 * (1.0 + fd.abs()),
-                    "{}: ∂f/∂v[{b}] {} vs {fd}",
-                    model.name,
-                    e.grad_v[b]
-                );
+                assert_fd(e.grad_v[b], fd, 1e-6, || {
+                    format!("{}: ∂f/∂v[{b}] {} vs {fd}", model.name, e.grad_v[b])
+                });
                 for a in 0..part.independent.len() {
                     let fdh = (ep.grad_v[a] - em.grad_v[a]) / (2.0 * step);
-                    assert!(
-                        (fdh - hr[(a, b)]).abs() < 1e-5 * (1.0 + fdh.abs()),
-                        "{}: reduced Hessian [{a},{b}] {} vs {fdh}",
-                        model.name,
-                        hr[(a, b)]
-                    );
+                    assert_fd(hr[(a, b)], fdh, 1e-5, || {
+                        format!(
+                            "{}: reduced Hessian [{a},{b}] {} vs {fdh}",
+                            model.name,
+                            hr[(a, b)]
+                        )
+                    });
                 }
             }
         }

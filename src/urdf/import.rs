@@ -351,9 +351,7 @@ pub(super) fn import(text: &str, file: &str, options: &ImportOptions) -> Result<
     let mut group_root: Vec<usize> = vec![root];
     group[root] = Some(0);
     let mut stack = vec![root];
-    let mut order = Vec::new();
     while let Some(l) = stack.pop() {
-        order.push(l);
         for &ji in &children[l] {
             let j = &joints_in[ji];
             let c = link_index[&j.child];
@@ -417,7 +415,6 @@ pub(super) fn import(text: &str, file: &str, options: &ImportOptions) -> Result<
             body_from_link: body_from_link[i],
         });
     }
-    let _ = order;
 
     // Joints.
     for j in &joints_in {

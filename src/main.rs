@@ -12,6 +12,8 @@ use std::process::ExitCode;
 const EXIT_NOT_CONVERGED: u8 = 3;
 /// Exit code for invalid input.
 const EXIT_INPUT: u8 = 1;
+/// Exit code when `verify` finds the pose is not a rest pose.
+const EXIT_NOT_BALANCED: u8 = 4;
 
 #[derive(Parser)]
 #[command(
@@ -28,6 +30,8 @@ struct Cli {
 enum Command {
     /// Solve for the stable rest pose and print a summary.
     Analyze(AnalyzeArgs),
+    /// Check whether a given pose is a rest pose, without moving it.
+    Verify(VerifyArgs),
     /// Write a generated benchmark mechanism (URDF) to standard output.
     Generate {
         /// Family.
@@ -37,6 +41,34 @@ enum Command {
         #[arg(long, default_value_t = 20)]
         size: usize,
     },
+}
+
+#[derive(clap::Args)]
+struct VerifyArgs {
+    /// URDF file.
+    file: PathBuf,
+    /// Pose: restpose result JSON, a {"joint": value} JSON map, or ROS joint_states-style
+    /// YAML/JSON (`name` and `position` lists).
+    #[arg(long, value_name = "POSE")]
+    pose: Option<PathBuf>,
+    /// Joint value (repeatable; overrides the pose file): JOINT=VALUE or JOINT[DOF]=VALUE.
+    #[arg(long, value_name = "JOINT=VALUE")]
+    joint: Vec<String>,
+    /// Largest effort a joint may need for the pose to pass [N m or N].
+    #[arg(long, default_value_t = 1e-6)]
+    force_tolerance: f64,
+    /// Largest constraint violation for the pose to pass [m or rad].
+    #[arg(long, default_value_t = 1e-8)]
+    constraint_tolerance: f64,
+    /// Write the verification as JSON to this file (`-` for standard output).
+    #[arg(long, value_name = "OUT.json")]
+    json: Option<PathBuf>,
+    /// Gravity [m/s²] when the file has no <mech:gravity>.
+    #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_hyphen_values = true)]
+    gravity: Option<Vec<f64>>,
+    /// Print only errors and the verdict.
+    #[arg(long, short)]
+    quiet: bool,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -184,6 +216,114 @@ fn analyze(a: &AnalyzeArgs) -> anyhow::Result<u8> {
     Ok(0)
 }
 
+fn verify(a: &VerifyArgs) -> anyhow::Result<u8> {
+    let mut opts = ImportOptions::default();
+    if let Some(g) = &a.gravity {
+        opts.gravity = nalgebra::Vector3::new(g[0], g[1], g[2]);
+    }
+    let loaded = load_file(&a.file, &opts)?;
+    let model = &loaded.model;
+    let mut values = match &a.pose {
+        Some(p) => restpose::verify::read_pose(p)?,
+        None => Default::default(),
+    };
+    for j in &a.joint {
+        let (name, dof, value) = coord(j, "joint")?;
+        let id = model
+            .joint_id(&name)
+            .with_context(|| format!("--joint {j}: the model has no joint `{name}`"))?;
+        let n = model.joint(id).kind.scalar_coordinates().max(dof + 1);
+        let v = values.entry(name).or_insert_with(|| vec![0.0; n]);
+        if v.len() <= dof {
+            v.resize(dof + 1, 0.0);
+        }
+        v[dof] = value;
+    }
+    if values.is_empty() {
+        bail!("give the pose with --pose FILE or --joint NAME=VALUE");
+    }
+    let (state, missing) = restpose::verify::pose_state(model, &values)?;
+    if !a.quiet && !missing.is_empty() {
+        eprintln!(
+            "warning: joints not in the pose keep their initial values: {}",
+            missing.join(", ")
+        );
+    }
+    let tol = restpose::verify::Tolerances {
+        force: a.force_tolerance,
+        constraint: a.constraint_tolerance,
+    };
+    let v = restpose::verify::verify(model, &state, &tol)?;
+    if let Some(path) = &a.json {
+        let text = serde_json::to_string_pretty(&v)?;
+        if path.as_os_str() == "-" {
+            println!("{text}");
+        } else {
+            restpose::export::write_atomic(path, text.as_bytes())?;
+        }
+    }
+    let stdout_json = a.json.as_ref().is_some_and(|p| p.as_os_str() == "-");
+    if !a.quiet && !stdout_json {
+        println!(
+            "robot `{}`: pose {}",
+            model.name,
+            if v.passed { "PASSES" } else { "FAILS" }
+        );
+        println!(
+            "  constraint residual {:.3e} (tolerance {:.1e}), potential energy {:.9} J",
+            v.constraint_residual, tol.constraint, v.potential_energy
+        );
+        for c in &v.closure {
+            println!(
+                "  {} `{}`: position error {:.3e} m, rotation error {:.3e} rad",
+                if c.loop_joint { "loop joint" } else { "joint" },
+                c.joint,
+                c.position_error,
+                c.rotation_error
+            );
+        }
+        println!("  joint                          dof   effort to hold [N m or N]");
+        for i in &v.imbalance {
+            let flag = if i.effort.abs() > tol.force {
+                "  <- out of balance"
+            } else {
+                ""
+            };
+            println!("  {:<30} {:>3}   {:>14.6e}{flag}", i.joint, i.dof, i.effort);
+        }
+        if v.unassigned > tol.force {
+            println!(
+                "  unassigned generalized force {:.3e} (spherical or floating joints)",
+                v.unassigned
+            );
+        }
+        if let Some(s) = &v.stability {
+            println!("  stability: {}", s.verdict);
+        }
+    }
+    if v.passed {
+        Ok(0)
+    } else {
+        if let Some(m) = &v.max_imbalance {
+            eprintln!(
+                "{}: not a rest pose: largest imbalance {:.3e} at joint `{}` (dof {}), constraint residual {:.3e}",
+                a.file.display(),
+                m.effort,
+                m.joint,
+                m.dof,
+                v.constraint_residual
+            );
+        } else {
+            eprintln!(
+                "{}: not a rest pose: constraint residual {:.3e}",
+                a.file.display(),
+                v.constraint_residual
+            );
+        }
+        Ok(EXIT_NOT_BALANCED)
+    }
+}
+
 fn print_summary(r: &AnalysisResult) {
     println!("robot `{}`", r.robot);
     println!(
@@ -249,6 +389,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let out = match &cli.command {
         Command::Analyze(a) => analyze(a),
+        Command::Verify(a) => verify(a),
         Command::Generate { family, size } => {
             let text = match family {
                 Family::Chain => restpose::generate::chain(*size, false),

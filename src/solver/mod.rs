@@ -77,6 +77,41 @@ pub(crate) fn assemble_only(
     assemble::project(model, q, locks, &Options::default())
 }
 
+/// The stability verdict from the reduced-Hessian eigenvalues (at least one).
+fn stability(eig: &nalgebra::DVector<f64>) -> Stability {
+    let tol = minimize::eigen_tolerance(eig);
+    let mut vals: Vec<f64> = eig.iter().copied().collect();
+    vals.sort_by(f64::total_cmp);
+    let verdict = if vals[0] < -tol {
+        "unstable"
+    } else if vals[0] <= tol {
+        "neutral"
+    } else {
+        "stable"
+    };
+    vals.truncate(6);
+    Stability {
+        verdict: verdict.into(),
+        tolerance: tol,
+        eigenvalues: vals,
+    }
+}
+
+/// Stability verdict at a state that is feasible and balanced (`None` with no degree of
+/// freedom or where the energy is undefined).
+pub(crate) fn stability_at(model: &Model, q: &nalgebra::DVector<f64>) -> Option<Stability> {
+    let sys_cons = Constraints::new(model, &lock_values(model));
+    let mut sys = System::new(model, sys_cons);
+    let part = sys.partition(q);
+    if part.independent.is_empty() {
+        return None;
+    }
+    let eval = sys.evaluate(q, &part)?;
+    Some(stability(
+        &SymmetricEigen::new(sys.reduced_hessian(q, &part, &eval)).eigenvalues,
+    ))
+}
+
 /// Finds the stable static equilibrium of `model` from its initial guess.
 ///
 /// # Errors
@@ -114,29 +149,11 @@ pub fn solve_from(model: &Model, start: State, options: &Options) -> Result<(Sta
     })?;
     let state = State { q: out.q.clone() };
     let dof = out.part.independent.len();
-    let stability = if dof > 0 {
-        let eig = out.eigenvalues.clone().unwrap_or_else(|| {
+    let stability = (dof > 0).then(|| {
+        stability(&out.eigenvalues.clone().unwrap_or_else(|| {
             SymmetricEigen::new(sys.reduced_hessian(&out.q, &out.part, &out.eval)).eigenvalues
-        });
-        let tol = minimize::eigen_tolerance(&eig);
-        let mut vals: Vec<f64> = eig.iter().copied().collect();
-        vals.sort_by(f64::total_cmp);
-        let verdict = if vals[0] < -tol {
-            "unstable"
-        } else if vals[0] <= tol {
-            "neutral"
-        } else {
-            "stable"
-        };
-        vals.truncate(6);
-        Some(Stability {
-            verdict: verdict.into(),
-            tolerance: tol,
-            eigenvalues: vals,
-        })
-    } else {
-        None
-    };
+        }))
+    });
     let reactions = reactions::reactions(&sys, &out.q, &out.part, &out.eval);
     let report = Report {
         termination: out.termination,

@@ -1,0 +1,60 @@
+//! How a user's project checks rest poses in its own test suite.
+//!
+//! `cargo run --example rest_pose_test` prints the check for the slider-crank;
+//! `cargo test --example rest_pose_test` runs the tests below, as a user's crate would.
+
+use restpose::verify::{pose_state, verify, Tolerances};
+
+fn main() -> Result<(), restpose::Error> {
+    let model = restpose::urdf::load_file("robots/slider_crank.urdf", &Default::default())?.model;
+    let (rest, report) = restpose::solve(&model, &Default::default())?;
+    println!(
+        "converged: {}, V = {:.9} J",
+        report.converged(),
+        report.energy.total
+    );
+    let check = verify(&model, &rest, &Tolerances::default())?;
+    println!(
+        "rest pose verified: {} (stability {:?})",
+        check.passed,
+        check.stability.map(|s| s.verdict)
+    );
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The solver's answer is a rest pose, and it is stable.
+    #[test]
+    fn slider_crank_rests_where_restpose_says() {
+        let model = restpose::urdf::load_file("robots/slider_crank.urdf", &Default::default())
+            .unwrap()
+            .model;
+        let (rest, report) = restpose::solve(&model, &Default::default()).unwrap();
+        assert!(report.converged());
+        let check = verify(&model, &rest, &Tolerances::default()).unwrap();
+        assert!(check.passed, "{check:?}");
+        assert_eq!(check.stability.unwrap().verdict, "stable");
+    }
+
+    /// A "home" keyframe that is not a rest pose fails, and names the joint out of balance.
+    #[test]
+    fn pendulum_home_keyframe_is_not_at_rest() {
+        let model = restpose::urdf::load_file("robots/pendulum.urdf", &Default::default())
+            .unwrap()
+            .model;
+        let home = [("pivot".to_string(), vec![0.0])].into_iter().collect();
+        let (state, _) = pose_state(&model, &home).unwrap();
+        let check = verify(&model, &state, &Tolerances::default()).unwrap();
+        assert!(!check.passed);
+        let worst = check.max_imbalance.unwrap();
+        assert_eq!(worst.joint, "pivot");
+        assert!(
+            worst.effort.abs() > 1.0,
+            "holding the bar level takes newton-metres: {}",
+            worst.effort
+        );
+    }
+}

@@ -1,0 +1,304 @@
+//! Is a given pose a rest pose? Independent checks of a configuration.
+//!
+//! Nothing here uses the solver's partition. With `S` the coordinate scaling of the solver
+//! (positions by the characteristic length) and `N` an orthonormal basis of the null space of
+//! `Φ_q S` (feasible motions), a pose is balanced when the projected gradient `Nᵀ S ∇V`
+//! vanishes.
+//!
+//! The per-joint imbalance is the effort `τ` each joint coordinate would need to hold the pose
+//! (Adams' "imbalance"): with `B` the gradients `∇θ_k` of the tree joints' scalar coordinates,
+//! `τ` is the minimum-norm solution of `Nᵀ S B τ = Nᵀ S ∇V`, i.e. the actuator efforts that,
+//! together with the joint reactions, balance the loads. For a tree it is `∂V/∂θ_k` exactly;
+//! with loops the split among the joints of a loop is the minimum-norm one. What no scalar
+//! joint coordinate can carry (a spherical or floating joint) is reported as `unassigned`.
+
+mod pose;
+
+pub use pose::{parse_pose, pose_state, read_pose};
+
+use crate::constraints::{joint, BlockKind, Constraints};
+use crate::error::{Error, Result};
+use crate::forces::potential;
+use crate::jet::{pair_of, scatter};
+use crate::model::Model;
+use crate::solver::Stability;
+use crate::state::State;
+use nalgebra::{DMatrix, DVector};
+
+/// Residuals of a configuration.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Balance {
+    /// `‖Φ‖∞` over all constraint rows (locks included).
+    pub constraint_residual: f64,
+    /// `‖Nᵀ S ∇V‖∞` \[J\]: the gradient of the energy along feasible motions, in coordinates
+    /// scaled like the solver's (positions by the characteristic length).
+    pub projected_gradient: f64,
+    /// Potential energy \[J\].
+    pub potential_energy: f64,
+    /// Degrees of freedom from the rank of `Φ_q` (singular values below 1e-6 of the largest
+    /// count as zero).
+    pub dof: usize,
+}
+
+/// Tolerances of [`verify`].
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Tolerances {
+    /// Largest joint effort (or unassigned generalized force) a balanced pose may need
+    /// \[N m or N\] (default: 1e-6).
+    pub force: f64,
+    /// Largest constraint violation \[m or rad\] (default: 1e-8).
+    pub constraint: f64,
+}
+
+impl Default for Tolerances {
+    fn default() -> Self {
+        Tolerances {
+            force: 1e-6,
+            constraint: 1e-8,
+        }
+    }
+}
+
+/// Closure error of one joint.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Closure {
+    /// Joint name.
+    pub joint: String,
+    /// Whether it closes a loop.
+    pub loop_joint: bool,
+    /// Largest violation of its position rows \[m\].
+    pub position_error: f64,
+    /// Largest violation of its orientation rows (sine of the angle error) \[rad\].
+    pub rotation_error: f64,
+}
+
+/// Effort a joint coordinate needs to hold the pose.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Imbalance {
+    /// Joint name.
+    pub joint: String,
+    /// Coordinate index.
+    pub dof: usize,
+    /// Effort on the child along the coordinate \[N m or N\].
+    pub effort: f64,
+}
+
+/// Result of [`verify`].
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Verification {
+    /// Constraint residual and tolerance met, and no joint needs more than the force tolerance.
+    pub passed: bool,
+    /// `‖Φ‖∞`.
+    pub constraint_residual: f64,
+    /// Per joint with constraint rows: loop joints always, tree joints when violated.
+    pub closure: Vec<Closure>,
+    /// Per tree-joint scalar coordinate.
+    pub imbalance: Vec<Imbalance>,
+    /// The largest `|effort|`, if any coordinate.
+    pub max_imbalance: Option<Imbalance>,
+    /// Generalized force no scalar joint coordinate carries (spherical, floating joints) \[J\].
+    pub unassigned: f64,
+    /// `‖Nᵀ S ∇V‖∞` \[J\].
+    pub projected_gradient: f64,
+    /// Potential energy \[J\].
+    pub potential_energy: f64,
+    /// Stability at the pose, when it passed and has degrees of freedom.
+    pub stability: Option<Stability>,
+    /// Tolerances used.
+    pub tolerances: Tolerances,
+}
+
+/// Everything the checks share: `Φ`, the scaled gradient and the null-space basis.
+struct Projection {
+    phi: DVector<f64>,
+    grad_s: DVector<f64>,
+    scale: Vec<f64>,
+    null: DMatrix<f64>,
+    energy: f64,
+    cons: Constraints,
+}
+
+fn project(model: &Model, state: &State) -> Result<Projection> {
+    let cons = Constraints::new(model, &crate::solver::lock_values(model));
+    let mut phi = DVector::zeros(cons.len());
+    let mut jac = crate::constraints::Triplets::default();
+    cons.evaluate(model, &state.q, &mut phi, Some(&mut jac));
+    let n = state.q.len();
+    let scale = crate::solver::system::coordinate_scale(model);
+    let mut j = jac.to_dense();
+    for c in 0..n {
+        j.column_mut(c).scale_mut(scale[c]);
+    }
+    let mut g = DVector::zeros(n);
+    let e = potential(model, &state.q, &mut g, None)
+        .ok_or_else(|| Error::Undefined("a force table is out of range".into()))?;
+    for c in 0..n {
+        g[c] *= scale[c];
+    }
+    // Null space: eigenvectors of JᵀJ whose eigenvalues are below 1e-12 of the largest.
+    let eig = nalgebra::SymmetricEigen::new(j.transpose() * &j);
+    let smax = eig.eigenvalues.amax().max(1e-300);
+    let cols: Vec<usize> = (0..n)
+        .filter(|&k| eig.eigenvalues[k] <= 1e-12 * smax)
+        .collect();
+    let null = DMatrix::from_fn(n, cols.len(), |r, c| eig.eigenvectors[(r, cols[c])]);
+    Ok(Projection {
+        phi,
+        grad_s: g,
+        scale,
+        null,
+        energy: e.total,
+        cons,
+    })
+}
+
+/// Potential energy of a state \[J\], `None` where a force table is out of its range.
+pub fn potential_energy(model: &Model, state: &State) -> Option<f64> {
+    let mut g = DVector::zeros(state.q.len());
+    potential(model, &state.q, &mut g, None).map(|e| e.total)
+}
+
+/// Constraint residual and projected energy gradient of `state` (with the model's locks held
+/// at their given values, or at the initial value when they have none).
+///
+/// # Errors
+/// [`Error::Undefined`] if the energy cannot be evaluated.
+pub fn balance(model: &Model, state: &State) -> Result<Balance> {
+    let p = project(model, state)?;
+    let pg = p.null.transpose() * &p.grad_s;
+    Ok(Balance {
+        constraint_residual: p.phi.amax(),
+        projected_gradient: pg.amax(),
+        potential_energy: p.energy,
+        dof: p.null.ncols(),
+    })
+}
+
+/// Verifies that `state` is a rest pose: it assembles, and no joint needs an effort to hold it.
+///
+/// # Errors
+/// [`Error::Undefined`] if the energy cannot be evaluated.
+///
+/// # Example
+/// ```
+/// let model = restpose::urdf::load_file("robots/pendulum.urdf", &Default::default())?.model;
+/// let (rest, _) = restpose::solve(&model, &Default::default())?;
+/// let v = restpose::verify::verify(&model, &rest, &Default::default())?;
+/// assert!(v.passed);
+/// let pose = [("pivot".to_string(), vec![-1.3])].into_iter().collect();
+/// let (moved, _) = restpose::verify::pose_state(&model, &pose)?;
+/// let v = restpose::verify::verify(&model, &moved, &Default::default())?;
+/// assert!(!v.passed);
+/// assert_eq!(v.max_imbalance.unwrap().joint, "pivot");
+/// # Ok::<(), restpose::Error>(())
+/// ```
+pub fn verify(model: &Model, state: &State, tol: &Tolerances) -> Result<Verification> {
+    let p = project(model, state)?;
+    let n = state.q.len();
+    // Closure per joint, rows classified by name.
+    let mut closure = Vec::new();
+    for block in &p.cons.blocks {
+        let BlockKind::Joint(id) = block.kind else {
+            continue;
+        };
+        let j = model.joint(id);
+        let (mut pos, mut rot) = (0.0f64, 0.0f64);
+        for (k, name) in joint::row_names(j).iter().enumerate() {
+            let r = p.phi[block.first + k].abs();
+            if name.starts_with("pos")
+                || name.starts_with("slide")
+                || name.starts_with("line")
+                || *name == "plane"
+                || *name == "thread"
+            {
+                pos = pos.max(r);
+            } else if *name == "length" {
+                if let crate::model::JointKind::Distance { length } = j.kind {
+                    pos = pos.max(r / (2.0 * length.max(1e-12)));
+                }
+            } else {
+                rot = rot.max(r);
+            }
+        }
+        if !j.tree || pos.max(rot) > tol.constraint {
+            closure.push(Closure {
+                joint: j.name.clone(),
+                loop_joint: !j.tree,
+                position_error: pos,
+                rotation_error: rot,
+            });
+        }
+    }
+    // Scalar coordinates of the tree joints and their (scaled) gradients.
+    let mut coords = Vec::new();
+    let mut b_cols = Vec::new();
+    for j in model.joints.iter().filter(|j| j.tree && !j.merged) {
+        let pair = pair_of(&j.bodies, &state.q, false);
+        for dof in 0..j.kind.scalar_coordinates() {
+            if let Some(s) = joint::coordinate(j, &pair, dof) {
+                let mut g = DVector::zeros(n);
+                scatter(&j.bodies, &s, 1.0, &mut g, None);
+                for c in 0..n {
+                    g[c] *= p.scale[c];
+                }
+                coords.push((j.name.clone(), dof));
+                b_cols.push(g);
+            }
+        }
+    }
+    let rhs = p.null.transpose() * &p.grad_s;
+    let (efforts, unassigned) = if b_cols.is_empty() || p.null.ncols() == 0 {
+        (DVector::zeros(b_cols.len()), rhs.amax())
+    } else {
+        let b = DMatrix::from_columns(&b_cols);
+        let m = p.null.transpose() * b;
+        let svd = m.clone().svd(true, true);
+        let eps = 1e-10 * svd.singular_values.max();
+        let tau = svd
+            .solve(&rhs, eps)
+            .unwrap_or_else(|_| DVector::zeros(b_cols.len()));
+        let rest = (&rhs - m * &tau).amax();
+        (tau, rest)
+    };
+    let imbalance: Vec<Imbalance> = coords
+        .into_iter()
+        .zip(efforts.iter())
+        .map(|((joint, dof), &effort)| Imbalance { joint, dof, effort })
+        .collect();
+    let max_imbalance = imbalance
+        .iter()
+        .max_by(|a, b| a.effort.abs().total_cmp(&b.effort.abs()))
+        .cloned();
+    let constraint_residual = p.phi.amax();
+    let passed = constraint_residual <= tol.constraint
+        && imbalance.iter().all(|i| i.effort.abs() <= tol.force)
+        && unassigned <= tol.force;
+    let stability = if passed {
+        crate::solver::stability_at(model, &state.q)
+    } else {
+        None
+    };
+    Ok(Verification {
+        passed,
+        constraint_residual,
+        closure,
+        imbalance,
+        max_imbalance,
+        unassigned,
+        projected_gradient: rhs.amax(),
+        potential_energy: p.energy,
+        stability,
+        tolerances: *tol,
+    })
+}
+
+/// Brings `state` onto `Φ = 0` by a damped Newton iteration that changes the dependent
+/// coordinates of a fresh partition at each step (as the solver's assembly does).
+///
+/// # Errors
+/// [`Error::Assembly`] if the constraints cannot be satisfied from there.
+pub fn assemble(model: &Model, state: &State) -> Result<State> {
+    let locks = crate::solver::lock_values(model);
+    let q = crate::solver::assemble_only(model, state.q.clone(), &locks)?;
+    Ok(State { q })
+}

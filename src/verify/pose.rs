@@ -1,0 +1,136 @@
+//! Poses given as joint values: restpose's result JSON, a `{"joint": value}` map (JSON), or a
+//! ROS `joint_states`-style document (`name` and `position` lists, JSON or YAML).
+//!
+//! A pose is turned into a state by forward kinematics along the spanning tree
+//! ([`State::from_joint_values`]); loop joints are not moved, so their closure error is part
+//! of what verification reports.
+
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::state::{JointValues, State};
+use std::path::Path;
+
+/// Reads a pose file (format detected from its content).
+///
+/// # Errors
+/// [`Error::Io`] if unreadable, [`Error::Option`] naming the file if it is none of the formats.
+pub fn read_pose(path: impl AsRef<Path>) -> Result<JointValues> {
+    let path = path.as_ref();
+    let text = std::fs::read_to_string(path).map_err(|cause| Error::Io {
+        path: path.display().to_string(),
+        cause,
+    })?;
+    parse_pose(&text, &path.display().to_string())
+}
+
+fn numbers(v: &serde_json::Value) -> Option<Vec<f64>> {
+    match v {
+        serde_json::Value::Number(n) => n.as_f64().map(|x| vec![x]),
+        serde_json::Value::Array(a) => a.iter().map(|x| x.as_f64()).collect(),
+        _ => None,
+    }
+}
+
+/// Parses pose text; `file` names it in errors.
+///
+/// # Errors
+/// [`Error::Option`] if the text is not one of the accepted formats.
+pub fn parse_pose(text: &str, file: &str) -> Result<JointValues> {
+    let bad = |why: String| Error::Option(format!("{file}: {why}"));
+    let value: serde_json::Value = match serde_json::from_str(text) {
+        Ok(v) => v,
+        Err(_) => serde_yaml_ng::from_str(text)
+            .map_err(|e| bad(format!("neither JSON nor YAML ({e})")))?,
+    };
+    let obj = value
+        .as_object()
+        .ok_or_else(|| bad("expected an object / mapping at the top".into()))?;
+    let mut out = JointValues::new();
+    if let (Some(names), Some(pos)) = (obj.get("name"), obj.get("position")) {
+        let names = names
+            .as_array()
+            .ok_or_else(|| bad("`name` must be a list".into()))?;
+        let pos = numbers(pos).ok_or_else(|| bad("`position` must be a list of numbers".into()))?;
+        if names.len() != pos.len() {
+            return Err(bad(format!(
+                "{} names but {} positions",
+                names.len(),
+                pos.len()
+            )));
+        }
+        for (n, p) in names.iter().zip(pos) {
+            let n = n
+                .as_str()
+                .ok_or_else(|| bad("joint names must be strings".into()))?;
+            out.insert(n.to_string(), vec![p]);
+        }
+    } else if let Some(joints) = obj.get("joints").and_then(|j| j.as_object()) {
+        for (name, j) in joints {
+            let p = j
+                .get("position")
+                .and_then(numbers)
+                .ok_or_else(|| bad(format!("joints.{name}.position must be a list of numbers")))?;
+            out.insert(name.clone(), p);
+        }
+    } else {
+        for (name, v) in obj {
+            let p = numbers(v)
+                .ok_or_else(|| bad(format!("`{name}`: expected a number or a list of numbers")))?;
+            out.insert(name.clone(), p);
+        }
+    }
+    if out.values().flatten().any(|x| !x.is_finite()) {
+        return Err(bad("non-finite joint value".into()));
+    }
+    Ok(out)
+}
+
+/// The state of a pose: forward kinematics with the given values; joints not given keep their
+/// initial-guess values. Returns the state and the names of the movable tree joints that were
+/// not given.
+///
+/// # Errors
+/// [`Error::Option`] for a joint the model does not have or a value list of the wrong length.
+pub fn pose_state(model: &Model, values: &JointValues) -> Result<(State, Vec<String>)> {
+    let mut all = JointValues::new();
+    for i in &model.initial {
+        let j = &model.joints[i.joint.0];
+        let v = all
+            .entry(j.name.clone())
+            .or_insert_with(|| vec![0.0; j.kind.scalar_coordinates()]);
+        if i.dof < v.len() {
+            v[i.dof] = i.value;
+        }
+    }
+    for (name, v) in values {
+        let id = model
+            .joint_id(name)
+            .ok_or_else(|| Error::Option(format!("pose: the model has no joint `{name}`")))?;
+        let j = model.joint(id);
+        let expected: &[usize] = match j.kind {
+            crate::model::JointKind::Spherical => &[3, 4],
+            crate::model::JointKind::Floating => &[6, 7],
+            k => &[k.scalar_coordinates()],
+        };
+        if !expected.contains(&v.len()) {
+            return Err(Error::Option(format!(
+                "pose: joint `{name}` ({}) takes {expected:?} value(s), got {}",
+                j.kind.name(),
+                v.len()
+            )));
+        }
+        all.insert(name.clone(), v.clone());
+    }
+    let missing = model
+        .joints
+        .iter()
+        .filter(|j| {
+            j.tree
+                && !j.merged
+                && j.kind != crate::model::JointKind::Fixed
+                && !values.contains_key(&j.name)
+        })
+        .map(|j| j.name.clone())
+        .collect();
+    Ok((State::from_joint_values(model, &all), missing))
+}

@@ -1,0 +1,162 @@
+//! `restpose verify` and the verification API.
+mod common;
+use approx::assert_abs_diff_eq;
+use common::*;
+use restpose::verify::{parse_pose, pose_state, verify, Tolerances};
+use std::process::Command;
+
+/// Holding the pendulum bar level takes the gravity and spring torques, by hand.
+#[test]
+fn pendulum_level_effort_by_hand() {
+    let m = robot("pendulum");
+    let pose = parse_pose(r#"{"pivot": 0.0}"#, "pose.json").unwrap();
+    let (s, missing) = pose_state(&m, &pose).unwrap();
+    assert!(missing.is_empty());
+    let v = verify(&m, &s, &Tolerances::default()).unwrap();
+    assert!(!v.passed);
+    // Weight 19.62 N at x = 1; spring from (2, 0) to (−1, −2), free length 2, k = 3.
+    let l = (9.0f64 + 4.0).sqrt();
+    let tension = 3.0 * (l - 2.0);
+    let spring_torque = 2.0 * tension * (-2.0 / l);
+    let load_torque = -19.62 + spring_torque;
+    let e = v.max_imbalance.unwrap();
+    assert_eq!(e.joint, "pivot");
+    assert_abs_diff_eq!(e.effort, -load_torque, epsilon = 1e-9);
+}
+
+/// The solver's answers pass; every format of the same pose gives the same verdict.
+#[test]
+fn solver_answers_pass_in_every_pose_format() {
+    for name in ["pendulum", "slider_crank", "four_bar_spatial", "chain20"] {
+        let m = robot(name);
+        let (rest, _) = solve(&m);
+        let result = restpose::export::json::AnalysisResult::new(&m, &rest, &solve(&m).1);
+        let json = result.to_json();
+        let values = parse_pose(&json, "result.json").unwrap();
+        let (s, _) = pose_state(&m, &values).unwrap();
+        let v = verify(&m, &s, &Tolerances::default()).unwrap();
+        assert!(v.passed, "{name}: {v:?}");
+        assert_eq!(v.stability.unwrap().verdict, "stable", "{name}");
+        // A {"joint": [values]} map.
+        let map: serde_json::Map<String, serde_json::Value> = result
+            .joints
+            .iter()
+            .map(|(n, j)| (n.clone(), serde_json::json!(j.position)))
+            .collect();
+        let values = parse_pose(&serde_json::Value::Object(map).to_string(), "map.json").unwrap();
+        let (s1, _) = pose_state(&m, &values).unwrap();
+        assert!(
+            verify(&m, &s1, &Tolerances::default()).unwrap().passed,
+            "{name}: map format"
+        );
+        // joint_states YAML carries one position per joint: only for scalar-joint models.
+        if result.joints.values().any(|j| j.position.len() > 1) {
+            continue;
+        }
+        let mut names = Vec::new();
+        let mut pos = Vec::new();
+        for (jn, jr) in &result.joints {
+            if jr.position.len() == 1 {
+                names.push(jn.clone());
+                pos.push(format!("{:?}", jr.position[0]));
+            }
+        }
+        let yaml = format!(
+            "name: [{}]\nposition: [{}]\n",
+            names.join(", "),
+            pos.join(", ")
+        );
+        let values = parse_pose(&yaml, "js.yaml").unwrap();
+        let (s2, _) = pose_state(&m, &values).unwrap();
+        let v2 = verify(&m, &s2, &Tolerances::default()).unwrap();
+        assert!(v2.passed, "{name}: joint_states format");
+    }
+}
+
+/// Perturbing one joint of the chain's rest pose fails, naming that joint.
+#[test]
+fn perturbed_chain_fails_at_the_perturbed_joint() {
+    let m = robot("chain20");
+    let (rest, _) = solve(&m);
+    for k in [0usize, 7, 19] {
+        let mut values: restpose::state::JointValues = rest.joint_values(&m).into_iter().collect();
+        values.get_mut(&format!("joint{k}")).unwrap()[0] += 0.01;
+        let (s, _) = pose_state(&m, &values).unwrap();
+        let v = verify(&m, &s, &Tolerances::default()).unwrap();
+        assert!(!v.passed);
+        assert_eq!(v.max_imbalance.unwrap().joint, format!("joint{k}"));
+    }
+}
+
+#[test]
+fn loop_closure_error_is_reported_per_loop_joint() {
+    let m = robot("slider_crank");
+    let (rest, _) = solve(&m);
+    let mut values: restpose::state::JointValues = rest.joint_values(&m).into_iter().collect();
+    values.get_mut("slide").unwrap()[0] += 0.002;
+    let (s, _) = pose_state(&m, &values).unwrap();
+    let v = verify(&m, &s, &Tolerances::default()).unwrap();
+    assert!(!v.passed);
+    let c = v.closure.iter().find(|c| c.joint == "wrist_pin").unwrap();
+    assert!(c.loop_joint);
+    assert_abs_diff_eq!(c.position_error, 0.002, epsilon = 1e-12);
+}
+
+#[test]
+fn bad_pose_files_are_errors() {
+    let m = robot("pendulum");
+    assert!(parse_pose("[1, 2]", "p.json").is_err());
+    assert!(parse_pose("name: [a]\nposition: [1, 2]\n", "p.yaml")
+        .unwrap_err()
+        .to_string()
+        .contains("1 names but 2 positions"));
+    let v = parse_pose(r#"{"elbow": 1.0}"#, "p.json").unwrap();
+    assert!(pose_state(&m, &v)
+        .unwrap_err()
+        .to_string()
+        .contains("no joint `elbow`"));
+}
+
+fn restpose() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_restpose"))
+}
+
+#[test]
+fn cli_verify_exit_codes_and_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let urdf = format!("{}/robots/slider_crank.urdf", env!("CARGO_MANIFEST_DIR"));
+    let result = dir.path().join("r.json");
+    assert!(restpose()
+        .args(["analyze", &urdf, "-q", "--json"])
+        .arg(&result)
+        .status()
+        .unwrap()
+        .success());
+    let o = restpose()
+        .args(["verify", &urdf, "--pose"])
+        .arg(&result)
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(String::from_utf8_lossy(&o.stdout).contains("PASSES"));
+    let o = restpose()
+        .args(["verify", &urdf, "--pose"])
+        .arg(&result)
+        .args(["--joint", "crank_joint=0.3", "--json", "-"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(4));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["passed"], false);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("not a rest pose"));
+    let o = restpose()
+        .args(["verify", &urdf, "--joint", "nope=1"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+}

@@ -3,7 +3,7 @@
 //! `cargo run --example rest_pose_test` prints the check for the slider-crank;
 //! `cargo test --example rest_pose_test` runs the tests below, as a user's crate would.
 
-use restpose::verify::{pose_state, verify, Tolerances};
+use restpose::verify::{verify, Tolerances};
 
 fn main() -> Result<(), restpose::Error> {
     let model = restpose::urdf::load_file("robots/slider_crank.urdf", &Default::default())?.model;
@@ -25,6 +25,7 @@ fn main() -> Result<(), restpose::Error> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use restpose::verify::pose_state;
 
     /// The solver's answer is a rest pose, and it is stable.
     #[test]

@@ -34,11 +34,12 @@ pub enum Error {
     /// The loop joints could not be closed from the initial guess.
     #[error(
         "cannot assemble the mechanism from the initial guess: constraint `{row}` is violated \
-         by {residual:.3e} and {iterations} damped Newton iterations could not close it (check \
-         the loop geometry or give `mech:initial` values near an assembled pose)"
+         by {residual:.3e} there and {iterations} damped Newton iterations could not close the \
+         constraints (check the loop geometry or give `mech:initial` values near an assembled \
+         pose)"
     )]
     Assembly {
-        /// Residual of that row \[m or 1\].
+        /// Residual of that row at the initial guess \[m or 1\].
         residual: f64,
         /// Name of the most violated constraint row.
         row: String,

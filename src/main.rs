@@ -8,6 +8,15 @@ use restpose::{Method, Options};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+/// Writes a line to standard output; a closed pipe (`restpose analyze … | head`) is not an
+/// error and must not panic.
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write;
+        let _ = writeln!(std::io::stdout().lock(), $($arg)*);
+    }};
+}
+
 /// Exit code when the solve did not converge.
 const EXIT_NOT_CONVERGED: u8 = 3;
 /// Exit code for invalid input.
@@ -257,24 +266,26 @@ fn verify(a: &VerifyArgs) -> anyhow::Result<u8> {
     if let Some(path) = &a.json {
         let text = serde_json::to_string_pretty(&v)?;
         if path.as_os_str() == "-" {
-            println!("{text}");
+            out!("{text}");
         } else {
             restpose::export::write_atomic(path, text.as_bytes())?;
         }
     }
     let stdout_json = a.json.as_ref().is_some_and(|p| p.as_os_str() == "-");
     if !a.quiet && !stdout_json {
-        println!(
+        out!(
             "robot `{}`: pose {}",
             model.name,
             if v.passed { "PASSES" } else { "FAILS" }
         );
-        println!(
+        out!(
             "  constraint residual {:.3e} (tolerance {:.1e}), potential energy {:.9} J",
-            v.constraint_residual, tol.constraint, v.potential_energy
+            v.constraint_residual,
+            tol.constraint,
+            v.potential_energy
         );
         for c in &v.closure {
-            println!(
+            out!(
                 "  {} `{}`: position error {:.3e} m, rotation error {:.3e} rad",
                 if c.loop_joint { "loop joint" } else { "joint" },
                 c.joint,
@@ -282,23 +293,23 @@ fn verify(a: &VerifyArgs) -> anyhow::Result<u8> {
                 c.rotation_error
             );
         }
-        println!("  joint                          dof   effort to hold [N m or N]");
+        out!("  joint                          dof   effort to hold [N m or N]");
         for i in &v.imbalance {
             let flag = if i.effort.abs() > tol.force {
                 "  <- out of balance"
             } else {
                 ""
             };
-            println!("  {:<30} {:>3}   {:>14.6e}{flag}", i.joint, i.dof, i.effort);
+            out!("  {:<30} {:>3}   {:>14.6e}{flag}", i.joint, i.dof, i.effort);
         }
         if v.unassigned > tol.force {
-            println!(
+            out!(
                 "  unassigned generalized force {:.3e} (spherical or floating joints)",
                 v.unassigned
             );
         }
         if let Some(s) = &v.stability {
-            println!("  stability: {}", s.verdict);
+            out!("  stability: {}", s.verdict);
         }
     }
     if v.passed {
@@ -325,8 +336,8 @@ fn verify(a: &VerifyArgs) -> anyhow::Result<u8> {
 }
 
 fn print_summary(r: &AnalysisResult) {
-    println!("robot `{}`", r.robot);
-    println!(
+    out!("robot `{}`", r.robot);
+    out!(
         "  bodies {}, coordinates {}, constraint rows {} ({} redundant), degrees of freedom {}",
         r.bodies,
         r.coordinates,
@@ -335,51 +346,61 @@ fn print_summary(r: &AnalysisResult) {
         r.dof
     );
     if !r.redundant_constraints.is_empty() {
-        println!(
+        out!(
             "  redundant constraints: {}",
             r.redundant_constraints.join(", ")
         );
     }
-    println!(
+    out!(
         "  independent coordinates: {}",
         r.independent_coordinates.join(", ")
     );
-    println!();
-    println!("  iteration   potential energy [J]   ‖∂V/∂v‖∞ [J]");
+    out!();
+    out!("  iteration   potential energy [J]   ‖∂V/∂v‖∞ [J]");
     for h in &r.history {
-        println!(
+        out!(
             "  {:>9}   {:>20.9}   {:>12.3e}",
-            h.iteration, h.potential_energy, h.gradient_norm
+            h.iteration,
+            h.potential_energy,
+            h.gradient_norm
         );
     }
-    println!();
-    println!(
+    out!();
+    out!(
         "  {}: {} iterations, V = {:.9} J",
-        r.termination, r.iterations, r.potential_energy
+        r.termination,
+        r.iterations,
+        r.potential_energy
     );
     if let Some(s) = &r.stability {
         let eig: Vec<String> = s.eigenvalues.iter().map(|e| format!("{e:.4e}")).collect();
-        println!(
+        out!(
             "  stability: {} (smallest reduced-Hessian eigenvalues {})",
             s.verdict,
             eig.join(", ")
         );
     }
-    println!();
-    println!("  joint                          type          position");
+    out!();
+    out!("  joint                          type          position");
     for (name, j) in &r.joints {
         let p: Vec<String> = j.position.iter().map(|v| format!("{v:.9}")).collect();
-        println!("  {:<30} {:<13} [{}]", name, j.kind, p.join(", "));
+        out!("  {:<30} {:<13} [{}]", name, j.kind, p.join(", "));
     }
     if !r.reactions.is_empty() {
-        println!();
-        println!("  reaction on child at joint origin (world)   force [N]                          torque [N m]");
+        out!();
+        out!("  reaction on child at joint origin (world)   force [N]                          torque [N m]");
         for (name, re) in &r.reactions {
             let f = re.force_world;
             let t = re.torque_world;
-            println!(
+            out!(
                 "  {:<30} [{:>10.4}, {:>10.4}, {:>10.4}]   [{:>10.4}, {:>10.4}, {:>10.4}]",
-                name, f[0], f[1], f[2], t[0], t[1], t[2]
+                name,
+                f[0],
+                f[1],
+                f[2],
+                t[0],
+                t[1],
+                t[2]
             );
         }
     }
@@ -395,7 +416,10 @@ fn main() -> ExitCode {
                 Family::Chain => restpose::generate::chain(*size, false),
                 Family::PlanarChain => restpose::generate::chain(*size, true),
             };
-            print!("{text}");
+            {
+                use std::io::Write;
+                let _ = std::io::stdout().lock().write_all(text.as_bytes());
+            }
             Ok(0)
         }
     };

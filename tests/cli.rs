@@ -167,3 +167,24 @@ fn same_input_same_json_bytes() {
     };
     assert_eq!(run("a.json"), run("b.json"));
 }
+
+/// `restpose analyze … | head -1`: a reader that closes the pipe early is not a crash.
+#[test]
+fn closed_stdout_is_not_a_panic() {
+    use std::io::{BufRead, BufReader};
+    use std::process::Stdio;
+    let mut child = restpose()
+        .args(["analyze", &robot("chain20")])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut first)
+        .unwrap();
+    assert!(first.starts_with("robot"));
+    let out = child.wait_with_output().unwrap();
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+    assert_eq!(out.status.code(), Some(0));
+}

@@ -91,7 +91,6 @@ fn metres_and_millimetres_agree() {
         &m2,
         &Options {
             gradient_tolerance: 1e-2,
-            constraint_tolerance: 1e-7,
             ..Default::default()
         },
     )

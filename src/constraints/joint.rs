@@ -110,6 +110,23 @@ pub(crate) fn row_names(joint: &Joint) -> &'static [&'static str] {
     }
 }
 
+/// Power of length in the unit of a joint row named `name` (`pos_x` is in m, `length` in m²,
+/// dot products of unit vectors are dimensionless).
+pub(crate) fn length_power(name: &str) -> i32 {
+    if name.starts_with("pos")
+        || name.starts_with("slide")
+        || name.starts_with("line")
+        || name == "plane"
+        || name == "thread"
+    {
+        1
+    } else if name == "length" {
+        2
+    } else {
+        0
+    }
+}
+
 /// Evaluates the constraint rows of a joint into `out` (cleared first).
 pub(crate) fn rows(joint: &Joint, pair: &Pair, out: &mut Vec<Scalar>) {
     out.clear();

@@ -66,6 +66,8 @@ pub(crate) struct Constraints {
     pub(crate) blocks: Vec<Block>,
     len: usize,
     names: Vec<String>,
+    /// Power of length in each row's unit (0, 1 or 2).
+    length_power: Vec<i32>,
 }
 
 impl Constraints {
@@ -73,6 +75,7 @@ impl Constraints {
     pub(crate) fn new(model: &Model, locks: &[(JointId, usize, f64)]) -> Self {
         let mut blocks = Vec::new();
         let mut names = Vec::new();
+        let mut length_power = Vec::new();
         let mut len = 0;
         let mut push = |kind: BlockKind, count: usize, blocks: &mut Vec<Block>| {
             blocks.push(Block { kind, first: len });
@@ -82,26 +85,48 @@ impl Constraints {
             let count = joint::row_count(j);
             if count > 0 {
                 push(BlockKind::Joint(JointId(i)), count, &mut blocks);
-                names.extend(
-                    joint::row_names(j)
-                        .iter()
-                        .map(|r| format!("{}.{}", j.name, r)),
-                );
+                for r in joint::row_names(j) {
+                    names.push(format!("{}.{}", j.name, r));
+                    length_power.push(joint::length_power(r));
+                }
             }
         }
         for (i, b) in model.bodies.iter().enumerate() {
             push(BlockKind::Normalization(BodyId(i)), 1, &mut blocks);
             names.push(format!("{}.normalization", b.name));
+            length_power.push(0);
         }
         for &(joint, dof, value) in locks {
             push(BlockKind::Lock { joint, dof, value }, 1, &mut blocks);
-            names.push(format!("{}.lock[{dof}]", model.joints[joint.0].name));
+            let j = &model.joints[joint.0];
+            names.push(format!("{}.lock[{dof}]", j.name));
+            length_power.push(if crate::forces::is_angle(j.kind, dof) {
+                0
+            } else {
+                1
+            });
         }
         for (i, m) in model.mimics.iter().enumerate() {
             push(BlockKind::Mimic(i), 1, &mut blocks);
-            names.push(format!("{}.mimic", model.joints[m.joint.0].name));
+            let j = &model.joints[m.joint.0];
+            names.push(format!("{}.mimic", j.name));
+            length_power.push(if crate::forces::is_angle(j.kind, 0) {
+                0
+            } else {
+                1
+            });
         }
-        Constraints { blocks, len, names }
+        Constraints {
+            blocks,
+            len,
+            names,
+            length_power,
+        }
+    }
+
+    /// Power of length in the unit of row `i`.
+    pub(crate) fn length_power(&self, i: usize) -> i32 {
+        self.length_power[i]
     }
 
     /// Number of rows `m`.

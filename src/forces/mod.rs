@@ -26,6 +26,9 @@ pub struct Energy {
     pub joint_springs: f64,
     /// Minus the work of dead loads and joint efforts \[J\].
     pub loads: f64,
+    /// `Σ |V_k|` over the individual terms: the scale of the rounding error of `total`.
+    #[serde(skip)]
+    pub(crate) magnitude: f64,
 }
 
 /// `wᵀ f` for a constant `w`.
@@ -65,8 +68,10 @@ pub(crate) fn potential(
 ) -> Option<Energy> {
     let want_h = hess.is_some();
     let mut e = Energy::default();
+    let mut magnitude = 0.0;
     let mut add = |bodies: &[Option<BodyId>; 2], s: &Scalar, c: f64, slot: &mut f64| {
         *slot += c * s.v;
+        magnitude += (c * s.v).abs();
         scatter(bodies, s, c, grad, hess.as_deref_mut());
     };
     for (i, b) in model.bodies.iter().enumerate() {
@@ -101,6 +106,7 @@ pub(crate) fn potential(
         let (u, f, k) = law::evaluate(&s.law, s.mode, l - s.free_length)?;
         if l < 1e-12 {
             e.springs += u;
+            e.magnitude += u.abs();
             continue;
         }
         let len = l2.compose(l, 0.5 / l, -0.25 / (l * l * l));
@@ -129,5 +135,6 @@ pub(crate) fn potential(
         add(&j.bodies, &theta, -ef.value, &mut e.loads);
     }
     e.total = e.gravity + e.springs + e.joint_springs + e.loads;
+    e.magnitude += magnitude;
     Some(e)
 }

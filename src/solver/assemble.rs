@@ -16,21 +16,21 @@ fn newton(
     sys: &mut System,
     mut q: DVector<f64>,
     tol: f64,
-) -> std::result::Result<DVector<f64>, (f64, usize, usize)> {
+) -> std::result::Result<DVector<f64>, usize> {
     const MAX: usize = 100;
     for it in 0..MAX {
         let j = sys.jacobian(&q);
         let phi = sys.phi().clone();
-        let res = phi.amax();
+        let res = sys.dimensionless_residual();
         if res <= tol {
             return Ok(q);
         }
-        let part = super::partition::partition(&j, &sys.scale);
+        let part = super::partition::partition(&j, &sys.row_scale, &sys.scale);
         let r = part.rows.len();
         let phi_u = nalgebra::DMatrix::from_fn(r, r, |a, b| j[(part.rows[a], part.dependent[b])]);
         let rhs = DVector::from_fn(r, |a, _| -phi[part.rows[a]]);
         let Some(du) = phi_u.lu().solve(&rhs) else {
-            return Err((res, phi.iamax(), it));
+            return Err(it);
         };
         let mut alpha = 1.0;
         let mut improved = false;
@@ -39,7 +39,8 @@ fn newton(
             for (k, &c) in part.dependent.iter().enumerate() {
                 qt[c] += alpha * du[k];
             }
-            if sys.residual(&qt).amax() < res {
+            sys.residual(&qt);
+            if sys.dimensionless_residual() < res {
                 q = qt;
                 improved = true;
                 break;
@@ -47,11 +48,10 @@ fn newton(
             alpha *= 0.5;
         }
         if !improved {
-            return Err((res, phi.iamax(), it));
+            return Err(it);
         }
     }
-    let phi = sys.residual(&q).clone();
-    Err((phi.amax(), phi.iamax(), MAX))
+    Err(MAX)
 }
 
 /// Assembles `q` (closes loops, applies locks and normalizes) or explains why it cannot.
@@ -72,7 +72,8 @@ pub(crate) fn assemble(
         let mut sys = System::new(model, Constraints::new(model, &held));
         if let Ok(qa) = newton(&mut sys, q.clone(), tol) {
             let mut fin = System::new(model, Constraints::new(model, locks));
-            if fin.residual(&qa).amax() <= tol.max(1e-8) {
+            fin.residual(&qa);
+            if fin.dimensionless_residual() <= tol.max(1e-8) {
                 return Ok(qa);
             }
         }
@@ -92,21 +93,20 @@ pub(crate) fn project(
     let q0 = q.clone();
     match newton(&mut sys, q, tol) {
         Ok(qa) => Ok(qa),
-        Err((residual, row, iterations)) => {
-            // Name the worst joint row rather than a normalization row, which only reflects
-            // how the Newton steps distorted the Euler parameters.
+        Err(iterations) => {
+            // Name the worst joint row at the initial guess rather than a normalization row,
+            // which only reflects how the Newton steps distorted the Euler parameters.
             let phi = sys.residual(&q0).clone();
             let worst = (0..phi.len())
                 .filter(|&r| !sys.cons.row_name(r).ends_with(".normalization"))
-                .max_by(|&a, &b| phi[a].abs().total_cmp(&phi[b].abs()))
-                .filter(|&r| phi[r].abs() > tol)
-                .unwrap_or(row);
+                .max_by(|&a, &b| {
+                    (phi[a] * sys.row_scale[a])
+                        .abs()
+                        .total_cmp(&(phi[b] * sys.row_scale[b]).abs())
+                })
+                .unwrap_or_else(|| phi.iamax());
             Err(Error::Assembly {
-                residual: if worst == row {
-                    residual
-                } else {
-                    phi[worst].abs()
-                },
+                residual: phi[worst].abs(),
                 row: sys.cons.row_name(worst).to_string(),
                 iterations,
             })

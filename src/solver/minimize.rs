@@ -4,7 +4,10 @@
 //! reduced Hessian replaced by their magnitudes, floored; BFGS / DFP: `−B ∇f` with the inverse
 //! update), caps `‖d‖∞` at `max_step`, and backtracks from `α = 1` until the Armijo condition
 //! `f(v̂ + α d) ≤ f + 10⁻⁴ α ∇fᵀ d` holds. A trial point starts from the first-order prediction
-//! `q + α Z d` and is brought back onto `Φ = 0` by the Newton corrector; if the corrector fails
+//! `q + α Z d` and is brought back onto `Φ = 0` by the Newton corrector; trial energies are
+//! compared through the Lagrangian `V − μᵀΦ`, which removes the first-order effect of the
+//! corrector's remaining residual (otherwise `μ·Φ` can exceed the decrease a Newton step
+//! promises near the minimum); if the corrector fails
 //! the step is halved (paper step (f)). When no step is found, the coordinates are
 //! re-partitioned once at the current point. At a stationary point with a negative reduced
 //! Hessian eigenvalue (a saddle or maximum) the search leaves along its eigenvector, unless
@@ -15,11 +18,12 @@
 //! - R. Fletcher, M. J. D. Powell, A rapidly convergent descent method for minimization,
 //!   *Computer Journal* 6 (1963) 163–168.
 
+use super::eigen::symmetric_eigen;
 use super::options::{Method, Options};
 use super::partition::Partition;
 use super::report::{Diagnostics, Iterate, Termination};
 use super::system::{Eval, System};
-use nalgebra::{DMatrix, DVector, SymmetricEigen};
+use nalgebra::{DMatrix, DVector};
 
 /// Outcome of the minimization.
 pub(crate) struct Outcome {
@@ -90,41 +94,40 @@ pub(crate) fn minimize(
     let mut linear_steps = 0;
     let mut eigenvalues = None;
     loop {
-        let f = eval.energy.total;
+        let f = eval.merit;
         let gnorm = eval.grad_v.amax();
         if history.last().map(|h: &Iterate| h.iteration) != Some(iteration) {
             history.push(Iterate {
                 iteration,
-                potential_energy: f,
+                potential_energy: eval.energy.total,
                 gradient_norm: gnorm,
             });
         }
         let mut negative_curvature = None;
         let eig = (dof > 0
             && (options.method == Method::Newton || gnorm <= options.gradient_tolerance))
-            .then(|| SymmetricEigen::new(sys.reduced_hessian(&q, &part, &eval)));
+            .then(|| symmetric_eigen(&sys.reduced_hessian(&q, &part, &eval)));
         if gnorm <= options.gradient_tolerance {
             match &eig {
                 Some(e) if !options.allow_unstable => {
-                    let tol = eigen_tolerance(&e.eigenvalues);
+                    let tol = eigen_tolerance(&e.0);
                     let (imin, lmin) =
-                        e.eigenvalues
-                            .iter()
+                        e.0.iter()
                             .enumerate()
                             .fold(
                                 (0, f64::INFINITY),
                                 |a, (i, &l)| if l < a.1 { (i, l) } else { a },
                             );
                     if lmin < -tol {
-                        negative_curvature = Some(e.eigenvectors.column(imin).into_owned());
+                        negative_curvature = Some(e.1.column(imin).into_owned());
                     } else {
-                        eigenvalues = Some(e.eigenvalues.clone());
+                        eigenvalues = Some(e.0.clone());
                         termination = Termination::Converged;
                         break;
                     }
                 }
                 _ => {
-                    eigenvalues = eig.as_ref().map(|e| e.eigenvalues.clone());
+                    eigenvalues = eig.as_ref().map(|e| e.0.clone());
                     termination = Termination::Converged;
                     break;
                 }
@@ -142,11 +145,11 @@ pub(crate) fn minimize(
         } else {
             match (&eig, options.method) {
                 (Some(e), Method::Newton) => {
-                    let floor = 1e-8 * e.eigenvalues.amax().max(1e-12);
+                    let floor = 1e-8 * e.0.amax().max(1e-12);
                     let mut d = DVector::zeros(dof);
                     for i in 0..dof {
-                        let v = e.eigenvectors.column(i);
-                        d -= v * (v.dot(g) / e.eigenvalues[i].abs().max(floor));
+                        let v = e.1.column(i);
+                        d -= v * (v.dot(g) / e.0[i].abs().max(floor));
                     }
                     d
                 }
@@ -204,10 +207,12 @@ pub(crate) fn minimize(
                 continue;
             };
             diag.function_evaluations += 1;
-            let ft = et.energy.total;
-            let roundoff = 1e-13 * (1.0 + f.abs());
+            let ft = et.merit;
+            // Rounding error of V: relative to the size of its terms, not of their sum.
+            let roundoff =
+                1e-12 * eval.energy.magnitude.max(et.energy.magnitude) + f64::MIN_POSITIVE;
             let armijo = ft <= f + 1e-4 * alpha * slope;
-            let flat = (ft - f).abs() <= roundoff && et.grad_v.amax() < gnorm;
+            let flat = (ft - f).abs() <= roundoff && et.grad_v.amax() < 0.5 * gnorm;
             if ft.is_finite() && (armijo || flat) {
                 accepted = Some((qt, et, alpha));
                 break;

@@ -15,6 +15,7 @@
 //!   (1985) 451–464 (`shared/paper/`).
 
 mod assemble;
+mod eigen;
 mod minimize;
 mod options;
 pub(crate) mod partition;
@@ -29,7 +30,6 @@ use crate::constraints::Constraints;
 use crate::error::{Error, Result};
 use crate::model::{JointId, Model};
 use crate::state::{JointValues, State};
-use nalgebra::SymmetricEigen;
 use system::System;
 
 /// Initial guess: forward kinematics with every joint at its `mech:initial` / `--initial`
@@ -108,7 +108,7 @@ pub(crate) fn stability_at(model: &Model, q: &nalgebra::DVector<f64>) -> Option<
     }
     let eval = sys.evaluate(q, &part)?;
     Some(stability(
-        &SymmetricEigen::new(sys.reduced_hessian(q, &part, &eval)).eigenvalues,
+        &eigen::symmetric_eigen(&sys.reduced_hessian(q, &part, &eval)).0,
     ))
 }
 
@@ -151,7 +151,7 @@ pub fn solve_from(model: &Model, start: State, options: &Options) -> Result<(Sta
     let dof = out.part.independent.len();
     let stability = (dof > 0).then(|| {
         stability(&out.eigenvalues.clone().unwrap_or_else(|| {
-            SymmetricEigen::new(sys.reduced_hessian(&out.q, &out.part, &out.eval)).eigenvalues
+            eigen::symmetric_eigen(&sys.reduced_hessian(&out.q, &out.part, &out.eval)).0
         }))
     });
     let reactions = reactions::reactions(&sys, &out.q, &out.part, &out.eval);

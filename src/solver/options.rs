@@ -22,7 +22,9 @@ pub struct Options {
     /// Convergence tolerance on the reduced gradient `‖∂V/∂v‖∞` in scaled coordinates \[J\]
     /// (default: 1e-8).
     pub gradient_tolerance: f64,
-    /// Newton corrector tolerance on `‖Φ‖∞` \[m or 1\] (default: 1e-10).
+    /// Newton corrector tolerance on the dimensionless residual `‖D Φ‖∞`: rows in m divided by
+    /// the characteristic length `L`, rows in m² by `L²`, dimensionless rows as they are, so
+    /// that the tolerance means the same in any length unit (default: 1e-10).
     pub constraint_tolerance: f64,
     /// Maximum minimizer iterations (default: 200).
     pub max_iterations: usize,

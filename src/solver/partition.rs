@@ -1,8 +1,10 @@
 //! Coordinate partitioning by Gaussian elimination with full pivoting of `Φ_q` (paper §3).
 //!
-//! Columns are first scaled (`Φ_q S`, `S = diag(L … , 1 …)`: position columns by the
-//! characteristic length `L`, Euler-parameter columns by 1) so that the choice does not depend
-//! on the length unit. At step `k` the entry of largest magnitude in the remaining block is the
+//! The Jacobian is first made dimensionless, `D Φ_q S`: `S = diag(L …, 1 …)` scales position
+//! columns by the characteristic length `L` (Euler-parameter columns by 1), and `D` divides
+//! each row by `L^k` for a row in m^k, so that the choice does not depend on the length unit.
+//! Near-ties (within a relative 1e-9) go to the first candidate, so that rounding differences
+//! cannot flip the choice. At step `k` the entry of largest magnitude in the remaining block is the
 //! pivot; its column becomes a dependent coordinate `u_k` and its row an independent row. The
 //! elimination stops when the largest remaining entry is below `tol · max|Φ_q S|`: the number
 //! of steps is the rank `r`, the unpivoted rows are redundant, the unpivoted columns are the
@@ -26,12 +28,15 @@ pub(crate) struct Partition {
 /// Relative rank tolerance of the full-pivoting elimination.
 pub(crate) const RANK_TOLERANCE: f64 = 1e-9;
 
-/// Partitions the (dense) Jacobian `jac` with column scales `scale`.
-pub(crate) fn partition(jac: &DMatrix<f64>, scale: &[f64]) -> Partition {
+/// Partitions the (dense) Jacobian `jac` with row scales `row_scale` and column scales `scale`.
+pub(crate) fn partition(jac: &DMatrix<f64>, row_scale: &[f64], scale: &[f64]) -> Partition {
     let (m, n) = jac.shape();
     let mut a = jac.clone();
     for j in 0..n {
         a.column_mut(j).scale_mut(scale[j]);
+    }
+    for i in 0..m {
+        a.row_mut(i).scale_mut(row_scale[i]);
     }
     let mut row_perm: Vec<usize> = (0..m).collect();
     let mut col_perm: Vec<usize> = (0..n).collect();
@@ -43,7 +48,7 @@ pub(crate) fn partition(jac: &DMatrix<f64>, scale: &[f64]) -> Partition {
             let c = col_perm[jj];
             for ii in k..m {
                 let v = a[(row_perm[ii], c)].abs();
-                if v > best.2 {
+                if v > best.2 * (1.0 + 1e-9) {
                     best = (ii, jj, v);
                 }
             }
@@ -91,7 +96,7 @@ mod tests {
             4,
             &[1.0, 2.0, 0.0, 0.0, 0.0, 1.0, 3.0, 0.0, 1.0, 3.0, 3.0, 0.0],
         );
-        let p = partition(&j, &[1.0; 4]);
+        let p = partition(&j, &[1.0; 3], &[1.0; 4]);
         assert_eq!(p.dependent.len(), 2);
         assert_eq!(p.redundant.len(), 1);
         assert_eq!(p.independent.len(), 2);
@@ -101,7 +106,7 @@ mod tests {
     #[test]
     fn full_pivot_picks_largest() {
         let j = DMatrix::from_row_slice(1, 3, &[0.1, -5.0, 2.0]);
-        let p = partition(&j, &[1.0; 3]);
+        let p = partition(&j, &[1.0; 1], &[1.0; 3]);
         assert_eq!(p.dependent, vec![1]);
         assert_eq!(p.independent, vec![0, 2]);
     }

@@ -22,6 +22,8 @@ pub(crate) struct System<'a> {
     pub(crate) cons: Constraints,
     /// Column scale per coordinate (`L` for positions, 1 for Euler parameters).
     pub(crate) scale: Vec<f64>,
+    /// Row scale per constraint row (`L^−k` for a row in m^k).
+    pub(crate) row_scale: Vec<f64>,
     phi: DVector<f64>,
     jac: Triplets,
 }
@@ -29,6 +31,9 @@ pub(crate) struct System<'a> {
 /// Quantities at a feasible configuration under a partition.
 pub(crate) struct Eval {
     pub(crate) energy: Energy,
+    /// `V − μᵀ Φ` over the independent rows: the energy corrected to first order for the
+    /// corrector's residual [J].
+    pub(crate) merit: f64,
     /// Multipliers of the independent rows (in `Partition::rows` order).
     pub(crate) mu: DVector<f64>,
     /// Reduced gradient in scaled coordinates.
@@ -64,7 +69,12 @@ pub(crate) struct CorrectorFailure;
 impl<'a> System<'a> {
     pub(crate) fn new(model: &'a Model, cons: Constraints) -> Self {
         let scale = coordinate_scale(model);
+        let l = model.length_scale;
+        let row_scale = (0..cons.len())
+            .map(|i| l.powi(-cons.length_power(i)))
+            .collect();
         System {
+            row_scale,
             model,
             phi: DVector::zeros(cons.len()),
             jac: Triplets::default(),
@@ -77,6 +87,16 @@ impl<'a> System<'a> {
     pub(crate) fn residual(&mut self, q: &DVector<f64>) -> &DVector<f64> {
         self.cons.evaluate(self.model, q, &mut self.phi, None);
         &self.phi
+    }
+
+    /// `‖D Φ‖∞` at the point of the last evaluation: the residual with each row in m^k divided
+    /// by `L^k`, so that one tolerance means the same in any length unit.
+    pub(crate) fn dimensionless_residual(&self) -> f64 {
+        self.phi
+            .iter()
+            .zip(&self.row_scale)
+            .map(|(p, s)| (p * s).abs())
+            .fold(0.0, f64::max)
     }
 
     /// `Φ` at the point of the last [`System::jacobian`] or [`System::residual`] call.
@@ -94,7 +114,7 @@ impl<'a> System<'a> {
     /// Partition at `q`.
     pub(crate) fn partition(&mut self, q: &DVector<f64>) -> Partition {
         let j = self.jacobian(q);
-        partition(&j, &self.scale)
+        partition(&j, &self.row_scale, &self.scale)
     }
 
     /// Newton corrector: solves the independent rows for `u` with `v` fixed; returns the number
@@ -113,13 +133,13 @@ impl<'a> System<'a> {
             let res = part
                 .rows
                 .iter()
-                .map(|&i| self.phi[i].abs())
+                .map(|&i| self.phi[i].abs() * self.row_scale[i])
                 .fold(0.0, f64::max);
             if !res.is_finite() {
                 return Err(CorrectorFailure);
             }
             if res <= tol {
-                let all = self.phi.amax();
+                let all = self.dimensionless_residual();
                 return if all <= tol.max(1e-8) {
                     Ok(it)
                 } else {
@@ -168,8 +188,16 @@ impl<'a> System<'a> {
         for (b, &c) in part.independent.iter().enumerate() {
             grad_v[b] *= self.scale[c];
         }
+        let merit = energy.total
+            - part
+                .rows
+                .iter()
+                .zip(mu.iter())
+                .map(|(&row, m)| m * self.phi[row])
+                .sum::<f64>();
         Some(Eval {
             energy,
+            merit,
             mu,
             grad_v,
             lu,

@@ -135,13 +135,33 @@ fn project(model: &Model, state: &State) -> Result<Projection> {
     for c in 0..n {
         g[c] *= scale[c];
     }
-    // Null space: eigenvectors of JᵀJ whose eigenvalues are below 1e-12 of the largest.
-    let eig = nalgebra::SymmetricEigen::new(j.transpose() * &j);
-    let smax = eig.eigenvalues.amax().max(1e-300);
-    let cols: Vec<usize> = (0..n)
-        .filter(|&k| eig.eigenvalues[k] <= 1e-12 * smax)
-        .collect();
-    let null = DMatrix::from_fn(n, cols.len(), |r, c| eig.eigenvectors[(r, cols[c])]);
+    // Null space of the dimensionless Jacobian D Φ_q S: Z = [−Φ_u⁻¹ Φ_v; I] for the rows and
+    // columns that full pivoting finds independent, made orthonormal by a QR factorization.
+    // The subspace does not depend on that choice.
+    let l = model.length_scale;
+    for r in 0..cons.len() {
+        j.row_mut(r).scale_mut(l.powi(-cons.length_power(r)));
+    }
+    let part = crate::solver::partition::partition(&j, &vec![1.0; cons.len()], &vec![1.0; n]);
+    let (r, dof) = (part.rows.len(), part.independent.len());
+    let phi_u = DMatrix::from_fn(r, r, |a, b| j[(part.rows[a], part.dependent[b])]);
+    let phi_v = DMatrix::from_fn(r, dof, |a, b| j[(part.rows[a], part.independent[b])]);
+    let h = if r > 0 {
+        phi_u
+            .lu()
+            .solve(&(-phi_v))
+            .ok_or_else(|| Error::Undefined("singular constraint Jacobian".into()))?
+    } else {
+        DMatrix::zeros(0, dof)
+    };
+    let mut z = DMatrix::zeros(n, dof);
+    for b in 0..dof {
+        z[(part.independent[b], b)] = 1.0;
+        for (k, &c) in part.dependent.iter().enumerate() {
+            z[(c, b)] = h[(k, b)];
+        }
+    }
+    let null = if dof > 0 { z.qr().q() } else { z };
     Ok(Projection {
         phi,
         grad_s: g,
@@ -203,21 +223,14 @@ pub fn verify(model: &Model, state: &State, tol: &Tolerances) -> Result<Verifica
         };
         let j = model.joint(id);
         let (mut pos, mut rot) = (0.0f64, 0.0f64);
-        for (k, name) in joint::row_names(j).iter().enumerate() {
+        for k in 0..joint::row_count(j) {
             let r = p.phi[block.first + k].abs();
-            if name.starts_with("pos")
-                || name.starts_with("slide")
-                || name.starts_with("line")
-                || *name == "plane"
-                || *name == "thread"
-            {
-                pos = pos.max(r);
-            } else if *name == "length" {
-                if let crate::model::JointKind::Distance { length } = j.kind {
+            match (p.cons.length_power(block.first + k), j.kind) {
+                (0, _) => rot = rot.max(r),
+                (2, crate::model::JointKind::Distance { length }) => {
                     pos = pos.max(r / (2.0 * length.max(1e-12)));
                 }
-            } else {
-                rot = rot.max(r);
+                _ => pos = pos.max(r),
             }
         }
         if !j.tree || pos.max(rot) > tol.constraint {

@@ -1,0 +1,125 @@
+//! Symmetric eigendecomposition `A = V Λ Vᵀ`, guarded.
+//!
+//! nalgebra's `SymmetricEigen` can return an orthonormal `V` whose columns are paired with the
+//! wrong eigenvalues (dimforge/nalgebra#1109; seen here on a 21 × 21 `JᵀJ`). Every eigenvalue
+//! is therefore recomputed as the Rayleigh quotient `λ_i = v_iᵀ A v_i`, and the residual
+//! `‖A V − V Λ‖` is checked; if it is still large the cyclic Jacobi method, slower but
+//! unconditionally convergent, is used instead.
+//!
+//! ## References
+//! - G. H. Golub, C. F. Van Loan, *Matrix Computations*, 4th ed. (2013), §8.5 (Jacobi).
+
+use nalgebra::{DMatrix, DVector};
+
+/// Eigenvalues (ascending) and matching orthonormal eigenvectors (columns) of a symmetric `a`.
+pub(crate) fn symmetric_eigen(a: &DMatrix<f64>) -> (DVector<f64>, DMatrix<f64>) {
+    let n = a.nrows();
+    let scale = a.amax().max(f64::MIN_POSITIVE);
+    let e = nalgebra::SymmetricEigen::new(a.clone());
+    let mut vecs = e.eigenvectors;
+    let mut vals = DVector::from_fn(n, |i, _| vecs.column(i).dot(&(a * vecs.column(i))));
+    let residual = (a * &vecs - &vecs * DMatrix::from_diagonal(&vals)).amax();
+    if residual.is_nan() || residual > 1e-9 * scale {
+        (vals, vecs) = jacobi(a);
+    }
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&i, &j| vals[i].total_cmp(&vals[j]));
+    let sorted_vals = DVector::from_fn(n, |i, _| vals[order[i]]);
+    let sorted_vecs = DMatrix::from_fn(n, n, |r, c| vecs[(r, order[c])]);
+    (sorted_vals, sorted_vecs)
+}
+
+/// Cyclic Jacobi rotations until the off-diagonal part is negligible.
+fn jacobi(a: &DMatrix<f64>) -> (DVector<f64>, DMatrix<f64>) {
+    let n = a.nrows();
+    let mut m = a.clone();
+    let mut v = DMatrix::identity(n, n);
+    let total = a.norm().max(f64::MIN_POSITIVE);
+    for _ in 0..100 {
+        let mut off = 0.0;
+        for p in 0..n {
+            for q in p + 1..n {
+                off += m[(p, q)] * m[(p, q)];
+            }
+        }
+        if off.sqrt() <= 1e-15 * total {
+            break;
+        }
+        for p in 0..n {
+            for q in p + 1..n {
+                let apq = m[(p, q)];
+                if apq == 0.0 {
+                    continue;
+                }
+                let theta = (m[(q, q)] - m[(p, p)]) / (2.0 * apq);
+                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+                let t = if theta == 0.0 { 1.0 } else { t };
+                let c = 1.0 / (t * t + 1.0).sqrt();
+                let s = t * c;
+                for k in 0..n {
+                    let (mkp, mkq) = (m[(k, p)], m[(k, q)]);
+                    m[(k, p)] = c * mkp - s * mkq;
+                    m[(k, q)] = s * mkp + c * mkq;
+                }
+                for k in 0..n {
+                    let (mpk, mqk) = (m[(p, k)], m[(q, k)]);
+                    m[(p, k)] = c * mpk - s * mqk;
+                    m[(q, k)] = s * mpk + c * mqk;
+                }
+                for k in 0..n {
+                    let (vkp, vkq) = (v[(k, p)], v[(k, q)]);
+                    v[(k, p)] = c * vkp - s * vkq;
+                    v[(k, q)] = s * vkp + c * vkq;
+                }
+            }
+        }
+    }
+    (m.diagonal(), v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn check(a: &DMatrix<f64>) {
+        let (vals, vecs) = symmetric_eigen(a);
+        let r = (a * &vecs - &vecs * DMatrix::from_diagonal(&vals)).amax();
+        assert!(r <= 1e-9 * a.amax(), "residual {r}");
+        for i in 1..vals.len() {
+            assert!(vals[i - 1] <= vals[i]);
+        }
+    }
+
+    /// The 4 × 4 matrix of dimforge/nalgebra#1109, where `SymmetricEigen` pairs eigenvectors
+    /// with the wrong eigenvalues.
+    #[test]
+    fn nalgebra_issue_1109_matrix() {
+        let a = DMatrix::from_row_slice(
+            4,
+            4,
+            &[
+                -19884.07, -10.07188, 11.277279, -188560.63, -10.07188, 12.518197, 1.3770627,
+                -102.97504, 11.277279, 1.3770627, 14.587362, 113.26099, -188560.63, -102.97504,
+                113.26099, -1788112.3,
+            ],
+        );
+        check(&a);
+    }
+
+    #[test]
+    fn jacobi_agrees_on_random_matrices() {
+        let mut s = 3u64;
+        for n in [1, 2, 5, 12] {
+            let b = DMatrix::from_fn(n, n, |_, _| {
+                s = s
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+            });
+            let a = &b + b.transpose();
+            check(&a);
+            let (vals, vecs) = jacobi(&a);
+            assert!((&a * &vecs - &vecs * DMatrix::from_diagonal(&vals)).amax() < 1e-10);
+        }
+    }
+}

@@ -66,6 +66,9 @@ pub struct Diagnostics {
     pub negative_curvature_steps: usize,
     /// Final `‖∂V/∂v‖∞` \[J\].
     pub gradient_norm: f64,
+    /// Gradient tolerance applied: the requested one, or the rounding floor
+    /// `1e-13 · Σ|V_k|` of the energy's terms if larger \[J\].
+    pub gradient_tolerance: f64,
     /// Final `‖Φ‖∞`.
     pub constraint_residual: f64,
 }

@@ -59,21 +59,28 @@ impl Builder {
 }
 
 /// Joint frame `J` with its z axis along `axis` (and x along the orthogonalized `axis2` for
-/// a universal joint).
+/// a universal joint); the origin frame itself for joints without an axis.
 pub(super) fn joint_axes(
     kind: JointKind,
     axis: Vector3<f64>,
     axis2: Vector3<f64>,
 ) -> UnitQuaternion<f64> {
-    if kind == JointKind::Universal {
-        let x = (axis2 - axis * axis.dot(&axis2))
-            .try_normalize(1e-9)
-            .unwrap_or_else(|| align_z(&axis) * Vector3::x());
-        let y = axis.cross(&x);
-        let m = Matrix3::from_columns(&[x, y, axis]);
-        UnitQuaternion::from_matrix(&m)
-    } else {
-        align_z(&axis)
+    match kind {
+        JointKind::Universal => {
+            let x = (axis2 - axis * axis.dot(&axis2))
+                .try_normalize(1e-9)
+                .unwrap_or_else(|| align_z(&axis) * Vector3::x());
+            let y = axis.cross(&x);
+            let m = Matrix3::from_columns(&[x, y, axis]);
+            UnitQuaternion::from_matrix(&m)
+        }
+        // No axis: J is the joint origin frame itself, so that spherical and floating joint
+        // values are expressed in it.
+        JointKind::Spherical
+        | JointKind::Floating
+        | JointKind::Fixed
+        | JointKind::Distance { .. } => UnitQuaternion::identity(),
+        _ => align_z(&axis),
     }
 }
 

@@ -111,6 +111,12 @@ struct AnalyzeArgs {
     /// Initial guess of a joint coordinate: JOINT=VALUE or JOINT\[DOF\]=VALUE (repeatable).
     #[arg(long, value_name = "JOINT=VALUE")]
     initial: Vec<String>,
+    /// Write the input file with the rest pose as `mech:initial` values (only when converged).
+    #[arg(long, value_name = "OUT.urdf")]
+    write_urdf: Option<PathBuf>,
+    /// Write the rest pose as ROS joint_states-style YAML (only when converged).
+    #[arg(long, value_name = "OUT.yaml")]
+    write_joint_states: Option<PathBuf>,
     /// Maximum minimizer iterations.
     #[arg(long, default_value_t = 200)]
     max_iterations: usize,
@@ -204,6 +210,27 @@ fn analyze(a: &AnalyzeArgs) -> anyhow::Result<u8> {
     let result = AnalysisResult::new(model, &state, &report);
     if let Some(path) = &a.json {
         restpose::export::write_atomic(path, result.to_json().as_bytes())?;
+    }
+    if result.converged {
+        if let Some(path) = &a.write_urdf {
+            let text = std::fs::read_to_string(&a.file)
+                .with_context(|| format!("{}", a.file.display()))?;
+            let out = restpose::urdf::with_initial_pose(
+                &text,
+                &a.file.display().to_string(),
+                model,
+                &state,
+            )?;
+            restpose::export::write_atomic(path, out.as_bytes())?;
+        }
+        if let Some(path) = &a.write_joint_states {
+            let out = restpose::export::joint_states::joint_states_yaml(model, &state);
+            restpose::export::write_atomic(path, out.as_bytes())?;
+        }
+    } else if a.write_urdf.is_some() || a.write_joint_states.is_some() {
+        eprintln!(
+            "note: --write-urdf / --write-joint-states are written only for a converged rest pose"
+        );
     }
     if !a.quiet {
         print_summary(&result);

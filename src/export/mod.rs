@@ -1,5 +1,7 @@
-//! Result writers: the result JSON ([`json`]), and atomic file output.
+//! Result writers: the result JSON ([`json`]), ROS joint states ([`joint_states`]), and
+//! atomic file output. The URDF write-back is [`crate::urdf::with_initial_pose`].
 
+pub mod joint_states;
 pub mod json;
 
 use crate::error::{Error, Result};

@@ -64,7 +64,8 @@ pub(crate) fn assemble(
     let tol = options.constraint_tolerance;
     let mut held: Vec<(JointId, usize, f64)> = locks.to_vec();
     for i in &model.initial {
-        if !held.iter().any(|l| l.0 == i.joint && l.1 == i.dof) {
+        let scalar = i.dof < model.joints[i.joint.0].kind.scalar_coordinates();
+        if scalar && !held.iter().any(|l| l.0 == i.joint && l.1 == i.dof) {
             held.push((i.joint, i.dof, i.value));
         }
     }

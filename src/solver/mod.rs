@@ -38,16 +38,18 @@ pub fn initial_state(model: &Model) -> State {
     State::from_joint_values(model, &initial_values(model))
 }
 
-fn initial_values(model: &Model) -> JointValues {
+/// The model's initial values by joint (missing coordinates 0).
+pub(crate) fn initial_values(model: &Model) -> JointValues {
     let mut values = JointValues::new();
     for i in &model.initial {
         let j = &model.joints[i.joint.0];
         let v = values
             .entry(j.name.clone())
             .or_insert_with(|| vec![0.0; j.kind.scalar_coordinates()]);
-        if i.dof < v.len() {
-            v[i.dof] = i.value;
+        if v.len() <= i.dof {
+            v.resize(i.dof + 1, 0.0);
         }
+        v[i.dof] = i.value;
     }
     values
 }

@@ -416,11 +416,48 @@ pub(super) fn read(
                 });
             }
             "initial" => {
-                let (joint, dof) = joint_coord(src, n, b)?;
-                let value = src
-                    .f64_opt(n, "value")?
-                    .ok_or_else(|| src.error(n, format!("{what} needs `value`")))?;
-                initial.push(Initial { joint, dof, value });
+                let list = n
+                    .attribute("value")
+                    .map(|v| v.split_whitespace().count())
+                    .unwrap_or(0);
+                if list > 1 {
+                    // restpose's extension: the whole coordinate vector of the joint, as in the
+                    // result JSON (a quaternion w x y z for a spherical joint).
+                    let name = src.req(n, "joint")?;
+                    let joint = b.model.joint_id(name).ok_or_else(|| {
+                        src.error(n, format!("{what} refers to an unknown joint `{name}`"))
+                    })?;
+                    let kind = b.model.joints[joint.0].kind;
+                    let expected = match kind {
+                        JointKind::Spherical => 4,
+                        JointKind::Floating => 7,
+                        k => k.scalar_coordinates(),
+                    };
+                    if list != expected || n.attribute("dof").is_some() {
+                        return Err(src.error(n, format!(
+                            "{what}: joint `{name}` ({}) takes {expected} values in a list `value` without `dof`, got {list}",
+                            kind.name()
+                        )));
+                    }
+                    let values: Vec<f64> = n
+                        .attribute("value")
+                        .unwrap_or_default()
+                        .split_whitespace()
+                        .map(super::xml::parse_f64)
+                        .collect::<Option<_>>()
+                        .ok_or_else(|| {
+                            src.error(n, format!("{what}: `value` must be finite numbers"))
+                        })?;
+                    for (dof, value) in values.into_iter().enumerate() {
+                        initial.push(Initial { joint, dof, value });
+                    }
+                } else {
+                    let (joint, dof) = joint_coord(src, n, b)?;
+                    let value = src
+                        .f64_opt(n, "value")?
+                        .ok_or_else(|| src.error(n, format!("{what} needs `value`")))?;
+                    initial.push(Initial { joint, dof, value });
+                }
             }
             _ => {}
         }

@@ -84,7 +84,11 @@ pub(super) fn joint_axes(
     }
 }
 
-fn repair_prefixes(text: &str, file: &str, warnings: &mut Vec<String>) -> Result<String> {
+pub(super) fn repair_prefixes(
+    text: &str,
+    file: &str,
+    warnings: &mut Vec<String>,
+) -> Result<String> {
     if let Some(off) = text.find("<xacro:").or_else(|| text.find("${")) {
         let line = text[..off].matches('\n').count() as u32 + 1;
         let col = (off - text[..off].rfind('\n').map_or(0, |p| p + 1)) as u32 + 1;

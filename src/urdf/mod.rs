@@ -8,7 +8,10 @@
 
 mod extensions;
 mod import;
+mod write_back;
 mod xml;
+
+pub use write_back::with_initial_pose;
 
 use crate::error::{Error, Result};
 use crate::model::Model;

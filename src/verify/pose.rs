@@ -92,16 +92,7 @@ pub fn parse_pose(text: &str, file: &str) -> Result<JointValues> {
 /// # Errors
 /// [`Error::Option`] for a joint the model does not have or a value list of the wrong length.
 pub fn pose_state(model: &Model, values: &JointValues) -> Result<(State, Vec<String>)> {
-    let mut all = JointValues::new();
-    for i in &model.initial {
-        let j = &model.joints[i.joint.0];
-        let v = all
-            .entry(j.name.clone())
-            .or_insert_with(|| vec![0.0; j.kind.scalar_coordinates()]);
-        if i.dof < v.len() {
-            v[i.dof] = i.value;
-        }
-    }
+    let mut all = crate::solver::initial_values(model);
     for (name, v) in values {
         let id = model
             .joint_id(name)

@@ -1,0 +1,103 @@
+//! `--write-urdf` and `--write-joint-states`: the next run starts at rest.
+mod common;
+use common::*;
+use std::process::Command;
+
+#[test]
+fn written_urdf_starts_at_rest_and_keeps_the_rest_of_the_file() {
+    for (name, max_iterations) in [
+        ("pendulum", 0),
+        ("slider_crank", 0),
+        ("four_bar_spatial", 0),
+        ("stewart_platform", 1),
+        ("tractor_trailer", 1),
+    ] {
+        let m = robot(name);
+        let (rest, _) = solve(&m);
+        let path = format!("{}/robots/{name}.urdf", env!("CARGO_MANIFEST_DIR"));
+        let text = std::fs::read_to_string(&path).unwrap();
+        let out = restpose::urdf::with_initial_pose(&text, &path, &m, &rest).unwrap();
+        // Comments and every non-initial element survive.
+        assert_eq!(
+            out.matches("<!--").count(),
+            text.matches("<!--").count(),
+            "{name}"
+        );
+        assert_eq!(
+            out.matches("<joint ").count(),
+            text.matches("<joint ").count(),
+            "{name}"
+        );
+        assert_eq!(
+            out.matches("mech:spring ").count(),
+            text.matches("mech:spring ").count(),
+            "{name}"
+        );
+        let m2 = model_from(&out);
+        let (s2, r2) = solve(&m2);
+        assert!(
+            r2.iterations <= max_iterations,
+            "{name}: {} iterations from the written pose",
+            r2.iterations
+        );
+        for l in &m.links {
+            let (a, b) = (
+                rest.link_pose(&m, &l.name).unwrap(),
+                s2.link_pose(&m2, &l.name).unwrap(),
+            );
+            assert!(
+                (a.translation.vector - b.translation.vector).norm() < 1e-8,
+                "{name}: link {}",
+                l.name
+            );
+        }
+        // Written twice: one set of initial values, not two.
+        let again = restpose::urdf::with_initial_pose(&out, &path, &m2, &s2).unwrap();
+        assert_eq!(
+            again.matches(":initial ").count(),
+            out.matches(":initial ").count(),
+            "{name}"
+        );
+    }
+}
+
+#[test]
+fn joint_states_round_trip_through_verify() {
+    let m = robot("slider_crank");
+    let (rest, _) = solve(&m);
+    let yaml = restpose::export::joint_states::joint_states_yaml(&m, &rest);
+    let values = restpose::verify::parse_pose(&yaml, "rest.yaml").unwrap();
+    assert_eq!(values.len(), 4);
+    let (s, _) = restpose::verify::pose_state(&m, &values).unwrap();
+    assert!(
+        restpose::verify::verify(&m, &s, &Default::default())
+            .unwrap()
+            .passed
+    );
+}
+
+#[test]
+fn cli_writes_only_converged_poses() {
+    let dir = tempfile::tempdir().unwrap();
+    let urdf = format!("{}/robots/pendulum.urdf", env!("CARGO_MANIFEST_DIR"));
+    let (u, y) = (dir.path().join("rest.urdf"), dir.path().join("rest.yaml"));
+    let run = |extra: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_restpose"))
+            .args(["analyze", &urdf, "-q", "--write-urdf"])
+            .arg(&u)
+            .arg("--write-joint-states")
+            .arg(&y)
+            .args(extra)
+            .status()
+            .unwrap()
+    };
+    assert_eq!(run(&["--max-iterations", "1"]).code(), Some(3));
+    assert!(!u.exists() && !y.exists());
+    assert_eq!(run(&[]).code(), Some(0));
+    assert!(std::fs::read_to_string(&u)
+        .unwrap()
+        .contains("<mech:initial joint=\"pivot\" value=\"-1.3815770"));
+    assert!(std::fs::read_to_string(&y)
+        .unwrap()
+        .contains("name: [\"pivot\"]"));
+}

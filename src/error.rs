@@ -49,13 +49,15 @@ pub enum Error {
     /// Redundant constraint rows that the assembled pose does not satisfy.
     #[error(
         "inconsistent over-constrained model: redundant constraint `{row}` is violated by \
-         {residual:.3e} when the independent rows hold"
+         {residual:.3e} when the independent rows hold (loop joints: {loops})"
     )]
     Inconsistent {
         /// Name of the violated redundant row.
         row: String,
         /// Its residual.
         residual: f64,
+        /// The model's loop joints, which close the over-constrained loops.
+        loops: String,
     },
     /// The potential energy cannot be evaluated at the start.
     #[error("potential energy is undefined at the initial guess ({0})")]

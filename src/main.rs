@@ -129,6 +129,10 @@ struct AnalyzeArgs {
     /// Minimizer.
     #[arg(long, value_enum, default_value = "newton")]
     method: MethodArg,
+    /// Ramp gravity, loads and efforts in N steps (0: automatic, 8 steps only if the direct
+    /// solve fails; 1: never).
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    load_steps: usize,
     /// Leave the root link free instead of welding it to the world.
     #[arg(long)]
     floating_base: bool,
@@ -203,6 +207,7 @@ fn analyze(a: &AnalyzeArgs) -> anyhow::Result<u8> {
         constraint_tolerance: a.constraint_tolerance,
         max_iterations: a.max_iterations,
         allow_unstable: a.allow_unstable,
+        load_steps: a.load_steps,
         ..Default::default()
     };
     let model = &loaded.model;

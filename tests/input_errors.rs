@@ -59,7 +59,35 @@ fn loop_that_cannot_close_is_reported() {
     let e = restpose::solve(&m, &Default::default())
         .unwrap_err()
         .to_string();
-    assert!(e.contains("cannot assemble") && e.contains("far."), "{e}");
+    // One revolute degree of freedom cannot bring a point 1 m from the axis to 5 m: the loop's
+    // rows are over-constrained and inconsistent.
+    assert!(
+        e.contains("inconsistent over-constrained") && e.contains("`far`"),
+        "{e}"
+    );
+}
+
+/// A planar four-bar whose loop pin is 5 cm out of the plane: the redundant out-of-plane rows
+/// cannot hold, and the error says so instead of solving something else.
+#[test]
+fn inconsistent_redundant_rows_are_refused() {
+    let path = format!("{}/robots/slider_crank.urdf", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(path).unwrap().replace(
+        r#"<child_origin xyz="0 0 0"/>"#,
+        r#"<child_origin xyz="0 0 0.05"/>"#,
+    );
+    let m = load_str(&text, "t.urdf", &ImportOptions::default())
+        .unwrap()
+        .model;
+    let e = restpose::solve(&m, &Default::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("inconsistent over-constrained")
+            && e.contains("pos_z")
+            && e.contains("`wrist_pin`"),
+        "{e}"
+    );
 }
 
 #[test]

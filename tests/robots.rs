@@ -250,3 +250,26 @@ fn stewart_platform_converges_from_far_starts() {
         );
     }
 }
+
+/// A jackknifed start (kingpin turned 1 rad) is beyond the direct Newton iteration
+/// (`load_steps = 1`) but not beyond load stepping, which the default options fall back to.
+#[test]
+fn load_stepping_rescues_a_far_tractor_start() {
+    let (m, rest, _) = solve_with_initial("tractor_trailer", &[]);
+    let path = format!("{}/robots/tractor_trailer.urdf", env!("CARGO_MANIFEST_DIR"));
+    let opts = restpose::urdf::ImportOptions {
+        initial: vec![("kingpin".into(), 0, 1.0)],
+        ..Default::default()
+    };
+    let far = restpose::urdf::load_file(&path, &opts).unwrap().model;
+    let direct = restpose::Options {
+        load_steps: 1,
+        ..Default::default()
+    };
+    let (_, r) = restpose::solve(&far, &direct).unwrap();
+    assert!(!r.converged());
+    let (s, r) = restpose::solve(&far, &Default::default()).unwrap();
+    assert!(r.converged(), "{:?}", r.termination);
+    assert_eq!(r.diagnostics.load_steps, 8);
+    assert!(max_link_distance(&m, &rest, &s) < 1e-7);
+}

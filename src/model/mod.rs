@@ -69,6 +69,20 @@ impl Model {
         &self.joints[id.0]
     }
 
+    /// The same model with gravity, dead loads and joint efforts scaled by `factor` (load
+    /// stepping).
+    pub fn with_load_factor(&self, factor: f64) -> Model {
+        let mut m = self.clone();
+        m.gravity *= factor;
+        for l in &mut m.loads {
+            l.force *= factor;
+        }
+        for e in &mut m.efforts {
+            e.value *= factor;
+        }
+        m
+    }
+
     /// Name of the coordinate `i` of the state vector, as `body.x` … `body.e3`.
     pub fn coordinate_name(&self, i: usize) -> String {
         const C: [&str; 7] = ["x", "y", "z", "e0", "e1", "e2", "e3"];

@@ -12,25 +12,53 @@ use crate::error::{Error, Result};
 use crate::model::{JointId, Model};
 use nalgebra::DVector;
 
+/// Why the damped Newton iteration stopped short.
+enum Failure {
+    /// No decrease after this many iterations.
+    Stuck(usize),
+    /// The independent rows hold, the redundant row `row` does not: no configuration
+    /// satisfies all rows.
+    Inconsistent(usize),
+}
+
 fn newton(
     sys: &mut System,
     mut q: DVector<f64>,
     tol: f64,
-) -> std::result::Result<DVector<f64>, usize> {
+) -> std::result::Result<DVector<f64>, Failure> {
     const MAX: usize = 100;
     for it in 0..MAX {
         let j = sys.jacobian(&q);
         let phi = sys.phi().clone();
-        let res = sys.dimensionless_residual();
-        if res <= tol {
+        if sys.dimensionless_residual() <= tol {
             return Ok(q);
         }
         let part = super::partition::partition(&j, &sys.row_scale, &sys.scale);
+        let rows_residual = |sys: &System, phi: &DVector<f64>| {
+            part.rows
+                .iter()
+                .map(|&i| (phi[i] * sys.row_scale[i]).abs())
+                .fold(0.0, f64::max)
+        };
+        let res = rows_residual(sys, &phi);
+        if res <= tol {
+            let worst = part
+                .redundant
+                .iter()
+                .copied()
+                .max_by(|&a, &b| {
+                    (phi[a] * sys.row_scale[a])
+                        .abs()
+                        .total_cmp(&(phi[b] * sys.row_scale[b]).abs())
+                })
+                .unwrap_or_else(|| phi.iamax());
+            return Err(Failure::Inconsistent(worst));
+        }
         let r = part.rows.len();
         let phi_u = nalgebra::DMatrix::from_fn(r, r, |a, b| j[(part.rows[a], part.dependent[b])]);
         let rhs = DVector::from_fn(r, |a, _| -phi[part.rows[a]]);
         let Some(du) = phi_u.lu().solve(&rhs) else {
-            return Err(it);
+            return Err(Failure::Stuck(it));
         };
         let mut alpha = 1.0;
         let mut improved = false;
@@ -39,8 +67,8 @@ fn newton(
             for (k, &c) in part.dependent.iter().enumerate() {
                 qt[c] += alpha * du[k];
             }
-            sys.residual(&qt);
-            if sys.dimensionless_residual() < res {
+            let trial = sys.residual(&qt).clone();
+            if rows_residual(sys, &trial) < res {
                 q = qt;
                 improved = true;
                 break;
@@ -48,10 +76,10 @@ fn newton(
             alpha *= 0.5;
         }
         if !improved {
-            return Err(it);
+            return Err(Failure::Stuck(it));
         }
     }
-    Err(MAX)
+    Err(Failure::Stuck(MAX))
 }
 
 /// Assembles `q` (closes loops, applies locks and normalizes) or explains why it cannot.
@@ -94,7 +122,25 @@ pub(crate) fn project(
     let q0 = q.clone();
     match newton(&mut sys, q, tol) {
         Ok(qa) => Ok(qa),
-        Err(iterations) => {
+        Err(Failure::Inconsistent(row)) => {
+            let phi = sys.phi();
+            let loops: Vec<String> = model
+                .joints
+                .iter()
+                .filter(|j| !j.tree)
+                .map(|j| format!("`{}`", j.name))
+                .collect();
+            Err(Error::Inconsistent {
+                row: sys.cons.row_name(row).to_string(),
+                residual: phi[row].abs(),
+                loops: if loops.is_empty() {
+                    "none".into()
+                } else {
+                    loops.join(", ")
+                },
+            })
+        }
+        Err(Failure::Stuck(iterations)) => {
             // Name the worst joint row at the initial guess rather than a normalization row,
             // which only reflects how the Newton steps distorted the Euler parameters.
             let phi = sys.residual(&q0).clone();

@@ -86,7 +86,10 @@ pub(crate) fn minimize(
     mut part: Partition,
     options: &Options,
 ) -> Option<Outcome> {
-    let mut diag = Diagnostics::default();
+    let mut diag = Diagnostics {
+        load_steps: 1,
+        ..Diagnostics::default()
+    };
     let mut eval = sys.evaluate(&q, &part)?;
     diag.function_evaluations += 1;
     let mut history = Vec::new();

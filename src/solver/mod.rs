@@ -142,7 +142,56 @@ pub fn solve(model: &Model, options: &Options) -> Result<(State, Report)> {
 pub fn solve_from(model: &Model, start: State, options: &Options) -> Result<(State, Report)> {
     let locks = lock_values(model);
     let q = assemble::assemble(model, start.q, &locks, options)?;
-    let mut sys = System::new(model, Constraints::new(model, &locks));
+    match options.load_steps {
+        0 => {
+            let direct = solve_assembled(model, q.clone(), &locks, options)?;
+            if direct.1.converged() || direct.1.termination == Termination::Unbounded {
+                return Ok(direct);
+            }
+            let ramped = ramp(model, q, AUTOMATIC_LOAD_STEPS, &locks, options)?;
+            Ok(if ramped.1.converged() { ramped } else { direct })
+        }
+        1 => solve_assembled(model, q, &locks, options),
+        n => ramp(model, q, n, &locks, options),
+    }
+}
+
+/// Load steps tried when a direct solve does not converge (`Options::load_steps = 0`).
+const AUTOMATIC_LOAD_STEPS: usize = 8;
+
+/// Load stepping: solves with gravity, loads and efforts scaled by `k / n`, `k = 1 … n`, each
+/// stage starting from the previous rest pose.
+fn ramp(
+    model: &Model,
+    mut q: nalgebra::DVector<f64>,
+    n: usize,
+    locks: &[(JointId, usize, f64)],
+    options: &Options,
+) -> Result<(State, Report)> {
+    let mut iterations = 0;
+    let mut counters = Diagnostics::default();
+    for k in 1..n {
+        let stage = model.with_load_factor(k as f64 / n as f64);
+        let (s, r) = solve_assembled(&stage, q, locks, options)?;
+        q = s.q;
+        iterations += r.iterations;
+        counters.add_counts(&r.diagnostics);
+    }
+    let (s, mut r) = solve_assembled(model, q, locks, options)?;
+    r.iterations += iterations;
+    r.diagnostics.add_counts(&counters);
+    r.diagnostics.load_steps = n;
+    Ok((s, r))
+}
+
+/// Minimizes from an assembled `q`: partition, minimize, stability, reactions.
+fn solve_assembled(
+    model: &Model,
+    q: nalgebra::DVector<f64>,
+    locks: &[(JointId, usize, f64)],
+    options: &Options,
+) -> Result<(State, Report)> {
+    let mut sys = System::new(model, Constraints::new(model, locks));
     let part = sys.partition(&q);
     let out = minimize::minimize(&mut sys, q, part, options).ok_or_else(|| {
         Error::Undefined(

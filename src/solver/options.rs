@@ -34,6 +34,10 @@ pub struct Options {
     /// parameters (0.3 is about 35° of rotation); body origins move at most ten times this in
     /// characteristic lengths.
     pub max_step: f64,
+    /// Load stepping: solve with gravity, loads and efforts ramped in this many equal steps,
+    /// each from the previous rest pose (default: 0 = automatic: the full load at once, and 8
+    /// steps if that does not converge; 1 = never ramp).
+    pub load_steps: usize,
     /// Stop at a stationary point even if it is unstable (default: false: leave saddles and
     /// maxima along the direction of negative curvature).
     pub allow_unstable: bool,
@@ -48,6 +52,7 @@ impl Default for Options {
             max_iterations: 200,
             max_corrector_iterations: 25,
             max_step: 0.3,
+            load_steps: 0,
             allow_unstable: false,
         }
     }

@@ -69,8 +69,21 @@ pub struct Diagnostics {
     /// Gradient tolerance applied: the requested one, or the rounding floor
     /// `1e-13 · Σ|V_k|` of the energy's terms if larger \[J\].
     pub gradient_tolerance: f64,
+    /// Load steps used (1: the full load at once).
+    pub load_steps: usize,
     /// Final `‖Φ‖∞`.
     pub constraint_residual: f64,
+}
+
+impl Diagnostics {
+    /// Adds the work counters of `other` (not its final norms).
+    pub(crate) fn add_counts(&mut self, other: &Diagnostics) {
+        self.function_evaluations += other.function_evaluations;
+        self.corrector_failures += other.corrector_failures;
+        self.step_halvings += other.step_halvings;
+        self.repartitions += other.repartitions;
+        self.negative_curvature_steps += other.negative_curvature_steps;
+    }
 }
 
 /// Reaction of a joint on its child link at the joint origin.

@@ -412,6 +412,23 @@ fn print_summary(r: &AnalysisResult) {
             eig.join(", ")
         );
     }
+    if let Some(mode) = r.stability.as_ref().and_then(|s| s.modes.first()) {
+        let mut parts: Vec<(&String, f64)> = mode
+            .iter()
+            .flat_map(|(n, v)| v.iter().map(move |x| (n, *x)))
+            .collect();
+        parts.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
+        let shown: Vec<String> = parts
+            .iter()
+            .take(4)
+            .map(|(n, x)| format!("{n} {x:+.3}"))
+            .collect();
+        out!(
+            "  softest mode: {}{}",
+            shown.join(", "),
+            if parts.len() > 4 { ", …" } else { "" }
+        );
+    }
     out!();
     out!("  joint                          type          position");
     for (name, j) in &r.joints {

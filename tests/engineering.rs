@@ -199,3 +199,49 @@ fn merged_fixed_links_report_their_poses_and_floating_base_solves() {
     assert_abs_diff_eq!(z, 1.0 - 2.0 * 9.81 / 1200.0, epsilon = 1e-9);
     assert_verified_minimum(&m, &s);
 }
+
+/// Mode shapes are joint-coordinate changes along the softest eigenvector: the pendulum's is
+/// its one joint; the slider-crank's keeps the loop closed (the slider does not turn:
+/// crank + crank pin + wrist pin angles sum to zero).
+#[test]
+fn mode_shapes_are_feasible_joint_motions() {
+    let m = robot("pendulum");
+    let (_, r) = solve(&m);
+    let s = r.stability.unwrap();
+    assert_eq!(s.modes.len(), 1);
+    assert_abs_diff_eq!(s.modes[0]["pivot"][0].abs(), 1.0, epsilon = 1e-12);
+    let m = robot("slider_crank");
+    let (_, r) = solve(&m);
+    let mode = &r.stability.unwrap().modes[0];
+    let sum = mode["crank_joint"][0] + mode["crank_pin"][0] + mode["wrist_pin"][0];
+    assert!(sum.abs() < 1e-9, "{mode:?}");
+    assert!(mode["crank_joint"][0].abs() > 0.1);
+}
+
+/// A planar arm locked straight out: each joint's holding torque equals the gravity torque of
+/// the links it carries, by hand.
+#[test]
+fn locked_arm_holding_torques_equal_gravity_torques() {
+    let n = 5;
+    let mut text = restpose::generate::chain(n, true);
+    let locks: String = (0..n)
+        .map(|i| format!("<mech:lock joint=\"joint{i}\" value=\"0\"/>"))
+        .collect();
+    text = text.replace("</robot>", &format!("{locks}</robot>"));
+    let m = model_from(&text);
+    let (_, r) = solve(&m);
+    assert_eq!(r.dof, 0);
+    for i in 0..n {
+        // Links j ≥ i, 1 kg each, centres at x = 0.2 j + 0.1; joint i at x = 0.2 i; weight along
+        // −z gives +y torque (x − x_i)·m·g about joint i; the lock holds its opposite.
+        let gravity: f64 = (i..n)
+            .map(|j| (0.2 * j as f64 + 0.1 - 0.2 * i as f64) * 9.81)
+            .sum();
+        let (_, re) = r
+            .reactions
+            .iter()
+            .find(|(name, _)| *name == format!("joint{i}"))
+            .unwrap();
+        assert_abs_diff_eq!(re.torque_world[1], -gravity, epsilon = 1e-9);
+    }
+}

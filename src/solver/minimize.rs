@@ -29,8 +29,9 @@ use nalgebra::{DMatrix, DVector};
 pub(crate) struct Outcome {
     pub(crate) q: DVector<f64>,
     pub(crate) part: Partition,
-    /// Reduced-Hessian eigenvalues at `q`, when the convergence test computed them.
-    pub(crate) eigenvalues: Option<DVector<f64>>,
+    /// Reduced-Hessian eigenvalues and eigenvectors at `q`, when the convergence test
+    /// computed them.
+    pub(crate) eigen: Option<(DVector<f64>, DMatrix<f64>)>,
     pub(crate) eval: Eval,
     pub(crate) termination: Termination,
     pub(crate) history: Vec<Iterate>,
@@ -100,7 +101,7 @@ pub(crate) fn minimize(
     let mut termination = Termination::MaxIterations;
     let mut iteration = 0;
     let mut linear_steps = 0;
-    let mut eigenvalues = None;
+    let mut eigen = None;
     loop {
         let f = eval.merit;
         let gnorm = eval.grad_v.amax();
@@ -133,13 +134,13 @@ pub(crate) fn minimize(
                     if lmin < -tol {
                         negative_curvature = Some(e.1.column(imin).into_owned());
                     } else {
-                        eigenvalues = Some(e.0.clone());
+                        eigen = Some(e.clone());
                         termination = Termination::Converged;
                         break;
                     }
                 }
                 _ => {
-                    eigenvalues = eig.as_ref().map(|e| e.0.clone());
+                    eigen = eig.clone();
                     termination = Termination::Converged;
                     break;
                 }
@@ -300,7 +301,7 @@ pub(crate) fn minimize(
     Some(Outcome {
         q,
         part,
-        eigenvalues,
+        eigen,
         eval,
         termination,
         history,

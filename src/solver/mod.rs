@@ -79,11 +79,16 @@ pub(crate) fn assemble_only(
     assemble::project(model, q, locks, &Options::default())
 }
 
-/// The stability verdict from the reduced-Hessian eigenvalues (at least one).
-fn stability(eig: &nalgebra::DVector<f64>) -> Stability {
-    let tol = minimize::eigen_tolerance(eig);
-    let mut vals: Vec<f64> = eig.iter().copied().collect();
-    vals.sort_by(f64::total_cmp);
+/// The stability verdict from the reduced-Hessian eigenvalues (ascending, at least one) and
+/// eigenvectors, with the mode shapes of the smallest as joint-coordinate changes.
+fn stability(
+    sys: &System,
+    q: &nalgebra::DVector<f64>,
+    part: &partition::Partition,
+    eval: &system::Eval,
+    (vals, vecs): &(nalgebra::DVector<f64>, nalgebra::DMatrix<f64>),
+) -> Stability {
+    let tol = minimize::eigen_tolerance(vals);
     let verdict = if vals[0] < -tol {
         "unstable"
     } else if vals[0] <= tol {
@@ -91,11 +96,39 @@ fn stability(eig: &nalgebra::DVector<f64>) -> Stability {
     } else {
         "stable"
     };
-    vals.truncate(6);
+    let shown = vals.len().min(6);
+    let modes = (0..shown)
+        .map(|k| {
+            let dq = sys.tangent_step(part, eval, &vecs.column(k).into_owned());
+            let mut mode = std::collections::BTreeMap::new();
+            for j in sys.model.joints.iter().filter(|j| !j.merged) {
+                let pair = crate::jet::pair_of(&j.bodies, q, false);
+                let d: Vec<f64> = (0..j.kind.scalar_coordinates())
+                    .filter_map(|dof| crate::constraints::joint::coordinate(j, &pair, dof))
+                    .map(|s| {
+                        (0..crate::jet::NL)
+                            .filter_map(|i| {
+                                crate::jet::global_index(&j.bodies, i).map(|g| s.g[i] * dq[g])
+                            })
+                            .sum()
+                    })
+                    .collect();
+                if !d.is_empty() {
+                    mode.insert(j.name.clone(), d);
+                }
+            }
+            let big = mode.values().flatten().fold(0.0f64, |a, &b| a.max(b.abs()));
+            if big > 0.0 {
+                mode.values_mut().flatten().for_each(|x| *x /= big);
+            }
+            mode
+        })
+        .collect();
     Stability {
         verdict: verdict.into(),
         tolerance: tol,
-        eigenvalues: vals,
+        eigenvalues: vals.iter().take(shown).copied().collect(),
+        modes,
     }
 }
 
@@ -109,9 +142,8 @@ pub(crate) fn stability_at(model: &Model, q: &nalgebra::DVector<f64>) -> Option<
         return None;
     }
     let eval = sys.evaluate(q, &part)?;
-    Some(stability(
-        &eigen::symmetric_eigen(&sys.reduced_hessian(q, &part, &eval)).0,
-    ))
+    let eig = eigen::symmetric_eigen(&sys.reduced_hessian(q, &part, &eval));
+    Some(stability(&sys, q, &part, &eval, &eig))
 }
 
 /// Finds the stable static equilibrium of `model` from its initial guess.
@@ -201,9 +233,10 @@ fn solve_assembled(
     let state = State { q: out.q.clone() };
     let dof = out.part.independent.len();
     let stability = (dof > 0).then(|| {
-        stability(&out.eigenvalues.clone().unwrap_or_else(|| {
-            eigen::symmetric_eigen(&sys.reduced_hessian(&out.q, &out.part, &out.eval)).0
-        }))
+        let eig = out.eigen.clone().unwrap_or_else(|| {
+            eigen::symmetric_eigen(&sys.reduced_hessian(&out.q, &out.part, &out.eval))
+        });
+        stability(&sys, &out.q, &out.part, &out.eval, &eig)
     });
     let reactions = reactions::reactions(&sys, &out.q, &out.part, &out.eval);
     let report = Report {

@@ -49,6 +49,9 @@ pub struct Stability {
     pub tolerance: f64,
     /// Smallest eigenvalues of the scaled reduced Hessian, ascending (at most 6) \[J\].
     pub eigenvalues: Vec<f64>,
+    /// Mode shape of each listed eigenvalue: the change of every joint coordinate along the
+    /// eigenvector, scaled so that the largest is ±1 (a rotation in rad, a slide in m).
+    pub modes: Vec<std::collections::BTreeMap<String, Vec<f64>>>,
 }
 
 /// Counters of what the solver had to do.

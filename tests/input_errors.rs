@@ -19,7 +19,7 @@ const J: &str = r#"<joint name="j" type="revolute"><parent link="world"/><child 
 #[test]
 fn each_error_names_file_line_and_element() {
     let cases: Vec<(String, &str, &str)> = vec![
-        (with(r#"<joint name="j" type="revolute"><parent link="world"/><child link="nope"/></joint>"#), "bad.urdf:4:", "unknown child link `nope`"),
+        (with(r#"<joint name="j" type="revolute"><parent link="world"/><child link="nope"/></joint>"#), "bad.urdf:4:", "<child> of joint `j` refers to an unknown link or frame `nope`"),
         (with(&format!("{J}\n<link name=\"a\"/>")), "bad.urdf:5:", "duplicate link name `a`"),
         (with("<link name=\"b\"/>"), "bad.urdf:3:", "second root link `a`"),
         (with(r#"<joint name="j" type="revolute"><parent link="world"/><child link="a"/><axis xyz="0 0 0"/></joint>"#), "bad.urdf:4:", "joint `j` has a zero-length axis"),

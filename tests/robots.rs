@@ -251,14 +251,14 @@ fn stewart_platform_converges_from_far_starts() {
     }
 }
 
-/// A jackknifed start (kingpin turned 1 rad) is beyond the direct Newton iteration
+/// A start with the fifth wheel pitched by 0.3 rad is beyond the direct Newton iteration
 /// (`load_steps = 1`) but not beyond load stepping, which the default options fall back to.
 #[test]
 fn load_stepping_rescues_a_far_tractor_start() {
     let (m, rest, _) = solve_with_initial("tractor_trailer", &[]);
     let path = format!("{}/robots/tractor_trailer.urdf", env!("CARGO_MANIFEST_DIR"));
     let opts = restpose::urdf::ImportOptions {
-        initial: vec![("kingpin".into(), 0, 1.0)],
+        initial: vec![("fifth_wheel_pitch".into(), 0, 0.3)],
         ..Default::default()
     };
     let far = restpose::urdf::load_file(&path, &opts).unwrap().model;

@@ -1,18 +1,18 @@
 //! The `mech:` extension elements (`urn:urdf-mech:1`) and URDF `<mimic>`.
 //!
-//! Loop joints are read first (they can be named by the other elements); then gravity,
+//! Loop joints and frames are part of the joint graph ([`super::edges`]); here: gravity,
 //! springs, joint springs, loads, efforts, locks and initial values. Command-line locks and
 //! initial values override the file's.
 
-use super::import::{joint_axes, Builder};
+use super::import::Builder;
 use super::xml::{child, Source};
 use super::ImportOptions;
 use crate::error::Result;
 use crate::model::{
-    Effort, ForceLaw, Initial, Joint, JointId, JointKind, JointSpring, Load, Lock, Mimic, Spring,
+    Effort, ForceLaw, Initial, JointId, JointKind, JointSpring, Load, Lock, Mimic, Spring,
     SpringEnd, SpringMode,
 };
-use nalgebra::{Isometry3, Vector3};
+use nalgebra::Vector3;
 use roxmltree::Node;
 
 const KNOWN: [&str; 10] = [
@@ -27,88 +27,6 @@ const KNOWN: [&str; 10] = [
     "initial",
     "frame",
 ];
-
-fn loop_kind(src: &Source, node: Node) -> Result<JointKind> {
-    let ty = src.req(node, "type")?;
-    Ok(match ty {
-        "fixed" => JointKind::Fixed,
-        "revolute" => JointKind::Revolute,
-        "continuous" => JointKind::Continuous,
-        "prismatic" => JointKind::Prismatic,
-        "cylindrical" => JointKind::Cylindrical,
-        "universal" => JointKind::Universal,
-        "spherical" | "ball" => JointKind::Spherical,
-        "planar" => JointKind::Planar,
-        "screw" => JointKind::Screw {
-            pitch: src.f64_or(node, "pitch", 0.0)?,
-        },
-        "distance" => JointKind::Distance {
-            length: src.f64_opt(node, "length")?.ok_or_else(|| {
-                src.error(
-                    node,
-                    format!("{}: a distance joint needs `length`", src.describe(node)),
-                )
-            })?,
-        },
-        "point_on_line" => JointKind::PointOnLine,
-        other => {
-            return Err(src.error(
-                node,
-                format!("{} has an unknown type \"{other}\"", src.describe(node)),
-            ))
-        }
-    })
-}
-
-fn loop_joint(src: &Source, node: Node, b: &Builder) -> Result<Joint> {
-    let name = src.req(node, "name")?.to_string();
-    let kind = loop_kind(src, node)?;
-    let side = |tag: &str| -> Result<(String, Option<crate::model::BodyId>, Isometry3<f64>)> {
-        let c = child(node, tag).ok_or_else(|| {
-            src.error(node, format!("loop joint `{name}` has no <{tag}> element"))
-        })?;
-        let (body, bfl) = b.link_ref(src, c, "link")?;
-        Ok((src.req(c, "link")?.to_string(), body, bfl))
-    };
-    let (pl, pb, pf) = side("parent")?;
-    let (cl, cb, cf) = side("child")?;
-    if let Some(co) = child(node, "child_origin") {
-        if co.attribute("auto").is_some() {
-            return Err(src.error(
-                co,
-                format!(
-                    "loop joint `{name}`: <child_origin auto> is not supported yet; give xyz/rpy"
-                ),
-            ));
-        }
-    }
-    let origin = src.frame(child(node, "origin"))?;
-    let child_origin = src.frame(child(node, "child_origin"))?;
-    let axis = src.axis(child(node, "axis"), node, Vector3::x())?;
-    let axis2 = src.axis(child(node, "axis2"), node, Vector3::y())?;
-    if kind == JointKind::Universal && axis.cross(&axis2).norm() < 1e-9 {
-        return Err(src.error(node, format!("universal joint `{name}` has parallel axes")));
-    }
-    let rot = Isometry3::from_parts(Default::default(), joint_axes(kind, axis, axis2));
-    let limits = match child(node, "limit") {
-        Some(l) => Some([src.f64_or(l, "lower", 0.0)?, src.f64_or(l, "upper", 0.0)?]),
-        None => None,
-    };
-    if pb == cb {
-        return Err(src.error(node, format!("loop joint `{name}` joins body `{pl}` to itself (links `{pl}` and `{cl}` are welded)")));
-    }
-    Ok(Joint {
-        name,
-        kind,
-        parent_link: pl,
-        child_link: cl,
-        bodies: [pb, cb],
-        body_from_joint: [pf * origin * rot, cf * child_origin * rot],
-        tree: false,
-        merged: false,
-        limits,
-    })
-}
 
 fn force_law(src: &Source, node: Node, what: &str) -> Result<ForceLaw> {
     let stiffness = src.f64_opt(node, "stiffness")?;
@@ -221,16 +139,6 @@ pub(super) fn read(
                 format!("unknown element <mech:{tag}> (known: {})", KNOWN.join(", ")),
             ));
         }
-        if tag == "frame" {
-            return Err(src.error(n, "<mech:frame> is not supported yet"));
-        }
-    }
-    for &n in ext.iter().filter(|n| n.tag_name().name() == "loop_joint") {
-        let j = loop_joint(src, n, b)?;
-        if b.model.joint_id(&j.name).is_some() {
-            return Err(src.error(n, format!("duplicate joint name `{}`", j.name)));
-        }
-        b.model.joints.push(j);
     }
     // URDF mimic.
     for (name, node) in urdf_joints {
@@ -270,9 +178,13 @@ pub(super) fn read(
         let mut cur = b.model.mimics[start].reference;
         for _ in 0..=b.model.mimics.len() {
             if cur == b.model.mimics[start].joint {
-                let (name, node) = &urdf_joints[b.model.mimics[start].joint.0];
-                let m = child(*node, "mimic").unwrap_or(*node);
-                return Err(src.error(m, format!("mimic cycle through joint `{name}`")));
+                let name = &b.model.joints[cur.0].name;
+                let node = urdf_joints.iter().find(|(n, _)| n == name).map(|(_, n)| *n);
+                let at = node
+                    .and_then(|n| child(n, "mimic"))
+                    .or(node)
+                    .unwrap_or(ext.first().copied().unwrap_or(src.doc.root_element()));
+                return Err(src.error(at, format!("mimic cycle through joint `{name}`")));
             }
             match b.model.mimics.iter().find(|m| m.joint == cur) {
                 Some(m) => cur = m.reference,

@@ -1,9 +1,14 @@
-//! The standard URDF tree: links, joints, fixed-joint merging into bodies.
+//! From the document to the model: links, the joint graph and its spanning tree, bodies.
 //!
-//! Links joined by `fixed` joints form one rigid body whose frame is the frame of its topmost
-//! link; `body_from_link` composes the fixed joint origins. The root link is welded to the
-//! world (its frame is the world frame) unless a floating base is asked for.
+//! URDF `<joint>`s, `<drake:joint>`s and the loop elements (`mech:loop_joint`, `<loop_joint>`,
+//! `<drake:ball_constraint>`) form one graph. The spanning tree grows from the root link along
+//! URDF and Drake joints first; a link they do not reach is reached through a loop element
+//! whose parent is already placed, which then becomes a tree edge. Every other edge closes a
+//! loop. Links joined by URDF `fixed` tree joints form one rigid body whose frame is the frame
+//! of its topmost link; `body_from_link` composes the fixed joint origins. The root link is
+//! welded to the world (its frame is the world frame) unless a floating base is asked for.
 
+use super::edges::{self, Edge, Frames, Source_, DRAKE_NS};
 use super::extensions;
 use super::xml::{child, is_mech, Source};
 use super::{ImportOptions, Loaded};
@@ -27,6 +32,8 @@ pub(super) struct Builder {
     pub(super) model: Model,
     /// Link name → index in `model.links`.
     pub(super) link_index: HashMap<String, usize>,
+    /// `mech:frame` name → (link index or world, link_from_frame).
+    pub(super) frames: HashMap<String, (Option<usize>, Isometry3<f64>)>,
     pub(super) link_in: Vec<LinkIn>,
     /// Links excluded from gravity.
     pub(super) no_gravity: Vec<usize>,
@@ -44,17 +51,18 @@ impl Builder {
         attr: &str,
     ) -> Result<(Option<BodyId>, Isometry3<f64>)> {
         let name = src.req(node, attr)?;
-        if name == "world" && !self.link_index.contains_key(name) {
-            return Ok((None, Isometry3::identity()));
-        }
-        let i = self.link_index.get(name).ok_or_else(|| {
-            src.error(
-                node,
-                format!("{} refers to an unknown link `{name}`", src.describe(node)),
-            )
-        })?;
-        let l = &self.model.links[*i];
-        Ok((l.body, l.body_from_link))
+        let frames = Frames {
+            links: &self.link_index,
+            frames: self.frames.clone(),
+        };
+        let (link, link_from_frame) = frames.resolve(src, node, name)?;
+        Ok(match link {
+            Some(i) => {
+                let l = &self.model.links[i];
+                (l.body, l.body_from_link * link_from_frame)
+            }
+            None => (None, link_from_frame),
+        })
     }
 }
 
@@ -121,36 +129,7 @@ pub(super) fn repair_prefixes(
     Ok(out)
 }
 
-fn joint_kind(src: &Source, node: Node, ty: &str, warnings: &mut Vec<String>) -> Result<JointKind> {
-    Ok(match ty {
-        "revolute" => JointKind::Revolute,
-        "continuous" => JointKind::Continuous,
-        "prismatic" => JointKind::Prismatic,
-        "fixed" => JointKind::Fixed,
-        "floating" => JointKind::Floating,
-        "planar" => JointKind::Planar,
-        "spherical" => JointKind::Spherical,
-        "ball" => {
-            let p = src.doc.text_pos_at(node.range().start);
-            warnings.push(format!(
-                "{}:{}:{}: {} has type \"ball\", read as \"spherical\"",
-                src.file,
-                p.row,
-                p.col,
-                src.describe(node)
-            ));
-            JointKind::Spherical
-        }
-        other => {
-            return Err(src.error(
-                node,
-                format!("{} has an unknown type \"{other}\"", src.describe(node)),
-            ))
-        }
-    })
-}
-
-fn read_link(src: &Source, node: Node) -> Result<LinkIn> {
+fn read_link(src: &Source, node: Node, warnings: &mut Vec<String>) -> Result<LinkIn> {
     let name = src.req(node, "name")?.to_string();
     let mut l = LinkIn {
         name,
@@ -188,55 +167,35 @@ fn read_link(src: &Source, node: Node) -> Result<LinkIn> {
             );
             let r = origin.rotation.to_rotation_matrix();
             l.inertia = r.matrix() * local * r.matrix().transpose();
+            if let Some(why) = inertia_problem(&local) {
+                let p = src.doc.text_pos_at(i.range().start);
+                warnings.push(format!(
+                    "{}:{}:{}: link `{}`: the inertia tensor is not physically valid ({why}); statics does not use it",
+                    src.file, p.row, p.col, l.name
+                ));
+            }
         }
     }
     Ok(l)
 }
 
-struct JointIn<'a> {
-    node: Node<'a, 'a>,
-    name: String,
-    kind: JointKind,
-    parent: String,
-    child: String,
-    origin: Isometry3<f64>,
-    axis: Vector3<f64>,
-    limits: Option<[f64; 2]>,
-}
-
-fn read_joint<'a>(
-    src: &Source,
-    node: Node<'a, 'a>,
-    warnings: &mut Vec<String>,
-) -> Result<JointIn<'a>> {
-    let name = src.req(node, "name")?.to_string();
-    let kind = joint_kind(src, node, src.req(node, "type")?, warnings)?;
-    let link_of = |tag: &str| -> Result<String> {
-        let c = child(node, tag)
-            .ok_or_else(|| src.error(node, format!("joint `{name}` has no <{tag}> element")))?;
-        Ok(src.req(c, "link")?.to_string())
-    };
-    let limits = match child(node, "limit") {
-        Some(l) => {
-            let lo = src.f64_opt(l, "lower")?;
-            let hi = src.f64_opt(l, "upper")?;
-            match (lo, hi) {
-                (None, None) => None,
-                (lo, hi) => Some([lo.unwrap_or(0.0), hi.unwrap_or(0.0)]),
-            }
+/// Why an inertia tensor is not physically valid (a principal moment negative, or one larger
+/// than the sum of the other two), if it is not.
+fn inertia_problem(i: &Matrix3<f64>) -> Option<String> {
+    let e = nalgebra::SymmetricEigen::new(*i).eigenvalues;
+    let tol = 1e-9 * e.amax().max(f64::MIN_POSITIVE);
+    if e.min() < -tol {
+        return Some(format!("principal moment {:.3e} < 0", e.min()));
+    }
+    for k in 0..3 {
+        if e[k] > e[(k + 1) % 3] + e[(k + 2) % 3] + tol {
+            return Some(format!(
+                "principal moment {:.3e} exceeds the sum of the other two",
+                e[k]
+            ));
         }
-        None => None,
-    };
-    Ok(JointIn {
-        node,
-        kind,
-        parent: link_of("parent")?,
-        child: link_of("child")?,
-        origin: src.frame(child(node, "origin"))?,
-        axis: src.axis(child(node, "axis"), node, Vector3::x())?,
-        limits,
-        name,
-    })
+    }
+    None
 }
 
 pub(super) fn import(text: &str, file: &str, options: &ImportOptions) -> Result<Loaded> {
@@ -268,30 +227,37 @@ pub(super) fn import(text: &str, file: &str, options: &ImportOptions) -> Result<
     }
     let mut link_nodes = Vec::new();
     let mut joint_nodes = Vec::new();
+    let mut loop_nodes = Vec::new();
+    let mut drake_nodes = Vec::new();
+    let mut gazebo_nodes = Vec::new();
     let mut ext = Vec::new();
     let mut ignored = Vec::new();
     for c in robot.children().filter(|c| c.is_element()) {
         let name = c.tag_name().name();
+        let ns = c.tag_name().namespace();
         if is_mech(c) {
             ext.push(c);
-        } else if c.tag_name().namespace().is_none() && name == "link" {
+        } else if ns == Some(DRAKE_NS) {
+            drake_nodes.push(c);
+        } else if ns.is_none() && name == "link" {
             link_nodes.push(c);
-        } else if c.tag_name().namespace().is_none() && name == "joint" {
+        } else if ns.is_none() && name == "joint" {
             joint_nodes.push(c);
-        } else if !matches!(
-            name,
-            "material" | "transmission" | "gazebo" | "ros2_control"
-        ) {
+        } else if ns.is_none() && name == "loop_joint" {
+            loop_nodes.push(c);
+        } else if ns.is_none() && name == "gazebo" {
+            gazebo_nodes.push(c);
+        } else if !matches!(name, "material" | "transmission" | "ros2_control") {
             let p = doc.text_pos_at(c.range().start);
             ignored.push(format!("{}:{} <{}>", p.row, p.col, name));
         }
     }
 
-    // Links.
+    // Links and named frames.
     let mut link_in = Vec::new();
     let mut link_index: HashMap<String, usize> = HashMap::new();
     for &n in &link_nodes {
-        let l = read_link(&src, n)?;
+        let l = read_link(&src, n, &mut warnings)?;
         if link_index.insert(l.name.clone(), link_in.len()).is_some() {
             return Err(src.error(n, format!("duplicate link name `{}`", l.name)));
         }
@@ -300,95 +266,196 @@ pub(super) fn import(text: &str, file: &str, options: &ImportOptions) -> Result<
     if link_in.is_empty() {
         return Err(src.error(robot, "the robot has no <link>"));
     }
-
-    // URDF joints and the tree.
-    let mut joints_in = Vec::new();
-    let mut joint_names: HashMap<String, ()> = HashMap::new();
-    let mut parent_joint: Vec<Option<usize>> = vec![None; link_in.len()];
-    let mut children: Vec<Vec<usize>> = vec![Vec::new(); link_in.len()];
-    for &n in &joint_nodes {
-        let j = read_joint(&src, n, &mut warnings)?;
-        if joint_names.insert(j.name.clone(), ()).is_some() {
-            return Err(src.error(n, format!("duplicate joint name `{}`", j.name)));
-        }
-        let find = |l: &str, role: &str| {
-            link_index.get(l).copied().ok_or_else(|| {
-                src.error(
-                    n,
-                    format!("joint `{}` refers to an unknown {role} link `{l}`", j.name),
-                )
-            })
-        };
-        let p = find(&j.parent, "parent")?;
-        let c = find(&j.child, "child")?;
-        if p == c {
+    let mut frames = Frames {
+        links: &link_index,
+        frames: HashMap::new(),
+    };
+    for &n in ext.iter().filter(|n| n.tag_name().name() == "frame") {
+        let name = src.req(n, "name")?;
+        let base = src.req(n, "link")?;
+        let (link, f) = frames.resolve(&src, n, base)?;
+        if link_index.contains_key(name) || frames.frames.contains_key(name) {
             return Err(src.error(
                 n,
-                format!("joint `{}` joins link `{}` to itself", j.name, j.parent),
+                format!("frame `{name}` has the name of another link or frame"),
             ));
         }
-        if let Some(other) = parent_joint[c] {
+        frames
+            .frames
+            .insert(name.to_string(), (link, f * src.frame(Some(n))?));
+    }
+
+    // The joint graph, URDF and Drake joints first.
+    let mut edges: Vec<Edge> = Vec::new();
+    for &n in &joint_nodes {
+        edges.push(edges::urdf_joint(&src, n, &frames, &mut warnings)?);
+    }
+    for &n in drake_nodes
+        .iter()
+        .filter(|n| n.tag_name().name() == "joint")
+    {
+        edges.push(edges::drake_joint(&src, n, &frames)?);
+    }
+    for &n in ext.iter().filter(|n| n.tag_name().name() == "loop_joint") {
+        edges.push(edges::mech_loop_joint(&src, n, &frames)?);
+    }
+    for &n in &loop_nodes {
+        edges.push(edges::foreign_loop_joint(&src, n, &frames)?);
+    }
+    for (k, &n) in drake_nodes
+        .iter()
+        .filter(|n| n.tag_name().name() == "ball_constraint")
+        .enumerate()
+    {
+        edges.push(edges::drake_ball_constraint(&src, n, &frames, k)?);
+    }
+    for &n in drake_nodes.iter().filter(|n| {
+        !matches!(
+            n.tag_name().name(),
+            "joint" | "ball_constraint" | "linear_spring_damper"
+        )
+    }) {
+        let p = doc.text_pos_at(n.range().start);
+        ignored.push(format!(
+            "{}:{} <drake:{}>",
+            p.row,
+            p.col,
+            n.tag_name().name()
+        ));
+    }
+    let frames_map = frames.frames.clone();
+    let mut names: HashMap<&str, ()> = HashMap::new();
+    let mut preferred_parent: Vec<Option<usize>> = vec![None; link_in.len()];
+    for (k, e) in edges.iter().enumerate() {
+        if names.insert(e.name.as_str(), ()).is_some() {
+            return Err(src.error(e.node, format!("duplicate joint name `{}`", e.name)));
+        }
+        if e.parent == e.child {
             return Err(src.error(
-                n,
+                e.node,
                 format!(
-                    "link `{}` is the child of two joints (`{}` and `{}`); close loops with mech:loop_joint",
-                    j.child, joints_in.get(other).map_or("?", |o: &JointIn| o.name.as_str()), j.name
+                    "joint `{}` joins link `{}` to itself",
+                    e.name, e.parent_link
                 ),
             ));
         }
-        parent_joint[c] = Some(joints_in.len());
-        children[p].push(joints_in.len());
-        joints_in.push(j);
+        if e.source != Source_::Loop {
+            let Some(c) = e.child else {
+                return Err(src.error(
+                    e.node,
+                    format!(
+                        "joint `{}` has the world as its child; swap parent and child",
+                        e.name
+                    ),
+                ));
+            };
+            if let Some(other) = preferred_parent[c] {
+                return Err(src.error(
+                    e.node,
+                    format!(
+                        "link `{}` is the child of two joints (`{}` and `{}`); close loops with mech:loop_joint",
+                        e.child_link, edges[other].name, e.name
+                    ),
+                ));
+            }
+            preferred_parent[c] = Some(k);
+        }
     }
-    let roots: Vec<usize> = (0..link_in.len())
-        .filter(|&i| parent_joint[i].is_none())
+    let candidates: Vec<usize> = (0..link_in.len())
+        .filter(|&i| preferred_parent[i].is_none())
         .collect();
-    if roots.len() > 1 {
-        return Err(src.error(
-            link_nodes[roots[1]],
-            format!(
-                "second root link `{}` (the tree already has root `{}`): every link but the root must be the child of a <joint>",
-                link_in[roots[1]].name, link_in[roots[0]].name
-            ),
-        ));
-    }
-    let Some(&root) = roots.first() else {
+    let Some(&root) = candidates
+        .iter()
+        .find(|&&i| link_in[i].name == "world")
+        .or(candidates.first())
+    else {
         return Err(src.error(robot, "the URDF joints form a cycle: no root link"));
     };
 
-    // Walk the tree: groups of links welded by fixed joints.
-    let mut group: Vec<Option<usize>> = vec![None; link_in.len()];
-    let mut body_from_link = vec![Isometry3::identity(); link_in.len()];
-    let mut group_root: Vec<usize> = vec![root];
-    group[root] = Some(0);
-    let mut stack = vec![root];
-    while let Some(l) = stack.pop() {
-        for &ji in &children[l] {
-            let j = &joints_in[ji];
-            let c = link_index[&j.child];
-            if j.kind == JointKind::Fixed {
-                group[c] = group[l];
-                body_from_link[c] = body_from_link[l] * j.origin;
-            } else {
-                group[c] = Some(group_root.len());
-                group_root.push(c);
+    // Spanning tree: breadth first from the root (and the undeclared world), preferred edges
+    // first, then loop elements whose parent is placed.
+    let mut reached = vec![false; link_in.len()];
+    let mut tree_order: Vec<usize> = Vec::new();
+    reached[root] = true;
+    let mut queue: std::collections::VecDeque<Option<usize>> =
+        [None, Some(root)].into_iter().collect();
+    loop {
+        while let Some(l) = queue.pop_front() {
+            for (k, e) in edges.iter().enumerate() {
+                if e.source != Source_::Loop && e.parent == l {
+                    if let Some(c) = e.child.filter(|&c| !reached[c]) {
+                        reached[c] = true;
+                        tree_order.push(k);
+                        queue.push_back(Some(c));
+                    }
+                }
             }
-            stack.push(c);
+        }
+        let next = edges.iter().enumerate().find(|(k, e)| {
+            e.source == Source_::Loop
+                && !tree_order.contains(k)
+                && e.parent.is_none_or(|p| reached[p])
+                && e.child.is_some_and(|c| !reached[c])
+        });
+        match next {
+            Some((k, e)) => {
+                let c = e.child.unwrap_or(root);
+                reached[c] = true;
+                tree_order.push(k);
+                queue.push_back(Some(c));
+            }
+            None => break,
         }
     }
-    if let Some(l) = (0..link_in.len()).find(|&l| group[l].is_none()) {
-        return Err(src.error(
-            link_nodes[l],
-            format!("link `{}` is on a cycle of URDF joints", link_in[l].name),
-        ));
-    }
-    // Group 0 is the world unless the base floats.
-    let ground = !options.floating_base;
-    let body_of_group = |g: usize| -> Option<BodyId> {
-        if ground {
-            g.checked_sub(1).map(BodyId)
+    if let Some(l) = (0..link_in.len()).find(|&l| !reached[l]) {
+        let message = if preferred_parent[l].is_none() {
+            format!(
+                "second root link `{}` (the tree already has root `{}`): every link but the root must be the child of a <joint> or be reached through a loop joint",
+                link_in[l].name, link_in[root].name
+            )
         } else {
-            Some(BodyId(g))
+            format!(
+                "link `{}` is on a cycle of URDF joints, not connected to the root `{}`",
+                link_in[l].name, link_in[root].name
+            )
+        };
+        return Err(src.error(link_nodes[l], message));
+    }
+
+    // Bodies: groups of links welded by URDF fixed tree joints. Group 0 holds the root.
+    let mut group: Vec<usize> = vec![0; link_in.len()];
+    let mut body_from_link = vec![Isometry3::identity(); link_in.len()];
+    let mut group_root: Vec<usize> = vec![root];
+    let mut world_welded = vec![false; link_in.len()];
+    for &k in &tree_order {
+        let e = &edges[k];
+        let Some(c) = e.child else { continue };
+        if e.source == Source_::Urdf && e.kind == JointKind::Fixed {
+            match e.parent {
+                Some(p) => {
+                    group[c] = group[p];
+                    body_from_link[c] = body_from_link[p] * e.origin;
+                    world_welded[c] = world_welded[p];
+                }
+                None => {
+                    group[c] = 0;
+                    body_from_link[c] = e.origin;
+                    world_welded[c] = true;
+                }
+            }
+        } else {
+            group[c] = group_root.len();
+            group_root.push(c);
+        }
+    }
+    let floating = options.floating_base;
+    let body_of = |l: usize| -> Option<BodyId> {
+        if world_welded[l] || (!floating && group[l] == 0) {
+            None
+        } else if floating {
+            Some(BodyId(group[l]))
+        } else {
+            Some(BodyId(group[l] - 1))
         }
     };
     let mut model = Model {
@@ -407,7 +474,7 @@ pub(super) fn import(text: &str, file: &str, options: &ImportOptions) -> Result<
         length_scale: 1.0,
     };
     for (g, &rl) in group_root.iter().enumerate() {
-        if body_of_group(g).is_some() {
+        if g > 0 || floating {
             model.bodies.push(Body {
                 name: link_in[rl].name.clone(),
                 mass: 0.0,
@@ -419,53 +486,79 @@ pub(super) fn import(text: &str, file: &str, options: &ImportOptions) -> Result<
         }
     }
     for (i, l) in link_in.iter().enumerate() {
-        let g = group[i].unwrap_or(0);
         model.links.push(Link {
             name: l.name.clone(),
-            body: body_of_group(g),
+            body: body_of(i),
             body_from_link: body_from_link[i],
         });
     }
 
-    // Joints.
-    for j in &joints_in {
-        let p = link_index[&j.parent];
-        let c = link_index[&j.child];
-        let rot = joint_axes(j.kind, j.axis, Vector3::y());
-        let frame_p = body_from_link[p] * j.origin * Isometry3::from_parts(Default::default(), rot);
-        let frame_c = body_from_link[c] * Isometry3::from_parts(Default::default(), rot);
-        let merged = j.kind == JointKind::Fixed;
+    // Joints, in document order by kind of element.
+    let mut auto_child = Vec::new();
+    for (k, e) in edges.iter().enumerate() {
+        let place = |l: Option<usize>| {
+            l.map_or((None, Isometry3::identity()), |l| {
+                (body_of(l), body_from_link[l])
+            })
+        };
+        let (pb, pf) = place(e.parent);
+        let (cb, cf) = place(e.child);
+        let tree = tree_order.contains(&k);
+        let merged = tree && e.source == Source_::Urdf && e.kind == JointKind::Fixed;
+        if !merged && pb == cb {
+            return Err(src.error(
+                e.node,
+                format!(
+                    "joint `{}` joins body `{}` to itself (links `{}` and `{}` are welded)",
+                    e.name, e.parent_link, e.parent_link, e.child_link
+                ),
+            ));
+        }
+        let rot = Isometry3::from_parts(Default::default(), joint_axes(e.kind, e.axis, e.axis2));
+        if e.auto_child_origin {
+            auto_child.push(model.joints.len());
+        }
         model.joints.push(Joint {
-            name: j.name.clone(),
-            kind: j.kind,
-            parent_link: j.parent.clone(),
-            child_link: j.child.clone(),
-            bodies: [model.links[p].body, model.links[c].body],
-            body_from_joint: [frame_p, frame_c],
-            tree: true,
+            name: e.name.clone(),
+            kind: e.kind,
+            parent_link: e.parent_link.clone(),
+            child_link: e.child_link.clone(),
+            bodies: [pb, cb],
+            body_from_joint: [pf * e.origin * rot, cf * e.child_origin * rot],
+            tree,
             merged,
-            limits: j.limits,
+            limits: e.limits,
         });
     }
 
+    let urdf_joints: Vec<(String, Node)> = edges
+        .iter()
+        .filter(|e| e.source == Source_::Urdf)
+        .map(|e| (e.name.clone(), e.node))
+        .collect();
     let mut b = Builder {
         model,
-        link_index,
+        link_index: link_index.clone(),
+        frames: frames_map,
         link_in,
         no_gravity: Vec::new(),
         gravity_set: false,
         warnings,
     };
-    extensions::read(
-        &src,
-        &ext,
-        &joints_in
-            .iter()
-            .map(|j| (j.name.clone(), j.node))
-            .collect::<Vec<_>>(),
-        &mut b,
-        options,
-    )?;
+    extensions::read(&src, &ext, &urdf_joints, &mut b, options)?;
+    super::foreign::read(&src, &drake_nodes, &gazebo_nodes, &mut b)?;
+    if !auto_child.is_empty() {
+        // The child's joint frame that makes the joint hold at the initial guess.
+        let start = crate::solver::initial_state(&b.model);
+        for &ji in &auto_child {
+            let j = &b.model.joints[ji];
+            let pose =
+                |body: Option<BodyId>| body.map_or(Isometry3::identity(), |x| start.body_pose(x));
+            let world_from_j = pose(j.bodies[0]) * j.body_from_joint[0];
+            let f = pose(j.bodies[1]).inverse() * world_from_j;
+            b.model.joints[ji].body_from_joint[1] = f;
+        }
+    }
     finish_mass(&mut b);
     b.model.length_scale = length_scale(&b.model);
     Ok(Loaded {

@@ -6,7 +6,9 @@
 //! elements are read in one pass; the spanning tree is the URDF `<joint>` tree, and every
 //! `mech:loop_joint` closes a loop.
 
+mod edges;
 mod extensions;
+mod foreign;
 mod import;
 mod write_back;
 mod xml;

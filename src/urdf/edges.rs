@@ -1,0 +1,392 @@
+//! Joint-like elements as edges of the joint graph: URDF `<joint>`, `<drake:joint>`,
+//! `<mech:loop_joint>`, a foreign `<loop_joint>` and `<drake:ball_constraint>`.
+//!
+//! Each edge places its joint frame `J` on both sides: `origin` is `J` in the parent link
+//! frame, `child_origin` is `J` in the child link frame (identity for tree joints, whose child
+//! link frame is `J` at zero displacement). An endpoint may also be a `mech:frame` (folded into
+//! the origin) or the undeclared `world`.
+
+use super::xml::{child, Source};
+use crate::error::Result;
+use crate::model::JointKind;
+use nalgebra::{Isometry3, Vector3};
+use roxmltree::Node;
+use std::collections::HashMap;
+
+/// The namespace URI Drake uses for its URDF extensions.
+pub(super) const DRAKE_NS: &str = "http://drake.mit.edu";
+
+/// Where an edge comes from, which decides its preference for the spanning tree.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Source_ {
+    /// URDF `<joint>`: a tree edge; fixed ones weld links into one body.
+    Urdf,
+    /// `<drake:joint>`: a tree edge of another type.
+    Drake,
+    /// A loop element: a loop closure unless the spanning tree needs it.
+    Loop,
+}
+
+/// One edge of the joint graph.
+pub(super) struct Edge<'a> {
+    pub(super) node: Node<'a, 'a>,
+    pub(super) name: String,
+    pub(super) kind: JointKind,
+    /// Parent and child link indices (`None`: the undeclared world).
+    pub(super) parent: Option<usize>,
+    pub(super) child: Option<usize>,
+    pub(super) parent_link: String,
+    pub(super) child_link: String,
+    pub(super) origin: Isometry3<f64>,
+    pub(super) child_origin: Isometry3<f64>,
+    pub(super) axis: Vector3<f64>,
+    pub(super) axis2: Vector3<f64>,
+    pub(super) limits: Option<[f64; 2]>,
+    pub(super) source: Source_,
+    /// `<child_origin auto="initial"/>`: computed so the joint holds at the initial guess.
+    pub(super) auto_child_origin: bool,
+}
+
+/// Link names and named frames: name → (link index or world, link_from_frame).
+pub(super) struct Frames<'a> {
+    pub(super) links: &'a HashMap<String, usize>,
+    pub(super) frames: HashMap<String, (Option<usize>, Isometry3<f64>)>,
+}
+
+impl Frames<'_> {
+    /// Resolves a link or frame name at `node`.
+    pub(super) fn resolve(
+        &self,
+        src: &Source,
+        node: Node,
+        name: &str,
+    ) -> Result<(Option<usize>, Isometry3<f64>)> {
+        if let Some(&i) = self.links.get(name) {
+            return Ok((Some(i), Isometry3::identity()));
+        }
+        if let Some(f) = self.frames.get(name) {
+            return Ok(*f);
+        }
+        if name == "world" {
+            return Ok((None, Isometry3::identity()));
+        }
+        Err(src.error(
+            node,
+            format!(
+                "{} refers to an unknown link or frame `{name}`",
+                src.describe(node)
+            ),
+        ))
+    }
+}
+
+fn limits(src: &Source, node: Node) -> Result<Option<[f64; 2]>> {
+    Ok(match child(node, "limit") {
+        Some(l) => match (src.f64_opt(l, "lower")?, src.f64_opt(l, "upper")?) {
+            (None, None) => None,
+            (lo, hi) => Some([lo.unwrap_or(0.0), hi.unwrap_or(0.0)]),
+        },
+        None => None,
+    })
+}
+
+/// A resolved endpoint: link index (or world), link_from_frame, the name as written.
+type End = (Option<usize>, Isometry3<f64>, String);
+
+/// Parent and child of a joint with `<parent link>` / `<child link>` children.
+fn ends(src: &Source, node: Node, frames: &Frames, name: &str) -> Result<[End; 2]> {
+    let side = |tag: &str| -> Result<End> {
+        let c = child(node, tag)
+            .ok_or_else(|| src.error(node, format!("joint `{name}` has no <{tag}> element")))?;
+        let l = src.req(c, "link")?;
+        let (i, f) = frames.resolve(src, c, l)?;
+        Ok((i, f, l.to_string()))
+    };
+    Ok([side("parent")?, side("child")?])
+}
+
+/// URDF joint types.
+pub(super) fn urdf_kind(
+    src: &Source,
+    node: Node,
+    ty: &str,
+    warnings: &mut Vec<String>,
+) -> Result<JointKind> {
+    Ok(match ty {
+        "revolute" => JointKind::Revolute,
+        "continuous" => JointKind::Continuous,
+        "prismatic" => JointKind::Prismatic,
+        "fixed" => JointKind::Fixed,
+        "floating" => JointKind::Floating,
+        "planar" => JointKind::Planar,
+        "spherical" => JointKind::Spherical,
+        "ball" => {
+            let p = src.doc.text_pos_at(node.range().start);
+            warnings.push(format!(
+                "{}:{}:{}: {} has type \"ball\", read as \"spherical\"",
+                src.file,
+                p.row,
+                p.col,
+                src.describe(node)
+            ));
+            JointKind::Spherical
+        }
+        other => {
+            return Err(src.error(
+                node,
+                format!("{} has an unknown type \"{other}\"", src.describe(node)),
+            ))
+        }
+    })
+}
+
+/// A URDF `<joint>` (tree edge).
+pub(super) fn urdf_joint<'a>(
+    src: &Source,
+    node: Node<'a, 'a>,
+    frames: &Frames,
+    warnings: &mut Vec<String>,
+) -> Result<Edge<'a>> {
+    let name = src.req(node, "name")?.to_string();
+    let kind = urdf_kind(src, node, src.req(node, "type")?, warnings)?;
+    let [(parent, pf, parent_link), (child_i, cf, child_link)] = ends(src, node, frames, &name)?;
+    Ok(Edge {
+        node,
+        kind,
+        parent,
+        child: child_i,
+        parent_link,
+        child_link,
+        origin: pf * src.frame(child(node, "origin"))?,
+        child_origin: cf,
+        axis: src.axis(child(node, "axis"), node, Vector3::x())?,
+        axis2: Vector3::y(),
+        limits: limits(src, node)?,
+        source: Source_::Urdf,
+        auto_child_origin: false,
+        name,
+    })
+}
+
+/// A `<drake:joint type="ball|universal|planar|screw">` (tree edge). Drake's planar and screw
+/// joints act about z unless an `<axis>` says otherwise; `drake:screw_thread_pitch` is in m
+/// per revolution.
+pub(super) fn drake_joint<'a>(
+    src: &Source,
+    node: Node<'a, 'a>,
+    frames: &Frames,
+) -> Result<Edge<'a>> {
+    let name = src.req(node, "name")?.to_string();
+    let ty = src.req(node, "type")?;
+    let kind = match ty {
+        "ball" => JointKind::Spherical,
+        "universal" => JointKind::Universal,
+        "planar" => JointKind::Planar,
+        "screw" => {
+            let p = node
+                .children()
+                .find(|c| c.is_element() && c.tag_name().name() == "screw_thread_pitch")
+                .ok_or_else(|| src.error(node, format!("drake joint `{name}`: a screw joint needs <drake:screw_thread_pitch value>")))?;
+            let per_rev = src.f64_opt(p, "value")?.ok_or_else(|| src.error(p, "<drake:screw_thread_pitch> needs `value`"))?;
+            JointKind::Screw { pitch: per_rev / (2.0 * std::f64::consts::PI) }
+        }
+        other => {
+            return Err(src.error(node, format!("drake joint `{name}` has type \"{other}\"; drake:joint types are ball, universal, planar and screw (use <joint> for the others)")))
+        }
+    };
+    let [(parent, pf, parent_link), (child_i, cf, child_link)] = ends(src, node, frames, &name)?;
+    let default_axis = if matches!(kind, JointKind::Universal) {
+        Vector3::x()
+    } else {
+        Vector3::z()
+    };
+    Ok(Edge {
+        node,
+        kind,
+        parent,
+        child: child_i,
+        parent_link,
+        child_link,
+        origin: pf * src.frame(child(node, "origin"))?,
+        child_origin: cf,
+        axis: src.axis(child(node, "axis"), node, default_axis)?,
+        axis2: Vector3::y(),
+        limits: limits(src, node)?,
+        source: Source_::Drake,
+        auto_child_origin: false,
+        name,
+    })
+}
+
+/// `mech:loop_joint` types.
+fn loop_kind(src: &Source, node: Node) -> Result<JointKind> {
+    let ty = src.req(node, "type")?;
+    Ok(match ty {
+        "fixed" => JointKind::Fixed,
+        "revolute" => JointKind::Revolute,
+        "continuous" => JointKind::Continuous,
+        "prismatic" => JointKind::Prismatic,
+        "cylindrical" => JointKind::Cylindrical,
+        "universal" => JointKind::Universal,
+        "spherical" | "ball" => JointKind::Spherical,
+        "planar" => JointKind::Planar,
+        "screw" => JointKind::Screw {
+            pitch: src.f64_or(node, "pitch", 0.0)?,
+        },
+        "distance" => JointKind::Distance {
+            length: src.f64_opt(node, "length")?.ok_or_else(|| {
+                src.error(
+                    node,
+                    format!("{}: a distance joint needs `length`", src.describe(node)),
+                )
+            })?,
+        },
+        "point_on_line" => JointKind::PointOnLine,
+        other => {
+            return Err(src.error(
+                node,
+                format!("{} has an unknown type \"{other}\"", src.describe(node)),
+            ))
+        }
+    })
+}
+
+/// A `<mech:loop_joint>`.
+pub(super) fn mech_loop_joint<'a>(
+    src: &Source,
+    node: Node<'a, 'a>,
+    frames: &Frames,
+) -> Result<Edge<'a>> {
+    let name = src.req(node, "name")?.to_string();
+    let kind = loop_kind(src, node)?;
+    let [(parent, pf, parent_link), (child_i, cf, child_link)] = ends(src, node, frames, &name)?;
+    let co = child(node, "child_origin");
+    let auto_child_origin = match co.and_then(|c| c.attribute("auto")) {
+        None => false,
+        Some("initial") => true,
+        Some(other) => {
+            return Err(src.error(co.unwrap_or(node), format!("loop joint `{name}`: <child_origin auto=\"{other}\"> (only \"initial\" is defined)")))
+        }
+    };
+    if auto_child_origin && matches!(kind, JointKind::Distance { .. }) {
+        return Err(src.error(co.unwrap_or(node), format!(
+            "loop joint `{name}`: <child_origin auto> places the child's joint frame on the parent's, which a distance joint of nonzero length cannot use; give the child point"
+        )));
+    }
+    let axis = src.axis(child(node, "axis"), node, Vector3::x())?;
+    let axis2 = src.axis(child(node, "axis2"), node, Vector3::y())?;
+    if kind == JointKind::Universal && axis.cross(&axis2).norm() < 1e-9 {
+        return Err(src.error(node, format!("universal joint `{name}` has parallel axes")));
+    }
+    Ok(Edge {
+        node,
+        kind,
+        parent,
+        child: child_i,
+        parent_link,
+        child_link,
+        origin: pf * src.frame(child(node, "origin"))?,
+        child_origin: cf * src.frame(co.filter(|_| !auto_child_origin))?,
+        axis,
+        axis2,
+        limits: limits(src, node)?,
+        source: Source_::Loop,
+        auto_child_origin,
+        name,
+    })
+}
+
+/// A foreign `<loop_joint name type><link1 link xyz rpy/><link2 link xyz rpy/><axis/>`.
+pub(super) fn foreign_loop_joint<'a>(
+    src: &Source,
+    node: Node<'a, 'a>,
+    frames: &Frames,
+) -> Result<Edge<'a>> {
+    let name = src.req(node, "name")?.to_string();
+    let kind = loop_kind(src, node)?;
+    let side = |tag: &str| -> Result<End> {
+        let c = child(node, tag).ok_or_else(|| {
+            src.error(node, format!("loop joint `{name}` has no <{tag}> element"))
+        })?;
+        let l = src.req(c, "link")?;
+        let (i, f) = frames.resolve(src, c, l)?;
+        Ok((i, f * src.frame(Some(c))?, l.to_string()))
+    };
+    let (parent, origin, parent_link) = side("link1")?;
+    let (child_i, child_origin, child_link) = side("link2")?;
+    Ok(Edge {
+        node,
+        kind,
+        parent,
+        child: child_i,
+        parent_link,
+        child_link,
+        origin,
+        child_origin,
+        axis: src.axis(child(node, "axis"), node, Vector3::x())?,
+        axis2: Vector3::y(),
+        limits: limits(src, node)?,
+        source: Source_::Loop,
+        auto_child_origin: false,
+        name,
+    })
+}
+
+/// The child element `drake:{prefix}{suffix}` and its attribute `attr`.
+pub(super) fn drake_part<'a>(
+    src: &Source,
+    node: Node<'a, 'a>,
+    tag: &str,
+    attr: &str,
+) -> Result<(Node<'a, 'a>, &'a str)> {
+    let c = node
+        .children()
+        .find(|c| c.is_element() && c.tag_name().name() == tag)
+        .ok_or_else(|| {
+            src.error(
+                node,
+                format!(
+                    "<drake:{}> has no <drake:{tag}> element",
+                    node.tag_name().name()
+                ),
+            )
+        })?;
+    Ok((c, src.req(c, attr)?))
+}
+
+/// A `<drake:ball_constraint>`: a spherical loop joint, parent A at `p_AP`, child B at `p_BQ`.
+pub(super) fn drake_ball_constraint<'a>(
+    src: &Source,
+    node: Node<'a, 'a>,
+    frames: &Frames,
+    index: usize,
+) -> Result<Edge<'a>> {
+    let name = node
+        .attribute("name")
+        .map_or_else(|| format!("ball_constraint_{index}"), str::to_string);
+    let point = |tag: &str| -> Result<Isometry3<f64>> {
+        let (c, _) = drake_part(src, node, tag, "value")?;
+        let p = src.vec3_opt(c, "value")?.unwrap_or_default();
+        Ok(Isometry3::translation(p.x, p.y, p.z))
+    };
+    let (na, a) = drake_part(src, node, "ball_constraint_body_A", "name")?;
+    let (nb, b) = drake_part(src, node, "ball_constraint_body_B", "name")?;
+    let (pa, fa) = frames.resolve(src, na, a)?;
+    let (pb, fb) = frames.resolve(src, nb, b)?;
+    Ok(Edge {
+        node,
+        kind: JointKind::Spherical,
+        parent: pa,
+        child: pb,
+        parent_link: a.to_string(),
+        child_link: b.to_string(),
+        origin: fa * point("ball_constraint_p_AP")?,
+        child_origin: fb * point("ball_constraint_p_BQ")?,
+        axis: Vector3::x(),
+        axis2: Vector3::y(),
+        limits: None,
+        source: Source_::Loop,
+        auto_child_origin: false,
+        name,
+    })
+}

@@ -1,0 +1,217 @@
+//! Foreign extensions, frames, automatic child origins and the joint graph.
+mod common;
+use approx::assert_abs_diff_eq;
+use common::*;
+use restpose::urdf::{load_str, ImportOptions};
+
+fn robot_text(name: &str) -> String {
+    std::fs::read_to_string(format!("{}/robots/{name}.urdf", env!("CARGO_MANIFEST_DIR"))).unwrap()
+}
+
+fn between<'a>(s: &'a str, a: &str, b: &str) -> &'a str {
+    let i = s.find(a).unwrap();
+    let j = s[i..].find(b).unwrap() + i + b.len();
+    &s[i..j]
+}
+
+/// The slider-crank with its pin written as the foreign `<loop_joint>` gives the same rest pose.
+#[test]
+fn foreign_loop_joint_equals_mech_loop_joint() {
+    let text = robot_text("slider_crank");
+    let mech = between(&text, "<mech:loop_joint", "</mech:loop_joint>");
+    let foreign = r#"<loop_joint name="wrist_pin" type="revolute"><link1 link="rod" xyz="0.3 0 0"/><link2 link="slider" xyz="0 0 0"/><axis xyz="0 0 1"/></loop_joint>"#;
+    let m1 = model_from(&text);
+    let m2 = model_from(&text.replace(mech, foreign));
+    let (s1, r1) = solve(&m1);
+    let (s2, r2) = solve(&m2);
+    assert_abs_diff_eq!(r1.energy.total, r2.energy.total, epsilon = 1e-12);
+    assert_abs_diff_eq!(
+        joint(&m1, &s1, "slide")[0],
+        joint(&m2, &s2, "slide")[0],
+        epsilon = 1e-12
+    );
+}
+
+/// The paper's pendulum with its spring written as `<drake:linear_spring_damper>` and its pivot
+/// as a planar `<drake:ball_constraint>`-free model still reaches φ = −1.381577.
+#[test]
+fn drake_linear_spring_damper_is_a_spring() {
+    let text = robot_text("pendulum");
+    let spring = between(&text, "<mech:spring", "</mech:spring>");
+    let drake = r#"<drake:linear_spring_damper>
+        <drake:linear_spring_damper_body_A name="bar"/><drake:linear_spring_damper_p_AP value="2 0 0"/>
+        <drake:linear_spring_damper_body_B name="world"/><drake:linear_spring_damper_p_BQ value="-1 -2 0"/>
+        <drake:linear_spring_damper_free_length value="2"/><drake:linear_spring_damper_stiffness value="3"/>
+        <drake:linear_spring_damper_damping value="0.5"/></drake:linear_spring_damper>"#;
+    let text = text.replace(spring, drake);
+    let l = load_str(&text, "p.urdf", &ImportOptions::default()).unwrap();
+    assert!(
+        l.warnings.iter().any(|w| w.contains("drake")),
+        "undeclared drake prefix repaired: {:?}",
+        l.warnings
+    );
+    let (s, r) = solve(&l.model);
+    assert_abs_diff_eq!(joint(&l.model, &s, "pivot")[0], -1.381577, epsilon = 1e-6);
+    assert_abs_diff_eq!(r.energy.total, -18.686957, epsilon = 1e-6);
+}
+
+/// `<gazebo reference><springStiffness>` is a joint spring: same rest pose as mech:joint_spring.
+#[test]
+fn gazebo_spring_stiffness_is_a_joint_spring() {
+    let text = restpose::generate::chain(4, true);
+    let mut gz = text.clone();
+    for i in 0..4 {
+        let k = 10.0 * ((4 - i) * (4 - i)) as f64;
+        gz = gz.replace(
+            &format!("<mech:joint_spring joint=\"joint{i}\" stiffness=\"{k}\" reference=\"0\"/>"),
+            &format!("<gazebo reference=\"joint{i}\"><springStiffness>{k}</springStiffness><springReference>0</springReference><implicitSpringDamper>true</implicitSpringDamper></gazebo>"),
+        );
+    }
+    assert_ne!(gz, text);
+    let (m1, m2) = (model_from(&text), model_from(&gz));
+    let (s1, _) = solve(&m1);
+    let (s2, _) = solve(&m2);
+    for i in 0..4 {
+        let n = format!("joint{i}");
+        assert_abs_diff_eq!(
+            joint(&m1, &s1, &n)[0],
+            joint(&m2, &s2, &n)[0],
+            epsilon = 1e-12
+        );
+    }
+}
+
+const BALL: &str = r#"<robot name="drake" xmlns:drake="http://drake.mit.edu" xmlns:mech="urn:urdf-mech:1">
+  <link name="world"/>
+  <link name="bob"><inertial><origin xyz="0 0 -0.5"/><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+  <link name="nut"><inertial><mass value="0.2"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+  <drake:joint name="ball" type="ball"><parent link="world"/><child link="bob"/><origin xyz="0 0 2"/></drake:joint>
+  <drake:joint name="screw" type="screw"><parent link="world"/><child link="nut"/><origin xyz="1 0 0"/><axis xyz="0 0 1"/><drake:screw_thread_pitch value="0.01"/></drake:joint>
+  <mech:spring name="side" stiffness="20" free_length="0"><end link="bob" xyz="0 0 -0.5"/><end link="world" xyz="0.3 0 1.5"/></mech:spring>
+  <mech:joint_spring joint="screw" stiffness="0.05"/>
+</robot>"#;
+
+/// Drake ball and screw joints: the bob hangs where gravity and the side spring balance (by
+/// hand), and the nut descends its thread until the twist spring holds it: θ = m g h / k.
+#[test]
+fn drake_ball_and_screw_joints() {
+    let m = model_from(BALL);
+    let (s, r) = solve(&m);
+    assert_eq!(r.dof, 4);
+    assert_verified_minimum(&m, &s);
+    // Screw: potential m g h θ/(2π)·… : V = m g (pitch θ) + ½ k θ², pitch = 0.01/(2π) m/rad.
+    let pitch = 0.01 / (2.0 * std::f64::consts::PI);
+    let theta = joint(&m, &s, "screw")[0];
+    assert_abs_diff_eq!(theta, -0.2 * 9.81 * pitch / 0.05, epsilon = 1e-9);
+    let nut = s.link_pose(&m, "nut").unwrap().translation.vector;
+    assert_abs_diff_eq!(nut.z, pitch * theta, epsilon = 1e-12);
+    // Ball: the bob's centre hangs 0.5 m from the pivot, pulled towards x = 0.3 by the spring.
+    let c = s.link_pose(&m, "bob").unwrap() * nalgebra::Point3::new(0.0, 0.0, -0.5);
+    let f =
+        (nalgebra::Point3::new(0.3, 0.0, 1.5) - c) * 20.0 + nalgebra::Vector3::new(0.0, 0.0, -9.81);
+    let r_arm = c - nalgebra::Point3::new(0.0, 0.0, 2.0);
+    assert!(
+        r_arm.cross(&f).norm() < 1e-8,
+        "moment about the ball: {}",
+        r_arm.cross(&f).norm()
+    );
+    assert_eq!(joint(&m, &s, "ball").len(), 4);
+}
+
+/// A `drake:ball_constraint` closing a loop, a `mech:frame` as a spring end, and
+/// `<child_origin auto="initial"/>`: the loop starts closed, with no assembly to do.
+#[test]
+fn ball_constraint_frames_and_auto_child_origin() {
+    let text = r#"<robot name="loop" xmlns:drake="http://drake.mit.edu" xmlns:mech="urn:urdf-mech:1">
+      <link name="world"/>
+      <link name="a"><inertial><origin xyz="0.5 0 0"/><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+      <link name="b"><inertial><origin xyz="0.5 0 0"/><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+      <joint name="ja" type="revolute"><parent link="world"/><child link="a"/><axis xyz="0 1 0"/></joint>
+      <joint name="jb" type="revolute"><parent link="world"/><child link="b"/><origin xyz="0 0.4 0"/><axis xyz="0 1 0"/></joint>
+      <mech:frame name="a_tip" link="a" xyz="1 0 0"/>
+      <mech:loop_joint name="tie" type="spherical"><parent link="a_tip"/><child link="b"/><child_origin auto="initial"/></mech:loop_joint>
+      <mech:spring name="s" stiffness="40" free_length="0.2"><end link="a_tip"/><end link="world" xyz="1 0 1"/></mech:spring>
+      <mech:initial joint="ja" value="0.2"/><mech:initial joint="jb" value="0.2"/>
+    </robot>"#;
+    let m = model_from(text);
+    let start = restpose::solver::initial_state(&m);
+    let b = restpose::verify::balance(&m, &start).unwrap();
+    assert!(
+        b.constraint_residual < 1e-12,
+        "auto child origin closes the loop at the start: {b:?}"
+    );
+    let (s, r) = solve(&m);
+    assert_eq!(r.dof, 1);
+    assert_verified_minimum(&m, &s);
+    // The spring end is the frame: 1 m along a's x axis.
+    let tip = s.link_pose(&m, "a").unwrap() * nalgebra::Point3::new(1.0, 0.0, 0.0);
+    let l = (nalgebra::Point3::new(1.0, 0.0, 1.0) - tip).norm();
+    assert_abs_diff_eq!(
+        r.energy.springs,
+        0.5 * 40.0 * (l - 0.2).powi(2),
+        epsilon = 1e-9
+    );
+
+    let ball = text.replace(
+        r#"<mech:loop_joint name="tie" type="spherical"><parent link="a_tip"/><child link="b"/><child_origin auto="initial"/></mech:loop_joint>"#,
+        r#"<drake:ball_constraint><drake:ball_constraint_body_A name="a"/><drake:ball_constraint_p_AP value="1 0 0"/><drake:ball_constraint_body_B name="b"/><drake:ball_constraint_p_BQ value="1 -0.4 0"/></drake:ball_constraint>"#,
+    );
+    let m = model_from(&ball);
+    assert!(m
+        .joints
+        .iter()
+        .any(|j| j.name == "ball_constraint_0" && !j.tree));
+    let (s, r) = solve(&m);
+    assert_eq!(r.dof, 1);
+    assert_verified_minimum(&m, &s);
+}
+
+/// A link reached only through a loop element: the importer makes that element a tree edge.
+#[test]
+fn loop_element_becomes_a_tree_edge_when_needed() {
+    let text = r#"<robot name="g" xmlns:mech="urn:urdf-mech:1"><link name="world"/>
+      <link name="p"><inertial><origin xyz="0 0 -1"/><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+      <mech:loop_joint name="hinge" type="revolute"><parent link="world"/><child link="p"/><axis xyz="0 1 0"/></mech:loop_joint>
+      <mech:joint_spring joint="hinge" stiffness="5" reference="0.5"/></robot>"#;
+    let m = model_from(text);
+    assert!(m.joint(m.joint_id("hinge").unwrap()).tree);
+    let (s, _) = solve(&m);
+    let th = joint(&m, &s, "hinge")[0];
+    // 5 (θ − 0.5) = −m g sin θ · 1 m (a rotation about +y moves the bob towards +x, up).
+    assert_abs_diff_eq!(5.0 * (th - 0.5), -9.81 * th.sin(), epsilon = 1e-9);
+}
+
+/// Massless dummy frames and a long fixed chain cost no coordinates; an invalid inertia is a
+/// warning.
+#[test]
+fn massless_fixed_chains_and_inertia_warning() {
+    let mut text = String::from(
+        r#"<robot name="flange" xmlns:mech="urn:urdf-mech:1"><link name="base"/>
+      <link name="arm"><inertial><origin xyz="0.5 0 0"/><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+      <joint name="j" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 1 0"/></joint>
+      <mech:joint_spring joint="j" stiffness="30"/>"#,
+    );
+    let mut parent = "arm".to_string();
+    for k in 0..10 {
+        text += &format!(
+            r#"<link name="f{k}"/><joint name="fj{k}" type="fixed"><parent link="{parent}"/><child link="f{k}"/><origin xyz="0.1 0 0"/></joint>"#
+        );
+        parent = format!("f{k}");
+    }
+    text += "</robot>";
+    let l = load_str(&text, "f.urdf", &ImportOptions::default()).unwrap();
+    assert_eq!(l.model.bodies.len(), 1);
+    assert!(
+        l.warnings
+            .iter()
+            .any(|w| w.contains("inertia tensor is not physically valid")),
+        "{:?}",
+        l.warnings
+    );
+    let (s, r) = solve(&l.model);
+    assert_eq!(r.dof, 1);
+    let th = joint(&l.model, &s, "j")[0];
+    let tip = s.link_pose(&l.model, "f9").unwrap().translation.vector;
+    assert_abs_diff_eq!(tip.x, 1.0 * th.cos(), epsilon = 1e-12);
+    assert_abs_diff_eq!(tip.z, -th.sin(), epsilon = 1e-12);
+}

@@ -29,6 +29,7 @@ pub mod error;
 pub mod export;
 pub mod forces;
 pub mod generate;
+pub mod geometry;
 pub(crate) mod jet;
 pub mod math;
 pub mod model;

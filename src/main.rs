@@ -39,6 +39,8 @@ struct Cli {
 enum Command {
     /// Solve for the stable rest pose and print a summary.
     Analyze(AnalyzeArgs),
+    /// Load and validate a file without solving; print the model as understood.
+    Check(CheckArgs),
     /// Check whether a given pose is a rest pose, without moving it.
     Verify(VerifyArgs),
     /// Write a generated benchmark mechanism (URDF) to standard output.
@@ -50,6 +52,68 @@ enum Command {
         #[arg(long, default_value_t = 20)]
         size: usize,
     },
+}
+
+#[derive(clap::Args, Clone)]
+struct InputArgs {
+    /// Gravity [m/s²] when the file has no <mech:gravity>.
+    #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_hyphen_values = true)]
+    gravity: Option<Vec<f64>>,
+    /// Where `package://NAME/…` meshes live (repeatable).
+    #[arg(long, value_name = "NAME=DIR")]
+    package: Vec<String>,
+    /// Give links without <inertial> the mass properties of their collision (else visual)
+    /// geometry at this density [kg/m³].
+    #[arg(long, value_name = "DENSITY")]
+    inertia_from_geometry: Option<f64>,
+    /// Leave the root link free instead of welding it to the world.
+    #[arg(long)]
+    floating_base: bool,
+}
+
+impl InputArgs {
+    fn options(&self) -> anyhow::Result<ImportOptions> {
+        let mut opts = ImportOptions {
+            floating_base: self.floating_base,
+            inertia_density: self.inertia_from_geometry,
+            ..Default::default()
+        };
+        if let Some(g) = &self.gravity {
+            opts.gravity = nalgebra::Vector3::new(g[0], g[1], g[2]);
+        }
+        for p in &self.package {
+            let (n, d) = p
+                .split_once('=')
+                .with_context(|| format!("--package {p}: expected NAME=DIR"))?;
+            opts.packages.push((n.to_string(), PathBuf::from(d)));
+        }
+        if let Some(d) = self.inertia_from_geometry {
+            if !(d.is_finite() && d > 0.0) {
+                bail!("--inertia-from-geometry {d}: the density must be positive");
+            }
+        }
+        Ok(opts)
+    }
+}
+
+#[derive(clap::Args)]
+struct CheckArgs {
+    /// URDF file.
+    file: PathBuf,
+    #[command(flatten)]
+    input: InputArgs,
+    /// Output format.
+    #[arg(long, value_enum, default_value = "text")]
+    format: Format,
+    /// Also list ignored foreign elements.
+    #[arg(long, short)]
+    verbose: bool,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Format {
+    Text,
+    Json,
 }
 
 #[derive(clap::Args)]
@@ -72,9 +136,8 @@ struct VerifyArgs {
     /// Write the verification as JSON to this file (`-` for standard output).
     #[arg(long, value_name = "OUT.json")]
     json: Option<PathBuf>,
-    /// Gravity [m/s²] when the file has no <mech:gravity>.
-    #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_hyphen_values = true)]
-    gravity: Option<Vec<f64>>,
+    #[command(flatten)]
+    input: InputArgs,
     /// Print only errors and the verdict.
     #[arg(long, short)]
     quiet: bool,
@@ -102,13 +165,12 @@ struct AnalyzeArgs {
     /// Write the result JSON here (written even when the solve does not converge).
     #[arg(long, value_name = "OUT.json")]
     json: Option<PathBuf>,
-    /// Gravity \[m/s²\] when the file has no <mech:gravity>.
-    #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_hyphen_values = true)]
-    gravity: Option<Vec<f64>>,
-    /// Hold a joint coordinate: JOINT=VALUE or JOINT\[DOF\]=VALUE (repeatable).
+    #[command(flatten)]
+    input: InputArgs,
+    /// Hold a joint coordinate: JOINT=VALUE or JOINT[DOF]=VALUE (repeatable).
     #[arg(long, value_name = "JOINT=VALUE")]
     lock: Vec<String>,
-    /// Initial guess of a joint coordinate: JOINT=VALUE or JOINT\[DOF\]=VALUE (repeatable).
+    /// Initial guess of a joint coordinate: JOINT=VALUE or JOINT[DOF]=VALUE (repeatable).
     #[arg(long, value_name = "JOINT=VALUE")]
     initial: Vec<String>,
     /// Write the input file with the rest pose as `mech:initial` values (only when converged).
@@ -120,7 +182,7 @@ struct AnalyzeArgs {
     /// Maximum minimizer iterations.
     #[arg(long, default_value_t = 200)]
     max_iterations: usize,
-    /// Tolerance on the scaled reduced gradient \[J\].
+    /// Tolerance on the scaled reduced gradient [J].
     #[arg(long, default_value_t = 1e-8)]
     tolerance: f64,
     /// Tolerance on the constraint residual ‖Φ‖∞.
@@ -133,9 +195,6 @@ struct AnalyzeArgs {
     /// solve fails; 1: never).
     #[arg(long, default_value_t = 0, value_name = "N")]
     load_steps: usize,
-    /// Leave the root link free instead of welding it to the world.
-    #[arg(long)]
-    floating_base: bool,
     /// Stop at an unstable stationary point instead of leaving it.
     #[arg(long)]
     allow_unstable: bool,
@@ -172,13 +231,7 @@ fn coord(s: &str, what: &str) -> anyhow::Result<(String, usize, f64)> {
 }
 
 fn analyze(a: &AnalyzeArgs) -> anyhow::Result<u8> {
-    let mut opts = ImportOptions {
-        floating_base: a.floating_base,
-        ..Default::default()
-    };
-    if let Some(g) = &a.gravity {
-        opts.gravity = nalgebra::Vector3::new(g[0], g[1], g[2]);
-    }
+    let mut opts = a.input.options()?;
     for l in &a.lock {
         let (n, d, v) = coord(l, "lock")?;
         opts.locks.push((n, d, Some(v)));
@@ -258,11 +311,7 @@ fn analyze(a: &AnalyzeArgs) -> anyhow::Result<u8> {
 }
 
 fn verify(a: &VerifyArgs) -> anyhow::Result<u8> {
-    let mut opts = ImportOptions::default();
-    if let Some(g) = &a.gravity {
-        opts.gravity = nalgebra::Vector3::new(g[0], g[1], g[2]);
-    }
-    let loaded = load_file(&a.file, &opts)?;
+    let loaded = load_file(&a.file, &a.input.options()?)?;
     let model = &loaded.model;
     let mut values = match &a.pose {
         Some(p) => restpose::verify::read_pose(p)?,
@@ -367,6 +416,85 @@ fn verify(a: &VerifyArgs) -> anyhow::Result<u8> {
     }
 }
 
+fn check(a: &CheckArgs) -> anyhow::Result<u8> {
+    let loaded = load_file(&a.file, &a.input.options()?)?;
+    let s = restpose::export::summary::ModelSummary::new(&loaded);
+    if let Format::Json = a.format {
+        out!("{}", serde_json::to_string_pretty(&s)?);
+    } else {
+        out!(
+            "robot `{}`: {} bodies, {} coordinates, {} constraint rows, {}",
+            s.robot,
+            s.bodies.len(),
+            s.coordinates,
+            s.constraints,
+            s.dof.map_or(
+                "does not assemble at the initial guess".to_string(),
+                |d| format!("{d} degrees of freedom")
+            )
+        );
+        out!(
+            "  gravity [{}, {}, {}] m/s²",
+            s.gravity[0],
+            s.gravity[1],
+            s.gravity[2]
+        );
+        out!(
+            "  links welded to the world: {}",
+            if s.fixed_links.is_empty() {
+                "none".to_string()
+            } else {
+                s.fixed_links.join(", ")
+            }
+        );
+        out!("  bodies:");
+        for b in &s.bodies {
+            out!(
+                "    {:<28} {:>10.4} kg   links: {}",
+                b.name,
+                b.mass,
+                b.links.join(", ")
+            );
+        }
+        out!("  joints:");
+        for j in &s.joints {
+            out!(
+                "    {:<28} {:<13} {:<7} {} -> {}  ({} rows)",
+                j.name,
+                j.kind,
+                j.role,
+                j.parent,
+                j.child,
+                j.rows
+            );
+        }
+        for sp in &s.springs {
+            out!("  spring {sp}");
+        }
+        for f in &s.forces {
+            out!("  {f}");
+        }
+        if let Some(e) = &s.assembly_error {
+            out!("  assembly: {e}");
+        }
+    }
+    if !matches!(a.format, Format::Json) {
+        for w in &s.warnings {
+            eprintln!("warning: {w}");
+        }
+        if a.verbose {
+            for i in &s.ignored {
+                eprintln!("ignored: {}:{i}", a.file.display());
+            }
+        }
+    }
+    Ok(if s.assembly_error.is_some() {
+        EXIT_INPUT
+    } else {
+        0
+    })
+}
+
 fn print_summary(r: &AnalysisResult) {
     out!("robot `{}`", r.robot);
     out!(
@@ -460,6 +588,7 @@ fn main() -> ExitCode {
     let out = match &cli.command {
         Command::Analyze(a) => analyze(a),
         Command::Verify(a) => verify(a),
+        Command::Check(a) => check(a),
         Command::Generate { family, size } => {
             let text = match family {
                 Family::Chain => restpose::generate::chain(*size, false),

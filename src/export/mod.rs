@@ -3,6 +3,7 @@
 
 pub mod joint_states;
 pub mod json;
+pub mod summary;
 
 use crate::error::{Error, Result};
 use std::io::Write;

@@ -32,4 +32,8 @@ pub struct Link {
     pub body: Option<BodyId>,
     /// Link frame in the body frame (in the world frame when welded to the world).
     pub body_from_link: Isometry3<f64>,
+    /// `<visual>` geometry, in the link frame.
+    pub visuals: Vec<crate::geometry::Geometry>,
+    /// `<collision>` geometry, in the link frame.
+    pub collisions: Vec<crate::geometry::Geometry>,
 }

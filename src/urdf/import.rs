@@ -13,18 +13,22 @@ use super::extensions;
 use super::xml::{child, is_mech, Source};
 use super::{ImportOptions, Loaded};
 use crate::error::{Error, Result};
+use crate::geometry::{Geometry, PackagePaths, ShapeKind};
 use crate::math::align_z;
 use crate::model::{Body, BodyId, Joint, JointKind, Link, Model};
 use nalgebra::{Isometry3, Matrix3, UnitQuaternion, Vector3};
 use roxmltree::Node;
 use std::collections::HashMap;
 
-/// Mass properties of one link, in its link frame.
+/// Mass properties and geometry of one link, in its link frame.
 pub(super) struct LinkIn {
     pub(super) name: String,
     pub(super) mass: f64,
     pub(super) com: Vector3<f64>,
     pub(super) inertia: Matrix3<f64>,
+    pub(super) has_inertial: bool,
+    pub(super) visuals: Vec<Geometry>,
+    pub(super) collisions: Vec<Geometry>,
 }
 
 /// The model under construction, shared with the extension readers.
@@ -129,14 +133,118 @@ pub(super) fn repair_prefixes(
     Ok(out)
 }
 
-fn read_link(src: &Source, node: Node, warnings: &mut Vec<String>) -> Result<LinkIn> {
+/// The `<geometry>` of a `<visual>` or `<collision>`; `None` (with a warning) for a mesh that
+/// is not found or a shape restpose does not know.
+fn read_geometry(
+    src: &Source,
+    owner: Node,
+    link: &str,
+    packages: &PackagePaths,
+    warnings: &mut Vec<String>,
+) -> Result<Option<Geometry>> {
+    let link_from_shape = src.frame(child(owner, "origin"))?;
+    let Some(g) = child(owner, "geometry") else {
+        return Ok(None);
+    };
+    let Some(s) = g.children().find(|c| c.is_element()) else {
+        return Ok(None);
+    };
+    let positive = |attr: &str| -> Result<f64> {
+        let v = src.f64_opt(s, attr)?.ok_or_else(|| {
+            src.error(
+                s,
+                format!("link `{link}`: <{}> needs `{attr}`", s.tag_name().name()),
+            )
+        })?;
+        if v < 0.0 {
+            return Err(src.error(
+                s,
+                format!(
+                    "link `{link}`: <{}> has a negative {attr} {v}",
+                    s.tag_name().name()
+                ),
+            ));
+        }
+        Ok(v)
+    };
+    let shape = match s.tag_name().name() {
+        "box" => {
+            let size = src
+                .vec3_opt(s, "size")?
+                .ok_or_else(|| src.error(s, format!("link `{link}`: <box> needs `size`")))?;
+            ShapeKind::Box { size }
+        }
+        "cylinder" => ShapeKind::Cylinder {
+            radius: positive("radius")?,
+            length: positive("length")?,
+        },
+        "sphere" => ShapeKind::Sphere {
+            radius: positive("radius")?,
+        },
+        "capsule" => ShapeKind::Capsule {
+            radius: positive("radius")?,
+            length: positive("length")?,
+        },
+        "mesh" => {
+            let uri = src.req(s, "filename")?.to_string();
+            let scale = src.vec3_or(s, "scale", Vector3::new(1.0, 1.0, 1.0))?;
+            let path = match packages.resolve(&uri) {
+                Ok(p) => Some(p),
+                Err(why) => {
+                    let p = src.doc.text_pos_at(s.range().start);
+                    warnings.push(format!(
+                        "{}:{}:{}: link `{link}`: mesh not found: {why}",
+                        src.file, p.row, p.col
+                    ));
+                    None
+                }
+            };
+            ShapeKind::Mesh { uri, path, scale }
+        }
+        other => {
+            let p = src.doc.text_pos_at(s.range().start);
+            warnings.push(format!(
+                "{}:{}:{}: link `{link}`: unknown geometry <{other}> ignored",
+                src.file, p.row, p.col
+            ));
+            return Ok(None);
+        }
+    };
+    Ok(Some(Geometry {
+        link_from_shape,
+        shape,
+    }))
+}
+
+fn read_link(
+    src: &Source,
+    node: Node,
+    packages: &PackagePaths,
+    warnings: &mut Vec<String>,
+) -> Result<LinkIn> {
     let name = src.req(node, "name")?.to_string();
     let mut l = LinkIn {
+        has_inertial: child(node, "inertial").is_some(),
+        visuals: Vec::new(),
+        collisions: Vec::new(),
         name,
         mass: 0.0,
         com: Vector3::zeros(),
         inertia: Matrix3::zeros(),
     };
+    for c in node.children().filter(|c| c.is_element()) {
+        let g = match c.tag_name().name() {
+            "visual" | "collision" => read_geometry(src, c, &l.name, packages, warnings)?,
+            _ => None,
+        };
+        if let Some(g) = g {
+            if c.tag_name().name() == "visual" {
+                l.visuals.push(g);
+            } else {
+                l.collisions.push(g);
+            }
+        }
+    }
     if let Some(inertial) = child(node, "inertial") {
         let origin = src.frame(child(inertial, "origin"))?;
         if let Some(m) = child(inertial, "mass") {
@@ -198,7 +306,16 @@ fn inertia_problem(i: &Matrix3<f64>) -> Option<String> {
     None
 }
 
-pub(super) fn import(text: &str, file: &str, options: &ImportOptions) -> Result<Loaded> {
+pub(super) fn import(
+    text: &str,
+    file: &str,
+    urdf_dir: Option<std::path::PathBuf>,
+    options: &ImportOptions,
+) -> Result<Loaded> {
+    let packages = PackagePaths {
+        explicit: options.packages.clone(),
+        urdf_dir,
+    };
     let mut warnings = Vec::new();
     let text = repair_prefixes(text, file, &mut warnings)?;
     let popts = roxmltree::ParsingOptions {
@@ -257,7 +374,26 @@ pub(super) fn import(text: &str, file: &str, options: &ImportOptions) -> Result<
     let mut link_in = Vec::new();
     let mut link_index: HashMap<String, usize> = HashMap::new();
     for &n in &link_nodes {
-        let l = read_link(&src, n, &mut warnings)?;
+        let mut l = read_link(&src, n, &packages, &mut warnings)?;
+        if let (Some(density), false) = (options.inertia_density, l.has_inertial) {
+            let shapes = if l.collisions.is_empty() {
+                &l.visuals
+            } else {
+                &l.collisions
+            };
+            if !shapes.is_empty() {
+                match crate::geometry::mass_properties(shapes, density) {
+                    Ok((m, c, i)) => (l.mass, l.com, l.inertia) = (m, c, i),
+                    Err(why) => {
+                        let p = doc.text_pos_at(n.range().start);
+                        warnings.push(format!(
+                            "{file}:{}:{}: link `{}`: no mass from geometry: {why}",
+                            p.row, p.col, l.name
+                        ));
+                    }
+                }
+            }
+        }
         if link_index.insert(l.name.clone(), link_in.len()).is_some() {
             return Err(src.error(n, format!("duplicate link name `{}`", l.name)));
         }
@@ -490,6 +626,8 @@ pub(super) fn import(text: &str, file: &str, options: &ImportOptions) -> Result<
             name: l.name.clone(),
             body: body_of(i),
             body_from_link: body_from_link[i],
+            visuals: l.visuals.clone(),
+            collisions: l.collisions.clone(),
         });
     }
 

@@ -31,6 +31,11 @@ pub struct ImportOptions {
     pub locks: Vec<(String, usize, Option<f64>)>,
     /// Initial values `(joint, dof, value)` that override `mech:initial`.
     pub initial: Vec<(String, usize, f64)>,
+    /// `--package NAME=DIR`: where `package://NAME/…` meshes live.
+    pub packages: Vec<(String, std::path::PathBuf)>,
+    /// `--inertia-from-geometry DENSITY` \[kg/m³\]: links without `<inertial>` get the mass
+    /// properties of their collision geometry (or visual, if none) at this density.
+    pub inertia_density: Option<f64>,
 }
 
 impl Default for ImportOptions {
@@ -40,6 +45,8 @@ impl Default for ImportOptions {
             floating_base: false,
             locks: Vec::new(),
             initial: Vec::new(),
+            packages: Vec::new(),
+            inertia_density: None,
         }
     }
 }
@@ -66,10 +73,18 @@ pub fn load_file(path: impl AsRef<Path>, options: &ImportOptions) -> Result<Load
         path: path.display().to_string(),
         cause,
     })?;
-    load_str(&text, &path.display().to_string(), options)
+    let dir = path.parent().map(|d| {
+        if d.as_os_str().is_empty() {
+            std::path::PathBuf::from(".")
+        } else {
+            d.to_path_buf()
+        }
+    });
+    import::import(&text, &path.display().to_string(), dir, options)
 }
 
-/// Reads URDF text; `file` names it in error messages.
+/// Reads URDF text; `file` names it in error messages; relative mesh paths are taken from the
+/// current folder.
 ///
 /// # Errors
 /// [`Error::Input`] (with line and column) if the text is not a valid restpose URDF.
@@ -84,5 +99,5 @@ pub fn load_file(path: impl AsRef<Path>, options: &ImportOptions) -> Result<Load
 /// assert_eq!(loaded.model.bodies.len(), 1);
 /// ```
 pub fn load_str(text: &str, file: &str, options: &ImportOptions) -> Result<Loaded> {
-    import::import(text, file, options)
+    import::import(text, file, None, options)
 }

@@ -1,0 +1,200 @@
+//! The normalized model as `restpose check` prints it: what the importer understood.
+
+use crate::model::ForceLaw;
+use serde::Serialize;
+
+/// One body.
+#[derive(Clone, Debug, Serialize)]
+pub struct BodySummary {
+    /// Body name (its topmost link).
+    pub name: String,
+    /// Mass \[kg\].
+    pub mass: f64,
+    /// Links it carries.
+    pub links: Vec<String>,
+}
+
+/// One joint.
+#[derive(Clone, Debug, Serialize)]
+pub struct JointSummary {
+    /// Joint name.
+    pub name: String,
+    /// Type.
+    #[serde(rename = "type")]
+    pub kind: String,
+    /// Parent link (or frame).
+    pub parent: String,
+    /// Child link (or frame).
+    pub child: String,
+    /// `tree`, `loop` (closes a loop) or `merged` (a fixed joint inside a body).
+    pub role: String,
+    /// Constraint rows it adds.
+    pub rows: usize,
+}
+
+/// The model as understood.
+#[derive(Clone, Debug, Serialize)]
+pub struct ModelSummary {
+    /// Robot name.
+    pub robot: String,
+    /// Moving bodies.
+    pub bodies: Vec<BodySummary>,
+    /// Links welded to the world.
+    pub fixed_links: Vec<String>,
+    /// Joints.
+    pub joints: Vec<JointSummary>,
+    /// Springs as `name: link-link (law)`.
+    pub springs: Vec<String>,
+    /// Joint springs, loads, efforts, locks, mimics, as one line each.
+    pub forces: Vec<String>,
+    /// Gravity \[m/s²\].
+    pub gravity: [f64; 3],
+    /// Coordinates (7 per body).
+    pub coordinates: usize,
+    /// Constraint rows (normalization, locks and mimics included).
+    pub constraints: usize,
+    /// Degrees of freedom at the assembled initial guess (`None` if it does not assemble).
+    pub dof: Option<usize>,
+    /// Why the initial guess does not assemble, if it does not.
+    pub assembly_error: Option<String>,
+    /// Importer warnings.
+    pub warnings: Vec<String>,
+    /// Ignored foreign elements.
+    pub ignored: Vec<String>,
+}
+
+fn law(l: &ForceLaw) -> String {
+    match l {
+        ForceLaw::Linear { stiffness, preload } if *preload == 0.0 => format!("k = {stiffness}"),
+        ForceLaw::Linear { stiffness, preload } => format!("k = {stiffness}, preload {preload}"),
+        ForceLaw::Table { points, .. } => format!("table of {} points", points.len()),
+    }
+}
+
+impl ModelSummary {
+    /// Summarizes a loaded model.
+    pub fn new(loaded: &crate::urdf::Loaded) -> Self {
+        let m = &loaded.model;
+        let bodies = m
+            .bodies
+            .iter()
+            .enumerate()
+            .map(|(i, b)| BodySummary {
+                name: b.name.clone(),
+                mass: b.mass,
+                links: m
+                    .links
+                    .iter()
+                    .filter(|l| l.body.map(|x| x.0) == Some(i))
+                    .map(|l| l.name.clone())
+                    .collect(),
+            })
+            .collect();
+        let joints = m
+            .joints
+            .iter()
+            .map(|j| JointSummary {
+                name: j.name.clone(),
+                kind: j.kind.name().to_string(),
+                parent: j.parent_link.clone(),
+                child: j.child_link.clone(),
+                role: (if j.merged {
+                    "merged"
+                } else if j.tree {
+                    "tree"
+                } else {
+                    "loop"
+                })
+                .to_string(),
+                rows: crate::constraints::joint::row_count(j),
+            })
+            .collect();
+        let body_name = |b: Option<crate::model::BodyId>| {
+            b.map_or("world".to_string(), |b| m.bodies[b.0].name.clone())
+        };
+        let springs = m
+            .springs
+            .iter()
+            .map(|s| {
+                format!(
+                    "{}: {} – {}, free length {} m, {}",
+                    s.name,
+                    body_name(s.ends[0].body),
+                    body_name(s.ends[1].body),
+                    s.free_length,
+                    law(&s.law)
+                )
+            })
+            .collect();
+        let jn = |id: crate::model::JointId| m.joints[id.0].name.clone();
+        let mut forces: Vec<String> = Vec::new();
+        forces.extend(m.joint_springs.iter().map(|s| {
+            format!(
+                "joint spring on {}[{}]: {}, reference {}",
+                jn(s.joint),
+                s.dof,
+                law(&s.law),
+                s.reference
+            )
+        }));
+        forces.extend(m.loads.iter().map(|l| {
+            format!(
+                "load {} on {}: {:?} N",
+                l.name,
+                m.bodies[l.body.0].name,
+                l.force.as_slice()
+            )
+        }));
+        forces.extend(
+            m.efforts
+                .iter()
+                .map(|e| format!("effort on {}[{}]: {}", jn(e.joint), e.dof, e.value)),
+        );
+        forces.extend(m.locks.iter().map(|l| {
+            format!(
+                "lock {}[{}] at {}",
+                jn(l.joint),
+                l.dof,
+                l.value
+                    .map_or("the initial value".to_string(), |v| v.to_string())
+            )
+        }));
+        forces.extend(m.mimics.iter().map(|x| {
+            format!(
+                "mimic {} = {} × {} + {}",
+                jn(x.joint),
+                x.multiplier,
+                jn(x.reference),
+                x.offset
+            )
+        }));
+        let start = crate::solver::initial_state(m);
+        let (dof, assembly_error) =
+            match crate::verify::assemble(m, &start).and_then(|s| crate::verify::balance(m, &s)) {
+                Ok(b) => (Some(b.dof), None),
+                Err(e) => (None, Some(e.to_string())),
+            };
+        let constraints =
+            crate::constraints::Constraints::new(m, &crate::solver::lock_values(m)).len();
+        ModelSummary {
+            robot: m.name.clone(),
+            bodies,
+            fixed_links: m
+                .links
+                .iter()
+                .filter(|l| l.body.is_none())
+                .map(|l| l.name.clone())
+                .collect(),
+            joints,
+            springs,
+            forces,
+            gravity: m.gravity.into(),
+            coordinates: m.coordinate_count(),
+            constraints,
+            dof,
+            assembly_error,
+            warnings: loaded.warnings.clone(),
+            ignored: loaded.ignored.clone(),
+        }
+    }
+}

@@ -1,0 +1,294 @@
+//! Link geometry (URDF `<visual>` / `<collision>`), mesh files, and mass properties computed
+//! from geometry with parry3d. This is the one place that converts parry (glam) types.
+//!
+//! Mesh URIs are resolved in this order: `package://PKG/…` and `model://PKG/…` through a
+//! `--package PKG=DIR` option, then `ROS_PACKAGE_PATH` (`DIR/PKG`) and `AMENT_PREFIX_PATH`
+//! (`DIR/share/PKG`), then by walking up from the URDF's folder for a folder named `PKG`;
+//! `file://` and plain paths are taken as they are (relative to the URDF's folder). STL, OBJ
+//! and COLLADA meshes are read with `mesh-loader`.
+//!
+//! Mass properties for `--inertia-from-geometry ρ`: each shape's mass `ρ V`, centre of mass
+//! and inertia (parry3d), moved to the link frame and summed with the parallel-axis theorem.
+
+use nalgebra::{Isometry3, Matrix3, Vector3};
+use parry3d_f64::mass_properties::MassProperties;
+use parry3d_f64::math::{Pose, Rotation, Vector};
+use parry3d_f64::shape::{Ball, Capsule, Cuboid, Cylinder, Shape, TriMesh};
+use std::path::{Path, PathBuf};
+
+/// A geometric shape of a link.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ShapeKind {
+    /// Box with full edge lengths \[m\].
+    Box {
+        /// Edge lengths along x, y, z.
+        size: Vector3<f64>,
+    },
+    /// Cylinder along z.
+    Cylinder {
+        /// Radius \[m\].
+        radius: f64,
+        /// Length \[m\].
+        length: f64,
+    },
+    /// Sphere.
+    Sphere {
+        /// Radius \[m\].
+        radius: f64,
+    },
+    /// Capsule along z (cylinder of `length` with hemispherical caps).
+    Capsule {
+        /// Radius \[m\].
+        radius: f64,
+        /// Length of the cylindrical part \[m\].
+        length: f64,
+    },
+    /// Triangle mesh file.
+    Mesh {
+        /// The URI as written.
+        uri: String,
+        /// The file it resolved to (`None`: not found; the import warned).
+        path: Option<PathBuf>,
+        /// Scale factors.
+        scale: Vector3<f64>,
+    },
+}
+
+/// A shape placed in its link frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Geometry {
+    /// Shape frame in the link frame.
+    pub link_from_shape: Isometry3<f64>,
+    /// The shape.
+    pub shape: ShapeKind,
+}
+
+/// Where to look for `package://` and `model://` folders.
+#[derive(Clone, Debug, Default)]
+pub struct PackagePaths {
+    /// `--package NAME=DIR` options.
+    pub explicit: Vec<(String, PathBuf)>,
+    /// The URDF's folder (`None` for text without a file).
+    pub urdf_dir: Option<PathBuf>,
+}
+
+impl PackagePaths {
+    /// Resolves a mesh URI to an existing file, or says where it looked.
+    pub fn resolve(&self, uri: &str) -> Result<PathBuf, String> {
+        let base = self.urdf_dir.clone().unwrap_or_else(|| PathBuf::from("."));
+        let found = |p: PathBuf| {
+            if p.is_file() {
+                Ok(p)
+            } else {
+                Err(format!("`{}` does not exist", p.display()))
+            }
+        };
+        if let Some(rest) = uri.strip_prefix("file://") {
+            let p = PathBuf::from(rest);
+            return found(if p.is_absolute() { p } else { base.join(p) });
+        }
+        let Some(rest) = uri
+            .strip_prefix("package://")
+            .or_else(|| uri.strip_prefix("model://"))
+        else {
+            let p = PathBuf::from(uri);
+            return found(if p.is_absolute() { p } else { base.join(p) });
+        };
+        let (pkg, rel) = rest.split_once('/').unwrap_or((rest, ""));
+        let mut tried = Vec::new();
+        let mut candidates: Vec<PathBuf> = self
+            .explicit
+            .iter()
+            .filter(|(n, _)| n == pkg)
+            .map(|(_, d)| d.clone())
+            .collect();
+        for var in ["ROS_PACKAGE_PATH", "AMENT_PREFIX_PATH"] {
+            if let Ok(v) = std::env::var(var) {
+                for d in std::env::split_paths(&v) {
+                    candidates.push(if var == "AMENT_PREFIX_PATH" {
+                        d.join("share").join(pkg)
+                    } else {
+                        d.join(pkg)
+                    });
+                }
+            }
+        }
+        let mut up: Option<&Path> = Some(base.as_path());
+        while let Some(dir) = up {
+            if dir.file_name().is_some_and(|n| n == pkg) {
+                candidates.push(dir.to_path_buf());
+            }
+            candidates.push(dir.join(pkg));
+            up = dir.parent();
+        }
+        for c in candidates {
+            let p = c.join(rel);
+            if p.is_file() {
+                return Ok(p);
+            }
+            tried.push(c.display().to_string());
+        }
+        tried.truncate(4);
+        Err(format!(
+            "package `{pkg}` has no `{rel}` (looked in {}, …; use --package {pkg}=DIR)",
+            tried.join(", ")
+        ))
+    }
+}
+
+/// A triangle mesh: vertices \[m\] and index triples.
+pub type Triangles = (Vec<[f64; 3]>, Vec<[u32; 3]>);
+
+/// Triangles of a mesh file, scaled.
+///
+/// # Errors
+/// A message naming the file if it cannot be read or holds no triangles.
+pub fn load_mesh(path: &Path, scale: &Vector3<f64>) -> Result<Triangles, String> {
+    let scene = mesh_loader::Loader::default()
+        .load(path)
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut vertices = Vec::new();
+    let mut faces = Vec::new();
+    for m in &scene.meshes {
+        let offset = vertices.len() as u32;
+        vertices.extend(m.vertices.iter().map(|v| {
+            [
+                v[0] as f64 * scale.x,
+                v[1] as f64 * scale.y,
+                v[2] as f64 * scale.z,
+            ]
+        }));
+        faces.extend(
+            m.faces
+                .iter()
+                .map(|f| [f[0] + offset, f[1] + offset, f[2] + offset]),
+        );
+    }
+    if faces.is_empty() {
+        return Err(format!("{}: no triangles", path.display()));
+    }
+    Ok((vertices, faces))
+}
+
+fn pose(iso: &Isometry3<f64>) -> Pose {
+    let t = iso.translation.vector;
+    let r = iso.rotation;
+    Pose::from_parts(
+        Vector::new(t.x, t.y, t.z),
+        Rotation::from_xyzw(r.i, r.j, r.k, r.w),
+    )
+}
+
+fn shape_mass(shape: &ShapeKind, density: f64) -> Result<MassProperties, String> {
+    Ok(match shape {
+        ShapeKind::Box { size } => {
+            Cuboid::new(Vector::new(size.x / 2.0, size.y / 2.0, size.z / 2.0))
+                .mass_properties(density)
+        }
+        // parry's cylinders and capsules are along y: turn them onto z.
+        ShapeKind::Cylinder { radius, length } => Cylinder::new(length / 2.0, *radius)
+            .mass_properties(density)
+            .transform_by(&pose(&Isometry3::rotation(
+                Vector3::x() * std::f64::consts::FRAC_PI_2,
+            ))),
+        ShapeKind::Capsule { radius, length } => {
+            Capsule::new_z(length / 2.0, *radius).mass_properties(density)
+        }
+        ShapeKind::Sphere { radius } => Ball::new(*radius).mass_properties(density),
+        ShapeKind::Mesh {
+            path: Some(path),
+            scale,
+            ..
+        } => {
+            let (v, f) = load_mesh(path, scale)?;
+            let v = v
+                .into_iter()
+                .map(|p| Vector::new(p[0], p[1], p[2]))
+                .collect();
+            TriMesh::new(v, f)
+                .map_err(|e| format!("{}: {e:?}", path.display()))?
+                .mass_properties(density)
+        }
+        ShapeKind::Mesh {
+            uri, path: None, ..
+        } => return Err(format!("mesh `{uri}` was not found")),
+    })
+}
+
+/// Mass \[kg\], centre of mass and inertia about it (link frame) of `geometry` at `density`
+/// \[kg/m³\].
+///
+/// # Errors
+/// A message if a mesh cannot be read or the result is not a positive mass.
+pub fn mass_properties(
+    geometry: &[Geometry],
+    density: f64,
+) -> Result<(f64, Vector3<f64>, Matrix3<f64>), String> {
+    let mut total: Option<MassProperties> = None;
+    for g in geometry {
+        let mp = shape_mass(&g.shape, density)?.transform_by(&pose(&g.link_from_shape));
+        total = Some(match total {
+            Some(t) => t + mp,
+            None => mp,
+        });
+    }
+    let mp = total.ok_or("no geometry")?;
+    let mass = mp.mass();
+    if !(mass.is_finite() && mass > 0.0) {
+        return Err(format!(
+            "geometry gives a mass of {mass} kg (is the mesh closed and outward-facing?)"
+        ));
+    }
+    let c = mp.local_com;
+    let i = mp.reconstruct_inertia_matrix();
+    let cols = i.to_cols_array();
+    Ok((
+        mass,
+        Vector3::new(c.x, c.y, c.z),
+        Matrix3::from_column_slice(&cols),
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Closed forms: a box m (b² + c²)/12, a cylinder along z m r²/2 about z.
+    #[test]
+    fn primitive_mass_properties() {
+        let g = |shape, x: f64| Geometry {
+            link_from_shape: Isometry3::translation(x, 0.0, 0.0),
+            shape,
+        };
+        let (m, c, i) = mass_properties(
+            &[g(
+                ShapeKind::Box {
+                    size: Vector3::new(1.0, 2.0, 3.0),
+                },
+                0.5,
+            )],
+            10.0,
+        )
+        .unwrap();
+        assert!((m - 60.0).abs() < 1e-9);
+        assert!((c - Vector3::new(0.5, 0.0, 0.0)).norm() < 1e-12);
+        assert!((i[(0, 0)] - 60.0 * (4.0 + 9.0) / 12.0).abs() < 1e-9);
+        let (m, _, i) = mass_properties(
+            &[g(
+                ShapeKind::Cylinder {
+                    radius: 0.5,
+                    length: 2.0,
+                },
+                0.0,
+            )],
+            1.0,
+        )
+        .unwrap();
+        assert!((m - std::f64::consts::PI * 0.25 * 2.0).abs() < 1e-9);
+        assert!(
+            (i[(2, 2)] - m * 0.25 / 2.0).abs() < 1e-9,
+            "about the cylinder axis z"
+        );
+        assert!((i[(0, 0)] - m * (3.0 * 0.25 + 4.0) / 12.0).abs() < 1e-9);
+    }
+}

@@ -1,0 +1,189 @@
+//! Meshes, packages, mass properties from geometry, and `restpose check`.
+use approx::assert_abs_diff_eq;
+use restpose::urdf::{load_file, ImportOptions};
+use std::path::Path;
+use std::process::Command;
+
+/// A closed unit cube centred on the origin, as ASCII STL, OBJ and COLLADA.
+fn write_cube_meshes(dir: &Path) {
+    let v = [
+        [-0.5, -0.5, -0.5],
+        [0.5, -0.5, -0.5],
+        [0.5, 0.5, -0.5],
+        [-0.5, 0.5, -0.5],
+        [-0.5, -0.5, 0.5],
+        [0.5, -0.5, 0.5],
+        [0.5, 0.5, 0.5],
+        [-0.5, 0.5, 0.5],
+    ];
+    let f: [[usize; 3]; 12] = [
+        [0, 2, 1],
+        [0, 3, 2],
+        [4, 5, 6],
+        [4, 6, 7],
+        [0, 1, 5],
+        [0, 5, 4],
+        [1, 2, 6],
+        [1, 6, 5],
+        [2, 3, 7],
+        [2, 7, 6],
+        [3, 0, 4],
+        [3, 4, 7],
+    ];
+    let mut stl = String::from("solid cube\n");
+    for t in &f {
+        stl += "facet normal 0 0 0\nouter loop\n";
+        for &i in t {
+            stl += &format!("vertex {} {} {}\n", v[i][0], v[i][1], v[i][2]);
+        }
+        stl += "endloop\nendfacet\n";
+    }
+    stl += "endsolid cube\n";
+    std::fs::write(dir.join("cube.stl"), stl).unwrap();
+    let mut obj = String::new();
+    for p in &v {
+        obj += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+    }
+    for t in &f {
+        obj += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+    }
+    std::fs::write(dir.join("cube.obj"), obj).unwrap();
+    let pos: Vec<String> = v
+        .iter()
+        .flat_map(|p| p.iter().map(|x| x.to_string()))
+        .collect();
+    let idx: Vec<String> = f
+        .iter()
+        .flat_map(|t| t.iter().map(|i| i.to_string()))
+        .collect();
+    let dae = format!(
+        r##"<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+<asset><unit name="meter" meter="1"/><up_axis>Z_UP</up_axis></asset>
+<library_geometries><geometry id="cube" name="cube"><mesh>
+<source id="cube-pos"><float_array id="cube-pos-array" count="24">{}</float_array>
+<technique_common><accessor source="#cube-pos-array" count="8" stride="3"><param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/></accessor></technique_common></source>
+<vertices id="cube-vtx"><input semantic="POSITION" source="#cube-pos"/></vertices>
+<triangles count="12"><input semantic="VERTEX" source="#cube-vtx" offset="0"/><p>{}</p></triangles>
+</mesh></geometry></library_geometries>
+<library_visual_scenes><visual_scene id="s"><node id="n"><instance_geometry url="#cube"/></node></visual_scene></library_visual_scenes>
+<scene><instance_visual_scene url="#s"/></scene>
+</COLLADA>"##,
+        pos.join(" "),
+        idx.join(" ")
+    );
+    std::fs::write(dir.join("cube.dae"), dae).unwrap();
+}
+
+fn arm(mesh: &str) -> String {
+    format!(
+        r#"<robot name="mesh_arm" xmlns:mech="urn:urdf-mech:1"><link name="world"/>
+  <link name="arm"><collision><origin xyz="0.5 0 0"/><geometry><mesh filename="{mesh}" scale="0.2 0.2 0.2"/></geometry></collision>
+    <visual><geometry><box size="1 0.1 0.1"/></geometry></visual></link>
+  <joint name="j" type="revolute"><parent link="world"/><child link="arm"/><axis xyz="0 1 0"/></joint>
+  <mech:joint_spring joint="j" stiffness="20"/></robot>"#
+    )
+}
+
+/// A 0.2 m cube of density 1000 kg/m³ (8 kg) whose centre is at x = 0.5: the mass comes from
+/// each mesh format and the arm balances 20 θ = 8 g 0.5 cos θ.
+#[test]
+fn inertia_from_mesh_geometry_in_every_format() {
+    let dir = tempfile::tempdir().unwrap();
+    let pkg = dir.path().join("share").join("mypkg").join("meshes");
+    std::fs::create_dir_all(&pkg).unwrap();
+    write_cube_meshes(&pkg);
+    let urdf_dir = dir.path().join("share").join("mypkg").join("urdf");
+    std::fs::create_dir_all(&urdf_dir).unwrap();
+    for ext in ["stl", "obj", "dae"] {
+        // Found by walking up from the URDF's folder to `mypkg`.
+        let file = urdf_dir.join(format!("arm_{ext}.urdf"));
+        std::fs::write(&file, arm(&format!("package://mypkg/meshes/cube.{ext}"))).unwrap();
+        let opts = ImportOptions {
+            inertia_density: Some(1000.0),
+            ..Default::default()
+        };
+        let l = load_file(&file, &opts).unwrap();
+        assert!(l.warnings.is_empty(), "{ext}: {:?}", l.warnings);
+        let b = &l.model.bodies[0];
+        assert_abs_diff_eq!(b.mass, 8.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(b.com.x, 0.5, epsilon = 1e-9);
+        assert_abs_diff_eq!(b.com.z, 0.0, epsilon = 1e-9);
+        // Inertia of a cube about its centre: m a² / 6.
+        assert_abs_diff_eq!(b.inertia[(1, 1)], 8.0 * 0.04 / 6.0, epsilon = 1e-9);
+        let (s, r) = restpose::solve(&l.model, &Default::default()).unwrap();
+        assert!(r.converged());
+        let th = s.joint_values(&l.model)[0].1[0];
+        assert_abs_diff_eq!(20.0 * th, 8.0 * 9.81 * 0.5 * th.cos(), epsilon = 1e-8);
+    }
+    // The same through --package and through file://.
+    let file = dir.path().join("elsewhere.urdf");
+    std::fs::write(&file, arm("package://other/cube.stl")).unwrap();
+    let opts = ImportOptions {
+        inertia_density: Some(1000.0),
+        packages: vec![("other".into(), pkg.clone())],
+        ..Default::default()
+    };
+    assert_abs_diff_eq!(
+        load_file(&file, &opts).unwrap().model.bodies[0].mass,
+        8.0,
+        epsilon = 1e-9
+    );
+    std::fs::write(
+        &file,
+        arm(&format!("file://{}", pkg.join("cube.obj").display())),
+    )
+    .unwrap();
+    let opts = ImportOptions {
+        inertia_density: Some(1000.0),
+        ..Default::default()
+    };
+    assert_abs_diff_eq!(
+        load_file(&file, &opts).unwrap().model.bodies[0].mass,
+        8.0,
+        epsilon = 1e-9
+    );
+}
+
+/// A missing mesh is a warning with the file position, never an error or a panic; without
+/// --inertia-from-geometry a link with no <inertial> stays massless.
+#[test]
+fn missing_mesh_is_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("arm.urdf");
+    std::fs::write(&file, arm("package://nowhere/cube.stl")).unwrap();
+    let l = load_file(&file, &ImportOptions::default()).unwrap();
+    assert_eq!(l.model.bodies[0].mass, 0.0);
+    assert!(
+        l.warnings.iter().any(|w| w.contains("arm.urdf:2:")
+            && w.contains("mesh not found")
+            && w.contains("nowhere")),
+        "{:?}",
+        l.warnings
+    );
+}
+
+#[test]
+fn check_prints_the_model_and_json() {
+    let urdf = format!("{}/robots/slider_crank.urdf", env!("CARGO_MANIFEST_DIR"));
+    let o = Command::new(env!("CARGO_BIN_EXE_restpose"))
+        .args(["check", &urdf, "--format", "json"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["dof"], 1);
+    assert_eq!(v["bodies"].as_array().unwrap().len(), 3);
+    let roles: Vec<&str> = v["joints"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|j| j["role"].as_str().unwrap())
+        .collect();
+    assert_eq!(roles, ["tree", "tree", "tree", "loop"]);
+    let o = Command::new(env!("CARGO_BIN_EXE_restpose"))
+        .args(["check", &urdf])
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&o.stdout).contains("1 degrees of freedom"));
+}

@@ -4,7 +4,8 @@
 //! wrong eigenvalues (dimforge/nalgebra#1109; seen here on a 21 × 21 `JᵀJ`). Every eigenvalue
 //! is therefore recomputed as the Rayleigh quotient `λ_i = v_iᵀ A v_i`, and the residual
 //! `‖A V − V Λ‖` is checked; if it is still large the cyclic Jacobi method, slower but
-//! unconditionally convergent, is used instead.
+//! unconditionally convergent, is used instead. A matrix with non-finite entries gets NaN
+//! eigenvalues (the caller's tests then fail) rather than an endless iteration.
 //!
 //! ## References
 //! - G. H. Golub, C. F. Van Loan, *Matrix Computations*, 4th ed. (2013), §8.5 (Jacobi).
@@ -14,10 +15,22 @@ use nalgebra::{DMatrix, DVector};
 /// Eigenvalues (ascending) and matching orthonormal eigenvectors (columns) of a symmetric `a`.
 pub(crate) fn symmetric_eigen(a: &DMatrix<f64>) -> (DVector<f64>, DMatrix<f64>) {
     let n = a.nrows();
+    if a.iter().any(|x| !x.is_finite()) {
+        return (DVector::from_element(n, f64::NAN), DMatrix::identity(n, n));
+    }
     let scale = a.amax().max(f64::MIN_POSITIVE);
-    let e = nalgebra::SymmetricEigen::new(a.clone());
-    let mut vecs = e.eigenvectors;
-    let mut vals = DVector::from_fn(n, |i, _| vecs.column(i).dot(&(a * vecs.column(i))));
+    // Bounded iterations: nalgebra's `new` iterates without limit.
+    let (mut vals, mut vecs) =
+        match nalgebra::SymmetricEigen::try_new(a.clone(), f64::EPSILON, 10_000) {
+            Some(e) => {
+                let vecs = e.eigenvectors;
+                (
+                    DVector::from_fn(n, |i, _| vecs.column(i).dot(&(a * vecs.column(i)))),
+                    vecs,
+                )
+            }
+            None => jacobi(a),
+        };
     let residual = (a * &vecs - &vecs * DMatrix::from_diagonal(&vals)).amax();
     if residual.is_nan() || residual > 1e-9 * scale {
         (vals, vecs) = jacobi(a);

@@ -290,7 +290,10 @@ fn read_link(
 /// Why an inertia tensor is not physically valid (a principal moment negative, or one larger
 /// than the sum of the other two), if it is not.
 fn inertia_problem(i: &Matrix3<f64>) -> Option<String> {
-    let e = nalgebra::SymmetricEigen::new(*i).eigenvalues;
+    let Some(e) = nalgebra::SymmetricEigen::try_new(*i, f64::EPSILON, 1000).map(|e| e.eigenvalues)
+    else {
+        return Some("its eigenvalues cannot be computed".into());
+    };
     let tol = 1e-9 * e.amax().max(f64::MIN_POSITIVE);
     if e.min() < -tol {
         return Some(format!("principal moment {:.3e} < 0", e.min()));

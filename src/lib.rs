@@ -37,6 +37,8 @@ pub mod solver;
 pub mod state;
 pub mod urdf;
 pub mod verify;
+#[cfg(feature = "viewer")]
+pub mod view;
 
 pub use error::{Error, Result};
 pub use model::Model;

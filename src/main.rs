@@ -41,6 +41,8 @@ enum Command {
     Analyze(AnalyzeArgs),
     /// Load and validate a file without solving; print the model as understood.
     Check(CheckArgs),
+    /// Solve and open the rest pose in the rerun viewer (feature `viewer`).
+    View(AnalyzeArgs),
     /// Check whether a given pose is a rest pose, without moving it.
     Verify(VerifyArgs),
     /// Write a generated benchmark mechanism (URDF) to standard output.
@@ -151,14 +153,14 @@ enum Family {
     PlanarChain,
 }
 
-#[derive(Clone, Copy, ValueEnum)]
+#[derive(Clone, Copy, ValueEnum, Debug)]
 enum MethodArg {
     Newton,
     Bfgs,
     Dfp,
 }
 
-#[derive(clap::Args)]
+#[derive(clap::Args, Clone)]
 struct AnalyzeArgs {
     /// URDF file.
     file: PathBuf,
@@ -173,6 +175,9 @@ struct AnalyzeArgs {
     /// Initial guess of a joint coordinate: JOINT=VALUE or JOINT[DOF]=VALUE (repeatable).
     #[arg(long, value_name = "JOINT=VALUE")]
     initial: Vec<String>,
+    /// Write a rerun recording (.rrd) of the rest pose and the search (feature `viewer`).
+    #[arg(long, value_name = "OUT.rrd")]
+    rrd: Option<PathBuf>,
     /// Write the input file with the rest pose as `mech:initial` values (only when converged).
     #[arg(long, value_name = "OUT.urdf")]
     write_urdf: Option<PathBuf>,
@@ -251,6 +256,7 @@ fn analyze(a: &AnalyzeArgs) -> anyhow::Result<u8> {
         }
     }
     let options = Options {
+        record_iterates: a.rrd.is_some(),
         method: match a.method {
             MethodArg::Newton => Method::Newton,
             MethodArg::Bfgs => Method::Bfgs,
@@ -268,6 +274,9 @@ fn analyze(a: &AnalyzeArgs) -> anyhow::Result<u8> {
     let result = AnalysisResult::new(model, &state, &report);
     if let Some(path) = &a.json {
         restpose::export::write_atomic(path, result.to_json().as_bytes())?;
+    }
+    if let Some(path) = &a.rrd {
+        write_rrd(path, model, &state, &report)?;
     }
     if result.converged {
         if let Some(path) = &a.write_urdf {
@@ -414,6 +423,53 @@ fn verify(a: &VerifyArgs) -> anyhow::Result<u8> {
         }
         Ok(EXIT_NOT_BALANCED)
     }
+}
+
+#[cfg(feature = "viewer")]
+fn write_rrd(
+    path: &std::path::Path,
+    model: &restpose::Model,
+    state: &restpose::State,
+    report: &restpose::Report,
+) -> anyhow::Result<()> {
+    restpose::view::write_recording(path, model, state, report)?;
+    Ok(())
+}
+
+#[cfg(not(feature = "viewer"))]
+fn write_rrd(
+    path: &std::path::Path,
+    _: &restpose::Model,
+    _: &restpose::State,
+    _: &restpose::Report,
+) -> anyhow::Result<()> {
+    bail!(
+        "{}: this restpose was built without the `viewer` feature; rebuild with `cargo build --release --features viewer`",
+        path.display()
+    )
+}
+
+/// `restpose view`: solve, write a recording next to the input, open it in `rerun`.
+fn view(a: &AnalyzeArgs) -> anyhow::Result<u8> {
+    let rrd = a
+        .rrd
+        .clone()
+        .unwrap_or_else(|| a.file.with_extension("rrd"));
+    let mut args = AnalyzeArgs {
+        rrd: Some(rrd.clone()),
+        ..a.clone()
+    };
+    args.quiet = true;
+    let code = analyze(&args)?;
+    eprintln!("wrote {}", rrd.display());
+    match std::process::Command::new("rerun").arg(&rrd).spawn() {
+        Ok(_) => eprintln!("opened it in the rerun viewer"),
+        Err(_) => eprintln!(
+            "the `rerun` viewer is not on the PATH: `pip install rerun-sdk==0.36.3`, then `rerun {}`",
+            rrd.display()
+        ),
+    }
+    Ok(code)
 }
 
 fn check(a: &CheckArgs) -> anyhow::Result<u8> {
@@ -563,6 +619,12 @@ fn print_summary(r: &AnalysisResult) {
         let p: Vec<String> = j.position.iter().map(|v| format!("{v:.9}")).collect();
         out!("  {:<30} {:<13} [{}]", name, j.kind, p.join(", "));
     }
+    for v in &r.limit_violations {
+        out!(
+            "  warning: joint `{}` rests at {:.6}, outside its limits [{}, {}] (limits are not enforced)",
+            v.joint, v.position, v.limits[0], v.limits[1]
+        );
+    }
     if !r.reactions.is_empty() {
         out!();
         out!("  reaction on child at joint origin (world)   force [N]                          torque [N m]");
@@ -587,6 +649,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let out = match &cli.command {
         Command::Analyze(a) => analyze(a),
+        Command::View(a) => view(a),
         Command::Verify(a) => verify(a),
         Command::Check(a) => check(a),
         Command::Generate { family, size } => {

@@ -245,3 +245,27 @@ fn locked_arm_holding_torques_equal_gravity_torques() {
         assert_abs_diff_eq!(re.torque_world[1], -gravity, epsilon = 1e-9);
     }
 }
+
+/// Limits are not enforced, but a rest pose outside them is reported.
+#[test]
+fn rest_outside_limits_is_reported() {
+    let text = bar(1.0, "").replace(
+        r#"<joint name="pivot" type="continuous">"#,
+        r#"<joint name="pivot" type="revolute"><limit lower="0" upper="0.5"/>"#,
+    );
+    let m = model_from(&text);
+    let (s, r) = solve(&m);
+    let res = restpose::export::json::AnalysisResult::new(&m, &s, &r);
+    assert_eq!(res.limit_violations.len(), 1);
+    assert_eq!(res.limit_violations[0].joint, "pivot");
+    assert_abs_diff_eq!(
+        res.limit_violations[0].position,
+        -std::f64::consts::FRAC_PI_2,
+        epsilon = 1e-8
+    );
+    let fine = model_from(&bar(1.0, ""));
+    let (s, r) = solve(&fine);
+    assert!(restpose::export::json::AnalysisResult::new(&fine, &s, &r)
+        .limit_violations
+        .is_empty());
+}

@@ -106,3 +106,13 @@ fn foreign_elements_are_ignored_and_listed() {
     let l = load_str(&text, "t.urdf", &ImportOptions::default()).unwrap();
     assert_eq!(l.ignored.len(), 1, "{:?}", l.ignored);
 }
+
+/// Prefixes and `${` inside comments are not markup: no warning, no error.
+#[test]
+fn comments_do_not_trigger_prefix_repair_or_xacro_errors() {
+    let text = format!("<robot name=\"r\">\n<!-- see <drake:ball_constraint> and ${{x}} -->\n<link name=\"world\"/><link name=\"a\"/>{J}</robot>");
+    let l = load_str(&text, "t.urdf", &ImportOptions::default()).unwrap();
+    assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+    let e = load_str(&text.replace("<link name=\"a\"/>", "<link name=\"a\"><visual><geometry><box size=\"${s} 1 1\"/></geometry></visual></link>"), "t.urdf", &ImportOptions::default());
+    assert!(e.unwrap_err().to_string().contains("xacro"));
+}

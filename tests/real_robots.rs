@@ -22,19 +22,38 @@ fn drake_closed_chain_rests_where_an_independent_minimization_says() {
 /// `<limit>` without velocity, and `package://` meshes found by walking up from the file.
 #[test]
 fn gazebo_transmission_file_loads_its_springs_and_meshes() {
-    let path = format!("{}/robots/gazebo_transmission.urdf", env!("CARGO_MANIFEST_DIR"));
+    let path = format!(
+        "{}/robots/gazebo_transmission.urdf",
+        env!("CARGO_MANIFEST_DIR")
+    );
     let l = restpose::urdf::load_file(&path, &Default::default()).unwrap();
     assert!(l.warnings.is_empty(), "{:?}", l.warnings);
     assert_eq!(l.model.joint_springs.len(), 3);
-    let meshes = l.model.links.iter().flat_map(|k| k.visuals.iter().chain(&k.collisions)).filter(|g| {
-        matches!(&g.shape, restpose::geometry::ShapeKind::Mesh { path: Some(_), .. })
-    });
+    let meshes = l
+        .model
+        .links
+        .iter()
+        .flat_map(|k| k.visuals.iter().chain(&k.collisions))
+        .filter(|g| {
+            matches!(
+                &g.shape,
+                restpose::geometry::ShapeKind::Mesh { path: Some(_), .. }
+            )
+        });
     assert!(meshes.count() >= 3);
     let (s, r) = solve(&l.model);
     assert_eq!(r.stability.unwrap().verdict, "stable");
     // The same springs written as mech:joint_spring give the same rest pose (0.3170, 0.3188).
-    assert_abs_diff_eq!(joint(&l.model, &s, "shoulder_joint")[0], 0.3170, epsilon = 1e-4);
-    assert_abs_diff_eq!(joint(&l.model, &s, "elbow_joint")[0], 0.3188, epsilon = 1e-4);
+    assert_abs_diff_eq!(
+        joint(&l.model, &s, "shoulder_joint")[0],
+        0.3170,
+        epsilon = 1e-4
+    );
+    assert_abs_diff_eq!(
+        joint(&l.model, &s, "elbow_joint")[0],
+        0.3188,
+        epsilon = 1e-4
+    );
 }
 
 /// Panda-class arm: the mimic finger follows the driven one.
@@ -60,7 +79,9 @@ fn ur5_spring_torques_equal_gravity_torques() {
     for js in &m.joint_springs {
         let j = m.joint(js.joint);
         let theta = joint(&m, &s, &j.name)[0];
-        let restpose::model::ForceLaw::Linear { stiffness, .. } = js.law else { continue };
+        let restpose::model::ForceLaw::Linear { stiffness, .. } = js.law else {
+            continue;
+        };
         let spring = -stiffness * (theta - js.reference);
         let e = v.imbalance.iter().find(|i| i.joint == j.name).unwrap();
         // Without its spring, the joint must exert what the spring exerted, −k (θ − θ_ref).

@@ -26,6 +26,17 @@ pub struct LinkResult {
     pub orientation_wxyz: [f64; 4],
 }
 
+/// A joint at rest outside its URDF `<limit>` (limits are not enforced; this says so).
+#[derive(Clone, Debug, Serialize)]
+pub struct LimitViolation {
+    /// Joint name.
+    pub joint: String,
+    /// Its rest position [rad or m].
+    pub position: f64,
+    /// `[lower, upper]`.
+    pub limits: [f64; 2],
+}
+
 /// The whole result, as written by `restpose analyze --json`.
 #[derive(Clone, Debug, Serialize)]
 pub struct AnalysisResult {
@@ -60,6 +71,8 @@ pub struct AnalysisResult {
     pub energy: Energy,
     /// Solver counters.
     pub diagnostics: Diagnostics,
+    /// Joints resting outside their URDF limits (not enforced).
+    pub limit_violations: Vec<LimitViolation>,
     /// Bodies, coordinates, constraint rows.
     pub bodies: usize,
     /// Cartesian coordinates (7 per body).
@@ -71,7 +84,7 @@ pub struct AnalysisResult {
 impl AnalysisResult {
     /// Builds the result of a solve.
     pub fn new(model: &Model, state: &State, report: &Report) -> Self {
-        let joints = state
+        let joints: BTreeMap<String, JointResult> = state
             .joint_values(model)
             .into_iter()
             .zip(&model.joints)
@@ -105,7 +118,29 @@ impl AnalysisResult {
                 ))
             })
             .collect();
+        let limit_violations = model
+            .joints
+            .iter()
+            .filter(|j| {
+                matches!(
+                    j.kind,
+                    crate::model::JointKind::Revolute | crate::model::JointKind::Prismatic
+                )
+            })
+            .filter_map(|j| {
+                let [lo, hi] = j.limits?;
+                let p = joints
+                    .get(&j.name)
+                    .and_then(|r: &JointResult| r.position.first().copied())?;
+                (hi > lo && (p < lo - 1e-9 || p > hi + 1e-9)).then(|| LimitViolation {
+                    joint: j.name.clone(),
+                    position: p,
+                    limits: [lo, hi],
+                })
+            })
+            .collect();
         AnalysisResult {
+            limit_violations,
             robot: model.name.clone(),
             converged: report.converged(),
             termination: report.termination.as_str().to_string(),

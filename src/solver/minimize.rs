@@ -32,6 +32,8 @@ pub(crate) struct Outcome {
     /// Reduced-Hessian eigenvalues and eigenvectors at `q`, when the convergence test
     /// computed them.
     pub(crate) eigen: Option<(DVector<f64>, DMatrix<f64>)>,
+    /// The accepted iterates, when `Options::record_iterates` is set.
+    pub(crate) iterates: Vec<DVector<f64>>,
     pub(crate) eval: Eval,
     pub(crate) termination: Termination,
     pub(crate) history: Vec<Iterate>,
@@ -102,6 +104,7 @@ pub(crate) fn minimize(
     let mut iteration = 0;
     let mut linear_steps = 0;
     let mut eigen = None;
+    let mut iterates = Vec::new();
     loop {
         let f = eval.merit;
         let gnorm = eval.grad_v.amax();
@@ -116,6 +119,9 @@ pub(crate) fn minimize(
                 potential_energy: eval.energy.total,
                 gradient_norm: gnorm,
             });
+            if options.record_iterates {
+                iterates.push(q.clone());
+            }
         }
         let mut negative_curvature = None;
         let eig = (dof > 0 && (options.method == Method::Newton || gnorm <= gtol))
@@ -267,6 +273,9 @@ pub(crate) fn minimize(
                         potential_energy: eval.energy.total,
                         gradient_norm: eval.grad_v.amax(),
                     });
+                    if options.record_iterates {
+                        iterates.push(q.clone());
+                    }
                     break;
                 }
                 // Re-partition when Φ_u becomes ill-conditioned.
@@ -302,6 +311,7 @@ pub(crate) fn minimize(
         q,
         part,
         eigen,
+        iterates,
         eval,
         termination,
         history,

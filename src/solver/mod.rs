@@ -261,6 +261,7 @@ fn solve_assembled(
         reactions,
         diagnostics: out.diagnostics,
         sizes: [model.bodies.len(), model.coordinate_count(), sys.cons.len()],
+        iterates: out.iterates.into_iter().map(|q| State { q }).collect(),
     };
     Ok((state, report))
 }

@@ -41,6 +41,9 @@ pub struct Options {
     /// Stop at a stationary point even if it is unstable (default: false: leave saddles and
     /// maxima along the direction of negative curvature).
     pub allow_unstable: bool,
+    /// Keep the configuration of every accepted iterate in [`crate::Report::iterates`] (for the
+    /// viewer's iteration timeline; default: false).
+    pub record_iterates: bool,
 }
 
 impl Default for Options {
@@ -54,6 +57,7 @@ impl Default for Options {
             max_step: 0.3,
             load_steps: 0,
             allow_unstable: false,
+            record_iterates: false,
         }
     }
 }

@@ -127,6 +127,9 @@ pub struct Report {
     pub diagnostics: Diagnostics,
     /// Number of bodies, coordinates and constraint rows.
     pub sizes: [usize; 3],
+    /// The configuration at each entry of `history` (only with `Options::record_iterates`;
+    /// with load stepping, the last stage's).
+    pub iterates: Vec<crate::State>,
 }
 
 impl Report {

@@ -96,39 +96,63 @@ pub(super) fn joint_axes(
     }
 }
 
+/// The xacro hint.
+const XACRO: &str =
+    "xacro macros are not expanded URDF: run `xacro FILE.urdf.xacro > FILE.urdf` first";
+
+/// Declares an undeclared `mech:` or `drake:` prefix (with a warning) and refuses xacro, by
+/// parsing: a prefix only counts where the XML parser meets it, not in comments.
 pub(super) fn repair_prefixes(
     text: &str,
     file: &str,
     warnings: &mut Vec<String>,
 ) -> Result<String> {
-    if let Some(off) = text.find("<xacro:").or_else(|| text.find("${")) {
-        let line = text[..off].matches('\n').count() as u32 + 1;
-        let col = (off - text[..off].rfind('\n').map_or(0, |p| p + 1)) as u32 + 1;
-        return Err(Error::Input {
-            file: file.to_string(),
-            line,
-            col,
-            message:
-                "xacro macros are not expanded URDF: run `xacro FILE.urdf.xacro > FILE.urdf` first"
-                    .into(),
-        });
-    }
     let mut out = text.to_string();
-    for (prefix, uri) in [
-        ("mech", super::xml::MECH_NS),
-        ("drake", "http://drake.mit.edu"),
-    ] {
-        let used = out.contains(&format!("<{prefix}:"));
-        let declared = out.contains(&format!("xmlns:{prefix}="));
-        if used && !declared {
-            if let Some(pos) = out.find("<robot") {
-                let at = pos + "<robot".len();
-                out.insert_str(at, &format!(" xmlns:{prefix}=\"{uri}\""));
-                warnings.push(format!(
-                    "{file}: the `{prefix}:` prefix is used but not declared; assumed xmlns:{prefix}=\"{uri}\""
-                ));
+    let popts = roxmltree::ParsingOptions {
+        allow_dtd: true,
+        ..Default::default()
+    };
+    for _ in 0..3 {
+        let (prefix, pos) = match roxmltree::Document::parse_with_options(&out, popts) {
+            Err(roxmltree::Error::UnknownNamespace(prefix, pos)) => (prefix, pos),
+            Err(_) => return Ok(out),
+            Ok(doc) => {
+                for n in doc.descendants().filter(|n| n.is_element()) {
+                    let xacro = n
+                        .tag_name()
+                        .namespace()
+                        .is_some_and(|u| u.contains("xacro"));
+                    if xacro || n.attributes().any(|a| a.value().contains("${")) {
+                        let p = doc.text_pos_at(n.range().start);
+                        return Err(Error::Input {
+                            file: file.to_string(),
+                            line: p.row,
+                            col: p.col,
+                            message: XACRO.into(),
+                        });
+                    }
+                }
+                return Ok(out);
             }
-        }
+        };
+        let uri = match prefix.as_str() {
+            "mech" => super::xml::MECH_NS,
+            "drake" => super::edges::DRAKE_NS,
+            "xacro" => {
+                return Err(Error::Input {
+                    file: file.to_string(),
+                    line: pos.row,
+                    col: pos.col,
+                    message: XACRO.into(),
+                })
+            }
+            _ => return Ok(out),
+        };
+        let Some(at) = out.find("<robot").map(|p| p + "<robot".len()) else {
+            return Ok(out);
+        };
+        out.insert_str(at, &format!(" xmlns:{prefix}=\"{uri}\""));
+        warnings.push(format!("{file}: the `{prefix}:` prefix is used but not declared; assumed xmlns:{prefix}=\"{uri}\""));
     }
     Ok(out)
 }

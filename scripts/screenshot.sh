@@ -21,5 +21,8 @@ cargo build --release --features viewer -q
 rrd="$(mktemp -d)/$(basename "${urdf%.urdf}").rrd"
 "$CARGO_TARGET_DIR/release/restpose" analyze "$urdf" --rrd "$rrd" -q
 mkdir -p "$(dirname "$png")"
-rerun --headless --screenshot-to "$png" --renderer vulkan "$rrd"
+# The headless viewer wants a runtime dir, and a window size (its default can exceed the GPU's
+# largest buffer with the software renderer).
+export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"
+rerun --headless --window-size 1280x720 --screenshot-to "$png" --renderer vulkan "$rrd"
 echo "wrote $png"

@@ -109,7 +109,7 @@ fn log_shape(
                     path,
                     &rerun::Mesh3D::new(v)
                         .with_triangle_indices(f)
-                        .with_albedo_factor(grey),
+                        .with_albedo_factor(rerun::Rgba32::from_rgb(170, 170, 180)),
                 )
             }
             Err(_) => Ok(()),

@@ -215,3 +215,48 @@ fn massless_fixed_chains_and_inertia_warning() {
     assert_abs_diff_eq!(tip.x, 1.0 * th.cos(), epsilon = 1e-12);
     assert_abs_diff_eq!(tip.z, -th.sin(), epsilon = 1e-12);
 }
+
+/// `mech:link_gravity enabled="false"` takes a link out of gravity; a `distance` loop joint
+/// (massless rod) and a `point_on_line` joint hold their geometry at rest.
+#[test]
+fn link_gravity_distance_and_point_on_line() {
+    let text = r#"<robot name="g" xmlns:mech="urn:urdf-mech:1"><link name="world"/>
+      <link name="a"><inertial><origin xyz="1 0 0"/><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+      <link name="b"><inertial><origin xyz="1 0 0"/><mass value="3"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+      <joint name="ja" type="revolute"><parent link="world"/><child link="a"/><axis xyz="0 1 0"/></joint>
+      <joint name="jb" type="revolute"><parent link="world"/><child link="b"/><origin xyz="0 0.5 0"/><axis xyz="0 1 0"/></joint>
+      <mech:loop_joint name="rod" type="distance" length="0.5"><parent link="a"/><origin xyz="1 0 0"/><child link="b"/><child_origin xyz="1 0 0"/></mech:loop_joint>
+      <mech:joint_spring joint="ja" stiffness="30"/>
+      <mech:link_gravity link="b" enabled="false"/></robot>"#;
+    let m = model_from(text);
+    assert_eq!(
+        m.bodies
+            .iter()
+            .find(|b| b.name == "b")
+            .unwrap()
+            .gravity_mass,
+        0.0
+    );
+    let (s, r) = solve(&m);
+    assert_eq!(r.dof, 1);
+    assert_verified_minimum(&m, &s);
+    let pa = s.link_pose(&m, "a").unwrap() * nalgebra::Point3::new(1.0, 0.0, 0.0);
+    let pb = s.link_pose(&m, "b").unwrap() * nalgebra::Point3::new(1.0, 0.0, 0.0);
+    assert_abs_diff_eq!((pa - pb).norm(), 0.5, epsilon = 1e-10);
+    // Only a's 1 kg feels gravity: the rod is parallel to y, carrying no moment about y, and
+    // 30 θ = 9.81 cos θ.
+    let th = joint(&m, &s, "ja")[0];
+    assert_abs_diff_eq!(30.0 * th, 9.81 * th.cos(), epsilon = 1e-8);
+
+    let pol = text.replace(
+        r#"<mech:loop_joint name="rod" type="distance" length="0.5"><parent link="a"/><origin xyz="1 0 0"/><child link="b"/><child_origin xyz="1 0 0"/></mech:loop_joint>"#,
+        r#"<mech:loop_joint name="rail" type="point_on_line"><parent link="a"/><origin xyz="1 0 0"/><child link="b"/><child_origin xyz="1 0 0"/><axis xyz="0 1 0"/></mech:loop_joint>"#,
+    );
+    let m = model_from(&pol);
+    let (s, _) = solve(&m);
+    assert_verified_minimum(&m, &s);
+    let pa = s.link_pose(&m, "a").unwrap() * nalgebra::Point3::new(1.0, 0.0, 0.0);
+    let pb = s.link_pose(&m, "b").unwrap() * nalgebra::Point3::new(1.0, 0.0, 0.0);
+    assert_abs_diff_eq!((pa - pb).x, 0.0, epsilon = 1e-10);
+    assert_abs_diff_eq!((pa - pb).z, 0.0, epsilon = 1e-10);
+}

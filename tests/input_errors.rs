@@ -33,6 +33,14 @@ fn each_error_names_file_line_and_element() {
         (with("<joint name=\"j\" type=\"hinge\"><parent link=\"world\"/><child link=\"a\"/></joint>"), "bad.urdf:4:", "unknown type \"hinge\""),
         (format!("{HEAD}<joint name=\"j\""), "bad.urdf:", "not well-formed XML"),
         (with(&format!("{J}\n<mech:spring name=\"s\" stiffness=\"1\" free_length=\"1\"><end link=\"a\"/></mech:spring>")), "bad.urdf:5:", "exactly two <end>"),
+        (with(&format!("{J}\n<joint name=\"j\" type=\"fixed\"><parent link=\"a\"/><child link=\"world\"/></joint>")), "bad.urdf:5:", "duplicate joint name `j`"),
+        (with(&format!("{J}\n<link name=\"b\"><inertial><mass value=\"nan\"/></inertial></link>")), "bad.urdf:5:", "is not a finite number"),
+        (with(&format!("{J}\n<link name=\"b\"><inertial><origin xyz=\"0 inf 0\"/><mass value=\"1\"/></inertial></link>")), "bad.urdf:5:", "must be 3 finite numbers"),
+        (
+            with(&format!("{J}\n<link name=\"b\"/><joint name=\"k\" type=\"revolute\"><parent link=\"a\"/><child link=\"b\"/><mimic joint=\"ghost\"/></joint>")),
+            "bad.urdf:5:",
+            "mimics an unknown joint `ghost`",
+        ),
         (
             with(&format!("{J}\n<link name=\"b\"/><link name=\"c\"/>\n<joint name=\"k\" type=\"revolute\"><parent link=\"a\"/><child link=\"b\"/><mimic joint=\"m\"/></joint>\n<joint name=\"m\" type=\"revolute\"><parent link=\"a\"/><child link=\"c\"/><mimic joint=\"k\"/></joint>")),
             "bad.urdf:",

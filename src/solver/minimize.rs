@@ -50,6 +50,22 @@ pub(crate) fn eigen_tolerance(eig: &DVector<f64>) -> f64 {
     1e-8 * eig.amax().max(1.0)
 }
 
+/// The inverse-Hessian approximation of BFGS / DFP in the current independent coordinates.
+struct QuasiNewton {
+    binv: DMatrix<f64>,
+    /// No update yet: the first one rescales the identity (Nocedal & Wright eq. 6.20).
+    fresh: bool,
+}
+
+impl QuasiNewton {
+    fn new(dof: usize) -> Self {
+        QuasiNewton {
+            binv: DMatrix::identity(dof, dof),
+            fresh: true,
+        }
+    }
+}
+
 fn quasi_newton_update(
     method: Method,
     b: &mut DMatrix<f64>,
@@ -83,6 +99,19 @@ fn quasi_newton_update(
     }
 }
 
+/// A fresh partition at `q`, its evaluation, and a reset quasi-Newton approximation.
+fn repartition(
+    sys: &mut System,
+    q: &DVector<f64>,
+    diag: &mut Diagnostics,
+) -> Option<(Partition, Eval, QuasiNewton)> {
+    let part = sys.partition(q);
+    diag.repartitions += 1;
+    let eval = sys.evaluate(q, &part)?;
+    let qn = QuasiNewton::new(part.independent.len());
+    Some((part, eval, qn))
+}
+
 pub(crate) fn minimize(
     sys: &mut System,
     mut q: DVector<f64>,
@@ -96,9 +125,7 @@ pub(crate) fn minimize(
     let mut eval = sys.evaluate(&q, &part)?;
     diag.function_evaluations += 1;
     let mut history = Vec::new();
-    let mut dof = part.independent.len();
-    let mut binv = DMatrix::identity(dof, dof);
-    let mut first_update = true;
+    let mut qn = QuasiNewton::new(part.independent.len());
     let mut just_repartitioned = false;
     let mut termination = Termination::MaxIterations;
     let mut iteration = 0;
@@ -124,6 +151,7 @@ pub(crate) fn minimize(
             }
         }
         let mut negative_curvature = None;
+        let dof = part.independent.len();
         let eig = (dof > 0 && (options.method == Method::Newton || gnorm <= gtol))
             .then(|| symmetric_eigen(&sys.reduced_hessian(&q, &part, &eval)));
         if gnorm <= gtol {
@@ -172,13 +200,12 @@ pub(crate) fn minimize(
                     }
                     d
                 }
-                _ => -(&binv * g),
+                _ => -(&qn.binv * g),
             }
         };
         if d.dot(g) > 0.0 {
             d = -g.clone();
-            binv = DMatrix::identity(dof, dof);
-            first_update = true;
+            qn = QuasiNewton::new(dof);
         }
         // Step limit on the motion of the whole mechanism, not on v alone: every body's Euler
         // parameters change by at most `max_step` (about 2·max_step rad of rotation) and its
@@ -257,8 +284,8 @@ pub(crate) fn minimize(
                 } else {
                     linear_steps = 0;
                 }
-                quasi_newton_update(options.method, &mut binv, &s, &y, first_update);
-                first_update = false;
+                quasi_newton_update(options.method, &mut qn.binv, &s, &y, qn.fresh);
+                qn.fresh = false;
                 q = qt;
                 eval = et;
                 iteration += 1;
@@ -282,21 +309,11 @@ pub(crate) fn minimize(
                 let u = eval.lu.u();
                 let diag_u = u.diagonal().abs();
                 if !diag_u.is_empty() && diag_u.min() < 1e-8 * diag_u.max() {
-                    part = sys.partition(&q);
-                    diag.repartitions += 1;
-                    eval = sys.evaluate(&q, &part)?;
-                    dof = part.independent.len();
-                    binv = DMatrix::identity(dof, dof);
-                    first_update = true;
+                    (part, eval, qn) = repartition(sys, &q, &mut diag)?;
                 }
             }
             None if !just_repartitioned => {
-                part = sys.partition(&q);
-                diag.repartitions += 1;
-                eval = sys.evaluate(&q, &part)?;
-                dof = part.independent.len();
-                binv = DMatrix::identity(dof, dof);
-                first_update = true;
+                (part, eval, qn) = repartition(sys, &q, &mut diag)?;
                 just_repartitioned = true;
             }
             None => {

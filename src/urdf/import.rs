@@ -345,19 +345,7 @@ pub(super) fn import(
     };
     let mut warnings = Vec::new();
     let text = repair_prefixes(text, file, &mut warnings)?;
-    let popts = roxmltree::ParsingOptions {
-        allow_dtd: true,
-        ..Default::default()
-    };
-    let doc = roxmltree::Document::parse_with_options(&text, popts).map_err(|e| {
-        let p = e.pos();
-        Error::Input {
-            file: file.to_string(),
-            line: p.row,
-            col: p.col,
-            message: format!("not well-formed XML: {e}"),
-        }
-    })?;
+    let doc = super::xml::parse_document(&text, file)?;
     let src = Source { file, doc: &doc };
     let robot = doc.root_element();
     if robot.tag_name().name() != "robot" {

@@ -8,7 +8,7 @@
 //! (quaternion `w x y z`; `x y z w qx qy qz`), a restpose extension of the format.
 
 use super::xml::MECH_NS;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::model::{JointKind, Model};
 use crate::state::State;
 use std::fmt::Write;
@@ -16,23 +16,11 @@ use std::fmt::Write;
 /// The URDF `text` (named `file` in errors) with `state`'s joint values as `mech:initial`.
 ///
 /// # Errors
-/// [`Error::Input`] if `text` is not well-formed XML.
+/// [`crate::Error::Input`] if `text` is not well-formed XML.
 pub fn with_initial_pose(text: &str, file: &str, model: &Model, state: &State) -> Result<String> {
     let mut warnings = Vec::new();
     let text = super::import::repair_prefixes(text, file, &mut warnings)?;
-    let opts = roxmltree::ParsingOptions {
-        allow_dtd: true,
-        ..Default::default()
-    };
-    let doc = roxmltree::Document::parse_with_options(&text, opts).map_err(|e| {
-        let p = e.pos();
-        Error::Input {
-            file: file.to_string(),
-            line: p.row,
-            col: p.col,
-            message: format!("not well-formed XML: {e}"),
-        }
-    })?;
+    let doc = super::xml::parse_document(&text, file)?;
     let robot = doc.root_element();
     let prefix = robot.lookup_prefix(MECH_NS).map(str::to_string);
     let tag = prefix.clone().map_or("mech".to_string(), |p| p);

@@ -158,6 +158,24 @@ impl Source<'_> {
     }
 }
 
+/// Parses XML text (DTDs allowed); a malformed document is an [`Error::Input`] at the
+/// position of the problem.
+pub(crate) fn parse_document<'a>(text: &'a str, file: &str) -> Result<roxmltree::Document<'a>> {
+    let opts = roxmltree::ParsingOptions {
+        allow_dtd: true,
+        ..Default::default()
+    };
+    roxmltree::Document::parse_with_options(text, opts).map_err(|e| {
+        let p = e.pos();
+        Error::Input {
+            file: file.to_string(),
+            line: p.row,
+            col: p.col,
+            message: format!("not well-formed XML: {e}"),
+        }
+    })
+}
+
 /// Parses a finite number.
 pub(crate) fn parse_f64(s: &str) -> Option<f64> {
     s.trim().parse::<f64>().ok().filter(|v| v.is_finite())

@@ -50,7 +50,7 @@ enum Command {
         /// Family.
         #[arg(value_enum)]
         family: Family,
-        /// Number of links.
+        /// Number of links (chains) or loops (ladder).
         #[arg(long, default_value_t = 20)]
         size: usize,
     },
@@ -151,6 +151,8 @@ enum Family {
     Chain,
     /// N-link planar chain (all axes parallel) with joint springs.
     PlanarChain,
+    /// Ladder of N closed four-bar loops.
+    Ladder,
 }
 
 #[derive(Clone, Copy, ValueEnum, Debug)]
@@ -656,6 +658,7 @@ fn main() -> ExitCode {
             let text = match family {
                 Family::Chain => restpose::generate::chain(*size, false),
                 Family::PlanarChain => restpose::generate::chain(*size, true),
+                Family::Ladder => restpose::generate::ladder(*size),
             };
             {
                 use std::io::Write;

@@ -273,3 +273,40 @@ fn load_stepping_rescues_a_far_tractor_start() {
     assert_eq!(r.diagnostics.load_steps, 8);
     assert!(max_link_distance(&m, &rest, &s) < 1e-7);
 }
+
+/// Generated ladder of parallelogram loops: one degree of freedom and three redundant rows
+/// per loop, and the rest angles are stationary for the ladder's energy written here
+/// independently in the posts' absolute angles (rungs stay horizontal).
+#[test]
+fn ladder_matches_minimal_coordinate_energy() {
+    let n = 6;
+    let m = model_from(&restpose::generate::ladder(n));
+    let (s, r) = solve(&m);
+    assert_eq!(r.dof, n);
+    assert_eq!(r.redundant_constraints.len(), 3 * n);
+    let phi: Vec<f64> = (0..n)
+        .map(|k| joint(&m, &s, &format!("hang_left{k}"))[0])
+        .collect();
+    let energy = |phi: &[f64]| {
+        let mut top = nalgebra::Vector2::new(0.0, 0.0);
+        let mut v = 0.0;
+        for k in 0..n {
+            let down = |len: f64| nalgebra::Vector2::new(len * phi[k].sin(), -len * phi[k].cos());
+            let left = top + down(0.15);
+            let right = top + nalgebra::Vector2::new(0.4, 0.0) + down(0.15);
+            let rung = top + down(0.3);
+            v += 9.81 * (left.y + right.y + rung.y);
+            v += 0.5 * 10.0 * (n - k) as f64 * (phi[k] - 0.1).powi(2);
+            top = rung;
+        }
+        v
+    };
+    assert_abs_diff_eq!(energy(&phi), r.energy.total, epsilon = 1e-9);
+    for k in 0..n {
+        let (mut p, mut q) = (phi.clone(), phi.clone());
+        p[k] += 1e-6;
+        q[k] -= 1e-6;
+        let g = (energy(&p) - energy(&q)) / 2e-6;
+        assert!(g.abs() < 1e-6, "∂V/∂φ{k} = {g}");
+    }
+}

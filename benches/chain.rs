@@ -2,6 +2,9 @@
 //! `cargo bench --bench chain [N …]` prints one row per family and size.
 use std::time::Instant;
 
+/// A benchmark family: its name and a generator of URDF text for size N.
+type Family = (&'static str, fn(usize) -> String);
+
 fn main() {
     let sizes: Vec<usize> = std::env::args()
         .skip(1)
@@ -14,7 +17,7 @@ fn main() {
     };
     println!("| family | N | coordinates | iterations | solve [ms] | ms / iteration |");
     println!("|---|---:|---:|---:|---:|---:|");
-    let families: [(&str, fn(usize) -> String); 2] = [
+    let families: [Family; 2] = [
         ("chain", |n| restpose::generate::chain(n, false)),
         ("ladder", |n| restpose::generate::ladder(n / 2)),
     ];

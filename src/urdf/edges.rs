@@ -121,13 +121,12 @@ pub(super) fn urdf_kind(
         "planar" => JointKind::Planar,
         "spherical" => JointKind::Spherical,
         "ball" => {
-            let p = src.doc.text_pos_at(node.range().start);
-            warnings.push(format!(
-                "{}:{}:{}: {} has type \"ball\", read as \"spherical\"",
-                src.file,
-                p.row,
-                p.col,
-                src.describe(node)
+            warnings.push(src.warning(
+                node,
+                format!(
+                    "{} has type \"ball\", read as \"spherical\"",
+                    src.describe(node)
+                ),
             ));
             JointKind::Spherical
         }

@@ -215,21 +215,16 @@ fn read_geometry(
             let path = match packages.resolve(&uri) {
                 Ok(p) => Some(p),
                 Err(why) => {
-                    let p = src.doc.text_pos_at(s.range().start);
-                    warnings.push(format!(
-                        "{}:{}:{}: link `{link}`: mesh not found: {why}",
-                        src.file, p.row, p.col
-                    ));
+                    warnings.push(src.warning(s, format!("link `{link}`: mesh not found: {why}")));
                     None
                 }
             };
             ShapeKind::Mesh { uri, path, scale }
         }
         other => {
-            let p = src.doc.text_pos_at(s.range().start);
-            warnings.push(format!(
-                "{}:{}:{}: link `{link}`: unknown geometry <{other}> ignored",
-                src.file, p.row, p.col
+            warnings.push(src.warning(
+                s,
+                format!("link `{link}`: unknown geometry <{other}> ignored"),
             ));
             return Ok(None);
         }
@@ -300,10 +295,9 @@ fn read_link(
             let r = origin.rotation.to_rotation_matrix();
             l.inertia = r.matrix() * local * r.matrix().transpose();
             if let Some(why) = inertia_problem(&local) {
-                let p = src.doc.text_pos_at(i.range().start);
-                warnings.push(format!(
-                    "{}:{}:{}: link `{}`: the inertia tensor is not physically valid ({why}); statics does not use it",
-                    src.file, p.row, p.col, l.name
+                warnings.push(src.warning(
+                    i,
+                    format!("link `{}`: the inertia tensor is not physically valid ({why}); statics does not use it", l.name),
                 ));
             }
         }
@@ -400,10 +394,9 @@ pub(super) fn import(
                 match crate::geometry::mass_properties(shapes, density) {
                     Ok((m, c, i)) => (l.mass, l.com, l.inertia) = (m, c, i),
                     Err(why) => {
-                        let p = doc.text_pos_at(n.range().start);
-                        warnings.push(format!(
-                            "{file}:{}:{}: link `{}`: no mass from geometry: {why}",
-                            p.row, p.col, l.name
+                        warnings.push(src.warning(
+                            n,
+                            format!("link `{}`: no mass from geometry: {why}", l.name),
                         ));
                     }
                 }

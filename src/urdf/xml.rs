@@ -26,6 +26,12 @@ impl Source<'_> {
         }
     }
 
+    /// A warning at `node`: `FILE:LINE:COLUMN: message`.
+    pub(crate) fn warning(&self, node: Node, message: impl std::fmt::Display) -> String {
+        let p = self.doc.text_pos_at(node.range().start);
+        format!("{}:{}:{}: {message}", self.file, p.row, p.col)
+    }
+
     /// Short description of an element for messages: ``joint `elbow` `` or `<origin>`.
     pub(crate) fn describe(&self, node: Node) -> String {
         let tag = node.tag_name().name();

@@ -315,13 +315,41 @@ pub(crate) fn global_index(bodies: &[Option<crate::model::BodyId>; 2], i: usize)
     bodies[i / 7].map(|b| 7 * b.0 + i % 7)
 }
 
-/// Adds `c ∇f` to the global vector `g` and `c ∇²f` to the global matrix `h` (if given).
-pub(crate) fn scatter(
+/// Where second derivatives over body pairs are accumulated: a dense matrix (small models) or
+/// the block-sparse Hessian of the large-scale path.
+pub(crate) trait HessianSink {
+    /// Adds `c h` for the local Hessian `h` over the coordinates of `bodies`.
+    fn add_block(&mut self, bodies: &[Option<crate::model::BodyId>; 2], h: &LMat, c: f64);
+    /// Adds `v` at the global position `(i, j)`.
+    fn add_entry(&mut self, i: usize, j: usize, v: f64);
+}
+
+impl HessianSink for nalgebra::DMatrix<f64> {
+    fn add_block(&mut self, bodies: &[Option<crate::model::BodyId>; 2], h: &LMat, c: f64) {
+        for i in 0..NL {
+            let Some(gi) = global_index(bodies, i) else {
+                continue;
+            };
+            for j in 0..NL {
+                if let Some(gj) = global_index(bodies, j) {
+                    self[(gi, gj)] += c * h[(i, j)];
+                }
+            }
+        }
+    }
+
+    fn add_entry(&mut self, i: usize, j: usize, v: f64) {
+        self[(i, j)] += v;
+    }
+}
+
+/// Adds `c ∇f` to the global vector `g` and `c ∇²f` to the Hessian sink `h` (if given).
+pub(crate) fn scatter<'h>(
     bodies: &[Option<crate::model::BodyId>; 2],
     f: &Scalar,
     c: f64,
     g: &mut nalgebra::DVector<f64>,
-    h: Option<&mut nalgebra::DMatrix<f64>>,
+    h: Option<&mut (dyn HessianSink + 'h)>,
 ) {
     for i in 0..NL {
         if let Some(gi) = global_index(bodies, i) {
@@ -329,15 +357,6 @@ pub(crate) fn scatter(
         }
     }
     if let Some(h) = h {
-        for i in 0..NL {
-            let Some(gi) = global_index(bodies, i) else {
-                continue;
-            };
-            for j in 0..NL {
-                if let Some(gj) = global_index(bodies, j) {
-                    h[(gi, gj)] += c * f.h[(i, j)];
-                }
-            }
-        }
+        h.add_block(bodies, &f.h, c);
     }
 }

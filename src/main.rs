@@ -4,7 +4,7 @@ use anyhow::{bail, Context};
 use clap::{Parser, Subcommand, ValueEnum};
 use restpose::export::json::AnalysisResult;
 use restpose::urdf::{load_file, ImportOptions};
-use restpose::{Method, Options};
+use restpose::{LinearAlgebra, Method, Options};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -156,6 +156,13 @@ enum Family {
 }
 
 #[derive(Clone, Copy, ValueEnum, Debug)]
+enum LinearAlgebraArg {
+    Auto,
+    Dense,
+    Sparse,
+}
+
+#[derive(Clone, Copy, ValueEnum, Debug)]
 enum MethodArg {
     Newton,
     Bfgs,
@@ -198,6 +205,10 @@ struct AnalyzeArgs {
     /// Minimizer.
     #[arg(long, value_enum, default_value = "newton")]
     method: MethodArg,
+    /// Linear algebra: dense matrices (small models), sparse (partition body by body, faer
+    /// sparse LU, Newton steps from the sparse KKT system), or auto: sparse above 40 bodies.
+    #[arg(long, value_enum, default_value = "auto")]
+    linear_algebra: LinearAlgebraArg,
     /// Ramp gravity, loads and efforts in N steps (0: automatic, 8 steps only if the direct
     /// solve fails; 1: never).
     #[arg(long, default_value_t = 0, value_name = "N")]
@@ -263,6 +274,11 @@ fn analyze(a: &AnalyzeArgs) -> anyhow::Result<u8> {
             MethodArg::Newton => Method::Newton,
             MethodArg::Bfgs => Method::Bfgs,
             MethodArg::Dfp => Method::Dfp,
+        },
+        linear_algebra: match a.linear_algebra {
+            LinearAlgebraArg::Auto => LinearAlgebra::Auto,
+            LinearAlgebraArg::Dense => LinearAlgebra::Dense,
+            LinearAlgebraArg::Sparse => LinearAlgebra::Sparse,
         },
         gradient_tolerance: a.tolerance,
         constraint_tolerance: a.constraint_tolerance,

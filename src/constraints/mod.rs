@@ -7,7 +7,7 @@
 
 pub(crate) mod joint;
 
-use crate::jet::{pair_of, scatter, Scalar};
+use crate::jet::{pair_of, HessianSink, LMat, Scalar};
 use crate::model::{BodyId, JointId, Model};
 use nalgebra::{DMatrix, DVector};
 
@@ -207,9 +207,8 @@ impl Constraints {
                 if let Some(t) = jac.as_deref_mut() {
                     for i in 0..crate::jet::NL {
                         if let Some(gi) = crate::jet::global_index(bodies, i) {
-                            if s.g[i] != 0.0 {
-                                t.entries.push((row, gi, c * s.g[i]));
-                            }
+                            // Zeros too: the sparsity pattern must not depend on `q`.
+                            t.entries.push((row, gi, c * s.g[i]));
                         }
                     }
                 }
@@ -227,27 +226,45 @@ impl Constraints {
         });
     }
 
-    /// Adds `Σ_k w_k ∇²Φ_k(q)` to `h`.
+    /// Adds `Σ_k w_k ∇²Φ_k(q)` to `h`; the rows of a joint are summed into one local
+    /// Hessian before they reach the sink.
     pub(crate) fn add_hessian(
         &self,
         model: &Model,
         q: &DVector<f64>,
         w: &DVector<f64>,
-        h: &mut DMatrix<f64>,
+        h: &mut dyn HessianSink,
     ) {
-        let mut g = DVector::zeros(q.len());
+        let mut pending: Option<([Option<BodyId>; 2], LMat)> = None;
+        let flush = |p: &mut Option<([Option<BodyId>; 2], LMat)>, h: &mut dyn HessianSink| {
+            if let Some((bodies, acc)) = p.take() {
+                h.add_block(&bodies, &acc, 1.0);
+            }
+        };
         self.for_each_row(model, q, true, |row, term| match term {
             Term::Jet(bodies, s, c) => {
                 if w[row] != 0.0 {
-                    scatter(bodies, s, c * w[row], &mut g, Some(&mut *h));
+                    let same = pending.as_ref().is_some_and(|(b, _)| {
+                        b.iter()
+                            .map(|x| x.map(|y| y.0))
+                            .eq(bodies.iter().map(|x| x.map(|y| y.0)))
+                    });
+                    if !same {
+                        flush(&mut pending, h);
+                        pending = Some((*bodies, LMat::zeros()));
+                    }
+                    if let Some((_, acc)) = pending.as_mut() {
+                        *acc += s.h * (c * w[row]);
+                    }
                 }
             }
             Term::Normalization(b) => {
                 let i = 7 * b.0 + 3;
                 for k in 0..4 {
-                    h[(i + k, i + k)] += 2.0 * w[row];
+                    h.add_entry(i + k, i + k, 2.0 * w[row]);
                 }
             }
         });
+        flush(&mut pending, h);
     }
 }

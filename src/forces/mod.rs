@@ -11,7 +11,7 @@ pub(crate) mod law;
 use crate::constraints::joint;
 use crate::jet::{pair_of, scatter, Pair, Scalar, Vec3Jet};
 use crate::model::{BodyId, JointKind, Model, SpringMode};
-use nalgebra::{DMatrix, DVector, Vector3};
+use nalgebra::{DVector, Vector3};
 
 /// Potential energy split by source \[J\].
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
@@ -64,7 +64,7 @@ pub(crate) fn potential(
     model: &Model,
     q: &DVector<f64>,
     grad: &mut DVector<f64>,
-    mut hess: Option<&mut DMatrix<f64>>,
+    mut hess: Option<&mut dyn crate::jet::HessianSink>,
 ) -> Option<Energy> {
     let want_h = hess.is_some();
     let mut e = Energy::default();

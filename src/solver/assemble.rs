@@ -28,12 +28,11 @@ fn newton(
 ) -> std::result::Result<DVector<f64>, Failure> {
     const MAX: usize = 100;
     for it in 0..MAX {
-        let j = sys.jacobian(&q);
-        let phi = sys.phi().clone();
+        let phi = sys.residual(&q).clone();
         if sys.dimensionless_residual() <= tol {
             return Ok(q);
         }
-        let part = super::partition::partition(&j, &sys.row_scale, &sys.scale);
+        let part = sys.partition(&q);
         let rows_residual = |sys: &System, phi: &DVector<f64>| {
             part.rows
                 .iter()
@@ -54,10 +53,7 @@ fn newton(
                 .unwrap_or_else(|| phi.iamax());
             return Err(Failure::Inconsistent(worst));
         }
-        let r = part.rows.len();
-        let phi_u = nalgebra::DMatrix::from_fn(r, r, |a, b| j[(part.rows[a], part.dependent[b])]);
-        let rhs = DVector::from_fn(r, |a, _| -phi[part.rows[a]]);
-        let Some(du) = phi_u.lu().solve(&rhs) else {
+        let Some(du) = sys.dependent_step(&q, &part) else {
             return Err(Failure::Stuck(it));
         };
         let mut alpha = 1.0;
@@ -98,9 +94,9 @@ pub(crate) fn assemble(
         }
     }
     if held.len() > locks.len() {
-        let mut sys = System::new(model, Constraints::new(model, &held));
+        let mut sys = System::with_options(model, Constraints::new(model, &held), options);
         if let Ok(qa) = newton(&mut sys, q.clone(), tol) {
-            let mut fin = System::new(model, Constraints::new(model, locks));
+            let mut fin = System::with_options(model, Constraints::new(model, locks), options);
             fin.residual(&qa);
             if fin.dimensionless_residual() <= tol.max(1e-8) {
                 return Ok(qa);
@@ -118,7 +114,7 @@ pub(crate) fn project(
     options: &Options,
 ) -> Result<DVector<f64>> {
     let tol = options.constraint_tolerance;
-    let mut sys = System::new(model, Constraints::new(model, locks));
+    let mut sys = System::with_options(model, Constraints::new(model, locks), options);
     let q0 = q.clone();
     match newton(&mut sys, q, tol) {
         Ok(qa) => Ok(qa),

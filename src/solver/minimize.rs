@@ -18,10 +18,10 @@
 //! - R. Fletcher, M. J. D. Powell, A rapidly convergent descent method for minimization,
 //!   *Computer Journal* 6 (1963) 163–168.
 
-use super::eigen::symmetric_eigen;
 use super::options::{Method, Options};
 use super::partition::Partition;
 use super::report::{Diagnostics, Iterate, Termination};
+use super::spectrum::{spectrum, Spectrum};
 use super::system::{Eval, System};
 use nalgebra::{DMatrix, DVector};
 
@@ -31,7 +31,7 @@ pub(crate) struct Outcome {
     pub(crate) part: Partition,
     /// Reduced-Hessian eigenvalues and eigenvectors at `q`, when the convergence test
     /// computed them.
-    pub(crate) eigen: Option<(DVector<f64>, DMatrix<f64>)>,
+    pub(crate) eigen: Option<Spectrum>,
     /// The accepted iterates, when `Options::record_iterates` is set.
     pub(crate) iterates: Vec<DVector<f64>>,
     pub(crate) eval: Eval,
@@ -45,11 +45,6 @@ pub(crate) struct Outcome {
 /// default 1e-8 J only for models whose energy terms add up to more than 10⁵ J.
 const GRADIENT_FLOOR: f64 = 1e-13;
 
-/// Eigenvalue tolerance for the stability verdict.
-pub(crate) fn eigen_tolerance(eig: &DVector<f64>) -> f64 {
-    1e-8 * eig.amax().max(1.0)
-}
-
 /// The inverse-Hessian approximation of BFGS / DFP in the current independent coordinates.
 struct QuasiNewton {
     binv: DMatrix<f64>,
@@ -58,9 +53,12 @@ struct QuasiNewton {
 }
 
 impl QuasiNewton {
-    fn new(dof: usize) -> Self {
+    /// The identity for BFGS / DFP; empty for Newton, which has no use for it (a dense
+    /// `dof × dof` matrix would dominate time and memory on large models).
+    fn new(dof: usize, method: Method) -> Self {
+        let dim = if method == Method::Newton { 0 } else { dof };
         QuasiNewton {
-            binv: DMatrix::identity(dof, dof),
+            binv: DMatrix::identity(dim, dim),
             fresh: true,
         }
     }
@@ -103,13 +101,71 @@ fn quasi_newton_update(
 fn repartition(
     sys: &mut System,
     q: &DVector<f64>,
+    method: Method,
     diag: &mut Diagnostics,
 ) -> Option<(Partition, Eval, QuasiNewton)> {
     let part = sys.partition(q);
     diag.repartitions += 1;
     let eval = sys.evaluate(q, &part)?;
-    let qn = QuasiNewton::new(part.independent.len());
+    let qn = QuasiNewton::new(part.independent.len(), method);
     Some((part, eval, qn))
+}
+
+/// The diagonal of the bounding box of the body origins.
+fn extent(q: &DVector<f64>) -> f64 {
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for b in 0..q.len() / 7 {
+        for k in 0..3 {
+            lo[k] = lo[k].min(q[7 * b + k]);
+            hi[k] = hi[k].max(q[7 * b + k]);
+        }
+    }
+    (0..3)
+        .map(|k| (hi[k] - lo[k]).max(0.0).powi(2))
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// The Newton direction from the sparse KKT system (module `sparse::kkt`): the exact
+/// reduced Newton step if it is a descent direction, else the step with the `W` block shifted
+/// by `δ I`, `δ = 10⁻⁶ max|Ŵ_ii|` and growing a hundredfold until it is (a
+/// Levenberg–Marquardt-type modification of an indefinite reduced Hessian); the steepest
+/// descent direction if no shift works.
+fn kkt_direction(
+    sys: &mut System,
+    q: &DVector<f64>,
+    part: &Partition,
+    eval: &Eval,
+) -> DVector<f64> {
+    let g = &eval.grad_v;
+    // Right side `−S (V_qᵀ − Φ_qᵀ μ)`: zero on the dependent coordinates (`Φ_uᵀ μ = V_uᵀ`) and
+    // `−∇f` on the independent ones. It has the same projection `Zᵀ b = −∇f` as `−S V_qᵀ`,
+    // but is small near the minimum where `V_q` is not (the applied forces balanced by the
+    // constraint forces), so the solve's rounding error shrinks with the gradient.
+    let mut b = DVector::zeros(q.len());
+    for (k, &c) in part.independent.iter().enumerate() {
+        b[c] = -g[k];
+    }
+    let mut delta = 0.0;
+    for attempt in 0..12 {
+        if sys.factor_kkt(q, part, eval, attempt == 0, delta) {
+            if let Some(dq) = sys.kkt_solve(&b) {
+                let d = DVector::from_iterator(
+                    part.independent.len(),
+                    part.independent.iter().map(|&c| dq[c]),
+                );
+                if d.dot(g) < -1e-12 * d.norm() * g.norm() {
+                    return d;
+                }
+            }
+        }
+        delta = if delta == 0.0 {
+            1e-6 * sys.kkt_scale().max(1e-12)
+        } else {
+            delta * 100.0
+        };
+    }
+    -g.clone()
 }
 
 pub(crate) fn minimize(
@@ -125,7 +181,7 @@ pub(crate) fn minimize(
     let mut eval = sys.evaluate(&q, &part)?;
     diag.function_evaluations += 1;
     let mut history = Vec::new();
-    let mut qn = QuasiNewton::new(part.independent.len());
+    let mut qn = QuasiNewton::new(part.independent.len(), options.method);
     let mut just_repartitioned = false;
     let mut termination = Termination::MaxIterations;
     let mut iteration = 0;
@@ -152,27 +208,21 @@ pub(crate) fn minimize(
         }
         let mut negative_curvature = None;
         let dof = part.independent.len();
-        let eig = (dof > 0 && (options.method == Method::Newton || gnorm <= gtol))
-            .then(|| symmetric_eigen(&sys.reduced_hessian(&q, &part, &eval)));
+        let dense_newton = options.method == Method::Newton && !sys.sparse;
+        let eig =
+            (dof > 0 && (dense_newton || gnorm <= gtol)).then(|| spectrum(sys, &q, &part, &eval));
         if gnorm <= gtol {
             match &eig {
-                Some(e) if !options.allow_unstable => {
-                    let tol = eigen_tolerance(&e.0);
-                    let (imin, lmin) =
-                        e.0.iter()
-                            .enumerate()
-                            .fold(
-                                (0, f64::INFINITY),
-                                |a, (i, &l)| if l < a.1 { (i, l) } else { a },
-                            );
-                    if lmin < -tol {
-                        negative_curvature = Some(e.1.column(imin).into_owned());
-                    } else {
+                Some(e) if !options.allow_unstable => match e.lowest() {
+                    Some((imin, lmin)) if lmin < -e.tolerance() => {
+                        negative_curvature = Some(e.vectors.column(imin).into_owned());
+                    }
+                    _ => {
                         eigen = Some(e.clone());
                         termination = Termination::Converged;
                         break;
                     }
-                }
+                },
                 _ => {
                     eigen = eig.clone();
                     termination = Termination::Converged;
@@ -191,27 +241,31 @@ pub(crate) fn minimize(
             nc * scale
         } else {
             match (&eig, options.method) {
-                (Some(e), Method::Newton) => {
-                    let floor = 1e-8 * e.0.amax().max(1e-12);
+                (Some(e), Method::Newton) if e.exact => {
+                    let floor = 1e-8 * e.values.amax().max(1e-12);
                     let mut d = DVector::zeros(dof);
                     for i in 0..dof {
-                        let v = e.1.column(i);
-                        d -= v * (v.dot(g) / e.0[i].abs().max(floor));
+                        let v = e.vectors.column(i);
+                        d -= v * (v.dot(g) / e.values[i].abs().max(floor));
                     }
                     d
                 }
+                (_, Method::Newton) => kkt_direction(sys, &q, &part, &eval),
                 _ => -(&qn.binv * g),
             }
         };
         if d.dot(g) > 0.0 {
             d = -g.clone();
-            qn = QuasiNewton::new(dof);
+            qn = QuasiNewton::new(dof, options.method);
         }
         // Step limit on the motion of the whole mechanism, not on v alone: every body's Euler
         // parameters change by at most `max_step` (about 2·max_step rad of rotation) and its
-        // origin by at most 10·max_step characteristic lengths.
+        // origin by at most 10·max_step lengths `ℓ`, `ℓ` the larger of the characteristic
+        // length and the extent of the mechanism (the diagonal of the bounding box of the body
+        // origins): in a long chain, small joint rotations move the far links by about the
+        // chain's length, and a cap in link lengths would make the iteration count grow with N.
         let mut dq = sys.tangent_step(&part, &eval, &d);
-        let l = sys.model.length_scale;
+        let l = sys.model.length_scale.max(extent(&q));
         let (mut rot, mut pos) = (0.0f64, 0.0f64);
         for (i, x) in dq.iter().enumerate() {
             if i % 7 < 3 {
@@ -306,14 +360,12 @@ pub(crate) fn minimize(
                     break;
                 }
                 // Re-partition when Φ_u becomes ill-conditioned.
-                let u = eval.lu.u();
-                let diag_u = u.diagonal().abs();
-                if !diag_u.is_empty() && diag_u.min() < 1e-8 * diag_u.max() {
-                    (part, eval, qn) = repartition(sys, &q, &mut diag)?;
+                if eval.factors.ill_conditioned() {
+                    (part, eval, qn) = repartition(sys, &q, options.method, &mut diag)?;
                 }
             }
             None if !just_repartitioned => {
-                (part, eval, qn) = repartition(sys, &q, &mut diag)?;
+                (part, eval, qn) = repartition(sys, &q, options.method, &mut diag)?;
                 just_repartitioned = true;
             }
             None => {

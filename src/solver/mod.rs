@@ -21,9 +21,11 @@ mod options;
 pub(crate) mod partition;
 mod reactions;
 mod report;
+pub(crate) mod sparse;
+mod spectrum;
 pub(crate) mod system;
 
-pub use options::{Method, Options};
+pub use options::{LinearAlgebra, Method, Options};
 pub use report::{Diagnostics, Iterate, Reaction, Report, Stability, Termination};
 
 use crate::constraints::Constraints;
@@ -86,9 +88,10 @@ fn stability(
     q: &nalgebra::DVector<f64>,
     part: &partition::Partition,
     eval: &system::Eval,
-    (vals, vecs): &(nalgebra::DVector<f64>, nalgebra::DMatrix<f64>),
+    spectrum: &spectrum::Spectrum,
 ) -> Stability {
-    let tol = minimize::eigen_tolerance(vals);
+    let (vals, vecs) = (&spectrum.values, &spectrum.vectors);
+    let tol = spectrum.tolerance();
     let verdict = if vals[0] < -tol {
         "unstable"
     } else if vals[0] <= tol {
@@ -142,7 +145,7 @@ pub(crate) fn stability_at(model: &Model, q: &nalgebra::DVector<f64>) -> Option<
         return None;
     }
     let eval = sys.evaluate(q, &part)?;
-    let eig = eigen::symmetric_eigen(&sys.reduced_hessian(q, &part, &eval));
+    let eig = spectrum::spectrum(&mut sys, q, &part, &eval);
     Some(stability(&sys, q, &part, &eval, &eig))
 }
 
@@ -188,6 +191,9 @@ pub fn solve_from(model: &Model, start: State, options: &Options) -> Result<(Sta
     }
 }
 
+/// BFGS / DFP store a dense `dof × dof` inverse-Hessian approximation: refused above this.
+const QUASI_NEWTON_DOF_LIMIT: usize = 2000;
+
 /// Load steps tried when a direct solve does not converge (`Options::load_steps = 0`).
 const AUTOMATIC_LOAD_STEPS: usize = 8;
 
@@ -223,8 +229,20 @@ fn solve_assembled(
     locks: &[(JointId, usize, f64)],
     options: &Options,
 ) -> Result<(State, Report)> {
-    let mut sys = System::new(model, Constraints::new(model, locks));
+    let mut sys = System::with_options(model, Constraints::new(model, locks), options);
     let part = sys.partition(&q);
+    let dof0 = part.independent.len();
+    if options.method != Method::Newton && dof0 > QUASI_NEWTON_DOF_LIMIT {
+        return Err(Error::Option(format!(
+            "--method {}: BFGS and DFP keep a dense {dof0} × {dof0} matrix ({:.1} GB) for {dof0} \
+             degrees of freedom; use --method newton (sparse KKT steps) above {QUASI_NEWTON_DOF_LIMIT}",
+            serde_json::to_value(options.method)
+                .ok()
+                .and_then(|v| v.as_str().map(str::to_owned))
+                .unwrap_or_default(),
+            (dof0 * dof0 * 8) as f64 / 1e9
+        )));
+    }
     let out = minimize::minimize(&mut sys, q, part, options).ok_or_else(|| {
         Error::Undefined(
             "a force table with extrapolate=\"error\" is out of range, or Φ_u is singular".into(),
@@ -232,10 +250,14 @@ fn solve_assembled(
     })?;
     let state = State { q: out.q.clone() };
     let dof = out.part.independent.len();
+    let mut diagnostics = out.diagnostics;
+    diagnostics.linear_algebra = if sys.sparse { "sparse" } else { "dense" }.into();
     let stability = (dof > 0).then(|| {
-        let eig = out.eigen.clone().unwrap_or_else(|| {
-            eigen::symmetric_eigen(&sys.reduced_hessian(&out.q, &out.part, &out.eval))
-        });
+        let eig = out
+            .eigen
+            .clone()
+            .unwrap_or_else(|| spectrum::spectrum(&mut sys, &out.q, &out.part, &out.eval));
+        diagnostics.eigenvalues_by = if eig.exact { "exact" } else { "lanczos" }.into();
         stability(&sys, &out.q, &out.part, &out.eval, &eig)
     });
     let reactions = reactions::reactions(&sys, &out.q, &out.part, &out.eval);
@@ -259,7 +281,7 @@ fn solve_assembled(
             .collect(),
         stability,
         reactions,
-        diagnostics: out.diagnostics,
+        diagnostics,
         sizes: [model.bodies.len(), model.coordinate_count(), sys.cons.len()],
         iterates: out.iterates.into_iter().map(|q| State { q }).collect(),
     };

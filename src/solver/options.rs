@@ -14,6 +14,20 @@ pub enum Method {
     Dfp,
 }
 
+/// Linear algebra of the solver.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LinearAlgebra {
+    /// Dense up to 40 bodies (280 coordinates), sparse above (default).
+    #[default]
+    Auto,
+    /// Dense matrices: full-pivoting partition, dense LU, exact reduced Hessian. `O(N³)`.
+    Dense,
+    /// Sparse partition, sparse LU (faer), Newton steps from the sparse KKT system. `O(N)` per
+    /// iteration for chains, trees and ladders.
+    Sparse,
+}
+
 /// Options of [`crate::solve`].
 #[derive(Clone, Debug)]
 pub struct Options {
@@ -32,7 +46,8 @@ pub struct Options {
     pub max_corrector_iterations: usize,
     /// Step limit per iteration (default: 0.3): the largest change of any body's Euler
     /// parameters (0.3 is about 35° of rotation); body origins move at most ten times this in
-    /// characteristic lengths.
+    /// lengths `ℓ`, the larger of the characteristic length and the mechanism's extent (the
+    /// diagonal of the bounding box of the body origins).
     pub max_step: f64,
     /// Load stepping: solve with gravity, loads and efforts ramped in this many equal steps,
     /// each from the previous rest pose (default: 0 = automatic: the full load at once, and 8
@@ -41,6 +56,8 @@ pub struct Options {
     /// Stop at a stationary point even if it is unstable (default: false: leave saddles and
     /// maxima along the direction of negative curvature).
     pub allow_unstable: bool,
+    /// Dense or sparse linear algebra (default: automatic by size).
+    pub linear_algebra: LinearAlgebra,
     /// Keep the configuration of every accepted iterate in [`crate::Report::iterates`] (for the
     /// viewer's iteration timeline; default: false).
     pub record_iterates: bool,
@@ -58,6 +75,7 @@ impl Default for Options {
             load_steps: 0,
             allow_unstable: false,
             record_iterates: false,
+            linear_algebra: LinearAlgebra::Auto,
         }
     }
 }

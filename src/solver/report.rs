@@ -76,6 +76,11 @@ pub struct Diagnostics {
     pub load_steps: usize,
     /// Final `‖Φ‖∞`.
     pub constraint_residual: f64,
+    /// Linear algebra used: `"dense"` or `"sparse"` (see [`crate::solver::LinearAlgebra`]).
+    pub linear_algebra: String,
+    /// How the stability eigenvalues were found: `"exact"` (the reduced Hessian decomposed) or
+    /// `"lanczos"` (its low end only, for many degrees of freedom); empty without any.
+    pub eigenvalues_by: String,
 }
 
 impl Diagnostics {

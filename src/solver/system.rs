@@ -11,8 +11,12 @@
 //! gradients and Hessians are reported in the scaled coordinates `v̂`.
 
 use super::partition::{partition, Partition};
+use super::sparse::factor::{SparseFactors, Split};
+use super::sparse::hessian::BlockHessian;
+use super::sparse::kkt::Kkt;
 use crate::constraints::{Constraints, Triplets};
 use crate::forces::{potential, Energy};
+use crate::jet::HessianSink;
 use crate::model::Model;
 use nalgebra::{DMatrix, DVector, LU};
 
@@ -24,11 +28,93 @@ pub(crate) struct System<'a> {
     pub(crate) scale: Vec<f64>,
     /// Row scale per constraint row (`L^−k` for a row in m^k).
     pub(crate) row_scale: Vec<f64>,
+    /// Sparse linear algebra (module `sparse`) instead of dense matrices.
+    pub(crate) sparse: bool,
     phi: DVector<f64>,
     jac: Triplets,
+    split: Option<Split>,
+    kkt: Option<Kkt>,
+    hess: BlockHessian,
+}
+
+/// The factorization of `Φ_u` and the values of `Φ_v` at one configuration.
+#[derive(Clone)]
+pub(crate) enum Factors {
+    /// Dense LU with partial pivoting (small models).
+    Dense {
+        lu: LU<f64, nalgebra::Dyn, nalgebra::Dyn>,
+        phi_v: DMatrix<f64>,
+    },
+    /// faer's sparse LU.
+    Sparse(SparseFactors),
+}
+
+impl Factors {
+    /// `Φ_u x = b`; `None` if `Φ_u` is singular.
+    pub(crate) fn solve(&self, b: &DVector<f64>) -> Option<DVector<f64>> {
+        match self {
+            Factors::Dense { lu, .. } => {
+                if b.is_empty() {
+                    Some(b.clone())
+                } else {
+                    lu.solve(b)
+                }
+            }
+            Factors::Sparse(f) => {
+                let mut x = b.clone();
+                f.solve(x.as_mut_slice()).then_some(x)
+            }
+        }
+    }
+
+    /// `Φ_uᵀ x = b`; `None` if `Φ_u` is singular.
+    pub(crate) fn solve_transpose(&self, b: DVector<f64>) -> Option<DVector<f64>> {
+        match self {
+            Factors::Dense { lu, .. } => {
+                if b.is_empty() {
+                    return Some(b);
+                }
+                solve_transpose(lu, b)
+            }
+            Factors::Sparse(f) => {
+                let mut x = b;
+                f.solve_transpose(x.as_mut_slice()).then_some(x)
+            }
+        }
+    }
+
+    /// `Φ_v x`.
+    pub(crate) fn phi_v_mul(&self, x: &DVector<f64>, rows: usize) -> DVector<f64> {
+        match self {
+            Factors::Dense { phi_v, .. } => phi_v * x,
+            Factors::Sparse(f) => DVector::from_vec(f.phi_v_mul(x.as_slice(), rows)),
+        }
+    }
+
+    /// `Φ_vᵀ y`.
+    pub(crate) fn phi_v_tr_mul(&self, y: &DVector<f64>, dof: usize) -> DVector<f64> {
+        match self {
+            Factors::Dense { phi_v, .. } => phi_v.transpose() * y,
+            Factors::Sparse(f) => DVector::from_vec(f.phi_v_tr_mul(y.as_slice(), dof)),
+        }
+    }
+
+    /// Whether `Φ_u` has become ill-conditioned (dense: a pivot of `U` below `1e-8` of the
+    /// largest; the sparse factors do not tell, and the minimizer re-partitions when the
+    /// corrector or the line search fails instead).
+    pub(crate) fn ill_conditioned(&self) -> bool {
+        match self {
+            Factors::Dense { lu, .. } => {
+                let d = lu.u().diagonal().abs();
+                !d.is_empty() && d.min() < 1e-8 * d.max()
+            }
+            Factors::Sparse(_) => false,
+        }
+    }
 }
 
 /// Quantities at a feasible configuration under a partition.
+#[derive(Clone)]
 pub(crate) struct Eval {
     pub(crate) energy: Energy,
     /// `V − μᵀ Φ` over the independent rows: the energy corrected to first order for the
@@ -38,8 +124,7 @@ pub(crate) struct Eval {
     pub(crate) mu: DVector<f64>,
     /// Reduced gradient in scaled coordinates.
     pub(crate) grad_v: DVector<f64>,
-    pub(crate) lu: LU<f64, nalgebra::Dyn, nalgebra::Dyn>,
-    pub(crate) phi_v: DMatrix<f64>,
+    pub(crate) factors: Factors,
 }
 
 /// Column scale per coordinate: the characteristic length for positions, 1 for Euler
@@ -66,6 +151,9 @@ fn solve_transpose(
 #[derive(Debug)]
 pub(crate) struct CorrectorFailure;
 
+/// Models with more coordinates than this use the sparse path when the choice is automatic.
+pub(crate) const SPARSE_FROM_COORDINATES: usize = 7 * 40;
+
 impl<'a> System<'a> {
     pub(crate) fn new(model: &'a Model, cons: Constraints) -> Self {
         let scale = coordinate_scale(model);
@@ -80,7 +168,26 @@ impl<'a> System<'a> {
             jac: Triplets::default(),
             cons,
             scale,
+            sparse: model.coordinate_count() > SPARSE_FROM_COORDINATES,
+            split: None,
+            kkt: None,
+            hess: BlockHessian::default(),
         }
+    }
+
+    /// The system with the linear algebra of `options` (automatic: by size).
+    pub(crate) fn with_options(
+        model: &'a Model,
+        cons: Constraints,
+        options: &super::Options,
+    ) -> Self {
+        let mut sys = Self::new(model, cons);
+        match options.linear_algebra {
+            super::LinearAlgebra::Auto => {}
+            super::LinearAlgebra::Dense => sys.sparse = false,
+            super::LinearAlgebra::Sparse => sys.sparse = true,
+        }
+        sys
     }
 
     /// `Φ(q)`.
@@ -104,17 +211,96 @@ impl<'a> System<'a> {
         &self.phi
     }
 
-    /// Dense `Φ_q(q)` (and `Φ(q)` into the scratch).
-    pub(crate) fn jacobian(&mut self, q: &DVector<f64>) -> DMatrix<f64> {
+    /// `Φ(q)` and the triplets of `Φ_q(q)` into the scratch.
+    fn triplets(&mut self, q: &DVector<f64>) {
         self.cons
             .evaluate(self.model, q, &mut self.phi, Some(&mut self.jac));
+    }
+
+    /// Dense `Φ_q(q)` (and `Φ(q)` into the scratch).
+    #[cfg(test)]
+    pub(crate) fn jacobian(&mut self, q: &DVector<f64>) -> DMatrix<f64> {
+        self.triplets(q);
         self.jac.to_dense()
     }
 
-    /// Partition at `q`.
+    /// Partition at `q` (full pivoting of the dense `Φ_q`, or the sparse body-by-body
+    /// elimination).
     pub(crate) fn partition(&mut self, q: &DVector<f64>) -> Partition {
-        let j = self.jacobian(q);
-        partition(&j, &self.row_scale, &self.scale)
+        self.triplets(q);
+        if self.sparse {
+            super::sparse::partition::partition(
+                self.model,
+                self.cons.len(),
+                q.len(),
+                &self.jac.entries,
+                &self.row_scale,
+                &self.scale,
+            )
+        } else {
+            partition(&self.jac.to_dense(), &self.row_scale, &self.scale)
+        }
+    }
+
+    /// Factors `Φ_u` of the last triplets under `part`.
+    fn factors(&mut self, part: &Partition) -> Option<Factors> {
+        let n = self.model.coordinate_count();
+        let m = self.cons.len();
+        if self.sparse {
+            let entries = &self.jac.entries;
+            if !self
+                .split
+                .as_ref()
+                .is_some_and(|s| s.fits(part, entries.len()))
+            {
+                self.split = Some(Split::new(part, m, n, entries)?);
+            }
+            let split = self.split.as_mut()?;
+            return Some(Factors::Sparse(split.factor(entries)));
+        }
+        let r = part.rows.len();
+        let dof = part.independent.len();
+        let mut row_pos = vec![usize::MAX; m];
+        for (k, &i) in part.rows.iter().enumerate() {
+            row_pos[i] = k;
+        }
+        // Column position: dependent k, or independent dof-offset k.
+        let mut col_pos = vec![(false, 0usize); n];
+        for (k, &c) in part.dependent.iter().enumerate() {
+            col_pos[c] = (true, k);
+        }
+        for (k, &c) in part.independent.iter().enumerate() {
+            col_pos[c] = (false, k);
+        }
+        let mut phi_u = DMatrix::zeros(r, r);
+        let mut phi_v = DMatrix::zeros(r, dof);
+        for &(i, c, v) in &self.jac.entries {
+            let a = row_pos[i];
+            if a == usize::MAX {
+                continue;
+            }
+            match col_pos[c] {
+                (true, k) => phi_u[(a, k)] += v,
+                (false, k) => phi_v[(a, k)] += v,
+            }
+        }
+        Some(Factors::Dense {
+            lu: phi_u.lu(),
+            phi_v,
+        })
+    }
+
+    /// The Newton change of the dependent coordinates `Φ_u δu = −Φ` at `q` (independent rows);
+    /// also leaves `Φ(q)` in the scratch.
+    pub(crate) fn dependent_step(
+        &mut self,
+        q: &DVector<f64>,
+        part: &Partition,
+    ) -> Option<DVector<f64>> {
+        self.triplets(q);
+        let f = self.factors(part)?;
+        let rhs = DVector::from_iterator(part.rows.len(), part.rows.iter().map(|&a| -self.phi[a]));
+        f.solve(&rhs)
     }
 
     /// Newton corrector: solves the independent rows for `u` with `v` fixed; returns the number
@@ -126,10 +312,9 @@ impl<'a> System<'a> {
         tol: f64,
         max_iterations: usize,
     ) -> Result<usize, CorrectorFailure> {
-        let r = part.rows.len();
         let mut first = f64::INFINITY;
         for it in 0..=max_iterations {
-            let j = self.jacobian(q);
+            self.residual(q);
             let res = part
                 .rows
                 .iter()
@@ -154,9 +339,7 @@ impl<'a> System<'a> {
             if it == max_iterations {
                 break;
             }
-            let phi_u = DMatrix::from_fn(r, r, |a, b| j[(part.rows[a], part.dependent[b])]);
-            let rhs = DVector::from_fn(r, |a, _| -self.phi[part.rows[a]]);
-            let Some(du) = phi_u.lu().solve(&rhs) else {
+            let Some(du) = self.dependent_step(q, part) else {
                 return Err(CorrectorFailure);
             };
             for (k, &c) in part.dependent.iter().enumerate() {
@@ -169,22 +352,18 @@ impl<'a> System<'a> {
     /// Energy, multipliers and reduced gradient at a feasible `q`; `None` where the energy is
     /// undefined or `Φ_u` is singular.
     pub(crate) fn evaluate(&mut self, q: &DVector<f64>, part: &Partition) -> Option<Eval> {
-        let j = self.jacobian(q);
+        self.triplets(q);
         let mut grad_q = DVector::zeros(q.len());
         let energy = potential(self.model, q, &mut grad_q, None)?;
-        let r = part.rows.len();
         let dof = part.independent.len();
-        let phi_u = DMatrix::from_fn(r, r, |a, b| j[(part.rows[a], part.dependent[b])]);
-        let phi_v = DMatrix::from_fn(r, dof, |a, b| j[(part.rows[a], part.independent[b])]);
-        let v_u = DVector::from_fn(r, |a, _| grad_q[part.dependent[a]]);
-        let lu = phi_u.lu();
-        let mu = if r > 0 {
-            solve_transpose(&lu, v_u)?
-        } else {
-            DVector::zeros(0)
-        };
-        let mut grad_v =
-            DVector::from_fn(dof, |b, _| grad_q[part.independent[b]]) - phi_v.transpose() * &mu;
+        let factors = self.factors(part)?;
+        let v_u = DVector::from_iterator(
+            part.dependent.len(),
+            part.dependent.iter().map(|&c| grad_q[c]),
+        );
+        let mu = factors.solve_transpose(v_u)?;
+        let v_v = DVector::from_iterator(dof, part.independent.iter().map(|&c| grad_q[c]));
+        let mut grad_v = v_v - factors.phi_v_tr_mul(&mu, dof);
         for (b, &c) in part.independent.iter().enumerate() {
             grad_v[b] *= self.scale[c];
         }
@@ -200,8 +379,7 @@ impl<'a> System<'a> {
             merit,
             mu,
             grad_v,
-            lu,
-            phi_v,
+            factors,
         })
     }
 
@@ -221,8 +399,8 @@ impl<'a> System<'a> {
             dq[c] = dvu[b];
         }
         if !part.rows.is_empty() {
-            let rhs = -(&eval.phi_v * dvu);
-            if let Some(du) = eval.lu.solve(&rhs) {
+            let rhs = -eval.factors.phi_v_mul(&dvu, part.rows.len());
+            if let Some(du) = eval.factors.solve(&rhs) {
                 for (k, &c) in part.dependent.iter().enumerate() {
                     dq[c] = du[k];
                 }
@@ -231,26 +409,49 @@ impl<'a> System<'a> {
         dq
     }
 
+    /// `Zᵀ y` for a covector `y` over all coordinates, in scaled independent coordinates:
+    /// `S (y_v − Φ_vᵀ Φ_u⁻ᵀ y_u)`.
+    pub(crate) fn tangent_transpose(
+        &self,
+        part: &Partition,
+        eval: &Eval,
+        y: &DVector<f64>,
+    ) -> DVector<f64> {
+        let dof = part.independent.len();
+        let y_u =
+            DVector::from_iterator(part.dependent.len(), part.dependent.iter().map(|&c| y[c]));
+        let w = eval
+            .factors
+            .solve_transpose(y_u)
+            .unwrap_or_else(|| DVector::zeros(part.rows.len()));
+        let mut out = DVector::from_iterator(dof, part.independent.iter().map(|&c| y[c]))
+            - eval.factors.phi_v_tr_mul(&w, dof);
+        for (b, &c) in part.independent.iter().enumerate() {
+            out[b] *= self.scale[c];
+        }
+        out
+    }
+
     /// The null-space basis `Z = [H; I] S` (n × dof) at `eval`.
     pub(crate) fn null_basis(&self, part: &Partition, eval: &Eval) -> DMatrix<f64> {
         let n = self.model.coordinate_count();
         let dof = part.independent.len();
         let mut z = DMatrix::zeros(n, dof);
-        let h = if part.rows.is_empty() {
-            DMatrix::zeros(0, dof)
-        } else {
-            eval.lu
-                .solve(&(-&eval.phi_v))
-                .unwrap_or_else(|| DMatrix::zeros(part.rows.len(), dof))
-        };
         for b in 0..dof {
-            let s = self.scale[part.independent[b]];
-            z[(part.independent[b], b)] = s;
-            for (k, &c) in part.dependent.iter().enumerate() {
-                z[(c, b)] = h[(k, b)] * s;
-            }
+            let mut e = DVector::zeros(dof);
+            e[b] = 1.0;
+            z.set_column(b, &self.tangent_step(part, eval, &e));
         }
         z
+    }
+
+    /// The multiplier weights `−μ` over all rows.
+    fn weights(&self, part: &Partition, eval: &Eval) -> DVector<f64> {
+        let mut weights = DVector::zeros(self.cons.len());
+        for (k, &row) in part.rows.iter().enumerate() {
+            weights[row] = -eval.mu[k];
+        }
+        weights
     }
 
     /// The Hessian of the Lagrangian `W = V_qq − Σ μ_k Φ_k,qq` at `q`.
@@ -263,26 +464,110 @@ impl<'a> System<'a> {
         let n = q.len();
         let mut w = DMatrix::zeros(n, n);
         let mut g = DVector::zeros(n);
-        let _ = potential(self.model, q, &mut g, Some(&mut w));
-        let mut weights = DVector::zeros(self.cons.len());
-        for (k, &row) in part.rows.iter().enumerate() {
-            weights[row] = -eval.mu[k];
-        }
-        self.cons.add_hessian(self.model, q, &weights, &mut w);
+        let _ = potential(self.model, q, &mut g, Some(&mut w as &mut dyn HessianSink));
+        self.cons
+            .add_hessian(self.model, q, &self.weights(part, eval), &mut w);
         w
     }
 
-    /// The reduced Hessian `Zᵀ W Z` in scaled coordinates.
+    /// `W` into the block-sparse scratch.
+    fn lagrangian_blocks(&mut self, q: &DVector<f64>, part: &Partition, eval: &Eval) {
+        let mut hess = std::mem::take(&mut self.hess);
+        hess.clear();
+        let mut g = DVector::zeros(q.len());
+        let _ = potential(
+            self.model,
+            q,
+            &mut g,
+            Some(&mut hess as &mut dyn HessianSink),
+        );
+        self.cons
+            .add_hessian(self.model, q, &self.weights(part, eval), &mut hess);
+        self.hess = hess;
+    }
+
+    /// The reduced Hessian `Zᵀ W Z` in scaled coordinates (dense: `O(n² dof)`; sparse: one
+    /// column at a time through the factors, `O(dof · nnz)`).
     pub(crate) fn reduced_hessian(
-        &self,
+        &mut self,
         q: &DVector<f64>,
         part: &Partition,
         eval: &Eval,
     ) -> DMatrix<f64> {
-        let z = self.null_basis(part, eval);
-        let w = self.lagrangian_hessian(q, part, eval);
-        let hr = z.transpose() * w * &z;
+        let hr = if self.sparse {
+            self.lagrangian_blocks(q, part, eval);
+            let dof = part.independent.len();
+            let mut hr = DMatrix::zeros(dof, dof);
+            for b in 0..dof {
+                let mut e = DVector::zeros(dof);
+                e[b] = 1.0;
+                hr.set_column(b, &self.reduced_apply(part, eval, &e));
+            }
+            hr
+        } else {
+            let z = self.null_basis(part, eval);
+            let w = self.lagrangian_hessian(q, part, eval);
+            z.transpose() * w * &z
+        };
         (&hr + hr.transpose()) * 0.5
+    }
+
+    /// `Zᵀ W Z x` with the `W` of the last block assembly (sparse path).
+    pub(crate) fn reduced_apply(
+        &self,
+        part: &Partition,
+        eval: &Eval,
+        x: &DVector<f64>,
+    ) -> DVector<f64> {
+        let zx = self.tangent_step(part, eval, x);
+        let mut wzx = DVector::zeros(zx.len());
+        self.hess.mul_add(zx.as_slice(), wzx.as_mut_slice());
+        self.tangent_transpose(part, eval, &wzx)
+    }
+
+    /// Assembles `W` at `q` and factors the KKT matrix with the shift `δ` (scaled coordinates);
+    /// `false` if the matrix is singular.
+    pub(crate) fn factor_kkt(
+        &mut self,
+        q: &DVector<f64>,
+        part: &Partition,
+        eval: &Eval,
+        fresh: bool,
+        delta: f64,
+    ) -> bool {
+        if fresh {
+            self.lagrangian_blocks(q, part, eval);
+            self.triplets(q);
+            let (m, n) = (self.cons.len(), q.len());
+            if !self
+                .kkt
+                .as_ref()
+                .is_some_and(|k| k.fits(part, self.jac.entries.len(), self.hess.keys.len()))
+            {
+                self.kkt = Kkt::new(part, m, n, &self.jac.entries, &self.hess);
+            }
+            let Some(kkt) = self.kkt.as_mut() else {
+                return false;
+            };
+            kkt.assemble(&self.jac.entries, &self.row_scale, &self.scale, &self.hess);
+        }
+        self.kkt.as_mut().is_some_and(|k| k.factor(delta))
+    }
+
+    /// The largest diagonal entry of the scaled `W` of the last KKT assembly.
+    pub(crate) fn kkt_scale(&self) -> f64 {
+        self.kkt.as_ref().map_or(0.0, |k| k.max_diagonal())
+    }
+
+    /// Solves the factored KKT system for the right side `b` over all coordinates (scaled;
+    /// zero constraint rows); returns the scaled `δq̂`.
+    pub(crate) fn kkt_solve(&self, b: &DVector<f64>) -> Option<DVector<f64>> {
+        let kkt = self.kkt.as_ref()?;
+        let n = kkt.coordinates();
+        let mut rhs = vec![0.0; n + kkt.rows()];
+        rhs[..n].copy_from_slice(b.as_slice());
+        kkt.solve(&mut rhs)
+            .then(|| DVector::from_column_slice(&rhs[..n]))
     }
 }
 
@@ -339,7 +624,7 @@ mod tests {
             let q = random_q(n, 7);
             let mut g = DVector::zeros(n);
             let mut h = DMatrix::zeros(n, n);
-            potential(&model, &q, &mut g, Some(&mut h)).unwrap();
+            potential(&model, &q, &mut g, Some(&mut h as &mut dyn HessianSink)).unwrap();
             let step = 1e-6;
             for i in 0..n {
                 let mut qp = q.clone();

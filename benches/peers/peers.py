@@ -1,0 +1,903 @@
+#!/usr/bin/env python3
+"""Solve restpose's generated benchmark mechanisms with peer tools and compare.
+
+Peers (each skipped with a message when its package does not import):
+
+* Pinocchio (``pin``): Newton on joint coordinates for the tree (chain) family,
+  g(q) + K (q - q_ref) = 0 with ``computeGeneralizedGravity`` and
+  ``computeGeneralizedGravityDerivatives``, backtracking line search on
+  ``computePotentialEnergy`` + spring energy, from q = 0, tolerance 1e-8 N m.
+* scipy SLSQP on maximal coordinates (7 per body: position + quaternion),
+  revolute-joint rows (3 position + 2 axis alignment), quaternion norms and
+  loop closures as equality constraints; analytic gradients; small N only.
+* MuJoCo damped settling: MJCF written from the same URDF data (hinges with
+  ``stiffness``/``springref`` and large damping, ``connect`` equalities closing
+  the ladder loops), stepped until max |qvel| falls below a threshold.
+* Closed form (ladder only): every ladder loop is a parallelogram whose rung
+  stays level, so each loop angle solves one scalar equation (see
+  ``ladder_closed_form``). Not a peer tool but an independent check.
+
+Usage: python benches/peers/peers.py [--restpose PATH] [--help for the rest]
+The Markdown table is printed on standard output (and written to --markdown).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import platform
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+MECH = "{urn:urdf-mech:1}"
+
+try:  # optional peers: a missing one is skipped with a message
+    import pinocchio as pin
+except Exception as e:  # noqa: BLE001 - report whatever went wrong
+    pin = None
+    PIN_ERROR = f"{type(e).__name__}: {e}"
+try:
+    import mujoco
+except Exception as e:  # noqa: BLE001
+    mujoco = None
+    MUJOCO_ERROR = f"{type(e).__name__}: {e}"
+try:
+    import scipy
+    from scipy.optimize import minimize
+except Exception as e:  # noqa: BLE001
+    scipy = None
+    SCIPY_ERROR = f"{type(e).__name__}: {e}"
+
+
+def log(*a):
+    print(*a, file=sys.stderr, flush=True)
+
+
+# --------------------------------------------------------------------------------------
+# URDF (with the mech: extensions) as plain data
+# --------------------------------------------------------------------------------------
+
+
+def rpy_matrix(rpy):
+    r, p, y = rpy
+    cr, sr, cp, sp, cy, sy = (math.cos(r), math.sin(r), math.cos(p), math.sin(p),
+                              math.cos(y), math.sin(y))
+    rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
+    ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
+    rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
+    return rz @ ry @ rx
+
+
+def mat_to_quat(r):
+    """Unit quaternion (w, x, y, z) of a rotation matrix."""
+    t = np.trace(r)
+    if t > 0:
+        s = math.sqrt(t + 1.0) * 2
+        q = [0.25 * s, (r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s]
+    elif r[0, 0] > r[1, 1] and r[0, 0] > r[2, 2]:
+        s = math.sqrt(1.0 + r[0, 0] - r[1, 1] - r[2, 2]) * 2
+        q = [(r[2, 1] - r[1, 2]) / s, 0.25 * s, (r[0, 1] + r[1, 0]) / s, (r[0, 2] + r[2, 0]) / s]
+    elif r[1, 1] > r[2, 2]:
+        s = math.sqrt(1.0 + r[1, 1] - r[0, 0] - r[2, 2]) * 2
+        q = [(r[0, 2] - r[2, 0]) / s, (r[0, 1] + r[1, 0]) / s, 0.25 * s, (r[1, 2] + r[2, 1]) / s]
+    else:
+        s = math.sqrt(1.0 + r[2, 2] - r[0, 0] - r[1, 1]) * 2
+        q = [(r[1, 0] - r[0, 1]) / s, (r[0, 2] + r[2, 0]) / s, (r[1, 2] + r[2, 1]) / s, 0.25 * s]
+    q = np.array(q)
+    return q / np.linalg.norm(q)
+
+
+def axis_angle_matrix(a, t):
+    a = np.asarray(a, float)
+    k = skew(a)
+    return np.eye(3) + math.sin(t) * k + (1 - math.cos(t)) * (k @ k)
+
+
+def skew(v):
+    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+
+
+def _floats(s, n=3, default=0.0):
+    if s is None:
+        return np.full(n, default, float)
+    return np.array([float(x) for x in s.split()], float)
+
+
+@dataclass
+class Link:
+    name: str
+    mass: float = 0.0
+    com: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    inertia: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))  # at COM, link axes
+
+
+@dataclass
+class Joint:
+    name: str
+    type: str
+    parent: str
+    child: str
+    xyz: np.ndarray
+    rpy: np.ndarray
+    axis: np.ndarray
+    loop: bool = False
+    child_xyz: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    child_rpy: np.ndarray = field(default_factory=lambda: np.zeros(3))
+
+
+@dataclass
+class Mech:
+    name: str
+    links: dict
+    joints: list  # tree joints, in file order
+    loops: list  # mech:loop_joint
+    springs: dict  # joint name -> (stiffness, reference)
+    gravity: np.ndarray
+    root: str
+
+    def tree_order(self):
+        """Tree joints ordered parents before children."""
+        placed = {self.root}
+        out, rest = [], list(self.joints)
+        while rest:
+            progress = False
+            for j in list(rest):
+                if j.parent in placed:
+                    out.append(j)
+                    placed.add(j.child)
+                    rest.remove(j)
+                    progress = True
+            if not progress:
+                raise ValueError("URDF tree is not connected to its root")
+        return out
+
+    def zero_pose(self):
+        """World rotation and position of every link at zero joint values."""
+        pose = {self.root: (np.eye(3), np.zeros(3))}
+        for j in self.tree_order():
+            rp, pp = pose[j.parent]
+            pose[j.child] = (rp @ rpy_matrix(j.rpy), pp + rp @ j.xyz)
+        return pose
+
+
+def parse_urdf(text: str) -> Mech:
+    root = ET.fromstring(text)
+    links = {}
+    for el in root.findall("link"):
+        lk = Link(el.get("name"))
+        inert = el.find("inertial")
+        if inert is not None:
+            org = inert.find("origin")
+            lk.com = _floats(org.get("xyz") if org is not None else None)
+            r = rpy_matrix(_floats(org.get("rpy") if org is not None else None))
+            lk.mass = float(inert.find("mass").get("value"))
+            i = inert.find("inertia")
+            g = lambda k: float(i.get(k, "0"))  # noqa: E731
+            ii = np.array([[g("ixx"), g("ixy"), g("ixz")], [g("ixy"), g("iyy"), g("iyz")],
+                           [g("ixz"), g("iyz"), g("izz")]])
+            lk.inertia = r @ ii @ r.T
+        links[lk.name] = lk
+
+    def origin(el, tag="origin"):
+        o = el.find(tag)
+        if o is None:
+            return np.zeros(3), np.zeros(3)
+        return _floats(o.get("xyz")), _floats(o.get("rpy"))
+
+    def axis(el):
+        a = el.find("axis")
+        v = _floats(a.get("xyz") if a is not None else "1 0 0")
+        return v / np.linalg.norm(v)
+
+    joints = []
+    for el in root.findall("joint"):
+        xyz, rpy = origin(el)
+        joints.append(Joint(el.get("name"), el.get("type"), el.find("parent").get("link"),
+                            el.find("child").get("link"), xyz, rpy, axis(el)))
+    loops = []
+    for el in root.findall(MECH + "loop_joint"):
+        xyz, rpy = origin(el)
+        cxyz, crpy = origin(el, "child_origin")
+        loops.append(Joint(el.get("name"), el.get("type"), el.find("parent").get("link"),
+                           el.find("child").get("link"), xyz, rpy, axis(el), True, cxyz, crpy))
+    springs = {}
+    for el in root.findall(MECH + "joint_spring"):
+        springs[el.get("joint")] = (float(el.get("stiffness")), float(el.get("reference", "0")))
+    g = root.find(MECH + "gravity")
+    gravity = _floats(g.get("xyz")) if g is not None else np.array([0, 0, -9.81])
+    children = {j.child for j in joints}
+    roots = [n for n in links if n not in children]
+    if len(roots) != 1:
+        raise ValueError(f"expected one root link, found {roots}")
+    for j in joints + loops:
+        if j.type not in ("revolute", "continuous"):
+            raise ValueError(f"joint {j.name}: only revolute/continuous joints are modelled here")
+    return Mech(root.get("name"), links, joints, loops, springs, gravity, roots[0])
+
+
+def wrap(d):
+    """Angle difference folded into (-pi, pi]."""
+    return (np.asarray(d) + math.pi) % (2 * math.pi) - math.pi
+
+
+def max_angle_diff(a: dict, b: dict):
+    """Max |a - b| over the joints both name (angles compared modulo 2 pi)."""
+    common = sorted(set(a) & set(b))
+    if not common:
+        return float("nan"), 0
+    return float(max(abs(wrap(a[k] - b[k])) for k in common)), len(common)
+
+
+# --------------------------------------------------------------------------------------
+# Results
+# --------------------------------------------------------------------------------------
+
+
+@dataclass
+class Result:
+    tool: str
+    ok: bool  # converged / settled
+    angles: dict = field(default_factory=dict)  # joint name -> angle [rad]
+    energy: float = float("nan")  # gravity + spring potential, restpose's zero
+    iterations: str = ""  # iterations or steps, as text
+    time_ms: float = float("nan")  # in-process solve time
+    note: str = ""
+    extra: dict = field(default_factory=dict)
+
+
+# --------------------------------------------------------------------------------------
+# restpose
+# --------------------------------------------------------------------------------------
+
+
+def default_restpose(repo: Path) -> str:
+    cands = [repo / "target" / "release" / "restpose"]
+    if os.environ.get("CARGO_TARGET_DIR"):
+        cands.append(Path(os.environ["CARGO_TARGET_DIR"]) / "release" / "restpose")
+    cands.append(Path.home() / ".cache" / "restpose-target" / "release" / "restpose")
+    for c in cands:
+        if c.is_file() and os.access(c, os.X_OK):
+            return str(c)
+    return str(cands[-1])
+
+
+def find_time_field(d, prefix=""):
+    """A solve-time field in restpose's JSON, if it has one: (key, milliseconds)."""
+    if not isinstance(d, dict):
+        return None
+    for k, v in d.items():
+        key = k.lower()
+        if isinstance(v, (int, float)) and not isinstance(v, bool) and (
+                "time" in key or "elapsed" in key or key.endswith("_ms") or key.endswith("_s")):
+            if "ms" in key or "milli" in key:
+                return prefix + k, float(v)
+            if key.endswith("_s") or "sec" in key:
+                return prefix + k, float(v) * 1e3
+            return prefix + k, float(v)  # unit unknown: assume ms, key is reported
+        if isinstance(v, dict) and k not in ("joints", "links", "reactions"):
+            r = find_time_field(v, prefix + k + ".")
+            if r:
+                return r
+    return None
+
+
+def run_restpose(exe, urdf: Path, timeout: float, repeats: int) -> Result:
+    out = urdf.with_suffix(".restpose.json")
+    walls, checks = [], []
+    data = None
+    for rep in range(repeats):
+        t0 = time.perf_counter()
+        try:
+            p = subprocess.run([exe, "analyze", str(urdf), "--json", str(out), "-q"],
+                               capture_output=True, text=True, timeout=timeout)
+        except subprocess.TimeoutExpired:
+            return Result("restpose", False, note=f"timed out after {timeout:.0f} s (skipped)",
+                          time_ms=float("nan"))
+        wall = (time.perf_counter() - t0) * 1e3
+        if not out.exists():
+            return Result("restpose", False, note=f"no JSON (exit {p.returncode}): "
+                          + (p.stderr.strip().splitlines() or ["?"])[-1][:120])
+        data = json.loads(out.read_text())
+        walls.append(wall)
+        # the same process without the solve: load + validate, to take out start-up and parsing
+        t0 = time.perf_counter()
+        subprocess.run([exe, "check", str(urdf)], capture_output=True, text=True, timeout=timeout)
+        checks.append((time.perf_counter() - t0) * 1e3)
+        if wall > 2000:  # slow: once is enough
+            break
+    angles = {}
+    for name, j in data["joints"].items():
+        pos = j.get("position") or []
+        if len(pos) == 1:
+            angles[name] = float(pos[0])
+    wall, check = min(walls), min(checks)
+    tf = find_time_field(data)
+    r = Result("restpose", bool(data.get("converged")), angles, float(data["potential_energy"]),
+               str(data.get("iterations", "")))
+    r.extra = {"wall_ms": wall, "check_ms": check, "runs": len(walls),
+               "termination": data.get("termination"), "dof": data.get("dof"),
+               "coordinates": data.get("coordinates"),
+               "stability": (data.get("stability") or {}).get("verdict")}
+    if tf:
+        r.time_ms = tf[1]
+        r.extra["time_basis"] = f"JSON `{tf[0]}`"
+    else:
+        r.time_ms = max(wall - check, 0.0)
+        r.extra["time_basis"] = "analyze − check wall"
+    if not r.ok:
+        r.note = f"termination: {data.get('termination')}"
+    return r
+
+
+# --------------------------------------------------------------------------------------
+# Pinocchio: Newton on joint coordinates (trees only)
+# --------------------------------------------------------------------------------------
+
+
+def solve_pinocchio(urdf: Path, mech: Mech, tol=1e-8, max_iter=500) -> Result:
+    if pin is None:
+        return Result("pinocchio", False, note=f"skipped: pinocchio does not import ({PIN_ERROR})")
+    if mech.loops:
+        return Result("pinocchio", False, note="skipped: closed loops (Pinocchio is used on trees only)")
+    model = pin.buildModelFromUrdf(str(urdf))  # mech: elements are ignored by urdfdom
+    model.gravity.linear = np.array(mech.gravity, float)
+    data = model.createData()
+    nv = model.nv
+    k = np.zeros(nv)
+    ref = np.zeros(nv)
+    names = []
+    for jid in range(1, model.njoints):
+        name = model.names[jid]
+        if model.nvs[jid] != 1:
+            return Result("pinocchio", False, note=f"skipped: joint {name} is not 1-dof")
+        names.append((name, model.idx_vs[jid]))
+        if name in mech.springs:
+            k[model.idx_vs[jid]], ref[model.idx_vs[jid]] = mech.springs[name]
+
+    t0 = time.perf_counter()
+    q = pin.neutral(model)
+    theta = np.zeros(nv)  # unwrapped joint angles: continuous joints are (cos, sin) in q
+
+    def energy(q, th):
+        return pin.computePotentialEnergy(model, data, q) + 0.5 * float(k @ (th - ref) ** 2)
+
+    v = energy(q, theta)
+    it = 0
+    gnorm = float("inf")
+    halvings = 0
+    ok = False
+    while it < max_iter:
+        grad = pin.computeGeneralizedGravity(model, data, q) + k * (theta - ref)
+        gnorm = float(np.max(np.abs(grad)))
+        if gnorm < tol:
+            ok = True
+            break
+        h = pin.computeGeneralizedGravityDerivatives(model, data, q) + np.diag(k)
+        h = 0.5 * (h + h.T)
+        shift = 0.0
+        while True:  # Newton step; shift the Hessian if it is not positive definite
+            try:
+                c = np.linalg.cholesky(h + shift * np.eye(nv))
+                break
+            except np.linalg.LinAlgError:
+                shift = max(2 * shift, 1e-6 * max(1.0, float(np.max(np.abs(np.diag(h))))))
+        dq = -np.linalg.solve(c.T, np.linalg.solve(c, grad))
+        slope = float(grad @ dq)
+        a = 1.0
+        while True:
+            qn = pin.integrate(model, q, a * dq)
+            thn = theta + a * dq
+            vn = energy(qn, thn)
+            if vn <= v + 1e-4 * a * slope or a < 1e-12:
+                break
+            a *= 0.5
+            halvings += 1
+        q, theta, v = qn, thn, vn
+        it += 1
+    ms = (time.perf_counter() - t0) * 1e3
+    angles = {name: float(theta[i]) for name, i in names}
+    return Result("pinocchio", ok, angles, v, str(it), ms,
+                  note="" if ok else f"not converged: max|g| = {gnorm:.1e}",
+                  extra={"halvings": halvings, "gnorm": gnorm})
+
+
+# --------------------------------------------------------------------------------------
+# scipy SLSQP on maximal coordinates
+# --------------------------------------------------------------------------------------
+
+
+def rot(q, c):
+    """q (w, x, y, z) applied to c, as c + 2w(v×c) + 2v×(v×c) (a rotation when |q| = 1)."""
+    w, v = q[0], q[1:]
+    u = np.cross(v, c)
+    return c + 2 * w * u + 2 * np.cross(v, u)
+
+
+def drot(q, c):
+    """3 × 4 Jacobian of rot(q, c) with respect to q."""
+    w, v = q[0], q[1:]
+    u = np.cross(v, c)
+    sc = skew(c)
+    jv = -2 * w * sc - 2 * skew(u) - 2 * skew(v) @ sc
+    return np.column_stack([2 * u, jv])
+
+
+def perp(a):
+    e = np.cross(a, [1.0, 0, 0])
+    if np.linalg.norm(e) < 1e-6:
+        e = np.cross(a, [0, 1.0, 0])
+    return e / np.linalg.norm(e)
+
+
+class MaxCoords:
+    """Maximal coordinates: body b holds x[7b:7b+3] = position, x[7b+3:7b+7] = quaternion."""
+
+    def __init__(self, mech: Mech):
+        self.mech = mech
+        self.bodies = [n for n in mech.links if n != mech.root]
+        self.index = {n: i for i, n in enumerate(self.bodies)}
+        self.n = 7 * len(self.bodies)
+        pose = mech.zero_pose()
+        self.x0 = np.zeros(self.n)
+        for n, i in self.index.items():
+            r, p = pose[n]
+            self.x0[7 * i:7 * i + 3] = p
+            self.x0[7 * i + 3:7 * i + 7] = mat_to_quat(r)
+        self.mass = np.array([mech.links[n].mass for n in self.bodies])
+        self.com = np.array([mech.links[n].com for n in self.bodies])
+        self.g = np.array(mech.gravity, float)
+        # joints as constant vectors: parent side in the parent's frame, child side in the child's
+        self.joints = []
+        for j in mech.joints + mech.loops:
+            ro = rpy_matrix(j.rpy)
+            roc = rpy_matrix(j.child_rpy)
+            e1 = perp(j.axis)
+            e2 = np.cross(j.axis, e1)
+            self.joints.append(dict(
+                name=j.name, p=self.index.get(j.parent, -1), c=self.index[j.child],
+                oP=j.xyz, oC=j.child_xyz, e1P=ro @ e1, e2P=ro @ e2, aC=roc @ j.axis,
+                e1C=roc @ e1, spring=mech.springs.get(j.name)))
+        self.m = 5 * len(self.joints) + len(self.bodies)
+        # check that the zero pose closes the loops
+        r = self.constraints(self.x0)
+        if np.max(np.abs(r)) > 1e-9:
+            raise ValueError(f"the zero pose violates the constraints by {np.max(np.abs(r)):.1e}")
+
+    def _pq(self, x, b):
+        if b < 0:
+            return np.zeros(3), np.array([1.0, 0, 0, 0])
+        return x[7 * b:7 * b + 3], x[7 * b + 3:7 * b + 7]
+
+    def angle_and_grad(self, x, j, want_grad=True):
+        """Joint angle atan2((R_P e2P)·(R_C e1C), (R_P e1P)·(R_C e1C)) and its gradient."""
+        _, qp = self._pq(x, j["p"])
+        _, qc = self._pq(x, j["c"])
+        f1 = rot(qp, j["e1P"])
+        f2 = rot(qp, j["e2P"])
+        h = rot(qc, j["e1C"])
+        cx, cy = f1 @ h, f2 @ h
+        t = math.atan2(cy, cx)
+        if not want_grad:
+            return t, None
+        den = cx * cx + cy * cy
+        grad = {}
+        dcx_c = drot(qc, j["e1C"]).T @ f1
+        dcy_c = drot(qc, j["e1C"]).T @ f2
+        grad[j["c"]] = (cx * dcy_c - cy * dcx_c) / den
+        if j["p"] >= 0:
+            dcx_p = drot(qp, j["e1P"]).T @ h
+            dcy_p = drot(qp, j["e2P"]).T @ h
+            grad[j["p"]] = (cx * dcy_p - cy * dcx_p) / den
+        return t, grad
+
+    def objective(self, x):
+        p = x.reshape(-1, 7)
+        v = 0.0
+        for b in range(len(self.bodies)):
+            v -= self.mass[b] * (self.g @ (p[b, :3] + rot(p[b, 3:], self.com[b])))
+        for j in self.joints:
+            if j["spring"]:
+                kk, ref = j["spring"]
+                t, _ = self.angle_and_grad(x, j, False)
+                v += 0.5 * kk * (t - ref) ** 2
+        return v
+
+    def gradient(self, x):
+        p = x.reshape(-1, 7)
+        gr = np.zeros_like(x).reshape(-1, 7)
+        for b in range(len(self.bodies)):
+            gr[b, :3] -= self.mass[b] * self.g
+            gr[b, 3:] -= self.mass[b] * (drot(p[b, 3:], self.com[b]).T @ self.g)
+        for j in self.joints:
+            if j["spring"]:
+                kk, ref = j["spring"]
+                t, g = self.angle_and_grad(x, j)
+                for b, gb in g.items():
+                    gr[b, 3:] += kk * (t - ref) * gb
+        return gr.ravel()
+
+    def constraints(self, x):
+        out = np.zeros(self.m)
+        r = 0
+        for j in self.joints:
+            pp, qp = self._pq(x, j["p"])
+            pc, qc = self._pq(x, j["c"])
+            out[r:r + 3] = pp + rot(qp, j["oP"]) - pc - rot(qc, j["oC"])
+            ac = rot(qc, j["aC"])
+            out[r + 3] = rot(qp, j["e1P"]) @ ac
+            out[r + 4] = rot(qp, j["e2P"]) @ ac
+            r += 5
+        q = x.reshape(-1, 7)[:, 3:]
+        out[r:] = np.sum(q * q, axis=1) - 1.0
+        return out
+
+    def jacobian(self, x):
+        jac = np.zeros((self.m, self.n))
+        r = 0
+        for j in self.joints:
+            b, c = j["p"], j["c"]
+            pp, qp = self._pq(x, b)
+            pc, qc = self._pq(x, c)
+            ac = rot(qc, j["aC"])
+            jac[r:r + 3, 7 * c:7 * c + 3] = -np.eye(3)
+            jac[r:r + 3, 7 * c + 3:7 * c + 7] = -drot(qc, j["oC"])
+            dac = drot(qc, j["aC"])
+            f1, f2 = rot(qp, j["e1P"]), rot(qp, j["e2P"])
+            jac[r + 3, 7 * c + 3:7 * c + 7] = f1 @ dac
+            jac[r + 4, 7 * c + 3:7 * c + 7] = f2 @ dac
+            if b >= 0:
+                jac[r:r + 3, 7 * b:7 * b + 3] = np.eye(3)
+                jac[r:r + 3, 7 * b + 3:7 * b + 7] = drot(qp, j["oP"])
+                jac[r + 3, 7 * b + 3:7 * b + 7] = ac @ drot(qp, j["e1P"])
+                jac[r + 4, 7 * b + 3:7 * b + 7] = ac @ drot(qp, j["e2P"])
+            r += 5
+        for i in range(len(self.bodies)):
+            jac[r + i, 7 * i + 3:7 * i + 7] = 2 * x[7 * i + 3:7 * i + 7]
+        return jac
+
+    def angles(self, x):
+        return {j["name"]: self.angle_and_grad(x, j, False)[0] for j in self.joints}
+
+
+def solve_slsqp(mech: Mech, max_bodies: int, max_iter=2000) -> Result:
+    if scipy is None:
+        return Result("scipy SLSQP", False, note=f"skipped: scipy does not import ({SCIPY_ERROR})")
+    nb = len(mech.links) - 1
+    if nb > max_bodies:
+        return Result("scipy SLSQP", False,
+                      note=f"skipped: {nb} bodies > --slsqp-max-bodies {max_bodies} (dense SQP, slow)")
+    mc = MaxCoords(mech)
+    t0 = time.perf_counter()
+    res = minimize(mc.objective, mc.x0, jac=mc.gradient, method="SLSQP",
+                   constraints=[{"type": "eq", "fun": mc.constraints, "jac": mc.jacobian}],
+                   options={"maxiter": max_iter, "ftol": 1e-16})
+    ms = (time.perf_counter() - t0) * 1e3
+    x = res.x
+    viol = float(np.max(np.abs(mc.constraints(x))))
+    # the projected gradient at the result: how stationary it is
+    jac = mc.jacobian(x)
+    lam, *_ = np.linalg.lstsq(jac.T, mc.gradient(x), rcond=None)
+    kkt = float(np.max(np.abs(mc.gradient(x) - jac.T @ lam)))
+    ok = res.success and viol < 1e-8
+    note = "" if res.success else f"SLSQP: {res.message}"
+    r = Result("scipy SLSQP", ok, mc.angles(x), float(res.fun), str(res.nit), ms, note)
+    r.extra = {"violation": viol, "kkt": kkt, "message": res.message, "nvar": mc.n, "ncon": mc.m}
+    return r
+
+
+# --------------------------------------------------------------------------------------
+# MuJoCo damped settling
+# --------------------------------------------------------------------------------------
+
+
+def write_mjcf(mech: Mech, damping: dict, timestep: float) -> str:
+    kids = {}
+    for j in mech.joints:
+        kids.setdefault(j.parent, []).append(j)
+    f = lambda v: " ".join(f"{x:.17g}" for x in v)  # noqa: E731
+    lines = [f'<mujoco model="{mech.name}">',
+             '  <compiler angle="radian" autolimits="true"/>',
+             f'  <option gravity="{f(mech.gravity)}" timestep="{timestep:g}" integrator="implicitfast">',
+             '    <flag energy="enable" contact="disable"/>',
+             '  </option>', "  <worldbody>"]
+
+    def body(j, depth):
+        ind = "  " * depth
+        lk = mech.links[j.child]
+        lines.append(f'{ind}<body name="{j.child}" pos="{f(j.xyz)}" quat="{f(mat_to_quat(rpy_matrix(j.rpy)))}">')
+        kk, ref = mech.springs.get(j.name, (0.0, 0.0))
+        lines.append(f'{ind}  <joint name="{j.name}" type="hinge" axis="{f(j.axis)}" '
+                     f'stiffness="{kk:.17g}" springref="{ref:.17g}" damping="{damping[j.name]:.17g}"/>')
+        ii = lk.inertia
+        lines.append(f'{ind}  <inertial pos="{f(lk.com)}" mass="{lk.mass:.17g}" '
+                     f'fullinertia="{f([ii[0, 0], ii[1, 1], ii[2, 2], ii[0, 1], ii[0, 2], ii[1, 2]])}"/>')
+        for c in kids.get(j.child, []):
+            body(c, depth + 1)
+        lines.append(f"{ind}</body>")
+
+    for j in kids.get(mech.root, []):
+        body(j, 2)
+    lines.append("  </worldbody>")
+    if mech.loops:
+        lines.append("  <equality>")
+        for lj in mech.loops:
+            # a ball closure at the loop joint's origin; the hinge axis rows of the loop joint are
+            # left out (for the planar ladder they are implied by the tree's parallel hinges)
+            lines.append(f'    <connect name="{lj.name}" body1="{lj.parent}" body2="{lj.child}" '
+                         f'anchor="{f(lj.xyz)}" solref="{2 * timestep:g} 1" '
+                         'solimp="0.9999 0.9999 0.001 0.5 2"/>')
+        lines.append("  </equality>")
+    lines.append("</mujoco>")
+    return "\n".join(lines)
+
+
+def solve_mujoco(mech: Mech, vtol: float, budget_s: float, timestep: float, alpha: float,
+                 mjcf_out: Path | None = None) -> Result:
+    if mujoco is None:
+        return Result("mujoco", False, note=f"skipped: mujoco does not import ({MUJOCO_ERROR})")
+    # Damping: c = alpha * k on sprung joints (every spring mode then relaxes at about the same
+    # rate 1/alpha), plus critical-ish damping from the joint's own inertia at the zero pose for
+    # joints with little or no spring.
+    probe = mujoco.MjModel.from_xml_string(write_mjcf(mech, {j.name: 0.0 for j in mech.joints}, timestep))
+    pd = mujoco.MjData(probe)
+    mujoco.mj_forward(probe, pd)
+    mdiag = np.zeros(probe.nv)
+    mujoco.mj_fullM(probe, full := np.zeros((probe.nv, probe.nv)), pd.qM)
+    mdiag = np.diag(full)
+    damping = {}
+    for j in mech.joints:
+        dof = probe.jnt_dofadr[mujoco.mj_name2id(probe, mujoco.mjtObj.mjOBJ_JOINT, j.name)]
+        kk = mech.springs.get(j.name, (0.0, 0.0))[0]
+        damping[j.name] = max(alpha * kk, 2.0 * math.sqrt(max(kk, 1.0) * mdiag[dof]), mdiag[dof] / timestep)
+    xml = write_mjcf(mech, damping, timestep)
+    if mjcf_out:
+        mjcf_out.write_text(xml)
+    m = mujoco.MjModel.from_xml_string(xml)
+    d = mujoco.MjData(m)
+    t0 = time.perf_counter()
+    steps = 0
+    batch = 10
+    vmax = float("inf")
+    while True:
+        mujoco.mj_step(m, d, nstep=batch)
+        steps += batch
+        vmax = float(np.max(np.abs(d.qvel)))
+        if vmax < vtol or not np.isfinite(vmax):
+            break
+        if time.perf_counter() - t0 > budget_s:
+            break
+    ms = (time.perf_counter() - t0) * 1e3
+    mujoco.mj_forward(m, d)
+    angles = {}
+    for j in mech.joints:
+        jid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, j.name)
+        angles[j.name] = float(d.qpos[m.jnt_qposadr[jid]])
+    # loop-joint angles from the body orientations, as the other tools report them
+    for lj in mech.loops:
+        rp = d.xmat[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, lj.parent)].reshape(3, 3)
+        rc = d.xmat[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, lj.child)].reshape(3, 3)
+        e1 = perp(lj.axis)
+        e2 = np.cross(lj.axis, e1)
+        ro, roc = rpy_matrix(lj.rpy), rpy_matrix(lj.child_rpy)
+        h = rc @ roc @ e1
+        angles[lj.name] = math.atan2((rp @ ro @ e2) @ h, (rp @ ro @ e1) @ h)
+    energy = float(d.energy[0])  # gravity (about the world origin) + joint springs
+    ok = vmax < vtol
+    viol = float(np.max(np.abs(d.efc_pos[d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY]))) \
+        if mech.loops and d.nefc else 0.0
+    note = "" if ok else (f"not settled in {budget_s:.0f} s budget: max|qvel| = {vmax:.1e}"
+                          if np.isfinite(vmax) else "diverged")
+    r = Result("mujoco", ok, angles, energy, f"{steps} steps", ms, note)
+    r.extra = {"vmax": vmax, "sim_time": float(d.time), "loop_violation": viol,
+               "timestep": timestep, "alpha": alpha}
+    return r
+
+
+# --------------------------------------------------------------------------------------
+# Ladder closed form
+# --------------------------------------------------------------------------------------
+
+
+def ladder_closed_form(mech: Mech, n: int) -> Result:
+    """Every loop k is a parallelogram (posts of equal length, rung level): its posts turn by
+    theta_k about their hanging points, its rung and everything below translate by
+    L (sin theta_k, -cos theta_k) (L = post length), so
+        V_k(theta) = -|g| (m_L c_L + m_R c_R + L M_k) cos theta + k/2 (theta - ref)^2
+    with c = post centre-of-mass distance from its pin and M_k = rung k + all lower loops.
+    Each theta_k solves V_k'(theta) = 0 by Newton; hang_left = hang_right = close = theta,
+    rung_pin = -theta. Needs gravity along -y and the generator's geometry."""
+    t0 = time.perf_counter()
+    g = float(np.linalg.norm(mech.gravity))
+    angles = {}
+    total = 0.0
+    masses = {nm: lk.mass for nm, lk in mech.links.items()}
+    jn = {j.name: j for j in mech.joints}
+    for k in range(n):
+        left, right, rung = f"left{k}", f"right{k}", f"rung{k}"
+        length = -jn[f"rung_pin{k}"].xyz[1]
+        cl, cr = -mech.links[left].com[1], -mech.links[right].com[1]
+        below = masses[rung] + sum(masses[f"left{i}"] + masses[f"right{i}"] + masses[f"rung{i}"]
+                                   for i in range(k + 1, n))
+        a = g * (masses[left] * cl + masses[right] * cr + length * below)
+        kk, ref = mech.springs[f"hang_left{k}"]
+        th = 0.0
+        for _ in range(50):
+            f_ = a * math.sin(th) + kk * (th - ref)
+            th -= f_ / (a * math.cos(th) + kk)
+            if abs(f_) < 1e-15:
+                break
+        for nm in ("hang_left", "hang_right", "close"):
+            angles[f"{nm}{k}"] = th
+        angles[f"rung_pin{k}"] = -th
+        total += 0.5 * kk * (th - ref) ** 2
+    # gravity energy from the positions (y only; x does not matter with gravity along y)
+    y0 = 0.0
+    for k in range(n):
+        th = angles[f"hang_left{k}"]
+        length = -jn[f"rung_pin{k}"].xyz[1]
+        for post in (f"left{k}", f"right{k}"):
+            total += masses[post] * g * (y0 + mech.links[post].com[1] * math.cos(th))
+        y0 -= length * math.cos(th)
+        total += masses[f"rung{k}"] * g * (y0 + mech.links[f"rung{k}"].com[1])
+    ms = (time.perf_counter() - t0) * 1e3
+    return Result("closed form", True, angles, total, "—", ms)
+
+
+# --------------------------------------------------------------------------------------
+# Main
+# --------------------------------------------------------------------------------------
+
+
+def fmt(x, spec):
+    return "—" if x is None or (isinstance(x, float) and not math.isfinite(x)) else format(x, spec)
+
+
+def main():
+    repo = Path(__file__).resolve().parents[2]
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    ap.add_argument("--restpose", default=default_restpose(repo), help="restpose binary")
+    ap.add_argument("--chain", default="10,100,1000", help="chain sizes (comma list, '' for none)")
+    ap.add_argument("--ladder", default="5,10,50", help="ladder sizes (comma list, '' for none)")
+    ap.add_argument("--tools", default="restpose,pinocchio,slsqp,mujoco,closed-form")
+    ap.add_argument("--restpose-timeout", type=float, default=60.0,
+                    help="skip a size when restpose analyze takes longer [s]")
+    ap.add_argument("--repeats", type=int, default=3, help="restpose runs (best kept; 1 when slow)")
+    ap.add_argument("--slsqp-max-bodies", type=int, default=30)
+    ap.add_argument("--mujoco-vtol", type=float, default=1e-8, help="settled when max|qvel| < this [rad/s]")
+    ap.add_argument("--mujoco-budget", type=float, default=30.0, help="settling wall-time budget [s]")
+    ap.add_argument("--mujoco-timestep", type=float, default=1e-3)
+    ap.add_argument("--mujoco-alpha", type=float, default=0.02,
+                    help="damping = alpha * stiffness on sprung joints [s]")
+    ap.add_argument("--exact-tol", type=float, default=1e-6, help="agreement for exact solvers [rad]")
+    ap.add_argument("--settle-tol", type=float, default=1e-5, help="agreement for MuJoCo settling [rad]")
+    ap.add_argument("--markdown", type=Path, help="also write the Markdown table here")
+    ap.add_argument("--json", type=Path, help="write all results as JSON here")
+    ap.add_argument("--keep", type=Path, help="keep generated URDF/MJCF/JSON files in this folder")
+    args = ap.parse_args()
+    tools = set(args.tools.split(","))
+    sizes = lambda s: [int(x) for x in s.split(",") if x.strip()]  # noqa: E731
+
+    exe = args.restpose
+    if not (Path(exe).is_file() and os.access(exe, os.X_OK)):
+        sys.exit(f"restpose binary not found: {exe} (build it or pass --restpose PATH)")
+    version = subprocess.run([exe, "--version"], capture_output=True, text=True).stdout.strip()
+    log(f"restpose: {exe} ({version})")
+    for nm, mod, err in (("pinocchio", pin, "PIN_ERROR"), ("mujoco", mujoco, "MUJOCO_ERROR"),
+                         ("scipy", scipy, "SCIPY_ERROR")):
+        log(f"{nm}: {mod.__version__ if mod else 'NOT AVAILABLE: ' + globals()[err]}")
+
+    work = Path(args.keep) if args.keep else Path(tempfile.mkdtemp(prefix="restpose-peers-"))
+    work.mkdir(parents=True, exist_ok=True)
+    cases = [("chain", n) for n in sizes(args.chain)] + [("ladder", n) for n in sizes(args.ladder)]
+    rows = []
+    all_results = []
+    for family, n in cases:
+        text = subprocess.run([exe, "generate", family, "--size", str(n)], capture_output=True,
+                              text=True, check=True).stdout
+        urdf = work / f"{family}{n}.urdf"
+        urdf.write_text(text)
+        mech = parse_urdf(text)
+        log(f"== {family} N={n}: {len(mech.links) - 1} bodies, {len(mech.joints)} joints, "
+            f"{len(mech.loops)} loop joints")
+        results = []
+        if "restpose" in tools:
+            log("  restpose ...")
+            results.append(run_restpose(exe, urdf, args.restpose_timeout, args.repeats))
+        if "pinocchio" in tools and not mech.loops:
+            log("  pinocchio ...")
+            results.append(solve_pinocchio(urdf, mech))
+        if "slsqp" in tools:
+            log("  slsqp ...")
+            results.append(solve_slsqp(mech, args.slsqp_max_bodies))
+        if "mujoco" in tools:
+            log("  mujoco ...")
+            results.append(solve_mujoco(mech, args.mujoco_vtol, args.mujoco_budget,
+                                        args.mujoco_timestep, args.mujoco_alpha,
+                                        work / f"{family}{n}.xml" if args.keep else None))
+        if "closed-form" in tools and family == "ladder":
+            results.append(ladder_closed_form(mech, n))
+        for r in results:
+            log(f"  {r.tool}: ok={r.ok} V={r.energy:.12g} it={r.iterations} t={r.time_ms:.2f} ms {r.note}")
+        ref = next((r for r in results if r.tool == "restpose" and r.angles), None)
+        # with no restpose result, compare with the first exact peer that converged, and say so
+        fallback = next((r for r in results if r.tool in ("pinocchio", "closed form") and r.ok), None)
+        for r in results:
+            cmp_to = ref if ref is not None else fallback
+            d, nj = (max_angle_diff(r.angles, cmp_to.angles) if cmp_to is not None and r.angles
+                     and r is not cmp_to else (float("nan"), 0))
+            de = r.energy - cmp_to.energy if cmp_to is not None and r is not cmp_to else float("nan")
+            tol = args.settle_tol if r.tool == "mujoco" else args.exact_tol
+            if r is ref:
+                verdict = "reference" if r.ok else "not converged"
+            elif not r.angles:
+                verdict = "—"
+            elif cmp_to is None:
+                verdict = "no reference"
+            else:
+                verdict = ("agrees" if d < tol else "DISAGREES") + f" (< {tol:g})"
+                if not r.ok:
+                    verdict += ", not converged"
+                if cmp_to is not ref:
+                    verdict += f" vs {cmp_to.tool}"
+            ratio = (r.time_ms / ref.time_ms if ref is not None and ref.ok and r is not ref
+                     and ref.time_ms > 0 else float("nan"))
+            rows.append((family, n, r, d, de, verdict, ratio, nj))
+            all_results.append({"family": family, "n": n, "tool": r.tool, "ok": r.ok,
+                                "energy": r.energy, "iterations": r.iterations,
+                                "time_ms": r.time_ms, "max_dtheta": d, "dV": de,
+                                "joints_compared": nj, "verdict": verdict, "ratio": ratio,
+                                "note": r.note, "extra": r.extra, "angles": r.angles})
+
+    # ---- Markdown ----
+    out = []
+    out.append(f"restpose: `{version}`; Python {platform.python_version()}; numpy {np.__version__}"
+               + (f"; scipy {scipy.__version__}" if scipy else "; scipy: not available")
+               + (f"; pin (Pinocchio) {pin.__version__}" if pin else "; pin: not available")
+               + (f"; mujoco {mujoco.__version__}" if mujoco else "; mujoco: not available") + ".")
+    out.append("")
+    out.append("| family | N | tool | converged | V [J] | ΔV [J] | max \\|Δθ\\| [rad] | agreement "
+               "| iterations | time [ms] | time / restpose | notes |")
+    out.append("|---|---:|---|---|---:|---:|---:|---|---:|---:|---:|---|")
+    for family, n, r, d, de, verdict, ratio, nj in rows:
+        note = r.note
+        if r.tool == "restpose" and "wall_ms" in r.extra:
+            e = r.extra
+            note = (f"process wall {e['wall_ms']:.1f} ms (best of {e['runs']}), `check` "
+                    f"{e['check_ms']:.1f} ms; time = {e['time_basis']}; {e['stability']}"
+                    + (f"; {r.note}" if r.note else ""))
+        elif r.tool == "scipy SLSQP" and "violation" in r.extra:
+            note = (f"{r.extra['nvar']} vars, {r.extra['ncon']} eq. rows, ‖Φ‖∞ {r.extra['violation']:.0e}, "
+                    f"KKT residual {r.extra['kkt']:.0e}" + (f"; {r.note}" if r.note else ""))
+        elif r.tool == "mujoco" and "vmax" in r.extra:
+            note = (f"sim time {r.extra['sim_time']:.2f} s, max\\|qvel\\| {r.extra['vmax']:.0e}"
+                    + (f", loop violation {r.extra['loop_violation']:.0e}" if r.extra["loop_violation"] else "")
+                    + (f"; {r.note}" if r.note else ""))
+        elif r.tool == "pinocchio" and "gnorm" in r.extra:
+            note = f"max\\|g + Kq\\| {r.extra['gnorm']:.0e}" + (f"; {r.note}" if r.note else "")
+        out.append("| " + " | ".join([
+            family, str(n), r.tool, "yes" if r.ok else "no",
+            fmt(r.energy, ".9f"), fmt(de, ".1e"), fmt(d, ".1e"), verdict,
+            r.iterations or "—", fmt(r.time_ms, ".2f"), fmt(ratio, ".3g"), note]) + " |")
+    table = "\n".join(out)
+    print(table)
+    if args.markdown:
+        args.markdown.write_text(table + "\n")
+    if args.json:
+        args.json.write_text(json.dumps(all_results, indent=1, default=float))
+    if not args.keep:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,166 @@
+//! Sparse `Φ_u` and `Φ_v` under a partition, and the sparse LU of `Φ_u`.
+//!
+//! The positions of the Jacobian's triplets do not depend on `q`, so the split of the triplets
+//! into `Φ_u` (independent rows × dependent columns, compressed-column for faer) and `Φ_v`
+//! (independent rows × independent columns, a list of entries) is computed once per partition,
+//! together with faer's symbolic LU analysis (COLAMD ordering, elimination structure); each
+//! evaluation only refills the values and refactors numerically.
+
+use super::pattern::{Pattern, NONE};
+use crate::solver::partition::Partition;
+use faer::linalg::solvers::SolveCore;
+use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::{Conj, MatMut};
+
+/// Where each Jacobian triplet goes under one partition.
+pub(crate) struct Split {
+    rows: Vec<usize>,
+    dependent: Vec<usize>,
+    /// Number of triplets the maps were built for.
+    triplets: usize,
+    pattern: Pattern,
+    symbolic: SymbolicLu<usize>,
+    /// Slot in `Φ_u` of each triplet, or `NONE`.
+    u_slot: Vec<usize>,
+    /// `(row position, independent position, triplet index)` of the `Φ_v` entries.
+    v_entries: Vec<(usize, usize, usize)>,
+    values: Vec<f64>,
+}
+
+/// The numeric factors of `Φ_u` and the values of `Φ_v` at one configuration.
+#[derive(Clone)]
+pub(crate) struct SparseFactors {
+    lu: Option<Lu<usize, f64>>,
+    /// `(row position, independent position, value)`.
+    phi_v: Vec<(usize, usize, f64)>,
+}
+
+impl Split {
+    /// The split of the triplets `entries` under `part`; `None` if faer's symbolic analysis
+    /// fails (out of memory).
+    pub(crate) fn new(
+        part: &Partition,
+        m: usize,
+        n: usize,
+        entries: &[(usize, usize, f64)],
+    ) -> Option<Self> {
+        let mut row_pos = vec![NONE; m];
+        for (k, &r) in part.rows.iter().enumerate() {
+            row_pos[r] = k;
+        }
+        let mut dep_pos = vec![NONE; n];
+        for (k, &c) in part.dependent.iter().enumerate() {
+            dep_pos[c] = k;
+        }
+        let mut ind_pos = vec![NONE; n];
+        for (k, &c) in part.independent.iter().enumerate() {
+            ind_pos[c] = k;
+        }
+        let r = part.rows.len();
+        let positions: Vec<(usize, usize)> = entries
+            .iter()
+            .filter(|e| row_pos[e.0] != NONE && dep_pos[e.1] != NONE)
+            .map(|e| (row_pos[e.0], dep_pos[e.1]))
+            .collect();
+        let pattern = Pattern::new(r, r, positions);
+        let symbolic = SymbolicLu::try_new(pattern.symbolic()).ok()?;
+        let mut u_slot = vec![NONE; entries.len()];
+        let mut v_entries = Vec::new();
+        for (k, e) in entries.iter().enumerate() {
+            let rp = row_pos[e.0];
+            if rp == NONE {
+                continue;
+            }
+            if dep_pos[e.1] != NONE {
+                u_slot[k] = pattern.slot(rp, dep_pos[e.1]);
+            } else if ind_pos[e.1] != NONE {
+                v_entries.push((rp, ind_pos[e.1], k));
+            }
+        }
+        let values = vec![0.0; pattern.nnz()];
+        Some(Split {
+            rows: part.rows.clone(),
+            dependent: part.dependent.clone(),
+            triplets: entries.len(),
+            pattern,
+            symbolic,
+            u_slot,
+            v_entries,
+            values,
+        })
+    }
+
+    /// Whether this split was built for `part` and a Jacobian of `triplets` entries.
+    pub(crate) fn fits(&self, part: &Partition, triplets: usize) -> bool {
+        self.triplets == triplets && self.rows == part.rows && self.dependent == part.dependent
+    }
+
+    /// Refills `Φ_u` from `entries` and factors it; `Φ_v` is copied.
+    pub(crate) fn factor(&mut self, entries: &[(usize, usize, f64)]) -> SparseFactors {
+        self.values.iter_mut().for_each(|v| *v = 0.0);
+        for (k, e) in entries.iter().enumerate() {
+            let s = self.u_slot[k];
+            if s != NONE {
+                self.values[s] += e.2;
+            }
+        }
+        let lu = if self.rows.is_empty() {
+            None
+        } else {
+            Lu::try_new_with_symbolic(self.symbolic.clone(), self.pattern.matrix(&self.values)).ok()
+        };
+        SparseFactors {
+            lu,
+            phi_v: self
+                .v_entries
+                .iter()
+                .map(|&(r, c, k)| (r, c, entries[k].2))
+                .collect(),
+        }
+    }
+}
+
+impl SparseFactors {
+    fn solve_with(&self, b: &mut [f64], transpose: bool) -> bool {
+        if b.is_empty() {
+            return true;
+        }
+        let Some(lu) = &self.lu else { return false };
+        let n = b.len();
+        let m = MatMut::from_column_major_slice_mut(b, n, 1);
+        if transpose {
+            lu.solve_transpose_in_place_with_conj(Conj::No, m);
+        } else {
+            lu.solve_in_place_with_conj(Conj::No, m);
+        }
+        b.iter().all(|x| x.is_finite())
+    }
+
+    /// `Φ_u x = b` in place; `false` if `Φ_u` is singular.
+    pub(crate) fn solve(&self, b: &mut [f64]) -> bool {
+        self.solve_with(b, false)
+    }
+
+    /// `Φ_uᵀ x = b` in place; `false` if `Φ_u` is singular.
+    pub(crate) fn solve_transpose(&self, b: &mut [f64]) -> bool {
+        self.solve_with(b, true)
+    }
+
+    /// `Φ_v x` (length: independent rows).
+    pub(crate) fn phi_v_mul(&self, x: &[f64], r: usize) -> Vec<f64> {
+        let mut y = vec![0.0; r];
+        for &(i, j, v) in &self.phi_v {
+            y[i] += v * x[j];
+        }
+        y
+    }
+
+    /// `Φ_vᵀ y` (length: degrees of freedom).
+    pub(crate) fn phi_v_tr_mul(&self, y: &[f64], dof: usize) -> Vec<f64> {
+        let mut x = vec![0.0; dof];
+        for &(i, j, v) in &self.phi_v {
+            x[j] += v * y[i];
+        }
+        x
+    }
+}

@@ -1,0 +1,253 @@
+//! Coordinate partitioning of a sparse `Φ_q` by Gaussian elimination with threshold pivoting
+//! restricted to one body's columns at a time.
+//!
+//! The dense partition (`solver::partition`) looks for the largest entry of the whole remaining
+//! matrix at every step: `O(m n)` per pivot, `O(m² n)` in all. Here the scaled Jacobian
+//! `D Φ_q S` is kept as sparse rows and the bodies are eliminated in an order that keeps the
+//! fill local: deepest first in a breadth-first search from the ground over all joints (leaves
+//! before their parents). At body `b`, among the active rows with entries in `b`'s free columns,
+//! the pivot is the largest entry `|a_rc|` that also passes the threshold test
+//! `|a_rc| ≥ τ max_k |a_rk|` (τ = 0.1: the pivot is not small against the rest of its row); its
+//! column becomes a dependent coordinate, its row an independent row, and it is eliminated from
+//! the other active rows, `a_i ← a_i − (a_ic / a_rc) a_r`. Up to seven pivots are taken per
+//! body. A row whose entries all fall below `RANK_TOLERANCE · max|D Φ_q S|` is redundant. Rows
+//! left at the end (loop rows whose bodies were all eliminated) are finished by full pivoting
+//! among themselves.
+//!
+//! For a tree, listing each body's joint rows and normalization row in child-before-parent order
+//! makes `Φ_u` block triangular with the 6 × 6 (or smaller) pivot block of each body on its
+//! diagonal: no fill at all and `O(N)` work. A closed loop's rows fill in only along the bodies
+//! of the loop that are eliminated after them.
+
+use super::super::partition::{Partition, RANK_TOLERANCE};
+use crate::model::Model;
+
+/// Threshold of the pivot test against the largest entry of its row.
+const THRESHOLD: f64 = 0.1;
+
+/// The bodies in elimination order: descending breadth-first depth from the ground over all
+/// joints (ties: higher index first); bodies not connected to the ground come last.
+fn elimination_order(model: &Model) -> Vec<usize> {
+    let nb = model.bodies.len();
+    let mut adjacent = vec![Vec::new(); nb];
+    let mut depth = vec![usize::MAX; nb];
+    let mut queue = std::collections::VecDeque::new();
+    for j in model.joints.iter().filter(|j| !j.merged) {
+        match (j.bodies[0], j.bodies[1]) {
+            (Some(a), Some(b)) => {
+                adjacent[a.0].push(b.0);
+                adjacent[b.0].push(a.0);
+            }
+            (Some(a), None) | (None, Some(a)) => {
+                if depth[a.0] == usize::MAX {
+                    depth[a.0] = 1;
+                    queue.push_back(a.0);
+                }
+            }
+            (None, None) => {}
+        }
+    }
+    while let Some(b) = queue.pop_front() {
+        for &c in &adjacent[b] {
+            if depth[c] == usize::MAX {
+                depth[c] = depth[b] + 1;
+                queue.push_back(c);
+            }
+        }
+    }
+    let mut order: Vec<usize> = (0..nb).collect();
+    order.sort_by_key(|&b| {
+        (
+            std::cmp::Reverse(if depth[b] == usize::MAX { 0 } else { depth[b] }),
+            std::cmp::Reverse(b),
+        )
+    });
+    order
+}
+
+/// The elimination state: active sparse rows and which rows touch which body.
+struct Elimination {
+    rows: Vec<Vec<(usize, f64)>>,
+    active: Vec<bool>,
+    free: Vec<bool>,
+    /// Rows that have (or had) entries in a body's columns; may hold stale entries.
+    body_rows: Vec<Vec<usize>>,
+    tol: f64,
+    dependent: Vec<usize>,
+    pivot_rows: Vec<usize>,
+    redundant: Vec<usize>,
+}
+
+impl Elimination {
+    fn row_max(&self, r: usize) -> f64 {
+        self.rows[r].iter().fold(0.0, |a, &(_, v)| a.max(v.abs()))
+    }
+
+    /// Pivots on `(r, c)`: eliminates column `c` from every other active row.
+    fn pivot(&mut self, r: usize, c: usize) {
+        self.active[r] = false;
+        self.free[c] = false;
+        self.dependent.push(c);
+        self.pivot_rows.push(r);
+        let pivot_row = std::mem::take(&mut self.rows[r]);
+        let a_rc = pivot_row.iter().find(|e| e.0 == c).map_or(0.0, |e| e.1);
+        let mut touched = std::mem::take(&mut self.body_rows[c / 7]);
+        touched.sort_unstable();
+        touched.dedup();
+        for &i in &touched {
+            if !self.active[i] {
+                continue;
+            }
+            let Some(k) = self.rows[i].iter().position(|e| e.0 == c) else {
+                continue;
+            };
+            let f = self.rows[i][k].1 / a_rc;
+            self.rows[i].swap_remove(k);
+            for &(col, v) in &pivot_row {
+                if col == c {
+                    continue;
+                }
+                match self.rows[i].iter_mut().find(|e| e.0 == col) {
+                    Some(e) => e.1 -= f * v,
+                    None => {
+                        self.rows[i].push((col, -f * v));
+                        self.body_rows[col / 7].push(i);
+                    }
+                }
+            }
+            if self.row_max(i) <= self.tol {
+                self.active[i] = false;
+                self.redundant.push(i);
+            }
+        }
+        touched.retain(|&i| self.active[i]);
+        self.body_rows[c / 7] = touched;
+        self.rows[r] = pivot_row;
+    }
+
+    /// The best threshold-passing pivot among active rows `cands` in the free columns `cols`.
+    fn best_pivot(&self, cands: &[usize], cols: impl Fn(usize) -> bool) -> Option<(usize, usize)> {
+        let mut best: Option<(usize, usize, f64)> = None;
+        for &r in cands {
+            if !self.active[r] {
+                continue;
+            }
+            let rmax = self.row_max(r);
+            let mut entries: Vec<(usize, f64)> = self.rows[r]
+                .iter()
+                .copied()
+                .filter(|&(c, _)| self.free[c] && cols(c))
+                .collect();
+            entries.sort_unstable_by_key(|e| e.0);
+            for (c, v) in entries {
+                let a = v.abs();
+                if a > self.tol
+                    && a >= THRESHOLD * rmax
+                    && best.is_none_or(|b| a > b.2 * (1.0 + 1e-9))
+                {
+                    best = Some((r, c, a));
+                }
+            }
+        }
+        best.map(|(r, c, _)| (r, c))
+    }
+}
+
+/// Partitions the Jacobian given as triplets (`(row, col, value)`, duplicates summed) of an
+/// `m × n` matrix, with row scales `row_scale` and column scales `scale`.
+pub(crate) fn partition(
+    model: &Model,
+    m: usize,
+    n: usize,
+    entries: &[(usize, usize, f64)],
+    row_scale: &[f64],
+    scale: &[f64],
+) -> Partition {
+    let nb = n / 7;
+    let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); m];
+    for &(r, c, v) in entries {
+        let a = v * row_scale[r] * scale[c];
+        match rows[r].iter_mut().find(|e| e.0 == c) {
+            Some(e) => e.1 += a,
+            None => rows[r].push((c, a)),
+        }
+    }
+    for row in &mut rows {
+        row.retain(|e| e.1 != 0.0);
+    }
+    let amax = rows.iter().flatten().fold(0.0f64, |a, e| a.max(e.1.abs()));
+    let mut body_rows = vec![Vec::new(); nb];
+    for (r, row) in rows.iter().enumerate() {
+        for &(c, _) in row {
+            body_rows[c / 7].push(r);
+        }
+    }
+    let tol = (RANK_TOLERANCE * amax).max(f64::MIN_POSITIVE);
+    let mut el = Elimination {
+        active: rows.iter().map(|r| !r.is_empty()).collect(),
+        redundant: (0..m).filter(|&r| rows[r].is_empty()).collect(),
+        rows,
+        free: vec![true; n],
+        body_rows,
+        tol,
+        dependent: Vec::new(),
+        pivot_rows: Vec::new(),
+    };
+    for r in 0..m {
+        if el.active[r] && el.row_max(r) <= tol {
+            el.active[r] = false;
+            el.redundant.push(r);
+        }
+    }
+    for b in elimination_order(model) {
+        for _ in 0..7 {
+            let mut cands = el.body_rows[b].clone();
+            cands.sort_unstable();
+            cands.dedup();
+            match el.best_pivot(&cands, |c| c / 7 == b) {
+                Some((r, c)) => el.pivot(r, c),
+                None => break,
+            }
+        }
+    }
+    // Rows left over: full pivoting among them over all free columns.
+    let mut left: Vec<usize> = (0..m).filter(|&r| el.active[r]).collect();
+    loop {
+        left.retain(|&r| el.active[r]);
+        if left.is_empty() {
+            break;
+        }
+        match el.best_pivot(&left, |_| true) {
+            Some((r, c)) => el.pivot(r, c),
+            None => {
+                // No entry passes the threshold test: plain full pivoting.
+                let mut best: Option<(usize, usize, f64)> = None;
+                for &r in &left {
+                    for &(c, v) in &el.rows[r] {
+                        if el.free[c] && best.is_none_or(|b| v.abs() > b.2) {
+                            best = Some((r, c, v.abs()));
+                        }
+                    }
+                }
+                match best {
+                    Some((r, c, a)) if a > tol => el.pivot(r, c),
+                    _ => {
+                        for &r in &left {
+                            el.active[r] = false;
+                            el.redundant.push(r);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let mut independent: Vec<usize> = (0..n).filter(|&c| el.free[c]).collect();
+    independent.sort_unstable();
+    el.redundant.sort_unstable();
+    Partition {
+        dependent: el.dependent,
+        independent,
+        rows: el.pivot_rows,
+        redundant: el.redundant,
+    }
+}

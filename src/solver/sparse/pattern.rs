@@ -1,0 +1,71 @@
+//! A compressed-column sparsity pattern, built once from (row, column) positions, that knows the
+//! slot of every position: values are then refilled in place at each evaluation
+//! (`values[slot(i, j)] += a_ij`) and handed to faer with the same symbolic structure.
+
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+
+/// Marks a position outside the pattern (or a triplet that does not belong to a sub-matrix).
+pub(crate) const NONE: usize = usize::MAX;
+
+/// The sorted, de-duplicated positions of a sparse matrix in compressed-column form.
+#[derive(Clone, Debug)]
+pub(crate) struct Pattern {
+    symbolic: SymbolicSparseColMat<usize>,
+}
+
+impl Pattern {
+    /// The pattern of `positions` (any order, duplicates allowed) in an `nrows × ncols` matrix.
+    pub(crate) fn new(nrows: usize, ncols: usize, mut positions: Vec<(usize, usize)>) -> Self {
+        positions.sort_unstable_by_key(|&(r, c)| (c, r));
+        positions.dedup();
+        let mut col_ptr = vec![0usize; ncols + 1];
+        for &(_, c) in &positions {
+            col_ptr[c + 1] += 1;
+        }
+        for c in 0..ncols {
+            col_ptr[c + 1] += col_ptr[c];
+        }
+        let row_idx = positions.iter().map(|&(r, _)| r).collect();
+        Pattern {
+            symbolic: SymbolicSparseColMat::new_checked(nrows, ncols, col_ptr, None, row_idx),
+        }
+    }
+
+    /// Number of stored entries.
+    pub(crate) fn nnz(&self) -> usize {
+        self.symbolic.row_idx().len()
+    }
+
+    /// The slot of position `(r, c)`, or [`NONE`].
+    pub(crate) fn slot(&self, r: usize, c: usize) -> usize {
+        let ptr = self.symbolic.col_ptr();
+        let rows = &self.symbolic.row_idx()[ptr[c]..ptr[c + 1]];
+        rows.binary_search(&r).map_or(NONE, |k| ptr[c] + k)
+    }
+
+    /// The structure, for faer's symbolic factorizations.
+    pub(crate) fn symbolic(&self) -> faer::sparse::SymbolicSparseColMatRef<'_, usize> {
+        self.symbolic.as_ref()
+    }
+
+    /// The matrix with this pattern and `values` (one per slot).
+    pub(crate) fn matrix<'a>(&'a self, values: &'a [f64]) -> SparseColMatRef<'a, usize, f64> {
+        SparseColMatRef::new(self.symbolic.as_ref(), values)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slots_cover_positions_and_duplicates_share_a_slot() {
+        let p = Pattern::new(3, 3, vec![(2, 0), (0, 0), (1, 2), (2, 0), (0, 2)]);
+        assert_eq!(p.nnz(), 4);
+        assert_eq!(p.slot(0, 0), 0);
+        assert_eq!(p.slot(2, 0), 1);
+        assert_eq!(p.slot(0, 2), 2);
+        assert_eq!(p.slot(1, 2), 3);
+        assert_eq!(p.slot(1, 1), NONE);
+    }
+}

@@ -398,7 +398,9 @@ def solve_pinocchio(urdf: Path, mech: Mech, tol=1e-8, max_iter=500) -> Result:
             qn = pin.integrate(model, q, a * dq)
             thn = theta + a * dq
             vn = energy(qn, thn)
-            if vn <= v + 1e-4 * a * slope or a < 1e-12:
+            # Armijo, with room for round-off in V near the solution (V changes there by
+            # ~|g|^2/k, far below eps |V|)
+            if vn <= v + 1e-4 * a * slope + 1e-13 * max(1.0, abs(v)) or a < 1e-12:
                 break
             a *= 0.5
             halvings += 1
@@ -651,8 +653,11 @@ def solve_mujoco(mech: Mech, vtol: float, budget_s: float, timestep: float, alph
     probe = mujoco.MjModel.from_xml_string(write_mjcf(mech, {j.name: 0.0 for j in mech.joints}, timestep))
     pd = mujoco.MjData(probe)
     mujoco.mj_forward(probe, pd)
-    mdiag = np.zeros(probe.nv)
-    mujoco.mj_fullM(probe, full := np.zeros((probe.nv, probe.nv)), pd.qM)
+    full = np.zeros((probe.nv, probe.nv))
+    try:
+        mujoco.mj_fullM(probe, pd, full)  # mujoco >= 4
+    except TypeError:
+        mujoco.mj_fullM(probe, full, pd.qM)  # mujoco 3
     mdiag = np.diag(full)
     damping = {}
     for j in mech.joints:

@@ -175,3 +175,65 @@ fn lanczos(sys: &mut System, q: &DVector<f64>, part: &Partition, eval: &Eval) ->
         exact: false,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::constraints::Constraints;
+    use crate::urdf::{load_str, ImportOptions};
+
+    /// Lanczos on the inverse through the KKT factors finds the smallest eigenvalues of the
+    /// explicitly formed reduced Hessian of a 240-link chain (more degrees of freedom than
+    /// `EXACT_UP_TO`), and a negative one on a chain held upside down.
+    #[test]
+    fn lanczos_finds_the_low_end_of_the_exact_spectrum() {
+        let n = EXACT_UP_TO + 40;
+        let text = crate::generate::chain(n, false);
+        for flip in [false, true] {
+            let text = if flip {
+                // Gravity up and weak springs: the bent chain is far from stable.
+                let mut t = String::new();
+                let mut rest = text.replace("0 0 -9.81", "0 0 9.81");
+                while let Some(i) = rest.find("stiffness=\"") {
+                    t.push_str(&rest[..i]);
+                    t.push_str("stiffness=\"0.01");
+                    let tail = &rest[i + 11..];
+                    rest = tail[tail.find('"').unwrap()..].to_string();
+                }
+                t + &rest
+            } else {
+                text.clone()
+            };
+            let model = load_str(&text, "c.urdf", &ImportOptions::default())
+                .unwrap()
+                .model;
+            // A bent configuration, away from any symmetry.
+            let mut values = crate::state::JointValues::new();
+            for i in 0..n {
+                values.insert(format!("joint{i}"), vec![0.3 * ((i as f64) * 0.7).sin()]);
+            }
+            let q = crate::state::State::from_joint_values(&model, &values).q;
+            let mut sys = System::new(&model, Constraints::new(&model, &[]));
+            sys.sparse = true;
+            let part = sys.partition(&q);
+            let eval = sys.evaluate(&q, &part).unwrap();
+            let exact = symmetric_eigen(&sys.reduced_hessian(&q, &part, &eval)).0;
+            let lz = lanczos(&mut sys, &q, &part, &eval).unwrap();
+            let lo = lz.values[0];
+            // Each Ritz value is an eigenvalue; without a flip the lowest is the lowest.
+            for &l in lz.values.iter() {
+                let nearest = exact
+                    .iter()
+                    .map(|e| (e - l).abs())
+                    .fold(f64::INFINITY, f64::min);
+                assert!(nearest <= 1e-6 * l.abs(), "flip {flip}: Ritz value {l} off the spectrum");
+            }
+            if !flip {
+                assert!((lo - exact[0]).abs() <= 1e-6 * exact[0].abs(), "{lo} vs {}", exact[0]);
+            }
+            assert_eq!(lo < 0.0, flip);
+            assert_eq!(exact[0] < 0.0, flip);
+            assert!((lz.largest - exact.amax()).abs() < 0.05 * exact.amax());
+        }
+    }
+}

@@ -1,47 +1,181 @@
-//! Solve time of generated chains and ladders (dense path), plain harness:
-//! `cargo bench --bench chain [N …]` prints one row per family and size.
+//! Solve time, iterations, time per iteration and peak memory of the generated benchmark
+//! families (plain harness, no criterion: the sizes span four decades and each large size is
+//! solved once, in its own process so that its peak memory can be read).
+//!
+//! `cargo bench --bench chain -- [--dense | --sparse] [--family chain|ladder|robots] [N …]`
+//!
+//! - `chain N`: `restpose generate chain --size N` (N bodies);
+//! - `ladder N`: `restpose generate ladder --size N` (N closed loops, 3N bodies);
+//! - `robots`: the tractor-trailer and the 7-axis arm of `robots/`.
+//!
+//! Each row is measured in a child process (this executable again, with
+//! `RESTPOSE_BENCH_CHILD=family:N:algebra`): best of 3 solves (1 above 2,000 bodies) with the
+//! default options (Newton, gradient tolerance 1e-8), then the process's peak resident memory
+//! (`VmHWM`). Solves are checked: converged, ‖Φ‖∞ below 1e-9. Below the table, the growth
+//! exponent `p` of time per iteration `∝ N^p`, fitted by least squares over N ≥ 100.
+use restpose::{LinearAlgebra, Options};
+use std::process::Command;
 use std::time::Instant;
 
-/// A benchmark family: its name and a generator of URDF text for size N.
-type Family = (&'static str, fn(usize) -> String);
+fn model_text(family: &str, n: usize) -> (String, String) {
+    match family {
+        "chain" => (format!("chain{n}"), restpose::generate::chain(n, false)),
+        "ladder" => (format!("ladder{n}"), restpose::generate::ladder(n)),
+        _ => {
+            let name = ["tractor_trailer", "panda_class", "stewart_platform"][n];
+            let path = format!("{}/robots/{name}.urdf", env!("CARGO_MANIFEST_DIR"));
+            (
+                name.to_string(),
+                std::fs::read_to_string(path).expect("robot file"),
+            )
+        }
+    }
+}
+
+fn peak_rss_mb() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
+        })
+        .map_or(f64::NAN, |kb| kb / 1024.0)
+}
+
+/// One measurement (child process): prints `name bodies dof iterations best_ms peak_mb`.
+fn child(spec: &str) {
+    let parts: Vec<&str> = spec.split(':').collect();
+    let (family, n, algebra) = (parts[0], parts[1].parse().unwrap(), parts[2]);
+    let (name, text) = model_text(family, n);
+    let model = restpose::urdf::load_str(&text, "bench.urdf", &Default::default())
+        .expect("benchmark model loads")
+        .model;
+    let options = Options {
+        linear_algebra: match algebra {
+            "dense" => LinearAlgebra::Dense,
+            "sparse" => LinearAlgebra::Sparse,
+            _ => LinearAlgebra::Auto,
+        },
+        ..Default::default()
+    };
+    let runs = if model.bodies.len() > 2000 { 1 } else { 3 };
+    let mut best = f64::INFINITY;
+    let mut report = None;
+    for _ in 0..runs {
+        let t = Instant::now();
+        let (_, r) = restpose::solve(&model, &options).expect("solves");
+        best = best.min(t.elapsed().as_secs_f64() * 1e3);
+        assert!(
+            r.converged(),
+            "{name} did not converge: {:?}",
+            r.termination
+        );
+        assert!(r.diagnostics.constraint_residual < 1e-9);
+        report = Some(r);
+    }
+    let r = report.unwrap();
+    println!(
+        "{name} {} {} {} {best} {} {}",
+        model.bodies.len(),
+        r.dof,
+        r.iterations,
+        peak_rss_mb(),
+        r.diagnostics.linear_algebra
+    );
+}
 
 fn main() {
-    let sizes: Vec<usize> = std::env::args()
-        .skip(1)
-        .filter_map(|a| a.parse().ok())
-        .collect::<Vec<_>>();
-    let sizes = if sizes.is_empty() {
-        vec![5, 10, 20, 40, 80]
+    if let Ok(spec) = std::env::var("RESTPOSE_BENCH_CHILD") {
+        child(&spec);
+        return;
+    }
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let algebra = if args.iter().any(|a| a == "--dense") {
+        "dense"
+    } else if args.iter().any(|a| a == "--sparse") {
+        "sparse"
     } else {
-        sizes
+        "auto"
     };
-    println!("| family | N | coordinates | iterations | solve [ms] | ms / iteration |");
-    println!("|---|---:|---:|---:|---:|---:|");
-    let families: [Family; 2] = [
-        ("chain", |n| restpose::generate::chain(n, false)),
-        ("ladder", |n| restpose::generate::ladder(n / 2)),
-    ];
-    for (family, make) in families {
-        for &n in &sizes {
-            let text = make(n);
-            let model = restpose::urdf::load_str(&text, "chain.urdf", &Default::default())
-                .expect("generated chain loads")
-                .model;
-            let mut best = f64::INFINITY;
-            let mut iterations = 0;
-            for _ in 0..3 {
-                let t = Instant::now();
-                let (_, report) = restpose::solve(&model, &Default::default()).expect("solves");
-                let ms = t.elapsed().as_secs_f64() * 1e3;
-                assert!(report.converged(), "{family} {n} did not converge");
-                iterations = report.iterations;
-                best = best.min(ms);
+    let family = args
+        .iter()
+        .position(|a| a == "--family")
+        .and_then(|i| args.get(i + 1).cloned());
+    let sizes: Vec<usize> = args.iter().filter_map(|a| a.parse().ok()).collect();
+    let families: Vec<(&str, Vec<usize>)> = match family.as_deref() {
+        Some("robots") => vec![("robots", vec![0, 1, 2])],
+        Some(f @ ("chain" | "ladder")) => vec![(
+            if f == "chain" { "chain" } else { "ladder" },
+            if sizes.is_empty() {
+                vec![10, 100, 1000]
+            } else {
+                sizes.clone()
+            },
+        )],
+        _ => {
+            let s = if sizes.is_empty() {
+                vec![10, 100, 1000]
+            } else {
+                sizes.clone()
+            };
+            vec![
+                ("chain", s.clone()),
+                ("ladder", s),
+                ("robots", vec![0, 1, 2]),
+            ]
+        }
+    };
+    let exe = std::env::current_exe().expect("own path");
+    println!("| model | bodies | dof | algebra | iterations | solve [ms] | ms / iteration | peak RSS [MB] |");
+    println!("|---|---:|---:|---|---:|---:|---:|---:|");
+    for (family, sizes) in families {
+        let mut fit = Vec::new();
+        for n in sizes {
+            let out = Command::new(&exe)
+                .env("RESTPOSE_BENCH_CHILD", format!("{family}:{n}:{algebra}"))
+                .output()
+                .expect("child runs");
+            let text = String::from_utf8_lossy(&out.stdout);
+            let f: Vec<&str> = text.split_whitespace().collect();
+            if !out.status.success() || f.len() < 7 {
+                println!(
+                    "| {family} {n} | failed: {} |",
+                    String::from_utf8_lossy(&out.stderr)
+                        .lines()
+                        .last()
+                        .unwrap_or("")
+                );
+                continue;
             }
+            let (bodies, its, ms): (f64, f64, f64) = (
+                f[1].parse().unwrap(),
+                f[3].parse().unwrap(),
+                f[4].parse().unwrap(),
+            );
+            let per = ms / its.max(1.0);
             println!(
-                "| {family} | {} | {} | {iterations} | {best:.2} | {:.2} |",
-                if family == "ladder" { n / 2 } else { n },
-                model.coordinate_count(),
-                best / iterations.max(1) as f64
+                "| {} | {} | {} | {} | {} | {ms:.2} | {per:.3} | {:.1} |",
+                f[0],
+                f[1],
+                f[2],
+                f[6],
+                f[3],
+                f[5].parse::<f64>().unwrap()
+            );
+            if family != "robots" && bodies >= 100.0 {
+                fit.push((bodies.ln(), per.ln()));
+            }
+        }
+        if fit.len() >= 2 {
+            let k = fit.len() as f64;
+            let (sx, sy) = fit.iter().fold((0.0, 0.0), |a, p| (a.0 + p.0, a.1 + p.1));
+            let (mx, my) = (sx / k, sy / k);
+            let num: f64 = fit.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+            let den: f64 = fit.iter().map(|p| (p.0 - mx).powi(2)).sum();
+            println!(
+                "\n{family}: time per iteration ∝ bodies^{:.2} (least squares, bodies ≥ 100)\n",
+                num / den
             );
         }
     }

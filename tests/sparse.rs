@@ -12,7 +12,12 @@ fn solve_with(model: &Model, la: LinearAlgebra) -> (restpose::State, restpose::R
         ..Default::default()
     };
     let (s, r) = restpose::solve(model, &options).unwrap_or_else(|e| panic!("{e}"));
-    assert!(r.converged(), "{} ({la:?}): {:?}", model.name, r.termination);
+    assert!(
+        r.converged(),
+        "{} ({la:?}): {:?}",
+        model.name,
+        r.termination
+    );
     (s, r)
 }
 
@@ -58,7 +63,11 @@ fn sparse_and_dense_paths_agree_on_every_robot_and_generated_family() {
         let js = ss.joint_values(m);
         for ((name, a), (_, b)) in jd.iter().zip(&js) {
             for (x, y) in a.iter().zip(b) {
-                assert!((x - y).abs() < 1e-6, "{}: {name} dense {x} sparse {y}", m.name);
+                assert!(
+                    (x - y).abs() < 1e-6,
+                    "{}: {name} dense {x} sparse {y}",
+                    m.name
+                );
             }
         }
         assert_verified_minimum(m, &ss);
@@ -100,7 +109,11 @@ fn long_chain_is_a_minimum_of_its_joint_space_energy() {
         v
     };
     let v = energy(&theta);
-    assert!((v - r.energy.total).abs() < 1e-9 * v.abs(), "{v} vs {}", r.energy.total);
+    assert!(
+        (v - r.energy.total).abs() < 1e-9 * v.abs(),
+        "{v} vs {}",
+        r.energy.total
+    );
     // Joint-space gradient by central differences, to their rounding error `ε |V| / h`.
     let h = 1e-5;
     for i in (0..n).step_by(7) {
@@ -143,7 +156,11 @@ fn long_ladder_is_stationary_for_its_loop_angle_energy() {
         v
     };
     let v = energy(&phi);
-    assert!((v - r.energy.total).abs() < 1e-9 * v.abs(), "{v} vs {}", r.energy.total);
+    assert!(
+        (v - r.energy.total).abs() < 1e-9 * v.abs(),
+        "{v} vs {}",
+        r.energy.total
+    );
     // Gradient by central differences, to their rounding error `ε |V| / h`.
     let h = 1e-5;
     for k in (0..n).step_by(5) {

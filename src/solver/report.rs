@@ -45,7 +45,7 @@ pub struct Iterate {
 pub struct Stability {
     /// `stable` (all eigenvalues > tolerance), `unstable` (one < −tolerance) or `neutral`.
     pub verdict: String,
-    /// Eigenvalue tolerance used: `1e-8 · max(1, max |λ|)` \[J\].
+    /// Eigenvalue tolerance used: `1e-10 · max(1, max |λ|)` \[J\].
     pub tolerance: f64,
     /// Smallest eigenvalues of the scaled reduced Hessian, ascending (at most 6) \[J\].
     pub eigenvalues: Vec<f64>,

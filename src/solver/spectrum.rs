@@ -226,10 +226,17 @@ mod tests {
                     .iter()
                     .map(|e| (e - l).abs())
                     .fold(f64::INFINITY, f64::min);
-                assert!(nearest <= 1e-6 * l.abs(), "flip {flip}: Ritz value {l} off the spectrum");
+                assert!(
+                    nearest <= 1e-6 * l.abs(),
+                    "flip {flip}: Ritz value {l} off the spectrum"
+                );
             }
             if !flip {
-                assert!((lo - exact[0]).abs() <= 1e-6 * exact[0].abs(), "{lo} vs {}", exact[0]);
+                assert!(
+                    (lo - exact[0]).abs() <= 1e-6 * exact[0].abs(),
+                    "{lo} vs {}",
+                    exact[0]
+                );
             }
             assert_eq!(lo < 0.0, flip);
             assert_eq!(exact[0] < 0.0, flip);

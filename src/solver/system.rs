@@ -701,9 +701,13 @@ mod tests {
     fn kkt_step_is_the_reduced_newton_step() {
         let mut all = models();
         all.push(
-            load_str(&crate::generate::ladder(3), "l.urdf", &ImportOptions::default())
-                .unwrap()
-                .model,
+            load_str(
+                &crate::generate::ladder(3),
+                "l.urdf",
+                &ImportOptions::default(),
+            )
+            .unwrap()
+            .model,
         );
         for model in all {
             let q0 = crate::solver::initial_state(&model).q;
@@ -724,7 +728,11 @@ mod tests {
             if g.amax() < 1e-12 {
                 continue;
             }
-            assert!(sparse.factor_kkt(&q, &part, &es, true, 0.0), "{}", model.name);
+            assert!(
+                sparse.factor_kkt(&q, &part, &es, true, 0.0),
+                "{}",
+                model.name
+            );
             let mut b = DVector::zeros(q.len());
             for (k, &c) in part.independent.iter().enumerate() {
                 b[c] = -g[k];
@@ -739,8 +747,13 @@ mod tests {
             );
             // δq is the tangent step of δv: Φ_q δq = 0 on the independent rows.
             let full = sparse.tangent_step(&part, &es, &d);
-            let dq_unscaled = DVector::from_iterator(q.len(), (0..q.len()).map(|i| dq[i] * sparse.scale[i]));
-            assert!((&full - &dq_unscaled).amax() < 1e-8 * (1.0 + full.amax()), "{}", model.name);
+            let dq_unscaled =
+                DVector::from_iterator(q.len(), (0..q.len()).map(|i| dq[i] * sparse.scale[i]));
+            assert!(
+                (&full - &dq_unscaled).amax() < 1e-8 * (1.0 + full.amax()),
+                "{}",
+                model.name
+            );
         }
     }
 

@@ -274,7 +274,11 @@ mod tests {
         texts.push(crate::generate::chain(9, false));
         texts
             .iter()
-            .map(|t| load_str(t, "m.urdf", &ImportOptions::default()).unwrap().model)
+            .map(|t| {
+                load_str(t, "m.urdf", &ImportOptions::default())
+                    .unwrap()
+                    .model
+            })
             .collect()
     }
 

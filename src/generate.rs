@@ -66,7 +66,7 @@ pub fn ladder(n: usize) -> String {
     );
     let _ = writeln!(s, "  <link name=\"world\"/>");
     let inertial = |x: f64, y: f64| {
-        format!("<inertial><origin xyz=\"{x} {y} 0\"/><mass value=\"1\"/><inertia ixx=\"1e-3\" ixy=\"0\" ixz=\"0\" iyy=\"1e-3\" iyz=\"0\" izz=\"1e-2\"/></inertial>")
+        format!("<inertial><origin xyz=\"{x} {y} 0\"/><mass value=\"1\"/><inertia ixx=\"7.5e-3\" ixy=\"0\" ixz=\"0\" iyy=\"1e-4\" iyz=\"0\" izz=\"7.5e-3\"/></inertial>")
     };
     for k in 0..n {
         let _ = writeln!(

@@ -22,6 +22,7 @@ use super::options::{Method, Options};
 use super::partition::Partition;
 use super::report::{Diagnostics, Iterate, Termination};
 use super::spectrum::{spectrum, Spectrum};
+use super::sparse::kkt::Factored;
 use super::system::{Eval, System};
 use nalgebra::{DMatrix, DVector};
 
@@ -148,15 +149,24 @@ fn kkt_direction(
     }
     let mut delta = 0.0;
     for attempt in 0..12 {
-        if sys.factor_kkt(q, part, eval, attempt == 0, delta) {
-            if let Some(dq) = sys.kkt_solve(&b) {
-                let d = DVector::from_iterator(
-                    part.independent.len(),
-                    part.independent.iter().map(|&c| dq[c]),
-                );
-                if d.dot(g) < -1e-12 * d.norm() * g.norm() {
-                    return d;
-                }
+        let mut factored = sys.factor_kkt(q, part, eval, attempt == 0, delta);
+        let mut dq = sys.kkt_solve(&b);
+        if dq.is_none() && matches!(factored, Factored::Ldlt { .. }) {
+            // LDLᵀ without pivoting was not accurate enough here: LU with partial pivoting.
+            factored = sys.kkt_fall_back_to_lu();
+            dq = sys.kkt_solve(&b);
+        }
+        // The step is taken if it goes downhill, even where the reduced Hessian is indefinite
+        // (LDLᵀ would count its negative eigenvalues, but a global shift large enough to
+        // remove them slows the soft parts of a stiff mechanism down to a crawl; the line
+        // search and the final stability check handle what is left).
+        if let (false, Some(dq)) = (factored == Factored::None, dq) {
+            let d = DVector::from_iterator(
+                part.independent.len(),
+                part.independent.iter().map(|&c| dq[c]),
+            );
+            if d.dot(g) < -1e-12 * d.norm() * g.norm() {
+                return d;
             }
         }
         delta = if delta == 0.0 {
@@ -288,11 +298,12 @@ pub(crate) fn minimize(
         for _ in 0..40 {
             let mut qt = &q + &dq * alpha;
             if sys
-                .correct(
+                .correct_from(
                     &mut qt,
                     &part,
                     options.constraint_tolerance,
                     options.max_corrector_iterations,
+                    Some(&eval.factors),
                 )
                 .is_err()
             {

@@ -15,6 +15,9 @@ use nalgebra::DMatrix;
 /// Result of a partition.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct Partition {
+    /// Distinct for every partition computed in this process (the sparse path keys its cached
+    /// structures on it).
+    pub(crate) id: usize,
     /// Dependent coordinates `u` (pivot columns), in pivot order.
     pub(crate) dependent: Vec<usize>,
     /// Independent coordinates `v`, ascending.
@@ -23,6 +26,12 @@ pub(crate) struct Partition {
     pub(crate) rows: Vec<usize>,
     /// Redundant constraint rows, ascending.
     pub(crate) redundant: Vec<usize>,
+}
+
+/// A fresh partition id.
+pub(crate) fn next_id() -> usize {
+    static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(1);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
 
 /// Relative rank tolerance of the full-pivoting elimination.
@@ -77,6 +86,7 @@ pub(crate) fn partition(jac: &DMatrix<f64>, row_scale: &[f64], scale: &[f64]) ->
     let mut redundant = row_perm[rank..].to_vec();
     redundant.sort_unstable();
     Partition {
+        id: next_id(),
         dependent: col_perm[..rank].to_vec(),
         independent,
         rows: row_perm[..rank].to_vec(),

@@ -27,11 +27,19 @@ pub(crate) fn reactions(
     }
     let mut out = Vec::new();
     let mut rows_buf = Vec::new();
+    // The joint and lock blocks of each joint (one pass: `O(N)`, not joints × blocks).
+    let mut by_joint = vec![Vec::new(); model.joints.len()];
+    for block in &sys.cons.blocks {
+        match &block.kind {
+            BlockKind::Joint(id) | BlockKind::Lock { joint: id, .. } => by_joint[id.0].push(block),
+            _ => {}
+        }
+    }
     for (ji, j) in model.joints.iter().enumerate() {
         let pair = pair_of(&j.bodies, q, false);
         let mut g = crate::jet::LVec::zeros();
         let mut any = false;
-        for block in &sys.cons.blocks {
+        for block in &by_joint[ji] {
             match &block.kind {
                 BlockKind::Joint(id) if id.0 == ji => {
                     joint::rows(j, &pair, &mut rows_buf);

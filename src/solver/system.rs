@@ -13,7 +13,7 @@
 use super::partition::{partition, Partition};
 use super::sparse::factor::{SparseFactors, Split};
 use super::sparse::hessian::BlockHessian;
-use super::sparse::kkt::Kkt;
+use super::sparse::kkt::{Factored, Kkt};
 use crate::constraints::{Constraints, Triplets};
 use crate::forces::{potential, Energy};
 use crate::jet::HessianSink;
@@ -32,6 +32,8 @@ pub(crate) struct System<'a> {
     pub(crate) sparse: bool,
     phi: DVector<f64>,
     jac: Triplets,
+    /// The configuration of the last triplets (`jac` and `phi`).
+    jac_at: DVector<f64>,
     split: Option<Split>,
     kkt: Option<Kkt>,
     hess: BlockHessian,
@@ -166,6 +168,7 @@ impl<'a> System<'a> {
             model,
             phi: DVector::zeros(cons.len()),
             jac: Triplets::default(),
+            jac_at: DVector::zeros(0),
             cons,
             scale,
             sparse: model.coordinate_count() > SPARSE_FROM_COORDINATES,
@@ -190,8 +193,9 @@ impl<'a> System<'a> {
         sys
     }
 
-    /// `Φ(q)`.
+    /// `Φ(q)` (invalidates the triplets' `Φ`).
     pub(crate) fn residual(&mut self, q: &DVector<f64>) -> &DVector<f64> {
+        self.jac_at = DVector::zeros(0);
         self.cons.evaluate(self.model, q, &mut self.phi, None);
         &self.phi
     }
@@ -211,10 +215,14 @@ impl<'a> System<'a> {
         &self.phi
     }
 
-    /// `Φ(q)` and the triplets of `Φ_q(q)` into the scratch.
+    /// `Φ(q)` and the triplets of `Φ_q(q)` into the scratch (kept if they are at `q`).
     fn triplets(&mut self, q: &DVector<f64>) {
+        if self.jac_at.len() == q.len() && self.jac_at == *q {
+            return;
+        }
         self.cons
             .evaluate(self.model, q, &mut self.phi, Some(&mut self.jac));
+        self.jac_at.clone_from(q);
     }
 
     /// Dense `Φ_q(q)` (and `Φ(q)` into the scratch).
@@ -305,6 +313,7 @@ impl<'a> System<'a> {
 
     /// Newton corrector: solves the independent rows for `u` with `v` fixed; returns the number
     /// of iterations. Also fails if the redundant rows are not satisfied at the end.
+    #[cfg(test)]
     pub(crate) fn correct(
         &mut self,
         q: &mut DVector<f64>,
@@ -312,7 +321,22 @@ impl<'a> System<'a> {
         tol: f64,
         max_iterations: usize,
     ) -> Result<usize, CorrectorFailure> {
+        self.correct_from(q, part, tol, max_iterations, None)
+    }
+
+    /// The corrector, starting with chord steps on the factors `chord` of `Φ_u` at a nearby
+    /// point (no Jacobian, no factorization: `Φ_u(q₀) δu = −Φ(q)`) while each step at least
+    /// halves the residual, then Newton steps with `Φ_u(q)` refactored.
+    pub(crate) fn correct_from(
+        &mut self,
+        q: &mut DVector<f64>,
+        part: &Partition,
+        tol: f64,
+        max_iterations: usize,
+        mut chord: Option<&Factors>,
+    ) -> Result<usize, CorrectorFailure> {
         let mut first = f64::INFINITY;
+        let mut last = f64::INFINITY;
         for it in 0..=max_iterations {
             self.residual(q);
             let res = part
@@ -339,7 +363,21 @@ impl<'a> System<'a> {
             if it == max_iterations {
                 break;
             }
-            let Some(du) = self.dependent_step(q, part) else {
+            if res > 0.5 * last {
+                chord = None;
+            }
+            last = res;
+            let du = match chord {
+                Some(f) => {
+                    let rhs = DVector::from_iterator(
+                        part.rows.len(),
+                        part.rows.iter().map(|&a| -self.phi[a]),
+                    );
+                    f.solve(&rhs)
+                }
+                None => self.dependent_step(q, part),
+            };
+            let Some(du) = du else {
                 return Err(CorrectorFailure);
             };
             for (k, &c) in part.dependent.iter().enumerate() {
@@ -525,8 +563,14 @@ impl<'a> System<'a> {
         self.tangent_transpose(part, eval, &wzx)
     }
 
-    /// Assembles `W` at `q` and factors the KKT matrix with the shift `δ` (scaled coordinates);
-    /// `false` if the matrix is singular.
+    /// Assembles `W` at `q` and factors the KKT matrix with the shift `δ` (scaled coordinates).
+    ///
+    /// `W` is augmented by `Φ_qᵀ D R D Φ_q` over the independent rows (`R` diagonal and
+    /// positive): the KKT solution is the same (its `δq` satisfies `Φ_q δq = 0`) and so is the
+    /// matrix's inertia (the augmented matrix is congruent to the plain one), but the position
+    /// coordinates, on which gravity has no curvature, get positive pivots in the LDLᵀ order.
+    /// `R_k` is the largest scaled diagonal entry of `W` among the row's coordinates (at least
+    /// `10⁻⁶` of the largest overall), so that the term is on the scale of `W` nearby.
     pub(crate) fn factor_kkt(
         &mut self,
         q: &DVector<f64>,
@@ -534,10 +578,11 @@ impl<'a> System<'a> {
         eval: &Eval,
         fresh: bool,
         delta: f64,
-    ) -> bool {
+    ) -> Factored {
         if fresh {
             self.lagrangian_blocks(q, part, eval);
             self.triplets(q);
+            self.augment(part);
             let (m, n) = (self.cons.len(), q.len());
             if !self
                 .kkt
@@ -547,11 +592,96 @@ impl<'a> System<'a> {
                 self.kkt = Kkt::new(part, m, n, &self.jac.entries, &self.hess);
             }
             let Some(kkt) = self.kkt.as_mut() else {
-                return false;
+                return Factored::None;
             };
             kkt.assemble(&self.jac.entries, &self.row_scale, &self.scale, &self.hess);
         }
-        self.kkt.as_mut().is_some_and(|k| k.factor(delta))
+        self.kkt.as_mut().map_or(Factored::None, |k| k.factor(delta))
+    }
+
+    /// Adds `Φ_qᵀ D R D Φ_q` over the independent rows to the block Hessian (see
+    /// [`System::factor_kkt`]).
+    fn augment(&mut self, part: &Partition) {
+        let n = self.model.coordinate_count();
+        let mut wdiag = vec![0.0f64; n];
+        for (&(a, b), blk) in self.hess.keys.iter().zip(&self.hess.values) {
+            if a == b {
+                for i in 0..7 {
+                    wdiag[7 * a + i] = blk[8 * i].abs() * self.scale[7 * a + i].powi(2);
+                }
+            }
+        }
+        let floor = 1e-6 * wdiag.iter().fold(0.0f64, |x, &y| x.max(y)) + 1e-12;
+        let mut in_part = vec![false; self.cons.len()];
+        for &r in &part.rows {
+            in_part[r] = true;
+        }
+        let entries = &self.jac.entries;
+        let mut pending: Option<([Option<crate::model::BodyId>; 2], crate::jet::LMat)> = None;
+        let mut k = 0;
+        while k < entries.len() {
+            let row = entries[k].0;
+            let mut end = k;
+            while end < entries.len() && entries[end].0 == row {
+                end += 1;
+            }
+            let group = &entries[k..end];
+            k = end;
+            if !in_part[row] {
+                continue;
+            }
+            let rho = group
+                .iter()
+                .fold(floor, |a, e| a.max(wdiag[e.1]))
+                * self.row_scale[row].powi(2);
+            let mut bodies: [Option<crate::model::BodyId>; 2] = [None, None];
+            let mut local = true;
+            for e in group {
+                let b = e.1 / 7;
+                if bodies.iter().any(|x| x.map(|y| y.0) == Some(b)) {
+                    continue;
+                }
+                match bodies.iter().position(|x| x.is_none()) {
+                    Some(slot) => bodies[slot] = Some(crate::model::BodyId(b)),
+                    None => local = false,
+                }
+            }
+            if !local {
+                for a in group {
+                    for b in group {
+                        self.hess.add_entry(a.1, b.1, rho * a.2 * b.2);
+                    }
+                }
+                continue;
+            }
+            let mut g = crate::jet::LVec::zeros();
+            for e in group {
+                let side = usize::from(bodies[0].map(|x| x.0) != Some(e.1 / 7));
+                g[7 * side + e.1 % 7] += e.2;
+            }
+            let same = pending
+                .as_ref()
+                .is_some_and(|(b, _)| b.iter().map(|x| x.map(|y| y.0)).eq(bodies.iter().map(|x| x.map(|y| y.0))));
+            if !same {
+                if let Some((b, acc)) = pending.take() {
+                    self.hess.add_block(&b, &acc, 1.0);
+                }
+                pending = Some((bodies, crate::jet::LMat::zeros()));
+            }
+            if let Some((_, acc)) = pending.as_mut() {
+                *acc += g * g.transpose() * rho;
+            }
+        }
+        if let Some((b, acc)) = pending.take() {
+            self.hess.add_block(&b, &acc, 1.0);
+        }
+    }
+
+    /// Replaces the KKT factors by LU (see [`Kkt::fall_back_to_lu`]).
+    pub(crate) fn kkt_fall_back_to_lu(&mut self) -> Factored {
+        self.kkt
+            .as_mut()
+            .map_or(Factored::None, |k| k.fall_back_to_lu())
     }
 
     /// The largest diagonal entry of the scaled `W` of the last KKT assembly.
@@ -729,7 +859,7 @@ mod tests {
                 continue;
             }
             assert!(
-                sparse.factor_kkt(&q, &part, &es, true, 0.0),
+                sparse.factor_kkt(&q, &part, &es, true, 0.0) != crate::solver::sparse::kkt::Factored::None,
                 "{}",
                 model.name
             );

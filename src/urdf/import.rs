@@ -340,7 +340,7 @@ pub(super) fn import(
     let mut warnings = Vec::new();
     let text = repair_prefixes(text, file, &mut warnings)?;
     let doc = super::xml::parse_document(&text, file)?;
-    let src = Source { file, doc: &doc };
+    let src = Source::new(file, &doc);
     let robot = doc.root_element();
     if robot.tag_name().name() != "robot" {
         return Err(src.error(
@@ -374,8 +374,8 @@ pub(super) fn import(
         } else if ns.is_none() && name == "gazebo" {
             gazebo_nodes.push(c);
         } else if !matches!(name, "material" | "transmission" | "ros2_control") {
-            let p = doc.text_pos_at(c.range().start);
-            ignored.push(format!("{}:{} <{}>", p.row, p.col, name));
+            let (row, col) = src.pos(c);
+            ignored.push(format!("{row}:{col} <{name}>"));
         }
     }
 
@@ -459,13 +459,8 @@ pub(super) fn import(
             "joint" | "ball_constraint" | "linear_spring_damper"
         )
     }) {
-        let p = doc.text_pos_at(n.range().start);
-        ignored.push(format!(
-            "{}:{} <drake:{}>",
-            p.row,
-            p.col,
-            n.tag_name().name()
-        ));
+        let (row, col) = src.pos(n);
+        ignored.push(format!("{row}:{col} <drake:{}>", n.tag_name().name()));
     }
     let frames_map = frames.frames.clone();
     let mut names: HashMap<&str, ()> = HashMap::new();

@@ -12,24 +12,50 @@ pub(crate) const MECH_NS: &str = "urn:urdf-mech:1";
 pub(crate) struct Source<'a> {
     pub(crate) file: &'a str,
     pub(crate) doc: &'a roxmltree::Document<'a>,
+    /// Byte offset of the start of each line: positions by binary search, where roxmltree's
+    /// `text_pos_at` scans the document from its start (quadratic over a file's warnings).
+    line_starts: Vec<usize>,
 }
 
-impl Source<'_> {
+impl<'a> Source<'a> {
+    /// The source of `doc`, read from `file`.
+    pub(crate) fn new(file: &'a str, doc: &'a roxmltree::Document<'a>) -> Self {
+        let text = doc.input_text();
+        let line_starts = std::iter::once(0)
+            .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+            .collect();
+        Source {
+            file,
+            doc,
+            line_starts,
+        }
+    }
+
+    /// Line and column (from 1, column in characters) of `node`.
+    pub(crate) fn pos(&self, node: Node) -> (u32, u32) {
+        let at = node.range().start;
+        let line = self.line_starts.partition_point(|&s| s <= at).max(1);
+        let start = self.line_starts[line - 1];
+        let text = self.doc.input_text();
+        let col = text.get(start..at).map_or(at - start, |t| t.chars().count()) + 1;
+        (line as u32, col as u32)
+    }
+
     /// An input error at `node`.
     pub(crate) fn error(&self, node: Node, message: impl Into<String>) -> Error {
-        let pos = self.doc.text_pos_at(node.range().start);
+        let (line, col) = self.pos(node);
         Error::Input {
             file: self.file.to_string(),
-            line: pos.row,
-            col: pos.col,
+            line,
+            col,
             message: message.into(),
         }
     }
 
     /// A warning at `node`: `FILE:LINE:COLUMN: message`.
     pub(crate) fn warning(&self, node: Node, message: impl std::fmt::Display) -> String {
-        let p = self.doc.text_pos_at(node.range().start);
-        format!("{}:{}:{}: {message}", self.file, p.row, p.col)
+        let (line, col) = self.pos(node);
+        format!("{}:{line}:{col}: {message}", self.file)
     }
 
     /// Short description of an element for messages: ``joint `elbow` `` or `<origin>`.

@@ -14,8 +14,9 @@ use faer::{Conj, MatMut};
 
 /// Where each Jacobian triplet goes under one partition.
 pub(crate) struct Split {
+    /// Id of the partition.
+    id: usize,
     rows: Vec<usize>,
-    dependent: Vec<usize>,
     /// Number of triplets the maps were built for.
     triplets: usize,
     pattern: Pattern,
@@ -79,8 +80,8 @@ impl Split {
         }
         let values = vec![0.0; pattern.nnz()];
         Some(Split {
+            id: part.id,
             rows: part.rows.clone(),
-            dependent: part.dependent.clone(),
             triplets: entries.len(),
             pattern,
             symbolic,
@@ -92,7 +93,7 @@ impl Split {
 
     /// Whether this split was built for `part` and a Jacobian of `triplets` entries.
     pub(crate) fn fits(&self, part: &Partition, triplets: usize) -> bool {
-        self.triplets == triplets && self.rows == part.rows && self.dependent == part.dependent
+        self.triplets == triplets && self.id == part.id
     }
 
     /// Refills `Φ_u` from `entries` and factors it; `Φ_v` is copied.

@@ -245,6 +245,7 @@ pub(crate) fn partition(
     independent.sort_unstable();
     el.redundant.sort_unstable();
     Partition {
+        id: super::super::partition::next_id(),
         dependent: el.dependent,
         independent,
         rows: el.pivot_rows,

@@ -37,7 +37,12 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
+# Single-threaded BLAS, like the other tools here: on this 2-core machine a threaded OpenBLAS
+# made SLSQP's small dense solves 10-30x slower and erratic (1.5 s instead of 47 ms on ladder 5).
+for _v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_v, "1")
+
+import numpy as np  # noqa: E402
 
 MECH = "{urn:urdf-mech:1}"
 
@@ -293,9 +298,10 @@ def find_time_field(d, prefix=""):
 
 def run_restpose(exe, urdf: Path, timeout: float, repeats: int) -> Result:
     out = urdf.with_suffix(".restpose.json")
-    walls, checks = [], []
+    walls = []
     data = None
     for rep in range(repeats):
+        out.unlink(missing_ok=True)
         t0 = time.perf_counter()
         try:
             p = subprocess.run([exe, "analyze", str(urdf), "--json", str(out), "-q"],
@@ -309,10 +315,6 @@ def run_restpose(exe, urdf: Path, timeout: float, repeats: int) -> Result:
                           + (p.stderr.strip().splitlines() or ["?"])[-1][:120])
         data = json.loads(out.read_text())
         walls.append(wall)
-        # the same process without the solve: load + validate, to take out start-up and parsing
-        t0 = time.perf_counter()
-        subprocess.run([exe, "check", str(urdf)], capture_output=True, text=True, timeout=timeout)
-        checks.append((time.perf_counter() - t0) * 1e3)
         if wall > 2000 or (wall > 200 and rep >= 2):  # slow: fewer runs
             break
     angles = {}
@@ -320,23 +322,56 @@ def run_restpose(exe, urdf: Path, timeout: float, repeats: int) -> Result:
         pos = j.get("position") or []
         if len(pos) == 1:
             angles[name] = float(pos[0])
-    wall, check = min(walls), min(checks)
-    tf = find_time_field(data)
+    wall = min(walls)
     r = Result("restpose", bool(data.get("converged")), angles, float(data["potential_energy"]),
                str(data.get("iterations", "")))
-    r.extra = {"wall_ms": wall, "check_ms": check, "runs": len(walls),
+    r.extra = {"wall_ms": wall, "runs": len(walls),
                "termination": data.get("termination"), "dof": data.get("dof"),
                "coordinates": data.get("coordinates"),
                "stability": (data.get("stability") or {}).get("verdict")}
+    tf = find_time_field(data)
     if tf:
         r.time_ms = tf[1]
         r.extra["time_basis"] = f"JSON `{tf[0]}`"
+        r.extra["json_time"] = True
     else:
-        r.time_ms = max(wall - check, 0.0)
-        r.extra["time_basis"] = "analyze − check wall"
+        r.time_ms = wall
+        r.extra["time_basis"] = "process wall (the JSON has no solve time)"
     if not r.ok:
         r.note = f"termination: {data.get('termination')}"
     return r
+
+
+def restpose_bench_time(bench: str, family: str, n: int, timeout: float):
+    """In-process solve time from restpose's own bench harness (benches/chain.rs, the compiled
+    `chain` binary run directly). Two formats are understood:
+    - child mode (RESTPOSE_BENCH_CHILD=family:N:auto): one line
+      `name bodies dof iterations best_ms peak_mb algebra`, best of 3 solves;
+    - the older table harness: `| family | N | coordinates | iterations | solve [ms] | ...`
+      rows for the chain of each size argument and the ladder of half of it.
+    Returns (ms, iterations, algebra) or None."""
+    arg = n if family == "chain" else 2 * n  # the older harness halves the ladder size
+    env = dict(os.environ, RESTPOSE_BENCH_CHILD=f"{family}:{n}:auto")
+    p = subprocess.Popen([bench, str(arg), "--bench"], stdout=subprocess.PIPE,
+                         stderr=subprocess.DEVNULL, text=True, env=env)
+    t0 = time.perf_counter()
+    found = None
+    try:
+        for line in p.stdout:
+            f = line.split()
+            if len(f) >= 5 and f[0] == f"{family}{n}":  # child mode
+                found = (float(f[4]), f[3], f[6] if len(f) > 6 else "")
+                break
+            cells = [c.strip() for c in line.strip().strip("|").split("|")]
+            if len(cells) >= 5 and cells[0] == family and cells[1] == str(n):
+                found = (float(cells[4]), cells[3], "")
+                break
+            if time.perf_counter() - t0 > timeout:
+                break
+    finally:
+        p.kill()
+        p.wait()
+    return found
 
 
 # --------------------------------------------------------------------------------------
@@ -431,6 +466,112 @@ def solve_pinocchio(urdf: Path, mech: Mech, tol=1e-8, max_iter=500) -> Result:
     return Result("pinocchio", ok, angles, v, str(it), ms,
                   note="" if ok else f"not converged: max|g| = {gnorm:.1e}",
                   extra={"halvings": halvings, "gnorm": gnorm})
+
+
+# --------------------------------------------------------------------------------------
+# Joint-space Newton in plain numpy (trees): an independent reference where Pinocchio cannot go
+# --------------------------------------------------------------------------------------
+
+
+def solve_numpy_tree(mech: Mech, tol=1e-8, max_iter=500) -> Result:
+    """V(θ) = -Σ m_b g·c_b(θ) + Σ ½ k_i (θ_i - ref_i)² on the joint angles of a tree, by Newton
+    with the same line search as the Pinocchio solver. With a_i, o_i joint i's world axis and
+    origin and M_i, S_i the mass and first moment Σ m_b c_b of the bodies it carries:
+        ∂V/∂θ_i = -g·(a_i × (S_i - M_i o_i)) + k_i (θ_i - ref_i)
+        ∂²V/∂θ_i∂θ_j = -(g × a_i)·(a_j × (S_j - M_j o_j))   (i = j or i an ancestor of j)
+    and zero for joints on different branches. O(N²) memory, not Pinocchio's O(N³)."""
+    if mech.loops:
+        return Result("numpy joint-space", False, note="skipped: closed loops")
+    t0 = time.perf_counter()
+    order = mech.tree_order()
+    nj = len(order)
+    idx = {j.name: i for i, j in enumerate(order)}
+    parent_joint = {}  # joint index -> index of the joint above it (or -1)
+    by_child = {j.child: i for i, j in enumerate(order)}
+    for i, j in enumerate(order):
+        parent_joint[i] = by_child.get(j.parent, -1)
+    anc = np.zeros((nj, nj), bool)  # anc[i, j]: i is j or an ancestor of j
+    for jj in range(nj):
+        i = jj
+        while i >= 0:
+            anc[i, jj] = True
+            i = parent_joint[i]
+    k = np.array([mech.springs.get(j.name, (0.0, 0.0))[0] for j in order])
+    ref = np.array([mech.springs.get(j.name, (0.0, 0.0))[1] for j in order])
+    mass = np.array([mech.links[j.child].mass for j in order])
+    com_local = np.array([mech.links[j.child].com for j in order])
+    g = np.array(mech.gravity, float)
+    ro = [rpy_matrix(j.rpy) for j in order]
+    root_mass_moment = 0.0  # bodies welded to the root do not move
+
+    def kin(th):
+        rot = {mech.root: np.eye(3)}
+        pos = {mech.root: np.zeros(3)}
+        a = np.zeros((nj, 3))
+        o = np.zeros((nj, 3))
+        c = np.zeros((nj, 3))
+        for i, j in enumerate(order):
+            rp, pp = rot[j.parent], pos[j.parent]
+            rj = rp @ ro[i]
+            o[i] = pp + rp @ j.xyz
+            a[i] = rj @ j.axis
+            r = rj @ axis_angle_matrix(j.axis, th[i])
+            rot[j.child], pos[j.child] = r, o[i]
+            c[i] = o[i] + r @ com_local[i]
+        # subtree sums, leaves first (tree_order puts parents first)
+        msub = mass.copy()
+        ssub = mass[:, None] * c
+        for i in range(nj - 1, -1, -1):
+            p = parent_joint[i]
+            if p >= 0:
+                msub[p] += msub[i]
+                ssub[p] += ssub[i]
+        w = ssub - msub[:, None] * o
+        return a, c, w
+
+    def energy(th, c):
+        return -float(mass @ (c @ g)) + 0.5 * float(k @ (th - ref) ** 2) + root_mass_moment
+
+    th = np.zeros(nj)
+    a, c, w = kin(th)
+    v = energy(th, c)
+    it, halvings, gnorm, ok = 0, 0, float("inf"), False
+    while it < max_iter:
+        grad = -np.cross(a, w) @ g + k * (th - ref)
+        gnorm = float(np.max(np.abs(grad)))
+        if gnorm < tol:
+            ok = True
+            break
+        u = np.cross(a, w)  # a_j × w_j
+        p = np.cross(g, a)  # g × a_i
+        h = -(p @ u.T) * anc
+        h = np.triu(h) + np.triu(h, 1).T + np.diag(k)
+        shift = 0.0
+        while True:
+            try:
+                ch = np.linalg.cholesky(h + shift * np.eye(nj))
+                break
+            except np.linalg.LinAlgError:
+                shift = max(2 * shift, 1e-6 * max(1.0, float(np.max(np.abs(np.diag(h))))))
+        d = -np.linalg.solve(ch.T, np.linalg.solve(ch, grad))
+        slope = float(grad @ d)
+        al = 1.0
+        while True:
+            thn = th + al * d
+            an, cn, wn = kin(thn)
+            vn = energy(thn, cn)
+            if vn <= v + 1e-4 * al * slope + 1e-13 * max(1.0, abs(v)) or al < 1e-12:
+                break
+            al *= 0.5
+            halvings += 1
+        th, a, c, w, v = thn, an, cn, wn, vn
+        it += 1
+    ms = (time.perf_counter() - t0) * 1e3
+    angles = {j.name: float(th[idx[j.name]]) for j in order}
+    r = Result("numpy joint-space", ok, angles, v, str(it), ms,
+               note="" if ok else f"not converged: max|∂V/∂θ| = {gnorm:.1e}")
+    r.extra = {"gnorm": gnorm, "halvings": halvings}
+    return r
 
 
 # --------------------------------------------------------------------------------------
@@ -622,15 +763,20 @@ class MaxCoords:
         return {j["name"]: self.angle_and_grad(x, j, False)[0] for j in self.joints}
 
 
-def solve_slsqp(mech: Mech, max_bodies: int, ftol=1e-14, max_iter=2000) -> Result:
+def solve_slsqp(mech: Mech, max_bodies: int, rel_ftol=1e-16, max_iter=1000) -> Result:
     if scipy is None:
         return Result("scipy SLSQP", False, note=f"skipped: scipy does not import ({SCIPY_ERROR})")
     nb = len(mech.links) - 1
     if nb > max_bodies:
         return Result("scipy SLSQP", False,
                       note=f"skipped: {nb} bodies > --slsqp-max-bodies {max_bodies} (dense SQP, slow)")
+    t0 = time.perf_counter()  # the time includes the choice of independent rows
     mc = MaxCoords(mech)
-    t0 = time.perf_counter()
+    # SLSQP's ftol is absolute on V: scale it by the mechanism's gravity energy scale
+    # (total weight × extent of the zero pose)
+    pts = mc.x0.reshape(-1, 7)[:, :3]
+    extent = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))) if len(pts) else 1.0
+    ftol = rel_ftol * max(1.0, float(mc.mass.sum()) * float(np.linalg.norm(mc.g)) * max(extent, 1e-3))
     keep = mc.keep
     res = minimize(mc.objective, mc.x0, jac=mc.gradient, method="SLSQP",
                    constraints=[{"type": "eq", "fun": lambda x: mc.constraints(x)[keep],
@@ -647,6 +793,7 @@ def solve_slsqp(mech: Mech, max_bodies: int, ftol=1e-14, max_iter=2000) -> Resul
     note = "" if res.success else f"SLSQP: {res.message}"
     r = Result("scipy SLSQP", ok, mc.angles(x), float(res.fun), str(res.nit), ms, note)
     r.extra = {"violation": viol, "kkt": kkt, "message": res.message, "nvar": mc.n, "ncon": mc.m,
+               "ftol": ftol,
                "nkept": len(keep), "dropped": mc.dropped}
     return r
 
@@ -870,14 +1017,21 @@ def main():
     ap.add_argument("--restpose", default=default_restpose(repo), help="restpose binary")
     ap.add_argument("--chain", default="10,100,1000", help="chain sizes (comma list, '' for none)")
     ap.add_argument("--ladder", default="5,10,50", help="ladder sizes (comma list, '' for none)")
-    ap.add_argument("--tools", default="restpose,pinocchio,slsqp,mujoco,closed-form")
+    ap.add_argument("--tools", default="restpose,pinocchio,numpy,slsqp,mujoco,closed-form",
+                    help="comma list of: restpose, pinocchio, numpy (joint-space Newton, trees), "
+                    "slsqp, mujoco, closed-form (ladder)")
     ap.add_argument("--restpose-timeout", type=float, default=60.0,
                     help="skip a size when restpose analyze takes longer [s]")
     ap.add_argument("--repeats", type=int, default=3,
                     help="runs of each fast peer (< 1 s), shortest time kept")
     ap.add_argument("--restpose-repeats", type=int, default=10,
-                    help="runs of restpose analyze and check (shortest kept; 3 over 200 ms, 1 over 2 s)")
-    ap.add_argument("--slsqp-max-bodies", type=int, default=30)
+                    help="runs of restpose analyze (shortest kept; 3 over 200 ms, 1 over 2 s)")
+    ap.add_argument("--restpose-bench", default=None, help=(
+        "restpose's compiled bench harness (the `chain` binary that `cargo bench --bench chain "
+        "--no-run` names, under target/release/deps/): gives restpose's in-process solve time; "
+        "without it restpose's time is the whole `analyze` process"))
+    ap.add_argument("--slsqp-max-bodies", type=int, default=150,
+                    help="skip SLSQP above this many bodies (dense SQP: ~20 s at 100 bodies)")
     ap.add_argument("--mujoco-vtol", type=float, default=1e-8, help="settled when max|qvel| < this [rad/s]")
     ap.add_argument("--mujoco-budget", type=float, default=30.0, help="settling wall-time budget [s]")
     ap.add_argument("--mujoco-timestep", type=float, default=2e-3,
@@ -918,10 +1072,25 @@ def main():
         results = []
         if "restpose" in tools:
             log("  restpose ...")
-            results.append(run_restpose(exe, urdf, args.restpose_timeout, args.restpose_repeats))
+            rr = run_restpose(exe, urdf, args.restpose_timeout, args.restpose_repeats)
+            if args.restpose_bench and rr.ok and not rr.extra.get("json_time"):
+                bt = restpose_bench_time(args.restpose_bench, family, n, 4 * args.restpose_timeout)
+                if bt:
+                    rr.time_ms = bt[0]
+                    rr.extra["time_basis"] = ("in-process solve, bench harness"
+                                              + (f" ({bt[2]})" if bt[2] else ""))
+                    if bt[1] != rr.iterations:
+                        rr.extra["time_basis"] += (f" (its solve took {bt[1]} iterations, the CLI's "
+                                                   f"{rr.iterations}: different builds?)")
+                else:
+                    log(f"  (no {family} {n} row from --restpose-bench)")
+            results.append(rr)
         if "pinocchio" in tools and not mech.loops:
             log("  pinocchio ...")
             results.append(best_of(lambda: solve_pinocchio(urdf, mech), args.repeats))
+        if "numpy" in tools and not mech.loops:
+            log("  numpy joint-space ...")
+            results.append(best_of(lambda: solve_numpy_tree(mech), args.repeats))
         if "slsqp" in tools:
             log("  slsqp ...")
             results.append(best_of(lambda: solve_slsqp(mech, args.slsqp_max_bodies), args.repeats))
@@ -936,7 +1105,8 @@ def main():
             log(f"  {r.tool}: ok={r.ok} V={r.energy:.12g} it={r.iterations} t={r.time_ms:.2f} ms {r.note}")
         ref = next((r for r in results if r.tool == "restpose" and r.angles), None)
         # with no restpose result, compare with the first exact peer that converged, and say so
-        fallback = next((r for r in results if r.tool in ("pinocchio", "closed form") and r.ok), None)
+        fallback = next((r for r in results if r.tool in ("pinocchio", "numpy joint-space",
+                                                          "closed form") and r.ok), None)
         for r in results:
             cmp_to = ref if ref is not None else fallback
             d, nj = (max_angle_diff(r.angles, cmp_to.angles) if cmp_to is not None and r.angles
@@ -981,8 +1151,8 @@ def main():
         note = r.note
         if r.tool == "restpose" and "wall_ms" in r.extra:
             e = r.extra
-            note = (f"process wall {e['wall_ms']:.1f} ms (best of {e['runs']}), `check` "
-                    f"{e['check_ms']:.1f} ms; time = {e['time_basis']}; {e['stability']}"
+            note = (f"time = {e['time_basis']}; `analyze` process wall {e['wall_ms']:.1f} ms "
+                    f"(best of {e['runs']}); {e['stability']}"
                     + (f"; {r.note}" if r.note else ""))
         elif r.tool == "scipy SLSQP" and "violation" in r.extra:
             dropped = (f" ({r.extra['ncon'] - r.extra['nkept']} dependent rows dropped)"
@@ -993,8 +1163,9 @@ def main():
             note = (f"sim time {r.extra['sim_time']:.2f} s, max\\|qvel\\| {r.extra['vmax']:.0e}"
                     + (f", loop violation {r.extra['loop_violation']:.0e}" if r.extra["loop_violation"] else "")
                     + (f"; {r.note}" if r.note else ""))
-        elif r.tool == "pinocchio" and "gnorm" in r.extra:
-            note = f"max\\|g + Kq\\| {r.extra['gnorm']:.0e}" + (f"; {r.note}" if r.note else "")
+        elif r.tool in ("pinocchio", "numpy joint-space") and "gnorm" in r.extra:
+            note = (f"max\\|∂V/∂θ\\| {r.extra['gnorm']:.0e}, {r.extra['halvings']} step halvings"
+                    + (f"; {r.note}" if r.note else ""))
         out.append("| " + " | ".join([
             family, str(n), r.tool, "yes" if r.ok else "no",
             fmt(r.energy, ".9f"), fmt(de, ".1e"), fmt(d, ".1e"), verdict,

@@ -21,8 +21,8 @@
 use super::options::{Method, Options};
 use super::partition::Partition;
 use super::report::{Diagnostics, Iterate, Termination};
-use super::spectrum::{spectrum, Spectrum};
 use super::sparse::kkt::Factored;
+use super::spectrum::{spectrum, Spectrum};
 use super::system::{Eval, System};
 use nalgebra::{DMatrix, DVector};
 

@@ -89,7 +89,13 @@ fn lanczos(sys: &mut System, q: &DVector<f64>, part: &Partition, eval: &Eval) ->
         return None;
     }
     // Make sure the factors solve accurately (LDLᵀ may not: then LU).
-    let probe = DVector::from_fn(n, |i, _| if part.independent.contains(&i) { 1.0 } else { 0.0 });
+    let probe = DVector::from_fn(n, |i, _| {
+        if part.independent.contains(&i) {
+            1.0
+        } else {
+            0.0
+        }
+    });
     if sys.kkt_solve(&probe).is_none() {
         sys.kkt_fall_back_to_lu();
     }

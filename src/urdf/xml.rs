@@ -37,7 +37,10 @@ impl<'a> Source<'a> {
         let line = self.line_starts.partition_point(|&s| s <= at).max(1);
         let start = self.line_starts[line - 1];
         let text = self.doc.input_text();
-        let col = text.get(start..at).map_or(at - start, |t| t.chars().count()) + 1;
+        let col = text
+            .get(start..at)
+            .map_or(at - start, |t| t.chars().count())
+            + 1;
         (line as u32, col as u32)
     }
 

@@ -267,10 +267,9 @@ impl Kkt {
     fn factor_ldlt(&mut self) -> Option<usize> {
         let sym = self.ldlt.as_ref()?;
         let par = Par::Seq;
-        let mut buf = MemBuffer::try_new(
-            sym.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()),
-        )
-        .ok()?;
+        let mut buf =
+            MemBuffer::try_new(sym.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()))
+                .ok()?;
         sym.factorize_numeric_ldlt(
             &mut self.ldlt_values,
             self.pattern.matrix(&self.shifted),
@@ -328,7 +327,11 @@ impl Kkt {
         let (ptr, idx) = (sym.col_ptr(), sym.row_idx());
         // ‖K‖∞ (the pattern is symmetric: column sums are row sums).
         let knorm = (0..rhs.len())
-            .map(|c| (ptr[c]..ptr[c + 1]).map(|k| self.shifted[k].abs()).sum::<f64>())
+            .map(|c| {
+                (ptr[c]..ptr[c + 1])
+                    .map(|k| self.shifted[k].abs())
+                    .sum::<f64>()
+            })
             .fold(0.0f64, f64::max);
         let mut omega = f64::INFINITY;
         for _ in 0..3 {

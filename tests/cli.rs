@@ -188,3 +188,48 @@ fn closed_stdout_is_not_a_panic() {
     assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
     assert_eq!(out.status.code(), Some(0));
 }
+
+/// `--linear-algebra`: the generated 60-body chain (auto: sparse) and the same chain forced
+/// onto the dense path give the same energy; the JSON says which path ran; a bad value is a
+/// usage error (exit 2).
+#[test]
+fn linear_algebra_flag_selects_the_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let urdf = dir.path().join("chain.urdf");
+    let gen = restpose()
+        .args(["generate", "chain", "--size", "60"])
+        .output()
+        .unwrap();
+    assert_eq!(gen.status.code(), Some(0));
+    std::fs::write(&urdf, &gen.stdout).unwrap();
+    let mut energies = Vec::new();
+    for (flag, expected) in [("auto", "sparse"), ("dense", "dense"), ("sparse", "sparse")] {
+        let out = dir.path().join(format!("{flag}.json"));
+        let st = restpose()
+            .arg("analyze")
+            .arg(&urdf)
+            .args(["--quiet", "--linear-algebra", flag, "--json"])
+            .arg(&out)
+            .status()
+            .unwrap();
+        assert_eq!(st.code(), Some(0), "{flag}");
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        assert_eq!(v["diagnostics"]["linear_algebra"], expected, "{flag}");
+        assert_eq!(v["stability"]["verdict"], "stable", "{flag}");
+        energies.push(v["potential_energy"].as_f64().unwrap());
+    }
+    for e in &energies[1..] {
+        assert!(
+            (e - energies[0]).abs() < 1e-9 * energies[0].abs(),
+            "{energies:?}"
+        );
+    }
+    let st = restpose()
+        .arg("analyze")
+        .arg(&urdf)
+        .args(["--quiet", "--linear-algebra", "magic"])
+        .status()
+        .unwrap();
+    assert_eq!(st.code(), Some(2));
+}

@@ -12,8 +12,9 @@
 //! over the independent rows of `Φ_q`: the second row gives `δq = Z δv`, and multiplying the
 //! first by `Zᵀ` (with `Zᵀ Φ_qᵀ = 0`) gives `Zᵀ W Z δv = −Zᵀ V_qᵀ = −∇f`. The matrix has
 //! `O(N)` nonzeros (7 × 7 blocks of `W` per pair of bodies sharing a term, the triplets of
-//! `Φ_q`), and a sparse LU with a fill-reducing ordering factors it in about `O(N)` for chains,
-//! trees and ladders, where `Zᵀ W Z` itself is dense (every joint of a chain carries all the
+//! `Φ_q`), and LDLᵀ in the partition's elimination order (LU with partial pivoting as the
+//! fallback) factors it in about `O(N)` for chains, trees and ladders, where `Zᵀ W Z` itself is
+//! dense (every joint of a chain carries all the
 //! bodies below it). The system is solved in the scaled coordinates `q̂ = S⁻¹ q` with the rows
 //! scaled by `D`, like the partition. A shift `δ I` on the `W` block (`δ ≥ 0`) makes the
 //! reduced matrix `Zᵀ (W + δ S⁻²) Z` positive definite away from a minimum.

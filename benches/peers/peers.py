@@ -7,15 +7,23 @@ Peers (each skipped with a message when its package does not import):
   g(q) + K (q - q_ref) = 0 with ``computeGeneralizedGravity`` and
   ``computeGeneralizedGravityDerivatives``, backtracking line search on
   ``computePotentialEnergy`` + spring energy, from q = 0, tolerance 1e-8 N m.
+  Skipped where its Data (O(nv^3) memory in pin 4.1) would not fit.
 * scipy SLSQP on maximal coordinates (7 per body: position + quaternion),
   revolute-joint rows (3 position + 2 axis alignment), quaternion norms and
-  loop closures as equality constraints; analytic gradients; small N only.
-* MuJoCo damped settling: MJCF written from the same URDF data (hinges with
-  ``stiffness``/``springref`` and large damping, ``connect`` equalities closing
-  the ladder loops), stepped until max |qvel| falls below a threshold.
-* Closed form (ladder only): every ladder loop is a parallelogram whose rung
-  stays level, so each loop angle solves one scalar equation (see
-  ``ladder_closed_form``). Not a peer tool but an independent check.
+  loop closures as equality constraints (dependent rows dropped: SLSQP needs
+  independent rows); analytic gradients; up to --slsqp-max-bodies.
+* MuJoCo damped settling: the same data built with MjSpec (hinges with
+  ``stiffness``/``springref``, each sprung joint critically damped on its own,
+  ``connect`` equalities closing the ladder loops, implicitfast integrator),
+  stepped until max |qvel| < --mujoco-vtol.
+
+Independent references written here (not peer tools):
+
+* numpy joint-space Newton (trees): gradient and Hessian of V(θ) from the
+  subtree masses and moments, O(N^2) memory; reaches N = 1000 where
+  Pinocchio's Data does not fit.
+* Closed form (ladder): every loop is a parallelogram whose rung stays level,
+  so each loop angle solves one scalar equation (``ladder_closed_form``).
 
 Usage: python benches/peers/peers.py [--restpose PATH] [--help for the rest]
 The Markdown table is printed on standard output (and written to --markdown).
@@ -24,6 +32,7 @@ The Markdown table is printed on standard output (and written to --markdown).
 from __future__ import annotations
 
 import argparse
+import atexit
 import json
 import math
 import os
@@ -502,7 +511,9 @@ def solve_numpy_tree(mech: Mech, tol=1e-8, max_iter=500) -> Result:
     com_local = np.array([mech.links[j.child].com for j in order])
     g = np.array(mech.gravity, float)
     ro = [rpy_matrix(j.rpy) for j in order]
-    root_mass_moment = 0.0  # bodies welded to the root do not move
+    # the root link does not move: its gravity energy is a constant (zero for the generated files)
+    root = mech.links[mech.root]
+    v_root = -root.mass * float(g @ root.com)
 
     def kin(th):
         rot = {mech.root: np.eye(3)}
@@ -530,7 +541,7 @@ def solve_numpy_tree(mech: Mech, tol=1e-8, max_iter=500) -> Result:
         return a, c, w
 
     def energy(th, c):
-        return -float(mass @ (c @ g)) + 0.5 * float(k @ (th - ref) ** 2) + root_mass_moment
+        return -float(mass @ (c @ g)) + 0.5 * float(k @ (th - ref) ** 2) + v_root
 
     th = np.zeros(nj)
     a, c, w = kin(th)
@@ -1058,6 +1069,8 @@ def main():
 
     work = Path(args.keep) if args.keep else Path(tempfile.mkdtemp(prefix="restpose-peers-"))
     work.mkdir(parents=True, exist_ok=True)
+    if not args.keep:
+        atexit.register(shutil.rmtree, work, ignore_errors=True)
     cases = [("chain", n) for n in sizes(args.chain)] + [("ladder", n) for n in sizes(args.ladder)]
     rows = []
     all_results = []
@@ -1106,7 +1119,7 @@ def main():
             results.append(best_of(lambda: ladder_closed_form(mech, n), args.repeats))
         for r in results:
             log(f"  {r.tool}: ok={r.ok} V={r.energy:.12g} it={r.iterations} t={r.time_ms:.2f} ms {r.note}")
-        ref = next((r for r in results if r.tool == "restpose" and r.angles), None)
+        ref = next((r for r in results if r.tool == "restpose" and r.ok and r.angles), None)
         # with no restpose result, compare with the first exact peer that converged, and say so
         fallback = next((r for r in results if r.tool in ("pinocchio", "numpy joint-space",
                                                           "closed form") and r.ok), None)
@@ -1116,8 +1129,8 @@ def main():
                      and r is not cmp_to else (float("nan"), 0))
             de = r.energy - cmp_to.energy if cmp_to is not None and r is not cmp_to else float("nan")
             tol = args.settle_tol if r.tool == "mujoco" else args.exact_tol
-            if r is ref:
-                verdict = "reference" if r.ok else "not converged"
+            if r is cmp_to:
+                verdict = "reference" if r is ref else "reference (no restpose result)"
             elif not r.angles:
                 verdict = "—"
             elif cmp_to is None:
@@ -1142,7 +1155,14 @@ def main():
 
     # ---- Markdown ----
     out = []
-    out.append(f"restpose: `{version}`; Python {platform.python_version()}; numpy {np.__version__}"
+    built = time.strftime("%Y-%m-%d %H:%M", time.localtime(os.path.getmtime(exe)))
+    bench_note = ""
+    if args.restpose_bench:
+        bench_note = (f", bench harness `{args.restpose_bench}` (built "
+                      + time.strftime("%Y-%m-%d %H:%M", time.localtime(os.path.getmtime(args.restpose_bench)))
+                      + ")")
+    out.append(f"restpose: `{version}` (`{exe}`, built {built}{bench_note}); "
+               f"Python {platform.python_version()}; numpy {np.__version__}"
                + (f"; scipy {scipy.__version__}" if scipy else "; scipy: not available")
                + (f"; pin (Pinocchio) {pin.__version__}" if pin else "; pin: not available")
                + (f"; mujoco {mujoco.__version__}" if mujoco else "; mujoco: not available") + ".")
@@ -1180,8 +1200,6 @@ def main():
         args.markdown.write_text(table + "\n")
     if args.json:
         args.json.write_text(json.dumps(all_results, indent=1, default=float))
-    if not args.keep:
-        shutil.rmtree(work, ignore_errors=True)
 
 
 if __name__ == "__main__":

@@ -11,9 +11,12 @@
 //! Each row is measured in a child process (this executable again, with
 //! `RESTPOSE_BENCH_CHILD=family:N:algebra`): best of 3 solves (1 above 2,000 bodies) with the
 //! default options (Newton, gradient tolerance 1e-8), then the process's peak resident memory
-//! (`VmHWM`). Solves are checked: converged, ‖Φ‖∞ below 1e-9. Below the table, the growth
+//! (`VmHWM`). Solves are checked: converged, ‖Φ‖∞ below 1e-9, and (chains and ladders, after
+//! the timing) the energy and its joint-space gradient against the family's energy written
+//! here in joint coordinates (`verify_family`). Below the table, the growth
 //! exponent `p` of time per iteration `∝ N^p`, fitted by least squares over N ≥ 100.
-use restpose::{LinearAlgebra, Options};
+use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector2, Vector3};
+use restpose::{LinearAlgebra, Model, Options, State};
 use std::process::Command;
 use std::time::Instant;
 
@@ -30,6 +33,85 @@ fn model_text(family: &str, n: usize) -> (String, String) {
             )
         }
     }
+}
+
+/// The family's potential energy written independently in joint coordinates: the chain by
+/// forward kinematics, the ladder in its posts' angles (rungs stay level).
+fn joint_space_energy(family: &str, n: usize, th: &[f64]) -> f64 {
+    let mut v = 0.0;
+    if family == "chain" {
+        let mut pose = Isometry3::identity();
+        for i in 0..n {
+            let axis = if i % 2 == 0 {
+                Vector3::y_axis()
+            } else {
+                Vector3::z_axis()
+            };
+            let x = if i == 0 { 0.0 } else { 0.2 };
+            pose = pose
+                * Translation3::new(x, 0.0, 0.0)
+                * UnitQuaternion::from_axis_angle(&axis, th[i]);
+            v += 9.81 * (pose * Point3::new(0.1, 0.0, 0.0)).z;
+            v += 0.5 * 10.0 * ((n - i) * (n - i)) as f64 * th[i] * th[i];
+        }
+    } else {
+        let mut top = Vector2::new(0.0, 0.0);
+        for k in 0..n {
+            let down = |len: f64| Vector2::new(len * th[k].sin(), -len * th[k].cos());
+            let (left, right, rung) = (
+                top + down(0.15),
+                top + Vector2::new(0.4, 0.0) + down(0.15),
+                top + down(0.3),
+            );
+            v += 9.81 * (left.y + right.y + rung.y);
+            v += 0.5 * 10.0 * (n - k) as f64 * (th[k] - 0.1).powi(2);
+            top = rung;
+        }
+    }
+    v
+}
+
+/// Independent check of a generated family's answer: restpose's energy equals the joint-space
+/// energy at its joint angles, and the joint-space gradient (central differences at 20 joints
+/// spread along the mechanism) vanishes to its rounding `ε |V| / h`. Returns the largest
+/// gradient found.
+fn verify_family(family: &str, n: usize, model: &Model, state: &State, energy: f64) -> f64 {
+    let values = state.joint_values(model);
+    let angle = |name: String| {
+        values
+            .iter()
+            .find(|(j, _)| *j == name)
+            .map(|(_, v)| v[0])
+            .expect("joint")
+    };
+    let th: Vec<f64> = (0..n)
+        .map(|i| {
+            angle(if family == "chain" {
+                format!("joint{i}")
+            } else {
+                format!("hang_left{i}")
+            })
+        })
+        .collect();
+    let v = joint_space_energy(family, n, &th);
+    assert!(
+        (v - energy).abs() <= 1e-9 * v.abs(),
+        "{family}{n}: energy {v} vs {energy}"
+    );
+    let h = 1e-5;
+    let mut worst = 0.0f64;
+    for i in (0..n).step_by((n / 20).max(1)) {
+        let (mut p, mut m) = (th.clone(), th.clone());
+        p[i] += h;
+        m[i] -= h;
+        let g = (joint_space_energy(family, n, &p) - joint_space_energy(family, n, &m)) / (2.0 * h);
+        assert!(
+            g.abs() < 1e-13 * v.abs() / h + 1e-6,
+            "{family}{n}: ∂V/∂θ{i} = {g}"
+        );
+        worst = worst.max(g.abs());
+    }
+    worst
 }
 
 fn peak_rss_mb() -> f64 {
@@ -64,7 +146,7 @@ fn child(spec: &str) {
     let mut report = None;
     for _ in 0..runs {
         let t = Instant::now();
-        let (_, r) = restpose::solve(&model, &options).expect("solves");
+        let (s, r) = restpose::solve(&model, &options).expect("solves");
         best = best.min(t.elapsed().as_secs_f64() * 1e3);
         assert!(
             r.converged(),
@@ -72,15 +154,20 @@ fn child(spec: &str) {
             r.termination
         );
         assert!(r.diagnostics.constraint_residual < 1e-9);
-        report = Some(r);
+        report = Some((s, r));
     }
-    let r = report.unwrap();
+    let (s, r) = report.unwrap();
+    let peak = peak_rss_mb();
+    let gradient = if family == "robots" {
+        f64::NAN
+    } else {
+        verify_family(family, n, &model, &s, r.energy.total)
+    };
     println!(
-        "{name} {} {} {} {best} {} {}",
+        "{name} {} {} {} {best} {peak} {} {gradient:.1e}",
         model.bodies.len(),
         r.dof,
         r.iterations,
-        peak_rss_mb(),
         r.diagnostics.linear_algebra
     );
 }
@@ -127,8 +214,8 @@ fn main() {
         }
     };
     let exe = std::env::current_exe().expect("own path");
-    println!("| model | bodies | dof | algebra | iterations | solve [ms] | ms / iteration | peak RSS [MB] |");
-    println!("|---|---:|---:|---|---:|---:|---:|---:|");
+    println!("| model | bodies | dof | algebra | iterations | solve [ms] | ms / iteration | peak RSS [MB] | joint-space check: max \\|∂V/∂θ\\| [N m] |");
+    println!("|---|---:|---:|---|---:|---:|---:|---:|---:|");
     for (family, sizes) in families {
         let mut fit = Vec::new();
         for n in sizes {
@@ -155,13 +242,14 @@ fn main() {
             );
             let per = ms / its.max(1.0);
             println!(
-                "| {} | {} | {} | {} | {} | {ms:.2} | {per:.3} | {:.1} |",
+                "| {} | {} | {} | {} | {} | {ms:.2} | {per:.3} | {:.1} | {} |",
                 f[0],
                 f[1],
                 f[2],
                 f[6],
                 f[3],
-                f[5].parse::<f64>().unwrap()
+                f[5].parse::<f64>().unwrap(),
+                f.get(7).filter(|g| **g != "NaN").unwrap_or(&"—")
             );
             if family != "robots" && bodies >= 100.0 {
                 fit.push((bodies.ln(), per.ln()));

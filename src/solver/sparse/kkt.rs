@@ -50,7 +50,8 @@ pub(crate) struct Kkt {
     jac_slots: Vec<(usize, usize)>,
     diag_slots: Vec<usize>,
     values: Vec<f64>,
-    shifted: Vec<f64>,
+    /// The shift `δ` now added to the diagonal of the `W` block in `values`.
+    delta: f64,
     lu: Option<Lu<usize, f64>>,
     /// Symmetric LDLᵀ in the elimination order of the partition (see [`Kkt::factor`]).
     ldlt: Option<SymbolicCholesky<usize>>,
@@ -109,22 +110,19 @@ impl Kkt {
             row_pos[r] = k;
         }
         let dim = n + part.rows.len();
-        let mut positions: Vec<(usize, usize)> = Vec::with_capacity(49 * hess.keys.len());
-        for &(a, b) in &hess.keys {
-            for i in 0..7 {
-                for j in 0..7 {
-                    positions.push((7 * a + i, 7 * b + j));
-                }
-            }
-        }
-        for e in entries {
-            if row_pos[e.0] != NONE {
-                positions.push((n + row_pos[e.0], e.1));
-                positions.push((e.1, n + row_pos[e.0]));
-            }
-        }
-        positions.extend((0..n).map(|i| (i, i)));
-        let pattern = Pattern::new(dim, dim, positions);
+        let blocks = hess
+            .keys
+            .iter()
+            .flat_map(|&(a, b)| (0..49).map(move |k| (7 * a + k / 7, 7 * b + k % 7)));
+        let jacobian = entries
+            .iter()
+            .filter(|e| row_pos[e.0] != NONE)
+            .flat_map(|e| [(n + row_pos[e.0], e.1), (e.1, n + row_pos[e.0])]);
+        let pattern = Pattern::new(
+            dim,
+            dim,
+            blocks.chain(jacobian).chain((0..n).map(|i| (i, i))),
+        );
         let block_slots = hess
             .keys
             .iter()
@@ -175,7 +173,7 @@ impl Kkt {
             jac_slots,
             diag_slots,
             values: vec![0.0; nnz],
-            shifted: vec![0.0; nnz],
+            delta: 0.0,
             lu: None,
             ldlt,
             ldlt_values,
@@ -198,6 +196,7 @@ impl Kkt {
         hess: &BlockHessian,
     ) {
         self.values.iter_mut().for_each(|v| *v = 0.0);
+        self.delta = 0.0;
         for ((&(a, b), blk), slots) in hess.keys.iter().zip(&hess.values).zip(&self.block_slots) {
             for i in 0..7 {
                 for j in 0..7 {
@@ -219,7 +218,7 @@ impl Kkt {
     pub(crate) fn max_diagonal(&self) -> f64 {
         self.diag_slots
             .iter()
-            .fold(0.0f64, |a, &s| a.max(self.values[s].abs()))
+            .fold(0.0f64, |a, &s| a.max((self.values[s] - self.delta).abs()))
     }
 
     /// Factors the matrix with `δ` added to the diagonal of the `W` block: LDLᵀ without
@@ -229,10 +228,11 @@ impl Kkt {
     /// `rows` negative pivots if and only if the reduced Hessian is positive definite); if a
     /// pivot is zero or not finite, LU with partial pivoting instead.
     pub(crate) fn factor(&mut self, delta: f64) -> Factored {
-        self.shifted.copy_from_slice(&self.values);
+        // The shift in place (no copy of the values): add the change since the last one.
         for &s in &self.diag_slots {
-            self.shifted[s] += delta;
+            self.values[s] += delta - self.delta;
         }
+        self.delta = delta;
         self.kind = Factored::None;
         if !self.lu_only {
             if let Some(negative) = self.factor_ldlt() {
@@ -256,7 +256,7 @@ impl Kkt {
             self.symbolic = SymbolicLu::try_new(self.pattern.symbolic()).ok();
         }
         self.lu = self.symbolic.as_ref().and_then(|sym| {
-            Lu::try_new_with_symbolic(sym.clone(), self.pattern.matrix(&self.shifted)).ok()
+            Lu::try_new_with_symbolic(sym.clone(), self.pattern.matrix(&self.values)).ok()
         });
         if self.lu.is_some() {
             self.kind = Factored::Lu;
@@ -273,7 +273,7 @@ impl Kkt {
                 .ok()?;
         sym.factorize_numeric_ldlt(
             &mut self.ldlt_values,
-            self.pattern.matrix(&self.shifted),
+            self.pattern.matrix(&self.values),
             Side::Lower,
             LdltRegularization::default(),
             par,
@@ -330,7 +330,7 @@ impl Kkt {
         let knorm = (0..rhs.len())
             .map(|c| {
                 (ptr[c]..ptr[c + 1])
-                    .map(|k| self.shifted[k].abs())
+                    .map(|k| self.values[k].abs())
                     .sum::<f64>()
             })
             .fold(0.0f64, f64::max);
@@ -339,7 +339,7 @@ impl Kkt {
             let mut r = b.clone();
             for c in 0..rhs.len() {
                 for k in ptr[c]..ptr[c + 1] {
-                    r[idx[k]] -= self.shifted[k] * rhs[c];
+                    r[idx[k]] -= self.values[k] * rhs[c];
                 }
             }
             let rnorm = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));

@@ -15,7 +15,6 @@
 //! the timing) the energy and its joint-space gradient against the family's energy written
 //! here in joint coordinates (`verify_family`). Below the table, the growth
 //! exponent `p` of time per iteration `∝ N^p`, fitted by least squares over N ≥ 100.
-use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector2, Vector3};
 use restpose::{LinearAlgebra, Model, Options, State};
 use std::process::Command;
 use std::time::Instant;
@@ -35,40 +34,16 @@ fn model_text(family: &str, n: usize) -> (String, String) {
     }
 }
 
-/// The family's potential energy written independently in joint coordinates: the chain by
-/// forward kinematics, the ladder in its posts' angles (rungs stay level).
+#[path = "../tests/common/energies.rs"]
+mod energies;
+
+/// The family's potential energy written independently in joint coordinates.
 fn joint_space_energy(family: &str, n: usize, th: &[f64]) -> f64 {
-    let mut v = 0.0;
     if family == "chain" {
-        let mut pose = Isometry3::identity();
-        for i in 0..n {
-            let axis = if i % 2 == 0 {
-                Vector3::y_axis()
-            } else {
-                Vector3::z_axis()
-            };
-            let x = if i == 0 { 0.0 } else { 0.2 };
-            pose = pose
-                * Translation3::new(x, 0.0, 0.0)
-                * UnitQuaternion::from_axis_angle(&axis, th[i]);
-            v += 9.81 * (pose * Point3::new(0.1, 0.0, 0.0)).z;
-            v += 0.5 * 10.0 * ((n - i) * (n - i)) as f64 * th[i] * th[i];
-        }
+        energies::chain(n, th)
     } else {
-        let mut top = Vector2::new(0.0, 0.0);
-        for k in 0..n {
-            let down = |len: f64| Vector2::new(len * th[k].sin(), -len * th[k].cos());
-            let (left, right, rung) = (
-                top + down(0.15),
-                top + Vector2::new(0.4, 0.0) + down(0.15),
-                top + down(0.3),
-            );
-            v += 9.81 * (left.y + right.y + rung.y);
-            v += 0.5 * 10.0 * (n - k) as f64 * (th[k] - 0.1).powi(2);
-            top = rung;
-        }
+        energies::ladder(n, th)
     }
-    v
 }
 
 /// Independent check of a generated family's answer: restpose's energy equals the joint-space

@@ -2,7 +2,7 @@
 mod common;
 use approx::assert_abs_diff_eq;
 use common::*;
-use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::Point3;
 
 #[test]
 fn every_robot_loads_and_solves_to_a_verified_minimum() {
@@ -71,26 +71,7 @@ fn chain_matches_minimal_coordinate_energy() {
     let theta: Vec<f64> = (0..n)
         .map(|i| joint(&m, &s, &format!("joint{i}"))[0])
         .collect();
-    let energy = |th: &[f64]| {
-        let mut pose = Isometry3::identity();
-        let mut v = 0.0;
-        for i in 0..n {
-            let axis = if i % 2 == 0 {
-                Vector3::y_axis()
-            } else {
-                Vector3::z_axis()
-            };
-            let x = if i == 0 { 0.0 } else { 0.2 };
-            pose = pose
-                * Translation3::new(x, 0.0, 0.0)
-                * UnitQuaternion::from_axis_angle(&axis, th[i]);
-            let com = pose * Point3::new(0.1, 0.0, 0.0);
-            v += 9.81 * com.z; // m = 1 kg
-            let k = 10.0 * ((n - i) * (n - i)) as f64;
-            v += 0.5 * k * th[i] * th[i];
-        }
-        v
-    };
+    let energy = |th: &[f64]| energies::chain(n, th);
     assert_abs_diff_eq!(energy(&theta), r.energy.total, epsilon = 1e-9);
     let h = 1e-6;
     for i in 0..n {
@@ -293,20 +274,7 @@ fn ladder_matches_minimal_coordinate_energy() {
     let phi: Vec<f64> = (0..n)
         .map(|k| joint(&m, &s, &format!("hang_left{k}"))[0])
         .collect();
-    let energy = |phi: &[f64]| {
-        let mut top = nalgebra::Vector2::new(0.0, 0.0);
-        let mut v = 0.0;
-        for k in 0..n {
-            let down = |len: f64| nalgebra::Vector2::new(len * phi[k].sin(), -len * phi[k].cos());
-            let left = top + down(0.15);
-            let right = top + nalgebra::Vector2::new(0.4, 0.0) + down(0.15);
-            let rung = top + down(0.3);
-            v += 9.81 * (left.y + right.y + rung.y);
-            v += 0.5 * 10.0 * (n - k) as f64 * (phi[k] - 0.1).powi(2);
-            top = rung;
-        }
-        v
-    };
+    let energy = |phi: &[f64]| energies::ladder(n, phi);
     assert_abs_diff_eq!(energy(&phi), r.energy.total, epsilon = 1e-9);
     for k in 0..n {
         let (mut p, mut q) = (phi.clone(), phi.clone());

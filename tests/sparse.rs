@@ -3,7 +3,6 @@
 //! checked against energies written here in joint coordinates.
 mod common;
 use common::*;
-use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use restpose::{LinearAlgebra, Model, Options};
 
 fn solve_with(model: &Model, la: LinearAlgebra) -> (restpose::State, restpose::Report) {
@@ -90,24 +89,7 @@ fn long_chain_is_a_minimum_of_its_joint_space_energy() {
     let theta: Vec<f64> = (0..n)
         .map(|i| joint(&m, &s, &format!("joint{i}"))[0])
         .collect();
-    let energy = |th: &[f64]| {
-        let mut pose = Isometry3::identity();
-        let mut v = 0.0;
-        for i in 0..n {
-            let axis = if i % 2 == 0 {
-                Vector3::y_axis()
-            } else {
-                Vector3::z_axis()
-            };
-            let x = if i == 0 { 0.0 } else { 0.2 };
-            pose = pose
-                * Translation3::new(x, 0.0, 0.0)
-                * UnitQuaternion::from_axis_angle(&axis, th[i]);
-            v += 9.81 * (pose * Point3::new(0.1, 0.0, 0.0)).z;
-            v += 0.5 * 10.0 * ((n - i) * (n - i)) as f64 * th[i] * th[i];
-        }
-        v
-    };
+    let energy = |th: &[f64]| energies::chain(n, th);
     let v = energy(&theta);
     assert!(
         (v - r.energy.total).abs() < 1e-9 * v.abs(),
@@ -141,20 +123,7 @@ fn long_ladder_is_stationary_for_its_loop_angle_energy() {
     let phi: Vec<f64> = (0..n)
         .map(|k| joint(&m, &s, &format!("hang_left{k}"))[0])
         .collect();
-    let energy = |phi: &[f64]| {
-        let mut top = nalgebra::Vector2::new(0.0, 0.0);
-        let mut v = 0.0;
-        for k in 0..n {
-            let down = |len: f64| nalgebra::Vector2::new(len * phi[k].sin(), -len * phi[k].cos());
-            let left = top + down(0.15);
-            let right = top + nalgebra::Vector2::new(0.4, 0.0) + down(0.15);
-            let rung = top + down(0.3);
-            v += 9.81 * (left.y + right.y + rung.y);
-            v += 0.5 * 10.0 * (n - k) as f64 * (phi[k] - 0.1).powi(2);
-            top = rung;
-        }
-        v
-    };
+    let energy = |phi: &[f64]| energies::ladder(n, phi);
     let v = energy(&phi);
     assert!(
         (v - r.energy.total).abs() < 1e-9 * v.abs(),

@@ -1,6 +1,8 @@
 //! Shared helpers of the integration tests.
 #![allow(dead_code)]
 
+pub(crate) mod energies;
+
 use restpose::state::State;
 use restpose::urdf::{load_file, load_str, ImportOptions};
 use restpose::{Model, Options, Report};

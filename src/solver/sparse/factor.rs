@@ -6,7 +6,7 @@
 //! together with faer's symbolic LU analysis (COLAMD ordering, elimination structure); each
 //! evaluation only refills the values and refactors numerically.
 
-use super::pattern::{Pattern, NONE};
+use super::pattern::{Ix, Pattern, NONE};
 use crate::solver::partition::Partition;
 use faer::linalg::solvers::SolveCore;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
@@ -20,9 +20,9 @@ pub(crate) struct Split {
     /// Number of triplets the maps were built for.
     triplets: usize,
     pattern: Pattern,
-    symbolic: SymbolicLu<usize>,
+    symbolic: SymbolicLu<Ix>,
     /// Slot in `Φ_u` of each triplet, or `NONE`.
-    u_slot: Vec<usize>,
+    u_slot: Vec<Ix>,
     /// `(row position, independent position, triplet index)` of the `Φ_v` entries.
     v_entries: Vec<(usize, usize, usize)>,
     values: Vec<f64>,
@@ -31,7 +31,7 @@ pub(crate) struct Split {
 /// The numeric factors of `Φ_u` and the values of `Φ_v` at one configuration.
 #[derive(Clone)]
 pub(crate) struct SparseFactors {
-    lu: Option<Lu<usize, f64>>,
+    lu: Option<Lu<Ix, f64>>,
     /// `(row position, independent position, value)`.
     phi_v: Vec<(usize, usize, f64)>,
 }
@@ -65,7 +65,7 @@ impl Split {
             .collect();
         let pattern = Pattern::new(r, r, positions);
         let symbolic = SymbolicLu::try_new(pattern.symbolic()).ok()?;
-        let mut u_slot = vec![NONE; entries.len()];
+        let mut u_slot = vec![Ix::MAX; entries.len()];
         let mut v_entries = Vec::new();
         for (k, e) in entries.iter().enumerate() {
             let rp = row_pos[e.0];
@@ -73,7 +73,7 @@ impl Split {
                 continue;
             }
             if dep_pos[e.1] != NONE {
-                u_slot[k] = pattern.slot(rp, dep_pos[e.1]);
+                u_slot[k] = pattern.slot(rp, dep_pos[e.1]) as Ix;
             } else if ind_pos[e.1] != NONE {
                 v_entries.push((rp, ind_pos[e.1], k));
             }
@@ -101,8 +101,8 @@ impl Split {
         self.values.iter_mut().for_each(|v| *v = 0.0);
         for (k, e) in entries.iter().enumerate() {
             let s = self.u_slot[k];
-            if s != NONE {
-                self.values[s] += e.2;
+            if s != Ix::MAX {
+                self.values[s as usize] += e.2;
             }
         }
         let lu = if self.rows.is_empty() {

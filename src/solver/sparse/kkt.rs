@@ -20,7 +20,7 @@
 //! reduced matrix `Zᵀ (W + δ S⁻²) Z` positive definite away from a minimum.
 
 use super::hessian::BlockHessian;
-use super::pattern::{Pattern, NONE};
+use super::pattern::{Ix, Pattern, NONE};
 use crate::solver::partition::Partition;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
@@ -44,17 +44,17 @@ pub(crate) struct Kkt {
     blocks: usize,
     pattern: Pattern,
     /// faer's symbolic LU (COLAMD ordering), computed on the first LU fallback.
-    symbolic: Option<SymbolicLu<usize>>,
-    block_slots: Vec<[usize; 49]>,
+    symbolic: Option<SymbolicLu<Ix>>,
+    block_slots: Vec<[Ix; 49]>,
     /// Slots of `(n + p, c)` and `(c, n + p)` for each Jacobian triplet in an independent row.
-    jac_slots: Vec<(usize, usize)>,
+    jac_slots: Vec<(Ix, Ix)>,
     diag_slots: Vec<usize>,
     values: Vec<f64>,
     /// The shift `δ` now added to the diagonal of the `W` block in `values`.
     delta: f64,
-    lu: Option<Lu<usize, f64>>,
+    lu: Option<Lu<Ix, f64>>,
     /// Symmetric LDLᵀ in the elimination order of the partition (see [`Kkt::factor`]).
-    ldlt: Option<SymbolicCholesky<usize>>,
+    ldlt: Option<SymbolicCholesky<Ix>>,
     ldlt_values: Vec<f64>,
     /// Which factors hold: LDLᵀ or LU.
     kind: Factored,
@@ -127,10 +127,11 @@ impl Kkt {
             .keys
             .iter()
             .map(|&(a, b)| {
-                let mut s = [NONE; 49];
+                let mut s = [0 as Ix; 49];
                 for i in 0..7 {
                     for j in 0..7 {
-                        s[7 * i + j] = pattern.slot(7 * a + i, 7 * b + j);
+                        // Every block position is in the pattern (it was built from them).
+                        s[7 * i + j] = pattern.slot(7 * a + i, 7 * b + j) as Ix;
                     }
                 }
                 s
@@ -139,16 +140,22 @@ impl Kkt {
         let jac_slots = entries
             .iter()
             .map(|e| match row_pos[e.0] {
-                NONE => (NONE, NONE),
-                p => (pattern.slot(n + p, e.1), pattern.slot(e.1, n + p)),
+                NONE => (Ix::MAX, Ix::MAX),
+                p => (
+                    pattern.slot(n + p, e.1) as Ix,
+                    pattern.slot(e.1, n + p) as Ix,
+                ),
             })
             .collect();
         let diag_slots = (0..n).map(|i| pattern.slot(i, i)).collect();
         let nnz = pattern.nnz();
-        let order = elimination_order(part, n);
-        let mut inverse = vec![0; dim];
+        let order: Vec<Ix> = elimination_order(part, n)
+            .into_iter()
+            .map(|i| i as Ix)
+            .collect();
+        let mut inverse: Vec<Ix> = vec![0; dim];
         for (i, &o) in order.iter().enumerate() {
-            inverse[o] = i;
+            inverse[o as usize] = i as Ix;
         }
         let ldlt = factorize_symbolic_cholesky(
             pattern.symbolic(),
@@ -200,16 +207,16 @@ impl Kkt {
         for ((&(a, b), blk), slots) in hess.keys.iter().zip(&hess.values).zip(&self.block_slots) {
             for i in 0..7 {
                 for j in 0..7 {
-                    self.values[slots[7 * i + j]] +=
+                    self.values[slots[7 * i + j] as usize] +=
                         blk[7 * i + j] * scale[7 * a + i] * scale[7 * b + j];
                 }
             }
         }
         for (e, &(s1, s2)) in entries.iter().zip(&self.jac_slots) {
-            if s1 != NONE {
+            if s1 != Ix::MAX {
                 let v = e.2 * row_scale[e.0] * scale[e.1];
-                self.values[s1] += v;
-                self.values[s2] += v;
+                self.values[s1 as usize] += v;
+                self.values[s2 as usize] += v;
             }
         }
     }
@@ -287,7 +294,7 @@ impl Kkt {
         let ptr = simplicial.col_ptr();
         let mut negative = 0;
         for j in 0..ptr.len() - 1 {
-            let d = self.ldlt_values[ptr[j]];
+            let d = self.ldlt_values[ptr[j] as usize];
             // The pivots of rows are about `−1/R`, those of coordinates about `R`: no relative
             // size test here; the solve's residual check catches a poor factorization.
             if !d.is_finite() || d == 0.0 {
@@ -329,7 +336,7 @@ impl Kkt {
         // ‖K‖∞ (the pattern is symmetric: column sums are row sums).
         let knorm = (0..rhs.len())
             .map(|c| {
-                (ptr[c]..ptr[c + 1])
+                (ptr[c] as usize..ptr[c + 1] as usize)
                     .map(|k| self.values[k].abs())
                     .sum::<f64>()
             })
@@ -338,8 +345,8 @@ impl Kkt {
         for _ in 0..3 {
             let mut r = b.clone();
             for c in 0..rhs.len() {
-                for k in ptr[c]..ptr[c + 1] {
-                    r[idx[k]] -= self.values[k] * rhs[c];
+                for k in ptr[c] as usize..ptr[c + 1] as usize {
+                    r[idx[k] as usize] -= self.values[k] * rhs[c];
                 }
             }
             let rnorm = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));

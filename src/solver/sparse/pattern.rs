@@ -4,13 +4,17 @@
 
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 
+/// Index type of the sparse structures: 32 bits (half the memory of `usize` for the patterns
+/// and factors; up to 4·10⁹ rows).
+pub(crate) type Ix = u32;
+
 /// Marks a position outside the pattern (or a triplet that does not belong to a sub-matrix).
 pub(crate) const NONE: usize = usize::MAX;
 
 /// The sorted, de-duplicated positions of a sparse matrix in compressed-column form.
 #[derive(Clone, Debug)]
 pub(crate) struct Pattern {
-    symbolic: SymbolicSparseColMat<usize>,
+    symbolic: SymbolicSparseColMat<Ix>,
 }
 
 impl Pattern {
@@ -29,14 +33,15 @@ impl Pattern {
             .collect();
         keys.sort_unstable();
         keys.dedup();
-        let mut col_ptr = vec![0usize; ncols + 1];
+        assert!(keys.len() < 1 << 32, "pattern too large");
+        let mut col_ptr: Vec<Ix> = vec![0; ncols + 1];
         for &k in &keys {
             col_ptr[(k >> 32) as usize + 1] += 1;
         }
         for c in 0..ncols {
             col_ptr[c + 1] += col_ptr[c];
         }
-        let row_idx = keys.iter().map(|&k| (k & 0xffff_ffff) as usize).collect();
+        let row_idx = keys.iter().map(|&k| (k & 0xffff_ffff) as Ix).collect();
         drop(keys);
         Pattern {
             symbolic: SymbolicSparseColMat::new_checked(nrows, ncols, col_ptr, None, row_idx),
@@ -51,17 +56,19 @@ impl Pattern {
     /// The slot of position `(r, c)`, or [`NONE`].
     pub(crate) fn slot(&self, r: usize, c: usize) -> usize {
         let ptr = self.symbolic.col_ptr();
-        let rows = &self.symbolic.row_idx()[ptr[c]..ptr[c + 1]];
-        rows.binary_search(&r).map_or(NONE, |k| ptr[c] + k)
+        let (a, b) = (ptr[c] as usize, ptr[c + 1] as usize);
+        self.symbolic.row_idx()[a..b]
+            .binary_search(&(r as Ix))
+            .map_or(NONE, |k| a + k)
     }
 
     /// The structure, for faer's symbolic factorizations.
-    pub(crate) fn symbolic(&self) -> faer::sparse::SymbolicSparseColMatRef<'_, usize> {
+    pub(crate) fn symbolic(&self) -> faer::sparse::SymbolicSparseColMatRef<'_, Ix> {
         self.symbolic.as_ref()
     }
 
     /// The matrix with this pattern and `values` (one per slot).
-    pub(crate) fn matrix<'a>(&'a self, values: &'a [f64]) -> SparseColMatRef<'a, usize, f64> {
+    pub(crate) fn matrix<'a>(&'a self, values: &'a [f64]) -> SparseColMatRef<'a, Ix, f64> {
         SparseColMatRef::new(self.symbolic.as_ref(), values)
     }
 }

@@ -92,7 +92,8 @@ fn stability(
 ) -> Stability {
     let (vals, vecs) = (&spectrum.values, &spectrum.vectors);
     let tol = spectrum.tolerance();
-    let verdict = if vals[0] < -tol {
+    let negative_by_inertia = spectrum.negative_by_inertia.unwrap_or(0) > 0;
+    let verdict = if vals[0] < -tol || negative_by_inertia {
         "unstable"
     } else if vals[0] <= tol {
         "neutral"

@@ -10,13 +10,16 @@
 //! positive eigenvalues of `Ĥ` and, if there is any negative eigenvalue, the negative end. Only
 //! Ritz pairs with residual `|β_k s_ki| ≤ 10⁻⁸ |θ_i|` are kept. The largest eigenvalue (scale
 //! of the verdict's tolerance) comes from 12 steps of power iteration on `Ĥ` (a few per cent
-//! suffice for a tolerance).
+//! suffice for a tolerance). When the KKT matrix was factored by an accurate LDLᵀ, the number
+//! of its negative pivots minus the number of rows is the number of negative eigenvalues of `Ĥ`
+//! (Sylvester's law of inertia): an exact count, whatever Lanczos found.
 //!
 //! ## References
 //! - Y. Saad, *Numerical Methods for Large Eigenvalue Problems*, 2nd ed., SIAM (2011), §6.6.
 
 use super::eigen::symmetric_eigen;
 use super::partition::Partition;
+use super::sparse::kkt::Factored;
 use super::system::{Eval, System};
 use nalgebra::{DMatrix, DVector};
 
@@ -34,6 +37,10 @@ pub(crate) struct Spectrum {
     pub(crate) largest: f64,
     /// Whether all eigenvalues are known (exact decomposition) or only the low end (Lanczos).
     pub(crate) exact: bool,
+    /// The number of negative eigenvalues by Sylvester's law of inertia, from an accurate LDLᵀ
+    /// of the KKT matrix (negative pivots minus rows), when the Lanczos path had one: a
+    /// certificate that does not depend on Lanczos finding the negative end.
+    pub(crate) negative_by_inertia: Option<usize>,
 }
 
 impl Spectrum {
@@ -71,6 +78,7 @@ pub(crate) fn spectrum(
             vectors,
             largest,
             exact: true,
+            negative_by_inertia: None,
         };
     }
     lanczos(sys, q, part, eval).unwrap_or_else(|| Spectrum {
@@ -79,26 +87,30 @@ pub(crate) fn spectrum(
         vectors: DMatrix::zeros(dof, 1),
         largest: 1.0,
         exact: false,
+        negative_by_inertia: None,
     })
 }
 
 fn lanczos(sys: &mut System, q: &DVector<f64>, part: &Partition, eval: &Eval) -> Option<Spectrum> {
     let dof = part.independent.len();
     let n = q.len();
-    if sys.factor_kkt(q, part, eval, true, 0.0) == super::sparse::kkt::Factored::None {
+    let factored = sys.factor_kkt(q, part, eval, true, 0.0);
+    if factored == Factored::None {
         return None;
     }
-    // Make sure the factors solve accurately (LDLᵀ may not: then LU).
-    let probe = DVector::from_fn(n, |i, _| {
-        if part.independent.contains(&i) {
-            1.0
-        } else {
-            0.0
-        }
-    });
-    if sys.kkt_solve(&probe).is_none() {
-        sys.kkt_fall_back_to_lu();
+    // Make sure the factors solve accurately (LDLᵀ may not: then LU, and no inertia).
+    let mut probe = DVector::zeros(n);
+    for &c in &part.independent {
+        probe[c] = 1.0;
     }
+    let negative_by_inertia = match (sys.kkt_solve(&probe), factored) {
+        (Some(_), Factored::Ldlt { negative }) => Some(negative.saturating_sub(part.rows.len())),
+        (Some(_), _) => None,
+        (None, _) => {
+            sys.kkt_fall_back_to_lu();
+            None
+        }
+    };
     let apply_inverse = |sys: &System, x: &DVector<f64>| -> Option<DVector<f64>> {
         let mut b = DVector::zeros(n);
         for (k, &c) in part.independent.iter().enumerate() {
@@ -185,6 +197,7 @@ fn lanczos(sys: &mut System, q: &DVector<f64>, part: &Partition, eval: &Eval) ->
         values,
         vectors,
         exact: false,
+        negative_by_inertia,
     })
 }
 
@@ -252,6 +265,9 @@ mod tests {
             }
             assert_eq!(lo < 0.0, flip);
             assert_eq!(exact[0] < 0.0, flip);
+            // The inertia of the KKT matrix counts the negative eigenvalues exactly.
+            let negatives = exact.iter().filter(|&&e| e < 0.0).count();
+            assert_eq!(lz.negative_by_inertia, Some(negatives), "flip {flip}");
             assert!((lz.largest - exact.amax()).abs() < 0.05 * exact.amax());
         }
     }

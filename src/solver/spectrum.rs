@@ -116,7 +116,8 @@ fn lanczos(sys: &mut System, q: &DVector<f64>, part: &Partition, eval: &Eval) ->
         for (k, &c) in part.independent.iter().enumerate() {
             b[c] = x[k];
         }
-        let dq = sys.kkt_solve(&b)?;
+        // Lanczos needs the solves to about 10⁻¹¹, not to the last digit.
+        let dq = sys.kkt_solve_to(&b, 1e-11)?;
         Some(DVector::from_iterator(
             dof,
             part.independent.iter().map(|&c| dq[c]),

@@ -703,11 +703,16 @@ impl<'a> System<'a> {
     /// Solves the factored KKT system for the right side `b` over all coordinates (scaled;
     /// zero constraint rows); returns the scaled `δq̂`.
     pub(crate) fn kkt_solve(&self, b: &DVector<f64>) -> Option<DVector<f64>> {
+        self.kkt_solve_to(b, 1e-13)
+    }
+
+    /// [`System::kkt_solve`], refined only until the backward error is below `target`.
+    pub(crate) fn kkt_solve_to(&self, b: &DVector<f64>, target: f64) -> Option<DVector<f64>> {
         let kkt = self.kkt.as_ref()?;
         let n = kkt.coordinates();
         let mut rhs = vec![0.0; n + kkt.rows()];
         rhs[..n].copy_from_slice(b.as_slice());
-        kkt.solve(&mut rhs)
+        kkt.solve(&mut rhs, target)
             .then(|| DVector::from_column_slice(&rhs[..n]))
     }
 }

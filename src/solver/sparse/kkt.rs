@@ -52,6 +52,8 @@ pub(crate) struct Kkt {
     values: Vec<f64>,
     /// The shift `δ` now added to the diagonal of the `W` block in `values`.
     delta: f64,
+    /// `‖K‖∞` of the factored matrix (for the backward error of solves).
+    knorm: f64,
     lu: Option<Lu<Ix, f64>>,
     /// Symmetric LDLᵀ in the elimination order of the partition (see [`Kkt::factor`]).
     ldlt: Option<SymbolicCholesky<Ix>>,
@@ -181,6 +183,7 @@ impl Kkt {
             diag_slots,
             values: vec![0.0; nnz],
             delta: 0.0,
+            knorm: 0.0,
             lu: None,
             ldlt,
             ldlt_values,
@@ -240,6 +243,16 @@ impl Kkt {
             self.values[s] += delta - self.delta;
         }
         self.delta = delta;
+        let sym = self.pattern.symbolic();
+        let ptr = sym.col_ptr();
+        // ‖K‖∞ (the pattern is symmetric: column sums are row sums).
+        self.knorm = (0..ptr.len() - 1)
+            .map(|c| {
+                (ptr[c] as usize..ptr[c + 1] as usize)
+                    .map(|k| self.values[k].abs())
+                    .sum::<f64>()
+            })
+            .fold(0.0f64, f64::max);
         self.kind = Factored::None;
         if !self.lu_only {
             if let Some(negative) = self.factor_ldlt() {
@@ -326,21 +339,14 @@ impl Kkt {
     /// Solves with the last factors in place (`rhs` of length `n + rows`), with iterative
     /// refinement (`x += K⁻¹ (b − K x)`, which recovers the digits lost to the pivot order)
     /// until the normwise backward error `ω = ‖b − K x‖∞ / (‖K‖∞ ‖x‖∞ + ‖b‖∞)` is below
-    /// 10⁻¹³ (at most three steps); `false` if singular or if `ω` stays above 10⁻¹⁰.
-    pub(crate) fn solve(&self, rhs: &mut [f64]) -> bool {
+    /// `target` (at most three steps); `false` if singular or if `ω` stays above 10⁻¹⁰.
+    pub(crate) fn solve(&self, rhs: &mut [f64], target: f64) -> bool {
         let b = rhs.to_vec();
         let bnorm = b.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         self.solve_once(rhs);
         let sym = self.pattern.symbolic();
         let (ptr, idx) = (sym.col_ptr(), sym.row_idx());
-        // ‖K‖∞ (the pattern is symmetric: column sums are row sums).
-        let knorm = (0..rhs.len())
-            .map(|c| {
-                (ptr[c] as usize..ptr[c + 1] as usize)
-                    .map(|k| self.values[k].abs())
-                    .sum::<f64>()
-            })
-            .fold(0.0f64, f64::max);
+        let knorm = self.knorm;
         let mut omega = f64::INFINITY;
         for _ in 0..3 {
             let mut r = b.clone();
@@ -352,7 +358,7 @@ impl Kkt {
             let rnorm = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
             let xnorm = rhs.iter().fold(0.0f64, |a, v| a.max(v.abs()));
             omega = rnorm / (knorm * xnorm + bnorm).max(f64::MIN_POSITIVE);
-            if !omega.is_finite() || omega <= 1e-13 {
+            if !omega.is_finite() || omega <= target {
                 break;
             }
             self.solve_once(&mut r);

@@ -16,7 +16,8 @@ use faer::{Conj, MatMut};
 pub(crate) struct Split {
     /// Id of the partition.
     id: usize,
-    rows: Vec<usize>,
+    /// Number of independent rows (the order of `Φ_u`).
+    rows: usize,
     /// Number of triplets the maps were built for.
     triplets: usize,
     pattern: Pattern,
@@ -81,7 +82,7 @@ impl Split {
         let values = vec![0.0; pattern.nnz()];
         Some(Split {
             id: part.id,
-            rows: part.rows.clone(),
+            rows: part.rows.len(),
             triplets: entries.len(),
             pattern,
             symbolic,
@@ -105,7 +106,7 @@ impl Split {
                 self.values[s as usize] += e.2;
             }
         }
-        let lu = if self.rows.is_empty() {
+        let lu = if self.rows == 0 {
             None
         } else {
             Lu::try_new_with_symbolic(self.symbolic.clone(), self.pattern.matrix(&self.values)).ok()

@@ -39,7 +39,8 @@ pub(crate) struct Kkt {
     n: usize,
     /// Id of the partition.
     id: usize,
-    rows: Vec<usize>,
+    /// Number of independent (multiplier) rows.
+    rows: usize,
     triplets: usize,
     blocks: usize,
     pattern: Pattern,
@@ -173,7 +174,7 @@ impl Kkt {
         Some(Kkt {
             n,
             id: part.id,
-            rows: part.rows.clone(),
+            rows: part.rows.len(),
             triplets: entries.len(),
             blocks: hess.keys.len(),
             pattern,
@@ -371,7 +372,7 @@ impl Kkt {
 
     /// Number of constraint rows.
     pub(crate) fn rows(&self) -> usize {
-        self.rows.len()
+        self.rows
     }
 
     /// Number of coordinates `n`.

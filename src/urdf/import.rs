@@ -611,6 +611,7 @@ pub(super) fn import(
         initial: Vec::new(),
         gravity: options.gravity,
         length_scale: 1.0,
+        joint_names: Default::default(),
     };
     for (g, &rl) in group_root.iter().enumerate() {
         if g > 0 || floating {
@@ -672,6 +673,7 @@ pub(super) fn import(
         });
     }
 
+    model.index_names();
     let urdf_joints: Vec<(String, Node)> = edges
         .iter()
         .filter(|e| e.source == Source_::Urdf)

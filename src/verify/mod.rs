@@ -119,7 +119,8 @@ struct Projection {
 }
 
 fn project(model: &Model, state: &State) -> Result<Projection> {
-    let cons = Constraints::new(model, &crate::solver::lock_values(model));
+    let cons = Constraints::new(model, &crate::solver::lock_values(model))
+        .on_branches(state.branches.clone());
     let mut phi = DVector::zeros(cons.len());
     let mut jac = crate::constraints::Triplets::default();
     cons.evaluate(model, &state.q, &mut phi, Some(&mut jac));
@@ -130,7 +131,7 @@ fn project(model: &Model, state: &State) -> Result<Projection> {
         j.column_mut(c).scale_mut(scale[c]);
     }
     let mut g = DVector::zeros(n);
-    let e = potential(model, &state.q, &mut g, None)
+    let e = potential(model, &state.branches, &state.q, &mut g, None)
         .ok_or_else(|| Error::Undefined("a force table is out of range".into()))?;
     for c in 0..n {
         g[c] *= scale[c];
@@ -175,7 +176,7 @@ fn project(model: &Model, state: &State) -> Result<Projection> {
 /// Potential energy of a state \[J\], `None` where a force table is out of its range.
 pub fn potential_energy(model: &Model, state: &State) -> Option<f64> {
     let mut g = DVector::zeros(state.q.len());
-    potential(model, &state.q, &mut g, None).map(|e| e.total)
+    potential(model, &state.branches, &state.q, &mut g, None).map(|e| e.total)
 }
 
 /// Constraint residual and projected energy gradient of `state` (with the model's locks held
@@ -248,7 +249,7 @@ pub fn verify(model: &Model, state: &State, tol: &Tolerances) -> Result<Verifica
     for j in model.joints.iter().filter(|j| j.tree && !j.merged) {
         let pair = pair_of(&j.bodies, &state.q, false);
         for dof in 0..j.kind.scalar_coordinates() {
-            if let Some(s) = joint::coordinate(j, &pair, dof) {
+            if let Some(s) = crate::kinematics::coordinate(j, &pair, dof, 0.0) {
                 let mut g = DVector::zeros(n);
                 scatter(&j.bodies, &s, 1.0, &mut g, None);
                 for c in 0..n {
@@ -287,7 +288,7 @@ pub fn verify(model: &Model, state: &State, tol: &Tolerances) -> Result<Verifica
         && imbalance.iter().all(|i| i.effort.abs() <= tol.force)
         && unassigned <= tol.force;
     let stability = if passed {
-        crate::solver::stability_at(model, &state.q)
+        crate::solver::stability_at(model, state)
     } else {
         None
     };
@@ -312,6 +313,7 @@ pub fn verify(model: &Model, state: &State, tol: &Tolerances) -> Result<Verifica
 /// [`Error::Assembly`] if the constraints cannot be satisfied from there.
 pub fn assemble(model: &Model, state: &State) -> Result<State> {
     let locks = crate::solver::lock_values(model);
-    let q = crate::solver::assemble_only(model, state.q.clone(), &locks)?;
-    Ok(State { q })
+    let mut branches = state.branches.clone();
+    let q = crate::solver::assemble_only(model, state.q.clone(), &mut branches, &locks)?;
+    Ok(State { q, branches })
 }

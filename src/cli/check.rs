@@ -8,7 +8,10 @@ use restpose::urdf::load_file;
 /// Runs `check`: exit 0, or 1 if the initial guess does not assemble.
 pub(crate) fn run(a: &CheckArgs) -> anyhow::Result<u8> {
     let loaded = load_file(&a.file, &a.input.options()?)?;
-    let s = restpose::export::summary::ModelSummary::new(&loaded);
+    let s = restpose::export::summary::ModelSummary::new(
+        &loaded,
+        &restpose::verify::check(&loaded.model),
+    );
     match a.format {
         Format::Json => out!("{}", serde_json::to_string_pretty(&s)?),
         Format::Text => {

@@ -156,9 +156,9 @@ impl AnalysisResult {
             independent_coordinates: report.independent_coordinates.clone(),
             energy: report.energy,
             diagnostics: report.diagnostics.clone(),
-            bodies: report.sizes[0],
-            coordinates: report.sizes[1],
-            constraints: report.sizes[2],
+            bodies: report.sizes.bodies,
+            coordinates: report.sizes.coordinates,
+            constraints: report.sizes.constraint_rows,
         }
     }
 

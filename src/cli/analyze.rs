@@ -31,7 +31,7 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
     let (state, report) = restpose::solve(model, &a.solver_options())?;
     let result = AnalysisResult::new(model, &state, &report);
     if let Some(path) = &a.json {
-        restpose::export::write_atomic(path, result.to_json().as_bytes())?;
+        print::write_json(path, &result.to_json())?;
     }
     if let Some(path) = &a.rrd {
         write_rrd(path, model, &state, &report)?;
@@ -57,7 +57,7 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
             "note: --write-urdf / --write-joint-states are written only for a converged rest pose"
         );
     }
-    if !a.quiet {
+    if !a.quiet && !print::is_stdout(a.json.as_ref()) {
         print::analysis(&result);
     }
     if !result.converged {

@@ -84,9 +84,13 @@ pub(crate) struct CheckArgs {
     pub(crate) file: PathBuf,
     #[command(flatten)]
     pub(crate) input: InputArgs,
-    /// Output format.
+    /// Output format on standard output.
     #[arg(long, value_enum, default_value = "text")]
     pub(crate) format: Format,
+    /// Also write the model summary as JSON to this file (`-`: standard output, which then
+    /// carries only the JSON).
+    #[arg(long, value_name = "OUT.json")]
+    pub(crate) json: Option<PathBuf>,
     /// Also list ignored foreign elements.
     #[arg(long, short)]
     pub(crate) verbose: bool,
@@ -116,7 +120,8 @@ pub(crate) struct VerifyArgs {
     /// Largest constraint violation for the pose to pass [m or rad].
     #[arg(long, default_value_t = Tolerances::default().constraint)]
     pub(crate) constraint_tolerance: f64,
-    /// Write the verification as JSON to this file (`-` for standard output).
+    /// Write the verification as JSON to this file (`-`: standard output, which then carries
+    /// only the JSON: no report).
     #[arg(long, value_name = "OUT.json")]
     pub(crate) json: Option<PathBuf>,
     #[command(flatten)]
@@ -151,7 +156,8 @@ pub(crate) enum Family {
 pub(crate) struct AnalyzeArgs {
     /// URDF file.
     pub(crate) file: PathBuf,
-    /// Write the result JSON here (written even when the solve does not converge).
+    /// Write the result JSON here (written even when the solve does not converge; `-`:
+    /// standard output, which then carries only the JSON: no summary).
     #[arg(long, value_name = "OUT.json")]
     pub(crate) json: Option<PathBuf>,
     #[command(flatten)]

@@ -12,8 +12,15 @@ pub(crate) fn run(a: &CheckArgs) -> anyhow::Result<u8> {
         &loaded,
         &restpose::verify::check(&loaded.model),
     );
+    if let Some(path) = &a.json {
+        print::write_json(path, &serde_json::to_string_pretty(&s)?)?;
+    }
     match a.format {
-        Format::Json => out!("{}", serde_json::to_string_pretty(&s)?),
+        Format::Json if !print::is_stdout(a.json.as_ref()) => {
+            out!("{}", serde_json::to_string_pretty(&s)?)
+        }
+        Format::Json => {}
+        Format::Text if print::is_stdout(a.json.as_ref()) => {}
         Format::Text => {
             print::model(&s);
             for w in &s.warnings {

@@ -15,6 +15,21 @@ macro_rules! out {
 }
 pub(crate) use out;
 
+/// Whether an output path means standard output (`-`).
+pub(crate) fn is_stdout(path: Option<&std::path::PathBuf>) -> bool {
+    path.is_some_and(|p| p.as_os_str() == "-")
+}
+
+/// Writes JSON text to `path` atomically, or to standard output for `-`.
+pub(crate) fn write_json(path: &std::path::Path, text: &str) -> anyhow::Result<()> {
+    if path.as_os_str() == "-" {
+        out!("{text}");
+    } else {
+        restpose::export::write_atomic(path, text.as_bytes())?;
+    }
+    Ok(())
+}
+
 /// The summary of a solve (`analyze`).
 pub(crate) fn analysis(r: &AnalysisResult) {
     out!("robot `{}`", r.robot);
@@ -82,7 +97,13 @@ pub(crate) fn analysis(r: &AnalysisResult) {
     out!("  joint                          type          position");
     for (name, j) in &r.joints {
         let p: Vec<String> = j.position.iter().map(|v| format!("{v:.9}")).collect();
-        out!("  {:<30} {:<13} [{}]", name, j.kind, p.join(", "));
+        out!(
+            "  {:<30} {:<13} [{}]{}",
+            name,
+            j.kind,
+            p.join(", "),
+            units(&j.units)
+        );
     }
     for v in &r.limit_violations {
         out!(
@@ -107,6 +128,16 @@ pub(crate) fn analysis(r: &AnalysisResult) {
                 t[2]
             );
         }
+    }
+}
+
+/// The units of a joint's coordinates after its values: ` rad` when they share one, ` [rad, m]`
+/// when they differ, nothing for a joint without coordinates.
+fn units(u: &[&str]) -> String {
+    match u.first() {
+        None => String::new(),
+        Some(first) if u.iter().all(|x| x == first) => format!(" {first}"),
+        Some(_) => format!(" [{}]", u.join(", ")),
     }
 }
 

@@ -3,7 +3,7 @@
 
 use super::args::{coord, VerifyArgs};
 use super::exit;
-use super::print::{self, out};
+use super::print;
 use anyhow::{bail, Context};
 use restpose::urdf::load_file;
 
@@ -43,15 +43,9 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
     };
     let v = restpose::verify::verify(model, &state, &tol)?;
     if let Some(path) = &a.json {
-        let text = serde_json::to_string_pretty(&v)?;
-        if path.as_os_str() == "-" {
-            out!("{text}");
-        } else {
-            restpose::export::write_atomic(path, text.as_bytes())?;
-        }
+        print::write_json(path, &serde_json::to_string_pretty(&v)?)?;
     }
-    let stdout_json = a.json.as_ref().is_some_and(|p| p.as_os_str() == "-");
-    if !a.quiet && !stdout_json {
+    if !a.quiet && !print::is_stdout(a.json.as_ref()) {
         print::verification(&model.name, &v, &tol);
     }
     if v.passed {

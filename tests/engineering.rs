@@ -34,7 +34,10 @@ fn inverted_start_ends_at_the_stable_equilibrium() {
         -std::f64::consts::FRAC_PI_2,
         epsilon = 1e-8
     );
-    assert_eq!(r.stability.unwrap().verdict, "stable");
+    assert_eq!(
+        r.stability.unwrap().verdict,
+        restpose::solver::Verdict::Stable
+    );
     assert!(r.diagnostics.negative_curvature_steps >= 1);
 
     let opts = Options {
@@ -48,7 +51,10 @@ fn inverted_start_ends_at_the_stable_equilibrium() {
         std::f64::consts::FRAC_PI_2,
         epsilon = 1e-12
     );
-    assert_eq!(r.stability.unwrap().verdict, "unstable");
+    assert_eq!(
+        r.stability.unwrap().verdict,
+        restpose::solver::Verdict::Unstable
+    );
 }
 
 /// A locked joint holds the gravity torque: m g x_com, by hand.

@@ -18,7 +18,10 @@ fn pendulum_reaches_the_papers_equilibrium() {
     assert_abs_diff_eq!(com.x, 0.188092, epsilon = 1e-6);
     assert_abs_diff_eq!(com.y, -0.982151, epsilon = 1e-6);
     assert_eq!(r.dof, 1);
-    assert_eq!(r.stability.as_ref().unwrap().verdict, "stable");
+    assert_eq!(
+        r.stability.as_ref().unwrap().verdict,
+        restpose::solver::Verdict::Stable
+    );
     assert_verified_minimum(&m, &s);
 }
 

@@ -50,7 +50,10 @@ fn gazebo_transmission_file_loads_its_springs_and_meshes() {
         });
     assert!(meshes.count() >= 3);
     let (s, r) = solve(&l.model);
-    assert_eq!(r.stability.unwrap().verdict, "stable");
+    assert_eq!(
+        r.stability.unwrap().verdict,
+        restpose::solver::Verdict::Stable
+    );
     // The same springs written as mech:joint_spring give the same rest pose (0.3170, 0.3188).
     assert_abs_diff_eq!(
         s.joint(&l.model, "shoulder_joint").unwrap()[0],

@@ -172,15 +172,18 @@ fn max_link_distance(m: &restpose::Model, a: &restpose::State, b: &restpose::Sta
 #[test]
 fn tractor_trailer_converges_from_near_and_far_starts() {
     let (m, rest, r) = solve_with_initial("tractor_trailer", &[]);
-    assert_eq!(r.sizes[0], 17);
+    assert_eq!(r.sizes.bodies, 17);
     assert_eq!(r.dof, 25);
     assert!(r.redundant_constraints.is_empty());
     assert_eq!(
-        r.sizes[2] - 17,
+        r.sizes.constraint_rows - 17,
         77,
         "joint rows besides the 17 normalization rows"
     );
-    assert_eq!(r.stability.as_ref().unwrap().verdict, "stable");
+    assert_eq!(
+        r.stability.as_ref().unwrap().verdict,
+        restpose::solver::Verdict::Stable
+    );
     for start in [
         [("fifth_wheel_pitch", 0, 0.0017)],
         [("fifth_wheel_pitch", 0, 0.054)],
@@ -204,7 +207,7 @@ fn tractor_trailer_converges_from_near_and_far_starts() {
 #[test]
 fn stewart_platform_converges_from_far_starts() {
     let (m, rest, r) = solve_with_initial("stewart_platform", &[]);
-    assert_eq!(r.sizes[0], 13);
+    assert_eq!(r.sizes.bodies, 13);
     assert_eq!(r.dof, 6);
     for start in [
         [("leg1_slide", 0, 0.3)],

@@ -36,7 +36,11 @@ fn solver_answers_pass_in_every_pose_format() {
         let (s, _) = pose_state(&m, &values).unwrap();
         let v = verify(&m, &s, &Tolerances::default()).unwrap();
         assert!(v.passed, "{name}: {v:?}");
-        assert_eq!(v.stability.unwrap().verdict, "stable", "{name}");
+        assert_eq!(
+            v.stability.unwrap().verdict,
+            restpose::solver::Verdict::Stable,
+            "{name}"
+        );
         // A {"joint": [values]} map.
         let map: serde_json::Map<String, serde_json::Value> = result
             .joints
@@ -50,7 +54,7 @@ fn solver_answers_pass_in_every_pose_format() {
             "{name}: map format"
         );
         // joint_states YAML carries one position per joint: only for scalar-joint models.
-        if result.joints.values().any(|j| j.position.len() > 1) {
+        if result.joints.iter().any(|(_, j)| j.position.len() > 1) {
             continue;
         }
         let mut names = Vec::new();

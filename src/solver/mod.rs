@@ -26,7 +26,7 @@ mod spectrum;
 pub(crate) mod system;
 
 pub use options::{LinearAlgebra, Method, Options};
-pub use report::{Diagnostics, Iterate, Reaction, Report, Stability, Termination};
+pub use report::{Diagnostics, Iterate, Reaction, Report, Sizes, Stability, Termination, Verdict};
 
 use crate::constraints::Constraints;
 use crate::error::{Error, Result};
@@ -109,11 +109,11 @@ fn stability(
     let tol = spectrum.tolerance();
     let negative_by_inertia = spectrum.negative_by_inertia.unwrap_or(0) > 0;
     let verdict = if vals[0] < -tol || negative_by_inertia {
-        "unstable"
+        Verdict::Unstable
     } else if vals[0] <= tol {
-        "neutral"
+        Verdict::Neutral
     } else {
-        "stable"
+        Verdict::Stable
     };
     let shown = vals.len().min(6);
     let modes = (0..shown)
@@ -144,7 +144,7 @@ fn stability(
         })
         .collect();
     Stability {
-        verdict: verdict.into(),
+        verdict,
         tolerance: tol,
         eigenvalues: vals.iter().take(shown).copied().collect(),
         modes,
@@ -306,7 +306,11 @@ fn solve_assembled(
         stability,
         reactions,
         diagnostics,
-        sizes: [model.bodies.len(), model.coordinate_count(), sys.cons.len()],
+        sizes: Sizes {
+            bodies: model.bodies.len(),
+            coordinates: model.coordinate_count(),
+            constraint_rows: sys.cons.len(),
+        },
         iterates: {
             let mut branches = start.branches;
             out.iterates

@@ -12,8 +12,10 @@
 //! with loops the split among the joints of a loop is the minimum-norm one. What no scalar
 //! joint coordinate can carry (a spherical or floating joint) is reported as `unassigned`.
 
+mod check;
 mod pose;
 
+pub use check::{check, ModelCheck};
 pub use pose::{parse_pose, pose_state, read_pose};
 
 use crate::constraints::{joint, BlockKind, Constraints};

@@ -129,7 +129,8 @@ struct VerifyArgs {
     /// Joint value (repeatable; overrides the pose file): JOINT=VALUE or JOINT[DOF]=VALUE.
     #[arg(long, value_name = "JOINT=VALUE")]
     joint: Vec<String>,
-    /// Largest effort a joint may need for the pose to pass [N m or N].
+    /// Largest effort a joint may need for the pose to pass [N m or N], plus 1e-9 of the
+    /// largest generalized force on any coordinate.
     #[arg(long, default_value_t = 1e-6)]
     force_tolerance: f64,
     /// Largest constraint violation for the pose to pass [m or rad].
@@ -369,6 +370,7 @@ fn verify(a: &VerifyArgs) -> anyhow::Result<u8> {
     let tol = restpose::verify::Tolerances {
         force: a.force_tolerance,
         constraint: a.constraint_tolerance,
+        ..Default::default()
     };
     let v = restpose::verify::verify(model, &state, &tol)?;
     if let Some(path) = &a.json {
@@ -403,14 +405,14 @@ fn verify(a: &VerifyArgs) -> anyhow::Result<u8> {
         }
         out!("  joint                          dof   effort to hold [N m or N]");
         for i in &v.imbalance {
-            let flag = if i.effort.abs() > tol.force {
+            let flag = if i.effort.abs() > v.effort_tolerance {
                 "  <- out of balance"
             } else {
                 ""
             };
             out!("  {:<30} {:>3}   {:>14.6e}{flag}", i.joint, i.dof, i.effort);
         }
-        if v.unassigned > tol.force {
+        if v.unassigned > v.effort_tolerance {
             out!(
                 "  unassigned generalized force {:.3e} (spherical or floating joints)",
                 v.unassigned

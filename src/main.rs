@@ -258,7 +258,9 @@ fn analyze(a: &AnalyzeArgs) -> anyhow::Result<u8> {
     for l in &a.initial {
         opts.initial.push(coord(l, "initial")?);
     }
+    let import_started = std::time::Instant::now();
     let loaded = load_file(&a.file, &opts)?;
+    let import = import_started.elapsed().as_secs_f64();
     if !a.quiet {
         for w in &loaded.warnings {
             eprintln!("warning: {w}");
@@ -289,8 +291,11 @@ fn analyze(a: &AnalyzeArgs) -> anyhow::Result<u8> {
         ..Default::default()
     };
     let model = &loaded.model;
-    let (state, report) = restpose::solve(model, &options)?;
-    let result = AnalysisResult::new(model, &state, &report);
+    let (state, mut report) = restpose::solve(model, &options)?;
+    report.diagnostics.timings.import = import;
+    let export_started = std::time::Instant::now();
+    let mut result = AnalysisResult::new(model, &state, &report);
+    result.diagnostics.timings.export = export_started.elapsed().as_secs_f64();
     if let Some(path) = &a.json {
         restpose::export::write_atomic(path, result.to_json().as_bytes())?;
     }

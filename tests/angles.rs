@@ -113,7 +113,10 @@ fn continuous_spring_winds_up_two_and_a_half_turns() {
     let spring = -k * rest * t + 0.5 * k * t * t;
     assert_abs_diff_eq!(r.energy.joint_springs, spring, epsilon = 1e-6);
     assert_abs_diff_eq!(r.energy.gravity, M * G * L * t.sin(), epsilon = 1e-9);
-    assert_eq!(r.stability.as_ref().unwrap().verdict, restpose::solver::Verdict::Stable);
+    assert_eq!(
+        r.stability.as_ref().unwrap().verdict,
+        restpose::solver::Verdict::Stable
+    );
     let json = restpose::export::json::AnalysisResult::new(&m, &s, &r);
     let v = serde_json::to_value(&json).unwrap();
     let reported = v["joints"]["pivot"]["position"][0].as_f64().unwrap();

@@ -16,7 +16,9 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
     for l in &a.initial {
         opts.initial.push(coord(l, "initial")?);
     }
+    let import_started = std::time::Instant::now();
     let loaded = load_file(&a.file, &opts)?;
+    let import = import_started.elapsed().as_secs_f64();
     if !a.quiet {
         for w in &loaded.warnings {
             eprintln!("warning: {w}");
@@ -28,8 +30,11 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
         }
     }
     let model = &loaded.model;
-    let (state, report) = restpose::solve(model, &a.solver_options())?;
-    let result = AnalysisResult::new(model, &state, &report);
+    let (state, mut report) = restpose::solve(model, &a.solver_options())?;
+    report.diagnostics.timings.import = import;
+    let export_started = std::time::Instant::now();
+    let mut result = AnalysisResult::new(model, &state, &report);
+    result.diagnostics.timings.export = export_started.elapsed().as_secs_f64();
     if let Some(path) = &a.json {
         print::write_json(path, &result.to_json())?;
     }

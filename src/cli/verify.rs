@@ -40,6 +40,7 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
     let tol = restpose::verify::Tolerances {
         force: a.force_tolerance,
         constraint: a.constraint_tolerance,
+        ..Default::default()
     };
     let v = restpose::verify::verify(model, &state, &tol)?;
     if let Some(path) = &a.json {

@@ -26,7 +26,9 @@ mod spectrum;
 pub(crate) mod system;
 
 pub use options::{LinearAlgebra, Method, Options};
-pub use report::{Diagnostics, Iterate, Reaction, Report, Sizes, Stability, Termination, Verdict};
+pub use report::{
+    Diagnostics, Iterate, Reaction, Report, Sizes, Stability, Termination, Timings, Verdict,
+};
 
 use crate::constraints::Constraints;
 use crate::error::{Error, Result};
@@ -192,22 +194,35 @@ pub fn solve(model: &Model, options: &Options) -> Result<(State, Report)> {
 /// # Errors
 /// As [`solve`].
 pub fn solve_from(model: &Model, start: State, options: &Options) -> Result<(State, Report)> {
+    let started = std::time::Instant::now();
     let locks = lock_values(model);
     let mut branches = start.branches;
     let q = assemble::assemble(model, start.q, &mut branches, &locks, options)?;
     let q = State { q, branches };
-    match options.load_steps {
+    let assembly = started.elapsed().as_secs_f64();
+    let (state, mut report) = match options.load_steps {
         0 => {
             let direct = solve_assembled(model, q.clone(), &locks, options)?;
             if direct.1.converged() || direct.1.termination == Termination::Unbounded {
-                return Ok(direct);
+                direct
+            } else {
+                let ramped = ramp(model, q, AUTOMATIC_LOAD_STEPS, &locks, options)?;
+                if ramped.1.converged() {
+                    ramped
+                } else {
+                    direct
+                }
             }
-            let ramped = ramp(model, q, AUTOMATIC_LOAD_STEPS, &locks, options)?;
-            Ok(if ramped.1.converged() { ramped } else { direct })
         }
-        1 => solve_assembled(model, q, &locks, options),
-        n => ramp(model, q, n, &locks, options),
-    }
+        1 => solve_assembled(model, q, &locks, options)?,
+        n => ramp(model, q, n, &locks, options)?,
+    };
+    // Everything after the assembly that is not the final stability is iterations (load
+    // stages and a direct attempt before a ramp included).
+    let t = &mut report.diagnostics.timings;
+    t.assembly = assembly;
+    t.iterations = (started.elapsed().as_secs_f64() - assembly - t.stability).max(0.0);
+    Ok((state, report))
 }
 
 /// BFGS / DFP store a dense `dof × dof` inverse-Hessian approximation: refused above this.
@@ -276,6 +291,7 @@ fn solve_assembled(
     let dof = out.part.independent.len();
     let mut diagnostics = out.diagnostics;
     diagnostics.linear_algebra = if sys.sparse { "sparse" } else { "dense" }.into();
+    let stability_started = std::time::Instant::now();
     let stability = (dof > 0).then(|| {
         let eig = out
             .eigen
@@ -285,6 +301,7 @@ fn solve_assembled(
         stability(&sys, &out.q, &out.part, &out.eval, &eig)
     });
     let reactions = reactions::reactions(&sys, &out.q, &out.part, &out.eval);
+    diagnostics.timings.stability = stability_started.elapsed().as_secs_f64();
     let report = Report {
         termination: out.termination,
         iterations: out.history.last().map_or(0, |h| h.iteration),

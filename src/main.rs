@@ -298,8 +298,7 @@ fn analyze(a: &AnalyzeArgs) -> anyhow::Result<u8> {
     }
     if result.converged {
         if let Some(path) = &a.write_urdf {
-            let text = std::fs::read_to_string(&a.file)
-                .with_context(|| format!("{}", a.file.display()))?;
+            let text = restpose::urdf::read_text(&a.file)?;
             let out = restpose::urdf::with_initial_pose(
                 &text,
                 &a.file.display().to_string(),

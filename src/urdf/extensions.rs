@@ -15,19 +15,6 @@ use crate::model::{
 use nalgebra::Vector3;
 use roxmltree::Node;
 
-const KNOWN: [&str; 10] = [
-    "gravity",
-    "link_gravity",
-    "loop_joint",
-    "spring",
-    "joint_spring",
-    "force",
-    "joint_effort",
-    "lock",
-    "initial",
-    "frame",
-];
-
 fn force_law(src: &Source, node: Node, what: &str) -> Result<ForceLaw> {
     let stiffness = src.f64_opt(node, "stiffness")?;
     let preload = src.f64_or(node, "preload", 0.0)?;
@@ -131,15 +118,6 @@ pub(super) fn read(
     b: &mut Builder,
     options: &ImportOptions,
 ) -> Result<()> {
-    for &n in ext {
-        let tag = n.tag_name().name();
-        if !KNOWN.contains(&tag) {
-            return Err(src.error(
-                n,
-                format!("unknown element <mech:{tag}> (known: {})", KNOWN.join(", ")),
-            ));
-        }
-    }
     // URDF mimic.
     for (name, node) in urdf_joints {
         if let Some(m) = child(*node, "mimic") {
@@ -148,22 +126,33 @@ pub(super) fn read(
                 .model
                 .joint_id(name)
                 .ok_or_else(|| src.error(m, "mimic on an unknown joint"))?;
-            let reference = b.model.joint_id(target).ok_or_else(|| {
-                src.error(
+            // urdfdom loads a mimic of a missing joint, and a mimic on or of a joint without a
+            // scalar coordinate: the joint is then independent.
+            let Some(reference) = b.model.joint_id(target) else {
+                let w = src.warning(
                     m,
-                    format!("joint `{name}` mimics an unknown joint `{target}`"),
-                )
-            })?;
-            for (jid, role) in [(id, "mimicking"), (reference, "mimicked")] {
-                if b.model.joints[jid.0].kind.scalar_coordinates() == 0 {
-                    return Err(src.error(
-                        m,
-                        format!(
-                            "{role} joint `{}` has no scalar coordinate",
-                            b.model.joints[jid.0].name
-                        ),
-                    ));
-                }
+                    format!(
+                        "joint `{name}` mimics an unknown joint `{target}`; <mimic> ignored (the joint is independent)"
+                    ),
+                );
+                b.warnings.push(w);
+                continue;
+            };
+            if let Some((jid, role)) = [(id, "mimicking"), (reference, "mimicked")]
+                .into_iter()
+                .find(|(jid, _)| b.model.joints[jid.0].kind.scalar_coordinates() == 0)
+            {
+                let j = &b.model.joints[jid.0];
+                let w = src.warning(
+                    m,
+                    format!(
+                        "{role} joint `{}` ({}) has no scalar coordinate; <mimic> ignored",
+                        j.name,
+                        j.kind.name()
+                    ),
+                );
+                b.warnings.push(w);
+                continue;
             }
             b.model.mimics.push(Mimic {
                 joint: id,
@@ -211,9 +200,7 @@ pub(super) fn read(
                         format!("<mech:link_gravity> refers to an unknown link `{name}`"),
                     )
                 })?;
-                if n.attribute("enabled")
-                    .is_some_and(|v| v == "false" || v == "0")
-                {
+                if !src.bool_opt(n, "enabled")?.unwrap_or(true) {
                     b.no_gravity.push(i);
                 }
             }

@@ -10,9 +10,9 @@
 
 use super::edges::{self, Edge, Frames, Source_, DRAKE_NS};
 use super::extensions;
-use super::xml::{child, is_mech, Source};
+use super::xml::{child, is_mech, parse_f64, Source};
 use super::{ImportOptions, Loaded};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::geometry::{Geometry, PackagePaths, ShapeKind};
 use crate::math::align_z;
 use crate::model::{Body, BodyId, Joint, JointKind, Link, Model};
@@ -96,67 +96,6 @@ pub(super) fn joint_axes(
     }
 }
 
-/// The xacro hint.
-const XACRO: &str =
-    "xacro macros are not expanded URDF: run `xacro FILE.urdf.xacro > FILE.urdf` first";
-
-/// Declares an undeclared `mech:` or `drake:` prefix (with a warning) and refuses xacro, by
-/// parsing: a prefix only counts where the XML parser meets it, not in comments.
-pub(super) fn repair_prefixes(
-    text: &str,
-    file: &str,
-    warnings: &mut Vec<String>,
-) -> Result<String> {
-    let mut out = text.to_string();
-    let popts = roxmltree::ParsingOptions {
-        allow_dtd: true,
-        ..Default::default()
-    };
-    for _ in 0..3 {
-        let (prefix, pos) = match roxmltree::Document::parse_with_options(&out, popts) {
-            Err(roxmltree::Error::UnknownNamespace(prefix, pos)) => (prefix, pos),
-            Err(_) => return Ok(out),
-            Ok(doc) => {
-                for n in doc.descendants().filter(|n| n.is_element()) {
-                    let xacro = n
-                        .tag_name()
-                        .namespace()
-                        .is_some_and(|u| u.contains("xacro"));
-                    if xacro || n.attributes().any(|a| a.value().contains("${")) {
-                        let p = doc.text_pos_at(n.range().start);
-                        return Err(Error::Input {
-                            file: file.to_string(),
-                            line: p.row,
-                            col: p.col,
-                            message: XACRO.into(),
-                        });
-                    }
-                }
-                return Ok(out);
-            }
-        };
-        let uri = match prefix.as_str() {
-            "mech" => super::xml::MECH_NS,
-            "drake" => super::edges::DRAKE_NS,
-            "xacro" => {
-                return Err(Error::Input {
-                    file: file.to_string(),
-                    line: pos.row,
-                    col: pos.col,
-                    message: XACRO.into(),
-                })
-            }
-            _ => return Ok(out),
-        };
-        let Some(at) = out.find("<robot").map(|p| p + "<robot".len()) else {
-            return Ok(out);
-        };
-        out.insert_str(at, &format!(" xmlns:{prefix}=\"{uri}\""));
-        warnings.push(format!("{file}: the `{prefix}:` prefix is used but not declared; assumed xmlns:{prefix}=\"{uri}\""));
-    }
-    Ok(out)
-}
-
 /// The `<geometry>` of a `<visual>` or `<collision>`; `None` (with a warning) for a mesh that
 /// is not found or a shape restpose does not know.
 fn read_geometry(
@@ -211,7 +150,7 @@ fn read_geometry(
         },
         "mesh" => {
             let uri = src.req(s, "filename")?.to_string();
-            let scale = src.vec3_or(s, "scale", Vector3::new(1.0, 1.0, 1.0))?;
+            let scale = mesh_scale(src, s, link, warnings)?;
             let path = match packages.resolve(&uri) {
                 Ok(p) => Some(p),
                 Err(why) => {
@@ -233,6 +172,41 @@ fn read_geometry(
         link_from_shape,
         shape,
     }))
+}
+
+/// A mesh's `scale`: three factors; more are ignored (with a warning, as several exporters
+/// write four), one is a uniform scale (with a warning).
+fn mesh_scale(
+    src: &Source,
+    s: Node,
+    link: &str,
+    warnings: &mut Vec<String>,
+) -> Result<Vector3<f64>> {
+    let Some(text) = s.attribute("scale") else {
+        return Ok(Vector3::new(1.0, 1.0, 1.0));
+    };
+    let v: Option<Vec<f64>> = text.split_whitespace().map(parse_f64).collect();
+    match v.as_deref() {
+        Some([x, y, z]) => Ok(Vector3::new(*x, *y, *z)),
+        Some([x, y, z, ..]) => {
+            warnings.push(src.warning(
+                s,
+                format!("link `{link}`: mesh scale=\"{text}\" has more than 3 components; the first three are used"),
+            ));
+            Ok(Vector3::new(*x, *y, *z))
+        }
+        Some([k]) => {
+            warnings.push(src.warning(
+                s,
+                format!("link `{link}`: mesh scale=\"{text}\" has one component; read as a uniform scale"),
+            ));
+            Ok(Vector3::new(*k, *k, *k))
+        }
+        _ => Err(src.error(
+            s,
+            format!("link `{link}`: mesh attribute `scale` = \"{text}\" must be 3 finite numbers"),
+        )),
+    }
 }
 
 fn read_link(
@@ -338,7 +312,7 @@ pub(super) fn import(
         urdf_dir,
     };
     let mut warnings = Vec::new();
-    let text = repair_prefixes(text, file, &mut warnings)?;
+    let text = super::text::repair(text, file, &mut warnings)?;
     let doc = super::xml::parse_document(&text, file)?;
     let src = Source::new(file, &doc);
     let robot = doc.root_element();
@@ -351,6 +325,7 @@ pub(super) fn import(
             ),
         ));
     }
+    super::schema::check(&src, robot, &mut warnings)?;
     let mut link_nodes = Vec::new();
     let mut joint_nodes = Vec::new();
     let mut loop_nodes = Vec::new();

@@ -89,6 +89,11 @@ impl State {
         s
     }
 
+    /// The initial guess: forward kinematics with the model's initial values.
+    pub fn initial(model: &Model) -> State {
+        State::from_joint_values(model, &initial_values(model))
+    }
+
     /// Coordinates of every joint, as reported in the result: scalar coordinates for
     /// revolute-like joints, the relative rotation `[w, x, y, z]` of a spherical joint,
     /// `[x, y, z, w, qx, qy, qz]` of a floating joint, `[]` otherwise.
@@ -130,6 +135,24 @@ impl State {
             })
             .collect()
     }
+}
+
+/// The model's initial values by joint (`mech:initial`; missing coordinates 0).
+pub(crate) fn initial_values(model: &Model) -> JointValues {
+    let mut values = JointValues::new();
+    for i in &model.initial {
+        let Some(j) = model.joints.get(i.joint.0) else {
+            continue;
+        };
+        let v = values
+            .entry(j.name.clone())
+            .or_insert_with(|| vec![0.0; j.kind.scalar_coordinates()]);
+        if v.len() <= i.dof {
+            v.resize(i.dof + 1, 0.0);
+        }
+        v[i.dof] = i.value;
+    }
+    values
 }
 
 /// Relative motion of a joint of this kind in its joint frame for coordinates `v` (the

@@ -37,23 +37,12 @@ use system::System;
 /// Initial guess: forward kinematics with every joint at its `mech:initial` / `--initial`
 /// value (0 otherwise). Loop joints are not yet closed.
 pub fn initial_state(model: &Model) -> State {
-    State::from_joint_values(model, &initial_values(model))
+    State::initial(model)
 }
 
 /// The model's initial values by joint (missing coordinates 0).
 pub(crate) fn initial_values(model: &Model) -> JointValues {
-    let mut values = JointValues::new();
-    for i in &model.initial {
-        let j = &model.joints[i.joint.0];
-        let v = values
-            .entry(j.name.clone())
-            .or_insert_with(|| vec![0.0; j.kind.scalar_coordinates()]);
-        if v.len() <= i.dof {
-            v.resize(i.dof + 1, 0.0);
-        }
-        v[i.dof] = i.value;
-    }
-    values
+    crate::state::initial_values(model)
 }
 
 /// Locks resolved to values: the given value, else the initial value, else 0.

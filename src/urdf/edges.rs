@@ -50,7 +50,7 @@ pub(super) struct Edge<'a> {
 /// Link names and named frames: name → (link index or world, link_from_frame).
 pub(super) struct Frames<'a> {
     pub(super) links: &'a HashMap<String, usize>,
-    pub(super) frames: HashMap<String, (Option<usize>, Isometry3<f64>)>,
+    pub(super) frames: FrameMap,
 }
 
 impl Frames<'_> {
@@ -61,23 +61,37 @@ impl Frames<'_> {
         node: Node,
         name: &str,
     ) -> Result<(Option<usize>, Isometry3<f64>)> {
-        if let Some(&i) = self.links.get(name) {
-            return Ok((Some(i), Isometry3::identity()));
-        }
-        if let Some(f) = self.frames.get(name) {
-            return Ok(*f);
-        }
-        if name == "world" {
-            return Ok((None, Isometry3::identity()));
-        }
-        Err(src.error(
-            node,
-            format!(
-                "{} refers to an unknown link or frame `{name}`",
-                src.describe(node)
-            ),
-        ))
+        resolve(self.links, &self.frames, src, node, name)
     }
+}
+
+/// Named frames: name → (link index or world, link_from_frame).
+pub(super) type FrameMap = HashMap<String, (Option<usize>, Isometry3<f64>)>;
+
+/// Resolves a link or frame name at `node`: a link, a `mech:frame`, or the world.
+pub(super) fn resolve(
+    links: &HashMap<String, usize>,
+    frames: &FrameMap,
+    src: &Source,
+    node: Node,
+    name: &str,
+) -> Result<(Option<usize>, Isometry3<f64>)> {
+    if let Some(&i) = links.get(name) {
+        return Ok((Some(i), Isometry3::identity()));
+    }
+    if let Some(f) = frames.get(name) {
+        return Ok(*f);
+    }
+    if name == "world" {
+        return Ok((None, Isometry3::identity()));
+    }
+    Err(src.error(
+        node,
+        format!(
+            "{} refers to an unknown link or frame `{name}`",
+            src.describe(node)
+        ),
+    ))
 }
 
 /// Position limits from `<limit lower upper>` (a missing bound is 0, as in urdfdom);

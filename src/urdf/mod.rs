@@ -10,8 +10,10 @@ mod edges;
 mod extensions;
 mod foreign;
 mod import;
+mod links;
 mod schema;
 mod text;
+mod tree;
 mod write_back;
 mod xml;
 

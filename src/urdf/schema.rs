@@ -288,7 +288,7 @@ pub(super) fn check(src: &Source, robot: Node, warnings: &mut Vec<String>) -> Re
                 spec.attributes,
                 spec.children,
             )?;
-        } else if !parent.is_some_and(|p| p.tag_name().namespace() == Some(MECH_NS)) {
+        } else if parent.is_none_or(|p| p.tag_name().namespace() != Some(MECH_NS)) {
             return Err(src.error(
                 n,
                 format!("<mech:{name}> must be a direct child of <robot>"),

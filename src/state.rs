@@ -119,6 +119,12 @@ impl State {
             .collect()
     }
 
+    /// The initial guess: forward kinematics with the model's initial values (loop joints
+    /// not yet closed).
+    pub fn initial(model: &Model) -> State {
+        State::from_joint_values(model, &initial_values(model))
+    }
+
     /// Coordinates of the joint `name` as in [`State::joint_values`] (angles unwrapped on the
     /// state's branches), or `None` if the model has no such joint.
     ///
@@ -161,4 +167,33 @@ impl State {
             }
         }
     }
+}
+
+/// The model's initial values by joint: `mech:initial`, then the values of locks (a joint
+/// locked at a value starts there, on that angle branch); missing coordinates 0.
+pub(crate) fn initial_values(model: &Model) -> JointValues {
+    let mut values = JointValues::new();
+    let given = model
+        .initial
+        .iter()
+        .map(|i| (i.joint, i.dof, i.value))
+        .chain(
+            model
+                .locks
+                .iter()
+                .filter_map(|l| l.value.map(|v| (l.joint, l.dof, v))),
+        );
+    for (joint, dof, value) in given {
+        let Some(j) = model.joints.get(joint.0) else {
+            continue;
+        };
+        let v = values
+            .entry(j.name.clone())
+            .or_insert_with(|| vec![0.0; j.kind.scalar_coordinates()]);
+        if v.len() <= dof {
+            v.resize(dof + 1, 0.0);
+        }
+        v[dof] = value;
+    }
+    values
 }

@@ -2,7 +2,6 @@
 
 use super::args::{coord, AnalyzeArgs};
 use super::{exit, print};
-use anyhow::Context;
 use restpose::export::json::AnalysisResult;
 use restpose::urdf::load_file;
 
@@ -43,8 +42,7 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
     }
     if result.converged {
         if let Some(path) = &a.write_urdf {
-            let text = std::fs::read_to_string(&a.file)
-                .with_context(|| format!("{}", a.file.display()))?;
+            let text = restpose::urdf::read_text(&a.file)?;
             let out = restpose::urdf::with_initial_pose(
                 &text,
                 &a.file.display().to_string(),

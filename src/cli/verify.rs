@@ -27,7 +27,7 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
         }
         v[dof] = value;
     }
-    if values.is_empty() {
+    if values.is_empty() && a.pose.is_none() {
         bail!("give the pose with --pose FILE or --joint NAME=VALUE");
     }
     let (state, missing) = restpose::verify::pose_state(model, &values)?;

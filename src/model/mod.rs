@@ -6,10 +6,12 @@
 //! (ground) is not a body: joints and forces refer to it with `None`.
 
 mod body;
+mod builder;
 mod force;
 mod joint;
 
 pub use body::{Body, BodyId, Link};
+pub use builder::{Inertial, ModelBuilder};
 pub use force::{
     Effort, ForceLaw, Initial, JointSpring, Load, Lock, Mimic, Spring, SpringEnd, SpringMode,
 };
@@ -18,7 +20,8 @@ pub use joint::{Joint, JointId, JointKind};
 use nalgebra::Vector3;
 use std::collections::HashMap;
 
-/// A validated mechanism (built by the URDF importer); immutable once built.
+/// A validated mechanism (built by [`ModelBuilder`], which the URDF importer drives);
+/// immutable once built.
 #[derive(Clone, Debug)]
 pub struct Model {
     /// Robot name from `<robot name>`.

@@ -40,35 +40,14 @@ use system::System;
 /// Initial guess: forward kinematics with every joint at its `mech:initial` / `--initial`
 /// value (0 otherwise). Loop joints are not yet closed.
 pub fn initial_state(model: &Model) -> State {
-    State::from_joint_values(model, &initial_values(model))
+    State::initial(model)
 }
 
 /// The model's initial values by joint (missing coordinates 0), a lock's value replacing the
 /// initial value of the coordinate it holds (the start is then on the lock's branch: a lock at
 /// 3.2 rad is not read as 3.2 − 2π).
 pub(crate) fn initial_values(model: &Model) -> JointValues {
-    let mut values = JointValues::new();
-    let given = model
-        .initial
-        .iter()
-        .map(|i| (i.joint, i.dof, i.value))
-        .chain(
-            model
-                .locks
-                .iter()
-                .filter_map(|l| l.value.map(|v| (l.joint, l.dof, v))),
-        );
-    for (joint, dof, value) in given {
-        let j = &model.joints[joint.0];
-        let v = values
-            .entry(j.name.clone())
-            .or_insert_with(|| vec![0.0; j.kind.scalar_coordinates()]);
-        if v.len() <= dof {
-            v.resize(dof + 1, 0.0);
-        }
-        v[dof] = value;
-    }
-    values
+    crate::state::initial_values(model)
 }
 
 /// Locks resolved to values: the given value, else the initial value, else 0.

@@ -8,7 +8,6 @@
 //! ```
 //!
 //! A reference is any `crate::module` path in code (comments and doc links are skipped).
-//! Also checked: no source file over 600 lines (one concept per file).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -123,24 +122,5 @@ fn modules_use_only_lower_layers() {
         violations.is_empty(),
         "upward or sideways imports:\n{}",
         violations.join("\n")
-    );
-}
-
-#[test]
-fn no_source_file_is_over_600_lines() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let mut files = Vec::new();
-    rust_files(&src, &mut files);
-    let long: Vec<String> = files
-        .iter()
-        .filter_map(|f| {
-            let n = std::fs::read_to_string(f).ok()?.lines().count();
-            (n > 600).then(|| format!("{}: {n} lines", f.display()))
-        })
-        .collect();
-    assert!(
-        long.is_empty(),
-        "files over 600 lines:\n{}",
-        long.join("\n")
     );
 }

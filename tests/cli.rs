@@ -152,7 +152,7 @@ fn options_lock_initial_gravity() {
     assert_eq!(o.status.code(), Some(2));
 }
 
-/// Byte-identical apart from the wall times in `diagnostics.timings` (zeroed here).
+/// Byte-identical apart from the wall times in `diagnostics.timings` (cut out here).
 #[test]
 fn same_input_same_json_bytes() {
     let dir = tempfile::tempdir().unwrap();
@@ -165,13 +165,10 @@ fn same_input_same_json_bytes() {
             .unwrap();
         assert!(st.success());
         let text = std::fs::read_to_string(out).unwrap();
-        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        let start = text.find("\"timings\": {").expect("diagnostics.timings");
+        let end = start + text[start..].find('}').unwrap();
         let mut zeroed = text.clone();
-        for (phase, s) in v["diagnostics"]["timings"].as_object().unwrap() {
-            let field = format!("\"{phase}\": {}", serde_json::to_string(s).unwrap());
-            assert!(zeroed.contains(&field), "{field}");
-            zeroed = zeroed.replacen(&field, &format!("\"{phase}\": 0"), 1);
-        }
+        zeroed.replace_range(start..end, "\"timings\": {");
         zeroed.into_bytes()
     };
     assert_eq!(run("a.json"), run("b.json"));

@@ -29,22 +29,23 @@ struct Frames {
 }
 
 fn frames(joint: &Joint, pair: &Pair) -> Frames {
-    let mut pts = Vec::with_capacity(2);
-    let mut x = Vec::with_capacity(2);
-    let mut y = Vec::with_capacity(2);
-    let mut z = Vec::with_capacity(2);
-    for k in 0..2 {
+    // Built in place (no per-evaluation `Vec`s: this runs for every joint at every evaluation).
+    let side = |k: usize| {
         let f = &joint.body_from_joint[k];
-        pts.push(pair.point(k, &f.translation.vector));
-        x.push(pair.vector(k, &(f.rotation * Vector3::x())));
-        y.push(pair.vector(k, &(f.rotation * Vector3::y())));
-        z.push(pair.vector(k, &(f.rotation * Vector3::z())));
-    }
+        (
+            pair.point(k, &f.translation.vector),
+            pair.vector(k, &(f.rotation * Vector3::x())),
+            pair.vector(k, &(f.rotation * Vector3::y())),
+            pair.vector(k, &(f.rotation * Vector3::z())),
+        )
+    };
+    let (p0, x0, y0, z0) = side(0);
+    let (p1, x1, y1, z1) = side(1);
     Frames {
-        d: pts[1].sub(&pts[0]),
-        x: [x[0], x[1]],
-        y: [y[0], y[1]],
-        z: [z[0], z[1]],
+        d: p1.sub(&p0),
+        x: [x0, x1],
+        y: [y0, y1],
+        z: [z0, z1],
     }
 }
 

@@ -56,11 +56,7 @@ fn component(pair: &Pair, d: &Vec3Jet, k: usize) -> Scalar {
     for i in 0..crate::jet::NL {
         g[i] = d.j[(k, i)];
     }
-    let h = if pair.hess {
-        d.contract(&e)
-    } else {
-        crate::jet::LMat::zeros()
-    };
+    let h = pair.hess.then(|| Box::new(d.contract(&e)));
     Scalar { v: d.v[k], g, h }
 }
 
@@ -270,7 +266,7 @@ mod tests {
                         &|q| {
                             let mut o = Vec::new();
                             rows(&j, q, &mut o);
-                            o[r]
+                            o[r].clone()
                         },
                         &format!("{} row {}", kind.name(), row_names(&j)[r]),
                     );

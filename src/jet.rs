@@ -39,12 +39,22 @@ pub(crate) struct Vec3Jet {
     s: [Vector3<f64>; 2],
 }
 
-/// A scalar with gradient and Hessian over the local coordinates.
-#[derive(Clone, Copy, Debug)]
+/// A Hessian over a body pair when asked for (`Pair::hess`), else `None`: a jet without one
+/// is 15 numbers instead of 211, and Jacobian-only evaluations (every corrector step) neither
+/// zero nor copy 14 × 14 blocks.
+pub(crate) type Hess = Option<Box<LMat>>;
+
+/// The Hessian `h`, zero if absent.
+pub(crate) fn hess_or_zero(h: &Hess) -> LMat {
+    h.as_deref().copied().unwrap_or_else(LMat::zeros)
+}
+
+/// A scalar with gradient and (when asked) Hessian over the local coordinates.
+#[derive(Clone, Debug)]
 pub(crate) struct Scalar {
     pub(crate) v: f64,
     pub(crate) g: LVec,
-    pub(crate) h: LMat,
+    pub(crate) h: Hess,
 }
 
 impl Pair {
@@ -82,12 +92,10 @@ impl Pair {
     pub(crate) fn dot(&self, a: &Vec3Jet, b: &Vec3Jet) -> Scalar {
         let v = a.v.dot(&b.v);
         let g = a.j.transpose() * b.v + b.j.transpose() * a.v;
-        let h = if self.hess {
+        let h = self.hess.then(|| {
             let cross = a.j.transpose() * b.j;
-            cross + cross.transpose() + a.contract(&b.v) + b.contract(&a.v)
-        } else {
-            LMat::zeros()
-        };
+            Box::new(cross + cross.transpose() + a.contract(&b.v) + b.contract(&a.v))
+        });
         Scalar { v, g, h }
     }
 
@@ -95,14 +103,13 @@ impl Pair {
     pub(crate) fn atan2(&self, s: &Scalar, c: &Scalar) -> Scalar {
         let rho = s.v * s.v + c.v * c.v;
         let n = s.g * (c.v / rho) - c.g * (s.v / rho);
-        let h = if self.hess {
-            let a = s.g * c.g.transpose() - c.g * s.g.transpose() + s.h * c.v - c.h * s.v;
+        let h = self.hess.then(|| {
+            let a = s.g * c.g.transpose() - c.g * s.g.transpose() + hess_or_zero(&s.h) * c.v
+                - hess_or_zero(&c.h) * s.v;
             let drho = s.g * (2.0 * s.v) + c.g * (2.0 * c.v);
             let m = a / rho - n * drho.transpose() / rho;
-            (m + m.transpose()) * 0.5
-        } else {
-            LMat::zeros()
-        };
+            Box::new((m + m.transpose()) * 0.5)
+        });
         Scalar {
             v: s.v.atan2(c.v),
             g: n,
@@ -151,7 +158,9 @@ impl Scalar {
     pub(crate) fn scale(mut self, c: f64) -> Scalar {
         self.v *= c;
         self.g *= c;
-        self.h *= c;
+        if let Some(h) = self.h.as_deref_mut() {
+            *h *= c;
+        }
         self
     }
 
@@ -159,7 +168,11 @@ impl Scalar {
     pub(crate) fn add(mut self, b: &Scalar) -> Scalar {
         self.v += b.v;
         self.g += b.g;
-        self.h += b.h;
+        match (self.h.as_deref_mut(), b.h.as_deref()) {
+            (Some(a), Some(b)) => *a += b,
+            (None, Some(b)) => self.h = Some(Box::new(*b)),
+            (_, None) => {}
+        }
         self
     }
 
@@ -168,7 +181,10 @@ impl Scalar {
         Scalar {
             v: u,
             g: self.g * du,
-            h: self.g * self.g.transpose() * ddu + self.h * du,
+            h: self
+                .h
+                .as_deref()
+                .map(|h| Box::new(self.g * self.g.transpose() * ddu + h * du)),
         }
     }
 }
@@ -224,12 +240,13 @@ pub(crate) mod testing {
                 s.g[i]
             );
             let fdh = (fp.g - fm.g) / (2.0 * h);
+            let sh = hess_or_zero(&s.h);
             for j in 0..NL {
-                let scale = 1.0 + s.h[(j, i)].abs();
+                let scale = 1.0 + sh[(j, i)].abs();
                 assert!(
-                    (fdh[j] - s.h[(j, i)]).abs() < 1e-5 * scale,
+                    (fdh[j] - sh[(j, i)]).abs() < 1e-5 * scale,
                     "{what}: hessian[{j},{i}] analytic {} vs central difference {}",
-                    s.h[(j, i)],
+                    sh[(j, i)],
                     fdh[j]
                 );
             }
@@ -357,6 +374,6 @@ pub(crate) fn scatter<'h>(
         }
     }
     if let Some(h) = h {
-        h.add_block(bodies, &f.h, c);
+        h.add_block(bodies, &hess_or_zero(&f.h), c);
     }
 }

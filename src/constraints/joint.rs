@@ -27,11 +27,7 @@ fn component(pair: &Pair, d: &Vec3Jet, k: usize) -> Scalar {
     for i in 0..crate::jet::NL {
         g[i] = d.j[(k, i)];
     }
-    let h = if pair.hess {
-        d.contract(&e)
-    } else {
-        crate::jet::LMat::zeros()
-    };
+    let h = pair.hess.then(|| Box::new(d.contract(&e)));
     Scalar { v: d.v[k], g, h }
 }
 
@@ -216,7 +212,7 @@ mod tests {
                         &|q| {
                             let mut o = Vec::new();
                             rows(&j, q, 0.0, &mut o);
-                            o[r]
+                            o[r].clone()
                         },
                         &format!("{} row {}", kind.name(), row_names(&j)[r]),
                     );

@@ -262,8 +262,8 @@ impl Constraints {
                         flush(&mut pending, h);
                         pending = Some((*bodies, LMat::zeros()));
                     }
-                    if let Some((_, acc)) = pending.as_mut() {
-                        *acc += s.h * (c * w[row]);
+                    if let (Some((_, acc)), Some(sh)) = (pending.as_mut(), s.h.as_deref()) {
+                        *acc += sh * (c * w[row]);
                     }
                 }
             }

@@ -34,11 +34,7 @@ pub struct Energy {
 
 /// `wᵀ f` for a constant `w`.
 fn weighted(pair: &Pair, f: &Vec3Jet, w: &Vector3<f64>) -> Scalar {
-    let h = if pair.hess {
-        f.contract(w)
-    } else {
-        crate::jet::LMat::zeros()
-    };
+    let h = pair.hess.then(|| Box::new(f.contract(w)));
     Scalar {
         v: w.dot(&f.v),
         g: f.j.transpose() * w,

@@ -152,7 +152,7 @@ fn options_lock_initial_gravity() {
     assert_eq!(o.status.code(), Some(2));
 }
 
-/// Byte-identical apart from the wall times in `diagnostics.timings` (zeroed here).
+/// Byte-identical apart from the wall times in `diagnostics.timings` (cut out here).
 #[test]
 fn same_input_same_json_bytes() {
     let dir = tempfile::tempdir().unwrap();

@@ -1,6 +1,6 @@
 //! Stability, reactions, locks, units and unbounded energy.
-use approx::assert_abs_diff_eq;
 use crate::common::*;
+use approx::assert_abs_diff_eq;
 use restpose::urdf::{load_str, ImportOptions};
 use restpose::Options;
 

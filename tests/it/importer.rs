@@ -1,6 +1,6 @@
 //! Foreign extensions, frames, automatic child origins and the joint graph.
-use approx::assert_abs_diff_eq;
 use crate::common::*;
+use approx::assert_abs_diff_eq;
 use restpose::urdf::{load_str, ImportOptions};
 
 fn robot_text(name: &str) -> String {

@@ -2,10 +2,10 @@
 //! one module per topic. `regressions/` holds one file per fixed bug, named
 //! `issue_<n>_<what>.rs`, each opening with a paragraph on the bug.
 
-mod common;
 mod angles;
 mod architecture;
 mod cli;
+mod common;
 mod engineering;
 mod importer;
 mod importer_fuzz;
@@ -14,10 +14,10 @@ mod meshes;
 mod paper_pendulum;
 mod properties;
 mod real_robots;
+mod regressions;
 mod robots;
 mod sparse;
 mod verify;
 #[cfg(feature = "viewer")]
 mod viewer;
 mod write_back;
-mod regressions;

@@ -1,6 +1,6 @@
 //! The pendulum with spring of the paper (NOTES.md): closed-form reference values.
-use approx::assert_abs_diff_eq;
 use crate::common::*;
+use approx::assert_abs_diff_eq;
 use restpose::{Method, Options};
 
 #[test]

@@ -1,6 +1,6 @@
 //! Every robot in `robots/` converges to a verified stable equilibrium.
-use approx::assert_abs_diff_eq;
 use crate::common::*;
+use approx::assert_abs_diff_eq;
 use nalgebra::Point3;
 
 #[test]

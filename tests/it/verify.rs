@@ -1,6 +1,6 @@
 //! `restpose verify` and the verification API.
-use approx::assert_abs_diff_eq;
 use crate::common::*;
+use approx::assert_abs_diff_eq;
 use restpose::verify::{parse_pose, pose_state, verify, Tolerances};
 use std::process::Command;
 

@@ -1,6 +1,5 @@
 //! Shared helpers of the integration tests.
 
-
 pub(crate) mod energies;
 
 use restpose::state::State;

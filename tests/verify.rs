@@ -54,7 +54,7 @@ fn solver_answers_pass_in_every_pose_format() {
             "{name}: map format"
         );
         // joint_states YAML carries one position per joint: only for scalar-joint models.
-        if result.joints.values().any(|j| j.position.len() > 1) {
+        if result.joints.iter().any(|(_, j)| j.position.len() > 1) {
             continue;
         }
         let mut names = Vec::new();

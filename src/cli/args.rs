@@ -105,7 +105,8 @@ pub(crate) struct VerifyArgs {
     /// URDF file.
     pub(crate) file: PathBuf,
     /// Pose: restpose result JSON, a {"joint": value} JSON map, or ROS joint_states-style
-    /// YAML/JSON (`name` and `position` lists).
+    /// YAML/JSON (`name` and `position` lists, restpose's `multi_dof` section, `rostopic echo`
+    /// output: the last message).
     #[arg(long, value_name = "POSE")]
     pub(crate) pose: Option<PathBuf>,
     /// Joint value (repeatable; overrides the pose file): JOINT=VALUE or JOINT[DOF]=VALUE.
@@ -132,21 +133,10 @@ pub(crate) struct VerifyArgs {
 pub(crate) struct GenerateArgs {
     /// Family.
     #[arg(value_enum)]
-    pub(crate) family: Family,
+    pub(crate) family: restpose::generate::Family,
     /// Number of links (chains) or loops (ladder), 1 to 1,000,000.
     #[arg(long, default_value_t = 20, value_parser = parse::generate_size)]
     pub(crate) size: usize,
-}
-
-/// Generated mechanism families.
-#[derive(Clone, Copy, ValueEnum)]
-pub(crate) enum Family {
-    /// N-link spatial pendulum chain with joint springs (alternating joint axes).
-    Chain,
-    /// N-link planar chain (all axes parallel) with joint springs.
-    PlanarChain,
-    /// Ladder of N closed four-bar loops.
-    Ladder,
 }
 
 #[derive(clap::Args, Clone)]

@@ -59,6 +59,10 @@ pub enum Error {
         /// The model's loop joints, which close the over-constrained loops.
         loops: String,
     },
+    /// A model built in code refers to an id or coordinate it does not have, or has a
+    /// non-finite or negative mass property.
+    #[error("invalid model: {0}")]
+    Model(String),
     /// The potential energy cannot be evaluated at the start.
     #[error("potential energy is undefined at the initial guess ({0})")]
     Undefined(String),

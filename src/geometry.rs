@@ -139,11 +139,27 @@ impl PackagePaths {
 /// A triangle mesh: vertices \[m\] and index triples.
 pub type Triangles = (Vec<[f64; 3]>, Vec<[u32; 3]>);
 
+/// Largest mesh file read \[bytes\] (256 MiB): a binary STL of 5 million triangles. The
+/// reader holds the whole file, so the cap bounds the memory a mesh can take.
+pub const MAX_MESH_BYTES: u64 = 256 << 20;
+
 /// Triangles of a mesh file, scaled.
 ///
 /// # Errors
-/// A message naming the file if it cannot be read or holds no triangles.
+/// A message naming the file if it cannot be read, is larger than [`MAX_MESH_BYTES`] or
+/// holds no triangles.
 pub fn load_mesh(path: &Path, scale: &Vector3<f64>) -> Result<Triangles, String> {
+    let meta = std::fs::metadata(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    if !meta.is_file() {
+        return Err(format!("{}: not a regular file", path.display()));
+    }
+    if meta.len() > MAX_MESH_BYTES {
+        return Err(format!(
+            "{}: the mesh has {} bytes, more than the {MAX_MESH_BYTES} bytes (256 MiB) restpose reads",
+            path.display(),
+            meta.len()
+        ));
+    }
     let scene = mesh_loader::Loader::default()
         .load(path)
         .map_err(|e| format!("{}: {e}", path.display()))?;

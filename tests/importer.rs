@@ -26,8 +26,8 @@ fn foreign_loop_joint_equals_mech_loop_joint() {
     let (s2, r2) = solve(&m2);
     assert_abs_diff_eq!(r1.energy.total, r2.energy.total, epsilon = 1e-12);
     assert_abs_diff_eq!(
-        joint(&m1, &s1, "slide")[0],
-        joint(&m2, &s2, "slide")[0],
+        s1.joint(&m1, "slide").unwrap()[0],
+        s2.joint(&m2, "slide").unwrap()[0],
         epsilon = 1e-12
     );
 }
@@ -51,7 +51,11 @@ fn drake_linear_spring_damper_is_a_spring() {
         l.warnings
     );
     let (s, r) = solve(&l.model);
-    assert_abs_diff_eq!(joint(&l.model, &s, "pivot")[0], -1.381577, epsilon = 1e-6);
+    assert_abs_diff_eq!(
+        s.joint(&l.model, "pivot").unwrap()[0],
+        -1.381577,
+        epsilon = 1e-6
+    );
     assert_abs_diff_eq!(r.energy.total, -18.686957, epsilon = 1e-6);
 }
 
@@ -74,8 +78,8 @@ fn gazebo_spring_stiffness_is_a_joint_spring() {
     for i in 0..4 {
         let n = format!("joint{i}");
         assert_abs_diff_eq!(
-            joint(&m1, &s1, &n)[0],
-            joint(&m2, &s2, &n)[0],
+            s1.joint(&m1, &n).unwrap()[0],
+            s2.joint(&m2, &n).unwrap()[0],
             epsilon = 1e-12
         );
     }
@@ -101,7 +105,7 @@ fn drake_ball_and_screw_joints() {
     assert_verified_minimum(&m, &s);
     // Screw: potential m g h θ/(2π)·… : V = m g (pitch θ) + ½ k θ², pitch = 0.01/(2π) m/rad.
     let pitch = 0.01 / (2.0 * std::f64::consts::PI);
-    let theta = joint(&m, &s, "screw")[0];
+    let theta = s.joint(&m, "screw").unwrap()[0];
     assert_abs_diff_eq!(theta, -0.2 * 9.81 * pitch / 0.05, epsilon = 1e-9);
     let nut = s.link_pose(&m, "nut").unwrap().translation.vector;
     assert_abs_diff_eq!(nut.z, pitch * theta, epsilon = 1e-12);
@@ -115,7 +119,7 @@ fn drake_ball_and_screw_joints() {
         "moment about the ball: {}",
         r_arm.cross(&f).norm()
     );
-    assert_eq!(joint(&m, &s, "ball").len(), 4);
+    assert_eq!(s.joint(&m, "ball").unwrap().len(), 4);
 }
 
 /// A `drake:ball_constraint` closing a loop, a `mech:frame` as a spring end, and
@@ -176,7 +180,7 @@ fn loop_element_becomes_a_tree_edge_when_needed() {
     let m = model_from(text);
     assert!(m.joint(m.joint_id("hinge").unwrap()).tree);
     let (s, _) = solve(&m);
-    let th = joint(&m, &s, "hinge")[0];
+    let th = s.joint(&m, "hinge").unwrap()[0];
     // 5 (θ − 0.5) = −m g sin θ · 1 m (a rotation about +y moves the bob towards +x, up).
     assert_abs_diff_eq!(5.0 * (th - 0.5), -9.81 * th.sin(), epsilon = 1e-9);
 }
@@ -210,7 +214,7 @@ fn massless_fixed_chains_and_inertia_warning() {
     );
     let (s, r) = solve(&l.model);
     assert_eq!(r.dof, 1);
-    let th = joint(&l.model, &s, "j")[0];
+    let th = s.joint(&l.model, "j").unwrap()[0];
     let tip = s.link_pose(&l.model, "f9").unwrap().translation.vector;
     assert_abs_diff_eq!(tip.x, 1.0 * th.cos(), epsilon = 1e-12);
     assert_abs_diff_eq!(tip.z, -th.sin(), epsilon = 1e-12);
@@ -245,7 +249,7 @@ fn link_gravity_distance_and_point_on_line() {
     assert_abs_diff_eq!((pa - pb).norm(), 0.5, epsilon = 1e-10);
     // Only a's 1 kg feels gravity: the rod is parallel to y, carrying no moment about y, and
     // 30 θ = 9.81 cos θ.
-    let th = joint(&m, &s, "ja")[0];
+    let th = s.joint(&m, "ja").unwrap()[0];
     assert_abs_diff_eq!(30.0 * th, 9.81 * th.cos(), epsilon = 1e-8);
 
     let pol = text.replace(
@@ -259,4 +263,236 @@ fn link_gravity_distance_and_point_on_line() {
     let pb = s.link_pose(&m, "b").unwrap() * nalgebra::Point3::new(1.0, 0.0, 0.0);
     assert_abs_diff_eq!((pa - pb).x, 0.0, epsilon = 1e-10);
     assert_abs_diff_eq!((pa - pb).z, 0.0, epsilon = 1e-10);
+}
+
+/// A pendulum about y (mass 1 kg at x = 0.5 m, torsion spring 10 N m/rad) hung from `mount`,
+/// which a fixed joint written by `fixed` welds to the world; `extra` goes before `</robot>`.
+fn pendulum(fixed: &str, extra: &str) -> String {
+    format!(
+        r#"<robot name="p">
+<link name="world"/>
+<link name="mount"/>
+<link name="arm"><inertial><origin xyz="0.5 0 0"/><mass value="1"/><inertia ixx="1e-3" ixy="0" ixz="0" iyy="1e-3" iyz="0" izz="1e-3"/></inertial></link>
+{fixed}
+<joint name="hinge" type="revolute"><parent link="mount"/><child link="arm"/><axis xyz="0 1 0"/></joint>
+<gazebo reference="hinge"><springStiffness>10</springStiffness></gazebo>
+{extra}
+</robot>"#
+    )
+}
+
+const FIXED: &str =
+    r#"<joint name="weld" type="fixed"><parent link="world"/><child link="mount"/></joint>"#;
+
+/// The closed form of [`pendulum`]: V = k θ²/2 − m g L sin θ, so k θ = m g L cos θ.
+fn pendulum_angle() -> f64 {
+    let (k, mgl) = (10.0, 9.81 * 0.5);
+    let mut t: f64 = 0.0;
+    for _ in 0..50 {
+        t -= (k * t - mgl * t.cos()) / (k + mgl * t.sin());
+    }
+    t
+}
+
+/// urdfdom does not read the axis of fixed, floating (and restpose's spherical) joints: CAD
+/// exporters write `0 0 0` there. It is ignored with a located warning, and the rest pose is
+/// the closed form; a zero axis on a revolute joint stays an error.
+#[test]
+fn zero_axis_on_fixed_joint_is_ignored() {
+    let fixed = FIXED.replace("</joint>", "<axis xyz=\"0 0 0\"/></joint>");
+    let l = load_str(&pendulum(&fixed, ""), "t.urdf", &ImportOptions::default()).unwrap();
+    assert!(
+        l.warnings
+            .iter()
+            .any(|w| w.starts_with("t.urdf:5:") && w.contains("axis") && w.contains("ignored")),
+        "{:?}",
+        l.warnings
+    );
+    assert_eq!(l.model.bodies.len(), 1, "mount is welded to the world");
+    let (s, _) = solve(&l.model);
+    assert_abs_diff_eq!(
+        s.joint(&l.model, "hinge").unwrap()[0],
+        pendulum_angle(),
+        epsilon = 1e-8
+    );
+    // A nonzero axis on a fixed joint is just as meaningless, but harmless: no warning.
+    let fixed = FIXED.replace("</joint>", "<axis xyz=\"1 0 0\"/></joint>");
+    let l = load_str(&pendulum(&fixed, ""), "t.urdf", &ImportOptions::default()).unwrap();
+    assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+    let bad = pendulum(FIXED, "").replace("<axis xyz=\"0 1 0\"/>", "<axis xyz=\"0 0 0\"/>");
+    let e = load_str(&bad, "t.urdf", &ImportOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("zero-length axis"), "{e}");
+}
+
+/// `<mimic>` in a fixed joint (Talos grippers) is ignored with a warning.
+#[test]
+fn mimic_in_fixed_joint_is_ignored() {
+    let fixed = FIXED.replace(
+        "</joint>",
+        "<mimic joint=\"hinge\" multiplier=\"2\"/></joint>",
+    );
+    let l = load_str(&pendulum(&fixed, ""), "t.urdf", &ImportOptions::default()).unwrap();
+    assert!(l.model.mimics.is_empty());
+    assert!(
+        l.warnings.iter().any(|w| w.starts_with("t.urdf:5:")
+            && w.contains("`weld` (fixed) has no scalar coordinate; <mimic> ignored")),
+        "{:?}",
+        l.warnings
+    );
+}
+
+/// `<mimic joint="X">` naming a joint that does not exist (Psyonic hands): the joint is
+/// independent, with a warning naming file and line; it solves as the plain pendulum.
+#[test]
+fn mimic_of_missing_joint_leaves_the_joint_independent() {
+    let text = pendulum(FIXED, "").replace(
+        "<axis xyz=\"0 1 0\"/></joint>",
+        "<axis xyz=\"0 1 0\"/>\n<mimic joint=\"ghost\"/></joint>",
+    );
+    let l = load_str(&text, "t.urdf", &ImportOptions::default()).unwrap();
+    assert!(l.model.mimics.is_empty());
+    assert!(
+        l.warnings
+            .iter()
+            .any(|w| w.starts_with("t.urdf:7:") && w.contains("mimics an unknown joint `ghost`")),
+        "{:?}",
+        l.warnings
+    );
+    let (s, _) = solve(&l.model);
+    assert_abs_diff_eq!(
+        s.joint(&l.model, "hinge").unwrap()[0],
+        pendulum_angle(),
+        epsilon = 1e-8
+    );
+}
+
+/// An XML declaration after leading whitespace or a comment (TinyXML2 accepts it) is read;
+/// line numbers in later messages are still those of the file.
+#[test]
+fn late_xml_declaration_is_accepted() {
+    let text = format!(
+        "\n  <!-- exported -->\n<?xml version=\"1.0\" encoding=\"utf-8\"?>\n{}",
+        pendulum(FIXED, "")
+    );
+    let l = load_str(&text, "t.urdf", &ImportOptions::default()).unwrap();
+    assert!(
+        l.warnings
+            .iter()
+            .any(|w| w.contains("XML declaration is not at the start")),
+        "{:?}",
+        l.warnings
+    );
+    assert_eq!(l.model.bodies.len(), 1);
+    let bad = text.replace("<mass value=\"1\"/>", "<mass value=\"-1\"/>");
+    let e = load_str(&bad, "t.urdf", &ImportOptions::default()).unwrap_err();
+    assert!(e.to_string().starts_with("t.urdf:7:"), "{e}");
+}
+
+/// A file declaring `encoding="ISO-8859-1"` is decoded as Latin-1 (é is byte 0xE9).
+#[test]
+fn latin1_file_is_decoded() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("latin.urdf");
+    let mut bytes =
+        b"<?xml version=\"1.0\" encoding=\"ISO-8859-1\"?>\n<!-- \xE9paule -->\n".to_vec();
+    bytes.extend(
+        pendulum(FIXED, "")
+            .replace("\"arm\"", "\"bras_\u{e9}\"")
+            .chars()
+            .map(|c| c as u8),
+    );
+    std::fs::write(&file, &bytes).unwrap();
+    let l = restpose::urdf::load_file(&file, &ImportOptions::default()).unwrap();
+    assert!(l.model.link("bras_\u{e9}").is_some());
+    // Without the declaration the same bytes are not UTF-8: a located error.
+    std::fs::write(
+        &file,
+        &bytes[bytes.iter().position(|&b| b == b'\n').unwrap() + 1..],
+    )
+    .unwrap();
+    let e = restpose::urdf::load_file(&file, &ImportOptions::default()).unwrap_err();
+    assert!(
+        e.to_string().contains("latin.urdf:1:6:") && e.to_string().contains("0xE9"),
+        "{e}"
+    );
+}
+
+/// Mesh `scale` with extra components: the first three are used, with a warning; one
+/// component is a uniform scale.
+#[test]
+fn mesh_scale_with_extra_components() {
+    let visual = |scale: &str| {
+        format!(
+            "<link name=\"tool\"><visual><geometry><mesh filename=\"m.stl\" scale=\"{scale}\"/></geometry></visual></link>\n<joint name=\"t\" type=\"fixed\"><parent link=\"arm\"/><child link=\"tool\"/></joint>"
+        )
+    };
+    let scale_of = |scale: &str| {
+        let l = load_str(
+            &pendulum(FIXED, &visual(scale)),
+            "t.urdf",
+            &ImportOptions::default(),
+        )
+        .unwrap();
+        let g = &l.model.link("tool").unwrap().visuals[0];
+        let restpose::geometry::ShapeKind::Mesh { scale, .. } = &g.shape else {
+            panic!("not a mesh")
+        };
+        (*scale, l.warnings)
+    };
+    let (s, w) = scale_of("0.001 0.002 0.003 1");
+    assert_eq!((s.x, s.y, s.z), (0.001, 0.002, 0.003));
+    assert!(
+        w.iter()
+            .any(|w| w.starts_with("t.urdf:8:") && w.contains("more than 3 components")),
+        "{w:?}"
+    );
+    let (s, w) = scale_of("0.5");
+    assert_eq!((s.x, s.y, s.z), (0.5, 0.5, 0.5));
+    assert!(w.iter().any(|w| w.contains("uniform")), "{w:?}");
+    let e = load_str(
+        &pendulum(FIXED, &visual("1 1")),
+        "t.urdf",
+        &ImportOptions::default(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("must be 3 finite numbers"), "{e}");
+}
+
+/// A namespace prefix used without a declaration in foreign content (old Gazebo sensor
+/// blocks): TinyXML2 does not know namespaces, so it is declared with a warning.
+#[test]
+fn undeclared_foreign_prefix_is_declared() {
+    let extra = "<gazebo reference=\"arm\"><sensor:camera name=\"c\"><sensor:fov>1</sensor:fov></sensor:camera></gazebo>";
+    let l = load_str(&pendulum(FIXED, extra), "t.urdf", &ImportOptions::default()).unwrap();
+    assert!(
+        l.warnings
+            .iter()
+            .any(|w| w.contains("`sensor:` prefix is used but not declared")),
+        "{:?}",
+        l.warnings
+    );
+    assert_eq!(l.model.bodies.len(), 1);
+}
+
+/// A continuous joint has no position limits (urdfdom and ROS ignore them): a `<limit>` with
+/// bounds is ignored with a warning instead of reporting violations.
+#[test]
+fn continuous_joint_position_limits_are_ignored() {
+    let text = pendulum(FIXED, "").replace(
+        "type=\"revolute\"><parent link=\"mount\"/><child link=\"arm\"/><axis xyz=\"0 1 0\"/>",
+        "type=\"continuous\"><parent link=\"mount\"/><child link=\"arm\"/><axis xyz=\"0 1 0\"/><limit lower=\"-0.1\" upper=\"0.1\" effort=\"1\" velocity=\"1\"/>",
+    );
+    let l = load_str(&text, "t.urdf", &ImportOptions::default()).unwrap();
+    let j = l.model.joint_id("hinge").unwrap();
+    assert_eq!(l.model.joint(j).limits, None);
+    assert!(l
+        .warnings
+        .iter()
+        .any(|w| w.contains("continuous joint has no position limits")));
+    // Effort and velocity only (the usual form) say nothing.
+    let plain = text.replace("lower=\"-0.1\" upper=\"0.1\" ", "");
+    assert!(load_str(&plain, "t.urdf", &ImportOptions::default())
+        .unwrap()
+        .warnings
+        .is_empty());
 }

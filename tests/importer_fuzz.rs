@@ -125,3 +125,56 @@ proptest! {
         }
     }
 }
+
+/// Hostile structure: a robot file with a random nesting of `depth` levels (elements,
+/// comments, self-closing tags and quoted `>` mixed in) inside a link. It loads when
+/// `depth` is within `MAX_DEPTH` and is refused with a located error beyond it: never a
+/// stack overflow, whatever the depth.
+fn nested(depth: usize, noise: &[u8]) -> String {
+    let mut open = String::new();
+    for (i, &n) in noise.iter().cycle().take(depth).enumerate() {
+        match n % 4 {
+            0 => open.push_str("<a>"),
+            1 => open.push_str("<b v=\"x>y\"><!-- <c> --><d/>"),
+            2 => open.push_str("<e><![CDATA[<f>]]>"),
+            _ => open.push_str(&format!("<g{i} w='/>'>")),
+        }
+    }
+    let mut close = String::new();
+    for (i, &n) in noise
+        .iter()
+        .cycle()
+        .take(depth)
+        .enumerate()
+        .collect::<Vec<_>>()
+        .into_iter()
+        .rev()
+    {
+        close.push_str(&match n % 4 {
+            0 => "</a>".to_string(),
+            1 => "</b>".to_string(),
+            2 => "</e>".to_string(),
+            _ => format!("</g{i}>"),
+        });
+    }
+    format!("<robot name=\"r\"><link name=\"l\"><visual>{open}{close}</visual></link></robot>")
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(cases().min(32)))]
+
+    #[test]
+    fn deep_nesting_is_refused_not_overflowed(depth in 0usize..20_000, noise in prop::collection::vec(any::<u8>(), 1..8)) {
+        let text = nested(depth, &noise);
+        // robot, link and visual are 3 levels above the nesting.
+        let limit = restpose::urdf::MAX_DEPTH;
+        match restpose::urdf::load_str(&text, "deep.urdf", &Default::default()) {
+            Ok(_) => prop_assert!(depth + 3 <= limit, "depth {depth} accepted"),
+            Err(e) => {
+                let e = e.to_string();
+                prop_assert!(depth + 3 > limit, "depth {depth} refused: {e}");
+                prop_assert!(e.starts_with("deep.urdf:1:") && e.contains("nested more than"), "{e}");
+            }
+        }
+    }
+}

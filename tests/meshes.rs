@@ -187,3 +187,29 @@ fn check_prints_the_model_and_json() {
         .unwrap();
     assert!(String::from_utf8_lossy(&o.stdout).contains("1 degrees of freedom"));
 }
+
+/// Meshes are read with a size cap: a (sparse) file over 256 MiB is refused before it is
+/// read, with a warning naming the file and its size; the link stays massless.
+#[test]
+fn oversized_mesh_is_refused_without_reading_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = dir.path().join("huge.stl");
+    let f = std::fs::File::create(&mesh).unwrap();
+    let len = restpose::geometry::MAX_MESH_BYTES + 1;
+    f.set_len(len).unwrap();
+    let file = dir.path().join("arm.urdf");
+    std::fs::write(&file, arm("huge.stl")).unwrap();
+    let opts = ImportOptions {
+        inertia_density: Some(1000.0),
+        ..Default::default()
+    };
+    let l = load_file(&file, &opts).unwrap();
+    assert_eq!(l.model.bodies[0].mass, 0.0);
+    assert!(
+        l.warnings.iter().any(|w| w.contains("huge.stl")
+            && w.contains(&format!("{len} bytes"))
+            && w.contains("256 MiB")),
+        "{:?}",
+        l.warnings
+    );
+}

@@ -69,7 +69,7 @@ fn chain_matches_minimal_coordinate_energy() {
     let (s, r) = solve(&m);
     assert_eq!(r.dof, n);
     let theta: Vec<f64> = (0..n)
-        .map(|i| joint(&m, &s, &format!("joint{i}"))[0])
+        .map(|i| s.joint(&m, &format!("joint{i}")).unwrap()[0])
         .collect();
     let energy = |th: &[f64]| energies::chain(n, th);
     assert_abs_diff_eq!(energy(&theta), r.energy.total, epsilon = 1e-9);
@@ -108,7 +108,7 @@ fn planar_chain_joint_torques_balance_by_hand() {
     let m = model_from(&restpose::generate::chain(n, true));
     let (s, _) = solve(&m);
     let theta: Vec<f64> = (0..n)
-        .map(|i| joint(&m, &s, &format!("joint{i}"))[0])
+        .map(|i| s.joint(&m, &format!("joint{i}")).unwrap()[0])
         .collect();
     // Joint i at x_i; link j's centre of mass at c_j (in the x-z plane).
     let mut pts = Vec::new();
@@ -223,7 +223,7 @@ fn stewart_platform_converges_from_far_starts() {
         );
     }
     // The floating joint reports the platform's own displacement.
-    let pf = common::joint(&m, &rest, "platform_float");
+    let pf = rest.joint(&m, "platform_float").unwrap();
     let link = rest.link_pose(&m, "platform").unwrap();
     let origin = restpose::State::from_joint_values(&m, &Default::default())
         .link_pose(&m, "platform")
@@ -275,7 +275,7 @@ fn ladder_matches_minimal_coordinate_energy() {
     assert_eq!(r.dof, n);
     assert_eq!(r.redundant_constraints.len(), 3 * n);
     let phi: Vec<f64> = (0..n)
-        .map(|k| joint(&m, &s, &format!("hang_left{k}"))[0])
+        .map(|k| s.joint(&m, &format!("hang_left{k}")).unwrap()[0])
         .collect();
     let energy = |phi: &[f64]| energies::ladder(n, phi);
     assert_abs_diff_eq!(energy(&phi), r.energy.total, epsilon = 1e-9);

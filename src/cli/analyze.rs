@@ -2,7 +2,6 @@
 
 use super::args::{coord, AnalyzeArgs};
 use super::{exit, print, suggest};
-use anyhow::Context;
 use restpose::export::json::AnalysisResult;
 use restpose::urdf::{load_file, ImportOptions};
 
@@ -16,10 +15,12 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
     for l in &a.initial {
         opts.initial.push(coord(l, "initial")?);
     }
+    let import_started = std::time::Instant::now();
     let loaded = match load_file(&a.file, &opts) {
         Ok(l) => l,
         Err(e) => return Err(unknown_joint(a, &opts).unwrap_or_else(|| e.into())),
     };
+    let import = import_started.elapsed().as_secs_f64();
     if !a.quiet {
         for w in &loaded.warnings {
             eprintln!("warning: {w}");
@@ -31,8 +32,11 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
         }
     }
     let model = &loaded.model;
-    let (state, report) = restpose::solve(model, &a.solver_options())?;
-    let result = AnalysisResult::new(model, &state, &report);
+    let (state, mut report) = restpose::solve(model, &a.solver_options())?;
+    report.diagnostics.timings.import = import;
+    let export_started = std::time::Instant::now();
+    let mut result = AnalysisResult::new(model, &state, &report);
+    result.diagnostics.timings.export = export_started.elapsed().as_secs_f64();
     if let Some(path) = &a.json {
         print::write_json(path, &result.to_json())?;
     }
@@ -41,8 +45,7 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
     }
     if result.converged {
         if let Some(path) = &a.write_urdf {
-            let text = std::fs::read_to_string(&a.file)
-                .with_context(|| format!("{}", a.file.display()))?;
+            let text = restpose::urdf::read_text(&a.file)?;
             let out = restpose::urdf::with_initial_pose(
                 &text,
                 &a.file.display().to_string(),

@@ -112,7 +112,8 @@ pub(crate) struct VerifyArgs {
     /// Joint value (repeatable; overrides the pose file): JOINT=VALUE or JOINT[DOF]=VALUE.
     #[arg(long, value_name = "JOINT=VALUE")]
     pub(crate) joint: Vec<String>,
-    /// Largest effort a joint may need for the pose to pass [N m or N].
+    /// Largest effort a joint may need for the pose to pass [N m or N], plus 1e-9 of the
+    /// largest generalized force on any coordinate.
     #[arg(long, default_value_t = Tolerances::default().force, value_parser = parse::positive)]
     pub(crate) force_tolerance: f64,
     /// Largest constraint violation for the pose to pass [m or rad].

@@ -224,14 +224,14 @@ pub(crate) fn verification(robot: &str, v: &Verification, tol: &Tolerances) {
     }
     out!("  joint                          dof   effort to hold [N m or N]");
     for i in &v.imbalance {
-        let flag = if i.effort.abs() > tol.force {
+        let flag = if i.effort.abs() > v.effort_tolerance {
             "  <- out of balance"
         } else {
             ""
         };
         out!("  {:<30} {:>3}   {:>14.6e}{flag}", i.joint, i.dof, i.effort);
     }
-    if v.unassigned > tol.force {
+    if v.unassigned > v.effort_tolerance {
         out!(
             "  unassigned generalized force {:.3e} (spherical or floating joints)",
             v.unassigned

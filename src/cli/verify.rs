@@ -31,7 +31,7 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
         }
         v[dof] = value;
     }
-    if values.is_empty() {
+    if values.is_empty() && a.pose.is_none() {
         bail!("give the pose with --pose FILE or --joint NAME=VALUE");
     }
     let (state, missing) = restpose::verify::pose_state(model, &values)?;
@@ -44,6 +44,7 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
     let tol = restpose::verify::Tolerances {
         force: a.force_tolerance,
         constraint: a.constraint_tolerance,
+        ..Default::default()
     };
     let v = restpose::verify::verify(model, &state, &tol)?;
     if let Some(path) = &a.json {

@@ -135,21 +135,25 @@ impl AnalysisResult {
         let links = model
             .links
             .iter()
-            .filter_map(|l| {
-                let pose = state.link_pose(model, &l.name)?;
+            .map(|l| {
+                // The link itself, not a lookup by name (O(N²) over all links).
+                let pose = match l.body {
+                    Some(b) => state.body_pose(b) * l.body_from_link,
+                    None => l.body_from_link,
+                };
                 let r = pose.rotation;
                 let (w, x, y, z) = if r.w < 0.0 {
                     (-r.w, -r.i, -r.j, -r.k)
                 } else {
                     (r.w, r.i, r.j, r.k)
                 };
-                Some((
+                (
                     l.name.clone(),
                     LinkResult {
                         position: pose.translation.vector.into(),
                         orientation_wxyz: [w, x, y, z],
                     },
-                ))
+                )
             })
             .collect();
         let limit_violations = model

@@ -111,6 +111,25 @@ pub struct Diagnostics {
     /// How the stability eigenvalues were found: `"exact"` (the reduced Hessian decomposed) or
     /// `"lanczos"` (its low end only, for many degrees of freedom); empty without any.
     pub eigenvalues_by: String,
+    /// Wall time of each phase \[s\].
+    pub timings: Timings,
+}
+
+/// Wall time of each phase of an analysis \[s\]. The solver fills `assembly`, `iterations`
+/// and `stability`; `import` and `export` are the caller's (the CLI measures reading the URDF
+/// and building the result; writing the text is not included).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Timings {
+    /// Reading and importing the model \[s\].
+    pub import: f64,
+    /// Closing the loops from the initial guess \[s\].
+    pub assembly: f64,
+    /// The minimizer's iterations, load stages included \[s\].
+    pub iterations: f64,
+    /// Stability (eigenvalues or inertia) and reactions at the rest pose \[s\].
+    pub stability: f64,
+    /// Building the result (joint values, link frames) \[s\].
+    pub export: f64,
 }
 
 impl Diagnostics {

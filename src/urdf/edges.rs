@@ -50,7 +50,7 @@ pub(super) struct Edge<'a> {
 /// Link names and named frames: name → (link index or world, link_from_frame).
 pub(super) struct Frames<'a> {
     pub(super) links: &'a HashMap<String, usize>,
-    pub(super) frames: HashMap<String, (Option<usize>, Isometry3<f64>)>,
+    pub(super) frames: FrameMap,
 }
 
 impl Frames<'_> {
@@ -61,33 +61,93 @@ impl Frames<'_> {
         node: Node,
         name: &str,
     ) -> Result<(Option<usize>, Isometry3<f64>)> {
-        if let Some(&i) = self.links.get(name) {
-            return Ok((Some(i), Isometry3::identity()));
-        }
-        if let Some(f) = self.frames.get(name) {
-            return Ok(*f);
-        }
-        if name == "world" {
-            return Ok((None, Isometry3::identity()));
-        }
-        Err(src.error(
-            node,
-            format!(
-                "{} refers to an unknown link or frame `{name}`",
-                src.describe(node)
-            ),
-        ))
+        resolve(self.links, &self.frames, src, node, name)
     }
 }
 
+/// Named frames: name → (link index or world, link_from_frame).
+pub(super) type FrameMap = HashMap<String, (Option<usize>, Isometry3<f64>)>;
+
+/// Resolves a link or frame name at `node`: a link, a `mech:frame`, or the world.
+pub(super) fn resolve(
+    links: &HashMap<String, usize>,
+    frames: &FrameMap,
+    src: &Source,
+    node: Node,
+    name: &str,
+) -> Result<(Option<usize>, Isometry3<f64>)> {
+    if let Some(&i) = links.get(name) {
+        return Ok((Some(i), Isometry3::identity()));
+    }
+    if let Some(f) = frames.get(name) {
+        return Ok(*f);
+    }
+    if name == "world" {
+        return Ok((None, Isometry3::identity()));
+    }
+    Err(src.error(
+        node,
+        format!(
+            "{} refers to an unknown link or frame `{name}`",
+            src.describe(node)
+        ),
+    ))
+}
+
+/// Position limits from `<limit lower upper>` (a missing bound is 0, as in urdfdom);
+/// `lower > upper` is an error.
 fn limits(src: &Source, node: Node) -> Result<Option<[f64; 2]>> {
-    Ok(match child(node, "limit") {
-        Some(l) => match (src.f64_opt(l, "lower")?, src.f64_opt(l, "upper")?) {
-            (None, None) => None,
-            (lo, hi) => Some([lo.unwrap_or(0.0), hi.unwrap_or(0.0)]),
-        },
-        None => None,
-    })
+    let Some(l) = child(node, "limit") else {
+        return Ok(None);
+    };
+    match (src.f64_opt(l, "lower")?, src.f64_opt(l, "upper")?) {
+        (None, None) => Ok(None),
+        (lo, hi) => {
+            let (lo, hi) = (lo.unwrap_or(0.0), hi.unwrap_or(0.0));
+            if lo > hi {
+                return Err(src.error(
+                    l,
+                    format!(
+                        "{}: <limit> has lower {lo} > upper {hi}",
+                        src.describe(node)
+                    ),
+                ));
+            }
+            Ok(Some([lo, hi]))
+        }
+    }
+}
+
+/// The axis of a URDF joint. Fixed, floating and spherical joints have none: urdfdom does not
+/// read it, so whatever is written there (often `0 0 0` from CAD exporters) is ignored, with a
+/// warning when it could not have been an axis.
+fn urdf_axis(
+    src: &Source,
+    node: Node,
+    kind: JointKind,
+    warnings: &mut Vec<String>,
+) -> Result<Vector3<f64>> {
+    let a = child(node, "axis");
+    if matches!(
+        kind,
+        JointKind::Fixed | JointKind::Floating | JointKind::Spherical
+    ) {
+        if let Some(a) = a {
+            if src.axis(Some(a), node, Vector3::x()).is_err() {
+                warnings.push(src.warning(
+                    a,
+                    format!(
+                        "{} ({}) has no axis; its <axis xyz=\"{}\"> is ignored",
+                        src.describe(node),
+                        kind.name(),
+                        a.attribute("xyz").unwrap_or_default()
+                    ),
+                ));
+            }
+        }
+        return Ok(Vector3::x());
+    }
+    src.axis(a, node, Vector3::x())
 }
 
 /// A resolved endpoint: link index (or world), link_from_frame, the name as written.
@@ -149,6 +209,16 @@ pub(super) fn urdf_joint<'a>(
     let name = src.req(node, "name")?.to_string();
     let kind = urdf_kind(src, node, src.req(node, "type")?, warnings)?;
     let [(parent, pf, parent_link), (child_i, cf, child_link)] = ends(src, node, frames, &name)?;
+    let mut lim = limits(src, node)?;
+    if kind == JointKind::Continuous && lim.take().is_some_and(|[lo, hi]| lo != 0.0 || hi != 0.0) {
+        warnings.push(src.warning(
+            node,
+            format!(
+                "{}: a continuous joint has no position limits; <limit lower upper> ignored",
+                src.describe(node)
+            ),
+        ));
+    }
     Ok(Edge {
         node,
         kind,
@@ -158,9 +228,9 @@ pub(super) fn urdf_joint<'a>(
         child_link,
         origin: pf * src.frame(child(node, "origin"))?,
         child_origin: cf,
-        axis: src.axis(child(node, "axis"), node, Vector3::x())?,
+        axis: urdf_axis(src, node, kind, warnings)?,
         axis2: Vector3::y(),
-        limits: limits(src, node)?,
+        limits: lim,
         source: Source_::Urdf,
         auto_child_origin: false,
         name,

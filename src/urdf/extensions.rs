@@ -15,19 +15,6 @@ use crate::model::{
 use nalgebra::Vector3;
 use roxmltree::Node;
 
-const KNOWN: [&str; 10] = [
-    "gravity",
-    "link_gravity",
-    "loop_joint",
-    "spring",
-    "joint_spring",
-    "force",
-    "joint_effort",
-    "lock",
-    "initial",
-    "frame",
-];
-
 fn force_law(src: &Source, node: Node, what: &str) -> Result<ForceLaw> {
     let stiffness = src.f64_opt(node, "stiffness")?;
     let preload = src.f64_or(node, "preload", 0.0)?;
@@ -113,7 +100,7 @@ fn joint_coord(src: &Source, node: Node, b: &Builder) -> Result<(JointId, usize)
         )
     })?;
     let dof = src.f64_or(node, "dof", 0.0)?;
-    let kind = b.model.joints[id.0].kind;
+    let kind = b.model.partial().joints[id.0].kind;
     let n = kind.scalar_coordinates();
     if dof < 0.0 || dof.fract() != 0.0 || dof as usize >= n {
         return Err(src.error(
@@ -131,15 +118,6 @@ pub(super) fn read(
     b: &mut Builder,
     options: &ImportOptions,
 ) -> Result<()> {
-    for &n in ext {
-        let tag = n.tag_name().name();
-        if !KNOWN.contains(&tag) {
-            return Err(src.error(
-                n,
-                format!("unknown element <mech:{tag}> (known: {})", KNOWN.join(", ")),
-            ));
-        }
-    }
     // URDF mimic.
     for (name, node) in urdf_joints {
         if let Some(m) = child(*node, "mimic") {
@@ -148,24 +126,35 @@ pub(super) fn read(
                 .model
                 .joint_id(name)
                 .ok_or_else(|| src.error(m, "mimic on an unknown joint"))?;
-            let reference = b.model.joint_id(target).ok_or_else(|| {
-                src.error(
+            // urdfdom loads a mimic of a missing joint, and a mimic on or of a joint without a
+            // scalar coordinate: the joint is then independent.
+            let Some(reference) = b.model.joint_id(target) else {
+                let w = src.warning(
                     m,
-                    format!("joint `{name}` mimics an unknown joint `{target}`"),
-                )
-            })?;
-            for (jid, role) in [(id, "mimicking"), (reference, "mimicked")] {
-                if b.model.joints[jid.0].kind.scalar_coordinates() == 0 {
-                    return Err(src.error(
-                        m,
-                        format!(
-                            "{role} joint `{}` has no scalar coordinate",
-                            b.model.joints[jid.0].name
-                        ),
-                    ));
-                }
+                    format!(
+                        "joint `{name}` mimics an unknown joint `{target}`; <mimic> ignored (the joint is independent)"
+                    ),
+                );
+                b.warnings.push(w);
+                continue;
+            };
+            if let Some((jid, role)) = [(id, "mimicking"), (reference, "mimicked")]
+                .into_iter()
+                .find(|(jid, _)| b.model.partial().joints[jid.0].kind.scalar_coordinates() == 0)
+            {
+                let j = &b.model.partial().joints[jid.0];
+                let w = src.warning(
+                    m,
+                    format!(
+                        "{role} joint `{}` ({}) has no scalar coordinate; <mimic> ignored",
+                        j.name,
+                        j.kind.name()
+                    ),
+                );
+                b.warnings.push(w);
+                continue;
             }
-            b.model.mimics.push(Mimic {
+            b.model.add_mimic(Mimic {
                 joint: id,
                 reference,
                 multiplier: src.f64_or(m, "multiplier", 1.0)?,
@@ -174,11 +163,11 @@ pub(super) fn read(
         }
     }
     // Mimic cycles.
-    for start in 0..b.model.mimics.len() {
-        let mut cur = b.model.mimics[start].reference;
-        for _ in 0..=b.model.mimics.len() {
-            if cur == b.model.mimics[start].joint {
-                let name = &b.model.joints[cur.0].name;
+    for start in 0..b.model.mimics().len() {
+        let mut cur = b.model.mimics()[start].reference;
+        for _ in 0..=b.model.mimics().len() {
+            if cur == b.model.mimics()[start].joint {
+                let name = &b.model.partial().joints[cur.0].name;
                 let node = urdf_joints.iter().find(|(n, _)| n == name).map(|(_, n)| *n);
                 let at = node
                     .and_then(|n| child(n, "mimic"))
@@ -186,7 +175,7 @@ pub(super) fn read(
                     .unwrap_or(ext.first().copied().unwrap_or(src.doc.root_element()));
                 return Err(src.error(at, format!("mimic cycle through joint `{name}`")));
             }
-            match b.model.mimics.iter().find(|m| m.joint == cur) {
+            match b.model.mimics().iter().find(|m| m.joint == cur) {
                 Some(m) => cur = m.reference,
                 None => break,
             }
@@ -198,9 +187,10 @@ pub(super) fn read(
         let what = src.describe(n);
         match n.tag_name().name() {
             "gravity" => {
-                b.model.gravity = src
+                let g = src
                     .vec3_opt(n, "xyz")?
                     .ok_or_else(|| src.error(n, "<mech:gravity> needs `xyz`"))?;
+                b.model.set_gravity(g);
                 b.gravity_set = true;
             }
             "link_gravity" => {
@@ -211,10 +201,8 @@ pub(super) fn read(
                         format!("<mech:link_gravity> refers to an unknown link `{name}`"),
                     )
                 })?;
-                if n.attribute("enabled")
-                    .is_some_and(|v| v == "false" || v == "0")
-                {
-                    b.no_gravity.push(i);
+                if !src.bool_opt(n, "enabled")?.unwrap_or(true) {
+                    b.model.exclude_from_gravity(i);
                 }
             }
             "spring" => {
@@ -266,7 +254,7 @@ pub(super) fn read(
                 };
                 let law = force_law(src, n, &format!("spring `{name}`"))?;
                 let ends = [se[0].clone(), se[1].clone()];
-                b.model.springs.push(Spring {
+                b.model.add_spring(Spring {
                     name,
                     ends,
                     free_length,
@@ -278,7 +266,7 @@ pub(super) fn read(
                 let (joint, dof) = joint_coord(src, n, b)?;
                 let law = force_law(src, n, &what)?;
                 let reference = src.f64_or(n, "reference", 0.0)?;
-                b.model.joint_springs.push(JointSpring {
+                b.model.push_joint_spring(JointSpring {
                     joint,
                     dof,
                     reference,
@@ -304,7 +292,7 @@ pub(super) fn read(
                     bfl * nalgebra::Point3::from(src.vec3_or(n, "xyz", Vector3::zeros())?);
                 let force = src.vec3_or(n, "force", Vector3::zeros())?;
                 if let Some(body) = body {
-                    b.model.loads.push(Load {
+                    b.model.add_load(Load {
                         name,
                         body,
                         point: point.coords,
@@ -317,7 +305,7 @@ pub(super) fn read(
                 let value = src
                     .f64_opt(n, "value")?
                     .ok_or_else(|| src.error(n, format!("{what} needs `value`")))?;
-                b.model.efforts.push(Effort { joint, dof, value });
+                b.model.add_effort(Effort { joint, dof, value });
             }
             "lock" => {
                 let (joint, dof) = joint_coord(src, n, b)?;
@@ -339,7 +327,7 @@ pub(super) fn read(
                     let joint = b.model.joint_id(name).ok_or_else(|| {
                         src.error(n, format!("{what} refers to an unknown joint `{name}`"))
                     })?;
-                    let kind = b.model.joints[joint.0].kind;
+                    let kind = b.model.partial().joints[joint.0].kind;
                     let expected = match kind {
                         JointKind::Spherical => 4,
                         JointKind::Floating => 7,
@@ -375,7 +363,7 @@ pub(super) fn read(
         }
     }
     if !b.gravity_set {
-        b.model.gravity = options.gravity;
+        b.model.set_gravity(options.gravity);
     }
     let resolve = |name: &str, dof: usize, what: &str| -> Result<JointId> {
         let id = b.model.joint_id(name).ok_or_else(|| {
@@ -383,11 +371,11 @@ pub(super) fn read(
                 "{what} `{name}`: the model has no joint of that name"
             ))
         })?;
-        let n = b.model.joints[id.0].kind.scalar_coordinates();
+        let n = b.model.partial().joints[id.0].kind.scalar_coordinates();
         if dof >= n {
             return Err(crate::error::Error::Option(format!(
                 "{what} `{name}`: joint is {} with {n} addressable coordinate(s), dof {dof} is out of range",
-                b.model.joints[id.0].kind.name()
+                b.model.partial().joints[id.0].kind.name()
             )));
         }
         Ok(id)
@@ -410,7 +398,11 @@ pub(super) fn read(
             value: *value,
         });
     }
-    b.model.locks = locks;
-    b.model.initial = initial;
+    for l in locks {
+        b.model.add_lock(l);
+    }
+    for i in initial {
+        b.model.add_initial(i);
+    }
     Ok(())
 }

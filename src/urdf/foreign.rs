@@ -43,7 +43,7 @@ pub(super) fn read(src: &Source, drake: &[Node], gazebo: &[Node], b: &mut Builde
         ];
         let free_length = value("linear_spring_damper_free_length")?;
         let stiffness = value("linear_spring_damper_stiffness")?;
-        b.model.springs.push(Spring {
+        b.model.add_spring(Spring {
             name,
             ends,
             free_length,
@@ -78,10 +78,10 @@ pub(super) fn read(src: &Source, drake: &[Node], gazebo: &[Node], b: &mut Builde
         let id = b.model.joint_id(joint).ok_or_else(|| {
             src.error(g, format!("<gazebo reference=\"{joint}\"> has a springStiffness but the model has no joint `{joint}`"))
         })?;
-        if b.model.joints[id.0].kind.scalar_coordinates() == 0 {
+        if b.model.partial().joints[id.0].kind.scalar_coordinates() == 0 {
             return Err(src.error(k, format!("joint `{joint}` has no coordinate for a spring")));
         }
-        b.model.joint_springs.push(JointSpring {
+        b.model.push_joint_spring(JointSpring {
             joint: id,
             dof: 0,
             reference,

@@ -1,46 +1,39 @@
-//! From the document to the model: links, the joint graph and its spanning tree, bodies.
+//! From the document to the model: the import pipeline, as calls on a [`ModelBuilder`].
 //!
-//! URDF `<joint>`s, `<drake:joint>`s and the loop elements (`mech:loop_joint`, `<loop_joint>`,
-//! `<drake:ball_constraint>`) form one graph. The spanning tree grows from the root link along
-//! URDF and Drake joints first; a link they do not reach is reached through a loop element
-//! whose parent is already placed, which then becomes a tree edge. Every other edge closes a
-//! loop. Links joined by URDF `fixed` tree joints form one rigid body whose frame is the frame
-//! of its topmost link; `body_from_link` composes the fixed joint origins. The root link is
-//! welded to the world (its frame is the world frame) unless a floating base is asked for.
+//! Text repair ([`super::text`]), the `mech:` schema check ([`super::schema`]), links and
+//! their geometry ([`super::links`]), named frames, the joint graph ([`super::edges`]), its
+//! spanning tree and bodies ([`super::tree`]), joint placement (here), then the extension
+//! elements ([`super::extensions`], [`super::foreign`]); the builder validates and sums the
+//! links' mass into their bodies.
+//!
+//! Joint placement: a joint's frame `J` in its parent body is
+//! `body_from_link(parent) · origin · R_axis`, in its child body
+//! `body_from_link(child) · child_origin · R_axis`, with `R_axis` turning z onto the axis.
+//! The root link is welded to the world (its frame is the world frame) unless a floating base
+//! is asked for.
 
-use super::edges::{self, Edge, Frames, Source_, DRAKE_NS};
+use super::edges::{self, Edge, FrameMap, Frames, Source_, DRAKE_NS};
 use super::extensions;
-use super::xml::{child, is_mech, Source};
+use super::links::read_link;
+use super::xml::{is_mech, Source};
 use super::{ImportOptions, Loaded};
-use crate::error::{Error, Result};
-use crate::geometry::{Geometry, PackagePaths, ShapeKind};
+use crate::error::Result;
+use crate::geometry::PackagePaths;
 use crate::math::align_z;
-use crate::model::{Body, BodyId, Joint, JointKind, Link, Model};
+use crate::model::{BodyId, Joint, JointKind, ModelBuilder};
+use crate::state::State;
 use nalgebra::{Isometry3, Matrix3, UnitQuaternion, Vector3};
 use roxmltree::Node;
 use std::collections::HashMap;
 
-/// Mass properties and geometry of one link, in its link frame.
-pub(super) struct LinkIn {
-    pub(super) name: String,
-    pub(super) mass: f64,
-    pub(super) com: Vector3<f64>,
-    pub(super) inertia: Matrix3<f64>,
-    pub(super) has_inertial: bool,
-    pub(super) visuals: Vec<Geometry>,
-    pub(super) collisions: Vec<Geometry>,
-}
-
-/// The model under construction, shared with the extension readers.
+/// The import context shared with the extension readers: the model builder and the names
+/// it resolves.
 pub(super) struct Builder {
-    pub(super) model: Model,
-    /// Link name → index in `model.links`.
+    pub(super) model: ModelBuilder,
+    /// Link name → index in the model's links.
     pub(super) link_index: HashMap<String, usize>,
     /// `mech:frame` name → (link index or world, link_from_frame).
-    pub(super) frames: HashMap<String, (Option<usize>, Isometry3<f64>)>,
-    pub(super) link_in: Vec<LinkIn>,
-    /// Links excluded from gravity.
-    pub(super) no_gravity: Vec<usize>,
+    pub(super) frames: FrameMap,
     pub(super) gravity_set: bool,
     pub(super) warnings: Vec<String>,
 }
@@ -55,16 +48,10 @@ impl Builder {
         attr: &str,
     ) -> Result<(Option<BodyId>, Isometry3<f64>)> {
         let name = src.req(node, attr)?;
-        let frames = Frames {
-            links: &self.link_index,
-            frames: self.frames.clone(),
-        };
-        let (link, link_from_frame) = frames.resolve(src, node, name)?;
-        Ok(match link {
-            Some(i) => {
-                let l = &self.model.links[i];
-                (l.body, l.body_from_link * link_from_frame)
-            }
+        let (link, link_from_frame) =
+            edges::resolve(&self.link_index, &self.frames, src, node, name)?;
+        Ok(match link.and_then(|i| self.model.link(i)) {
+            Some(l) => (l.body, l.body_from_link * link_from_frame),
             None => (None, link_from_frame),
         })
     }
@@ -96,237 +83,6 @@ pub(super) fn joint_axes(
     }
 }
 
-/// The xacro hint.
-const XACRO: &str =
-    "xacro macros are not expanded URDF: run `xacro FILE.urdf.xacro > FILE.urdf` first";
-
-/// Declares an undeclared `mech:` or `drake:` prefix (with a warning) and refuses xacro, by
-/// parsing: a prefix only counts where the XML parser meets it, not in comments.
-pub(super) fn repair_prefixes(
-    text: &str,
-    file: &str,
-    warnings: &mut Vec<String>,
-) -> Result<String> {
-    let mut out = text.to_string();
-    let popts = roxmltree::ParsingOptions {
-        allow_dtd: true,
-        ..Default::default()
-    };
-    for _ in 0..3 {
-        let (prefix, pos) = match roxmltree::Document::parse_with_options(&out, popts) {
-            Err(roxmltree::Error::UnknownNamespace(prefix, pos)) => (prefix, pos),
-            Err(_) => return Ok(out),
-            Ok(doc) => {
-                for n in doc.descendants().filter(|n| n.is_element()) {
-                    let xacro = n
-                        .tag_name()
-                        .namespace()
-                        .is_some_and(|u| u.contains("xacro"));
-                    if xacro || n.attributes().any(|a| a.value().contains("${")) {
-                        let p = doc.text_pos_at(n.range().start);
-                        return Err(Error::Input {
-                            file: file.to_string(),
-                            line: p.row,
-                            col: p.col,
-                            message: XACRO.into(),
-                        });
-                    }
-                }
-                return Ok(out);
-            }
-        };
-        let uri = match prefix.as_str() {
-            "mech" => super::xml::MECH_NS,
-            "drake" => super::edges::DRAKE_NS,
-            "xacro" => {
-                return Err(Error::Input {
-                    file: file.to_string(),
-                    line: pos.row,
-                    col: pos.col,
-                    message: XACRO.into(),
-                })
-            }
-            _ => return Ok(out),
-        };
-        let Some(at) = out.find("<robot").map(|p| p + "<robot".len()) else {
-            return Ok(out);
-        };
-        out.insert_str(at, &format!(" xmlns:{prefix}=\"{uri}\""));
-        warnings.push(format!("{file}: the `{prefix}:` prefix is used but not declared; assumed xmlns:{prefix}=\"{uri}\""));
-    }
-    Ok(out)
-}
-
-/// The `<geometry>` of a `<visual>` or `<collision>`; `None` (with a warning) for a mesh that
-/// is not found or a shape restpose does not know.
-fn read_geometry(
-    src: &Source,
-    owner: Node,
-    link: &str,
-    packages: &PackagePaths,
-    warnings: &mut Vec<String>,
-) -> Result<Option<Geometry>> {
-    let link_from_shape = src.frame(child(owner, "origin"))?;
-    let Some(g) = child(owner, "geometry") else {
-        return Ok(None);
-    };
-    let Some(s) = g.children().find(|c| c.is_element()) else {
-        return Ok(None);
-    };
-    let positive = |attr: &str| -> Result<f64> {
-        let v = src.f64_opt(s, attr)?.ok_or_else(|| {
-            src.error(
-                s,
-                format!("link `{link}`: <{}> needs `{attr}`", s.tag_name().name()),
-            )
-        })?;
-        if v < 0.0 {
-            return Err(src.error(
-                s,
-                format!(
-                    "link `{link}`: <{}> has a negative {attr} {v}",
-                    s.tag_name().name()
-                ),
-            ));
-        }
-        Ok(v)
-    };
-    let shape = match s.tag_name().name() {
-        "box" => {
-            let size = src
-                .vec3_opt(s, "size")?
-                .ok_or_else(|| src.error(s, format!("link `{link}`: <box> needs `size`")))?;
-            ShapeKind::Box { size }
-        }
-        "cylinder" => ShapeKind::Cylinder {
-            radius: positive("radius")?,
-            length: positive("length")?,
-        },
-        "sphere" => ShapeKind::Sphere {
-            radius: positive("radius")?,
-        },
-        "capsule" => ShapeKind::Capsule {
-            radius: positive("radius")?,
-            length: positive("length")?,
-        },
-        "mesh" => {
-            let uri = src.req(s, "filename")?.to_string();
-            let scale = src.vec3_or(s, "scale", Vector3::new(1.0, 1.0, 1.0))?;
-            let path = match packages.resolve(&uri) {
-                Ok(p) => Some(p),
-                Err(why) => {
-                    warnings.push(src.warning(s, format!("link `{link}`: mesh not found: {why}")));
-                    None
-                }
-            };
-            ShapeKind::Mesh { uri, path, scale }
-        }
-        other => {
-            warnings.push(src.warning(
-                s,
-                format!("link `{link}`: unknown geometry <{other}> ignored"),
-            ));
-            return Ok(None);
-        }
-    };
-    Ok(Some(Geometry {
-        link_from_shape,
-        shape,
-    }))
-}
-
-fn read_link(
-    src: &Source,
-    node: Node,
-    packages: &PackagePaths,
-    warnings: &mut Vec<String>,
-) -> Result<LinkIn> {
-    let name = src.req(node, "name")?.to_string();
-    let mut l = LinkIn {
-        has_inertial: child(node, "inertial").is_some(),
-        visuals: Vec::new(),
-        collisions: Vec::new(),
-        name,
-        mass: 0.0,
-        com: Vector3::zeros(),
-        inertia: Matrix3::zeros(),
-    };
-    for c in node.children().filter(|c| c.is_element()) {
-        let g = match c.tag_name().name() {
-            "visual" | "collision" => read_geometry(src, c, &l.name, packages, warnings)?,
-            _ => None,
-        };
-        if let Some(g) = g {
-            if c.tag_name().name() == "visual" {
-                l.visuals.push(g);
-            } else {
-                l.collisions.push(g);
-            }
-        }
-    }
-    if let Some(inertial) = child(node, "inertial") {
-        let origin = src.frame(child(inertial, "origin"))?;
-        if let Some(m) = child(inertial, "mass") {
-            let mass = src.f64_opt(m, "value")?.ok_or_else(|| {
-                src.error(m, format!("link `{}`: <mass> is missing `value`", l.name))
-            })?;
-            if mass < 0.0 {
-                return Err(src.error(
-                    m,
-                    format!("link `{}` has a negative mass {mass} kg", l.name),
-                ));
-            }
-            l.mass = mass;
-        }
-        l.com = origin.translation.vector;
-        if let Some(i) = child(inertial, "inertia") {
-            let g = |a: &str| src.f64_or(i, a, 0.0);
-            let local = Matrix3::new(
-                g("ixx")?,
-                g("ixy")?,
-                g("ixz")?,
-                g("ixy")?,
-                g("iyy")?,
-                g("iyz")?,
-                g("ixz")?,
-                g("iyz")?,
-                g("izz")?,
-            );
-            let r = origin.rotation.to_rotation_matrix();
-            l.inertia = r.matrix() * local * r.matrix().transpose();
-            if let Some(why) = inertia_problem(&local) {
-                warnings.push(src.warning(
-                    i,
-                    format!("link `{}`: the inertia tensor is not physically valid ({why}); statics does not use it", l.name),
-                ));
-            }
-        }
-    }
-    Ok(l)
-}
-
-/// Why an inertia tensor is not physically valid (a principal moment negative, or one larger
-/// than the sum of the other two), if it is not.
-fn inertia_problem(i: &Matrix3<f64>) -> Option<String> {
-    let Some(e) = nalgebra::SymmetricEigen::try_new(*i, f64::EPSILON, 1000).map(|e| e.eigenvalues)
-    else {
-        return Some("its eigenvalues cannot be computed".into());
-    };
-    let tol = 1e-9 * e.amax().max(f64::MIN_POSITIVE);
-    if e.min() < -tol {
-        return Some(format!("principal moment {:.3e} < 0", e.min()));
-    }
-    for k in 0..3 {
-        if e[k] > e[(k + 1) % 3] + e[(k + 2) % 3] + tol {
-            return Some(format!(
-                "principal moment {:.3e} exceeds the sum of the other two",
-                e[k]
-            ));
-        }
-    }
-    None
-}
-
 pub(super) fn import(
     text: &str,
     file: &str,
@@ -338,7 +94,7 @@ pub(super) fn import(
         urdf_dir,
     };
     let mut warnings = Vec::new();
-    let text = repair_prefixes(text, file, &mut warnings)?;
+    let text = super::text::repair(text, file, &mut warnings)?;
     let doc = super::xml::parse_document(&text, file)?;
     let src = Source::new(file, &doc);
     let robot = doc.root_element();
@@ -351,6 +107,7 @@ pub(super) fn import(
             ),
         ));
     }
+    super::schema::check(&src, robot, &mut warnings)?;
     let mut link_nodes = Vec::new();
     let mut joint_nodes = Vec::new();
     let mut loop_nodes = Vec::new();
@@ -383,25 +140,7 @@ pub(super) fn import(
     let mut link_in = Vec::new();
     let mut link_index: HashMap<String, usize> = HashMap::new();
     for &n in &link_nodes {
-        let mut l = read_link(&src, n, &packages, &mut warnings)?;
-        if let (Some(density), false) = (options.inertia_density, l.has_inertial) {
-            let shapes = if l.collisions.is_empty() {
-                &l.visuals
-            } else {
-                &l.collisions
-            };
-            if !shapes.is_empty() {
-                match crate::geometry::mass_properties(shapes, density) {
-                    Ok((m, c, i)) => (l.mass, l.com, l.inertia) = (m, c, i),
-                    Err(why) => {
-                        warnings.push(src.warning(
-                            n,
-                            format!("link `{}`: no mass from geometry: {why}", l.name),
-                        ));
-                    }
-                }
-            }
-        }
+        let l = read_link(&src, n, &packages, options.inertia_density, &mut warnings)?;
         if link_index.insert(l.name.clone(), link_in.len()).is_some() {
             return Err(src.error(n, format!("duplicate link name `{}`", l.name)));
         }
@@ -462,7 +201,7 @@ pub(super) fn import(
         let (row, col) = src.pos(n);
         ignored.push(format!("{row}:{col} <drake:{}>", n.tag_name().name()));
     }
-    let frames_map = frames.frames.clone();
+    let frames_map = std::mem::take(&mut frames.frames);
     let mut names: HashMap<&str, ()> = HashMap::new();
     let mut preferred_parent: Vec<Option<usize>> = vec![None; link_in.len()];
     for (k, e) in edges.iter().enumerate() {
@@ -511,42 +250,8 @@ pub(super) fn import(
         return Err(src.error(robot, "the URDF joints form a cycle: no root link"));
     };
 
-    // Spanning tree: breadth first from the root (and the undeclared world), preferred edges
-    // first, then loop elements whose parent is placed.
-    let mut reached = vec![false; link_in.len()];
-    let mut tree_order: Vec<usize> = Vec::new();
-    reached[root] = true;
-    let mut queue: std::collections::VecDeque<Option<usize>> =
-        [None, Some(root)].into_iter().collect();
-    loop {
-        while let Some(l) = queue.pop_front() {
-            for (k, e) in edges.iter().enumerate() {
-                if e.source != Source_::Loop && e.parent == l {
-                    if let Some(c) = e.child.filter(|&c| !reached[c]) {
-                        reached[c] = true;
-                        tree_order.push(k);
-                        queue.push_back(Some(c));
-                    }
-                }
-            }
-        }
-        let next = edges.iter().enumerate().find(|(k, e)| {
-            e.source == Source_::Loop
-                && !tree_order.contains(k)
-                && e.parent.is_none_or(|p| reached[p])
-                && e.child.is_some_and(|c| !reached[c])
-        });
-        match next {
-            Some((k, e)) => {
-                let c = e.child.unwrap_or(root);
-                reached[c] = true;
-                tree_order.push(k);
-                queue.push_back(Some(c));
-            }
-            None => break,
-        }
-    }
-    if let Some(l) = (0..link_in.len()).find(|&l| !reached[l]) {
+    let tree = super::tree::spanning_tree(&edges, link_in.len(), root);
+    if let Some(l) = (0..link_in.len()).find(|&l| !tree.reached[l]) {
         let message = if preferred_parent[l].is_none() {
             format!(
                 "second root link `{}` (the tree already has root `{}`): every link but the root must be the child of a <joint> or be reached through a loop joint",
@@ -560,78 +265,32 @@ pub(super) fn import(
         };
         return Err(src.error(link_nodes[l], message));
     }
+    let groups = super::tree::group_links(&edges, &tree, link_in.len(), root);
 
-    // Bodies: groups of links welded by URDF fixed tree joints. Group 0 holds the root.
-    let mut group: Vec<usize> = vec![0; link_in.len()];
-    let mut body_from_link = vec![Isometry3::identity(); link_in.len()];
-    let mut group_root: Vec<usize> = vec![root];
-    let mut world_welded = vec![false; link_in.len()];
-    for &k in &tree_order {
-        let e = &edges[k];
-        let Some(c) = e.child else { continue };
-        if e.source == Source_::Urdf && e.kind == JointKind::Fixed {
-            match e.parent {
-                Some(p) => {
-                    group[c] = group[p];
-                    body_from_link[c] = body_from_link[p] * e.origin;
-                    world_welded[c] = world_welded[p];
-                }
-                None => {
-                    group[c] = 0;
-                    body_from_link[c] = e.origin;
-                    world_welded[c] = true;
-                }
-            }
-        } else {
-            group[c] = group_root.len();
-            group_root.push(c);
-        }
-    }
+    // Bodies (group 0, the root's, is the world unless the base floats) and links.
     let floating = options.floating_base;
-    let body_of = |l: usize| -> Option<BodyId> {
-        if world_welded[l] || (!floating && group[l] == 0) {
-            None
-        } else if floating {
-            Some(BodyId(group[l]))
-        } else {
-            Some(BodyId(group[l] - 1))
-        }
-    };
-    let mut model = Model {
-        name: robot.attribute("name").unwrap_or("robot").to_string(),
-        bodies: Vec::new(),
-        links: Vec::new(),
-        joints: Vec::new(),
-        springs: Vec::new(),
-        joint_springs: Vec::new(),
-        loads: Vec::new(),
-        efforts: Vec::new(),
-        locks: Vec::new(),
-        mimics: Vec::new(),
-        initial: Vec::new(),
-        gravity: options.gravity,
-        length_scale: 1.0,
-    };
-    for (g, &rl) in group_root.iter().enumerate() {
-        if g > 0 || floating {
-            model.bodies.push(Body {
-                name: link_in[rl].name.clone(),
-                mass: 0.0,
-                com: Vector3::zeros(),
-                inertia: Matrix3::zeros(),
-                gravity_mass: 0.0,
-                gravity_com: Vector3::zeros(),
-            });
-        }
+    let mut model = ModelBuilder::new(robot.attribute("name").unwrap_or("robot"));
+    model.set_gravity(options.gravity);
+    let mut body_ids: Vec<Option<BodyId>> = Vec::with_capacity(groups.group_root.len());
+    for (g, &rl) in groups.group_root.iter().enumerate() {
+        body_ids.push((g > 0 || floating).then(|| model.add_body(link_in[rl].name.clone())));
     }
-    for (i, l) in link_in.iter().enumerate() {
-        model.links.push(Link {
-            name: l.name.clone(),
-            body: body_of(i),
-            body_from_link: body_from_link[i],
-            visuals: l.visuals.clone(),
-            collisions: l.collisions.clone(),
-        });
+    let body_of = |l: usize| -> Option<BodyId> {
+        if groups.world_welded[l] {
+            None
+        } else {
+            body_ids[groups.group[l]]
+        }
+    };
+    for (i, l) in link_in.into_iter().enumerate() {
+        model.add_link(
+            l.name,
+            body_of(i),
+            groups.body_from_link[i],
+            l.inertial,
+            l.visuals,
+            l.collisions,
+        );
     }
 
     // Joints, in document order by kind of element.
@@ -639,13 +298,13 @@ pub(super) fn import(
     for (k, e) in edges.iter().enumerate() {
         let place = |l: Option<usize>| {
             l.map_or((None, Isometry3::identity()), |l| {
-                (body_of(l), body_from_link[l])
+                (body_of(l), groups.body_from_link[l])
             })
         };
         let (pb, pf) = place(e.parent);
         let (cb, cf) = place(e.child);
-        let tree = tree_order.contains(&k);
-        let merged = tree && e.source == Source_::Urdf && e.kind == JointKind::Fixed;
+        let tree_edge = tree.in_tree[k];
+        let merged = tree_edge && e.source == Source_::Urdf && e.kind == JointKind::Fixed;
         if !merged && pb == cb {
             return Err(src.error(
                 e.node,
@@ -656,20 +315,20 @@ pub(super) fn import(
             ));
         }
         let rot = Isometry3::from_parts(Default::default(), joint_axes(e.kind, e.axis, e.axis2));
-        if e.auto_child_origin {
-            auto_child.push(model.joints.len());
-        }
-        model.joints.push(Joint {
+        let id = model.push_joint(Joint {
             name: e.name.clone(),
             kind: e.kind,
             parent_link: e.parent_link.clone(),
             child_link: e.child_link.clone(),
             bodies: [pb, cb],
             body_from_joint: [pf * e.origin * rot, cf * e.child_origin * rot],
-            tree,
+            tree: tree_edge,
             merged,
             limits: e.limits,
         });
+        if e.auto_child_origin {
+            auto_child.push(id);
+        }
     }
 
     let urdf_joints: Vec<(String, Node)> = edges
@@ -679,10 +338,8 @@ pub(super) fn import(
         .collect();
     let mut b = Builder {
         model,
-        link_index: link_index.clone(),
+        link_index,
         frames: frames_map,
-        link_in,
-        no_gravity: Vec::new(),
         gravity_set: false,
         warnings,
     };
@@ -690,93 +347,19 @@ pub(super) fn import(
     super::foreign::read(&src, &drake_nodes, &gazebo_nodes, &mut b)?;
     if !auto_child.is_empty() {
         // The child's joint frame that makes the joint hold at the initial guess.
-        let start = crate::solver::initial_state(&b.model);
+        let start = State::initial(b.model.partial());
         for &ji in &auto_child {
-            let j = &b.model.joints[ji];
+            let Some(j) = b.model.joint(ji) else { continue };
             let pose =
                 |body: Option<BodyId>| body.map_or(Isometry3::identity(), |x| start.body_pose(x));
             let world_from_j = pose(j.bodies[0]) * j.body_from_joint[0];
             let f = pose(j.bodies[1]).inverse() * world_from_j;
-            b.model.joints[ji].body_from_joint[1] = f;
+            b.model.set_child_frame(ji, f);
         }
     }
-    finish_mass(&mut b);
-    b.model.length_scale = length_scale(&b.model);
     Ok(Loaded {
-        model: b.model,
+        model: b.model.build()?,
         warnings: b.warnings,
         ignored,
     })
-}
-
-/// Sums link masses into their bodies (parallel-axis theorem for the inertia).
-fn finish_mass(b: &mut Builder) {
-    let n = b.model.bodies.len();
-    let mut m = vec![0.0; n];
-    let mut mc = vec![Vector3::zeros(); n];
-    let mut gm = vec![0.0; n];
-    let mut gmc = vec![Vector3::zeros(); n];
-    for (i, l) in b.link_in.iter().enumerate() {
-        let link = &b.model.links[i];
-        let Some(body) = link.body else { continue };
-        let c = link.body_from_link * nalgebra::Point3::from(l.com);
-        m[body.0] += l.mass;
-        mc[body.0] += l.mass * c.coords;
-        if !b.no_gravity.contains(&i) {
-            gm[body.0] += l.mass;
-            gmc[body.0] += l.mass * c.coords;
-        }
-    }
-    for k in 0..n {
-        let body = &mut b.model.bodies[k];
-        body.mass = m[k];
-        body.com = if m[k] > 0.0 {
-            mc[k] / m[k]
-        } else {
-            Vector3::zeros()
-        };
-        body.gravity_mass = gm[k];
-        body.gravity_com = if gm[k] > 0.0 {
-            gmc[k] / gm[k]
-        } else {
-            Vector3::zeros()
-        };
-    }
-    for (i, l) in b.link_in.iter().enumerate() {
-        let link = &b.model.links[i];
-        let Some(body) = link.body else { continue };
-        let r = link.body_from_link.rotation.to_rotation_matrix();
-        let c = (link.body_from_link * nalgebra::Point3::from(l.com)).coords
-            - b.model.bodies[body.0].com;
-        let parallel = l.mass * (Matrix3::identity() * c.dot(&c) - c * c.transpose());
-        b.model.bodies[body.0].inertia +=
-            r.matrix() * l.inertia * r.matrix().transpose() + parallel;
-    }
-}
-
-/// Characteristic length: the largest offset of a joint frame, spring end or centre of mass
-/// from its body origin (1 m if all are zero).
-fn length_scale(model: &Model) -> f64 {
-    let mut l: f64 = 0.0;
-    for j in &model.joints {
-        for f in &j.body_from_joint {
-            l = l.max(f.translation.vector.norm());
-        }
-    }
-    for b in &model.bodies {
-        l = l.max(b.com.norm());
-    }
-    for s in &model.springs {
-        for e in &s.ends {
-            if e.body.is_some() {
-                l = l.max(e.point.norm());
-            }
-        }
-        l = l.max(s.free_length.abs());
-    }
-    if l > 0.0 {
-        l
-    } else {
-        1.0
-    }
 }

@@ -10,12 +10,19 @@ mod edges;
 mod extensions;
 mod foreign;
 mod import;
+mod links;
+mod schema;
+mod text;
+mod tree;
 mod write_back;
 mod xml;
 
+pub use text::{read_file as read_text, MAX_DEPTH, MAX_FILE_BYTES};
 pub use write_back::with_initial_pose;
 
-use crate::error::{Error, Result};
+#[cfg(doc)]
+use crate::error::Error;
+use crate::error::Result;
 use crate::model::Model;
 use nalgebra::Vector3;
 use std::path::Path;
@@ -66,13 +73,11 @@ pub struct Loaded {
 ///
 /// # Errors
 /// [`Error::Io`] if the file cannot be read, [`Error::Input`] (with line and column) if it is
-/// not a valid restpose URDF.
+/// not a valid restpose URDF, larger than [`MAX_FILE_BYTES`] or nested deeper than
+/// [`MAX_DEPTH`].
 pub fn load_file(path: impl AsRef<Path>, options: &ImportOptions) -> Result<Loaded> {
     let path = path.as_ref();
-    let text = std::fs::read_to_string(path).map_err(|cause| Error::Io {
-        path: path.display().to_string(),
-        cause,
-    })?;
+    let text = text::read_file(path)?;
     let dir = path.parent().map(|d| {
         if d.as_os_str().is_empty() {
             std::path::PathBuf::from(".")

@@ -19,7 +19,7 @@ use std::fmt::Write;
 /// [`crate::Error::Input`] if `text` is not well-formed XML.
 pub fn with_initial_pose(text: &str, file: &str, model: &Model, state: &State) -> Result<String> {
     let mut warnings = Vec::new();
-    let text = super::import::repair_prefixes(text, file, &mut warnings)?;
+    let text = super::text::repair(text, file, &mut warnings)?;
     let doc = super::xml::parse_document(&text, file)?;
     let robot = doc.root_element();
     let prefix = robot.lookup_prefix(MECH_NS).map(str::to_string);

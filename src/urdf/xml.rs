@@ -105,6 +105,22 @@ impl<'a> Source<'a> {
         }
     }
 
+    /// An optional boolean: `true`, `false`, `1` or `0` (XML Schema's canonical forms).
+    pub(crate) fn bool_opt(&self, node: Node, attr: &str) -> Result<Option<bool>> {
+        match node.attribute(attr) {
+            None => Ok(None),
+            Some("true" | "1") => Ok(Some(true)),
+            Some("false" | "0") => Ok(Some(false)),
+            Some(s) => Err(self.error(
+                node,
+                format!(
+                    "{}: attribute `{attr}` = \"{s}\" is not a boolean (true, false, 1 or 0)",
+                    self.describe(node)
+                ),
+            )),
+        }
+    }
+
     /// A number with a default.
     pub(crate) fn f64_or(&self, node: Node, attr: &str, default: f64) -> Result<f64> {
         Ok(self.f64_opt(node, attr)?.unwrap_or(default))

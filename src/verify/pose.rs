@@ -137,9 +137,17 @@ fn has_content(doc: &str) -> bool {
 /// [`Error::Option`] for a joint the model does not have or a value list of the wrong length.
 pub fn pose_state(model: &Model, values: &JointValues) -> Result<(State, Vec<String>)> {
     let mut all = crate::solver::initial_values(model);
+    // Names by map: a pose names every joint, and a linear search each is O(N²).
+    let ids: std::collections::HashMap<&str, crate::model::JointId> = model
+        .joints
+        .iter()
+        .enumerate()
+        .map(|(i, j)| (j.name.as_str(), crate::model::JointId(i)))
+        .collect();
     for (name, v) in values {
-        let id = model
-            .joint_id(name)
+        let id = ids
+            .get(name.as_str())
+            .copied()
             .ok_or_else(|| Error::Option(format!("pose: the model has no joint `{name}`")))?;
         let j = model.joint(id);
         let expected: &[usize] = match j.kind {

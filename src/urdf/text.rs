@@ -1,0 +1,346 @@
+//! From the bytes of a file to XML text that the parser accepts, the way ROS's parser
+//! (urdfdom, on TinyXML2) accepts it: Latin-1 decoding when the declaration says so, an XML
+//! declaration after leading whitespace or comments, namespace prefixes used without being
+//! declared. Each repair leaves a warning. Also the resource bounds of the importer: file size
+//! and nesting depth, checked before the (recursive) XML parser sees the text.
+//!
+//! Repairs keep every byte offset of the original text where they can (a misplaced declaration
+//! is blanked, not removed), so that line and column numbers in messages are those of the file.
+
+use crate::error::{Error, Result};
+
+/// Largest URDF file read \[bytes\] (256 MiB): a description of 100,000 links is ~50 MB.
+pub const MAX_FILE_BYTES: u64 = 256 << 20;
+
+/// Deepest element nesting accepted. URDF nests at most ~6 levels (robot, link, visual,
+/// geometry, mesh); the XML parser recurses once per level, so a hostile file of 100,000
+/// levels would overflow the stack.
+pub const MAX_DEPTH: usize = 1_000;
+
+/// The xacro hint.
+const XACRO: &str =
+    "xacro macros are not expanded URDF: run `xacro FILE.urdf.xacro > FILE.urdf` first";
+
+/// Encoding names (lower case) read as Latin-1, where every byte is the code point of that
+/// value. `windows-1252` differs only in 0x80–0x9F, which URDF files do not use for markup.
+const LATIN1: [&str; 8] = [
+    "iso-8859-1",
+    "iso_8859-1",
+    "iso8859-1",
+    "latin1",
+    "latin-1",
+    "l1",
+    "windows-1252",
+    "cp1252",
+];
+
+/// The encoding declared in a leading `<?xml … encoding="…"?>`, lower case.
+fn declared_encoding(bytes: &[u8]) -> Option<String> {
+    let head = &bytes[..bytes.len().min(1024)];
+    let head: String = head.iter().map(|&b| b as char).collect();
+    let at = head.find("<?xml")?;
+    let end = at + head[at..].find("?>")?;
+    let decl = &head[at..end];
+    let e = decl.find("encoding")? + "encoding".len();
+    let rest = decl[e..].trim_start().strip_prefix('=')?.trim_start();
+    let quote = rest.chars().next().filter(|c| *c == '"' || *c == '\'')?;
+    let value = &rest[1..];
+    Some(value[..value.find(quote)?].to_ascii_lowercase())
+}
+
+/// Decodes the bytes of `file`: UTF-8 (with or without a byte-order mark), or Latin-1 when
+/// the declaration names it.
+///
+/// # Errors
+/// [`Error::Input`] if the bytes are neither valid UTF-8 nor in a declared encoding restpose
+/// reads.
+pub(crate) fn decode(bytes: &[u8], file: &str) -> Result<String> {
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    let encoding = declared_encoding(bytes);
+    if encoding
+        .as_deref()
+        .is_some_and(|e| LATIN1.contains(&e) || e == "us-ascii" || e == "ascii")
+    {
+        return Ok(bytes.iter().map(|&b| b as char).collect());
+    }
+    match std::str::from_utf8(bytes) {
+        Ok(s) => Ok(s.to_string()),
+        Err(e) => {
+            let at = e.valid_up_to();
+            let before = &bytes[..at];
+            let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+            let line_start = before
+                .iter()
+                .rposition(|&b| b == b'\n')
+                .map_or(0, |p| p + 1);
+            let col = String::from_utf8_lossy(&before[line_start..])
+                .chars()
+                .count()
+                + 1;
+            Err(Error::Input {
+                file: file.to_string(),
+                line: line as u32,
+                col: col as u32,
+                message: format!(
+                    "byte 0x{:02X} is not UTF-8 and the file declares {} (restpose reads UTF-8, and ISO-8859-1 when declared)",
+                    bytes[at],
+                    encoding.map_or("no encoding".to_string(), |e| format!("encoding \"{e}\""))
+                ),
+            })
+        }
+    }
+}
+
+/// Reads and decodes a URDF file, refusing one larger than [`MAX_FILE_BYTES`].
+///
+/// # Errors
+/// [`Error::Io`] if the file cannot be read, [`Error::Input`] if it is too large or not
+/// decodable.
+pub fn read_file(path: &std::path::Path) -> Result<String> {
+    let io = |cause| Error::Io {
+        path: path.display().to_string(),
+        cause,
+    };
+    let len = std::fs::metadata(path).map_err(io)?.len();
+    if len > MAX_FILE_BYTES {
+        return Err(Error::Input {
+            file: path.display().to_string(),
+            line: 1,
+            col: 1,
+            message: format!(
+                "the file has {len} bytes, more than the {MAX_FILE_BYTES} bytes (256 MiB) restpose reads"
+            ),
+        });
+    }
+    let bytes = std::fs::read(path).map_err(io)?;
+    decode(&bytes, &path.display().to_string())
+}
+
+/// Line and column (from 1, column in characters) of byte offset `at` of `text`.
+fn line_col(text: &str, at: usize) -> (u32, u32) {
+    let before = &text[..at.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let start = before.rfind('\n').map_or(0, |p| p + 1);
+    (line as u32, before[start..].chars().count() as u32 + 1)
+}
+
+/// Blanks an XML declaration that follows leading whitespace or comments (TinyXML2 accepts
+/// it there; XML does not), keeping offsets. Returns whether it did.
+fn blank_late_declaration(text: &mut String) -> bool {
+    let mut at = 0;
+    let b = text.as_bytes();
+    if b.starts_with(b"<?xml") {
+        return false;
+    }
+    loop {
+        while at < b.len() && b[at].is_ascii_whitespace() {
+            at += 1;
+        }
+        if b[at..].starts_with(b"<!--") {
+            match text[at..].find("-->") {
+                Some(e) => at += e + 3,
+                None => return false,
+            }
+        } else if b[at..].starts_with(b"<?xml")
+            && b.get(at + 5).is_some_and(|c| c.is_ascii_whitespace())
+        {
+            let Some(e) = text[at..].find("?>") else {
+                return false;
+            };
+            let blank: String = text[at..at + e + 2]
+                .chars()
+                .map(|c| if c == '\n' { '\n' } else { ' ' })
+                .collect();
+            text.replace_range(at..at + e + 2, &blank);
+            return true;
+        } else {
+            return false;
+        }
+    }
+}
+
+/// Refuses text nested deeper than [`MAX_DEPTH`], by a scan that skips comments, CDATA,
+/// processing instructions, the DOCTYPE and quoted attribute values. Malformed text is left
+/// to the parser, which reports it.
+fn check_depth(text: &str, file: &str) -> Result<()> {
+    let b = text.as_bytes();
+    let mut depth = 0usize;
+    let mut i = 0;
+    let skip_to = |from: usize, end: &str| text[from..].find(end).map(|e| from + e + end.len());
+    while i < b.len() {
+        if b[i] != b'<' {
+            i += 1;
+            continue;
+        }
+        let rest = &b[i..];
+        let next = if rest.starts_with(b"<!--") {
+            skip_to(i, "-->")
+        } else if rest.starts_with(b"<![CDATA[") {
+            skip_to(i, "]]>")
+        } else if rest.starts_with(b"<?") {
+            skip_to(i, "?>")
+        } else if rest.starts_with(b"<!") {
+            // DOCTYPE with an optional internal subset in brackets.
+            let mut k = i + 2;
+            let mut brackets = 0i32;
+            while k < b.len() && !(b[k] == b'>' && brackets <= 0) {
+                match b[k] {
+                    b'[' => brackets += 1,
+                    b']' => brackets -= 1,
+                    _ => {}
+                }
+                k += 1;
+            }
+            Some(k + 1)
+        } else if rest.starts_with(b"</") {
+            depth = depth.saturating_sub(1);
+            skip_to(i, ">")
+        } else {
+            // A start tag: skip quoted values, then see whether it closes itself.
+            let mut k = i + 1;
+            let mut quote: Option<u8> = None;
+            while k < b.len() {
+                match (quote, b[k]) {
+                    (None, b'"' | b'\'') => quote = Some(b[k]),
+                    (Some(q), c) if c == q => quote = None,
+                    (None, b'>') => break,
+                    _ => {}
+                }
+                k += 1;
+            }
+            if k < b.len() && b[k - 1] != b'/' {
+                depth += 1;
+                if depth > MAX_DEPTH {
+                    let (line, col) = line_col(text, i);
+                    return Err(Error::Input {
+                        file: file.to_string(),
+                        line,
+                        col,
+                        message: format!(
+                            "elements are nested more than {MAX_DEPTH} levels deep (URDF needs about 6)"
+                        ),
+                    });
+                }
+            }
+            Some(k + 1)
+        };
+        match next {
+            Some(n) => i = n,
+            None => return Ok(()),
+        }
+    }
+    Ok(())
+}
+
+/// The URI given to a prefix used without a declaration, other than `mech:` and `drake:`.
+fn undeclared_uri(prefix: &str) -> String {
+    format!("urn:restpose:undeclared:{prefix}")
+}
+
+/// Makes `text` parseable the way urdfdom reads it: checks the nesting depth, blanks a late
+/// XML declaration, declares prefixes used without a declaration (`mech:` and `drake:` to
+/// their namespaces, others to a placeholder) on `<robot>`, and refuses xacro. Each repair
+/// adds a warning.
+///
+/// # Errors
+/// [`Error::Input`] for text nested too deeply or a xacro file.
+pub(crate) fn repair(text: &str, file: &str, warnings: &mut Vec<String>) -> Result<String> {
+    check_depth(text, file)?;
+    let mut out = text.to_string();
+    if blank_late_declaration(&mut out) {
+        warnings.push(format!(
+            "{file}: the XML declaration is not at the start of the file; read as if it were"
+        ));
+    }
+    let popts = roxmltree::ParsingOptions {
+        allow_dtd: true,
+        ..Default::default()
+    };
+    // Each round declares one prefix; a file uses a handful.
+    for _ in 0..64 {
+        let (prefix, pos) = match roxmltree::Document::parse_with_options(&out, popts) {
+            Err(roxmltree::Error::UnknownNamespace(prefix, pos)) => (prefix, pos),
+            Err(_) => return Ok(out),
+            Ok(doc) => {
+                for n in doc.descendants().filter(|n| n.is_element()) {
+                    let xacro = n
+                        .tag_name()
+                        .namespace()
+                        .is_some_and(|u| u.contains("xacro"));
+                    if xacro || n.attributes().any(|a| a.value().contains("${")) {
+                        let p = doc.text_pos_at(n.range().start);
+                        return Err(Error::Input {
+                            file: file.to_string(),
+                            line: p.row,
+                            col: p.col,
+                            message: XACRO.into(),
+                        });
+                    }
+                }
+                return Ok(out);
+            }
+        };
+        let uri = match prefix.as_str() {
+            "mech" => super::xml::MECH_NS.to_string(),
+            "drake" => super::edges::DRAKE_NS.to_string(),
+            "xacro" => {
+                return Err(Error::Input {
+                    file: file.to_string(),
+                    line: pos.row,
+                    col: pos.col,
+                    message: XACRO.into(),
+                })
+            }
+            other => undeclared_uri(other),
+        };
+        let Some(at) = out.find("<robot").map(|p| p + "<robot".len()) else {
+            return Ok(out);
+        };
+        out.insert_str(at, &format!(" xmlns:{prefix}=\"{uri}\""));
+        warnings.push(format!(
+            "{file}:{}:{}: the `{prefix}:` prefix is used but not declared; assumed xmlns:{prefix}=\"{uri}\"",
+            pos.row, pos.col
+        ));
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn late_declaration_is_blanked_in_place() {
+        let mut t = "<!-- c -->\n  <?xml version=\"1.0\"?>\n<robot/>".to_string();
+        let before = t.len();
+        assert!(blank_late_declaration(&mut t));
+        assert_eq!(t.len(), before);
+        assert!(!t.contains("<?xml"));
+        assert!(roxmltree::Document::parse(&t).is_ok());
+        let mut ok = "<?xml version=\"1.0\"?><robot/>".to_string();
+        assert!(!blank_late_declaration(&mut ok));
+    }
+
+    #[test]
+    fn latin1_is_decoded_when_declared() {
+        let bytes = b"<?xml version=\"1.0\" encoding=\"ISO-8859-1\"?><robot name=\"r\xE9\"/>";
+        let s = decode(bytes, "f").unwrap();
+        assert!(s.contains("r\u{e9}"));
+        let err = decode(b"<robot name=\"r\xE9\"/>", "f").unwrap_err();
+        assert!(err.to_string().starts_with("f:1:15:"), "{err}");
+    }
+
+    #[test]
+    fn depth_scan_counts_elements_only() {
+        let deep = |n: usize| format!("{}{}", "<a>".repeat(n), "</a>".repeat(n));
+        assert!(check_depth(&deep(MAX_DEPTH), "f").is_ok());
+        let e = check_depth(&deep(MAX_DEPTH + 1), "f").unwrap_err();
+        assert!(e.to_string().contains("nested more than"), "{e}");
+        // Self-closing tags, comments, attribute values with `>` and CDATA do not nest.
+        let flat = format!(
+            "<r>{}<!-- <a> --><b v=\"<a>\"/><![CDATA[<a><a>]]></r>",
+            "<c/>".repeat(5000)
+        );
+        assert!(check_depth(&flat, "f").is_ok());
+    }
+}

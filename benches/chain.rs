@@ -34,7 +34,7 @@ fn model_text(family: &str, n: usize) -> (String, String) {
     }
 }
 
-#[path = "../tests/common/energies.rs"]
+#[path = "../tests/it/common/energies.rs"]
 mod energies;
 
 /// The family's potential energy written independently in joint coordinates.

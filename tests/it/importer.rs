@@ -1,7 +1,6 @@
 //! Foreign extensions, frames, automatic child origins and the joint graph.
-mod common;
+use crate::common::*;
 use approx::assert_abs_diff_eq;
-use common::*;
 use restpose::urdf::{load_str, ImportOptions};
 
 fn robot_text(name: &str) -> String {

@@ -1,6 +1,5 @@
 //! `--write-urdf` and `--write-joint-states`: the next run starts at rest.
-mod common;
-use common::*;
+use crate::common::*;
 use std::process::Command;
 
 #[test]

@@ -2,7 +2,7 @@
 //! `robots/`, compared with `tests/golden/ROBOT.json` field by field.
 //!
 //! Regenerate after an intended change with
-//! `RESTPOSE_BLESS=1 cargo test --release --test golden`, and review the diff.
+//! `RESTPOSE_BLESS=1 cargo test --release --test it golden`, and review the diff.
 //!
 //! Compared: every key (none missing, none extra), strings and booleans exactly, integers
 //! (iterations, counters, sizes) exactly, other numbers within `|a − b| ≤ 1e-9 + 1e-7 |b|`
@@ -206,7 +206,7 @@ fn results_match_the_golden_files() {
     }
     assert!(
         failures.is_empty(),
-        "{}\n(after an intended change: RESTPOSE_BLESS=1 cargo test --release --test golden, then review the diff)",
+        "{}\n(after an intended change: RESTPOSE_BLESS=1 cargo test --release --test it golden, then review the diff)",
         failures.join("\n")
     );
 }

@@ -1,7 +1,6 @@
 //! Every robot in `robots/` converges to a verified stable equilibrium.
-mod common;
+use crate::common::*;
 use approx::assert_abs_diff_eq;
-use common::*;
 use nalgebra::Point3;
 
 #[test]

@@ -1,7 +1,6 @@
 //! The pendulum with spring of the paper (NOTES.md): closed-form reference values.
-mod common;
+use crate::common::*;
 use approx::assert_abs_diff_eq;
-use common::*;
 use restpose::{Method, Options};
 
 #[test]

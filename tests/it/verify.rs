@@ -1,7 +1,6 @@
 //! `restpose verify` and the verification API.
-mod common;
+use crate::common::*;
 use approx::assert_abs_diff_eq;
-use common::*;
 use restpose::verify::{parse_pose, pose_state, verify, Tolerances};
 use std::process::Command;
 

@@ -1,7 +1,6 @@
 //! Stability, reactions, locks, units and unbounded energy.
-mod common;
+use crate::common::*;
 use approx::assert_abs_diff_eq;
-use common::*;
 use restpose::urdf::{load_str, ImportOptions};
 use restpose::Options;
 

@@ -1,7 +1,5 @@
 //! The rerun recording (feature `viewer`): written, then read back with rerun's own decoder.
-#![cfg(feature = "viewer")]
-mod common;
-use common::*;
+use crate::common::*;
 
 #[test]
 fn recording_holds_the_mechanism_the_search_and_the_forces() {

@@ -1,8 +1,7 @@
 //! The sparse large-scale path (`LinearAlgebra::Sparse`): the same equilibria as the dense path
 //! on every robot, and verified equilibria of chains and ladders too large for the dense path,
 //! checked against energies written here in joint coordinates.
-mod common;
-use common::*;
+use crate::common::*;
 use restpose::{LinearAlgebra, Model, Options};
 
 fn solve_with(model: &Model, la: LinearAlgebra) -> (restpose::State, restpose::Report) {

@@ -1,8 +1,7 @@
 //! Robots written from published data of real machines, and files as ROS and Drake users
 //! write them.
-mod common;
+use crate::common::*;
 use approx::assert_abs_diff_eq;
-use common::*;
 
 /// Drake tags: a four-bar closed by `drake:ball_constraint`, with a `drake:joint` universal and
 /// a `drake:linear_spring_damper`. The rest angles agree with an independent minimization of

@@ -1,0 +1,126 @@
+//! The layers of the library, held by a test: each top-level module of `src/` may use only
+//! the modules of lower layers (and, within its own layer, only itself), so the module graph
+//! has no cycle and no upward import. The table is the architecture of `docs/architecture.md`:
+//!
+//! ```text
+//! error, math  →  geometry  →  model  →  jet  →  kinematics  →  constraints | forces
+//!   →  state  →  urdf | generate  →  solver  →  verify  →  export | view  →  (cli)
+//! ```
+//!
+//! A reference is any `crate::module` path in code (comments and doc links are skipped).
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Layer of each top-level module; a module may use modules of strictly lower layers.
+const LAYERS: &[(&str, u32)] = &[
+    ("error", 0),
+    ("math", 0),
+    ("geometry", 1),
+    ("model", 2),
+    ("jet", 3),
+    ("kinematics", 4),
+    ("constraints", 5),
+    ("forces", 5),
+    ("state", 6),
+    ("urdf", 7),
+    ("generate", 7),
+    ("solver", 8),
+    ("verify", 9),
+    ("export", 10),
+    ("view", 10),
+    ("cli", 11),
+];
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).expect("src/ is readable") {
+        let path = entry.expect("directory entry").path();
+        if path.is_dir() {
+            rust_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            out.push(path);
+        }
+    }
+}
+
+/// The top-level module a file of `src/` belongs to (`None` for lib.rs and main.rs).
+fn module_of(src: &Path, file: &Path) -> Option<String> {
+    let rel = file.strip_prefix(src).ok()?;
+    let first = rel.components().next()?.as_os_str().to_str()?.to_owned();
+    let name = first.trim_end_matches(".rs").to_owned();
+    (name != "lib" && name != "main").then_some(name)
+}
+
+/// Modules named by `crate::NAME` in the code of `text`, with the line of each use.
+fn references(text: &str) -> Vec<(String, usize)> {
+    let mut found = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let code = line.trim_start();
+        if code.starts_with("//") {
+            continue;
+        }
+        let code = code.split("//").next().unwrap_or("");
+        // `use crate::{a, b::c}` groups.
+        if let Some(rest) = code.split("crate::{").nth(1) {
+            let group = rest.split('}').next().unwrap_or("");
+            for item in group.split(',') {
+                let head = item.trim().split("::").next().unwrap_or("").trim();
+                if !head.is_empty() {
+                    found.push((head.to_owned(), n + 1));
+                }
+            }
+        }
+        for part in code.split("crate::").skip(1) {
+            let head: String = part
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .collect();
+            if !head.is_empty() {
+                found.push((head, n + 1));
+            }
+        }
+    }
+    found
+}
+
+#[test]
+fn modules_use_only_lower_layers() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let layer: BTreeMap<&str, u32> = LAYERS.iter().copied().collect();
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    files.sort();
+    let mut violations = Vec::new();
+    for file in &files {
+        let Some(module) = module_of(&src, file) else {
+            continue;
+        };
+        let Some(&own) = layer.get(module.as_str()) else {
+            violations.push(format!(
+                "{}: module `{module}` has no layer",
+                file.display()
+            ));
+            continue;
+        };
+        let text = std::fs::read_to_string(file).expect("source is readable");
+        for (used, line) in references(&text) {
+            if used == module {
+                continue;
+            }
+            match layer.get(used.as_str()) {
+                Some(&l) if l < own => {}
+                Some(&l) => violations.push(format!(
+                    "{}:{line}: `{module}` (layer {own}) uses `{used}` (layer {l})",
+                    file.display()
+                )),
+                // Re-exports at the crate root (`crate::Error`, `crate::Model`) and macros.
+                None => {}
+            }
+        }
+    }
+    assert!(
+        violations.is_empty(),
+        "upward or sideways imports:\n{}",
+        violations.join("\n")
+    );
+}

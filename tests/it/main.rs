@@ -1,0 +1,24 @@
+//! The integration tests, one crate (the shared helpers of `common` are compiled once),
+//! one module per topic. `regressions/` holds one file per fixed bug, named
+//! `issue_<n>_<what>.rs`, each opening with a paragraph on the bug.
+
+mod angles;
+mod architecture;
+mod cli;
+mod common;
+mod engineering;
+mod golden;
+mod importer;
+mod importer_fuzz;
+mod input_errors;
+mod meshes;
+mod paper_pendulum;
+mod properties;
+mod real_robots;
+mod regressions;
+mod robots;
+mod sparse;
+mod verify;
+#[cfg(feature = "viewer")]
+mod viewer;
+mod write_back;

@@ -8,6 +8,27 @@
 
 use std::fmt::Write;
 
+/// A generated mechanism family.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+pub enum Family {
+    /// N-link spatial pendulum chain with joint springs (alternating joint axes).
+    Chain,
+    /// N-link planar chain (all axes parallel) with joint springs.
+    PlanarChain,
+    /// Ladder of N closed four-bar loops.
+    Ladder,
+}
+
+/// URDF text of a mechanism of `family` with `n` links (chains) or loops (ladder).
+pub fn family(family: Family, n: usize) -> String {
+    match family {
+        Family::Chain => chain(n, false),
+        Family::PlanarChain => chain(n, true),
+        Family::Ladder => ladder(n),
+    }
+}
+
 /// URDF text of an `n`-link pendulum chain with joint springs.
 pub fn chain(n: usize, planar: bool) -> String {
     let mut s = String::new();

@@ -1,9 +1,9 @@
 //! `restpose analyze`: solve for the rest pose, write the requested files, print a summary.
 
 use super::args::{coord, AnalyzeArgs};
-use super::{exit, print};
+use super::{exit, print, suggest};
 use restpose::export::json::AnalysisResult;
-use restpose::urdf::load_file;
+use restpose::urdf::{load_file, ImportOptions};
 
 /// Runs `analyze`: exit 0 when converged, 3 when not.
 pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
@@ -16,7 +16,10 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
         opts.initial.push(coord(l, "initial")?);
     }
     let import_started = std::time::Instant::now();
-    let loaded = load_file(&a.file, &opts)?;
+    let loaded = match load_file(&a.file, &opts) {
+        Ok(l) => l,
+        Err(e) => return Err(unknown_joint(a, &opts).unwrap_or_else(|| e.into())),
+    };
     let import = import_started.elapsed().as_secs_f64();
     if !a.quiet {
         for w in &loaded.warnings {
@@ -78,6 +81,33 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
         return Ok(exit::NOT_CONVERGED);
     }
     Ok(0)
+}
+
+/// When loading failed: the first `--lock` or `--initial` naming a joint the model does not
+/// have, with the closest joint name (found by loading the file again without them).
+fn unknown_joint(a: &AnalyzeArgs, opts: &ImportOptions) -> Option<anyhow::Error> {
+    if opts.locks.is_empty() && opts.initial.is_empty() {
+        return None;
+    }
+    let plain = ImportOptions {
+        locks: Vec::new(),
+        initial: Vec::new(),
+        ..opts.clone()
+    };
+    let model = load_file(&a.file, &plain).ok()?.model;
+    let given =
+        (a.lock.iter().map(|s| ("lock", s))).chain(a.initial.iter().map(|s| ("initial", s)));
+    for (what, s) in given {
+        let (name, _, _) = coord(s, what).ok()?;
+        if model.joint_id(&name).is_none() {
+            let names = model.joints.iter().map(|j| j.name.as_str());
+            return Some(anyhow::anyhow!(
+                "--{what} {s}: the model has no joint `{name}`{}",
+                suggest::hint(&name, names)
+            ));
+        }
+    }
+    None
 }
 
 #[cfg(feature = "viewer")]

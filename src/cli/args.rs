@@ -2,6 +2,7 @@
 //! for the solver and [`Tolerances::default`] for `verify`; the solver's enums are
 //! `clap::ValueEnum` themselves (feature `cli`).
 
+use super::parse;
 use anyhow::{bail, Context};
 use clap::{Parser, Subcommand, ValueEnum};
 use restpose::urdf::ImportOptions;
@@ -38,14 +39,15 @@ pub(crate) enum Command {
 #[derive(clap::Args, Clone)]
 pub(crate) struct InputArgs {
     /// Gravity [m/s²] when the file has no <mech:gravity>.
-    #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_hyphen_values = true)]
+    #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_hyphen_values = true,
+          value_parser = parse::finite)]
     pub(crate) gravity: Option<Vec<f64>>,
     /// Where `package://NAME/…` meshes live (repeatable).
     #[arg(long, value_name = "NAME=DIR")]
     pub(crate) package: Vec<String>,
     /// Give links without <inertial> the mass properties of their collision (else visual)
     /// geometry at this density [kg/m³].
-    #[arg(long, value_name = "DENSITY")]
+    #[arg(long, value_name = "DENSITY", value_parser = parse::positive)]
     pub(crate) inertia_from_geometry: Option<f64>,
     /// Leave the root link free instead of welding it to the world.
     #[arg(long)]
@@ -68,11 +70,6 @@ impl InputArgs {
                 .split_once('=')
                 .with_context(|| format!("--package {p}: expected NAME=DIR"))?;
             opts.packages.push((n.to_string(), PathBuf::from(d)));
-        }
-        if let Some(d) = self.inertia_from_geometry {
-            if !(d.is_finite() && d > 0.0) {
-                bail!("--inertia-from-geometry {d}: the density must be positive");
-            }
         }
         Ok(opts)
     }
@@ -108,7 +105,8 @@ pub(crate) struct VerifyArgs {
     /// URDF file.
     pub(crate) file: PathBuf,
     /// Pose: restpose result JSON, a {"joint": value} JSON map, or ROS joint_states-style
-    /// YAML/JSON (`name` and `position` lists).
+    /// YAML/JSON (`name` and `position` lists, restpose's `multi_dof` section, `rostopic echo`
+    /// output: the last message).
     #[arg(long, value_name = "POSE")]
     pub(crate) pose: Option<PathBuf>,
     /// Joint value (repeatable; overrides the pose file): JOINT=VALUE or JOINT[DOF]=VALUE.
@@ -116,10 +114,10 @@ pub(crate) struct VerifyArgs {
     pub(crate) joint: Vec<String>,
     /// Largest effort a joint may need for the pose to pass [N m or N], plus 1e-9 of the
     /// largest generalized force on any coordinate.
-    #[arg(long, default_value_t = Tolerances::default().force)]
+    #[arg(long, default_value_t = Tolerances::default().force, value_parser = parse::positive)]
     pub(crate) force_tolerance: f64,
     /// Largest constraint violation for the pose to pass [m or rad].
-    #[arg(long, default_value_t = Tolerances::default().constraint)]
+    #[arg(long, default_value_t = Tolerances::default().constraint, value_parser = parse::positive)]
     pub(crate) constraint_tolerance: f64,
     /// Write the verification as JSON to this file (`-`: standard output, which then carries
     /// only the JSON: no report).
@@ -136,21 +134,10 @@ pub(crate) struct VerifyArgs {
 pub(crate) struct GenerateArgs {
     /// Family.
     #[arg(value_enum)]
-    pub(crate) family: Family,
-    /// Number of links (chains) or loops (ladder).
-    #[arg(long, default_value_t = 20)]
+    pub(crate) family: restpose::generate::Family,
+    /// Number of links (chains) or loops (ladder), 1 to 1,000,000.
+    #[arg(long, default_value_t = 20, value_parser = parse::generate_size)]
     pub(crate) size: usize,
-}
-
-/// Generated mechanism families.
-#[derive(Clone, Copy, ValueEnum)]
-pub(crate) enum Family {
-    /// N-link spatial pendulum chain with joint springs (alternating joint axes).
-    Chain,
-    /// N-link planar chain (all axes parallel) with joint springs.
-    PlanarChain,
-    /// Ladder of N closed four-bar loops.
-    Ladder,
 }
 
 #[derive(clap::Args, Clone)]
@@ -182,10 +169,10 @@ pub(crate) struct AnalyzeArgs {
     #[arg(long, default_value_t = Options::default().max_iterations)]
     pub(crate) max_iterations: usize,
     /// Tolerance on the scaled reduced gradient [J].
-    #[arg(long, default_value_t = Options::default().gradient_tolerance)]
+    #[arg(long, default_value_t = Options::default().gradient_tolerance, value_parser = parse::positive)]
     pub(crate) tolerance: f64,
     /// Tolerance on the constraint residual ‖Φ‖∞.
-    #[arg(long, default_value_t = Options::default().constraint_tolerance)]
+    #[arg(long, default_value_t = Options::default().constraint_tolerance, value_parser = parse::positive)]
     pub(crate) constraint_tolerance: f64,
     /// Minimizer.
     #[arg(long, value_enum, default_value_t = Options::default().method)]
@@ -195,8 +182,9 @@ pub(crate) struct AnalyzeArgs {
     #[arg(long, value_enum, default_value_t = Options::default().linear_algebra)]
     pub(crate) linear_algebra: LinearAlgebra,
     /// Ramp gravity, loads and efforts in N steps (0: automatic, 8 steps only if the direct
-    /// solve fails; 1: never).
-    #[arg(long, default_value_t = Options::default().load_steps, value_name = "N")]
+    /// solve fails; 1: never; at most 1000).
+    #[arg(long, default_value_t = Options::default().load_steps, value_name = "N",
+          value_parser = parse::load_steps)]
     pub(crate) load_steps: usize,
     /// Stop at an unstable stationary point instead of leaving it.
     #[arg(long)]

@@ -15,21 +15,20 @@ pub(crate) fn run(a: &CheckArgs) -> anyhow::Result<u8> {
     if let Some(path) = &a.json {
         print::write_json(path, &serde_json::to_string_pretty(&s)?)?;
     }
+    let stdout_json = print::is_stdout(a.json.as_ref());
     match a.format {
-        Format::Json if !print::is_stdout(a.json.as_ref()) => {
-            out!("{}", serde_json::to_string_pretty(&s)?)
+        Format::Json if !stdout_json => out!("{}", serde_json::to_string_pretty(&s)?),
+        Format::Text if !stdout_json => print::model(&s),
+        _ => {}
+    }
+    // The JSON carries the warnings; the text form gives them on standard error.
+    if let Format::Text = a.format {
+        for w in &s.warnings {
+            eprintln!("warning: {w}");
         }
-        Format::Json => {}
-        Format::Text if print::is_stdout(a.json.as_ref()) => {}
-        Format::Text => {
-            print::model(&s);
-            for w in &s.warnings {
-                eprintln!("warning: {w}");
-            }
-            if a.verbose {
-                for i in &s.ignored {
-                    eprintln!("ignored: {}:{i}", a.file.display());
-                }
+        if a.verbose {
+            for i in &s.ignored {
+                eprintln!("ignored: {}:{i}", a.file.display());
             }
         }
     }

@@ -7,6 +7,8 @@ pub(crate) mod args;
 pub(crate) mod check;
 pub(crate) mod exit;
 pub(crate) mod generate;
+pub(crate) mod parse;
 pub(crate) mod print;
+pub(crate) mod suggest;
 pub(crate) mod verify;
 pub(crate) mod view;

@@ -432,6 +432,163 @@ fn joints_in_file_order_with_units() {
     }
 }
 
+/// Issue 12 §3: numeric options are checked when parsed; the message names the option and
+/// the run stops with a usage error (exit 2) before reading the file.
+#[test]
+fn numeric_options_are_validated() {
+    let pendulum = robot("pendulum");
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec!["analyze", &pendulum, "--tolerance", "0"],
+            "--tolerance",
+        ),
+        (
+            vec!["analyze", &pendulum, "--tolerance=-1e-8"],
+            "--tolerance",
+        ),
+        (
+            vec!["analyze", &pendulum, "--tolerance", "nan"],
+            "--tolerance",
+        ),
+        (
+            vec!["analyze", &pendulum, "--constraint-tolerance", "inf"],
+            "--constraint-tolerance",
+        ),
+        (
+            vec!["analyze", &pendulum, "--constraint-tolerance", "0"],
+            "--constraint-tolerance",
+        ),
+        (
+            vec!["analyze", &pendulum, "--gravity", "0", "nan", "-9.81"],
+            "--gravity",
+        ),
+        (
+            vec!["analyze", &pendulum, "--gravity", "0", "0", "-inf"],
+            "--gravity",
+        ),
+        (
+            vec!["analyze", &pendulum, "--load-steps", "1001"],
+            "--load-steps",
+        ),
+        (
+            vec!["analyze", &pendulum, "--inertia-from-geometry=-5"],
+            "--inertia-from-geometry",
+        ),
+        (
+            vec!["analyze", &pendulum, "--inertia-from-geometry", "0"],
+            "--inertia-from-geometry",
+        ),
+        (
+            vec![
+                "verify",
+                &pendulum,
+                "--joint",
+                "pivot=0",
+                "--force-tolerance=-1",
+            ],
+            "--force-tolerance",
+        ),
+        (
+            vec![
+                "verify",
+                &pendulum,
+                "--joint",
+                "pivot=0",
+                "--constraint-tolerance",
+                "nan",
+            ],
+            "--constraint-tolerance",
+        ),
+        (
+            vec!["check", &pendulum, "--gravity", "inf", "0", "0"],
+            "--gravity",
+        ),
+        (vec!["generate", "chain", "--size", "0"], "--size"),
+    ];
+    for (args, option) in cases {
+        let o = restpose().args(&args).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(option), "{args:?}: {err}");
+        assert!(o.stdout.is_empty(), "{args:?}");
+    }
+    // The bound of --load-steps is in the message; values inside the ranges run.
+    let o = restpose()
+        .args(["analyze", &pendulum, "--load-steps", "5000"])
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&o.stderr).contains("1000"));
+    let o = restpose()
+        .args([
+            "analyze",
+            &pendulum,
+            "-q",
+            "--load-steps",
+            "1000",
+            "--tolerance",
+            "1e-9",
+        ])
+        .args([
+            "--constraint-tolerance",
+            "1e-11",
+            "--gravity",
+            "0",
+            "0",
+            "-9.81",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+/// Issue 12 §4: a joint name on the command line that the model does not have is an input
+/// error (exit 1) naming the option and suggesting the closest joint name.
+#[test]
+fn unknown_joint_names_get_a_suggestion() {
+    let arm = robot("ur5_class");
+    for (args, hint) in [
+        (
+            vec!["analyze", &arm, "--lock", "elbow_jiont=0.3"],
+            Some("elbow_joint"),
+        ),
+        (
+            vec!["analyze", &arm, "--initial", "wrist_2=0.3"],
+            Some("wrist_2_joint"),
+        ),
+        (
+            vec!["analyze", &arm, "--lock", "Shoulder_Lift_Joint=0.1"],
+            Some("shoulder_lift_joint"),
+        ),
+        (vec!["analyze", &arm, "--lock", "gripper=0"], None),
+        (
+            vec!["verify", &arm, "--joint", "wrist_3_jont=0.1"],
+            Some("wrist_3_joint"),
+        ),
+    ] {
+        let o = restpose().args(&args).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        let option = args[2];
+        assert!(
+            err.contains(&format!("{option} {}", args[3])),
+            "{args:?}: {err}"
+        );
+        assert!(err.contains("the model has no joint"), "{args:?}: {err}");
+        match hint {
+            Some(h) => assert!(
+                err.contains(&format!("did you mean `{h}`?")),
+                "{args:?}: {err}"
+            ),
+            None => assert!(!err.contains("did you mean"), "{args:?}: {err}"),
+        }
+    }
+}
+
 /// Issue 14: the result JSON reports the wall time of each phase; each is a finite,
 /// non-negative number of seconds and together they fit in the process's own wall time.
 #[test]

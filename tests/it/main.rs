@@ -7,6 +7,7 @@ mod architecture;
 mod cli;
 mod common;
 mod engineering;
+mod golden;
 mod importer;
 mod importer_fuzz;
 mod input_errors;

@@ -1,0 +1,78 @@
+//! "Did you mean": the closest name by edit distance (Levenshtein, case-insensitive), for
+//! names given on the command line that the model does not have.
+
+/// Edit distance between `a` and `b` (insertions, deletions, substitutions), ignoring case.
+fn distance(a: &str, b: &str) -> usize {
+    let a: Vec<char> = a.to_lowercase().chars().collect();
+    let b: Vec<char> = b.to_lowercase().chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.iter().enumerate() {
+        let mut diag = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let next = (diag + usize::from(ca != cb))
+                .min(row[j] + 1)
+                .min(row[j + 1] + 1);
+            diag = row[j + 1];
+            row[j + 1] = next;
+        }
+    }
+    row[b.len()]
+}
+
+/// The candidate closest to `name`: the nearest within a third of the name's length (at
+/// least one edit; ties go to the first), else the only candidate that starts with `name`
+/// (ignoring case).
+pub(crate) fn closest<'a>(
+    name: &str,
+    candidates: impl Iterator<Item = &'a str> + Clone,
+) -> Option<&'a str> {
+    let limit = (name.chars().count() / 3).max(1);
+    let near = candidates
+        .clone()
+        .map(|c| (distance(name, c), c))
+        .filter(|(d, _)| *d <= limit)
+        .min_by_key(|(d, _)| *d)
+        .map(|(_, c)| c);
+    near.or_else(|| {
+        let lower = name.to_lowercase();
+        let mut prefixed = candidates.filter(|c| c.to_lowercase().starts_with(&lower));
+        match (prefixed.next(), prefixed.next()) {
+            (Some(c), None) if !name.is_empty() => Some(c),
+            _ => None,
+        }
+    })
+}
+
+/// ` (did you mean `x`?)` or nothing.
+pub(crate) fn hint<'a>(name: &str, candidates: impl Iterator<Item = &'a str> + Clone) -> String {
+    closest(name, candidates).map_or(String::new(), |c| format!(" (did you mean `{c}`?)"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn edit_distance() {
+        assert_eq!(distance("kitten", "sitting"), 3);
+        assert_eq!(distance("", "abc"), 3);
+        assert_eq!(distance("Pivot", "pivot"), 0);
+        assert_eq!(distance("pivto", "pivot"), 2);
+    }
+
+    #[test]
+    fn closest_name() {
+        let names = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint"];
+        let c = || names.iter().copied();
+        assert_eq!(closest("shoulder_lift", c()), Some("shoulder_lift_joint"));
+        assert_eq!(closest("shoulder", c()), None);
+        assert_eq!(
+            closest("shoulder_lift_jiont", c()),
+            Some("shoulder_lift_joint")
+        );
+        assert_eq!(closest("elbow", c()), Some("elbow_joint"));
+        assert_eq!(closest("elbo_joint", c()), Some("elbow_joint"));
+        assert_eq!(closest("zzz", c()), None);
+    }
+}

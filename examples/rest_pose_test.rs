@@ -37,7 +37,10 @@ mod tests {
         assert!(report.converged());
         let check = verify(&model, &rest, &Tolerances::default()).unwrap();
         assert!(check.passed, "{check:?}");
-        assert_eq!(check.stability.unwrap().verdict, "stable");
+        assert_eq!(
+            check.stability.unwrap().verdict,
+            restpose::solver::Verdict::Stable
+        );
     }
 
     /// A "home" keyframe that is not a rest pose fails, and names the joint out of balance.

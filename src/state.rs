@@ -5,12 +5,16 @@
 //! kinematics along the spanning tree: `world_from_child = world_from_parent * parent_from_J ·
 //! M(θ) · (child_from_J)⁻¹` with `M` the joint motion in the joint frame (see
 //! [`crate::model::JointKind`]).
+//!
+//! Joint angles are real numbers, read on the branches the state carries
+//! ([`crate::kinematics::Branches`]): a state built with a joint at 3.5 rad reports 3.5, not
+//! 3.5 − 2π, and a solve tracks each angle continuously from its start.
 
-use crate::constraints::joint;
 use crate::jet::pair_of;
+use crate::kinematics::{coordinate, motion, Branches};
 use crate::math::{euler_parameters, unit_quaternion};
-use crate::model::{BodyId, JointKind, Model};
-use nalgebra::{DVector, Isometry3, Translation3, UnitQuaternion, Vector3, Vector4};
+use crate::model::{BodyId, JointId, JointKind, Model};
+use nalgebra::{DVector, Isometry3, Translation3, Vector4};
 use std::collections::HashMap;
 
 /// A configuration of the model.
@@ -18,6 +22,8 @@ use std::collections::HashMap;
 pub struct State {
     /// Coordinates, 7 per body.
     pub q: DVector<f64>,
+    /// The branch on which each joint angle is read (which multiple of 2π it carries).
+    pub branches: Branches,
 }
 
 /// Joint coordinate values by joint name (see [`JointKind`] for the order of coordinates).
@@ -58,7 +64,19 @@ impl State {
     pub fn from_joint_values(model: &Model, values: &JointValues) -> State {
         let mut s = State {
             q: DVector::zeros(model.coordinate_count()),
+            branches: Branches::default(),
         };
+        for (name, v) in values {
+            if let Some(id) = model.joint_id(name) {
+                let kind = model.joint(id).kind;
+                let n = kind.scalar_coordinates();
+                for (dof, &x) in v.iter().enumerate().take(n) {
+                    if kind.is_angle(dof) {
+                        s.branches.set(id, dof, x);
+                    }
+                }
+            }
+        }
         for b in 0..model.bodies.len() {
             s.q[7 * b + 3] = 1.0;
         }
@@ -89,7 +107,8 @@ impl State {
         s
     }
 
-    /// The initial guess: forward kinematics with the model's initial values.
+    /// The initial guess: forward kinematics with the model's initial values (see
+    /// [`initial_values`]).
     pub fn initial(model: &Model) -> State {
         State::from_joint_values(model, &initial_values(model))
     }
@@ -101,95 +120,81 @@ impl State {
         model
             .joints
             .iter()
-            .map(|j| {
-                let pair = pair_of(&j.bodies, &self.q, false);
-                let n = j.kind.scalar_coordinates();
-                let v = if n > 0 {
-                    (0..n)
-                        .map(|d| {
-                            let x = joint::coordinate(j, &pair, d).map_or(0.0, |s| s.v);
-                            if crate::forces::is_angle(j.kind, d) {
-                                crate::math::wrap_angle(x)
-                            } else {
-                                x
-                            }
-                        })
-                        .collect()
-                } else {
-                    let pose = |k: usize| match j.bodies[k] {
-                        Some(b) => self.body_pose(b) * j.body_from_joint[k],
-                        None => j.body_from_joint[k],
-                    };
-                    let rel = pose(0).inverse() * pose(1);
-                    let r = rel.rotation;
-                    match j.kind {
-                        JointKind::Spherical => vec![r.w, r.i, r.j, r.k],
-                        JointKind::Floating => {
-                            let t = rel.translation.vector;
-                            vec![t.x, t.y, t.z, r.w, r.i, r.j, r.k]
-                        }
-                        _ => vec![],
-                    }
-                };
-                (j.name.clone(), v)
-            })
+            .enumerate()
+            .map(|(i, j)| (j.name.clone(), self.values_of(model, JointId(i))))
             .collect()
+    }
+
+    /// Coordinates of the joint `name` as in [`State::joint_values`] (angles unwrapped on the
+    /// state's branches), or `None` if the model has no such joint.
+    ///
+    /// ```
+    /// let loaded = restpose::urdf::load_file("robots/pendulum.urdf", &Default::default())?;
+    /// let (state, _) = restpose::solve(&loaded.model, &Default::default())?;
+    /// let theta = state.joint(&loaded.model, "pivot").unwrap();
+    /// assert_eq!(theta.len(), 1);
+    /// # Ok::<(), restpose::Error>(())
+    /// ```
+    pub fn joint(&self, model: &Model, name: &str) -> Option<Vec<f64>> {
+        model.joint_id(name).map(|id| self.values_of(model, id))
+    }
+
+    fn values_of(&self, model: &Model, id: JointId) -> Vec<f64> {
+        let j = model.joint(id);
+        if self.q.len() != model.coordinate_count() {
+            return vec![];
+        }
+        let pair = pair_of(&j.bodies, &self.q, false);
+        let n = j.kind.scalar_coordinates();
+        if n > 0 {
+            (0..n)
+                .map(|d| coordinate(j, &pair, d, self.branches.get(id, d)).map_or(0.0, |s| s.v))
+                .collect()
+        } else {
+            let pose = |k: usize| match j.bodies[k] {
+                Some(b) => self.body_pose(b) * j.body_from_joint[k],
+                None => j.body_from_joint[k],
+            };
+            let rel = pose(0).inverse() * pose(1);
+            let r = rel.rotation;
+            match j.kind {
+                JointKind::Spherical => vec![r.w, r.i, r.j, r.k],
+                JointKind::Floating => {
+                    let t = rel.translation.vector;
+                    vec![t.x, t.y, t.z, r.w, r.i, r.j, r.k]
+                }
+                _ => vec![],
+            }
+        }
     }
 }
 
-/// The model's initial values by joint (`mech:initial`; missing coordinates 0).
-pub(crate) fn initial_values(model: &Model) -> JointValues {
+/// The model's initial values by joint (missing coordinates 0), a lock's value replacing the
+/// initial value of the coordinate it holds (the start is then on the lock's branch: a lock at
+/// 3.2 rad is not read as 3.2 − 2π).
+pub fn initial_values(model: &Model) -> JointValues {
     let mut values = JointValues::new();
-    for i in &model.initial {
-        let Some(j) = model.joints.get(i.joint.0) else {
+    let given = model
+        .initial
+        .iter()
+        .map(|i| (i.joint, i.dof, i.value))
+        .chain(
+            model
+                .locks
+                .iter()
+                .filter_map(|l| l.value.map(|v| (l.joint, l.dof, v))),
+        );
+    for (joint, dof, value) in given {
+        let Some(j) = model.joints.get(joint.0) else {
             continue;
         };
         let v = values
             .entry(j.name.clone())
             .or_insert_with(|| vec![0.0; j.kind.scalar_coordinates()]);
-        if v.len() <= i.dof {
-            v.resize(i.dof + 1, 0.0);
+        if v.len() <= dof {
+            v.resize(dof + 1, 0.0);
         }
-        v[i.dof] = i.value;
+        v[dof] = value;
     }
     values
-}
-
-/// Relative motion of a joint of this kind in its joint frame for coordinates `v` (the
-/// coordinates of [`State::joint_values`]; a spherical joint also takes a rotation vector of 3
-/// values, a floating joint `[x, y, z, rx, ry, rz]`).
-pub(crate) fn motion(kind: JointKind, v: &[f64]) -> Isometry3<f64> {
-    let at = |i: usize| v.get(i).copied().unwrap_or(0.0);
-    let rz = |a: f64| UnitQuaternion::from_axis_angle(&Vector3::z_axis(), a);
-    let rx = |a: f64| UnitQuaternion::from_axis_angle(&Vector3::x_axis(), a);
-    let t = |x: f64, y: f64, z: f64| Translation3::new(x, y, z);
-    let rotvec = |a: f64, b: f64, c: f64| UnitQuaternion::from_scaled_axis(Vector3::new(a, b, c));
-    let quat = |w: f64, x: f64, y: f64, z: f64| unit_quaternion(&Vector4::new(w, x, y, z));
-    match kind {
-        JointKind::Revolute | JointKind::Continuous => {
-            Isometry3::from_parts(t(0.0, 0.0, 0.0), rz(at(0)))
-        }
-        JointKind::Prismatic => {
-            Isometry3::from_parts(t(0.0, 0.0, at(0)), UnitQuaternion::identity())
-        }
-        JointKind::Cylindrical => Isometry3::from_parts(t(0.0, 0.0, at(1)), rz(at(0))),
-        JointKind::Universal => Isometry3::from_parts(t(0.0, 0.0, 0.0), rz(at(0)) * rx(at(1))),
-        JointKind::Planar => Isometry3::from_parts(t(at(0), at(1), 0.0), rz(at(2))),
-        JointKind::Screw { pitch } => Isometry3::from_parts(t(0.0, 0.0, pitch * at(0)), rz(at(0))),
-        JointKind::Spherical if v.len() == 4 => {
-            Isometry3::from_parts(t(0.0, 0.0, 0.0), quat(at(0), at(1), at(2), at(3)))
-        }
-        JointKind::Spherical => {
-            Isometry3::from_parts(t(0.0, 0.0, 0.0), rotvec(at(0), at(1), at(2)))
-        }
-        JointKind::Floating if v.len() == 7 => {
-            Isometry3::from_parts(t(at(0), at(1), at(2)), quat(at(3), at(4), at(5), at(6)))
-        }
-        JointKind::Floating => {
-            Isometry3::from_parts(t(at(0), at(1), at(2)), rotvec(at(3), at(4), at(5)))
-        }
-        JointKind::Fixed | JointKind::Distance { .. } | JointKind::PointOnLine => {
-            Isometry3::identity()
-        }
-    }
 }

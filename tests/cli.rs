@@ -152,6 +152,7 @@ fn options_lock_initial_gravity() {
     assert_eq!(o.status.code(), Some(2));
 }
 
+/// Byte-identical apart from the wall times in `diagnostics.timings` (zeroed here).
 #[test]
 fn same_input_same_json_bytes() {
     let dir = tempfile::tempdir().unwrap();
@@ -163,7 +164,15 @@ fn same_input_same_json_bytes() {
             .status()
             .unwrap();
         assert!(st.success());
-        std::fs::read(out).unwrap()
+        let text = std::fs::read_to_string(out).unwrap();
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        let mut zeroed = text.clone();
+        for (phase, s) in v["diagnostics"]["timings"].as_object().unwrap() {
+            let field = format!("\"{phase}\": {}", serde_json::to_string(s).unwrap());
+            assert!(zeroed.contains(&field), "{field}");
+            zeroed = zeroed.replacen(&field, &format!("\"{phase}\": 0"), 1);
+        }
+        zeroed.into_bytes()
     };
     assert_eq!(run("a.json"), run("b.json"));
 }
@@ -232,4 +241,216 @@ fn linear_algebra_flag_selects_the_path() {
         .status()
         .unwrap();
     assert_eq!(st.code(), Some(2));
+}
+
+/// The rest pose of the pendulum from `analyze --json -`.
+fn pendulum_rest_angle() -> f64 {
+    let o = restpose()
+        .args(["analyze", &robot("pendulum"), "--json", "-"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    v["joints"]["pivot"]["position"][0].as_f64().unwrap()
+}
+
+/// `rostopic echo /joint_states` output (header, velocity and effort lists, every message
+/// ended by `---`) is a pose for `verify`; with several messages, the last one counts.
+#[test]
+fn verify_reads_rostopic_echo_output() {
+    let rest = pendulum_rest_angle();
+    let message = |angle: f64, seq: usize| {
+        format!(
+            "header: \n  seq: {seq}\n  stamp: \n    secs: 1700000000\n    nsecs: 5000\n  frame_id: ''\nname: [pivot]\nposition: [{angle}]\nvelocity: [0.0]\neffort: []\n---\n"
+        )
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let run = |text: String| {
+        let path = dir.path().join("echo.yaml");
+        std::fs::write(&path, text).unwrap();
+        restpose()
+            .args(["verify", &robot("pendulum"), "-q", "--pose"])
+            .arg(&path)
+            .status()
+            .unwrap()
+            .code()
+    };
+    assert_eq!(run(message(rest, 1)), Some(0));
+    assert_eq!(run(message(rest + 0.2, 1) + &message(rest, 2)), Some(0));
+    assert_eq!(run(message(rest, 1) + &message(rest + 0.2, 2)), Some(4));
+    // ROS 2 (`ros2 topic echo`): block lists, `sec`/`nanosec`.
+    let ros2 = format!(
+        "header:\n  stamp:\n    sec: 0\n    nanosec: 0\n  frame_id: ''\nname:\n- pivot\nposition:\n- {rest}\nvelocity: []\neffort: []\n---\n"
+    );
+    assert_eq!(run(ros2), Some(0));
+}
+
+/// `--json -` writes the JSON, and only the JSON, to standard output for `analyze`, `check`
+/// and `verify`; no file named `-` appears.
+#[test]
+fn json_dash_means_standard_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let rest = pendulum_rest_angle();
+    for args in [
+        vec!["analyze".to_string(), robot("slider_crank")],
+        vec!["check".to_string(), robot("slider_crank")],
+        vec![
+            "check".to_string(),
+            robot("slider_crank"),
+            "--format".into(),
+            "json".into(),
+        ],
+        vec![
+            "verify".to_string(),
+            robot("pendulum"),
+            "--joint".into(),
+            format!("pivot={rest}"),
+        ],
+    ] {
+        let o = restpose()
+            .current_dir(dir.path())
+            .args(&args)
+            .args(["--json", "-"])
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0), "{args:?}");
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout)
+            .unwrap_or_else(|e| panic!("{args:?}: stdout is not one JSON document: {e}"));
+        assert!(v.is_object(), "{args:?}");
+        match args[0].as_str() {
+            "analyze" => assert_eq!(v["converged"], true),
+            "check" => assert_eq!(v["dof"], 1),
+            _ => assert_eq!(v["passed"], true),
+        }
+        assert!(!dir.path().join("-").exists(), "{args:?}");
+    }
+}
+
+/// The keys of a JSON object in the order they were written.
+struct Keys(Vec<String>);
+
+impl<'de> serde::Deserialize<'de> for Keys {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visit;
+        impl<'de> serde::de::Visitor<'de> for Visit {
+            type Value = Keys;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("an object")
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, mut m: A) -> Result<Keys, A::Error> {
+                let mut k = Vec::new();
+                while let Some((key, _)) = m.next_entry::<String, serde::de::IgnoredAny>()? {
+                    k.push(key);
+                }
+                Ok(Keys(k))
+            }
+        }
+        d.deserialize_map(Visit)
+    }
+}
+
+#[derive(serde::Deserialize)]
+struct Ordered {
+    joints: Keys,
+    reactions: Keys,
+}
+
+/// Joints are listed in URDF file order (not alphabetically) in the JSON and the summary, and
+/// every coordinate has its unit.
+#[test]
+fn joints_in_file_order_with_units() {
+    for name in ["chain20", "four_bar_spatial", "slider_crank"] {
+        let text = std::fs::read_to_string(robot(name)).unwrap();
+        // `<joint name="…"` in file order, then the extension's loop joint.
+        let mut file_order: Vec<String> = text
+            .split("<joint name=\"")
+            .skip(1)
+            .map(|s| s[..s.find('"').unwrap()].to_string())
+            .collect();
+        file_order.extend(
+            text.split("loop_joint name=\"")
+                .skip(1)
+                .map(|s| s[..s.find('"').unwrap()].to_string()),
+        );
+        let o = restpose()
+            .args(["analyze", &robot(name), "--json", "-"])
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0));
+        let ordered: Ordered = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(ordered.joints.0, file_order, "{name}");
+        let in_order: Vec<&String> = file_order
+            .iter()
+            .filter(|j| ordered.reactions.0.contains(j))
+            .collect();
+        assert_eq!(
+            ordered.reactions.0.iter().collect::<Vec<_>>(),
+            in_order,
+            "{name}"
+        );
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        for (j, r) in v["joints"].as_object().unwrap() {
+            let units: Vec<&str> = r["units"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|u| u.as_str().unwrap())
+                .collect();
+            assert_eq!(units.len(), r["position"].as_array().unwrap().len(), "{j}");
+            let expected: &[&str] = match r["type"].as_str().unwrap() {
+                "revolute" | "continuous" => &["rad"],
+                "prismatic" => &["m"],
+                "universal" => &["rad", "rad"],
+                "spherical" => &["1", "1", "1", "1"],
+                other => panic!("{name}: joint type {other} not expected here"),
+            };
+            assert_eq!(units, expected, "{name}: {j}");
+        }
+        // The summary lists the joints in the same order, each with its unit.
+        let o = restpose().args(["analyze", &robot(name)]).output().unwrap();
+        let summary = String::from_utf8_lossy(&o.stdout);
+        let lines: Vec<&str> = summary
+            .lines()
+            .skip_while(|l| !l.contains("joint                          type"))
+            .skip(1)
+            .take(file_order.len())
+            .collect();
+        for (line, j) in lines.iter().zip(&file_order) {
+            assert_eq!(line.split_whitespace().next(), Some(j.as_str()), "{name}");
+            assert!(
+                line.ends_with(" rad") || line.ends_with(" m") || line.ends_with(" 1"),
+                "{name}: {line}"
+            );
+        }
+    }
+}
+
+/// Issue 14: the result JSON reports the wall time of each phase; each is a finite,
+/// non-negative number of seconds and together they fit in the process's own wall time.
+#[test]
+fn analyze_reports_timings_of_each_phase() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("t.json");
+    let started = std::time::Instant::now();
+    let st = restpose()
+        .args(["analyze", &robot("four_bar_spatial"), "--quiet", "--json"])
+        .arg(&out)
+        .status()
+        .unwrap();
+    let wall = started.elapsed().as_secs_f64();
+    assert_eq!(st.code(), Some(0));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let t = &v["diagnostics"]["timings"];
+    let mut sum = 0.0;
+    for phase in ["import", "assembly", "iterations", "stability", "export"] {
+        let s = t[phase].as_f64().unwrap_or(-1.0);
+        assert!(s.is_finite() && s >= 0.0, "{phase}: {t}");
+        sum += s;
+    }
+    assert!(t["iterations"].as_f64().unwrap() > 0.0, "{t}");
+    assert!(
+        sum > 0.0 && sum <= wall,
+        "phases {sum} s, process {wall} s: {t}"
+    );
 }

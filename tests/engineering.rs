@@ -30,11 +30,14 @@ fn inverted_start_ends_at_the_stable_equilibrium() {
     ));
     let (s, r) = solve(&m);
     assert_abs_diff_eq!(
-        joint(&m, &s, "pivot")[0],
+        s.joint(&m, "pivot").unwrap()[0],
         -std::f64::consts::FRAC_PI_2,
         epsilon = 1e-8
     );
-    assert_eq!(r.stability.unwrap().verdict, "stable");
+    assert_eq!(
+        r.stability.unwrap().verdict,
+        restpose::solver::Verdict::Stable
+    );
     assert!(r.diagnostics.negative_curvature_steps >= 1);
 
     let opts = Options {
@@ -44,11 +47,14 @@ fn inverted_start_ends_at_the_stable_equilibrium() {
     let (s, r) = restpose::solve(&m, &opts).unwrap();
     assert!(r.converged());
     assert_abs_diff_eq!(
-        joint(&m, &s, "pivot")[0],
+        s.joint(&m, "pivot").unwrap()[0],
         std::f64::consts::FRAC_PI_2,
         epsilon = 1e-12
     );
-    assert_eq!(r.stability.unwrap().verdict, "unstable");
+    assert_eq!(
+        r.stability.unwrap().verdict,
+        restpose::solver::Verdict::Unstable
+    );
 }
 
 /// A locked joint holds the gravity torque: m g x_com, by hand.
@@ -61,7 +67,7 @@ fn lock_holding_torque_equals_gravity_torque() {
     ));
     let (s, r) = solve(&m);
     assert_eq!(r.dof, 0);
-    assert_abs_diff_eq!(joint(&m, &s, "pivot")[0], angle, epsilon = 1e-12);
+    assert_abs_diff_eq!(s.joint(&m, "pivot").unwrap()[0], angle, epsilon = 1e-12);
     let (_, re) = r.reactions.iter().find(|(n, _)| n == "pivot").unwrap();
     // Gravity torque about +z of the weight (0, −19.62) at (cos a, sin a): −19.62 cos a; the
     // joint holds it with the opposite torque.
@@ -97,8 +103,8 @@ fn metres_and_millimetres_agree() {
     .unwrap();
     assert!(r2.converged());
     assert_abs_diff_eq!(
-        joint(&m1, &s1, "pivot")[0],
-        joint(&m2, &s2, "pivot")[0],
+        s1.joint(&m1, "pivot").unwrap()[0],
+        s2.joint(&m2, "pivot").unwrap()[0],
         epsilon = 1e-8
     );
     assert_eq!(r1.independent_coordinates, r2.independent_coordinates);
@@ -132,7 +138,7 @@ fn energy_breakdown_sums_and_spring_energy_by_hand() {
     let slider = s.link_pose(&m, "slider").unwrap().translation.vector;
     let l = (nalgebra::Vector3::new(0.6, 0.0, 0.0) - slider).norm();
     assert_abs_diff_eq!(e.springs, 0.5 * 500.0 * (l - 0.15).powi(2), epsilon = 1e-12);
-    let crank = joint(&m, &s, "crank_joint")[0];
+    let crank = s.joint(&m, "crank_joint").unwrap()[0];
     assert_abs_diff_eq!(e.joint_springs, 0.5 * 2.0 * crank * crank, epsilon = 1e-12);
     // Load −20 N along x on the slider: minus its work.
     assert_abs_diff_eq!(e.loads, 20.0 * slider.x, epsilon = 1e-12);
@@ -167,7 +173,7 @@ fn merged_fixed_links_report_their_poses_and_floating_base_solves() {
     assert_eq!(m.bodies.len(), 1, "arm, tool and tip are one body");
     let (s, r) = solve(&m);
     assert_eq!(r.dof, 1);
-    let th = joint(&m, &s, "shoulder")[0];
+    let th = s.joint(&m, "shoulder").unwrap()[0];
     // Balance: 50 θ = g (1·0.5 cos θ + 0.5·1 cos θ) about +y (weight along −z).
     assert_abs_diff_eq!(50.0 * th, 9.81 * (0.5 + 0.5) * th.cos(), epsilon = 1e-9);
     let tip = s.link_pose(&m, "tip").unwrap();

@@ -26,8 +26,8 @@ fn foreign_loop_joint_equals_mech_loop_joint() {
     let (s2, r2) = solve(&m2);
     assert_abs_diff_eq!(r1.energy.total, r2.energy.total, epsilon = 1e-12);
     assert_abs_diff_eq!(
-        joint(&m1, &s1, "slide")[0],
-        joint(&m2, &s2, "slide")[0],
+        s1.joint(&m1, "slide").unwrap()[0],
+        s2.joint(&m2, "slide").unwrap()[0],
         epsilon = 1e-12
     );
 }
@@ -51,7 +51,11 @@ fn drake_linear_spring_damper_is_a_spring() {
         l.warnings
     );
     let (s, r) = solve(&l.model);
-    assert_abs_diff_eq!(joint(&l.model, &s, "pivot")[0], -1.381577, epsilon = 1e-6);
+    assert_abs_diff_eq!(
+        s.joint(&l.model, "pivot").unwrap()[0],
+        -1.381577,
+        epsilon = 1e-6
+    );
     assert_abs_diff_eq!(r.energy.total, -18.686957, epsilon = 1e-6);
 }
 
@@ -74,8 +78,8 @@ fn gazebo_spring_stiffness_is_a_joint_spring() {
     for i in 0..4 {
         let n = format!("joint{i}");
         assert_abs_diff_eq!(
-            joint(&m1, &s1, &n)[0],
-            joint(&m2, &s2, &n)[0],
+            s1.joint(&m1, &n).unwrap()[0],
+            s2.joint(&m2, &n).unwrap()[0],
             epsilon = 1e-12
         );
     }
@@ -101,7 +105,7 @@ fn drake_ball_and_screw_joints() {
     assert_verified_minimum(&m, &s);
     // Screw: potential m g h θ/(2π)·… : V = m g (pitch θ) + ½ k θ², pitch = 0.01/(2π) m/rad.
     let pitch = 0.01 / (2.0 * std::f64::consts::PI);
-    let theta = joint(&m, &s, "screw")[0];
+    let theta = s.joint(&m, "screw").unwrap()[0];
     assert_abs_diff_eq!(theta, -0.2 * 9.81 * pitch / 0.05, epsilon = 1e-9);
     let nut = s.link_pose(&m, "nut").unwrap().translation.vector;
     assert_abs_diff_eq!(nut.z, pitch * theta, epsilon = 1e-12);
@@ -115,7 +119,7 @@ fn drake_ball_and_screw_joints() {
         "moment about the ball: {}",
         r_arm.cross(&f).norm()
     );
-    assert_eq!(joint(&m, &s, "ball").len(), 4);
+    assert_eq!(s.joint(&m, "ball").unwrap().len(), 4);
 }
 
 /// A `drake:ball_constraint` closing a loop, a `mech:frame` as a spring end, and
@@ -176,7 +180,7 @@ fn loop_element_becomes_a_tree_edge_when_needed() {
     let m = model_from(text);
     assert!(m.joint(m.joint_id("hinge").unwrap()).tree);
     let (s, _) = solve(&m);
-    let th = joint(&m, &s, "hinge")[0];
+    let th = s.joint(&m, "hinge").unwrap()[0];
     // 5 (θ − 0.5) = −m g sin θ · 1 m (a rotation about +y moves the bob towards +x, up).
     assert_abs_diff_eq!(5.0 * (th - 0.5), -9.81 * th.sin(), epsilon = 1e-9);
 }
@@ -210,7 +214,7 @@ fn massless_fixed_chains_and_inertia_warning() {
     );
     let (s, r) = solve(&l.model);
     assert_eq!(r.dof, 1);
-    let th = joint(&l.model, &s, "j")[0];
+    let th = s.joint(&l.model, "j").unwrap()[0];
     let tip = s.link_pose(&l.model, "f9").unwrap().translation.vector;
     assert_abs_diff_eq!(tip.x, 1.0 * th.cos(), epsilon = 1e-12);
     assert_abs_diff_eq!(tip.z, -th.sin(), epsilon = 1e-12);
@@ -245,7 +249,7 @@ fn link_gravity_distance_and_point_on_line() {
     assert_abs_diff_eq!((pa - pb).norm(), 0.5, epsilon = 1e-10);
     // Only a's 1 kg feels gravity: the rod is parallel to y, carrying no moment about y, and
     // 30 θ = 9.81 cos θ.
-    let th = joint(&m, &s, "ja")[0];
+    let th = s.joint(&m, "ja").unwrap()[0];
     assert_abs_diff_eq!(30.0 * th, 9.81 * th.cos(), epsilon = 1e-8);
 
     let pol = text.replace(
@@ -307,7 +311,7 @@ fn zero_axis_on_fixed_joint_is_ignored() {
     assert_eq!(l.model.bodies.len(), 1, "mount is welded to the world");
     let (s, _) = solve(&l.model);
     assert_abs_diff_eq!(
-        joint(&l.model, &s, "hinge")[0],
+        s.joint(&l.model, "hinge").unwrap()[0],
         pendulum_angle(),
         epsilon = 1e-8
     );
@@ -356,7 +360,7 @@ fn mimic_of_missing_joint_leaves_the_joint_independent() {
     );
     let (s, _) = solve(&l.model);
     assert_abs_diff_eq!(
-        joint(&l.model, &s, "hinge")[0],
+        s.joint(&l.model, "hinge").unwrap()[0],
         pendulum_angle(),
         epsilon = 1e-8
     );

@@ -121,7 +121,7 @@ proptest! {
         if let Ok(l) = restpose::urdf::load_str(&text, "mutated.urdf", &Default::default()) {
             let opts = restpose::Options { max_iterations: 20, load_steps: 1, ..Default::default() };
             let _ = restpose::solve(&l.model, &opts);
-            let _ = restpose::export::summary::ModelSummary::new(&l);
+            let _ = restpose::export::summary::ModelSummary::new(&l, &restpose::verify::check(&l.model));
         }
     }
 }

@@ -69,7 +69,7 @@ fn chain_matches_minimal_coordinate_energy() {
     let (s, r) = solve(&m);
     assert_eq!(r.dof, n);
     let theta: Vec<f64> = (0..n)
-        .map(|i| joint(&m, &s, &format!("joint{i}"))[0])
+        .map(|i| s.joint(&m, &format!("joint{i}")).unwrap()[0])
         .collect();
     let energy = |th: &[f64]| energies::chain(n, th);
     assert_abs_diff_eq!(energy(&theta), r.energy.total, epsilon = 1e-9);
@@ -108,7 +108,7 @@ fn planar_chain_joint_torques_balance_by_hand() {
     let m = model_from(&restpose::generate::chain(n, true));
     let (s, _) = solve(&m);
     let theta: Vec<f64> = (0..n)
-        .map(|i| joint(&m, &s, &format!("joint{i}"))[0])
+        .map(|i| s.joint(&m, &format!("joint{i}")).unwrap()[0])
         .collect();
     // Joint i at x_i; link j's centre of mass at c_j (in the x-z plane).
     let mut pts = Vec::new();
@@ -172,15 +172,18 @@ fn max_link_distance(m: &restpose::Model, a: &restpose::State, b: &restpose::Sta
 #[test]
 fn tractor_trailer_converges_from_near_and_far_starts() {
     let (m, rest, r) = solve_with_initial("tractor_trailer", &[]);
-    assert_eq!(r.sizes[0], 17);
+    assert_eq!(r.sizes.bodies, 17);
     assert_eq!(r.dof, 25);
     assert!(r.redundant_constraints.is_empty());
     assert_eq!(
-        r.sizes[2] - 17,
+        r.sizes.constraint_rows - 17,
         77,
         "joint rows besides the 17 normalization rows"
     );
-    assert_eq!(r.stability.as_ref().unwrap().verdict, "stable");
+    assert_eq!(
+        r.stability.as_ref().unwrap().verdict,
+        restpose::solver::Verdict::Stable
+    );
     for start in [
         [("fifth_wheel_pitch", 0, 0.0017)],
         [("fifth_wheel_pitch", 0, 0.054)],
@@ -204,7 +207,7 @@ fn tractor_trailer_converges_from_near_and_far_starts() {
 #[test]
 fn stewart_platform_converges_from_far_starts() {
     let (m, rest, r) = solve_with_initial("stewart_platform", &[]);
-    assert_eq!(r.sizes[0], 13);
+    assert_eq!(r.sizes.bodies, 13);
     assert_eq!(r.dof, 6);
     for start in [
         [("leg1_slide", 0, 0.3)],
@@ -220,7 +223,7 @@ fn stewart_platform_converges_from_far_starts() {
         );
     }
     // The floating joint reports the platform's own displacement.
-    let pf = common::joint(&m, &rest, "platform_float");
+    let pf = rest.joint(&m, "platform_float").unwrap();
     let link = rest.link_pose(&m, "platform").unwrap();
     let origin = restpose::State::from_joint_values(&m, &Default::default())
         .link_pose(&m, "platform")
@@ -272,7 +275,7 @@ fn ladder_matches_minimal_coordinate_energy() {
     assert_eq!(r.dof, n);
     assert_eq!(r.redundant_constraints.len(), 3 * n);
     let phi: Vec<f64> = (0..n)
-        .map(|k| joint(&m, &s, &format!("hang_left{k}"))[0])
+        .map(|k| s.joint(&m, &format!("hang_left{k}")).unwrap()[0])
         .collect();
     let energy = |phi: &[f64]| energies::ladder(n, phi);
     assert_abs_diff_eq!(energy(&phi), r.energy.total, epsilon = 1e-9);

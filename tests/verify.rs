@@ -36,7 +36,11 @@ fn solver_answers_pass_in_every_pose_format() {
         let (s, _) = pose_state(&m, &values).unwrap();
         let v = verify(&m, &s, &Tolerances::default()).unwrap();
         assert!(v.passed, "{name}: {v:?}");
-        assert_eq!(v.stability.unwrap().verdict, "stable", "{name}");
+        assert_eq!(
+            v.stability.unwrap().verdict,
+            restpose::solver::Verdict::Stable,
+            "{name}"
+        );
         // A {"joint": [values]} map.
         let map: serde_json::Map<String, serde_json::Value> = result
             .joints
@@ -50,7 +54,7 @@ fn solver_answers_pass_in_every_pose_format() {
             "{name}: map format"
         );
         // joint_states YAML carries one position per joint: only for scalar-joint models.
-        if result.joints.values().any(|j| j.position.len() > 1) {
+        if result.joints.iter().any(|(_, j)| j.position.len() > 1) {
             continue;
         }
         let mut names = Vec::new();
@@ -159,4 +163,59 @@ fn cli_verify_exit_codes_and_json() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(1));
+}
+
+/// Issue 12 §6: at 1,000+ links `verify` (sparse path, relative effort tolerance) accepts the
+/// solver's own answer after its JSON round trip, rejects the same pose with one joint turned,
+/// and `balance` (what `check` reports) counts the degrees of freedom.
+#[test]
+fn verify_accepts_analyze_answers_at_1000_links() {
+    for (family, m) in [
+        (
+            "chain1000",
+            restpose::urdf::load_str(
+                &restpose::generate::chain(1000, false),
+                "chain.urdf",
+                &Default::default(),
+            )
+            .unwrap()
+            .model,
+        ),
+        (
+            "ladder400",
+            restpose::urdf::load_str(
+                &restpose::generate::ladder(400),
+                "ladder.urdf",
+                &Default::default(),
+            )
+            .unwrap()
+            .model,
+        ),
+    ] {
+        let (rest, report) = restpose::solve(&m, &Default::default()).unwrap();
+        assert!(report.converged(), "{family}");
+        let json = restpose::export::json::AnalysisResult::new(&m, &rest, &report).to_json();
+        let mut values = parse_pose(&json, "result.json").unwrap();
+        let (s, missing) = pose_state(&m, &values).unwrap();
+        assert!(missing.is_empty(), "{family}");
+        let v = verify(&m, &s, &Tolerances::default()).unwrap();
+        assert!(v.passed, "{family}: {:?}", v.max_imbalance);
+        assert!(
+            v.effort_tolerance < 1e-3 * v.force_scale.max(1.0),
+            "{family}"
+        );
+        let b = restpose::verify::balance(&m, &s).unwrap();
+        assert_eq!(b.dof, report.dof, "{family}");
+        // One joint turned by 0.01 rad needs an effort there.
+        let name = if family == "chain1000" {
+            "joint500"
+        } else {
+            "hang_left200"
+        };
+        values.get_mut(name).unwrap()[0] += 0.01;
+        let (s, _) = pose_state(&m, &values).unwrap();
+        let v = verify(&m, &s, &Tolerances::default()).unwrap();
+        assert!(!v.passed, "{family}: turned {name}");
+        assert!(v.max_imbalance.unwrap().effort.abs() > 1e3 * v.effort_tolerance);
+    }
 }

@@ -101,3 +101,65 @@ fn cli_writes_only_converged_poses() {
         .unwrap()
         .contains("name: [\"pivot\"]"));
 }
+
+/// Issue 12 §6: `analyze --write-joint-states` then `verify --pose` passes for every robot in
+/// `robots/`, including the joints `sensor_msgs/JointState` cannot carry (spherical,
+/// universal, floating: the `multi_dof` section). Before it, four of them failed.
+#[test]
+fn every_robot_round_trips_joint_states_through_verify() {
+    let dir = tempfile::tempdir().unwrap();
+    let robots = format!("{}/robots", env!("CARGO_MANIFEST_DIR"));
+    let mut names: Vec<_> = std::fs::read_dir(&robots)
+        .unwrap()
+        .filter_map(|e| e.ok()?.path().to_str().map(str::to_string))
+        .filter(|p| p.ends_with(".urdf"))
+        .collect();
+    names.sort();
+    assert!(names.len() >= 11, "{names:?}");
+    let mut with_multi = 0;
+    for urdf in &names {
+        let yaml = dir.path().join("rest.yaml");
+        let st = Command::new(env!("CARGO_BIN_EXE_restpose"))
+            .args(["analyze", urdf, "-q", "--write-joint-states"])
+            .arg(&yaml)
+            .status()
+            .unwrap();
+        assert_eq!(st.code(), Some(0), "{urdf}: analyze");
+        let text = std::fs::read_to_string(&yaml).unwrap();
+        // Every joint with coordinates is in the file, with as many values as it has.
+        let m = restpose::urdf::load_file(urdf, &Default::default())
+            .unwrap()
+            .model;
+        let values = restpose::verify::parse_pose(&text, "rest.yaml").unwrap();
+        for j in &m.joints {
+            let n = restpose::export::json::coordinate_units(j.kind).len();
+            if n > 0 {
+                assert_eq!(
+                    values.get(&j.name).map(Vec::len),
+                    Some(n),
+                    "{urdf}: joint `{}`",
+                    j.name
+                );
+            }
+        }
+        with_multi += usize::from(text.contains("multi_dof:"));
+        let o = Command::new(env!("CARGO_BIN_EXE_restpose"))
+            .args(["verify", urdf, "--pose"])
+            .arg(&yaml)
+            .output()
+            .unwrap();
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{urdf}: verify\n{}\n{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(String::from_utf8_lossy(&o.stdout).contains("pose PASSES"));
+        assert!(
+            !String::from_utf8_lossy(&o.stderr).contains("keep their initial values"),
+            "{urdf}: a joint is missing from the joint states"
+        );
+    }
+    assert!(with_multi >= 4, "{with_multi} robots with multi_dof joints");
+}

@@ -10,43 +10,15 @@
 //! z_i·y_j, y_i·x_j`; universal = spherical + `z_i·x_j`; planar = `z_i·x_j, z_i·y_j, d·z_i`;
 //! screw = cylindrical + `d·z_i − h θ`; distance = `d·d − L²`; point-on-line = `d·x_i, d·y_i`.
 //!
-//! Joint coordinates: `θ = atan2(y_i·x_j, x_i·x_j)` about z, `d·z_i` along z; universal
-//! `θ₂ = atan2(z_i·y_j, z_i·z_j)`; planar `x = d·x_i, y = d·y_i`.
+//! Joint frames and coordinates come from [`crate::kinematics`].
 //!
 //! ## References
 //! - E. J. Haug, *Computer-Aided Kinematics and Dynamics of Mechanical Systems* (1989), ch. 3.
 
 use crate::jet::{Pair, Scalar, Vec3Jet};
+use crate::kinematics::{angle, frames};
 use crate::model::{Joint, JointKind};
 use nalgebra::Vector3;
-
-/// Joint-frame points and axes of both sides.
-struct Frames {
-    d: Vec3Jet,
-    x: [Vec3Jet; 2],
-    y: [Vec3Jet; 2],
-    z: [Vec3Jet; 2],
-}
-
-fn frames(joint: &Joint, pair: &Pair) -> Frames {
-    let mut pts = Vec::with_capacity(2);
-    let mut x = Vec::with_capacity(2);
-    let mut y = Vec::with_capacity(2);
-    let mut z = Vec::with_capacity(2);
-    for k in 0..2 {
-        let f = &joint.body_from_joint[k];
-        pts.push(pair.point(k, &f.translation.vector));
-        x.push(pair.vector(k, &(f.rotation * Vector3::x())));
-        y.push(pair.vector(k, &(f.rotation * Vector3::y())));
-        z.push(pair.vector(k, &(f.rotation * Vector3::z())));
-    }
-    Frames {
-        d: pts[1].sub(&pts[0]),
-        x: [x[0], x[1]],
-        y: [y[0], y[1]],
-        z: [z[0], z[1]],
-    }
-}
 
 fn component(pair: &Pair, d: &Vec3Jet, k: usize) -> Scalar {
     let mut e = Vector3::zeros();
@@ -61,12 +33,6 @@ fn component(pair: &Pair, d: &Vec3Jet, k: usize) -> Scalar {
         crate::jet::LMat::zeros()
     };
     Scalar { v: d.v[k], g, h }
-}
-
-fn angle(pair: &Pair, f: &Frames) -> Scalar {
-    let s = pair.dot(&f.y[0], &f.x[1]);
-    let c = pair.dot(&f.x[0], &f.x[1]);
-    pair.atan2(&s, &c)
 }
 
 /// Number of constraint rows of a joint (0 for merged and floating joints).
@@ -127,8 +93,10 @@ pub(crate) fn length_power(name: &str) -> i32 {
     }
 }
 
-/// Evaluates the constraint rows of a joint into `out` (cleared first).
-pub(crate) fn rows(joint: &Joint, pair: &Pair, out: &mut Vec<Scalar>) {
+/// Evaluates the constraint rows of a joint into `out` (cleared first); a screw's thread row
+/// reads its angle on the branch `reference` (see [`crate::kinematics::Branches`]), so that a
+/// screw advances over many turns.
+pub(crate) fn rows(joint: &Joint, pair: &Pair, reference: f64, out: &mut Vec<Scalar>) {
     out.clear();
     if joint.merged || joint.kind == JointKind::Floating {
         return;
@@ -178,35 +146,14 @@ pub(crate) fn rows(joint: &Joint, pair: &Pair, out: &mut Vec<Scalar>) {
         JointKind::Screw { pitch } => {
             parallel(out);
             on_axis(out);
-            let t = angle(pair, &f).scale(-pitch);
+            let mut theta = angle(pair, &f);
+            theta.v = reference + crate::math::wrap_angle(theta.v - reference);
+            let t = theta.scale(-pitch);
             out.push(pair.dot(&f.z[0], &f.d).add(&t));
         }
         JointKind::Distance { length } => out.push(pair.dot(&f.d, &f.d).minus(length * length)),
         JointKind::PointOnLine => on_axis(out),
         JointKind::Floating => {}
-    }
-}
-
-/// Scalar joint coordinate `dof` (see the module docs), or `None` if the joint has none.
-pub(crate) fn coordinate(joint: &Joint, pair: &Pair, dof: usize) -> Option<Scalar> {
-    let f = frames(joint, pair);
-    match (joint.kind, dof) {
-        (JointKind::Revolute | JointKind::Continuous | JointKind::Screw { .. }, 0) => {
-            Some(angle(pair, &f))
-        }
-        (JointKind::Prismatic, 0) => Some(pair.dot(&f.z[0], &f.d)),
-        (JointKind::Cylindrical, 0) => Some(angle(pair, &f)),
-        (JointKind::Cylindrical, 1) => Some(pair.dot(&f.z[0], &f.d)),
-        (JointKind::Universal, 0) => Some(angle(pair, &f)),
-        (JointKind::Universal, 1) => {
-            let s = pair.dot(&f.z[0], &f.y[1]);
-            let c = pair.dot(&f.z[0], &f.z[1]);
-            Some(pair.atan2(&s, &c))
-        }
-        (JointKind::Planar, 0) => Some(pair.dot(&f.x[0], &f.d)),
-        (JointKind::Planar, 1) => Some(pair.dot(&f.y[0], &f.d)),
-        (JointKind::Planar, 2) => Some(angle(pair, &f)),
-        _ => None,
     }
 }
 
@@ -260,7 +207,7 @@ mod tests {
             for seed in 0..3 {
                 let pair = sample_pair(seed);
                 let mut out = Vec::new();
-                rows(&j, &pair, &mut out);
+                rows(&j, &pair, 0.0, &mut out);
                 assert_eq!(out.len(), row_count(&j));
                 assert_eq!(row_names(&j).len(), row_count(&j));
                 for r in 0..out.len() {
@@ -268,7 +215,7 @@ mod tests {
                         &pair,
                         &|q| {
                             let mut o = Vec::new();
-                            rows(&j, q, &mut o);
+                            rows(&j, q, 0.0, &mut o);
                             o[r]
                         },
                         &format!("{} row {}", kind.name(), row_names(&j)[r]),
@@ -277,7 +224,7 @@ mod tests {
                 for dof in 0..kind.scalar_coordinates() {
                     check_scalar(
                         &pair,
-                        &|q| coordinate(&j, q, dof).unwrap(),
+                        &|q| crate::kinematics::coordinate(&j, q, dof, 0.0).unwrap(),
                         &format!("{} coordinate {dof}", kind.name()),
                     );
                 }

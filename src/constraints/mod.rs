@@ -8,6 +8,7 @@
 pub(crate) mod joint;
 
 use crate::jet::{pair_of, HessianSink, LMat, Scalar};
+use crate::kinematics::{coordinate, Branches};
 use crate::model::{BodyId, JointId, Model};
 use nalgebra::{DMatrix, DVector};
 
@@ -68,6 +69,9 @@ pub(crate) struct Constraints {
     names: Vec<String>,
     /// Power of length in each row's unit (0, 1 or 2).
     length_power: Vec<i32>,
+    /// The branch each joint angle is read on (lock, mimic and screw rows); the solver moves
+    /// it along with the configuration.
+    pub(crate) branches: Branches,
 }
 
 impl Constraints {
@@ -100,28 +104,27 @@ impl Constraints {
             push(BlockKind::Lock { joint, dof, value }, 1, &mut blocks);
             let j = &model.joints[joint.0];
             names.push(format!("{}.lock[{dof}]", j.name));
-            length_power.push(if crate::forces::is_angle(j.kind, dof) {
-                0
-            } else {
-                1
-            });
+            length_power.push(if j.kind.is_angle(dof) { 0 } else { 1 });
         }
         for (i, m) in model.mimics.iter().enumerate() {
             push(BlockKind::Mimic(i), 1, &mut blocks);
             let j = &model.joints[m.joint.0];
             names.push(format!("{}.mimic", j.name));
-            length_power.push(if crate::forces::is_angle(j.kind, 0) {
-                0
-            } else {
-                1
-            });
+            length_power.push(if j.kind.is_angle(0) { 0 } else { 1 });
         }
         Constraints {
             blocks,
             len,
             names,
             length_power,
+            branches: Branches::default(),
         }
+    }
+
+    /// The same rows with joint angles read on `branches`.
+    pub(crate) fn on_branches(mut self, branches: Branches) -> Self {
+        self.branches = branches;
+        self
     }
 
     /// Power of length in the unit of row `i`.
@@ -153,7 +156,7 @@ impl Constraints {
                 BlockKind::Joint(id) => {
                     let j = &model.joints[id.0];
                     let pair = pair_of(&j.bodies, q, hess);
-                    joint::rows(j, &pair, &mut buf);
+                    joint::rows(j, &pair, self.branches.get(*id, 0), &mut buf);
                     for (k, s) in buf.iter().enumerate() {
                         visit(block.first + k, Term::Jet(&j.bodies, s, 1.0));
                     }
@@ -166,7 +169,7 @@ impl Constraints {
                 } => {
                     let j = &model.joints[id.0];
                     let pair = pair_of(&j.bodies, q, hess);
-                    if let Some(s) = joint::coordinate(j, &pair, *dof) {
+                    if let Some(s) = coordinate(j, &pair, *dof, self.branches.get(*id, *dof)) {
                         visit(block.first, Term::Jet(&j.bodies, &s.minus(*value), 1.0));
                     }
                 }
@@ -176,9 +179,10 @@ impl Constraints {
                     let jb = &model.joints[m.reference.0];
                     let pa = pair_of(&ja.bodies, q, hess);
                     let pb = pair_of(&jb.bodies, q, hess);
-                    if let (Some(a), Some(b)) =
-                        (joint::coordinate(ja, &pa, 0), joint::coordinate(jb, &pb, 0))
-                    {
+                    if let (Some(a), Some(b)) = (
+                        coordinate(ja, &pa, 0, self.branches.get(m.joint, 0)),
+                        coordinate(jb, &pb, 0, self.branches.get(m.reference, 0)),
+                    ) {
                         visit(block.first, Term::Jet(&ja.bodies, &a.minus(m.offset), 1.0));
                         visit(block.first, Term::Jet(&jb.bodies, &b, -m.multiplier));
                     }

@@ -1,11 +1,11 @@
 //! The result JSON (field names are a contract; see the README).
 
 use crate::forces::Energy;
-use crate::model::Model;
+use crate::model::{JointKind, Model};
 use crate::solver::{Diagnostics, Iterate, Reaction, Report, Stability};
 use crate::state::State;
-use serde::Serialize;
-use std::collections::BTreeMap;
+use serde::ser::SerializeMap;
+use serde::{Serialize, Serializer};
 
 /// A joint's type and coordinates.
 #[derive(Clone, Debug, Serialize)]
@@ -15,6 +15,35 @@ pub struct JointResult {
     pub kind: String,
     /// Coordinates \[rad or m\]; quaternion `wxyz` for spherical joints; `[]` for fixed joints.
     pub position: Vec<f64>,
+    /// Unit of each entry of `position`: `"rad"`, `"m"`, or `"1"` (a quaternion component).
+    pub units: Vec<&'static str>,
+}
+
+/// Unit of each coordinate of a joint of this kind, in the order of
+/// [`State::joint_values`]: `"rad"`, `"m"`, or `"1"` for a quaternion component.
+pub fn coordinate_units(kind: JointKind) -> Vec<&'static str> {
+    match kind {
+        JointKind::Revolute | JointKind::Continuous | JointKind::Screw { .. } => vec!["rad"],
+        JointKind::Prismatic => vec!["m"],
+        JointKind::Universal => vec!["rad", "rad"],
+        JointKind::Cylindrical => vec!["rad", "m"],
+        JointKind::Planar => vec!["m", "m", "rad"],
+        JointKind::Spherical => vec!["1"; 4],
+        JointKind::Floating => vec!["m", "m", "m", "1", "1", "1", "1"],
+        JointKind::Fixed | JointKind::Distance { .. } | JointKind::PointOnLine => vec![],
+    }
+}
+
+/// Serializes `(name, value)` pairs as a JSON object with the keys in the given order.
+fn ordered_map<T: Serialize, S: Serializer>(
+    pairs: &[(String, T)],
+    s: S,
+) -> std::result::Result<S::Ok, S::Error> {
+    let mut map = s.serialize_map(Some(pairs.len()))?;
+    for (k, v) in pairs {
+        map.serialize_entry(k, v)?;
+    }
+    map.end()
 }
 
 /// A link frame in the world.
@@ -54,15 +83,19 @@ pub struct AnalysisResult {
     pub dof: usize,
     /// Iteration history.
     pub history: Vec<Iterate>,
-    /// Every joint's coordinates.
-    pub joints: BTreeMap<String, JointResult>,
-    /// Every link's frame in the world.
-    pub links: BTreeMap<String, LinkResult>,
+    /// Every joint's coordinates, in model order (URDF `<joint>` elements in file order, then
+    /// loop joints declared by extensions).
+    #[serde(serialize_with = "ordered_map")]
+    pub joints: Vec<(String, JointResult)>,
+    /// Every link's frame in the world, in model order.
+    #[serde(serialize_with = "ordered_map")]
+    pub links: Vec<(String, LinkResult)>,
     /// Stability verdict (absent for a structure with no degree of freedom).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stability: Option<Stability>,
-    /// Reaction of each joint on its child link at the joint origin.
-    pub reactions: BTreeMap<String, Reaction>,
+    /// Reaction of each joint on its child link at the joint origin, in model order.
+    #[serde(serialize_with = "ordered_map")]
+    pub reactions: Vec<(String, Reaction)>,
     /// Constraint rows dropped as redundant.
     pub redundant_constraints: Vec<String>,
     /// Independent coordinates of the final partition.
@@ -84,7 +117,7 @@ pub struct AnalysisResult {
 impl AnalysisResult {
     /// Builds the result of a solve.
     pub fn new(model: &Model, state: &State, report: &Report) -> Self {
-        let joints: BTreeMap<String, JointResult> = state
+        let joints: Vec<(String, JointResult)> = state
             .joint_values(model)
             .into_iter()
             .zip(&model.joints)
@@ -94,6 +127,7 @@ impl AnalysisResult {
                     JointResult {
                         kind: j.kind.name().to_string(),
                         position,
+                        units: coordinate_units(j.kind),
                     },
                 )
             })
@@ -101,37 +135,35 @@ impl AnalysisResult {
         let links = model
             .links
             .iter()
-            .filter_map(|l| {
-                let pose = state.link_pose(model, &l.name)?;
+            .map(|l| {
+                // The link itself, not a lookup by name (O(N²) over all links).
+                let pose = match l.body {
+                    Some(b) => state.body_pose(b) * l.body_from_link,
+                    None => l.body_from_link,
+                };
                 let r = pose.rotation;
                 let (w, x, y, z) = if r.w < 0.0 {
                     (-r.w, -r.i, -r.j, -r.k)
                 } else {
                     (r.w, r.i, r.j, r.k)
                 };
-                Some((
+                (
                     l.name.clone(),
                     LinkResult {
                         position: pose.translation.vector.into(),
                         orientation_wxyz: [w, x, y, z],
                     },
-                ))
+                )
             })
             .collect();
         let limit_violations = model
             .joints
             .iter()
-            .filter(|j| {
-                matches!(
-                    j.kind,
-                    crate::model::JointKind::Revolute | crate::model::JointKind::Prismatic
-                )
-            })
-            .filter_map(|j| {
+            .zip(&joints)
+            .filter(|(j, _)| matches!(j.kind, JointKind::Revolute | JointKind::Prismatic))
+            .filter_map(|(j, (_, r))| {
                 let [lo, hi] = j.limits?;
-                let p = joints
-                    .get(&j.name)
-                    .and_then(|r: &JointResult| r.position.first().copied())?;
+                let p = r.position.first().copied()?;
                 (hi > lo && (p < lo - 1e-9 || p > hi + 1e-9)).then(|| LimitViolation {
                     joint: j.name.clone(),
                     position: p,
@@ -151,14 +183,14 @@ impl AnalysisResult {
             joints,
             links,
             stability: report.stability.clone(),
-            reactions: report.reactions.iter().cloned().collect(),
+            reactions: report.reactions.clone(),
             redundant_constraints: report.redundant_constraints.clone(),
             independent_coordinates: report.independent_coordinates.clone(),
             energy: report.energy,
             diagnostics: report.diagnostics.clone(),
-            bodies: report.sizes[0],
-            coordinates: report.sizes[1],
-            constraints: report.sizes[2],
+            bodies: report.sizes.bodies,
+            coordinates: report.sizes.coordinates,
+            constraints: report.sizes.constraint_rows,
         }
     }
 

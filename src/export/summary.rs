@@ -72,8 +72,8 @@ fn law(l: &ForceLaw) -> String {
 }
 
 impl ModelSummary {
-    /// Summarizes a loaded model.
-    pub fn new(loaded: &crate::urdf::Loaded) -> Self {
+    /// Summarizes a loaded model and its check ([`crate::verify::check`]).
+    pub fn new(loaded: &crate::urdf::Loaded, check: &crate::verify::ModelCheck) -> Self {
         let m = &loaded.model;
         let bodies = m
             .bodies
@@ -168,14 +168,6 @@ impl ModelSummary {
                 x.offset
             )
         }));
-        let start = crate::solver::initial_state(m);
-        let (dof, assembly_error) =
-            match crate::verify::assemble(m, &start).and_then(|s| crate::verify::balance(m, &s)) {
-                Ok(b) => (Some(b.dof), None),
-                Err(e) => (None, Some(e.to_string())),
-            };
-        let constraints =
-            crate::constraints::Constraints::new(m, &crate::solver::lock_values(m)).len();
         ModelSummary {
             robot: m.name.clone(),
             bodies,
@@ -190,9 +182,9 @@ impl ModelSummary {
             forces,
             gravity: m.gravity.into(),
             coordinates: m.coordinate_count(),
-            constraints,
-            dof,
-            assembly_error,
+            constraints: check.constraint_rows,
+            dof: check.dof,
+            assembly_error: check.assembly_error.clone(),
             warnings: loaded.warnings.clone(),
             ignored: loaded.ignored.clone(),
         }

@@ -3,14 +3,15 @@
 //! `V = V_gravity + V_springs + V_joint_springs − W_loads − W_efforts` with
 //! - gravity `−Σ_i m_i gᵀ (r_i + A_i c_i)` (zero at the world origin),
 //! - translational springs `∫₀^{L−L₀} F(δ) dδ`, `L = ‖r_Pj − r_Pi‖`,
-//! - joint springs `∫₀^{θ−θ_ref} F(δ) dδ`,
+//! - joint springs `∫₀^{θ−θ_ref} F(δ) dδ` with `θ` the unwrapped joint angle (module
+//!   [`crate::kinematics`]: never wrapped into (−π, π]),
 //! - dead loads `W = fᵀ r_P`, joint efforts `W = τ θ`.
 
 pub(crate) mod law;
 
-use crate::constraints::joint;
 use crate::jet::{pair_of, scatter, Pair, Scalar, Vec3Jet};
-use crate::model::{BodyId, JointKind, Model, SpringMode};
+use crate::kinematics::{coordinate, Branches};
+use crate::model::{BodyId, Model, SpringMode};
 use nalgebra::{DVector, Vector3};
 
 /// Potential energy split by source \[J\].
@@ -45,23 +46,13 @@ fn weighted(pair: &Pair, f: &Vec3Jet, w: &Vector3<f64>) -> Scalar {
     }
 }
 
-/// Whether coordinate `dof` of a joint of this kind is an angle (wrapped into (−π, π]).
-pub(crate) fn is_angle(kind: JointKind, dof: usize) -> bool {
-    matches!(
-        (kind, dof),
-        (
-            JointKind::Revolute | JointKind::Continuous | JointKind::Screw { .. },
-            0
-        ) | (JointKind::Cylindrical, 0)
-            | (JointKind::Universal, _)
-            | (JointKind::Planar, 2)
-    )
-}
-
-/// Evaluates `V(q)`; adds `V_q` to `grad` and, when given, `V_qq` to `hess`. Returns `None`
-/// where `V` is undefined (a force table with `extrapolate="error"` left its range).
+/// Evaluates `V(q)` with joint angles read on `branches` (unwrapped: a spring wound by several
+/// turns stores the energy of all of them); adds `V_q` to `grad` and, when given, `V_qq` to
+/// `hess`. Returns `None` where `V` is undefined (a force table with `extrapolate="error"` left
+/// its range).
 pub(crate) fn potential(
     model: &Model,
+    branches: &Branches,
     q: &DVector<f64>,
     grad: &mut DVector<f64>,
     mut hess: Option<&mut dyn crate::jet::HessianSink>,
@@ -115,12 +106,8 @@ pub(crate) fn potential(
     for js in &model.joint_springs {
         let j = &model.joints[js.joint.0];
         let pair = pair_of(&j.bodies, q, want_h);
-        let theta = joint::coordinate(j, &pair, js.dof)?;
-        let mut delta = theta.v - js.reference;
-        if is_angle(j.kind, js.dof) {
-            delta = crate::math::wrap_angle(delta);
-        }
-        let (u, f, k) = law::evaluate(&js.law, SpringMode::Both, delta)?;
+        let theta = coordinate(j, &pair, js.dof, branches.get(js.joint, js.dof))?;
+        let (u, f, k) = law::evaluate(&js.law, SpringMode::Both, theta.v - js.reference)?;
         add(
             &j.bodies,
             &theta.compose(u, f, k),
@@ -131,7 +118,7 @@ pub(crate) fn potential(
     for ef in &model.efforts {
         let j = &model.joints[ef.joint.0];
         let pair = pair_of(&j.bodies, q, want_h);
-        let theta = joint::coordinate(j, &pair, ef.dof)?;
+        let theta = coordinate(j, &pair, ef.dof, branches.get(ef.joint, ef.dof))?;
         add(&j.bodies, &theta, -ef.value, &mut e.loads);
     }
     e.total = e.gravity + e.springs + e.joint_springs + e.loads;

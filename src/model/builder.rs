@@ -87,6 +87,7 @@ impl ModelBuilder {
                 initial: Vec::new(),
                 gravity: Vector3::new(0.0, 0.0, -9.81),
                 length_scale: 1.0,
+                joint_names: Default::default(),
             },
             inertials: Vec::new(),
             no_gravity: Vec::new(),
@@ -298,6 +299,7 @@ impl ModelBuilder {
         self.validate()?;
         aggregate_mass(&mut self.model, &self.inertials, &self.no_gravity);
         self.model.length_scale = length_scale(&self.model);
+        self.model.index_names();
         Ok(self.model)
     }
 

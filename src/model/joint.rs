@@ -66,20 +66,6 @@ impl JointKind {
             JointKind::PointOnLine => "point_on_line",
         }
     }
-
-    /// Number of scalar joint coordinates that springs, efforts, locks and initial values can
-    /// address (`dof` index).
-    pub fn scalar_coordinates(&self) -> usize {
-        match self {
-            JointKind::Revolute
-            | JointKind::Continuous
-            | JointKind::Prismatic
-            | JointKind::Screw { .. } => 1,
-            JointKind::Universal | JointKind::Cylindrical => 2,
-            JointKind::Planar => 3,
-            _ => 0,
-        }
-    }
 }
 
 /// A joint between a parent and a child body.

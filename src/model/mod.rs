@@ -18,6 +18,7 @@ pub use force::{
 pub use joint::{Joint, JointId, JointKind};
 
 use nalgebra::Vector3;
+use std::collections::HashMap;
 
 /// A validated mechanism (built by [`ModelBuilder`], which the URDF importer drives);
 /// immutable once built.
@@ -49,6 +50,8 @@ pub struct Model {
     pub gravity: Vector3<f64>,
     /// Characteristic length of the mechanism \[m\], used to scale position coordinates.
     pub length_scale: f64,
+    /// Joint ids by name, built once by [`Model::index_names`].
+    pub(crate) joint_names: HashMap<String, JointId>,
 }
 
 impl Model {
@@ -57,9 +60,21 @@ impl Model {
         7 * self.bodies.len()
     }
 
-    /// Looks a joint up by name.
+    /// Looks a joint up by name (through the name map when it is current, else by a scan).
     pub fn joint_id(&self, name: &str) -> Option<JointId> {
-        self.joints.iter().position(|j| j.name == name).map(JointId)
+        match self.joint_names.get(name) {
+            Some(&id) if self.joints.get(id.0).is_some_and(|j| j.name == name) => Some(id),
+            _ => self.joints.iter().position(|j| j.name == name).map(JointId),
+        }
+    }
+
+    /// Builds the joint name map (the first joint of a name wins); called by the importer once
+    /// the joints are in place.
+    pub(crate) fn index_names(&mut self) {
+        self.joint_names.clear();
+        for (i, j) in self.joints.iter().enumerate() {
+            self.joint_names.entry(j.name.clone()).or_insert(JointId(i));
+        }
     }
 
     /// Looks a link up by name.

@@ -9,6 +9,7 @@ use super::options::Options;
 use super::system::System;
 use crate::constraints::Constraints;
 use crate::error::{Error, Result};
+use crate::kinematics::Branches;
 use crate::model::{JointId, Model};
 use nalgebra::DVector;
 
@@ -66,6 +67,7 @@ fn newton(
             let trial = sys.residual(&qt).clone();
             if rows_residual(sys, &trial) < res {
                 q = qt;
+                sys.cons.branches.follow(sys.model, &q);
                 improved = true;
                 break;
             }
@@ -82,6 +84,7 @@ fn newton(
 pub(crate) fn assemble(
     model: &Model,
     q: DVector<f64>,
+    branches: &mut Branches,
     locks: &[(JointId, usize, f64)],
     options: &Options,
 ) -> Result<DVector<f64>> {
@@ -94,30 +97,38 @@ pub(crate) fn assemble(
         }
     }
     if held.len() > locks.len() {
-        let mut sys = System::with_options(model, Constraints::new(model, &held), options);
+        let cons = Constraints::new(model, &held).on_branches(branches.clone());
+        let mut sys = System::with_options(model, cons, options);
         if let Ok(qa) = newton(&mut sys, q.clone(), tol) {
-            let mut fin = System::with_options(model, Constraints::new(model, locks), options);
+            let cons = Constraints::new(model, locks).on_branches(sys.cons.branches.clone());
+            let mut fin = System::with_options(model, cons, options);
             fin.residual(&qa);
             if fin.dimensionless_residual() <= tol.max(1e-8) {
+                *branches = fin.cons.branches;
                 return Ok(qa);
             }
         }
     }
-    project(model, q, locks, options)
+    project(model, q, branches, locks, options)
 }
 
 /// Damped Newton onto `Φ = 0` with the given locks only.
 pub(crate) fn project(
     model: &Model,
     q: DVector<f64>,
+    branches: &mut Branches,
     locks: &[(JointId, usize, f64)],
     options: &Options,
 ) -> Result<DVector<f64>> {
     let tol = options.constraint_tolerance;
-    let mut sys = System::with_options(model, Constraints::new(model, locks), options);
+    let cons = Constraints::new(model, locks).on_branches(branches.clone());
+    let mut sys = System::with_options(model, cons, options);
     let q0 = q.clone();
     match newton(&mut sys, q, tol) {
-        Ok(qa) => Ok(qa),
+        Ok(qa) => {
+            *branches = sys.cons.branches;
+            Ok(qa)
+        }
         Err(Failure::Inconsistent(row)) => {
             let phi = sys.phi();
             let loops: Vec<String> = model

@@ -352,6 +352,7 @@ pub(crate) fn minimize(
                 quasi_newton_update(options.method, &mut qn.binv, &s, &y, qn.fresh);
                 qn.fresh = false;
                 q = qt;
+                sys.cons.branches.follow(sys.model, &q);
                 eval = et;
                 iteration += 1;
                 just_repartitioned = false;

@@ -26,10 +26,13 @@ mod spectrum;
 pub(crate) mod system;
 
 pub use options::{LinearAlgebra, Method, Options};
-pub use report::{Diagnostics, Iterate, Reaction, Report, Stability, Termination};
+pub use report::{
+    Diagnostics, Iterate, Reaction, Report, Sizes, Stability, Termination, Timings, Verdict,
+};
 
 use crate::constraints::Constraints;
 use crate::error::{Error, Result};
+use crate::kinematics::Branches;
 use crate::model::{JointId, Model};
 use crate::state::{JointValues, State};
 use system::System;
@@ -40,7 +43,9 @@ pub fn initial_state(model: &Model) -> State {
     State::initial(model)
 }
 
-/// The model's initial values by joint (missing coordinates 0).
+/// The model's initial values by joint (missing coordinates 0), a lock's value replacing the
+/// initial value of the coordinate it holds (the start is then on the lock's branch: a lock at
+/// 3.2 rad is not read as 3.2 − 2π).
 pub(crate) fn initial_values(model: &Model) -> JointValues {
     crate::state::initial_values(model)
 }
@@ -61,13 +66,15 @@ pub(crate) fn lock_values(model: &Model) -> Vec<(JointId, usize, f64)> {
         .collect()
 }
 
-/// Closes the constraints from `q` without the initial-value holds (see module `assemble`).
+/// Closes the constraints from `q` without the initial-value holds (see module `assemble`),
+/// with joint angles read on (and moved along) `branches`.
 pub(crate) fn assemble_only(
     model: &Model,
     q: nalgebra::DVector<f64>,
+    branches: &mut Branches,
     locks: &[(JointId, usize, f64)],
 ) -> Result<nalgebra::DVector<f64>> {
-    assemble::project(model, q, locks, &Options::default())
+    assemble::project(model, q, branches, locks, &Options::default())
 }
 
 /// The stability verdict from the reduced-Hessian eigenvalues (ascending, at least one) and
@@ -83,11 +90,11 @@ fn stability(
     let tol = spectrum.tolerance();
     let negative_by_inertia = spectrum.negative_by_inertia.unwrap_or(0) > 0;
     let verdict = if vals[0] < -tol || negative_by_inertia {
-        "unstable"
+        Verdict::Unstable
     } else if vals[0] <= tol {
-        "neutral"
+        Verdict::Neutral
     } else {
-        "stable"
+        Verdict::Stable
     };
     let shown = vals.len().min(6);
     let modes = (0..shown)
@@ -97,7 +104,7 @@ fn stability(
             for j in sys.model.joints.iter().filter(|j| !j.merged) {
                 let pair = crate::jet::pair_of(&j.bodies, q, false);
                 let d: Vec<f64> = (0..j.kind.scalar_coordinates())
-                    .filter_map(|dof| crate::constraints::joint::coordinate(j, &pair, dof))
+                    .filter_map(|dof| crate::kinematics::coordinate(j, &pair, dof, 0.0))
                     .map(|s| {
                         (0..crate::jet::NL)
                             .filter_map(|i| {
@@ -118,7 +125,7 @@ fn stability(
         })
         .collect();
     Stability {
-        verdict: verdict.into(),
+        verdict,
         tolerance: tol,
         eigenvalues: vals.iter().take(shown).copied().collect(),
         modes,
@@ -127,8 +134,9 @@ fn stability(
 
 /// Stability verdict at a state that is feasible and balanced (`None` with no degree of
 /// freedom or where the energy is undefined).
-pub(crate) fn stability_at(model: &Model, q: &nalgebra::DVector<f64>) -> Option<Stability> {
-    let sys_cons = Constraints::new(model, &lock_values(model));
+pub(crate) fn stability_at(model: &Model, state: &State) -> Option<Stability> {
+    let q = &state.q;
+    let sys_cons = Constraints::new(model, &lock_values(model)).on_branches(state.branches.clone());
     let mut sys = System::new(model, sys_cons);
     let part = sys.partition(q);
     if part.independent.is_empty() {
@@ -165,20 +173,35 @@ pub fn solve(model: &Model, options: &Options) -> Result<(State, Report)> {
 /// # Errors
 /// As [`solve`].
 pub fn solve_from(model: &Model, start: State, options: &Options) -> Result<(State, Report)> {
+    let started = std::time::Instant::now();
     let locks = lock_values(model);
-    let q = assemble::assemble(model, start.q, &locks, options)?;
-    match options.load_steps {
+    let mut branches = start.branches;
+    let q = assemble::assemble(model, start.q, &mut branches, &locks, options)?;
+    let q = State { q, branches };
+    let assembly = started.elapsed().as_secs_f64();
+    let (state, mut report) = match options.load_steps {
         0 => {
             let direct = solve_assembled(model, q.clone(), &locks, options)?;
             if direct.1.converged() || direct.1.termination == Termination::Unbounded {
-                return Ok(direct);
+                direct
+            } else {
+                let ramped = ramp(model, q, AUTOMATIC_LOAD_STEPS, &locks, options)?;
+                if ramped.1.converged() {
+                    ramped
+                } else {
+                    direct
+                }
             }
-            let ramped = ramp(model, q, AUTOMATIC_LOAD_STEPS, &locks, options)?;
-            Ok(if ramped.1.converged() { ramped } else { direct })
         }
-        1 => solve_assembled(model, q, &locks, options),
-        n => ramp(model, q, n, &locks, options),
-    }
+        1 => solve_assembled(model, q, &locks, options)?,
+        n => ramp(model, q, n, &locks, options)?,
+    };
+    // Everything after the assembly that is not the final stability is iterations (load
+    // stages and a direct attempt before a ramp included).
+    let t = &mut report.diagnostics.timings;
+    t.assembly = assembly;
+    t.iterations = (started.elapsed().as_secs_f64() - assembly - t.stability).max(0.0);
+    Ok((state, report))
 }
 
 /// BFGS / DFP store a dense `dof × dof` inverse-Hessian approximation: refused above this.
@@ -191,7 +214,7 @@ const AUTOMATIC_LOAD_STEPS: usize = 8;
 /// stage starting from the previous rest pose.
 fn ramp(
     model: &Model,
-    mut q: nalgebra::DVector<f64>,
+    mut q: State,
     n: usize,
     locks: &[(JointId, usize, f64)],
     options: &Options,
@@ -201,7 +224,7 @@ fn ramp(
     for k in 1..n {
         let stage = model.with_load_factor(k as f64 / n as f64);
         let (s, r) = solve_assembled(&stage, q, locks, options)?;
-        q = s.q;
+        q = s;
         iterations += r.iterations;
         counters.add_counts(&r.diagnostics);
     }
@@ -215,11 +238,13 @@ fn ramp(
 /// Minimizes from an assembled `q`: partition, minimize, stability, reactions.
 fn solve_assembled(
     model: &Model,
-    q: nalgebra::DVector<f64>,
+    start: State,
     locks: &[(JointId, usize, f64)],
     options: &Options,
 ) -> Result<(State, Report)> {
-    let mut sys = System::with_options(model, Constraints::new(model, locks), options);
+    let q = start.q;
+    let cons = Constraints::new(model, locks).on_branches(start.branches.clone());
+    let mut sys = System::with_options(model, cons, options);
     let part = sys.partition(&q);
     let dof0 = part.independent.len();
     if options.method != Method::Newton && dof0 > QUASI_NEWTON_DOF_LIMIT {
@@ -238,10 +263,14 @@ fn solve_assembled(
             "a force table with extrapolate=\"error\" is out of range, or Φ_u is singular".into(),
         )
     })?;
-    let state = State { q: out.q.clone() };
+    let state = State {
+        q: out.q.clone(),
+        branches: sys.cons.branches.clone(),
+    };
     let dof = out.part.independent.len();
     let mut diagnostics = out.diagnostics;
     diagnostics.linear_algebra = if sys.sparse { "sparse" } else { "dense" }.into();
+    let stability_started = std::time::Instant::now();
     let stability = (dof > 0).then(|| {
         let eig = out
             .eigen
@@ -251,6 +280,7 @@ fn solve_assembled(
         stability(&sys, &out.q, &out.part, &out.eval, &eig)
     });
     let reactions = reactions::reactions(&sys, &out.q, &out.part, &out.eval);
+    diagnostics.timings.stability = stability_started.elapsed().as_secs_f64();
     let report = Report {
         termination: out.termination,
         iterations: out.history.last().map_or(0, |h| h.iteration),
@@ -272,8 +302,24 @@ fn solve_assembled(
         stability,
         reactions,
         diagnostics,
-        sizes: [model.bodies.len(), model.coordinate_count(), sys.cons.len()],
-        iterates: out.iterates.into_iter().map(|q| State { q }).collect(),
+        sizes: Sizes {
+            bodies: model.bodies.len(),
+            coordinates: model.coordinate_count(),
+            constraint_rows: sys.cons.len(),
+        },
+        iterates: {
+            let mut branches = start.branches;
+            out.iterates
+                .into_iter()
+                .map(|q| {
+                    branches.follow(model, &q);
+                    State {
+                        q,
+                        branches: branches.clone(),
+                    }
+                })
+                .collect()
+        },
     };
     Ok((state, report))
 }

@@ -2,6 +2,7 @@
 
 /// Minimization method in the independent coordinates.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum Method {
     /// Newton's method with the exact reduced Hessian (modified to be positive definite away
@@ -16,6 +17,7 @@ pub enum Method {
 
 /// Linear algebra of the solver.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum LinearAlgebra {
     /// Dense up to 40 bodies (280 coordinates), sparse above (default).

@@ -42,14 +42,14 @@ pub(crate) fn reactions(
         for block in &by_joint[ji] {
             match &block.kind {
                 BlockKind::Joint(id) if id.0 == ji => {
-                    joint::rows(j, &pair, &mut rows_buf);
+                    joint::rows(j, &pair, sys.cons.branches.get(*id, 0), &mut rows_buf);
                     for (k, s) in rows_buf.iter().enumerate() {
                         g += s.g * mu[block.first + k];
                     }
                     any = true;
                 }
                 BlockKind::Lock { joint: id, dof, .. } if id.0 == ji => {
-                    if let Some(s) = joint::coordinate(j, &pair, *dof) {
+                    if let Some(s) = crate::kinematics::coordinate(j, &pair, *dof, 0.0) {
                         g += s.g * mu[block.first];
                         any = true;
                     }

@@ -40,11 +40,41 @@ pub struct Iterate {
     pub gradient_norm: f64,
 }
 
+/// The stability verdict, from the smallest eigenvalue `λ₁` of the reduced Hessian and the
+/// eigenvalue tolerance `ε`; serialized as `"stable"`, `"unstable"` or `"neutral"`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// Every eigenvalue `> ε`: a strict local minimum of the energy.
+    Stable,
+    /// `λ₁ < −ε` (or a negative eigenvalue counted by the KKT inertia): a saddle or maximum.
+    Unstable,
+    /// `|λ₁| ≤ ε`: flat to second order along some motion (higher orders decide).
+    Neutral,
+}
+
+impl Verdict {
+    /// The snake-case name used in the JSON.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Verdict::Stable => "stable",
+            Verdict::Unstable => "unstable",
+            Verdict::Neutral => "neutral",
+        }
+    }
+}
+
+impl std::fmt::Display for Verdict {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
 /// Stability of the equilibrium from the eigenvalues of the reduced Hessian.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Stability {
     /// `stable` (all eigenvalues > tolerance), `unstable` (one < −tolerance) or `neutral`.
-    pub verdict: String,
+    pub verdict: Verdict,
     /// Eigenvalue tolerance used: `1e-10 · max(1, max |λ|)` \[J\].
     pub tolerance: f64,
     /// Smallest eigenvalues of the scaled reduced Hessian, ascending (at most 6) \[J\].
@@ -81,6 +111,25 @@ pub struct Diagnostics {
     /// How the stability eigenvalues were found: `"exact"` (the reduced Hessian decomposed) or
     /// `"lanczos"` (its low end only, for many degrees of freedom); empty without any.
     pub eigenvalues_by: String,
+    /// Wall time of each phase \[s\].
+    pub timings: Timings,
+}
+
+/// Wall time of each phase of an analysis \[s\]. The solver fills `assembly`, `iterations`
+/// and `stability`; `import` and `export` are the caller's (the CLI measures reading the URDF
+/// and building the result; writing the text is not included).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Timings {
+    /// Reading and importing the model \[s\].
+    pub import: f64,
+    /// Closing the loops from the initial guess \[s\].
+    pub assembly: f64,
+    /// The minimizer's iterations, load stages included \[s\].
+    pub iterations: f64,
+    /// Stability (eigenvalues or inertia) and reactions at the rest pose \[s\].
+    pub stability: f64,
+    /// Building the result (joint values, link frames) \[s\].
+    pub export: f64,
 }
 
 impl Diagnostics {
@@ -107,6 +156,18 @@ pub struct Reaction {
     pub torque_joint: [f64; 3],
 }
 
+/// Sizes of the solved problem.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct Sizes {
+    /// Moving bodies.
+    pub bodies: usize,
+    /// Cartesian coordinates (7 per body).
+    pub coordinates: usize,
+    /// Constraint rows, before redundant ones are dropped (normalization, locks and mimics
+    /// included).
+    pub constraint_rows: usize,
+}
+
 /// The solve's report.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Report {
@@ -130,8 +191,8 @@ pub struct Report {
     pub reactions: Vec<(String, Reaction)>,
     /// Counters.
     pub diagnostics: Diagnostics,
-    /// Number of bodies, coordinates and constraint rows.
-    pub sizes: [usize; 3],
+    /// Sizes of the problem.
+    pub sizes: Sizes,
     /// The configuration at each entry of `history` (only with `Options::record_iterates`;
     /// with load stepping, the last stage's).
     pub iterates: Vec<crate::State>,
@@ -141,5 +202,23 @@ impl Report {
     /// Whether the solve converged.
     pub fn converged(&self) -> bool {
         self.termination == Termination::Converged
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Verdict;
+
+    /// The JSON keeps the strings it had before the verdict became an enum.
+    #[test]
+    fn verdict_serializes_as_before() {
+        for (v, s) in [
+            (Verdict::Stable, "stable"),
+            (Verdict::Unstable, "unstable"),
+            (Verdict::Neutral, "neutral"),
+        ] {
+            assert_eq!(serde_json::to_string(&v).unwrap(), format!("\"{s}\""));
+            assert_eq!(v.to_string(), s);
+        }
     }
 }

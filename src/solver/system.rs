@@ -401,7 +401,7 @@ impl<'a> System<'a> {
     pub(crate) fn evaluate(&mut self, q: &DVector<f64>, part: &Partition) -> Option<Eval> {
         self.triplets(q);
         let mut grad_q = DVector::zeros(q.len());
-        let energy = potential(self.model, q, &mut grad_q, None)?;
+        let energy = potential(self.model, &self.cons.branches, q, &mut grad_q, None)?;
         let dof = part.independent.len();
         let factors = self.factors(part)?;
         let v_u = DVector::from_iterator(
@@ -511,7 +511,13 @@ impl<'a> System<'a> {
         let n = q.len();
         let mut w = DMatrix::zeros(n, n);
         let mut g = DVector::zeros(n);
-        let _ = potential(self.model, q, &mut g, Some(&mut w as &mut dyn HessianSink));
+        let _ = potential(
+            self.model,
+            &self.cons.branches,
+            q,
+            &mut g,
+            Some(&mut w as &mut dyn HessianSink),
+        );
         self.cons
             .add_hessian(self.model, q, &self.weights(part, eval), &mut w);
         w
@@ -524,6 +530,7 @@ impl<'a> System<'a> {
         let mut g = DVector::zeros(q.len());
         let _ = potential(
             self.model,
+            &self.cons.branches,
             q,
             &mut g,
             Some(&mut hess as &mut dyn HessianSink),
@@ -770,7 +777,14 @@ mod tests {
             let q = random_q(n, 7);
             let mut g = DVector::zeros(n);
             let mut h = DMatrix::zeros(n, n);
-            potential(&model, &q, &mut g, Some(&mut h as &mut dyn HessianSink)).unwrap();
+            potential(
+                &model,
+                &Default::default(),
+                &q,
+                &mut g,
+                Some(&mut h as &mut dyn HessianSink),
+            )
+            .unwrap();
             let step = 1e-6;
             for i in 0..n {
                 let mut qp = q.clone();
@@ -778,8 +792,12 @@ mod tests {
                 qp[i] += step;
                 qm[i] -= step;
                 let (mut gp, mut gm) = (DVector::zeros(n), DVector::zeros(n));
-                let vp = potential(&model, &qp, &mut gp, None).unwrap().total;
-                let vm = potential(&model, &qm, &mut gm, None).unwrap().total;
+                let vp = potential(&model, &Default::default(), &qp, &mut gp, None)
+                    .unwrap()
+                    .total;
+                let vm = potential(&model, &Default::default(), &qm, &mut gm, None)
+                    .unwrap()
+                    .total;
                 let fd = (vp - vm) / (2.0 * step);
                 assert_fd(g[i], fd, 1e-6, || {
                     format!("{}: V_q[{i}] {} vs {fd}", model.name, g[i])
@@ -857,7 +875,7 @@ mod tests {
         );
         for model in all {
             let q0 = crate::solver::initial_state(&model).q;
-            let q = crate::solver::assemble_only(&model, q0, &[]).unwrap();
+            let q = crate::solver::assemble_only(&model, q0, &mut Default::default(), &[]).unwrap();
             let mut dense = System::new(&model, Constraints::new(&model, &[]));
             dense.sparse = false;
             let part = dense.partition(&q);
@@ -911,7 +929,7 @@ mod tests {
     fn reduced_gradient_and_hessian_match_differences_through_the_corrector() {
         for model in models() {
             let q0 = crate::solver::initial_state(&model).q;
-            let q = crate::solver::assemble_only(&model, q0, &[]).unwrap();
+            let q = crate::solver::assemble_only(&model, q0, &mut Default::default(), &[]).unwrap();
             let mut sys = System::new(&model, Constraints::new(&model, &[]));
             let part = sys.partition(&q);
             let e = sys.evaluate(&q, &part).unwrap();

@@ -1,5 +1,8 @@
 //! Poses given as joint values: restpose's result JSON, a `{"joint": value}` map (JSON), or a
-//! ROS `joint_states`-style document (`name` and `position` lists, JSON or YAML).
+//! ROS `joint_states`-style document (`name` and `position` lists, JSON or YAML, with
+//! restpose's `multi_dof` mapping `JOINT: [values]` for joints with several coordinates). The
+//! output of `rostopic echo` / `ros2 topic echo` is accepted: YAML documents separated or
+//! ended by `---` lines, of which the last non-empty one is the pose.
 //!
 //! A pose is turned into a state by forward kinematics along the spanning tree
 //! ([`State::from_joint_values`]); loop joints are not moved, so their closure error is part
@@ -39,7 +42,7 @@ pub fn parse_pose(text: &str, file: &str) -> Result<JointValues> {
     let bad = |why: String| Error::Option(format!("{file}: {why}"));
     let value: serde_json::Value = match serde_json::from_str(text) {
         Ok(v) => v,
-        Err(_) => serde_yaml_ng::from_str(text)
+        Err(_) => serde_yaml_ng::from_str(last_document(text))
             .map_err(|e| bad(format!("neither JSON nor YAML ({e})")))?,
     };
     let obj = value
@@ -64,6 +67,16 @@ pub fn parse_pose(text: &str, file: &str) -> Result<JointValues> {
                 .ok_or_else(|| bad("joint names must be strings".into()))?;
             out.insert(n.to_string(), vec![p]);
         }
+        if let Some(multi) = obj.get("multi_dof") {
+            let multi = multi
+                .as_object()
+                .ok_or_else(|| bad("`multi_dof` must map joint names to lists".into()))?;
+            for (name, v) in multi {
+                let p = numbers(v)
+                    .ok_or_else(|| bad(format!("multi_dof.{name}: expected a list of numbers")))?;
+                out.insert(name.clone(), p);
+            }
+        }
     } else if let Some(joints) = obj.get("joints").and_then(|j| j.as_object()) {
         for (name, j) in joints {
             let p = j
@@ -85,6 +98,37 @@ pub fn parse_pose(text: &str, file: &str) -> Result<JointValues> {
     Ok(out)
 }
 
+/// The last non-empty YAML document of `text`: documents are separated or ended by `---`
+/// lines (`rostopic echo` ends each message with one) and may end with `...`.
+fn last_document(text: &str) -> &str {
+    let mut last = text;
+    let mut start = 0;
+    let mut pos = 0;
+    for line in text.split_inclusive('\n') {
+        let marker = line.trim_end();
+        if marker == "---" || marker == "..." {
+            let doc = &text[start..pos];
+            if has_content(doc) {
+                last = doc;
+            }
+            start = pos + line.len();
+        }
+        pos += line.len();
+    }
+    let tail = &text[start..];
+    if has_content(tail) {
+        last = tail;
+    }
+    last
+}
+
+/// Whether a YAML document has anything besides blank lines and comments.
+fn has_content(doc: &str) -> bool {
+    doc.lines()
+        .map(str::trim)
+        .any(|l| !l.is_empty() && !l.starts_with('#'))
+}
+
 /// The state of a pose: forward kinematics with the given values; joints not given keep their
 /// initial-guess values. Returns the state and the names of the movable tree joints that were
 /// not given.
@@ -93,9 +137,17 @@ pub fn parse_pose(text: &str, file: &str) -> Result<JointValues> {
 /// [`Error::Option`] for a joint the model does not have or a value list of the wrong length.
 pub fn pose_state(model: &Model, values: &JointValues) -> Result<(State, Vec<String>)> {
     let mut all = crate::solver::initial_values(model);
+    // Names by map: a pose names every joint, and a linear search each is O(N²).
+    let ids: std::collections::HashMap<&str, crate::model::JointId> = model
+        .joints
+        .iter()
+        .enumerate()
+        .map(|(i, j)| (j.name.as_str(), crate::model::JointId(i)))
+        .collect();
     for (name, v) in values {
-        let id = model
-            .joint_id(name)
+        let id = ids
+            .get(name.as_str())
+            .copied()
             .ok_or_else(|| Error::Option(format!("pose: the model has no joint `{name}`")))?;
         let j = model.joint(id);
         let expected: &[usize] = match j.kind {

@@ -34,16 +34,6 @@ pub(crate) fn solve(model: &Model) -> (State, Report) {
     (s, r)
 }
 
-/// Joint coordinate by name.
-pub(crate) fn joint(model: &Model, state: &State, name: &str) -> Vec<f64> {
-    state
-        .joint_values(model)
-        .into_iter()
-        .find(|(n, _)| n == name)
-        .map(|(_, v)| v)
-        .unwrap()
-}
-
 /// Independent equilibrium checks: constraints hold, the projected gradient vanishes, and no
 /// small feasible perturbation (random joint displacements, then re-assembly) lowers the
 /// energy.
@@ -74,7 +64,14 @@ pub(crate) fn assert_verified_minimum(model: &Model, state: &State) {
         for i in 0..q.len() {
             q[i] += 1e-4 * rnd();
         }
-        let perturbed = restpose::verify::assemble(model, &State { q }).unwrap();
+        let perturbed = restpose::verify::assemble(
+            model,
+            &State {
+                q,
+                branches: state.branches.clone(),
+            },
+        )
+        .unwrap();
         let moved = (&perturbed.q - &state.q).amax();
         let v = restpose::verify::potential_energy(model, &perturbed).unwrap();
         assert!(

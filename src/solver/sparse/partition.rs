@@ -289,7 +289,7 @@ mod tests {
     fn same_rank_as_full_pivoting_and_well_conditioned() {
         for model in models() {
             let q0 = crate::solver::initial_state(&model).q;
-            let q = crate::solver::assemble_only(&model, q0, &[]).unwrap();
+            let q = crate::solver::assemble_only(&model, q0, &mut Default::default(), &[]).unwrap();
             let mut dense = System::new(&model, Constraints::new(&model, &[]));
             dense.sparse = false;
             let mut sparse = System::new(&model, Constraints::new(&model, &[]));

@@ -1,0 +1,105 @@
+//! `restpose analyze`: solve for the rest pose, write the requested files, print a summary.
+
+use super::args::{coord, AnalyzeArgs};
+use super::{exit, print};
+use restpose::export::json::AnalysisResult;
+use restpose::urdf::load_file;
+
+/// Runs `analyze`: exit 0 when converged, 3 when not.
+pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
+    let mut opts = a.input.options()?;
+    for l in &a.lock {
+        let (n, d, v) = coord(l, "lock")?;
+        opts.locks.push((n, d, Some(v)));
+    }
+    for l in &a.initial {
+        opts.initial.push(coord(l, "initial")?);
+    }
+    let import_started = std::time::Instant::now();
+    let loaded = load_file(&a.file, &opts)?;
+    let import = import_started.elapsed().as_secs_f64();
+    if !a.quiet {
+        for w in &loaded.warnings {
+            eprintln!("warning: {w}");
+        }
+        if a.verbose {
+            for i in &loaded.ignored {
+                eprintln!("ignored: {}:{i}", a.file.display());
+            }
+        }
+    }
+    let model = &loaded.model;
+    let (state, mut report) = restpose::solve(model, &a.solver_options())?;
+    report.diagnostics.timings.import = import;
+    let export_started = std::time::Instant::now();
+    let mut result = AnalysisResult::new(model, &state, &report);
+    result.diagnostics.timings.export = export_started.elapsed().as_secs_f64();
+    if let Some(path) = &a.json {
+        print::write_json(path, &result.to_json())?;
+    }
+    if let Some(path) = &a.rrd {
+        write_rrd(path, model, &state, &report)?;
+    }
+    if result.converged {
+        if let Some(path) = &a.write_urdf {
+            let text = restpose::urdf::read_text(&a.file)?;
+            let out = restpose::urdf::with_initial_pose(
+                &text,
+                &a.file.display().to_string(),
+                model,
+                &state,
+            )?;
+            restpose::export::write_atomic(path, out.as_bytes())?;
+        }
+        if let Some(path) = &a.write_joint_states {
+            let out = restpose::export::joint_states::joint_states_yaml(model, &state);
+            restpose::export::write_atomic(path, out.as_bytes())?;
+        }
+    } else if a.write_urdf.is_some() || a.write_joint_states.is_some() {
+        eprintln!(
+            "note: --write-urdf / --write-joint-states are written only for a converged rest pose"
+        );
+    }
+    if !a.quiet && !print::is_stdout(a.json.as_ref()) {
+        print::analysis(&result);
+    }
+    if !result.converged {
+        eprintln!(
+            "error: {}: did not converge ({}) after {} iterations; ‖∂V/∂v‖∞ = {:.3e}, ‖Φ‖∞ = {:.3e}, corrector failures {}, step halvings {}, re-partitions {}",
+            a.file.display(),
+            result.termination,
+            result.iterations,
+            result.diagnostics.gradient_norm,
+            result.diagnostics.constraint_residual,
+            result.diagnostics.corrector_failures,
+            result.diagnostics.step_halvings,
+            result.diagnostics.repartitions
+        );
+        return Ok(exit::NOT_CONVERGED);
+    }
+    Ok(0)
+}
+
+#[cfg(feature = "viewer")]
+fn write_rrd(
+    path: &std::path::Path,
+    model: &restpose::Model,
+    state: &restpose::State,
+    report: &restpose::Report,
+) -> anyhow::Result<()> {
+    restpose::view::write_recording(path, model, state, report)?;
+    Ok(())
+}
+
+#[cfg(not(feature = "viewer"))]
+fn write_rrd(
+    path: &std::path::Path,
+    _: &restpose::Model,
+    _: &restpose::State,
+    _: &restpose::Report,
+) -> anyhow::Result<()> {
+    anyhow::bail!(
+        "{}: this restpose was built without the `viewer` feature; rebuild with `cargo build --release --features viewer`",
+        path.display()
+    )
+}

@@ -1,0 +1,252 @@
+//! Argument definitions (clap derive). Defaults come from the library: [`Options::default`]
+//! for the solver and [`Tolerances::default`] for `verify`; the solver's enums are
+//! `clap::ValueEnum` themselves (feature `cli`).
+
+use anyhow::{bail, Context};
+use clap::{Parser, Subcommand, ValueEnum};
+use restpose::urdf::ImportOptions;
+use restpose::verify::Tolerances;
+use restpose::{LinearAlgebra, Method, Options};
+use std::path::PathBuf;
+
+#[derive(Parser)]
+#[command(
+    name = "restpose",
+    version,
+    about = "Static equilibrium (rest pose) of URDF mechanisms"
+)]
+pub(crate) struct Cli {
+    #[command(subcommand)]
+    pub(crate) command: Command,
+}
+
+#[derive(Subcommand)]
+pub(crate) enum Command {
+    /// Solve for the stable rest pose and print a summary.
+    Analyze(AnalyzeArgs),
+    /// Load and validate a file without solving; print the model as understood.
+    Check(CheckArgs),
+    /// Solve and open the rest pose in the rerun viewer (feature `viewer`).
+    View(AnalyzeArgs),
+    /// Check whether a given pose is a rest pose, without moving it.
+    Verify(VerifyArgs),
+    /// Write a generated benchmark mechanism (URDF) to standard output.
+    Generate(GenerateArgs),
+}
+
+/// How the model is read (shared by every subcommand that reads a URDF).
+#[derive(clap::Args, Clone)]
+pub(crate) struct InputArgs {
+    /// Gravity [m/s²] when the file has no <mech:gravity>.
+    #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_hyphen_values = true)]
+    pub(crate) gravity: Option<Vec<f64>>,
+    /// Where `package://NAME/…` meshes live (repeatable).
+    #[arg(long, value_name = "NAME=DIR")]
+    pub(crate) package: Vec<String>,
+    /// Give links without <inertial> the mass properties of their collision (else visual)
+    /// geometry at this density [kg/m³].
+    #[arg(long, value_name = "DENSITY")]
+    pub(crate) inertia_from_geometry: Option<f64>,
+    /// Leave the root link free instead of welding it to the world.
+    #[arg(long)]
+    pub(crate) floating_base: bool,
+}
+
+impl InputArgs {
+    /// The importer's options.
+    pub(crate) fn options(&self) -> anyhow::Result<ImportOptions> {
+        let mut opts = ImportOptions {
+            floating_base: self.floating_base,
+            inertia_density: self.inertia_from_geometry,
+            ..Default::default()
+        };
+        if let Some(g) = &self.gravity {
+            opts.gravity = nalgebra::Vector3::new(g[0], g[1], g[2]);
+        }
+        for p in &self.package {
+            let (n, d) = p
+                .split_once('=')
+                .with_context(|| format!("--package {p}: expected NAME=DIR"))?;
+            opts.packages.push((n.to_string(), PathBuf::from(d)));
+        }
+        if let Some(d) = self.inertia_from_geometry {
+            if !(d.is_finite() && d > 0.0) {
+                bail!("--inertia-from-geometry {d}: the density must be positive");
+            }
+        }
+        Ok(opts)
+    }
+}
+
+#[derive(clap::Args)]
+pub(crate) struct CheckArgs {
+    /// URDF file.
+    pub(crate) file: PathBuf,
+    #[command(flatten)]
+    pub(crate) input: InputArgs,
+    /// Output format on standard output.
+    #[arg(long, value_enum, default_value = "text")]
+    pub(crate) format: Format,
+    /// Also write the model summary as JSON to this file (`-`: standard output, which then
+    /// carries only the JSON).
+    #[arg(long, value_name = "OUT.json")]
+    pub(crate) json: Option<PathBuf>,
+    /// Also list ignored foreign elements.
+    #[arg(long, short)]
+    pub(crate) verbose: bool,
+}
+
+/// Output format of `check`.
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum Format {
+    Text,
+    Json,
+}
+
+#[derive(clap::Args)]
+pub(crate) struct VerifyArgs {
+    /// URDF file.
+    pub(crate) file: PathBuf,
+    /// Pose: restpose result JSON, a {"joint": value} JSON map, or ROS joint_states-style
+    /// YAML/JSON (`name` and `position` lists).
+    #[arg(long, value_name = "POSE")]
+    pub(crate) pose: Option<PathBuf>,
+    /// Joint value (repeatable; overrides the pose file): JOINT=VALUE or JOINT[DOF]=VALUE.
+    #[arg(long, value_name = "JOINT=VALUE")]
+    pub(crate) joint: Vec<String>,
+    /// Largest effort a joint may need for the pose to pass [N m or N], plus 1e-9 of the
+    /// largest generalized force on any coordinate.
+    #[arg(long, default_value_t = Tolerances::default().force)]
+    pub(crate) force_tolerance: f64,
+    /// Largest constraint violation for the pose to pass [m or rad].
+    #[arg(long, default_value_t = Tolerances::default().constraint)]
+    pub(crate) constraint_tolerance: f64,
+    /// Write the verification as JSON to this file (`-`: standard output, which then carries
+    /// only the JSON: no report).
+    #[arg(long, value_name = "OUT.json")]
+    pub(crate) json: Option<PathBuf>,
+    #[command(flatten)]
+    pub(crate) input: InputArgs,
+    /// Print only errors and the verdict.
+    #[arg(long, short)]
+    pub(crate) quiet: bool,
+}
+
+#[derive(clap::Args)]
+pub(crate) struct GenerateArgs {
+    /// Family.
+    #[arg(value_enum)]
+    pub(crate) family: Family,
+    /// Number of links (chains) or loops (ladder).
+    #[arg(long, default_value_t = 20)]
+    pub(crate) size: usize,
+}
+
+/// Generated mechanism families.
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum Family {
+    /// N-link spatial pendulum chain with joint springs (alternating joint axes).
+    Chain,
+    /// N-link planar chain (all axes parallel) with joint springs.
+    PlanarChain,
+    /// Ladder of N closed four-bar loops.
+    Ladder,
+}
+
+#[derive(clap::Args, Clone)]
+pub(crate) struct AnalyzeArgs {
+    /// URDF file.
+    pub(crate) file: PathBuf,
+    /// Write the result JSON here (written even when the solve does not converge; `-`:
+    /// standard output, which then carries only the JSON: no summary).
+    #[arg(long, value_name = "OUT.json")]
+    pub(crate) json: Option<PathBuf>,
+    #[command(flatten)]
+    pub(crate) input: InputArgs,
+    /// Hold a joint coordinate: JOINT=VALUE or JOINT[DOF]=VALUE (repeatable).
+    #[arg(long, value_name = "JOINT=VALUE")]
+    pub(crate) lock: Vec<String>,
+    /// Initial guess of a joint coordinate: JOINT=VALUE or JOINT[DOF]=VALUE (repeatable).
+    #[arg(long, value_name = "JOINT=VALUE")]
+    pub(crate) initial: Vec<String>,
+    /// Write a rerun recording (.rrd) of the rest pose and the search (feature `viewer`).
+    #[arg(long, value_name = "OUT.rrd")]
+    pub(crate) rrd: Option<PathBuf>,
+    /// Write the input file with the rest pose as `mech:initial` values (only when converged).
+    #[arg(long, value_name = "OUT.urdf")]
+    pub(crate) write_urdf: Option<PathBuf>,
+    /// Write the rest pose as ROS joint_states-style YAML (only when converged).
+    #[arg(long, value_name = "OUT.yaml")]
+    pub(crate) write_joint_states: Option<PathBuf>,
+    /// Maximum minimizer iterations.
+    #[arg(long, default_value_t = Options::default().max_iterations)]
+    pub(crate) max_iterations: usize,
+    /// Tolerance on the scaled reduced gradient [J].
+    #[arg(long, default_value_t = Options::default().gradient_tolerance)]
+    pub(crate) tolerance: f64,
+    /// Tolerance on the constraint residual ‖Φ‖∞.
+    #[arg(long, default_value_t = Options::default().constraint_tolerance)]
+    pub(crate) constraint_tolerance: f64,
+    /// Minimizer.
+    #[arg(long, value_enum, default_value_t = Options::default().method)]
+    pub(crate) method: Method,
+    /// Linear algebra: dense matrices (small models), sparse (partition body by body, faer
+    /// sparse LU, Newton steps from the sparse KKT system), or auto: sparse above 40 bodies.
+    #[arg(long, value_enum, default_value_t = Options::default().linear_algebra)]
+    pub(crate) linear_algebra: LinearAlgebra,
+    /// Ramp gravity, loads and efforts in N steps (0: automatic, 8 steps only if the direct
+    /// solve fails; 1: never).
+    #[arg(long, default_value_t = Options::default().load_steps, value_name = "N")]
+    pub(crate) load_steps: usize,
+    /// Stop at an unstable stationary point instead of leaving it.
+    #[arg(long)]
+    pub(crate) allow_unstable: bool,
+    /// Print only errors.
+    #[arg(long, short)]
+    pub(crate) quiet: bool,
+    /// Also list ignored foreign elements.
+    #[arg(long, short)]
+    pub(crate) verbose: bool,
+}
+
+impl AnalyzeArgs {
+    /// The solver's options.
+    pub(crate) fn solver_options(&self) -> Options {
+        Options {
+            record_iterates: self.rrd.is_some(),
+            method: self.method,
+            linear_algebra: self.linear_algebra,
+            gradient_tolerance: self.tolerance,
+            constraint_tolerance: self.constraint_tolerance,
+            max_iterations: self.max_iterations,
+            allow_unstable: self.allow_unstable,
+            load_steps: self.load_steps,
+            ..Default::default()
+        }
+    }
+}
+
+/// A joint coordinate given as `JOINT=VALUE` or `JOINT[DOF]=VALUE` to option `--{what}`.
+pub(crate) fn coord(s: &str, what: &str) -> anyhow::Result<(String, usize, f64)> {
+    let (name, value) = s
+        .split_once('=')
+        .with_context(|| format!("--{what} {s}: expected JOINT=VALUE"))?;
+    let value: f64 = value
+        .trim()
+        .parse()
+        .with_context(|| format!("--{what} {s}: `{value}` is not a number"))?;
+    if !value.is_finite() {
+        bail!("--{what} {s}: value must be finite");
+    }
+    let (name, dof) = match name.split_once('[') {
+        Some((n, rest)) => {
+            let d = rest
+                .trim_end_matches(']')
+                .parse()
+                .with_context(|| format!("--{what} {s}: bad [DOF]"))?;
+            (n, d)
+        }
+        None => (name, 0),
+    };
+    Ok((name.to_string(), dof, value))
+}

@@ -1,0 +1,41 @@
+//! `restpose check`: load and validate a file without solving; print the model as understood.
+
+use super::args::{CheckArgs, Format};
+use super::exit;
+use super::print::{self, out};
+use restpose::urdf::load_file;
+
+/// Runs `check`: exit 0, or 1 if the initial guess does not assemble.
+pub(crate) fn run(a: &CheckArgs) -> anyhow::Result<u8> {
+    let loaded = load_file(&a.file, &a.input.options()?)?;
+    let s = restpose::export::summary::ModelSummary::new(
+        &loaded,
+        &restpose::verify::check(&loaded.model),
+    );
+    if let Some(path) = &a.json {
+        print::write_json(path, &serde_json::to_string_pretty(&s)?)?;
+    }
+    match a.format {
+        Format::Json if !print::is_stdout(a.json.as_ref()) => {
+            out!("{}", serde_json::to_string_pretty(&s)?)
+        }
+        Format::Json => {}
+        Format::Text if print::is_stdout(a.json.as_ref()) => {}
+        Format::Text => {
+            print::model(&s);
+            for w in &s.warnings {
+                eprintln!("warning: {w}");
+            }
+            if a.verbose {
+                for i in &s.ignored {
+                    eprintln!("ignored: {}:{i}", a.file.display());
+                }
+            }
+        }
+    }
+    Ok(if s.assembly_error.is_some() {
+        exit::INPUT
+    } else {
+        0
+    })
+}

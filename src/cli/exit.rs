@@ -1,0 +1,8 @@
+//! Exit codes (documented in the README's "Command line" section; 2 is clap's usage error).
+
+/// Invalid input or another error (file, option, assembly).
+pub(crate) const INPUT: u8 = 1;
+/// The solve did not converge.
+pub(crate) const NOT_CONVERGED: u8 = 3;
+/// `verify`: the pose is not a rest pose.
+pub(crate) const NOT_BALANCED: u8 = 4;

@@ -1,0 +1,15 @@
+//! `restpose generate`: a generated benchmark mechanism as URDF on standard output.
+
+use super::args::{Family, GenerateArgs};
+use std::io::Write;
+
+/// Writes the mechanism; a closed pipe is not an error.
+pub(crate) fn run(a: &GenerateArgs) -> anyhow::Result<u8> {
+    let text = match a.family {
+        Family::Chain => restpose::generate::chain(a.size, false),
+        Family::PlanarChain => restpose::generate::chain(a.size, true),
+        Family::Ladder => restpose::generate::ladder(a.size),
+    };
+    let _ = std::io::stdout().lock().write_all(text.as_bytes());
+    Ok(0)
+}

@@ -1,0 +1,243 @@
+//! Human-readable output: the analysis summary, the model as `check` understood it, and the
+//! verification report. Everything here formats values it is given; nothing computes.
+
+use restpose::export::json::AnalysisResult;
+use restpose::export::summary::ModelSummary;
+use restpose::verify::{Tolerances, Verification};
+
+/// Writes a line to standard output; a closed pipe (`restpose analyze … | head`) is not an
+/// error and must not panic.
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write;
+        let _ = writeln!(std::io::stdout().lock(), $($arg)*);
+    }};
+}
+pub(crate) use out;
+
+/// Whether an output path means standard output (`-`).
+pub(crate) fn is_stdout(path: Option<&std::path::PathBuf>) -> bool {
+    path.is_some_and(|p| p.as_os_str() == "-")
+}
+
+/// Writes JSON text to `path` atomically, or to standard output for `-`.
+pub(crate) fn write_json(path: &std::path::Path, text: &str) -> anyhow::Result<()> {
+    if path.as_os_str() == "-" {
+        out!("{text}");
+    } else {
+        restpose::export::write_atomic(path, text.as_bytes())?;
+    }
+    Ok(())
+}
+
+/// The summary of a solve (`analyze`).
+pub(crate) fn analysis(r: &AnalysisResult) {
+    out!("robot `{}`", r.robot);
+    out!(
+        "  bodies {}, coordinates {}, constraint rows {} ({} redundant), degrees of freedom {}",
+        r.bodies,
+        r.coordinates,
+        r.constraints,
+        r.redundant_constraints.len(),
+        r.dof
+    );
+    if !r.redundant_constraints.is_empty() {
+        out!(
+            "  redundant constraints: {}",
+            r.redundant_constraints.join(", ")
+        );
+    }
+    out!(
+        "  independent coordinates: {}",
+        r.independent_coordinates.join(", ")
+    );
+    out!();
+    out!("  iteration   potential energy [J]   ‖∂V/∂v‖∞ [J]");
+    for h in &r.history {
+        out!(
+            "  {:>9}   {:>20.9}   {:>12.3e}",
+            h.iteration,
+            h.potential_energy,
+            h.gradient_norm
+        );
+    }
+    out!();
+    out!(
+        "  {}: {} iterations, V = {:.9} J",
+        r.termination,
+        r.iterations,
+        r.potential_energy
+    );
+    if let Some(s) = &r.stability {
+        let eig: Vec<String> = s.eigenvalues.iter().map(|e| format!("{e:.4e}")).collect();
+        out!(
+            "  stability: {} (smallest reduced-Hessian eigenvalues {})",
+            s.verdict,
+            eig.join(", ")
+        );
+    }
+    if let Some(mode) = r.stability.as_ref().and_then(|s| s.modes.first()) {
+        let mut parts: Vec<(&String, f64)> = mode
+            .iter()
+            .flat_map(|(n, v)| v.iter().map(move |x| (n, *x)))
+            .collect();
+        parts.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
+        let shown: Vec<String> = parts
+            .iter()
+            .take(4)
+            .map(|(n, x)| format!("{n} {x:+.3}"))
+            .collect();
+        out!(
+            "  softest mode: {}{}",
+            shown.join(", "),
+            if parts.len() > 4 { ", …" } else { "" }
+        );
+    }
+    out!();
+    out!("  joint                          type          position");
+    for (name, j) in &r.joints {
+        let p: Vec<String> = j.position.iter().map(|v| format!("{v:.9}")).collect();
+        out!(
+            "  {:<30} {:<13} [{}]{}",
+            name,
+            j.kind,
+            p.join(", "),
+            units(&j.units)
+        );
+    }
+    for v in &r.limit_violations {
+        out!(
+            "  warning: joint `{}` rests at {:.6}, outside its limits [{}, {}] (limits are not enforced)",
+            v.joint, v.position, v.limits[0], v.limits[1]
+        );
+    }
+    if !r.reactions.is_empty() {
+        out!();
+        out!("  reaction on child at joint origin (world)   force [N]                          torque [N m]");
+        for (name, re) in &r.reactions {
+            let f = re.force_world;
+            let t = re.torque_world;
+            out!(
+                "  {:<30} [{:>10.4}, {:>10.4}, {:>10.4}]   [{:>10.4}, {:>10.4}, {:>10.4}]",
+                name,
+                f[0],
+                f[1],
+                f[2],
+                t[0],
+                t[1],
+                t[2]
+            );
+        }
+    }
+}
+
+/// The units of a joint's coordinates after its values: ` rad` when they share one, ` [rad, m]`
+/// when they differ, nothing for a joint without coordinates.
+fn units(u: &[&str]) -> String {
+    match u.first() {
+        None => String::new(),
+        Some(first) if u.iter().all(|x| x == first) => format!(" {first}"),
+        Some(_) => format!(" [{}]", u.join(", ")),
+    }
+}
+
+/// The model as understood (`check`).
+pub(crate) fn model(s: &ModelSummary) {
+    out!(
+        "robot `{}`: {} bodies, {} coordinates, {} constraint rows, {}",
+        s.robot,
+        s.bodies.len(),
+        s.coordinates,
+        s.constraints,
+        s.dof.map_or(
+            "does not assemble at the initial guess".to_string(),
+            |d| format!("{d} degrees of freedom")
+        )
+    );
+    out!(
+        "  gravity [{}, {}, {}] m/s²",
+        s.gravity[0],
+        s.gravity[1],
+        s.gravity[2]
+    );
+    out!(
+        "  links welded to the world: {}",
+        if s.fixed_links.is_empty() {
+            "none".to_string()
+        } else {
+            s.fixed_links.join(", ")
+        }
+    );
+    out!("  bodies:");
+    for b in &s.bodies {
+        out!(
+            "    {:<28} {:>10.4} kg   links: {}",
+            b.name,
+            b.mass,
+            b.links.join(", ")
+        );
+    }
+    out!("  joints:");
+    for j in &s.joints {
+        out!(
+            "    {:<28} {:<13} {:<7} {} -> {}  ({} rows)",
+            j.name,
+            j.kind,
+            j.role,
+            j.parent,
+            j.child,
+            j.rows
+        );
+    }
+    for sp in &s.springs {
+        out!("  spring {sp}");
+    }
+    for f in &s.forces {
+        out!("  {f}");
+    }
+    if let Some(e) = &s.assembly_error {
+        out!("  assembly: {e}");
+    }
+}
+
+/// The verification of a pose (`verify`).
+pub(crate) fn verification(robot: &str, v: &Verification, tol: &Tolerances) {
+    out!(
+        "robot `{}`: pose {}",
+        robot,
+        if v.passed { "PASSES" } else { "FAILS" }
+    );
+    out!(
+        "  constraint residual {:.3e} (tolerance {:.1e}), potential energy {:.9} J",
+        v.constraint_residual,
+        tol.constraint,
+        v.potential_energy
+    );
+    for c in &v.closure {
+        out!(
+            "  {} `{}`: position error {:.3e} m, rotation error {:.3e} rad",
+            if c.loop_joint { "loop joint" } else { "joint" },
+            c.joint,
+            c.position_error,
+            c.rotation_error
+        );
+    }
+    out!("  joint                          dof   effort to hold [N m or N]");
+    for i in &v.imbalance {
+        let flag = if i.effort.abs() > v.effort_tolerance {
+            "  <- out of balance"
+        } else {
+            ""
+        };
+        out!("  {:<30} {:>3}   {:>14.6e}{flag}", i.joint, i.dof, i.effort);
+    }
+    if v.unassigned > v.effort_tolerance {
+        out!(
+            "  unassigned generalized force {:.3e} (spherical or floating joints)",
+            v.unassigned
+        );
+    }
+    if let Some(s) = &v.stability {
+        out!("  stability: {}", s.verdict);
+    }
+}

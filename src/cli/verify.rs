@@ -1,0 +1,72 @@
+//! `restpose verify`: is a given pose a rest pose? Reads the pose, evaluates it without moving
+//! it, prints the report.
+
+use super::args::{coord, VerifyArgs};
+use super::exit;
+use super::print;
+use anyhow::{bail, Context};
+use restpose::urdf::load_file;
+
+/// Runs `verify`: exit 0 when the pose passes, 4 when it does not.
+pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
+    let loaded = load_file(&a.file, &a.input.options()?)?;
+    let model = &loaded.model;
+    let mut values = match &a.pose {
+        Some(p) => restpose::verify::read_pose(p)?,
+        None => Default::default(),
+    };
+    for j in &a.joint {
+        let (name, dof, value) = coord(j, "joint")?;
+        let id = model
+            .joint_id(&name)
+            .with_context(|| format!("--joint {j}: the model has no joint `{name}`"))?;
+        let n = model.joint(id).kind.scalar_coordinates().max(dof + 1);
+        let v = values.entry(name).or_insert_with(|| vec![0.0; n]);
+        if v.len() <= dof {
+            v.resize(dof + 1, 0.0);
+        }
+        v[dof] = value;
+    }
+    if values.is_empty() && a.pose.is_none() {
+        bail!("give the pose with --pose FILE or --joint NAME=VALUE");
+    }
+    let (state, missing) = restpose::verify::pose_state(model, &values)?;
+    if !a.quiet && !missing.is_empty() {
+        eprintln!(
+            "warning: joints not in the pose keep their initial values: {}",
+            missing.join(", ")
+        );
+    }
+    let tol = restpose::verify::Tolerances {
+        force: a.force_tolerance,
+        constraint: a.constraint_tolerance,
+        ..Default::default()
+    };
+    let v = restpose::verify::verify(model, &state, &tol)?;
+    if let Some(path) = &a.json {
+        print::write_json(path, &serde_json::to_string_pretty(&v)?)?;
+    }
+    if !a.quiet && !print::is_stdout(a.json.as_ref()) {
+        print::verification(&model.name, &v, &tol);
+    }
+    if v.passed {
+        return Ok(0);
+    }
+    if let Some(m) = &v.max_imbalance {
+        eprintln!(
+            "{}: not a rest pose: largest imbalance {:.3e} at joint `{}` (dof {}), constraint residual {:.3e}",
+            a.file.display(),
+            m.effort,
+            m.joint,
+            m.dof,
+            v.constraint_residual
+        );
+    } else {
+        eprintln!(
+            "{}: not a rest pose: constraint residual {:.3e}",
+            a.file.display(),
+            v.constraint_residual
+        );
+    }
+    Ok(exit::NOT_BALANCED)
+}

@@ -1,0 +1,96 @@
+//! Scalar joint coordinates `θ(q)` with exact gradients and Hessians.
+//!
+//! `θ = atan2(y_i·x_j, x_i·x_j)` about z, `d·z_i` along z; universal
+//! `θ₂ = atan2(z_i·y_j, z_i·z_j)`; planar `x = d·x_i, y = d·y_i`. An angle is read on the
+//! branch of the reference `θ_b`: `θ = θ_b + wrap(atan2 − θ_b)`, so `θ` is the real number
+//! within π of `θ_b` (`θ_b = 3.5` reads the pose at 3.5 − 2π as 3.5, not −2.78). The
+//! derivatives do not depend on the branch.
+
+use super::frames::{angle, frames};
+use crate::jet::{Pair, Scalar};
+use crate::math::wrap_angle;
+use crate::model::{Joint, JointKind};
+
+/// Scalar joint coordinate `dof` read on the branch `reference` (used only if the
+/// coordinate is an angle), or `None` if the joint has no such coordinate.
+pub(crate) fn coordinate(joint: &Joint, pair: &Pair, dof: usize, reference: f64) -> Option<Scalar> {
+    let f = frames(joint, pair);
+    let s = match (joint.kind, dof) {
+        (JointKind::Revolute | JointKind::Continuous | JointKind::Screw { .. }, 0) => {
+            angle(pair, &f)
+        }
+        (JointKind::Prismatic, 0) => pair.dot(&f.z[0], &f.d),
+        (JointKind::Cylindrical, 0) => angle(pair, &f),
+        (JointKind::Cylindrical, 1) => pair.dot(&f.z[0], &f.d),
+        (JointKind::Universal, 0) => angle(pair, &f),
+        (JointKind::Universal, 1) => {
+            let s = pair.dot(&f.z[0], &f.y[1]);
+            let c = pair.dot(&f.z[0], &f.z[1]);
+            pair.atan2(&s, &c)
+        }
+        (JointKind::Planar, 0) => pair.dot(&f.x[0], &f.d),
+        (JointKind::Planar, 1) => pair.dot(&f.y[0], &f.d),
+        (JointKind::Planar, 2) => angle(pair, &f),
+        _ => return None,
+    };
+    Some(if joint.kind.is_angle(dof) {
+        on_branch(s, reference)
+    } else {
+        s
+    })
+}
+
+/// `θ_b + wrap(θ − θ_b)` with the derivatives of `θ`.
+fn on_branch(mut s: Scalar, reference: f64) -> Scalar {
+    if reference.is_finite() {
+        s.v = reference + wrap_angle(s.v - reference);
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::jet::pair_of;
+    use crate::model::BodyId;
+    use nalgebra::{DVector, Isometry3, UnitQuaternion, Vector3};
+
+    fn revolute() -> Joint {
+        Joint {
+            name: "j".into(),
+            kind: JointKind::Revolute,
+            parent_link: "a".into(),
+            child_link: "b".into(),
+            bodies: [None, Some(BodyId(0))],
+            body_from_joint: [Isometry3::identity(), Isometry3::identity()],
+            tree: true,
+            merged: false,
+            limits: None,
+        }
+    }
+
+    /// A body turned by `a` about z reads as the real number within π of the reference.
+    #[test]
+    fn angle_is_read_on_the_reference_branch() {
+        let j = revolute();
+        for (turned, reference, expected) in [
+            (3.5, 3.5, 3.5),
+            (3.5, 0.0, 3.5 - std::f64::consts::TAU),
+            (-3.5, -3.2, -3.5),
+            (
+                0.3,
+                4.0 * std::f64::consts::PI,
+                0.3 + 4.0 * std::f64::consts::PI,
+            ),
+        ] {
+            let r = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), turned);
+            let q = DVector::from_vec(vec![0.0, 0.0, 0.0, r.w, r.i, r.j, r.k]);
+            let pair = pair_of(&j.bodies, &q, false);
+            let theta = coordinate(&j, &pair, 0, reference).unwrap().v;
+            assert!(
+                (theta - expected).abs() < 1e-12,
+                "turned {turned} reference {reference}: {theta} ≠ {expected}"
+            );
+        }
+    }
+}

@@ -1,0 +1,20 @@
+//! Joint kinematics shared by the constraint equations and the forces: joint frames, joint
+//! coordinates read on a continuous branch, and the [`crate::model::JointKind`] queries (how many
+//! values each joint kind takes, which of them are angles).
+//!
+//! Layering: `math → model → kinematics → {constraints, forces} → state → solver`. Constraints
+//! and forces both read joint coordinates from here and never from each other.
+//!
+//! A joint angle is `θ = θ_b + wrap(atan2(s, c) − θ_b)` for the branch reference `θ_b` of
+//! [`Branches`]: a real number, continuous within π of `θ_b`, never wrapped into (−π, π].
+
+mod branches;
+mod coordinate;
+mod frames;
+mod kind;
+mod motion;
+
+pub use branches::Branches;
+pub(crate) use coordinate::coordinate;
+pub(crate) use frames::{angle, frames};
+pub(crate) use motion::motion;

@@ -107,6 +107,12 @@ impl State {
         s
     }
 
+    /// The initial guess: forward kinematics with the model's initial values (see
+    /// [`initial_values`]).
+    pub fn initial(model: &Model) -> State {
+        State::from_joint_values(model, &initial_values(model))
+    }
+
     /// Coordinates of every joint, as reported in the result: scalar coordinates for
     /// revolute-like joints, the relative rotation `[w, x, y, z]` of a spherical joint,
     /// `[x, y, z, w, qx, qy, qz]` of a floating joint, `[]` otherwise.
@@ -117,12 +123,6 @@ impl State {
             .enumerate()
             .map(|(i, j)| (j.name.clone(), self.values_of(model, JointId(i))))
             .collect()
-    }
-
-    /// The initial guess: forward kinematics with the model's initial values (loop joints
-    /// not yet closed).
-    pub fn initial(model: &Model) -> State {
-        State::from_joint_values(model, &initial_values(model))
     }
 
     /// Coordinates of the joint `name` as in [`State::joint_values`] (angles unwrapped on the
@@ -169,9 +169,10 @@ impl State {
     }
 }
 
-/// The model's initial values by joint: `mech:initial`, then the values of locks (a joint
-/// locked at a value starts there, on that angle branch); missing coordinates 0.
-pub(crate) fn initial_values(model: &Model) -> JointValues {
+/// The model's initial values by joint (missing coordinates 0), a lock's value replacing the
+/// initial value of the coordinate it holds (the start is then on the lock's branch: a lock at
+/// 3.2 rad is not read as 3.2 − 2π).
+pub fn initial_values(model: &Model) -> JointValues {
     let mut values = JointValues::new();
     let given = model
         .initial

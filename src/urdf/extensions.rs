@@ -367,8 +367,10 @@ pub(super) fn read(
     }
     let resolve = |name: &str, dof: usize, what: &str| -> Result<JointId> {
         let id = b.model.joint_id(name).ok_or_else(|| {
+            let names = b.model.partial().joints.iter().map(|j| j.name.as_str());
             crate::error::Error::Option(format!(
-                "{what} `{name}`: the model has no joint of that name"
+                "{what} `{name}`: the model has no joint of that name ({})",
+                super::schema::suggest(name, names)
             ))
         })?;
         let n = b.model.partial().joints[id.0].kind.scalar_coordinates();
@@ -381,7 +383,7 @@ pub(super) fn read(
         Ok(id)
     };
     for (name, dof, value) in &options.locks {
-        let id = resolve(name, *dof, "--lock")?;
+        let id = resolve(name, *dof, "lock")?;
         locks.retain(|l| !(l.joint == id && l.dof == *dof));
         locks.push(Lock {
             joint: id,
@@ -390,7 +392,7 @@ pub(super) fn read(
         });
     }
     for (name, dof, value) in &options.initial {
-        let id = resolve(name, *dof, "--initial")?;
+        let id = resolve(name, *dof, "initial value")?;
         initial.retain(|l| !(l.joint == id && l.dof == *dof));
         initial.push(Initial {
             joint: id,

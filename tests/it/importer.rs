@@ -495,3 +495,32 @@ fn continuous_joint_position_limits_are_ignored() {
         .warnings
         .is_empty());
 }
+
+/// A lock or initial value naming a joint the model lacks gets a suggestion; the library's
+/// message names no command-line flag.
+#[test]
+fn unknown_joint_in_options_gets_a_suggestion() {
+    let opts = ImportOptions {
+        locks: vec![("hinj".into(), 0, Some(0.0))],
+        ..Default::default()
+    };
+    let e = load_str(&pendulum(FIXED, ""), "t.urdf", &opts)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("lock `hinj`") && e.contains("did you mean `hinge`?"),
+        "{e}"
+    );
+    assert!(!e.contains("--"), "{e}");
+    let opts = ImportOptions {
+        initial: vec![("zzzzzz".into(), 0, 1.0)],
+        ..Default::default()
+    };
+    let e = load_str(&pendulum(FIXED, ""), "t.urdf", &opts)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("initial value `zzzzzz`") && e.contains("known: "),
+        "{e}"
+    );
+}

@@ -332,6 +332,12 @@ fn analyze(a: &AnalyzeArgs) -> anyhow::Result<u8> {
             result.diagnostics.step_halvings,
             result.diagnostics.repartitions
         );
+        if !result.diagnostics.free_directions.is_empty() {
+            eprintln!(
+                "  the energy falls without bound along: {}",
+                result.diagnostics.free_directions.join(", ")
+            );
+        }
         return Ok(EXIT_NOT_CONVERGED);
     }
     Ok(0)

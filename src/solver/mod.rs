@@ -24,6 +24,7 @@ mod report;
 pub(crate) mod sparse;
 mod spectrum;
 pub(crate) mod system;
+mod unbounded;
 
 pub use options::{LinearAlgebra, Method, Options};
 pub use report::{Diagnostics, Iterate, Reaction, Report, Stability, Termination};

@@ -288,7 +288,12 @@ fn analyze(a: &AnalyzeArgs) -> anyhow::Result<u8> {
         ..Default::default()
     };
     let model = &loaded.model;
-    let (state, report) = restpose::solve(model, &options)?;
+    let (state, report) = restpose::solve(model, &options).map_err(|e| match e {
+        restpose::Error::ConstantEnergy { .. } if a.input.inertia_from_geometry.is_none() => {
+            anyhow::anyhow!("{e}; links without <inertial> can get masses from their geometry with --inertia-from-geometry DENSITY")
+        }
+        e => e.into(),
+    })?;
     let result = AnalysisResult::new(model, &state, &report);
     if let Some(path) = &a.json {
         restpose::export::write_atomic(path, result.to_json().as_bytes())?;

@@ -6,10 +6,12 @@
 //! (ground) is not a body: joints and forces refer to it with `None`.
 
 mod body;
+mod check;
 mod force;
 mod joint;
 
 pub use body::{Body, BodyId, Link};
+pub use check::{LARGEST_GRAVITY, LARGEST_LENGTH, LARGEST_MAGNITUDE};
 pub use force::{
     Effort, ForceLaw, Initial, JointSpring, Load, Lock, Mimic, Spring, SpringEnd, SpringMode,
 };
@@ -65,6 +67,27 @@ impl Model {
         }
     }
 
+    /// The joint name closest to `name` by edit distance, if it is close (at most a third of
+    /// the name's length, and at least 1, edits): the "did you mean" of error messages.
+    pub fn closest_joint(&self, name: &str) -> Option<String> {
+        let limit = (name.chars().count() / 3).max(1);
+        self.joints
+            .iter()
+            .map(|j| (edit_distance(name, &j.name), &j.name))
+            .filter(|(d, _)| *d <= limit)
+            .min_by_key(|(d, _)| *d)
+            .map(|(_, n)| n.clone())
+    }
+
+    /// [`crate::Error::UnknownJoint`] for `name`, with the closest joint name as a suggestion.
+    pub fn unknown_joint(&self, what: &str, name: &str) -> crate::Error {
+        crate::Error::UnknownJoint {
+            what: what.into(),
+            name: name.into(),
+            suggestion: self.closest_joint(name),
+        }
+    }
+
     /// Builds the joint name map (the first joint of a name wins); called by the importer once
     /// the joints are in place.
     pub(crate) fn index_names(&mut self) {
@@ -105,5 +128,35 @@ impl Model {
             Some(b) => format!("{}.{}", b.name, C[i % 7]),
             None => format!("q{i}"),
         }
+    }
+}
+
+/// Levenshtein distance between two strings (by characters).
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut diagonal = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let up = row[j + 1];
+            row[j + 1] = (up + 1)
+                .min(row[j] + 1)
+                .min(diagonal + usize::from(ca != cb));
+            diagonal = up;
+        }
+    }
+    row[b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn edit_distance_counts_insertions_deletions_and_substitutions() {
+        assert_eq!(super::edit_distance("pivot", "pivot"), 0);
+        assert_eq!(super::edit_distance("pivto", "pivot"), 2);
+        assert_eq!(super::edit_distance("pivt", "pivot"), 1);
+        assert_eq!(super::edit_distance("", "abc"), 3);
+        assert_eq!(super::edit_distance("wrist_3_joint", "wrist_2_joint"), 1);
     }
 }

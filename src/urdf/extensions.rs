@@ -378,22 +378,24 @@ pub(super) fn read(
         b.model.gravity = options.gravity;
     }
     let resolve = |name: &str, dof: usize, what: &str| -> Result<JointId> {
-        let id = b.model.joint_id(name).ok_or_else(|| {
-            crate::error::Error::Option(format!(
-                "{what} `{name}`: the model has no joint of that name"
-            ))
-        })?;
+        let id = b
+            .model
+            .joint_id(name)
+            .ok_or_else(|| b.model.unknown_joint(what, name))?;
         let n = b.model.joints[id.0].kind.scalar_coordinates();
         if dof >= n {
-            return Err(crate::error::Error::Option(format!(
-                "{what} `{name}`: joint is {} with {n} addressable coordinate(s), dof {dof} is out of range",
-                b.model.joints[id.0].kind.name()
-            )));
+            return Err(crate::error::Error::CoordinateOutOfRange {
+                what: what.into(),
+                joint: name.into(),
+                kind: b.model.joints[id.0].kind.name().into(),
+                dof,
+                count: n,
+            });
         }
         Ok(id)
     };
     for (name, dof, value) in &options.locks {
-        let id = resolve(name, *dof, "--lock")?;
+        let id = resolve(name, *dof, "lock")?;
         locks.retain(|l| !(l.joint == id && l.dof == *dof));
         locks.push(Lock {
             joint: id,
@@ -402,7 +404,7 @@ pub(super) fn read(
         });
     }
     for (name, dof, value) in &options.initial {
-        let id = resolve(name, *dof, "--initial")?;
+        let id = resolve(name, *dof, "initial value")?;
         initial.retain(|l| !(l.joint == id && l.dof == *dof));
         initial.push(Initial {
             joint: id,

@@ -68,9 +68,9 @@ impl Model {
     }
 
     /// The joint name closest to `name` by edit distance, if it is close (at most a third of
-    /// the name's length, and at least 1, edits): the "did you mean" of error messages.
+    /// the name's length, and at least 2, edits): the "did you mean" of error messages.
     pub fn closest_joint(&self, name: &str) -> Option<String> {
-        let limit = (name.chars().count() / 3).max(1);
+        let limit = (name.chars().count() / 3).max(2);
         self.joints
             .iter()
             .map(|j| (edit_distance(name, &j.name), &j.name))

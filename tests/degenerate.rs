@@ -229,3 +229,54 @@ fn unknown_joint_names_get_a_suggestion() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("did you mean `pivot`?"), "{err}");
 }
+
+#[test]
+fn force_table_out_of_range_names_the_spring_and_the_deflection() {
+    let link =
+        format!(r#"<link name="bar"><inertial><mass value="1"/>{INERTIA}</inertial></link>"#);
+    let m = load(&one_joint(
+        "continuous",
+        &link,
+        r#"<mech:joint_spring joint="pivot"><force_deflection extrapolate="error">
+             <point deflection="-0.1" force="-1"/><point deflection="0.1" force="1"/>
+           </force_deflection></mech:joint_spring>
+           <mech:initial joint="pivot" value="0.5"/>"#,
+    ))
+    .unwrap();
+    match restpose::solve(&m, &Options::default()) {
+        Err(Error::ForceTableOutOfRange {
+            element,
+            deflection,
+            lower,
+            upper,
+        }) => {
+            assert_eq!(element, "joint spring on `pivot`");
+            assert!((deflection - 0.5).abs() < 1e-9, "{deflection}");
+            assert_eq!((lower, upper), (-0.1, 0.1));
+        }
+        other => panic!("expected ForceTableOutOfRange, got {other:?}"),
+    }
+    // A lock on a coordinate the joint does not have.
+    let text = one_joint("continuous", &link, "");
+    let e = urdf::load_str(
+        &text,
+        "bad.urdf",
+        &urdf::ImportOptions {
+            locks: vec![("pivot".into(), 1, Some(0.0))],
+            ..Default::default()
+        },
+    )
+    .unwrap_err();
+    assert!(
+        matches!(
+            &e,
+            Error::CoordinateOutOfRange {
+                dof: 1,
+                count: 1,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    assert!(!e.to_string().contains("--"), "{e}");
+}

@@ -28,9 +28,98 @@ pub enum Error {
         /// What is wrong, naming the element.
         message: String,
     },
-    /// An option refers to something the model does not have, or has a bad value.
-    #[error("{0}")]
-    Option(String),
+    /// A joint name that the model does not have.
+    #[error("{what} `{name}`: the model has no joint of that name{}", suggestion.as_ref().map(|s| format!(" (did you mean `{s}`?)")).unwrap_or_default())]
+    UnknownJoint {
+        /// What named it (`lock`, `initial value`, `pose`, ...).
+        what: String,
+        /// The name given.
+        name: String,
+        /// The closest joint name of the model, if one is close.
+        suggestion: Option<String>,
+    },
+    /// A coordinate index beyond the joint's coordinates.
+    #[error(
+        "{what} `{joint}`: the joint is {kind} with {count} addressable coordinate(s), \
+         coordinate {dof} is out of range"
+    )]
+    CoordinateOutOfRange {
+        /// What addressed it.
+        what: String,
+        /// Joint name.
+        joint: String,
+        /// Joint type name.
+        kind: String,
+        /// The coordinate index given.
+        dof: usize,
+        /// Number of scalar coordinates of the joint.
+        count: usize,
+    },
+    /// A pose gives a joint the wrong number of values.
+    #[error("{file}: joint `{joint}` ({kind}) takes {expected:?} value(s), got {got}")]
+    ValueCount {
+        /// The pose file (or `<pose>`).
+        file: String,
+        /// Joint name.
+        joint: String,
+        /// Joint type name.
+        kind: String,
+        /// Accepted numbers of values.
+        expected: Vec<usize>,
+        /// Number given.
+        got: usize,
+    },
+    /// A pose file that is none of the accepted formats.
+    #[error("{file}: {message}")]
+    Pose {
+        /// The pose file.
+        file: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// The quasi-Newton methods keep a dense matrix that would not fit.
+    #[error(
+        "{method}: BFGS and DFP keep a dense {dof} × {dof} matrix ({gigabytes:.1} GB) for \
+         {dof} degrees of freedom; use the Newton method (sparse KKT steps) above {limit}"
+    )]
+    TooManyDegreesOfFreedom {
+        /// The method asked for.
+        method: String,
+        /// Degrees of freedom.
+        dof: usize,
+        /// Largest number of degrees of freedom BFGS / DFP accept.
+        limit: usize,
+        /// Memory the matrix would take \[GB\].
+        gigabytes: f64,
+    },
+    /// Nothing stores or releases energy while the mechanism can move: every pose is a rest
+    /// pose.
+    #[error(
+        "the potential energy of `{robot}` is constant: it has {dof} degree(s) of freedom but \
+         no moving body has mass under gravity and there is no spring, load or effort, so every \
+         pose is a rest pose (give the moving links <inertial> masses, or add springs)"
+    )]
+    ConstantEnergy {
+        /// Robot name.
+        robot: String,
+        /// Degrees of freedom.
+        dof: usize,
+    },
+    /// A number of the model that is negative where it must not be, or too large to compute
+    /// with.
+    #[error("{element}: {attribute} = {value:e} {why}")]
+    InvalidNumber {
+        /// The element (`link `bar``, `joint spring on `pivot``, ...).
+        element: String,
+        /// The element's bare name (link, joint, spring or load name).
+        name: String,
+        /// The attribute.
+        attribute: String,
+        /// Its value.
+        value: f64,
+        /// Why it is refused.
+        why: String,
+    },
     /// The loop joints could not be closed from the initial guess.
     #[error(
         "cannot assemble the mechanism from the initial guess: constraint `{row}` is violated \
@@ -63,9 +152,52 @@ pub enum Error {
     /// non-finite or negative mass property.
     #[error("invalid model: {0}")]
     Model(String),
-    /// The potential energy cannot be evaluated at the start.
-    #[error("potential energy is undefined at the initial guess ({0})")]
-    Undefined(String),
+    /// A force table with `extrapolate="error"` is evaluated outside its range.
+    #[error(
+        "{element}: deflection {deflection:.6e} is outside its force table \
+         [{lower:.6e}, {upper:.6e}] (extrapolate=\"error\")"
+    )]
+    ForceTableOutOfRange {
+        /// The spring (`spring `s``, `joint spring on `j``).
+        element: String,
+        /// The deflection \[m or rad\].
+        deflection: f64,
+        /// First knot.
+        lower: f64,
+        /// Last knot.
+        upper: f64,
+    },
+    /// The solve produced a non-finite number (never reported as a result).
+    #[error("the solve produced a non-finite {what} at iteration {iteration}")]
+    NonFinite {
+        /// What (`potential energy`, `coordinate x of body `b``).
+        what: String,
+        /// Iteration.
+        iteration: usize,
+    },
+    /// `verify` on the sparse path: holding every tree-joint coordinate makes model rows
+    /// redundant, so the joints' efforts cannot be told apart from the loop reactions.
+    #[error(
+        "the efforts of the joint coordinates cannot be separated from the loop reactions \
+         ({dependent} constraint rows dependent on the joint coordinates, {without} without them)"
+    )]
+    InseparableEfforts {
+        /// Redundant model rows with every joint coordinate held.
+        dependent: usize,
+        /// Redundant model rows without them.
+        without: usize,
+    },
+    /// The dependent block `Φ_u` of the constraint Jacobian is singular at a pose.
+    #[error(
+        "the constraint Jacobian is singular at {at}: the partition into dependent and \
+         independent coordinates failed ({rows} independent rows)"
+    )]
+    SingularPartition {
+        /// Where (`the initial guess`, `the given pose`).
+        at: String,
+        /// Rank found.
+        rows: usize,
+    },
 }
 
 /// Result with [`enum@Error`].

@@ -34,6 +34,7 @@ pub(crate) mod jet;
 pub mod kinematics;
 pub mod math;
 pub mod model;
+pub mod names;
 pub mod solver;
 pub mod state;
 pub mod urdf;

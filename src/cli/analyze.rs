@@ -1,9 +1,9 @@
 //! `restpose analyze`: solve for the rest pose, write the requested files, print a summary.
 
 use super::args::{coord, AnalyzeArgs};
-use super::{exit, print, suggest};
+use super::{exit, print};
 use restpose::export::json::AnalysisResult;
-use restpose::urdf::{load_file, ImportOptions};
+use restpose::urdf::load_file;
 
 /// Runs `analyze`: exit 0 when converged, 3 when not.
 pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
@@ -16,10 +16,7 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
         opts.initial.push(coord(l, "initial")?);
     }
     let import_started = std::time::Instant::now();
-    let loaded = match load_file(&a.file, &opts) {
-        Ok(l) => l,
-        Err(e) => return Err(unknown_joint(a, &opts).unwrap_or_else(|| e.into())),
-    };
+    let loaded = load_file(&a.file, &opts).map_err(|e| with_option(a, e))?;
     let import = import_started.elapsed().as_secs_f64();
     if !a.quiet {
         for w in &loaded.warnings {
@@ -32,7 +29,15 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
         }
     }
     let model = &loaded.model;
-    let (state, mut report) = restpose::solve(model, &a.solver_options())?;
+    let (state, mut report) = restpose::solve(model, &a.solver_options()).map_err(|e| match e {
+        restpose::Error::ConstantEnergy { .. } if a.input.inertia_from_geometry.is_none() => {
+            anyhow::anyhow!(
+                "{e}; links without <inertial> can get masses from their geometry with \
+                 --inertia-from-geometry DENSITY"
+            )
+        }
+        e => e.into(),
+    })?;
     report.diagnostics.timings.import = import;
     let export_started = std::time::Instant::now();
     let mut result = AnalysisResult::new(model, &state, &report);
@@ -78,36 +83,30 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
             result.diagnostics.step_halvings,
             result.diagnostics.repartitions
         );
+        if !result.diagnostics.free_directions.is_empty() {
+            eprintln!(
+                "  the energy falls without bound along: {}",
+                result.diagnostics.free_directions.join(", ")
+            );
+        }
         return Ok(exit::NOT_CONVERGED);
     }
     Ok(0)
 }
 
-/// When loading failed: the first `--lock` or `--initial` naming a joint the model does not
-/// have, with the closest joint name (found by loading the file again without them).
-fn unknown_joint(a: &AnalyzeArgs, opts: &ImportOptions) -> Option<anyhow::Error> {
-    if opts.locks.is_empty() && opts.initial.is_empty() {
-        return None;
-    }
-    let plain = ImportOptions {
-        locks: Vec::new(),
-        initial: Vec::new(),
-        ..opts.clone()
+/// A joint named by `--lock` or `--initial` that the model lacks: the error names the option.
+fn with_option(a: &AnalyzeArgs, e: restpose::Error) -> anyhow::Error {
+    let restpose::Error::UnknownJoint { name, .. } = &e else {
+        return e.into();
     };
-    let model = load_file(&a.file, &plain).ok()?.model;
     let given =
         (a.lock.iter().map(|s| ("lock", s))).chain(a.initial.iter().map(|s| ("initial", s)));
-    for (what, s) in given {
-        let (name, _, _) = coord(s, what).ok()?;
-        if model.joint_id(&name).is_none() {
-            let names = model.joints.iter().map(|j| j.name.as_str());
-            return Some(anyhow::anyhow!(
-                "--{what} {s}: the model has no joint `{name}`{}",
-                suggest::hint(&name, names)
-            ));
+    for (option, s) in given {
+        if coord(s, option).is_ok_and(|(n, _, _)| &n == name) {
+            return anyhow::Error::from(e).context(format!("--{option} {s}"));
         }
     }
-    None
+    e.into()
 }
 
 #[cfg(feature = "viewer")]

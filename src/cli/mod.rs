@@ -9,6 +9,5 @@ pub(crate) mod exit;
 pub(crate) mod generate;
 pub(crate) mod parse;
 pub(crate) mod print;
-pub(crate) mod suggest;
 pub(crate) mod verify;
 pub(crate) mod view;

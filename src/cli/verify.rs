@@ -2,8 +2,8 @@
 //! it, prints the report.
 
 use super::args::{coord, VerifyArgs};
+use super::exit;
 use super::print;
-use super::{exit, suggest};
 use anyhow::{bail, Context};
 use restpose::urdf::load_file;
 
@@ -17,13 +17,10 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
     };
     for j in &a.joint {
         let (name, dof, value) = coord(j, "joint")?;
-        let id = model.joint_id(&name).with_context(|| {
-            let names = model.joints.iter().map(|j| j.name.as_str());
-            format!(
-                "--joint {j}: the model has no joint `{name}`{}",
-                suggest::hint(&name, names)
-            )
-        })?;
+        let id = model
+            .joint_id(&name)
+            .ok_or_else(|| model.unknown_joint("joint", &name))
+            .with_context(|| format!("--joint {j}"))?;
         let n = model.joint(id).kind.scalar_coordinates().max(dof + 1);
         let v = values.entry(name).or_insert_with(|| vec![0.0; n]);
         if v.len() <= dof {

@@ -16,7 +16,7 @@
 //! - E. J. Haug, *Computer-Aided Kinematics and Dynamics of Mechanical Systems* (1989), ch. 3.
 
 use crate::jet::{Pair, Scalar, Vec3Jet};
-use crate::kinematics::{angle, frames};
+use crate::kinematics::{angle, frames, on_branch};
 use crate::model::{Joint, JointKind};
 use nalgebra::Vector3;
 
@@ -142,9 +142,7 @@ pub(crate) fn rows(joint: &Joint, pair: &Pair, reference: f64, out: &mut Vec<Sca
         JointKind::Screw { pitch } => {
             parallel(out);
             on_axis(out);
-            let mut theta = angle(pair, &f);
-            theta.v = reference + crate::math::wrap_angle(theta.v - reference);
-            let t = theta.scale(-pitch);
+            let t = on_branch(angle(pair, &f), reference).scale(-pitch);
             out.push(pair.dot(&f.z[0], &f.d).add(&t));
         }
         JointKind::Distance { length } => out.push(pair.dot(&f.d, &f.d).minus(length * length)),

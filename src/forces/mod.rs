@@ -121,3 +121,59 @@ pub(crate) fn potential(
     e.magnitude += magnitude;
     Some(e)
 }
+
+/// The error naming the first force table evaluated outside its range at `q` (tables with
+/// `extrapolate="error"`), or `None` if every term of `V` is defined there.
+pub(crate) fn undefined_term(
+    model: &Model,
+    branches: &Branches,
+    q: &DVector<f64>,
+) -> Option<crate::Error> {
+    let refuse = |element: String, law: &crate::model::ForceLaw, deflection: f64| {
+        let crate::model::ForceLaw::Table { points, .. } = law else {
+            return None;
+        };
+        Some(crate::Error::ForceTableOutOfRange {
+            element,
+            deflection,
+            lower: points.first().map_or(0.0, |p| p.0),
+            upper: points.last().map_or(0.0, |p| p.0),
+        })
+    };
+    for s in &model.springs {
+        let pair = pair_of(&[s.ends[0].body, s.ends[1].body], q, false);
+        let d = pair
+            .point(1, &s.ends[1].point)
+            .sub(&pair.point(0, &s.ends[0].point));
+        let delta = d.v.norm() - s.free_length;
+        if law::evaluate(&s.law, s.mode, delta).is_none() {
+            return refuse(format!("spring `{}`", s.name), &s.law, delta);
+        }
+    }
+    for js in &model.joint_springs {
+        let j = &model.joints[js.joint.0];
+        let pair = pair_of(&j.bodies, q, false);
+        let Some(theta) = coordinate(j, &pair, js.dof, branches.get(js.joint, js.dof)) else {
+            continue;
+        };
+        let delta = theta.v - js.reference;
+        if law::evaluate(&js.law, SpringMode::Both, delta).is_none() {
+            return refuse(format!("joint spring on `{}`", j.name), &js.law, delta);
+        }
+    }
+    None
+}
+
+/// Whether anything in `model` stores or releases energy: a body with mass under non-zero
+/// gravity, a spring, a joint spring, a non-zero load or effort.
+pub(crate) fn has_energy(model: &Model) -> bool {
+    (model.gravity != nalgebra::Vector3::zeros()
+        && model.bodies.iter().any(|b| b.gravity_mass != 0.0))
+        || !model.springs.is_empty()
+        || !model.joint_springs.is_empty()
+        || model
+            .loads
+            .iter()
+            .any(|l| l.force != nalgebra::Vector3::zeros())
+        || model.efforts.iter().any(|e| e.value != 0.0)
+}

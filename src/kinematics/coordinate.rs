@@ -41,7 +41,7 @@ pub(crate) fn coordinate(joint: &Joint, pair: &Pair, dof: usize, reference: f64)
 }
 
 /// `θ_b + wrap(θ − θ_b)` with the derivatives of `θ`.
-fn on_branch(mut s: Scalar, reference: f64) -> Scalar {
+pub(crate) fn on_branch(mut s: Scalar, reference: f64) -> Scalar {
     if reference.is_finite() {
         s.v = reference + wrap_angle(s.v - reference);
     }

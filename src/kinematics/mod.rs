@@ -15,6 +15,6 @@ mod kind;
 mod motion;
 
 pub use branches::Branches;
-pub(crate) use coordinate::coordinate;
+pub(crate) use coordinate::{coordinate, on_branch};
 pub(crate) use frames::{angle, frames};
 pub(crate) use motion::motion;

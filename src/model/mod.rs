@@ -7,11 +7,13 @@
 
 mod body;
 mod builder;
+mod check;
 mod force;
 mod joint;
 
 pub use body::{Body, BodyId, Link};
 pub use builder::{Inertial, ModelBuilder};
+pub use check::{LARGEST_GRAVITY, LARGEST_LENGTH, LARGEST_MAGNITUDE};
 pub use force::{
     Effort, ForceLaw, Initial, JointSpring, Load, Lock, Mimic, Spring, SpringEnd, SpringMode,
 };
@@ -65,6 +67,21 @@ impl Model {
         match self.joint_names.get(name) {
             Some(&id) if self.joints.get(id.0).is_some_and(|j| j.name == name) => Some(id),
             _ => self.joints.iter().position(|j| j.name == name).map(JointId),
+        }
+    }
+
+    /// The joint name closest to `name`, if one is close ([`crate::names::closest`]): the
+    /// "did you mean" of error messages.
+    pub fn closest_joint(&self, name: &str) -> Option<String> {
+        crate::names::closest(name, self.joints.iter().map(|j| j.name.as_str())).map(str::to_owned)
+    }
+
+    /// [`crate::Error::UnknownJoint`] for `name`, with the closest joint name as a suggestion.
+    pub fn unknown_joint(&self, what: &str, name: &str) -> crate::Error {
+        crate::Error::UnknownJoint {
+            what: what.into(),
+            name: name.into(),
+            suggestion: self.closest_joint(name),
         }
     }
 

@@ -196,6 +196,7 @@ pub(crate) fn minimize(
     let mut termination = Termination::MaxIterations;
     let mut iteration = 0;
     let mut linear_steps = 0;
+    let mut descent = super::unbounded::LinearDescent::default();
     let mut eigen = None;
     let mut iterates = Vec::new();
     loop {
@@ -351,16 +352,20 @@ pub(crate) fn minimize(
                 }
                 quasi_newton_update(options.method, &mut qn.binv, &s, &y, qn.fresh);
                 qn.fresh = false;
+                let linear = descent.record(slope * alpha, &(&dq * alpha), l);
                 q = qt;
                 sys.cons.branches.follow(sys.model, &q);
                 eval = et;
                 iteration += 1;
                 just_repartitioned = false;
-                if linear_steps >= 5
+                if linear
+                    || linear_steps >= 5
                     || eval.energy.total < -1e15
                     || (0..q.len()).any(|i| i % 7 < 3 && q[i].abs() > 1e6 * sys.model.length_scale)
                 {
                     termination = Termination::Unbounded;
+                    diag.free_directions =
+                        super::unbounded::free_directions(sys.model, &q, &(&dq * alpha));
                     history.push(Iterate {
                         iteration,
                         potential_energy: eval.energy.total,

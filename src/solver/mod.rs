@@ -24,6 +24,7 @@ mod report;
 pub(crate) mod sparse;
 mod spectrum;
 pub(crate) mod system;
+mod unbounded;
 
 pub use options::{LinearAlgebra, Method, Options};
 pub use report::{
@@ -151,8 +152,11 @@ pub(crate) fn stability_at(model: &Model, state: &State) -> Option<Stability> {
 ///
 /// # Errors
 /// [`Error::Assembly`] if the loops cannot be closed from the initial guess,
-/// [`Error::Inconsistent`] for contradictory redundant constraints, [`Error::Undefined`] if
-/// the energy cannot be evaluated at the start. Not converging is not an error: see
+/// [`Error::Inconsistent`] for contradictory redundant constraints,
+/// [`Error::ForceTableOutOfRange`] if the energy cannot be evaluated at the start,
+/// [`Error::SingularPartition`] if the partition fails there, [`Error::ConstantEnergy`] if the
+/// mechanism can move but nothing stores energy, [`Error::TooManyDegreesOfFreedom`] for BFGS /
+/// DFP on a large model. Not converging is not an error: see
 /// [`Report::termination`].
 ///
 /// # Example
@@ -248,21 +252,46 @@ fn solve_assembled(
     let part = sys.partition(&q);
     let dof0 = part.independent.len();
     if options.method != Method::Newton && dof0 > QUASI_NEWTON_DOF_LIMIT {
-        return Err(Error::Option(format!(
-            "--method {}: BFGS and DFP keep a dense {dof0} × {dof0} matrix ({:.1} GB) for {dof0} \
-             degrees of freedom; use --method newton (sparse KKT steps) above {QUASI_NEWTON_DOF_LIMIT}",
-            serde_json::to_value(options.method)
+        return Err(Error::TooManyDegreesOfFreedom {
+            method: serde_json::to_value(options.method)
                 .ok()
                 .and_then(|v| v.as_str().map(str::to_owned))
                 .unwrap_or_default(),
-            (dof0 * dof0 * 8) as f64 / 1e9
-        )));
+            dof: dof0,
+            limit: QUASI_NEWTON_DOF_LIMIT,
+            gigabytes: (dof0 * dof0 * 8) as f64 / 1e9,
+        });
     }
-    let out = minimize::minimize(&mut sys, q, part, options).ok_or_else(|| {
-        Error::Undefined(
-            "a force table with extrapolate=\"error\" is out of range, or Φ_u is singular".into(),
-        )
-    })?;
+    if dof0 > 0 && !crate::forces::has_energy(model) {
+        return Err(Error::ConstantEnergy {
+            robot: model.name.clone(),
+            dof: dof0,
+        });
+    }
+    let rank = part.rows.len();
+    let Some(out) = minimize::minimize(&mut sys, q.clone(), part, options) else {
+        return Err(
+            crate::forces::undefined_term(model, &start.branches, &q).unwrap_or(
+                Error::SingularPartition {
+                    at: "the assembled initial guess".into(),
+                    rows: rank,
+                },
+            ),
+        );
+    };
+    let iteration = out.history.last().map_or(0, |h| h.iteration);
+    if !out.eval.energy.total.is_finite() {
+        return Err(Error::NonFinite {
+            what: "potential energy".into(),
+            iteration,
+        });
+    }
+    if let Some(i) = out.q.iter().position(|x| !x.is_finite()) {
+        return Err(Error::NonFinite {
+            what: format!("coordinate {}", model.coordinate_name(i)),
+            iteration,
+        });
+    }
     let state = State {
         q: out.q.clone(),
         branches: sys.cons.branches.clone(),

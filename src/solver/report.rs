@@ -87,6 +87,10 @@ pub struct Stability {
 /// Counters of what the solver had to do.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct Diagnostics {
+    /// With termination `unbounded`: the motions along which the energy falls without bound
+    /// (joints with the sense of their coordinate, free bodies with their direction).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub free_directions: Vec<String>,
     /// Potential evaluations (trial points that assembled).
     pub function_evaluations: usize,
     /// Trial points where the Newton corrector failed.

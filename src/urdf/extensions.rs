@@ -366,19 +366,19 @@ pub(super) fn read(
         b.model.set_gravity(options.gravity);
     }
     let resolve = |name: &str, dof: usize, what: &str| -> Result<JointId> {
-        let id = b.model.joint_id(name).ok_or_else(|| {
-            let names = b.model.partial().joints.iter().map(|j| j.name.as_str());
-            crate::error::Error::Option(format!(
-                "{what} `{name}`: the model has no joint of that name ({})",
-                super::schema::suggest(name, names)
-            ))
-        })?;
+        let id = b
+            .model
+            .joint_id(name)
+            .ok_or_else(|| b.model.partial().unknown_joint(what, name))?;
         let n = b.model.partial().joints[id.0].kind.scalar_coordinates();
         if dof >= n {
-            return Err(crate::error::Error::Option(format!(
-                "{what} `{name}`: joint is {} with {n} addressable coordinate(s), dof {dof} is out of range",
-                b.model.partial().joints[id.0].kind.name()
-            )));
+            return Err(crate::error::Error::CoordinateOutOfRange {
+                what: what.into(),
+                joint: name.into(),
+                kind: b.model.partial().joints[id.0].kind.name().into(),
+                dof,
+                count: n,
+            });
         }
         Ok(id)
     };

@@ -357,9 +357,44 @@ pub(super) fn import(
             b.model.set_child_frame(ji, f);
         }
     }
+    let model = b.model.build()?;
+    model
+        .check_numbers()
+        .map_err(|e| locate_invalid(&src, robot, e))?;
     Ok(Loaded {
-        model: b.model.build()?,
+        model,
         warnings: b.warnings,
         ignored,
     })
+}
+
+/// Places a [`crate::Error::InvalidNumber`] of the built model at its element in the file: the
+/// element named by it (a `name`, `joint` or `link` attribute), at its child element named
+/// like the attribute when it has one (`<mass>`, `<inertia>`), else at `<robot>`.
+fn locate_invalid(src: &Source, robot: Node, e: crate::Error) -> crate::Error {
+    let crate::Error::InvalidNumber {
+        name, attribute, ..
+    } = &e
+    else {
+        return e;
+    };
+    let named = |n: &Node| {
+        n.is_element()
+            && !name.is_empty()
+            && ["name", "joint", "link"]
+                .iter()
+                .any(|a| n.attribute(*a) == Some(name.as_str()))
+    };
+    let element = robot
+        .descendants()
+        .find(|n| named(n) && n.has_attribute(attribute.as_str()))
+        .or_else(|| robot.descendants().find(|n| named(n)));
+    let node = element
+        .and_then(|n| {
+            n.descendants()
+                .find(|c| c.is_element() && c.tag_name().name() == attribute.as_str())
+        })
+        .or(element)
+        .unwrap_or(robot);
+    src.error(node, e.to_string())
 }

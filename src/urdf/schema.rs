@@ -153,32 +153,12 @@ pub(super) fn element_names() -> impl Iterator<Item = &'static str> {
     ELEMENTS.iter().map(|e| e.name)
 }
 
-/// Levenshtein distance between two short names.
-fn edit_distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut row: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut prev = row[0];
-        row[0] = i + 1;
-        for (j, &cb) in b.iter().enumerate() {
-            let cur = row[j + 1];
-            row[j + 1] = (prev + usize::from(ca != cb)).min(row[j] + 1).min(cur + 1);
-            prev = cur;
-        }
-    }
-    row[b.len()]
-}
-
 /// "did you mean `x`?" for the closest known name within a third of its length (at least 2
 /// edits), else the list of known names.
 pub(super) fn suggest<'a>(name: &str, known: impl IntoIterator<Item = &'a str>) -> String {
     let known: Vec<&str> = known.into_iter().collect();
-    let best = known
-        .iter()
-        .map(|k| (edit_distance(name, k), *k))
-        .min_by_key(|(d, _)| *d);
-    match best {
-        Some((d, k)) if d <= (k.chars().count() / 3).max(2) => format!("did you mean `{k}`?"),
+    match crate::names::closest(name, known.iter().copied()) {
+        Some(k) => format!("did you mean `{k}`?"),
         _ if known.is_empty() => "it takes none".to_string(),
         _ => format!("known: {}", known.join(", ")),
     }
@@ -304,9 +284,9 @@ mod tests {
 
     #[test]
     fn suggestions_by_edit_distance() {
-        assert_eq!(edit_distance("refrence", "reference"), 1);
-        assert_eq!(edit_distance("sprng", "spring"), 1);
-        assert_eq!(edit_distance("", "abc"), 3);
+        assert_eq!(crate::names::distance("refrence", "reference"), 1);
+        assert_eq!(crate::names::distance("sprng", "spring"), 1);
+        assert_eq!(crate::names::distance("", "abc"), 3);
         assert_eq!(
             suggest("refrence", ["joint", "reference", "dof"]),
             "did you mean `reference`?"

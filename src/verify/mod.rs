@@ -157,8 +157,14 @@ fn project(model: &Model, state: &State) -> Result<Projection> {
         j.column_mut(c).scale_mut(scale[c]);
     }
     let mut g = DVector::zeros(n);
-    let e = potential(model, &state.branches, &state.q, &mut g, None)
-        .ok_or_else(|| Error::Undefined("a force table is out of range".into()))?;
+    let e = potential(model, &state.branches, &state.q, &mut g, None).ok_or_else(|| {
+        crate::forces::undefined_term(model, &state.branches, &state.q).unwrap_or(
+            Error::SingularPartition {
+                at: "the given pose".into(),
+                rows: 0,
+            },
+        )
+    })?;
     for c in 0..n {
         g[c] *= scale[c];
     }
@@ -177,7 +183,10 @@ fn project(model: &Model, state: &State) -> Result<Projection> {
         phi_u
             .lu()
             .solve(&(-phi_v))
-            .ok_or_else(|| Error::Undefined("singular constraint Jacobian".into()))?
+            .ok_or_else(|| Error::SingularPartition {
+                at: "the given pose".into(),
+                rows: r,
+            })?
     } else {
         DMatrix::zeros(0, dof)
     };
@@ -209,7 +218,8 @@ pub fn potential_energy(model: &Model, state: &State) -> Option<f64> {
 /// at their given values, or at the initial value when they have none).
 ///
 /// # Errors
-/// [`Error::Undefined`] if the energy cannot be evaluated.
+/// [`Error::ForceTableOutOfRange`] if the energy cannot be evaluated,
+/// [`Error::SingularPartition`] if the constraint Jacobian is singular there.
 pub fn balance(model: &Model, state: &State) -> Result<Balance> {
     if sparse_path(model) {
         let r = {
@@ -236,7 +246,8 @@ pub fn balance(model: &Model, state: &State) -> Result<Balance> {
 /// Verifies that `state` is a rest pose: it assembles, and no joint needs an effort to hold it.
 ///
 /// # Errors
-/// [`Error::Undefined`] if the energy cannot be evaluated.
+/// [`Error::ForceTableOutOfRange`] if the energy cannot be evaluated,
+/// [`Error::SingularPartition`] if the constraint Jacobian is singular there.
 ///
 /// # Example
 /// ```

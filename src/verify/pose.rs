@@ -16,7 +16,7 @@ use std::path::Path;
 /// Reads a pose file (format detected from its content).
 ///
 /// # Errors
-/// [`Error::Io`] if unreadable, [`Error::Option`] naming the file if it is none of the formats.
+/// [`Error::Io`] if unreadable, [`Error::Pose`] naming the file if it is none of the formats.
 pub fn read_pose(path: impl AsRef<Path>) -> Result<JointValues> {
     let path = path.as_ref();
     let text = std::fs::read_to_string(path).map_err(|cause| Error::Io {
@@ -37,9 +37,12 @@ fn numbers(v: &serde_json::Value) -> Option<Vec<f64>> {
 /// Parses pose text; `file` names it in errors.
 ///
 /// # Errors
-/// [`Error::Option`] if the text is not one of the accepted formats.
+/// [`Error::Pose`] if the text is not one of the accepted formats.
 pub fn parse_pose(text: &str, file: &str) -> Result<JointValues> {
-    let bad = |why: String| Error::Option(format!("{file}: {why}"));
+    let bad = |why: String| Error::Pose {
+        file: file.into(),
+        message: why,
+    };
     let value: serde_json::Value = match serde_json::from_str(text) {
         Ok(v) => v,
         Err(_) => serde_yaml_ng::from_str(last_document(text))
@@ -134,33 +137,25 @@ fn has_content(doc: &str) -> bool {
 /// not given.
 ///
 /// # Errors
-/// [`Error::Option`] for a joint the model does not have or a value list of the wrong length.
+/// [`Error::UnknownJoint`] for a joint the model does not have, [`Error::ValueCount`] for a
+/// value list of the wrong length.
 pub fn pose_state(model: &Model, values: &JointValues) -> Result<(State, Vec<String>)> {
     let mut all = crate::solver::initial_values(model);
-    // Names by map: a pose names every joint, and a linear search each is O(N²).
-    let ids: std::collections::HashMap<&str, crate::model::JointId> = model
-        .joints
-        .iter()
-        .enumerate()
-        .map(|(i, j)| (j.name.as_str(), crate::model::JointId(i)))
-        .collect();
+    // `joint_id` looks names up in the model's map: a pose names every joint.
     for (name, v) in values {
-        let id = ids
-            .get(name.as_str())
-            .copied()
-            .ok_or_else(|| Error::Option(format!("pose: the model has no joint `{name}`")))?;
+        let id = model
+            .joint_id(name)
+            .ok_or_else(|| model.unknown_joint("pose", name))?;
         let j = model.joint(id);
-        let expected: &[usize] = match j.kind {
-            crate::model::JointKind::Spherical => &[3, 4],
-            crate::model::JointKind::Floating => &[6, 7],
-            k => &[k.scalar_coordinates()],
-        };
+        let expected = j.kind.value_counts();
         if !expected.contains(&v.len()) {
-            return Err(Error::Option(format!(
-                "pose: joint `{name}` ({}) takes {expected:?} value(s), got {}",
-                j.kind.name(),
-                v.len()
-            )));
+            return Err(Error::ValueCount {
+                file: "pose".into(),
+                joint: name.clone(),
+                kind: j.kind.name().into(),
+                expected: expected.to_vec(),
+                got: v.len(),
+            });
         }
         all.insert(name.clone(), v.clone());
     }

@@ -63,8 +63,14 @@ pub(super) fn reduced(
 ) -> Result<Reduced> {
     let q = &state.q;
     let mut g = DVector::zeros(q.len());
-    potential(model, &state.branches, q, &mut g, None)
-        .ok_or_else(|| Error::Undefined("a force table is out of range".into()))?;
+    potential(model, &state.branches, q, &mut g, None).ok_or_else(|| {
+        crate::forces::undefined_term(model, &state.branches, q).unwrap_or(
+            Error::SingularPartition {
+                at: "the given pose".into(),
+                rows: 0,
+            },
+        )
+    })?;
     let scale = coordinate_scale(model);
     let force_scale = g
         .iter()
@@ -82,7 +88,10 @@ pub(super) fn reduced(
     let part = sys.partition(q);
     let eval = sys
         .evaluate(q, &part)
-        .ok_or_else(|| Error::Undefined("singular constraint Jacobian".into()))?;
+        .ok_or_else(|| Error::SingularPartition {
+            at: "the given pose".into(),
+            rows: part.rows.len(),
+        })?;
     let mut multipliers = vec![0.0; sys.cons.len()];
     for (k, &r) in part.rows.iter().enumerate() {
         multipliers[r] = eval.mu[k];
@@ -124,10 +133,10 @@ pub(super) fn efforts(
     let first_added = r.cons.len() - model.mimics.len() - (all.len() - locks.len());
     let dropped = r.redundant.iter().filter(|&&i| i < first_added).count();
     if dropped > base {
-        return Err(Error::Undefined(format!(
-            "the efforts of the joint coordinates cannot be separated from the loop reactions \
-             ({dropped} constraint rows dependent on the joint coordinates, {base} without them)"
-        )));
+        return Err(Error::InseparableEfforts {
+            dependent: dropped,
+            without: base,
+        });
     }
     let first_lock = r
         .cons

@@ -16,6 +16,7 @@ use std::path::{Path, PathBuf};
 const LAYERS: &[(&str, u32)] = &[
     ("error", 0),
     ("math", 0),
+    ("names", 0),
     ("geometry", 1),
     ("model", 2),
     ("jet", 3),

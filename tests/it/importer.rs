@@ -520,7 +520,8 @@ fn unknown_joint_in_options_gets_a_suggestion() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("initial value `zzzzzz`") && e.contains("known: "),
+        // No close name: no suggestion, and no list (models have thousands of joints).
+        e.contains("initial value `zzzzzz`") && !e.contains("did you mean"),
         "{e}"
     );
 }

@@ -6,6 +6,7 @@ mod angles;
 mod architecture;
 mod cli;
 mod common;
+mod degenerate;
 mod engineering;
 mod golden;
 mod importer;

@@ -117,7 +117,7 @@ fn bad_pose_files_are_errors() {
     assert!(pose_state(&m, &v)
         .unwrap_err()
         .to_string()
-        .contains("no joint `elbow`"));
+        .contains("pose `elbow`: the model has no joint"));
 }
 
 fn restpose() -> Command {

@@ -1,8 +1,13 @@
-//! "Did you mean": the closest name by edit distance (Levenshtein, case-insensitive), for
-//! names given on the command line that the model does not have.
+//! "Did you mean": the closest known name to a misspelt one, for every message that names
+//! something the input does not have (joints on the command line or in a pose, `mech:`
+//! elements and attributes).
+//!
+//! The distance is Levenshtein's `d(a, b)` (insertions, deletions, substitutions; case
+//! ignored). A candidate is suggested when `d ≤ max(2, ⌊|name| / 3⌋)` (the nearest; ties go
+//! to the first), else when it is the only candidate that starts with the name.
 
 /// Edit distance between `a` and `b` (insertions, deletions, substitutions), ignoring case.
-fn distance(a: &str, b: &str) -> usize {
+pub fn distance(a: &str, b: &str) -> usize {
     let a: Vec<char> = a.to_lowercase().chars().collect();
     let b: Vec<char> = b.to_lowercase().chars().collect();
     let mut row: Vec<usize> = (0..=b.len()).collect();
@@ -20,14 +25,12 @@ fn distance(a: &str, b: &str) -> usize {
     row[b.len()]
 }
 
-/// The candidate closest to `name`: the nearest within a third of the name's length (at
-/// least one edit; ties go to the first), else the only candidate that starts with `name`
-/// (ignoring case).
-pub(crate) fn closest<'a>(
+/// The candidate closest to `name` (see the module docs), if one is close.
+pub fn closest<'a>(
     name: &str,
     candidates: impl Iterator<Item = &'a str> + Clone,
 ) -> Option<&'a str> {
-    let limit = (name.chars().count() / 3).max(1);
+    let limit = (name.chars().count() / 3).max(2);
     let near = candidates
         .clone()
         .map(|c| (distance(name, c), c))
@@ -44,11 +47,6 @@ pub(crate) fn closest<'a>(
     })
 }
 
-/// ` (did you mean `x`?)` or nothing.
-pub(crate) fn hint<'a>(name: &str, candidates: impl Iterator<Item = &'a str> + Clone) -> String {
-    closest(name, candidates).map_or(String::new(), |c| format!(" (did you mean `{c}`?)"))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -59,6 +57,8 @@ mod tests {
         assert_eq!(distance("", "abc"), 3);
         assert_eq!(distance("Pivot", "pivot"), 0);
         assert_eq!(distance("pivto", "pivot"), 2);
+        assert_eq!(distance("pivt", "pivot"), 1);
+        assert_eq!(distance("wrist_3_joint", "wrist_2_joint"), 1);
     }
 
     #[test]
@@ -71,7 +71,12 @@ mod tests {
             closest("shoulder_lift_jiont", c()),
             Some("shoulder_lift_joint")
         );
-        assert_eq!(closest("elbow", c()), Some("elbow_joint"));
+        assert_eq!(closest("pivto", ["pivot"].into_iter()), Some("pivot"));
+        assert_eq!(
+            closest("refrence", ["reference", "stiffness"].into_iter()),
+            Some("reference")
+        );
+        assert_eq!(closest("xyz", ["pivot"].into_iter()), None);
         assert_eq!(closest("elbo_joint", c()), Some("elbow_joint"));
         assert_eq!(closest("zzz", c()), None);
     }

@@ -37,7 +37,7 @@ fn newton(
         let rows_residual = |sys: &System, phi: &DVector<f64>| {
             part.rows
                 .iter()
-                .map(|&i| (phi[i] * sys.row_scale[i]).abs())
+                .map(|&i| (phi[i] * sys.problem.scaling.rows[i]).abs())
                 .fold(0.0, f64::max)
         };
         let res = rows_residual(sys, &phi);
@@ -47,9 +47,9 @@ fn newton(
                 .iter()
                 .copied()
                 .max_by(|&a, &b| {
-                    (phi[a] * sys.row_scale[a])
+                    (phi[a] * sys.problem.scaling.rows[a])
                         .abs()
-                        .total_cmp(&(phi[b] * sys.row_scale[b]).abs())
+                        .total_cmp(&(phi[b] * sys.problem.scaling.rows[b]).abs())
                 })
                 .unwrap_or_else(|| phi.iamax());
             return Err(Failure::Inconsistent(worst));
@@ -67,7 +67,7 @@ fn newton(
             let trial = sys.residual(&qt).clone();
             if rows_residual(sys, &trial) < res {
                 q = qt;
-                sys.cons.branches.follow(sys.model, &q);
+                sys.problem.cons.branches.follow(sys.problem.model, &q);
                 improved = true;
                 break;
             }
@@ -100,11 +100,12 @@ pub(crate) fn assemble(
         let cons = Constraints::new(model, &held).on_branches(branches.clone());
         let mut sys = System::with_options(model, cons, options);
         if let Ok(qa) = newton(&mut sys, q.clone(), tol) {
-            let cons = Constraints::new(model, locks).on_branches(sys.cons.branches.clone());
+            let cons =
+                Constraints::new(model, locks).on_branches(sys.problem.cons.branches.clone());
             let mut fin = System::with_options(model, cons, options);
             fin.residual(&qa);
             if fin.dimensionless_residual() <= tol.max(1e-8) {
-                *branches = fin.cons.branches;
+                *branches = fin.problem.cons.branches;
                 return Ok(qa);
             }
         }
@@ -126,7 +127,7 @@ pub(crate) fn project(
     let q0 = q.clone();
     match newton(&mut sys, q, tol) {
         Ok(qa) => {
-            *branches = sys.cons.branches;
+            *branches = sys.problem.cons.branches;
             Ok(qa)
         }
         Err(Failure::Inconsistent(row)) => {
@@ -138,7 +139,7 @@ pub(crate) fn project(
                 .map(|j| format!("`{}`", j.name))
                 .collect();
             Err(Error::Inconsistent {
-                row: sys.cons.row_name(row).to_string(),
+                row: sys.problem.cons.row_name(row).to_string(),
                 residual: phi[row].abs(),
                 loops: if loops.is_empty() {
                     "none".into()
@@ -152,16 +153,16 @@ pub(crate) fn project(
             // which only reflects how the Newton steps distorted the Euler parameters.
             let phi = sys.residual(&q0).clone();
             let worst = (0..phi.len())
-                .filter(|&r| !sys.cons.row_name(r).ends_with(".normalization"))
+                .filter(|&r| !sys.problem.cons.row_name(r).ends_with(".normalization"))
                 .max_by(|&a, &b| {
-                    (phi[a] * sys.row_scale[a])
+                    (phi[a] * sys.problem.scaling.rows[a])
                         .abs()
-                        .total_cmp(&(phi[b] * sys.row_scale[b]).abs())
+                        .total_cmp(&(phi[b] * sys.problem.scaling.rows[b]).abs())
                 })
                 .unwrap_or_else(|| phi.iamax());
             Err(Error::Assembly {
                 residual: phi[worst].abs(),
-                row: sys.cons.row_name(worst).to_string(),
+                row: sys.problem.cons.row_name(worst).to_string(),
                 iterations,
             })
         }

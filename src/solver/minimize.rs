@@ -23,7 +23,7 @@ use super::partition::Partition;
 use super::report::{Diagnostics, Iterate, Termination};
 use super::sparse::kkt::Factored;
 use super::spectrum::{spectrum, Spectrum};
-use super::system::{Eval, System};
+use super::system::{Backend, Eval, System};
 use nalgebra::{DMatrix, DVector};
 
 /// Outcome of the minimization.
@@ -219,7 +219,7 @@ pub(crate) fn minimize(
         }
         let mut negative_curvature = None;
         let dof = part.independent.len();
-        let dense_newton = options.method == Method::Newton && !sys.sparse;
+        let dense_newton = options.method == Method::Newton && sys.backend == Backend::Dense;
         let eig =
             (dof > 0 && (dense_newton || gnorm <= gtol)).then(|| spectrum(sys, &q, &part, &eval));
         if gnorm <= gtol {
@@ -276,7 +276,7 @@ pub(crate) fn minimize(
         // origins): in a long chain, small joint rotations move the far links by about the
         // chain's length, and a cap in link lengths would make the iteration count grow with N.
         let mut dq = sys.tangent_step(&part, &eval, &d);
-        let l = sys.model.length_scale.max(extent(&q));
+        let l = sys.problem.model.length_scale.max(extent(&q));
         let (mut rot, mut pos) = (0.0f64, 0.0f64);
         for (i, x) in dq.iter().enumerate() {
             if i % 7 < 3 {
@@ -354,18 +354,19 @@ pub(crate) fn minimize(
                 qn.fresh = false;
                 let linear = descent.record(slope * alpha, &(&dq * alpha), l);
                 q = qt;
-                sys.cons.branches.follow(sys.model, &q);
+                sys.problem.cons.branches.follow(sys.problem.model, &q);
                 eval = et;
                 iteration += 1;
                 just_repartitioned = false;
                 if linear
                     || linear_steps >= 5
                     || eval.energy.total < -1e15
-                    || (0..q.len()).any(|i| i % 7 < 3 && q[i].abs() > 1e6 * sys.model.length_scale)
+                    || (0..q.len())
+                        .any(|i| i % 7 < 3 && q[i].abs() > 1e6 * sys.problem.model.length_scale)
                 {
                     termination = Termination::Unbounded;
                     diag.free_directions =
-                        super::unbounded::free_directions(sys.model, &q, &(&dq * alpha));
+                        super::unbounded::free_directions(sys.problem.model, &q, &(&dq * alpha));
                     history.push(Iterate {
                         iteration,
                         potential_energy: eval.energy.total,

@@ -102,7 +102,7 @@ fn stability(
         .map(|k| {
             let dq = sys.tangent_step(part, eval, &vecs.column(k).into_owned());
             let mut mode = std::collections::BTreeMap::new();
-            for j in sys.model.joints.iter().filter(|j| !j.merged) {
+            for j in sys.problem.model.joints.iter().filter(|j| !j.merged) {
                 let pair = crate::jet::pair_of(&j.bodies, q, false);
                 let d: Vec<f64> = (0..j.kind.scalar_coordinates())
                     .filter_map(|dof| crate::kinematics::coordinate(j, &pair, dof, 0.0))
@@ -294,11 +294,11 @@ fn solve_assembled(
     }
     let state = State {
         q: out.q.clone(),
-        branches: sys.cons.branches.clone(),
+        branches: sys.problem.cons.branches.clone(),
     };
     let dof = out.part.independent.len();
     let mut diagnostics = out.diagnostics;
-    diagnostics.linear_algebra = if sys.sparse { "sparse" } else { "dense" }.into();
+    diagnostics.linear_algebra = sys.backend.name().into();
     let stability_started = std::time::Instant::now();
     let stability = (dof > 0).then(|| {
         let eig = out
@@ -326,7 +326,7 @@ fn solve_assembled(
             .part
             .redundant
             .iter()
-            .map(|&r| sys.cons.row_name(r).to_string())
+            .map(|&r| sys.problem.cons.row_name(r).to_string())
             .collect(),
         stability,
         reactions,
@@ -334,7 +334,7 @@ fn solve_assembled(
         sizes: Sizes {
             bodies: model.bodies.len(),
             coordinates: model.coordinate_count(),
-            constraint_rows: sys.cons.len(),
+            constraint_rows: sys.problem.cons.len(),
         },
         iterates: {
             let mut branches = start.branches;

@@ -20,8 +20,8 @@ pub(crate) fn reactions(
     part: &Partition,
     eval: &Eval,
 ) -> Vec<(String, Reaction)> {
-    let model = sys.model;
-    let mut mu = DVector::zeros(sys.cons.len());
+    let model = sys.problem.model;
+    let mut mu = DVector::zeros(sys.problem.cons.len());
     for (k, &row) in part.rows.iter().enumerate() {
         mu[row] = eval.mu[k];
     }
@@ -29,7 +29,7 @@ pub(crate) fn reactions(
     let mut rows_buf = Vec::new();
     // The joint and lock blocks of each joint (one pass: `O(N)`, not joints × blocks).
     let mut by_joint = vec![Vec::new(); model.joints.len()];
-    for block in &sys.cons.blocks {
+    for block in &sys.problem.cons.blocks {
         match &block.kind {
             BlockKind::Joint(id) | BlockKind::Lock { joint: id, .. } => by_joint[id.0].push(block),
             _ => {}
@@ -42,7 +42,12 @@ pub(crate) fn reactions(
         for block in &by_joint[ji] {
             match &block.kind {
                 BlockKind::Joint(id) if id.0 == ji => {
-                    joint::rows(j, &pair, sys.cons.branches.get(*id, 0), &mut rows_buf);
+                    joint::rows(
+                        j,
+                        &pair,
+                        sys.problem.cons.branches.get(*id, 0),
+                        &mut rows_buf,
+                    );
                     for (k, s) in rows_buf.iter().enumerate() {
                         g += s.g * mu[block.first + k];
                     }

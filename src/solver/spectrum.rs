@@ -20,7 +20,7 @@
 use super::eigen::symmetric_eigen;
 use super::partition::Partition;
 use super::sparse::kkt::Factored;
-use super::system::{Eval, System};
+use super::system::{Backend, Eval, System};
 use nalgebra::{DMatrix, DVector};
 
 /// Up to this many degrees of freedom the reduced Hessian is formed and decomposed exactly.
@@ -70,7 +70,7 @@ pub(crate) fn spectrum(
     eval: &Eval,
 ) -> Spectrum {
     let dof = part.independent.len();
-    if !sys.sparse || dof <= EXACT_UP_TO {
+    if sys.backend == Backend::Dense || dof <= EXACT_UP_TO {
         let (values, vectors) = symmetric_eigen(&sys.reduced_hessian(q, part, eval));
         let largest = values.amax();
         return Spectrum {
@@ -239,8 +239,8 @@ mod tests {
                 values.insert(format!("joint{i}"), vec![0.3 * ((i as f64) * 0.7).sin()]);
             }
             let q = crate::state::State::from_joint_values(&model, &values).q;
-            let mut sys = System::new(&model, Constraints::new(&model, &[]));
-            sys.sparse = true;
+            let mut sys =
+                System::with_backend(&model, Constraints::new(&model, &[]), Backend::Sparse);
             let part = sys.partition(&q);
             let eval = sys.evaluate(&q, &part).unwrap();
             let exact = symmetric_eigen(&sys.reduced_hessian(&q, &part, &eval)).0;

@@ -34,6 +34,7 @@ use crate::error::{Error, Result};
 use crate::forces::potential;
 use crate::jet::{pair_of, scatter};
 use crate::model::Model;
+use crate::solver::system::{Backend, Scaling};
 use crate::solver::Stability;
 use crate::state::State;
 use nalgebra::{DMatrix, DVector};
@@ -131,7 +132,7 @@ pub struct Verification {
 
 /// Whether `model` is verified on the sparse path (module `reduced`).
 fn sparse_path(model: &Model) -> bool {
-    model.coordinate_count() > crate::solver::system::SPARSE_FROM_COORDINATES
+    Backend::choose(model, crate::solver::LinearAlgebra::Auto) == Backend::Sparse
 }
 
 /// Everything the checks share: `Φ`, the scaled gradient and the null-space basis.
@@ -151,7 +152,10 @@ fn project(model: &Model, state: &State) -> Result<Projection> {
     let mut jac = crate::constraints::Triplets::default();
     cons.evaluate(model, &state.q, &mut phi, Some(&mut jac));
     let n = state.q.len();
-    let scale = crate::solver::system::coordinate_scale(model);
+    let Scaling {
+        columns: scale,
+        rows: row_scale,
+    } = Scaling::new(model, &cons);
     let mut j = jac.to_dense();
     for c in 0..n {
         j.column_mut(c).scale_mut(scale[c]);
@@ -171,9 +175,8 @@ fn project(model: &Model, state: &State) -> Result<Projection> {
     // Null space of the dimensionless Jacobian D Φ_q S: Z = [−Φ_u⁻¹ Φ_v; I] for the rows and
     // columns that full pivoting finds independent, made orthonormal by a QR factorization.
     // The subspace does not depend on that choice.
-    let l = model.length_scale;
     for r in 0..cons.len() {
-        j.row_mut(r).scale_mut(l.powi(-cons.length_power(r)));
+        j.row_mut(r).scale_mut(row_scale[r]);
     }
     let part = crate::solver::partition::partition(&j, &vec![1.0; cons.len()], &vec![1.0; n]);
     let (r, dof) = (part.rows.len(), part.independent.len());

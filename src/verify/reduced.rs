@@ -25,7 +25,7 @@ use crate::constraints::{BlockKind, Constraints};
 use crate::error::{Error, Result};
 use crate::forces::potential;
 use crate::model::{JointId, Model};
-use crate::solver::system::{coordinate_scale, System};
+use crate::solver::system::{coordinate_scale, Backend, System};
 use crate::state::State;
 use nalgebra::DVector;
 
@@ -76,14 +76,14 @@ pub(super) fn reduced(
         .iter()
         .zip(&scale)
         .fold(0.0f64, |a, (x, s)| a.max((x * s).abs()));
-    let mut sys = System::new(
+    let mut sys = System::with_backend(
         model,
         Constraints::new(model, locks).on_branches(state.branches.clone()),
+        Backend::Sparse,
     );
-    sys.sparse = true;
-    let added = sys.cons.len() - model.mimics.len() - (locks.len() - preferred);
-    for r in added..sys.cons.len() - model.mimics.len() {
-        sys.row_scale[r] *= LOCK_PREFERENCE;
+    let added = sys.problem.cons.len() - model.mimics.len() - (locks.len() - preferred);
+    for r in added..sys.problem.cons.len() - model.mimics.len() {
+        sys.problem.scaling.rows[r] *= LOCK_PREFERENCE;
     }
     let part = sys.partition(q);
     let eval = sys
@@ -92,7 +92,7 @@ pub(super) fn reduced(
             at: "the given pose".into(),
             rows: part.rows.len(),
         })?;
-    let mut multipliers = vec![0.0; sys.cons.len()];
+    let mut multipliers = vec![0.0; sys.problem.cons.len()];
     for (k, &r) in part.rows.iter().enumerate() {
         multipliers[r] = eval.mu[k];
     }
@@ -104,7 +104,7 @@ pub(super) fn reduced(
         dof: part.independent.len(),
         multipliers,
         redundant: part.redundant.clone(),
-        cons: sys.cons,
+        cons: sys.problem.cons,
     })
 }
 

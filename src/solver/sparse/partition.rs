@@ -256,7 +256,7 @@ pub(crate) fn partition(
 #[cfg(test)]
 mod tests {
     use crate::constraints::Constraints;
-    use crate::solver::system::System;
+    use crate::solver::system::{Backend, System};
     use crate::urdf::{load_str, ImportOptions};
 
     fn models() -> Vec<crate::model::Model> {
@@ -290,22 +290,24 @@ mod tests {
         for model in models() {
             let q0 = crate::solver::initial_state(&model).q;
             let q = crate::solver::assemble_only(&model, q0, &mut Default::default(), &[]).unwrap();
-            let mut dense = System::new(&model, Constraints::new(&model, &[]));
-            dense.sparse = false;
-            let mut sparse = System::new(&model, Constraints::new(&model, &[]));
-            sparse.sparse = true;
+            let cons = || Constraints::new(&model, &[]);
+            let mut dense = System::with_backend(&model, cons(), Backend::Dense);
+            let mut sparse = System::with_backend(&model, cons(), Backend::Sparse);
             let pd = dense.partition(&q);
             let ps = sparse.partition(&q);
             assert_eq!(ps.independent.len(), pd.independent.len(), "{}", model.name);
             assert_eq!(ps.redundant.len(), pd.redundant.len(), "{}", model.name);
-            assert_eq!(ps.rows.len() + ps.redundant.len(), sparse.cons.len());
+            assert_eq!(
+                ps.rows.len() + ps.redundant.len(),
+                sparse.problem.cons.len()
+            );
             let j = sparse.jacobian(&q);
             let r = ps.rows.len();
             let cond = |p: &crate::solver::partition::Partition| {
                 let a = nalgebra::DMatrix::from_fn(r, r, |i, k| {
                     j[(p.rows[i], p.dependent[k])]
-                        * sparse.row_scale[p.rows[i]]
-                        * sparse.scale[p.dependent[k]]
+                        * sparse.problem.scaling.rows[p.rows[i]]
+                        * sparse.problem.scaling.columns[p.dependent[k]]
                 });
                 let sv = a.singular_values();
                 sv.max() / sv.min()

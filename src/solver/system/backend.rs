@@ -1,0 +1,72 @@
+//! Dense or sparse linear algebra, chosen once per system.
+//!
+//! Both backends partition `Φ_q = [Φ_u Φ_v]` and factor `Φ_u`; the dense one by full pivoting
+//! of the dense Jacobian and nalgebra's LU, the sparse one body by body (module `sparse`) and
+//! with faer's sparse LU. The sparse backend also forms the reduced Hessian column by column
+//! and solves Newton steps through the KKT system instead of the dense `Zᵀ W Z`.
+
+use super::problem::Problem;
+use crate::constraints::Triplets;
+use crate::model::Model;
+use crate::solver::partition::{partition, Partition};
+use crate::solver::LinearAlgebra;
+
+/// Models with more coordinates than this (40 bodies) use the sparse path when the choice is
+/// automatic. The sparse path is as fast or faster from 5 bodies up (BENCHMARKS.md), but the
+/// dense path stays the default for small models: its Newton steps use the exact eigenvalues
+/// of the reduced Hessian (negative curvature handled mode by mode), and its full-pivoting
+/// partition picks the assembly branch the robot tests are written against (from a far start
+/// the tractor-trailer reaches a different, lower-energy branch on the sparse path).
+const SPARSE_FROM_COORDINATES: usize = 7 * 40;
+
+/// The linear algebra of a system.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Backend {
+    /// Dense matrices (small models).
+    Dense,
+    /// Sparse matrices (module `sparse`).
+    Sparse,
+}
+
+impl Backend {
+    /// The backend `choice` asks for; automatic: by the size of `model`.
+    pub(crate) fn choose(model: &Model, choice: LinearAlgebra) -> Self {
+        match choice {
+            LinearAlgebra::Auto if model.coordinate_count() > SPARSE_FROM_COORDINATES => {
+                Backend::Sparse
+            }
+            LinearAlgebra::Auto | LinearAlgebra::Dense => Backend::Dense,
+            LinearAlgebra::Sparse => Backend::Sparse,
+        }
+    }
+
+    /// `"dense"` or `"sparse"` (as the report's diagnostics name it).
+    pub(crate) fn name(self) -> &'static str {
+        match self {
+            Backend::Dense => "dense",
+            Backend::Sparse => "sparse",
+        }
+    }
+
+    /// Partition of the Jacobian `jac` of `problem` (full pivoting of the dense `Φ_q`, or the
+    /// sparse body-by-body elimination).
+    pub(crate) fn partition(
+        self,
+        problem: &Problem,
+        jac: &Triplets,
+        coordinates: usize,
+    ) -> Partition {
+        let scaling = &problem.scaling;
+        match self {
+            Backend::Sparse => crate::solver::sparse::partition::partition(
+                problem.model,
+                problem.cons.len(),
+                coordinates,
+                &jac.entries,
+                &scaling.rows,
+                &scaling.columns,
+            ),
+            Backend::Dense => partition(&jac.to_dense(), &scaling.rows, &scaling.columns),
+        }
+    }
+}

@@ -1,0 +1,108 @@
+//! The corrector: Newton on `Φ(u; v) = 0` for fixed `v`, `Φ_u δu = −Φ` over the independent
+//! rows, optionally starting with chord steps on the factors of a nearby point.
+
+use super::{Factors, System};
+use crate::solver::partition::Partition;
+use nalgebra::DVector;
+
+/// Why the corrector gave up.
+#[derive(Debug)]
+pub(crate) struct CorrectorFailure;
+
+impl System<'_> {
+    /// The Newton change of the dependent coordinates `Φ_u δu = −Φ` at `q` (independent rows);
+    /// also leaves `Φ(q)` in the scratch.
+    pub(crate) fn dependent_step(
+        &mut self,
+        q: &DVector<f64>,
+        part: &Partition,
+    ) -> Option<DVector<f64>> {
+        self.triplets(q);
+        let f = self.factors(part)?;
+        let rhs = DVector::from_iterator(
+            part.rows.len(),
+            part.rows.iter().map(|&a| -self.work.phi[a]),
+        );
+        f.solve(&rhs)
+    }
+
+    /// Newton corrector: solves the independent rows for `u` with `v` fixed; returns the number
+    /// of iterations. Also fails if the redundant rows are not satisfied at the end.
+    #[cfg(test)]
+    pub(crate) fn correct(
+        &mut self,
+        q: &mut DVector<f64>,
+        part: &Partition,
+        tol: f64,
+        max_iterations: usize,
+    ) -> Result<usize, CorrectorFailure> {
+        self.correct_from(q, part, tol, max_iterations, None)
+    }
+
+    /// The corrector, starting with chord steps on the factors `chord` of `Φ_u` at a nearby
+    /// point (no Jacobian, no factorization: `Φ_u(q₀) δu = −Φ(q)`) while each step at least
+    /// halves the residual, then Newton steps with `Φ_u(q)` refactored.
+    pub(crate) fn correct_from(
+        &mut self,
+        q: &mut DVector<f64>,
+        part: &Partition,
+        tol: f64,
+        max_iterations: usize,
+        mut chord: Option<&Factors>,
+    ) -> Result<usize, CorrectorFailure> {
+        let mut first = f64::INFINITY;
+        let mut last = f64::INFINITY;
+        for it in 0..=max_iterations {
+            self.residual(q);
+            let res = part
+                .rows
+                .iter()
+                .map(|&i| self.work.phi[i].abs() * self.problem.scaling.rows[i])
+                .fold(0.0, f64::max);
+            if !res.is_finite() {
+                return Err(CorrectorFailure);
+            }
+            // Chord steps converge linearly: they go on to 10⁻³ of the tolerance, so that the
+            // result is as tight as a Newton step would leave it (a stalled chord step
+            // switches to Newton).
+            let target = if chord.is_some() { 1e-3 * tol } else { tol };
+            if res <= target || (res <= tol && it == max_iterations) {
+                let all = self.dimensionless_residual();
+                return if all <= tol.max(1e-8) {
+                    Ok(it)
+                } else {
+                    Err(CorrectorFailure)
+                };
+            }
+            if it == 0 {
+                first = res;
+            } else if res > 1e3 * first.max(tol) {
+                return Err(CorrectorFailure);
+            }
+            if it == max_iterations {
+                break;
+            }
+            if res > 0.5 * last {
+                chord = None;
+            }
+            last = res;
+            let du = match chord {
+                Some(f) => {
+                    let rhs = DVector::from_iterator(
+                        part.rows.len(),
+                        part.rows.iter().map(|&a| -self.work.phi[a]),
+                    );
+                    f.solve(&rhs)
+                }
+                None => self.dependent_step(q, part),
+            };
+            let Some(du) = du else {
+                return Err(CorrectorFailure);
+            };
+            for (k, &c) in part.dependent.iter().enumerate() {
+                q[c] += du[k];
+            }
+        }
+        Err(CorrectorFailure)
+    }
+}

@@ -1,0 +1,146 @@
+//! The factors of `Φ_u` and the values of `Φ_v` at one configuration: `Φ_u x = b`,
+//! `Φ_uᵀ x = b`, `Φ_v x` and `Φ_vᵀ y`, dense (nalgebra's LU with partial pivoting) or sparse
+//! (faer's sparse LU).
+
+use super::{Backend, System};
+use crate::solver::partition::Partition;
+use crate::solver::sparse::factor::{SparseFactors, Split};
+use nalgebra::{DMatrix, DVector, LU};
+
+/// The factorization of `Φ_u` and the values of `Φ_v` at one configuration.
+#[derive(Clone)]
+pub(crate) enum Factors {
+    /// Dense LU with partial pivoting (small models).
+    Dense {
+        lu: LU<f64, nalgebra::Dyn, nalgebra::Dyn>,
+        phi_v: DMatrix<f64>,
+    },
+    /// faer's sparse LU.
+    Sparse(SparseFactors),
+}
+
+impl Factors {
+    /// `Φ_u x = b`; `None` if `Φ_u` is singular.
+    pub(crate) fn solve(&self, b: &DVector<f64>) -> Option<DVector<f64>> {
+        match self {
+            Factors::Dense { lu, .. } => {
+                if b.is_empty() {
+                    Some(b.clone())
+                } else {
+                    lu.solve(b)
+                }
+            }
+            Factors::Sparse(f) => {
+                let mut x = b.clone();
+                f.solve(x.as_mut_slice()).then_some(x)
+            }
+        }
+    }
+
+    /// `Φ_uᵀ x = b`; `None` if `Φ_u` is singular.
+    pub(crate) fn solve_transpose(&self, b: DVector<f64>) -> Option<DVector<f64>> {
+        match self {
+            Factors::Dense { lu, .. } => {
+                if b.is_empty() {
+                    return Some(b);
+                }
+                solve_transpose(lu, b)
+            }
+            Factors::Sparse(f) => {
+                let mut x = b;
+                f.solve_transpose(x.as_mut_slice()).then_some(x)
+            }
+        }
+    }
+
+    /// `Φ_v x`.
+    pub(crate) fn phi_v_mul(&self, x: &DVector<f64>, rows: usize) -> DVector<f64> {
+        match self {
+            Factors::Dense { phi_v, .. } => phi_v * x,
+            Factors::Sparse(f) => DVector::from_vec(f.phi_v_mul(x.as_slice(), rows)),
+        }
+    }
+
+    /// `Φ_vᵀ y`.
+    pub(crate) fn phi_v_tr_mul(&self, y: &DVector<f64>, dof: usize) -> DVector<f64> {
+        match self {
+            Factors::Dense { phi_v, .. } => phi_v.transpose() * y,
+            Factors::Sparse(f) => DVector::from_vec(f.phi_v_tr_mul(y.as_slice(), dof)),
+        }
+    }
+
+    /// Whether `Φ_u` has become ill-conditioned (dense: a pivot of `U` below `1e-8` of the
+    /// largest; the sparse factors do not tell, and the minimizer re-partitions when the
+    /// corrector or the line search fails instead).
+    pub(crate) fn ill_conditioned(&self) -> bool {
+        match self {
+            Factors::Dense { lu, .. } => {
+                let d = lu.u().diagonal().abs();
+                !d.is_empty() && d.min() < 1e-8 * d.max()
+            }
+            Factors::Sparse(_) => false,
+        }
+    }
+}
+
+/// Solves `Aᵀ x = b` with the factors `P A = L U` of `A`: `Uᵀ y = b`, `Lᵀ z = y`, `x = Pᵀ z`.
+fn solve_transpose(
+    lu: &LU<f64, nalgebra::Dyn, nalgebra::Dyn>,
+    b: DVector<f64>,
+) -> Option<DVector<f64>> {
+    let y = lu.u().tr_solve_upper_triangular(&b)?;
+    let mut z = lu.l().tr_solve_lower_triangular(&y)?;
+    lu.p().inv_permute_rows(&mut z);
+    Some(z)
+}
+
+impl System<'_> {
+    /// Factors `Φ_u` of the last triplets under `part`.
+    pub(super) fn factors(&mut self, part: &Partition) -> Option<Factors> {
+        let n = self.problem.model.coordinate_count();
+        let m = self.problem.cons.len();
+        let work = &mut self.work;
+        if self.backend == Backend::Sparse {
+            let entries = &work.jac.entries;
+            if !work
+                .split
+                .as_ref()
+                .is_some_and(|s| s.fits(part, entries.len()))
+            {
+                work.split = Some(Split::new(part, m, n, entries)?);
+            }
+            let split = work.split.as_mut()?;
+            return Some(Factors::Sparse(split.factor(entries)));
+        }
+        let r = part.rows.len();
+        let dof = part.independent.len();
+        let mut row_pos = vec![usize::MAX; m];
+        for (k, &i) in part.rows.iter().enumerate() {
+            row_pos[i] = k;
+        }
+        // Column position: dependent k, or independent dof-offset k.
+        let mut col_pos = vec![(false, 0usize); n];
+        for (k, &c) in part.dependent.iter().enumerate() {
+            col_pos[c] = (true, k);
+        }
+        for (k, &c) in part.independent.iter().enumerate() {
+            col_pos[c] = (false, k);
+        }
+        let mut phi_u = DMatrix::zeros(r, r);
+        let mut phi_v = DMatrix::zeros(r, dof);
+        for &(i, c, v) in &work.jac.entries {
+            let a = row_pos[i];
+            if a == usize::MAX {
+                continue;
+            }
+            match col_pos[c] {
+                (true, k) => phi_u[(a, k)] += v,
+                (false, k) => phi_v[(a, k)] += v,
+            }
+        }
+        Some(Factors::Dense {
+            lu: phi_u.lu(),
+            phi_v,
+        })
+    }
+}

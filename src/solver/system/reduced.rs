@@ -1,0 +1,216 @@
+//! The reduced problem at a feasible configuration: energy, multipliers `Φ_uᵀ μ = V_uᵀ`,
+//! reduced gradient `∂V/∂v = V_v − Φ_vᵀ μ` (eq. 37), the tangent map `Z = [H; I] S` with
+//! `H = −Φ_u⁻¹ Φ_v`, and the reduced Hessian `Zᵀ W Z`, `W = V_qq − Σ_k μ_k Φ_k,qq`.
+
+use super::{Backend, Factors, System};
+use crate::forces::{potential, Energy};
+use crate::jet::HessianSink;
+use crate::solver::partition::Partition;
+use nalgebra::{DMatrix, DVector};
+
+/// Quantities at a feasible configuration under a partition.
+#[derive(Clone)]
+pub(crate) struct Eval {
+    pub(crate) energy: Energy,
+    /// `V − μᵀ Φ` over the independent rows: the energy corrected to first order for the
+    /// corrector's residual [J].
+    pub(crate) merit: f64,
+    /// Multipliers of the independent rows (in `Partition::rows` order).
+    pub(crate) mu: DVector<f64>,
+    /// Reduced gradient in scaled coordinates.
+    pub(crate) grad_v: DVector<f64>,
+    pub(crate) factors: Factors,
+}
+
+impl System<'_> {
+    /// Energy, multipliers and reduced gradient at a feasible `q`; `None` where the energy is
+    /// undefined or `Φ_u` is singular.
+    pub(crate) fn evaluate(&mut self, q: &DVector<f64>, part: &Partition) -> Option<Eval> {
+        self.triplets(q);
+        let mut grad_q = DVector::zeros(q.len());
+        let energy = potential(
+            self.problem.model,
+            &self.problem.cons.branches,
+            q,
+            &mut grad_q,
+            None,
+        )?;
+        let dof = part.independent.len();
+        let factors = self.factors(part)?;
+        let v_u = DVector::from_iterator(
+            part.dependent.len(),
+            part.dependent.iter().map(|&c| grad_q[c]),
+        );
+        let mu = factors.solve_transpose(v_u)?;
+        let v_v = DVector::from_iterator(dof, part.independent.iter().map(|&c| grad_q[c]));
+        let mut grad_v = v_v - factors.phi_v_tr_mul(&mu, dof);
+        for (b, &c) in part.independent.iter().enumerate() {
+            grad_v[b] *= self.problem.scaling.columns[c];
+        }
+        let merit = energy.total
+            - part
+                .rows
+                .iter()
+                .zip(mu.iter())
+                .map(|(&row, m)| m * self.work.phi[row])
+                .sum::<f64>();
+        Some(Eval {
+            energy,
+            merit,
+            mu,
+            grad_v,
+            factors,
+        })
+    }
+
+    /// `Z δv̂` for a step `δv̂` in scaled independent coordinates: the first-order change of all
+    /// coordinates.
+    pub(crate) fn tangent_step(
+        &self,
+        part: &Partition,
+        eval: &Eval,
+        dv: &DVector<f64>,
+    ) -> DVector<f64> {
+        let n = self.problem.model.coordinate_count();
+        let mut dq = DVector::zeros(n);
+        let mut dvu = dv.clone();
+        for (b, &c) in part.independent.iter().enumerate() {
+            dvu[b] *= self.problem.scaling.columns[c];
+            dq[c] = dvu[b];
+        }
+        if !part.rows.is_empty() {
+            let rhs = -eval.factors.phi_v_mul(&dvu, part.rows.len());
+            if let Some(du) = eval.factors.solve(&rhs) {
+                for (k, &c) in part.dependent.iter().enumerate() {
+                    dq[c] = du[k];
+                }
+            }
+        }
+        dq
+    }
+
+    /// `Zᵀ y` for a covector `y` over all coordinates, in scaled independent coordinates:
+    /// `S (y_v − Φ_vᵀ Φ_u⁻ᵀ y_u)`.
+    pub(crate) fn tangent_transpose(
+        &self,
+        part: &Partition,
+        eval: &Eval,
+        y: &DVector<f64>,
+    ) -> DVector<f64> {
+        let dof = part.independent.len();
+        let y_u =
+            DVector::from_iterator(part.dependent.len(), part.dependent.iter().map(|&c| y[c]));
+        let w = eval
+            .factors
+            .solve_transpose(y_u)
+            .unwrap_or_else(|| DVector::zeros(part.rows.len()));
+        let mut out = DVector::from_iterator(dof, part.independent.iter().map(|&c| y[c]))
+            - eval.factors.phi_v_tr_mul(&w, dof);
+        for (b, &c) in part.independent.iter().enumerate() {
+            out[b] *= self.problem.scaling.columns[c];
+        }
+        out
+    }
+
+    /// The null-space basis `Z = [H; I] S` (n × dof) at `eval`.
+    pub(crate) fn null_basis(&self, part: &Partition, eval: &Eval) -> DMatrix<f64> {
+        let n = self.problem.model.coordinate_count();
+        let dof = part.independent.len();
+        let mut z = DMatrix::zeros(n, dof);
+        for b in 0..dof {
+            let mut e = DVector::zeros(dof);
+            e[b] = 1.0;
+            z.set_column(b, &self.tangent_step(part, eval, &e));
+        }
+        z
+    }
+
+    /// The multiplier weights `−μ` over all rows.
+    pub(super) fn weights(&self, part: &Partition, eval: &Eval) -> DVector<f64> {
+        let mut weights = DVector::zeros(self.problem.cons.len());
+        for (k, &row) in part.rows.iter().enumerate() {
+            weights[row] = -eval.mu[k];
+        }
+        weights
+    }
+
+    /// The Hessian of the Lagrangian `W = V_qq − Σ μ_k Φ_k,qq` at `q`.
+    pub(crate) fn lagrangian_hessian(
+        &self,
+        q: &DVector<f64>,
+        part: &Partition,
+        eval: &Eval,
+    ) -> DMatrix<f64> {
+        let n = q.len();
+        let mut w = DMatrix::zeros(n, n);
+        let mut g = DVector::zeros(n);
+        let _ = potential(
+            self.problem.model,
+            &self.problem.cons.branches,
+            q,
+            &mut g,
+            Some(&mut w as &mut dyn HessianSink),
+        );
+        self.problem
+            .cons
+            .add_hessian(self.problem.model, q, &self.weights(part, eval), &mut w);
+        w
+    }
+
+    /// `W` into the block-sparse scratch.
+    pub(super) fn lagrangian_blocks(&mut self, q: &DVector<f64>, part: &Partition, eval: &Eval) {
+        let mut hess = std::mem::take(&mut self.work.hess);
+        hess.clear();
+        let mut g = DVector::zeros(q.len());
+        let _ = potential(
+            self.problem.model,
+            &self.problem.cons.branches,
+            q,
+            &mut g,
+            Some(&mut hess as &mut dyn HessianSink),
+        );
+        self.problem
+            .cons
+            .add_hessian(self.problem.model, q, &self.weights(part, eval), &mut hess);
+        self.work.hess = hess;
+    }
+
+    /// The reduced Hessian `Zᵀ W Z` in scaled coordinates (dense: `O(n² dof)`; sparse: one
+    /// column at a time through the factors, `O(dof · nnz)`).
+    pub(crate) fn reduced_hessian(
+        &mut self,
+        q: &DVector<f64>,
+        part: &Partition,
+        eval: &Eval,
+    ) -> DMatrix<f64> {
+        let hr = if self.backend == Backend::Sparse {
+            self.lagrangian_blocks(q, part, eval);
+            let dof = part.independent.len();
+            let mut hr = DMatrix::zeros(dof, dof);
+            for b in 0..dof {
+                let mut e = DVector::zeros(dof);
+                e[b] = 1.0;
+                hr.set_column(b, &self.reduced_apply(part, eval, &e));
+            }
+            hr
+        } else {
+            let z = self.null_basis(part, eval);
+            let w = self.lagrangian_hessian(q, part, eval);
+            z.transpose() * w * &z
+        };
+        (&hr + hr.transpose()) * 0.5
+    }
+
+    /// `Zᵀ W Z x` with the `W` of the last block assembly (sparse path).
+    pub(crate) fn reduced_apply(
+        &self,
+        part: &Partition,
+        eval: &Eval,
+        x: &DVector<f64>,
+    ) -> DVector<f64> {
+        let zx = self.tangent_step(part, eval, x);
+        let mut wzx = DVector::zeros(zx.len());
+        self.work.hess.mul_add(zx.as_slice(), wzx.as_mut_slice());
+        self.tangent_transpose(part, eval, &wzx)
+    }
+}

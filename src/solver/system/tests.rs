@@ -1,0 +1,239 @@
+//! The assembled global derivatives against central differences, on real robots at
+//! random (non-assembled, non-unit) configurations.
+use super::*;
+use crate::forces::potential;
+use crate::jet::HessianSink;
+use crate::urdf::{load_str, ImportOptions};
+use nalgebra::DMatrix;
+
+/// Analytic value against a central difference, relative to `1 + |value|`.
+fn assert_fd(analytic: f64, fd: f64, tol: f64, what: impl Fn() -> String) {
+    assert!(
+        (fd - analytic).abs() < tol * (1.0 + analytic.abs().min(fd.abs())),
+        "{}",
+        what()
+    );
+}
+
+fn models() -> Vec<Model> {
+    [
+        include_str!("../../../robots/pendulum.urdf"),
+        include_str!("../../../robots/slider_crank.urdf"),
+        include_str!("../../../robots/four_bar_spatial.urdf"),
+    ]
+    .iter()
+    .map(|t| {
+        load_str(t, "robot.urdf", &ImportOptions::default())
+            .unwrap()
+            .model
+    })
+    .collect()
+}
+
+fn random_q(n: usize, seed: u64) -> DVector<f64> {
+    let mut s = seed;
+    DVector::from_fn(n, |i, _| {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        let r = ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0;
+        if i % 7 == 3 {
+            1.0 + 0.2 * r
+        } else {
+            0.3 * r
+        }
+    })
+}
+
+#[test]
+fn potential_gradient_and_hessian_match_finite_differences() {
+    for model in models() {
+        let n = model.coordinate_count();
+        let q = random_q(n, 7);
+        let mut g = DVector::zeros(n);
+        let mut h = DMatrix::zeros(n, n);
+        potential(
+            &model,
+            &Default::default(),
+            &q,
+            &mut g,
+            Some(&mut h as &mut dyn HessianSink),
+        )
+        .unwrap();
+        let step = 1e-6;
+        for i in 0..n {
+            let mut qp = q.clone();
+            let mut qm = q.clone();
+            qp[i] += step;
+            qm[i] -= step;
+            let (mut gp, mut gm) = (DVector::zeros(n), DVector::zeros(n));
+            let vp = potential(&model, &Default::default(), &qp, &mut gp, None)
+                .unwrap()
+                .total;
+            let vm = potential(&model, &Default::default(), &qm, &mut gm, None)
+                .unwrap()
+                .total;
+            let fd = (vp - vm) / (2.0 * step);
+            assert_fd(g[i], fd, 1e-6, || {
+                format!("{}: V_q[{i}] {} vs {fd}", model.name, g[i])
+            });
+            for j in 0..n {
+                let fdh = (gp[j] - gm[j]) / (2.0 * step);
+                assert_fd(h[(j, i)], fdh, 1e-5, || {
+                    format!("{}: V_qq[{j},{i}] {} vs {fdh}", model.name, h[(j, i)])
+                });
+            }
+        }
+    }
+}
+
+#[test]
+fn constraint_jacobian_and_weighted_hessian_match_finite_differences() {
+    for model in models() {
+        let n = model.coordinate_count();
+        let sys_cons = Constraints::new(&model, &[(crate::model::JointId(0), 0, 0.3)]);
+        let mut sys = System::new(&model, sys_cons);
+        let m = sys.problem.cons.len();
+        let q = random_q(n, 11);
+        let j = sys.jacobian(&q);
+        let w = DVector::from_fn(m, |i, _| ((i * 37 % 11) as f64 - 5.0) * 0.1);
+        let mut h = DMatrix::zeros(n, n);
+        sys.problem.cons.add_hessian(&model, &q, &w, &mut h);
+        let step = 1e-6;
+        for i in 0..n {
+            let mut qp = q.clone();
+            let mut qm = q.clone();
+            qp[i] += step;
+            qm[i] -= step;
+            let jp = sys.jacobian(&qp);
+            let php = sys.work.phi.clone();
+            let jm = sys.jacobian(&qm);
+            let phm = sys.work.phi.clone();
+            for r in 0..m {
+                let fd = (php[r] - phm[r]) / (2.0 * step);
+                assert_fd(j[(r, i)], fd, 1e-6, || {
+                    format!(
+                        "{}: Φ_q[{},{i}] ({}) {} vs {fd}",
+                        model.name,
+                        r,
+                        sys.problem.cons.row_name(r),
+                        j[(r, i)]
+                    )
+                });
+            }
+            let gp = jp.transpose() * &w;
+            let gm = jm.transpose() * &w;
+            for k in 0..n {
+                let fd = (gp[k] - gm[k]) / (2.0 * step);
+                assert_fd(h[(k, i)], fd, 1e-5, || {
+                    format!("{}: (wᵀΦ)_qq[{k},{i}] {} vs {fd}", model.name, h[(k, i)])
+                });
+            }
+        }
+    }
+}
+
+/// The Newton step from the sparse KKT system equals `−Ĥ⁻¹ ∇f` with the reduced Hessian
+/// formed explicitly (dense path), and the sparse path's reduced gradient and reduced
+/// Hessian equal the dense path's under the same partition.
+#[test]
+fn kkt_step_is_the_reduced_newton_step() {
+    let mut all = models();
+    all.push(
+        load_str(
+            &crate::generate::ladder(3),
+            "l.urdf",
+            &ImportOptions::default(),
+        )
+        .unwrap()
+        .model,
+    );
+    for model in all {
+        let q0 = crate::solver::initial_state(&model).q;
+        let q = crate::solver::assemble_only(&model, q0, &mut Default::default(), &[]).unwrap();
+        let mut dense = System::with_backend(&model, Constraints::new(&model, &[]), Backend::Dense);
+        let part = dense.partition(&q);
+        let ed = dense.evaluate(&q, &part).unwrap();
+        let hd = dense.reduced_hessian(&q, &part, &ed);
+        let mut sparse =
+            System::with_backend(&model, Constraints::new(&model, &[]), Backend::Sparse);
+        let es = sparse.evaluate(&q, &part).unwrap();
+        let hs = sparse.reduced_hessian(&q, &part, &es);
+        let scale = hd.amax().max(1.0);
+        assert!((&hd - &hs).amax() < 1e-9 * scale, "{}", model.name);
+        assert!((&ed.grad_v - &es.grad_v).amax() < 1e-9 * (1.0 + ed.grad_v.amax()));
+        let g = &es.grad_v;
+        if g.amax() < 1e-12 {
+            continue;
+        }
+        assert!(
+            sparse.factor_kkt(&q, &part, &es, true, 0.0)
+                != crate::solver::sparse::kkt::Factored::None,
+            "{}",
+            model.name
+        );
+        let mut b = DVector::zeros(q.len());
+        for (k, &c) in part.independent.iter().enumerate() {
+            b[c] = -g[k];
+        }
+        let dq = sparse.kkt_solve(&b).unwrap();
+        let d = DVector::from_iterator(g.len(), part.independent.iter().map(|&c| dq[c]));
+        let expected = hd.clone().lu().solve(&(-g)).unwrap();
+        assert!(
+            (&d - &expected).amax() < 1e-8 * expected.amax(),
+            "{}: KKT step {d} vs reduced Newton step {expected}",
+            model.name
+        );
+        // δq is the tangent step of δv: Φ_q δq = 0 on the independent rows.
+        let full = sparse.tangent_step(&part, &es, &d);
+        let dq_unscaled = DVector::from_iterator(
+            q.len(),
+            (0..q.len()).map(|i| dq[i] * sparse.problem.scaling.columns[i]),
+        );
+        assert!(
+            (&full - &dq_unscaled).amax() < 1e-8 * (1.0 + full.amax()),
+            "{}",
+            model.name
+        );
+    }
+}
+
+/// The reduced gradient equals the derivative of f(v) = V(u(v), v) along each independent
+/// coordinate (finite differences through the corrector), and the reduced Hessian the
+/// derivative of the reduced gradient.
+#[test]
+fn reduced_gradient_and_hessian_match_differences_through_the_corrector() {
+    for model in models() {
+        let q0 = crate::solver::initial_state(&model).q;
+        let q = crate::solver::assemble_only(&model, q0, &mut Default::default(), &[]).unwrap();
+        let mut sys = System::new(&model, Constraints::new(&model, &[]));
+        let part = sys.partition(&q);
+        let e = sys.evaluate(&q, &part).unwrap();
+        let hr = sys.reduced_hessian(&q, &part, &e);
+        let step = 1e-5;
+        for (b, &c) in part.independent.iter().enumerate() {
+            let at = |sign: f64, sys: &mut System| {
+                let mut qq = q.clone();
+                qq[c] += sign * step * sys.problem.scaling.columns[c];
+                sys.correct(&mut qq, &part, 1e-13, 50).unwrap();
+                sys.evaluate(&qq, &part).unwrap()
+            };
+            let ep = at(1.0, &mut sys);
+            let em = at(-1.0, &mut sys);
+            let fd = (ep.energy.total - em.energy.total) / (2.0 * step);
+            assert_fd(e.grad_v[b], fd, 1e-6, || {
+                format!("{}: ∂f/∂v[{b}] {} vs {fd}", model.name, e.grad_v[b])
+            });
+            for a in 0..part.independent.len() {
+                let fdh = (ep.grad_v[a] - em.grad_v[a]) / (2.0 * step);
+                assert_fd(hr[(a, b)], fdh, 1e-5, || {
+                    format!(
+                        "{}: reduced Hessian [{a},{b}] {} vs {fdh}",
+                        model.name,
+                        hr[(a, b)]
+                    )
+                });
+            }
+        }
+    }
+}

@@ -7,7 +7,8 @@
 //!   →  state  →  urdf | generate  →  solver  →  verify  →  export | view  →  (cli)
 //! ```
 //!
-//! A reference is any `crate::module` path in code (comments and doc links are skipped).
+//! A reference is any `crate::module` path in code (comments and doc links are skipped). A
+//! second test holds every file of `src/` to at most 600 lines.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -123,5 +124,34 @@ fn modules_use_only_lower_layers() {
         violations.is_empty(),
         "upward or sideways imports:\n{}",
         violations.join("\n")
+    );
+}
+
+/// Longest file allowed under `src/` [lines]: one concept per file (STYLE.md, issue 11).
+const MAX_FILE_LINES: usize = 600;
+
+#[test]
+fn no_source_file_is_longer_than_the_limit() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    files.sort();
+    assert!(
+        files.len() > 10,
+        "found only {} files under src/",
+        files.len()
+    );
+    let long: Vec<String> = files
+        .iter()
+        .filter_map(|file| {
+            let text = std::fs::read_to_string(file).expect("source is readable");
+            let lines = text.lines().count();
+            (lines > MAX_FILE_LINES).then(|| format!("{}: {lines} lines", file.display()))
+        })
+        .collect();
+    assert!(
+        long.is_empty(),
+        "files over {MAX_FILE_LINES} lines (split them by concept):\n{}",
+        long.join("\n")
     );
 }

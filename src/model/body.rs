@@ -3,8 +3,22 @@
 use nalgebra::{Isometry3, Matrix3, Vector3};
 
 /// Index of a moving body in [`crate::Model::bodies`].
+///
+/// Ids come from the model (or [`crate::model::ModelBuilder::add_body`]); they cannot be
+/// written by hand, so an id always names a body of the model it came from.
+///
+/// ```compile_fail
+/// let forged = restpose::model::BodyId(7);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct BodyId(pub usize);
+pub struct BodyId(pub(crate) usize);
+
+impl BodyId {
+    /// Position of the body in [`crate::Model::bodies`].
+    pub fn index(self) -> usize {
+        self.0
+    }
+}
 
 /// A moving rigid body: one URDF link, or several welded by fixed joints.
 #[derive(Clone, Debug)]

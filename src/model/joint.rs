@@ -10,8 +10,22 @@ use super::BodyId;
 use nalgebra::Isometry3;
 
 /// Index of a joint in [`crate::Model::joints`].
+///
+/// Ids come from the model (or [`crate::model::ModelBuilder`]); they cannot be written by
+/// hand, so an id always names a joint of the model it came from.
+///
+/// ```compile_fail
+/// let forged = restpose::model::JointId(7);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct JointId(pub usize);
+pub struct JointId(pub(crate) usize);
+
+impl JointId {
+    /// Position of the joint in [`crate::Model::joints`].
+    pub fn index(self) -> usize {
+        self.0
+    }
+}
 
 /// Joint type.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -62,6 +62,16 @@ impl Model {
         7 * self.bodies.len()
     }
 
+    /// The ids of the bodies, in model order.
+    pub fn body_ids(&self) -> impl Iterator<Item = BodyId> {
+        (0..self.bodies.len()).map(BodyId)
+    }
+
+    /// The ids of the joints, in model order.
+    pub fn joint_ids(&self) -> impl Iterator<Item = JointId> {
+        (0..self.joints.len()).map(JointId)
+    }
+
     /// Looks a joint up by name (through the name map when it is current, else by a scan).
     pub fn joint_id(&self, name: &str) -> Option<JointId> {
         match self.joint_names.get(name) {

@@ -4,7 +4,6 @@
 //! expectation is a hand computation written in the test.
 
 use approx::assert_abs_diff_eq;
-use restpose::model::BodyId;
 use restpose::{urdf, Options};
 use std::f64::consts::{PI, TAU};
 use std::process::Command;
@@ -149,8 +148,8 @@ fn verify_evaluates_springs_at_the_given_angle() {
         s
     };
     let (a, b) = (at(3.5), at(3.5 - TAU));
-    for i in 0..m.bodies.len() {
-        let (pa, pb) = (a.body_pose(BodyId(i)), b.body_pose(BodyId(i)));
+    for id in m.body_ids() {
+        let (pa, pb) = (a.body_pose(id), b.body_pose(id));
         assert!(
             pa.rotation.angle_to(&pb.rotation) < 1e-9,
             "same configuration"

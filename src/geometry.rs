@@ -63,10 +63,14 @@ pub struct Geometry {
     pub shape: ShapeKind,
 }
 
+/// The end of the message for a `package://` mesh that is not found: a front end that takes
+/// package directories in another form (a command-line option) may replace it.
+pub const UNKNOWN_PACKAGE_HINT: &str = "give the package's directory in the import options";
+
 /// Where to look for `package://` and `model://` folders.
 #[derive(Clone, Debug, Default)]
 pub struct PackagePaths {
-    /// `--package NAME=DIR` options.
+    /// Package directories given by the user: `(NAME, DIR)`.
     pub explicit: Vec<(String, PathBuf)>,
     /// The URDF's folder (`None` for text without a file).
     pub urdf_dir: Option<PathBuf>,
@@ -130,7 +134,7 @@ impl PackagePaths {
         }
         tried.truncate(4);
         Err(format!(
-            "package `{pkg}` has no `{rel}` (looked in {}, …; use --package {pkg}=DIR)",
+            "package `{pkg}` has no `{rel}` (looked in {}, …; {UNKNOWN_PACKAGE_HINT})",
             tried.join(", ")
         ))
     }

@@ -20,7 +20,7 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
     let import = import_started.elapsed().as_secs_f64();
     if !a.quiet {
         for w in &loaded.warnings {
-            eprintln!("warning: {w}");
+            print::warning(w);
         }
         if a.verbose {
             for i in &loaded.ignored {

@@ -24,7 +24,7 @@ pub(crate) fn run(a: &CheckArgs) -> anyhow::Result<u8> {
     // The JSON carries the warnings; the text form gives them on standard error.
     if let Format::Text = a.format {
         for w in &s.warnings {
-            eprintln!("warning: {w}");
+            print::warning(w);
         }
         if a.verbose {
             for i in &s.ignored {

@@ -30,6 +30,21 @@ pub(crate) fn write_json(path: &std::path::Path, text: &str) -> anyhow::Result<(
     Ok(())
 }
 
+/// Prints an import warning on standard error, with the library's hint for a missing
+/// `package://` folder given as the `--package` option that supplies it.
+pub(crate) fn warning(w: &str) {
+    let hint = restpose::geometry::UNKNOWN_PACKAGE_HINT;
+    let package = w
+        .split("package `")
+        .nth(1)
+        .and_then(|rest| rest.split('`').next())
+        .unwrap_or("NAME");
+    eprintln!(
+        "warning: {}",
+        w.replace(hint, &format!("use --package {package}=DIR"))
+    );
+}
+
 /// The summary of a solve (`analyze`).
 pub(crate) fn analysis(r: &AnalysisResult) {
     out!("robot `{}`", r.robot);

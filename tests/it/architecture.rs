@@ -155,3 +155,41 @@ fn no_source_file_is_longer_than_the_limit() {
         long.join("\n")
     );
 }
+
+/// Library messages speak in library terms: no string literal outside `src/cli/` (and
+/// `main.rs`) names a command-line option (`--name`); the CLI adds such hints itself.
+#[test]
+fn library_strings_name_no_command_line_option() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    files.sort();
+    let mut found = Vec::new();
+    for file in &files {
+        let rel = file.strip_prefix(&src).expect("under src/");
+        if rel.starts_with("cli") || rel == Path::new("main.rs") {
+            continue;
+        }
+        let text = std::fs::read_to_string(file).expect("source is readable");
+        for (n, line) in text.lines().enumerate() {
+            let code = line.trim_start();
+            if code.starts_with("//") {
+                continue;
+            }
+            // Text inside string literals: every other piece between quotes.
+            let strings = code.split('"').skip(1).step_by(2);
+            let flag = strings.into_iter().any(|s| {
+                s.match_indices("--")
+                    .any(|(i, _)| s[i + 2..].starts_with(|c: char| c.is_ascii_lowercase()))
+            });
+            if flag {
+                found.push(format!("{}:{}: {}", file.display(), n + 1, code));
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "library strings that name a CLI option:\n{}",
+        found.join("\n")
+    );
+}

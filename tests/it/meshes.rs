@@ -163,6 +163,38 @@ fn missing_mesh_is_a_warning() {
     );
 }
 
+/// The library's warning for a missing package says what to do in library terms (no CLI
+/// option); the CLI says it with its `--package` option, naming the package.
+#[test]
+fn missing_package_hint_is_the_library_s_and_the_cli_names_its_option() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("arm.urdf");
+    std::fs::write(&file, arm("package://nowhere/cube.stl")).unwrap();
+    let l = load_file(&file, &ImportOptions::default()).unwrap();
+    let w = l
+        .warnings
+        .iter()
+        .find(|w| w.contains("mesh not found"))
+        .expect("a missing-mesh warning");
+    assert!(w.contains(restpose::geometry::UNKNOWN_PACKAGE_HINT), "{w}");
+    assert!(!w.contains("--"), "library warning names a CLI option: {w}");
+    for sub in ["check", "analyze"] {
+        let o = Command::new(env!("CARGO_BIN_EXE_restpose"))
+            .args([sub, file.to_str().unwrap()])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            err.contains("mesh not found") && err.contains("use --package nowhere=DIR"),
+            "{sub}: {err}"
+        );
+        assert!(
+            !err.contains(restpose::geometry::UNKNOWN_PACKAGE_HINT),
+            "{sub}: {err}"
+        );
+    }
+}
+
 #[test]
 fn check_prints_the_model_and_json() {
     let urdf = format!("{}/robots/slider_crank.urdf", env!("CARGO_MANIFEST_DIR"));

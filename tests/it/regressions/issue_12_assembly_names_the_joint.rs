@@ -7,7 +7,7 @@ use restpose::urdf::{load_file, ImportOptions};
 use std::process::Command;
 
 /// A planar four-bar whose ground link (2 m) is longer than crank, coupler and rocker together
-/// (0.1 + 0.3 + 0.15 m): the loop joint on line 23 cannot close.
+/// (0.1 + 0.3 + 0.15 m): the loop joint on line 19 cannot close.
 const SHORT_FOUR_BAR: &str = r#"<?xml version="1.0"?>
 <robot name="short_four_bar" xmlns:mech="urn:urdf-mech:1">
   <link name="world"/>

@@ -1,6 +1,49 @@
 //! The one error type of the library.
 
+use std::fmt;
 use thiserror::Error;
+
+/// Where an element starts in an input file.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SourceLocation {
+    /// The file (or `<string>`).
+    pub file: String,
+    /// Line, from 1.
+    pub line: u32,
+    /// Column, from 1.
+    pub col: u32,
+    /// The element's tag as written (`joint`, `mech:loop_joint`, `drake:joint`).
+    pub element: String,
+}
+
+impl fmt::Display for SourceLocation {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}:{}:{}", self.file, self.line, self.col)
+    }
+}
+
+/// The joint an error is about, with where it is declared when the model came from a file.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct JointSite {
+    /// Joint name.
+    pub joint: String,
+    /// The joint's element in the input file (`None` for a model built in code).
+    pub at: Option<SourceLocation>,
+}
+
+impl fmt::Display for JointSite {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.at {
+            Some(at) => write!(f, "{at}: joint `{}` ({})", self.joint, at.element),
+            None => write!(f, "joint `{}`", self.joint),
+        }
+    }
+}
+
+/// `"{site}: "`, or nothing without a site.
+fn prefix<T: fmt::Display>(site: &Option<T>) -> String {
+    site.as_ref().map(|s| format!("{s}: ")).unwrap_or_default()
+}
 
 /// Everything that can go wrong loading or solving a mechanism.
 ///
@@ -40,10 +83,13 @@ pub enum Error {
     },
     /// A coordinate index beyond the joint's coordinates.
     #[error(
-        "{what} `{joint}`: the joint is {kind} with {count} addressable coordinate(s), \
-         coordinate {dof} is out of range"
+        "{}{what} `{joint}`: the joint is {kind} with {count} addressable coordinate(s), \
+         coordinate {dof} is out of range",
+        prefix(at)
     )]
     CoordinateOutOfRange {
+        /// The joint's element in the input file, if it came from one.
+        at: Option<Box<SourceLocation>>,
         /// What addressed it.
         what: String,
         /// Joint name.
@@ -122,12 +168,15 @@ pub enum Error {
     },
     /// The loop joints could not be closed from the initial guess.
     #[error(
-        "cannot assemble the mechanism from the initial guess: constraint `{row}` is violated \
+        "{}cannot assemble the mechanism from the initial guess: constraint `{row}` is violated \
          by {residual:.3e} there and {iterations} damped Newton iterations could not close the \
          constraints (check the loop geometry or give `mech:initial` values near an assembled \
-         pose)"
+         pose)",
+        prefix(site)
     )]
     Assembly {
+        /// The joint of that row and where it is declared.
+        site: Option<Box<JointSite>>,
         /// Residual of that row at the initial guess \[m or 1\].
         residual: f64,
         /// Name of the most violated constraint row.
@@ -137,10 +186,13 @@ pub enum Error {
     },
     /// Redundant constraint rows that the assembled pose does not satisfy.
     #[error(
-        "inconsistent over-constrained model: redundant constraint `{row}` is violated by \
-         {residual:.3e} when the independent rows hold (loop joints: {loops})"
+        "{}inconsistent over-constrained model: redundant constraint `{row}` is violated by \
+         {residual:.3e} when the independent rows hold (loop joints: {loops})",
+        prefix(site)
     )]
     Inconsistent {
+        /// The joint of that row and where it is declared.
+        site: Option<Box<JointSite>>,
         /// Name of the violated redundant row.
         row: String,
         /// Its residual.

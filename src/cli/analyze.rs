@@ -5,8 +5,12 @@ use super::{exit, print};
 use restpose::export::json::AnalysisResult;
 use restpose::urdf::load_file;
 
-/// Runs `analyze`: exit 0 when converged, 3 when not.
+/// Runs `analyze`: exit 0 when converged, 3 when not, 2 for two outputs to standard output.
 pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
+    if let Err(e) = a.check_outputs() {
+        let _ = e.print();
+        return Ok(exit::USAGE);
+    }
     let mut opts = a.input.options()?;
     for l in &a.lock {
         let (n, d, v) = coord(l, "lock")?;
@@ -57,18 +61,18 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
                 model,
                 &state,
             )?;
-            restpose::export::write_atomic(path, out.as_bytes())?;
+            print::write_output(path, &out)?;
         }
         if let Some(path) = &a.write_joint_states {
             let out = restpose::export::joint_states::joint_states_yaml(model, &state);
-            restpose::export::write_atomic(path, out.as_bytes())?;
+            print::write_output(path, &out)?;
         }
     } else if a.write_urdf.is_some() || a.write_joint_states.is_some() {
         eprintln!(
             "note: --write-urdf / --write-joint-states are written only for a converged rest pose"
         );
     }
-    if !a.quiet && !print::is_stdout(a.json.as_ref()) {
+    if !a.quiet && a.stdout_outputs().is_empty() {
         print::analysis(&result);
     }
     if !result.converged {

@@ -159,10 +159,12 @@ pub(crate) struct AnalyzeArgs {
     /// Write a rerun recording (.rrd) of the rest pose and the search (feature `viewer`).
     #[arg(long, value_name = "OUT.rrd")]
     pub(crate) rrd: Option<PathBuf>,
-    /// Write the input file with the rest pose as `mech:initial` values (only when converged).
+    /// Write the input file with the rest pose as `mech:initial` values (only when converged;
+    /// `-`: standard output, which then carries only this file).
     #[arg(long, value_name = "OUT.urdf")]
     pub(crate) write_urdf: Option<PathBuf>,
-    /// Write the rest pose as ROS joint_states-style YAML (only when converged).
+    /// Write the rest pose as ROS joint_states-style YAML (only when converged; `-`: standard
+    /// output, which then carries only this file).
     #[arg(long, value_name = "OUT.yaml")]
     pub(crate) write_joint_states: Option<PathBuf>,
     /// Maximum minimizer iterations.
@@ -198,6 +200,37 @@ pub(crate) struct AnalyzeArgs {
 }
 
 impl AnalyzeArgs {
+    /// The outputs given as `-` (standard output), as their options.
+    pub(crate) fn stdout_outputs(&self) -> Vec<&'static str> {
+        [
+            ("--json", &self.json),
+            ("--write-urdf", &self.write_urdf),
+            ("--write-joint-states", &self.write_joint_states),
+        ]
+        .into_iter()
+        .filter(|(_, p)| super::print::is_stdout(p.as_ref()))
+        .map(|(o, _)| o)
+        .collect()
+    }
+
+    /// A usage error (exit code 2) when more than one output is standard output: their texts
+    /// would be interleaved in one stream.
+    pub(crate) fn check_outputs(&self) -> Result<(), clap::Error> {
+        let to_stdout = self.stdout_outputs();
+        if to_stdout.len() > 1 {
+            return Err(<Cli as clap::CommandFactory>::command().error(
+                clap::error::ErrorKind::ArgumentConflict,
+                format!(
+                    "{} {} write to standard output (`-`); only one output can go there: \
+                     give the others a file name",
+                    to_stdout.join(" and "),
+                    if to_stdout.len() == 2 { "both" } else { "all" }
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     /// The solver's options.
     pub(crate) fn solver_options(&self) -> Options {
         Options {

@@ -2,6 +2,8 @@
 
 /// Invalid input or another error (file, option, assembly).
 pub(crate) const INPUT: u8 = 1;
+/// Bad command-line usage (clap's code), e.g. two outputs to standard output.
+pub(crate) const USAGE: u8 = 2;
 /// The solve did not converge.
 pub(crate) const NOT_CONVERGED: u8 = 3;
 /// `verify`: the pose is not a rest pose.

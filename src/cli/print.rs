@@ -45,6 +45,21 @@ pub(crate) fn warning(w: &str) {
     );
 }
 
+/// Writes a whole output file to `path` atomically, or to standard output for `-` (as is: the
+/// text ends with its own newline; a closed pipe is not an error).
+pub(crate) fn write_output(path: &std::path::Path, text: &str) -> anyhow::Result<()> {
+    if path.as_os_str() == "-" {
+        use std::io::Write;
+        let mut stdout = std::io::stdout().lock();
+        let _ = stdout
+            .write_all(text.as_bytes())
+            .and_then(|_| stdout.flush());
+    } else {
+        restpose::export::write_atomic(path, text.as_bytes())?;
+    }
+    Ok(())
+}
+
 /// The summary of a solve (`analyze`).
 pub(crate) fn analysis(r: &AnalysisResult) {
     out!("robot `{}`", r.robot);

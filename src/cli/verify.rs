@@ -9,12 +9,19 @@ use restpose::urdf::load_file;
 
 /// Runs `verify`: exit 0 when the pose passes, 4 when it does not.
 pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
-    let loaded = load_file(&a.file, &a.input.options()?)?;
+    let options = a.input.options()?;
+    // The URDF and the pose file are read at the same time (both are large for large models).
+    let (loaded, values) = std::thread::scope(|s| {
+        let pose = s.spawn(|| a.pose.as_ref().map(restpose::verify::read_pose));
+        let loaded = load_file(&a.file, &options);
+        let values = pose
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (loaded, values)
+    });
+    let loaded = loaded?;
     let model = &loaded.model;
-    let mut values = match &a.pose {
-        Some(p) => restpose::verify::read_pose(p)?,
-        None => Default::default(),
-    };
+    let mut values = values.transpose()?.unwrap_or_default();
     for j in &a.joint {
         let (name, dof, value) = coord(j, "joint")?;
         let id = model

@@ -177,6 +177,7 @@ mod tests {
             tree: false,
             merged: false,
             limits: None,
+            source: None,
         }
     }
 

@@ -75,19 +75,21 @@ impl ModelSummary {
     /// Summarizes a loaded model and its check ([`crate::verify::check`]).
     pub fn new(loaded: &crate::urdf::Loaded, check: &crate::verify::ModelCheck) -> Self {
         let m = &loaded.model;
+        // Links by body in one pass (a scan of all links per body was O(N²)).
+        let mut links_of: Vec<Vec<String>> = vec![Vec::new(); m.bodies.len()];
+        for l in &m.links {
+            if let Some(list) = l.body.and_then(|b| links_of.get_mut(b.0)) {
+                list.push(l.name.clone());
+            }
+        }
         let bodies = m
             .bodies
             .iter()
-            .enumerate()
-            .map(|(i, b)| BodySummary {
+            .zip(links_of)
+            .map(|(b, links)| BodySummary {
                 name: b.name.clone(),
                 mass: b.mass,
-                links: m
-                    .links
-                    .iter()
-                    .filter(|l| l.body.map(|x| x.0) == Some(i))
-                    .map(|l| l.name.clone())
-                    .collect(),
+                links,
             })
             .collect();
         let joints = m

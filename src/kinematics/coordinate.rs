@@ -66,6 +66,7 @@ mod tests {
             tree: true,
             merged: false,
             limits: None,
+            source: None,
         }
     }
 

@@ -13,7 +13,7 @@ use super::{
     Body, BodyId, Effort, ForceLaw, Initial, Joint, JointId, JointKind, JointSpring, Link, Load,
     Lock, Mimic, Model, Spring,
 };
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, SourceLocation};
 use crate::geometry::Geometry;
 use nalgebra::{Isometry3, Matrix3, Point3, Vector3};
 use std::collections::HashMap;
@@ -197,6 +197,7 @@ impl ModelBuilder {
             tree: true,
             merged: false,
             limits: None,
+            source: None,
         };
         self.push_joint(joint)
     }
@@ -279,6 +280,13 @@ impl ModelBuilder {
     /// initial pose during import).
     pub fn partial(&self) -> &Model {
         &self.model
+    }
+
+    /// Records where joint `joint` is declared in the input file (named in later errors).
+    pub fn set_joint_source(&mut self, joint: JointId, source: SourceLocation) {
+        if let Some(j) = self.model.joints.get_mut(joint.0) {
+            j.source = Some(source);
+        }
     }
 
     /// Replaces the child-side joint frame of `joint` (a loop joint closed at the initial

@@ -7,6 +7,7 @@
 //! `Rz(θ₁) Rx(θ₂)` (universal), `T(x, y, 0) Rz(θ)` (planar), `Rz(θ) Tz(h θ)` (screw).
 
 use super::BodyId;
+use crate::error::SourceLocation;
 use nalgebra::Isometry3;
 
 /// Index of a joint in [`crate::Model::joints`].
@@ -103,4 +104,6 @@ pub struct Joint {
     pub merged: bool,
     /// Position limits `[lower, upper]` of the first coordinate, if any.
     pub limits: Option<[f64; 2]>,
+    /// The joint's element in the input file (`None` for a joint built in code).
+    pub source: Option<SourceLocation>,
 }

@@ -10,6 +10,7 @@ mod builder;
 mod check;
 mod force;
 mod joint;
+mod site;
 
 pub use body::{Body, BodyId, Link};
 pub use builder::{Inertial, ModelBuilder};

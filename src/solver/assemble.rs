@@ -131,16 +131,22 @@ pub(crate) fn project(
             Ok(qa)
         }
         Err(Failure::Inconsistent(row)) => {
-            let phi = sys.phi();
+            let residual = sys.phi()[row].abs();
             let loops: Vec<String> = model
                 .joints
                 .iter()
                 .filter(|j| !j.tree)
                 .map(|j| format!("`{}`", j.name))
                 .collect();
+            // The redundant row is the partition's choice; the joint that does not close is
+            // the one violated at the start.
+            let start = worst_joint_row(&mut sys, &q0);
             Err(Error::Inconsistent {
+                site: model
+                    .row_site(sys.problem.cons.row_name(start))
+                    .map(Box::new),
                 row: sys.problem.cons.row_name(row).to_string(),
-                residual: phi[row].abs(),
+                residual,
                 loops: if loops.is_empty() {
                     "none".into()
                 } else {
@@ -149,22 +155,28 @@ pub(crate) fn project(
             })
         }
         Err(Failure::Stuck(iterations)) => {
-            // Name the worst joint row at the initial guess rather than a normalization row,
-            // which only reflects how the Newton steps distorted the Euler parameters.
-            let phi = sys.residual(&q0).clone();
-            let worst = (0..phi.len())
-                .filter(|&r| !sys.problem.cons.row_name(r).ends_with(".normalization"))
-                .max_by(|&a, &b| {
-                    (phi[a] * sys.problem.scaling.rows[a])
-                        .abs()
-                        .total_cmp(&(phi[b] * sys.problem.scaling.rows[b]).abs())
-                })
-                .unwrap_or_else(|| phi.iamax());
+            let worst = worst_joint_row(&mut sys, &q0);
+            let row = sys.problem.cons.row_name(worst).to_string();
             Err(Error::Assembly {
-                residual: phi[worst].abs(),
-                row: sys.problem.cons.row_name(worst).to_string(),
+                site: model.row_site(&row).map(Box::new),
+                residual: sys.phi()[worst].abs(),
+                row,
                 iterations,
             })
         }
     }
+}
+
+/// The most violated row at `q0` (scaled), a joint row rather than a normalization row, which
+/// only reflects how Newton steps distorted the Euler parameters; leaves `Φ(q0)` in `sys`.
+fn worst_joint_row(sys: &mut System, q0: &DVector<f64>) -> usize {
+    let phi = sys.residual(q0).clone();
+    (0..phi.len())
+        .filter(|&r| !sys.problem.cons.row_name(r).ends_with(".normalization"))
+        .max_by(|&a, &b| {
+            (phi[a] * sys.problem.scaling.rows[a])
+                .abs()
+                .total_cmp(&(phi[b] * sys.problem.scaling.rows[b]).abs())
+        })
+        .unwrap_or_else(|| phi.iamax())
 }

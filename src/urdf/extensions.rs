@@ -373,6 +373,7 @@ pub(super) fn read(
         let n = b.model.partial().joints[id.0].kind.scalar_coordinates();
         if dof >= n {
             return Err(crate::error::Error::CoordinateOutOfRange {
+                at: b.model.partial().joints[id.0].source.clone().map(Box::new),
                 what: what.into(),
                 joint: name.into(),
                 kind: b.model.partial().joints[id.0].kind.name().into(),

@@ -325,6 +325,7 @@ pub(super) fn import(
             tree: tree_edge,
             merged,
             limits: e.limits,
+            source: Some(src.location(e.node)),
         });
         if e.auto_child_origin {
             auto_child.push(id);

@@ -31,6 +31,22 @@ impl<'a> Source<'a> {
         }
     }
 
+    /// Where element `node` starts, with its tag as written (`mech:loop_joint`).
+    pub(crate) fn location(&self, node: Node) -> crate::error::SourceLocation {
+        let (line, col) = self.pos(node);
+        let tag = node.tag_name();
+        let element = match tag.namespace().and_then(|uri| node.lookup_prefix(uri)) {
+            Some(prefix) if !prefix.is_empty() => format!("{prefix}:{}", tag.name()),
+            _ => tag.name().to_string(),
+        };
+        crate::error::SourceLocation {
+            file: self.file.to_string(),
+            line,
+            col,
+            element,
+        }
+    }
+
     /// Line and column (from 1, column in characters) of `node`.
     pub(crate) fn pos(&self, node: Node) -> (u32, u32) {
         let at = node.range().start;

@@ -326,7 +326,29 @@ fn tree_coordinates(
 }
 
 /// [`verify`] on the dense (`sparse = false`) or the sparse path.
+///
+/// On the sparse path the stability verdict (a Lanczos run through KKT factors, the largest
+/// cost at 10,000 links) is computed on a second thread while the balance is checked, and kept
+/// only when the pose passes; both only read the model and the state.
 fn verify_on(model: &Model, state: &State, tol: &Tolerances, sparse: bool) -> Result<Verification> {
+    if !sparse {
+        return verify_with(model, state, tol, false, None);
+    }
+    std::thread::scope(|s| {
+        let stability = s.spawn(|| crate::solver::stability_at(model, state));
+        verify_with(model, state, tol, true, Some(stability))
+    })
+}
+
+/// The checks of [`verify_on`]; the stability comes from `stability` when given (joined only
+/// when the pose passes), else it is computed here.
+fn verify_with(
+    model: &Model,
+    state: &State,
+    tol: &Tolerances,
+    sparse: bool,
+    stability: Option<std::thread::ScopedJoinHandle<'_, Option<Stability>>>,
+) -> Result<Verification> {
     let coords = tree_coordinates(model, state);
     let (phi, energy, projected_gradient, force_scale, closure, efforts, unassigned) = if sparse {
         let locks = crate::solver::lock_values(model);
@@ -402,10 +424,13 @@ fn verify_on(model: &Model, state: &State, tol: &Tolerances, sparse: bool) -> Re
     let passed = constraint_residual <= tol.constraint
         && imbalance.iter().all(|i| i.effort.abs() <= effort_tolerance)
         && unassigned <= effort_tolerance;
-    let stability = if passed {
-        crate::solver::stability_at(model, state)
-    } else {
-        None
+    let stability = match (passed, stability) {
+        (false, _) => None,
+        // A panic there is re-raised here, as if the verdict had been computed on this thread.
+        (true, Some(handle)) => handle
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
+        (true, None) => crate::solver::stability_at(model, state),
     };
     Ok(Verification {
         passed,

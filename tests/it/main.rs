@@ -19,6 +19,7 @@ mod real_robots;
 mod regressions;
 mod robots;
 mod sparse;
+mod stdout_outputs;
 mod verify;
 #[cfg(feature = "viewer")]
 mod viewer;

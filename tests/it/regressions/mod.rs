@@ -1,3 +1,4 @@
 //! One file per fixed bug: `issue_<n>_<what>.rs`, opening with a paragraph on the bug.
 
+mod issue_12_assembly_names_the_joint;
 mod issue_12_sparse_verify_angle_branch;

@@ -26,7 +26,7 @@ mod spectrum;
 pub(crate) mod system;
 mod unbounded;
 
-pub use options::{LinearAlgebra, Method, Options};
+pub use options::{Limits, LinearAlgebra, Method, Options};
 pub use report::{
     Diagnostics, Iterate, Reaction, Report, Sizes, Stability, Termination, Timings, Verdict,
 };

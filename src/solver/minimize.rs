@@ -23,6 +23,7 @@ use super::partition::Partition;
 use super::report::{Diagnostics, Iterate, Termination};
 use super::sparse::kkt::Factored;
 use super::spectrum::{spectrum, Spectrum};
+use super::active_set::Guard;
 use super::system::{Eval, System};
 use nalgebra::{DMatrix, DVector};
 
@@ -39,6 +40,9 @@ pub(crate) struct Outcome {
     pub(crate) termination: Termination,
     pub(crate) history: Vec<Iterate>,
     pub(crate) diagnostics: Diagnostics,
+    /// The inactive inequalities (indices into the guard's list) that stopped the last step: `q`
+    /// is on its boundary.
+    pub(crate) blocked: Option<Vec<usize>>,
 }
 
 /// Relative rounding floor of the reduced gradient: the convergence test uses
@@ -178,11 +182,15 @@ fn kkt_direction(
     -g.clone()
 }
 
+/// Minimizes from `q`; with a `guard`, a step that would violate one of its inequalities is
+/// cut where the first one reaches its boundary, and the minimization stops there
+/// (`Outcome::blocked`).
 pub(crate) fn minimize(
     sys: &mut System,
     mut q: DVector<f64>,
     mut part: Partition,
     options: &Options,
+    guard: Option<&Guard>,
 ) -> Option<Outcome> {
     let mut diag = Diagnostics {
         load_steps: 1,
@@ -199,6 +207,7 @@ pub(crate) fn minimize(
     let mut descent = super::unbounded::LinearDescent::default();
     let mut eigen = None;
     let mut iterates = Vec::new();
+    let mut blocked = None;
     loop {
         let f = eval.merit;
         let gnorm = eval.grad_v.amax();
@@ -313,6 +322,23 @@ pub(crate) fn minimize(
                 alpha *= 0.5;
                 continue;
             }
+            if let Some(guard) = guard.filter(|g| g.violated(sys, &qt)) {
+                // Cut the step where the first inequality reaches its boundary.
+                if let Some((qb, k)) = guard.boundary(sys, &q, &dq, alpha, &part, options, &eval)
+                {
+                    if let Some(eb) = sys.evaluate(&qb, &part) {
+                        diag.function_evaluations += 1;
+                        if eb.merit <= f + roundoff_of(&eval, &eb) {
+                            accepted = Some((qb, eb, 0.0));
+                            blocked = Some(k);
+                            break;
+                        }
+                    }
+                }
+                diag.step_halvings += 1;
+                alpha *= 0.5;
+                continue;
+            }
             let Some(et) = sys.evaluate(&qt, &part) else {
                 diag.step_halvings += 1;
                 alpha *= 0.5;
@@ -340,6 +366,21 @@ pub(crate) fn minimize(
             diag.step_halvings += 1;
         }
         match accepted {
+            Some((qt, et, _)) if blocked.is_some() => {
+                q = qt;
+                sys.cons.branches.follow(sys.model, &q);
+                eval = et;
+                iteration += 1;
+                history.push(Iterate {
+                    iteration,
+                    potential_energy: eval.energy.total,
+                    gradient_norm: eval.grad_v.amax(),
+                });
+                if options.record_iterates {
+                    iterates.push(q.clone());
+                }
+                break;
+            }
             Some((qt, et, alpha)) => {
                 let s = &d * alpha;
                 let y = &et.grad_v - &eval.grad_v;
@@ -358,8 +399,9 @@ pub(crate) fn minimize(
                 eval = et;
                 iteration += 1;
                 just_repartitioned = false;
-                if linear
-                    || linear_steps >= 5
+                // With inequalities left to meet, a linear descent may end on one of them.
+                let may_be_stopped = guard.is_some_and(|g| !g.is_empty());
+                if (!may_be_stopped && (linear || linear_steps >= 5))
                     || eval.energy.total < -1e15
                     || (0..q.len()).any(|i| i % 7 < 3 && q[i].abs() > 1e6 * sys.model.length_scale)
                 {
@@ -402,5 +444,12 @@ pub(crate) fn minimize(
         termination,
         history,
         diagnostics: diag,
+        blocked,
     })
+}
+
+/// Rounding error of the merit function between two evaluations: relative to the size of the
+/// energy's terms, not of their sum.
+fn roundoff_of(a: &Eval, b: &Eval) -> f64 {
+    1e-12 * a.energy.magnitude.max(b.energy.magnitude) + f64::MIN_POSITIVE
 }

@@ -8,8 +8,10 @@
 //! An active inequality joins `Φ` as the row `g(q) = 0` (module docs of the solver's
 //! `active_set`); its multiplier `λ` (`V_qᵀ = Φ_qᵀ μ`) is the stop's holding effort or the
 //! contact's normal force, and must not be negative. A sticking contact adds the two tangential
-//! rows `t_k·(r_i + A(p_i) s − a) = 0`, `a` the world point where it first touched, `t_1, t_2`
-//! an orthonormal basis of the ground plane; their multipliers are the friction force.
+//! rows `t_k·(r_i + A(p_i) c − a) = 0`: `c` the material point that touched (body frame), `a`
+//! the world point where it touched, `t_1, t_2` an orthonormal basis of the ground plane; their
+//! multipliers are the friction force. (A sphere held at its material point can roll, as a real
+//! foot does; holding its centre would forbid rolling.)
 
 use crate::jet::{pair_of, Pair, Scalar};
 use crate::kinematics::{coordinate, Branches};
@@ -46,12 +48,23 @@ pub(crate) enum Unilateral {
     Contact { point: usize, ground: usize },
 }
 
+/// Where a sticking contact is held: the material point of the shape that touched (body
+/// frame, on the shape's surface: a sphere's centre minus its radius along the normal at first
+/// touch) stays at the world point where it touched, tangentially. A sphere can still roll.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Anchor {
+    /// The world point where it first touched \[m\].
+    pub(crate) world: Vector3<f64>,
+    /// The material point that touched, body frame \[m\].
+    pub(crate) body: Vector3<f64>,
+}
+
 /// An inequality held as an equality: a stop the joint rests on, a contact that touches.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Active {
     pub(crate) row: Unilateral,
-    /// Sticking contact: the world point where it first touched (tangential rows hold it).
-    pub(crate) anchor: Option<Vector3<f64>>,
+    /// Sticking contact: where it is held (tangential rows).
+    pub(crate) anchor: Option<Anchor>,
 }
 
 impl Active {
@@ -168,7 +181,7 @@ pub(crate) fn rows(model: &Model, a: &Active, pair: &Pair, branches: &Branches) 
                 .dot(&x.sub(&pair.point(1, &gr.origin)), &n)
                 .minus(c.radius)];
             if let Some(anchor) = a.anchor {
-                let d = x.sub(&pair.point(1, &anchor));
+                let d = pair.point(0, &anchor.body).sub(&pair.point(1, &anchor.world));
                 for t in tangents(&gr.normal) {
                     out.push(pair.dot(&d, &pair.vector(1, &t)));
                 }
@@ -222,7 +235,10 @@ mod tests {
                 point: 0,
                 ground: 0,
             },
-            anchor: Some(Vector3::new(0.5, 0.4, -0.1)),
+            anchor: Some(Anchor {
+                world: Vector3::new(0.5, 0.4, -0.1),
+                body: Vector3::new(0.2, -0.3, 0.1),
+            }),
         };
         for k in 0..3 {
             check_scalar(

@@ -157,7 +157,13 @@ pub(crate) fn activate(
                 let gr = &model.grounds[ground];
                 let x = unilateral::point_world(model, point, q);
                 let g = gr.normal.dot(&(x - gr.origin)) - c.radius;
-                x - gr.normal * g
+                let i = 7 * c.body.0;
+                let p = nalgebra::Vector4::new(q[i + 3], q[i + 4], q[i + 5], q[i + 6]);
+                let a = crate::math::rotation(&p);
+                unilateral::Anchor {
+                    world: x - gr.normal * (g + c.radius),
+                    body: c.point - a.transpose() * gr.normal * c.radius,
+                }
             })
         }
         Unilateral::Limit { .. } => None,

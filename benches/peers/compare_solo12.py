@@ -14,7 +14,7 @@ ground, base roll and pitch, and the foot forces. Sticking adds tangential force
 Bounds (documented in docs/contact-validation.md); delta = MuJoCo's largest foot penetration:
 * restpose vs rigid KKT (both exact statics):  1e-6 rad, 1e-6 m, 1e-3 N.
 * restpose or rigid vs MuJoCo settling: base height 1.5 delta + 1e-7 m; angles
-  delta / 0.16 m (the shank) + 1e-5 rad; forces 1e-4 N + 1e-4 x the force.
+  delta / 0.16 m (the shank) + 1e-5 rad; forces 1e-4 N + |F| (1e-4 + 2 delta / 0.16 m).
 * Sticking: restpose must match one of the two rigid stick models exactly (sphere centre held,
   or sphere rolling without slip, which is what MuJoCo's condim-3 friction does), and MuJoCo
   must match the rolling one within the settling bounds. restpose vs MuJoCo is then printed
@@ -48,7 +48,7 @@ def settle_bound(kind: str, delta: float, value: float = 0.0) -> float:
         return 1.5 * delta + 1e-7
     if kind == "angle":
         return delta / SHANK + 1e-5
-    return 1e-4 + 1e-4 * abs(value)
+    return 1e-4 + abs(value) * (1e-4 + 2 * delta / SHANK)
 
 
 def find_restpose(arg: str | None) -> Path | None:

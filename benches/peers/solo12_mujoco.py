@@ -411,7 +411,8 @@ class Rigid:
                 n = st.ground_normal
                 psi = rotation_vector(d.geom_xmat[g].reshape(3, 3) @ self.R0[i].T)
                 rows += list(c - self.anchor[i] - f.radius * np.cross(psi, n))
-                jac += list(jp - f.radius * np.cross(jr.T, n).T)
+                dpsi = inv_left_jacobian(psi) @ jr  # d psi = J_l(psi)^-1 omega (world frame)
+                jac += list(jp - f.radius * np.cross(dpsi.T, n).T)
         if self.friction == "none":  # neutral directions pinned: base x, y (world) and yaw
             xyy, R = self.base_xy_yaw(q)
             r = xyy - self.pin
@@ -435,6 +436,23 @@ class Rigid:
         q2 = q.copy()
         mujoco.mj_integratePos(self.m, q2, dv, 1.0)
         return q2
+
+    def fd_check(self, q, h=1e-6) -> tuple[float, float]:
+        """Analytic constraint Jacobian and energy gradient against central differences."""
+        nv = self.m.nv
+        _, J = self.cons(q)
+        g = self.grad_v().copy()
+        jerr, gerr = 0.0, 0.0
+        for k in range(nv):
+            e = np.zeros(nv)
+            e[k] = h
+            cp, _ = self.cons(self.step_q(q, e))
+            vp = self.energy()
+            cm, _ = self.cons(self.step_q(q, -e))
+            vm = self.energy()
+            jerr = max(jerr, float(np.max(np.abs((cp - cm) / (2 * h) - J[:, k]))))
+            gerr = max(gerr, abs((vp - vm) / (2 * h) - g[k]))
+        return jerr, gerr
 
     def solve(self, tol=1e-10, max_iter=60) -> dict:
         t0 = time.perf_counter()
@@ -478,8 +496,9 @@ class Rigid:
         rank = int(np.sum(s > 1e-10 * s[0]))
         Z = vt[rank:].T
         eig = np.linalg.eigvalsh(Z.T @ H @ Z) if Z.shape[1] else np.array([])
-        self.eval(q)
         wall = time.perf_counter() - t0
+        jac_err, grad_err = self.fd_check(q)
+        self.eval(q)
         feet = []
         total = 0.0
         nf = len(self.st.feet)
@@ -505,6 +524,8 @@ class Rigid:
                 "sum_normal_force": total, "potential_energy": self.energy(),
                 "pin_multipliers_x_y_yaw": pins,
                 "reduced_hessian_min_eig": float(eig.min()) if eig.size else None,
+                "fd_check": {"constraint_jacobian_max_abs_error": jac_err,
+                             "energy_gradient_max_abs_error": grad_err},
                 "constraint_rank": rank}
 
 
@@ -515,6 +536,15 @@ def rotation_vector(R: np.ndarray) -> np.ndarray:
         q = -q
     s = np.linalg.norm(q[1:])
     return np.zeros(3) if s < 1e-300 else 2.0 * math.atan2(s, q[0]) * q[1:] / s
+
+
+def inv_left_jacobian(psi: np.ndarray) -> np.ndarray:
+    """Inverse left Jacobian of SO(3): psi' = J_l(psi)^-1 omega for R = exp([psi]x), R' = [omega]x R."""
+    th = float(np.linalg.norm(psi))
+    K = np.array([[0, -psi[2], psi[1]], [psi[2], 0, -psi[0]], [-psi[1], psi[0], 0]])
+    if th < 1e-8:
+        return np.eye(3) - 0.5 * K + K @ K / 12.0
+    return np.eye(3) - 0.5 * K + (1 / th**2 - (1 + math.cos(th)) / (2 * th * math.sin(th))) * K @ K
 
 
 def main() -> int:

@@ -407,6 +407,17 @@ class Rigid:
             elif self.friction == "stick":
                 rows += list(c - self.anchor[i])
                 jac += list(jp.copy())
+            elif self.friction == "stick-material":  # gap on the sphere; the material point
+                n = st.ground_normal  # that touched (c0 - r n at touch) held tangentially
+                R = d.geom_xmat[g].reshape(3, 3)
+                pm = c + R @ (self.R0[i].T @ (-f.radius * n))
+                jpm = np.zeros((3, m.nv))
+                mujoco.mj_jac(m, d, jpm, None, pm, m.geom_bodyid[g])
+                rows.append(n @ (c - st.ground_point) - f.radius)
+                jac.append(n @ jp)
+                for t in plane_basis(n):
+                    rows.append(t @ (pm - (self.anchor[i] - f.radius * n)))
+                    jac.append(t @ jpm)
             else:  # stick-rolling: c - c0 = r psi x n, psi the foot's rotation vector (world)
                 n = st.ground_normal
                 psi = rotation_vector(d.geom_xmat[g].reshape(3, 3) @ self.R0[i].T)
@@ -505,8 +516,10 @@ class Rigid:
         for i, f in enumerate(self.st.feet):
             if self.friction == "none":
                 fn, ftv = -lam[i], np.zeros(3)
-            else:
-                fw = -lam[3 * i:3 * i + 3]  # force of the ground on the foot, world
+            else:  # force of the ground on the foot, world
+                B = np.vstack([self.st.ground_normal, *plane_basis(self.st.ground_normal)]) \
+                    if self.friction == "stick-material" else np.eye(3)
+                fw = -B.T @ lam[3 * i:3 * i + 3]
                 fn = float(self.st.ground_normal @ fw)
                 ftv = fw - fn * self.st.ground_normal
             total += fn
@@ -527,6 +540,13 @@ class Rigid:
                 "fd_check": {"constraint_jacobian_max_abs_error": jac_err,
                              "energy_gradient_max_abs_error": grad_err},
                 "constraint_rank": rank}
+
+
+def plane_basis(n: np.ndarray) -> list[np.ndarray]:
+    a = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    t1 = np.cross(n, a)
+    t1 /= np.linalg.norm(t1)
+    return [t1, np.cross(n, t1)]
 
 
 def rotation_vector(R: np.ndarray) -> np.ndarray:
@@ -580,6 +600,8 @@ def main() -> int:
             if fr == "stick":
                 log("rigid KKT, friction stick with rolling feet ...")
                 run["rigid_rolling"] = Rigid(st, tree, "stick-rolling").solve()
+                log("rigid KKT, friction stick, material contact point held ...")
+                run["rigid_material"] = Rigid(st, tree, "stick-material").solve()
         if a.method in ("settle", "both"):
             log(f"settling, friction {fr} ...")
             p = Params(fr, a.timestep, a.solref_tc, tuple(a.solimp), a.mu, a.noslip, a.zeta,

@@ -68,7 +68,7 @@ HEADER = f"""<!-- restpose validation model (issue 13): the published Solo-12 qu
      - xmlns:mech declared on <robot>;
      - the four FOOT links: <collision> mesh solo_foot.stl -> <sphere radius="{FOOT_RADIUS}"/> at the
        FOOT origin (the mesh spans x, z in [-0.016, 0.016] there; its visual is kept);
-     - added at the end: <mech:ground> (plane z = {GROUND_Z:.9f}, +z up), <mech:contact> for the
+     - added at the end: <mech:ground> (plane z = {GROUND_Z:.15g}, +z up), <mech:contact> for the
        four feet only, a <mech:joint_spring> of {STIFFNESS:g} N m/rad on each of the 12 joints with
        its reference at the published srdf's "straight_standing" angles (HAA 0, front HFE 0.8 /
        KFE -1.6, hind HFE -0.8 / KFE 1.6), and <mech:initial> values at those references.
@@ -99,7 +99,7 @@ def main() -> int:
     assert n == 4, n
 
     extra = ["  <!-- restpose statics (not in the published file) -->",
-             f'  <mech:ground name="floor" xyz="0 0 {GROUND_Z:.9f}" normal="0 0 1"/>']
+             f'  <mech:ground name="floor" xyz="0 0 {GROUND_Z:.15g}" normal="0 0 1"/>']
     extra += [f'  <mech:contact link="{leg}_FOOT"/>' for leg in LEGS]
     for j, ref in REFERENCE.items():
         extra.append(f'  <mech:joint_spring joint="{j}" stiffness="{STIFFNESS:g}" reference="{ref:g}"/>')

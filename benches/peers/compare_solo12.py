@@ -147,6 +147,47 @@ def compare(a: dict | None, b: dict, joints, feet, stick, bound_of, extra=None):
     return worst_ratio, out
 
 
+def model_check(exe: Path | None, urdf: Path, mj: dict) -> bool:
+    """Base welded, no ground: restpose (on a copy without mech:ground/mech:contact) against the
+    rigid reference on MuJoCo's import of the same file. Checks that both read the same model
+    (masses, frames, spring signs), so that the comparisons below are about contact alone.
+    Returns True on a failure."""
+    ref = mj["runs"].get("welded", {}).get("rigid")
+    print("## model check: base welded, no ground\n")
+    if ref is None or exe is None:
+        print("not run (no `welded` run in the MuJoCo JSON, or no restpose binary)\n")
+        return False
+    import tempfile
+    import xml.etree.ElementTree as ET
+    text = urdf.read_text()
+    kept = "\n".join(ln for ln in text.splitlines()
+                     if "<mech:ground" not in ln and "<mech:contact" not in ln)
+    with tempfile.TemporaryDirectory() as td:
+        copy = Path(td) / urdf.name
+        copy.write_text(kept)
+        ET.parse(copy)  # still well-formed
+        t0 = time.perf_counter()
+        p = subprocess.run([str(exe), "analyze", str(copy), "--json", "-"], capture_output=True,
+                           text=True)
+        dt = time.perf_counter() - t0
+    if p.returncode != 0:
+        print(f"restpose failed ({p.returncode}): {p.stderr.strip()[:400]}\n")
+        return True
+    try:
+        r = json.loads(p.stdout)
+        dj = max(abs(r["joints"][j]["position"][0] - v) for j, v in ref["joints"].items())
+        dv = abs(r["potential_energy"] - ref["potential_energy"])
+    except (json.JSONDecodeError, KeyError, IndexError, TypeError) as e:
+        print(f"restpose JSON not as expected: {type(e).__name__}: {e}\n")
+        return True
+    bad = dj > EXACT["angle"] or dv > 1e-8
+    print(f"restpose {r['termination']} in {r['iterations']} iterations ({dt * 1e3:.0f} ms process); "
+          f"rigid reference {ref['iterations']} Newton iterations. max |Δθ| = {dj:.2e} rad "
+          f"(bound {EXACT['angle']:g}), |ΔV| = {dv:.2e} J (bound 1e-8; V = {ref['potential_energy']:.12f} J)"
+          f": {'FAIL' if bad else 'agree'}.\n")
+    return bad
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--urdf", default=str(DEFAULT_URDF))
@@ -161,7 +202,8 @@ def main() -> int:
     if a.mujoco_json:
         mj = json.loads(Path(a.mujoco_json).read_text())
     else:
-        p = subprocess.run([a.python, str(Path(__file__).parent / "solo12_mujoco.py"), str(urdf)],
+        p = subprocess.run([a.python, str(Path(__file__).parent / "solo12_mujoco.py"), str(urdf),
+                            "--welded"],
                            capture_output=True, text=True)
         if p.returncode != 0:
             print(f"solo12_mujoco.py failed ({p.returncode}):\n{p.stderr[-2000:]}")
@@ -184,7 +226,10 @@ def main() -> int:
     fail, missing = False, False
     print(f"# Solo-12 on the ground: restpose vs MuJoCo ({mj['mujoco_version']})\n")
     print(f"model: {urdf}; restpose: {exe if exe else 'not found'}\n")
+    fail |= model_check(exe, urdf, mj)
     for mode, runs in mj["runs"].items():
+        if mode == "welded":
+            continue
         stick = mode == "stick"
         settle, rigid = runs["settle"], runs["rigid"]
         rolling = runs.get("rigid_rolling")

@@ -362,6 +362,8 @@ class Rigid:
         self.gaps0 = [float(st.ground_normal @ (c - st.ground_point)) - f.radius
                       for c, f in zip(self.anchor, st.feet)]
         self.pin = self.base_xy_yaw(q0)[0]
+        self.Rb0 = self.base_xy_yaw(q0)[1]
+        self.pb0 = q0[self.qa:self.qa + 3].copy()
         self.q0 = q0
 
     def eval(self, q):
@@ -398,6 +400,14 @@ class Rigid:
         rows, jac = [], []
         jp = np.zeros((3, m.nv))
         jr = np.zeros((3, m.nv))
+        if self.friction == "welded":  # base held at its initial pose, feet free: model check
+            _, R = self.base_xy_yaw(q)
+            psi = rotation_vector(R @ self.Rb0.T)
+            rows = list(q[self.qa:self.qa + 3] - self.pb0) + list(psi)
+            J = np.zeros((6, m.nv))
+            J[0:3, self.da:self.da + 3] = np.eye(3)
+            J[3:6, self.da + 3:self.da + 6] = inv_left_jacobian(psi) @ R  # local -> world rate
+            return np.array(rows), J
         for i, (f, g) in enumerate(zip(st.feet, self.gids)):
             c = d.geom_xpos[g]
             mujoco.mj_jac(m, d, jp, jr, c, m.geom_bodyid[g])
@@ -514,6 +524,8 @@ class Rigid:
         total = 0.0
         nf = len(self.st.feet)
         for i, f in enumerate(self.st.feet):
+            if self.friction == "welded":
+                break
             if self.friction == "none":
                 fn, ftv = -lam[i], np.zeros(3)
             else:  # force of the ground on the foot, world
@@ -530,6 +542,8 @@ class Rigid:
                          "centre_world": self.d.geom_xpos[self.gids[i]].tolist(),
                          "initial_gap": self.gaps0[i]})
         pins = lam[nf:].tolist() if self.friction == "none" else []
+        if self.friction == "welded":
+            nf = 0
         return {"converged": bool(history[-1] < tol), "iterations": len(history) - 1,
                 "kkt_residual": float(max(np.max(np.abs(g)), np.max(np.abs(c)))),
                 "wall_time_s": wall, "base": base_summary(self.m, self.d, self.st),
@@ -586,6 +600,9 @@ def main() -> int:
     ap.add_argument("--lift", type=float, default=1e-4, help="start this far above touching [m]")
     ap.add_argument("--vtol", type=float, default=1e-6, help="settled: max|qvel| below this")
     ap.add_argument("--budget", type=float, default=120.0, help="wall-time budget per run [s]")
+    ap.add_argument("--welded", action="store_true",
+                    help="also solve with the base welded and no contact (runs.welded.rigid): checks "
+                         "that MuJoCo's import and restpose's agree on the model, contact aside")
     ap.add_argument("--json", help="also write the JSON here")
     a = ap.parse_args()
 
@@ -608,6 +625,9 @@ def main() -> int:
                        a.base_damping, a.lift)
             run["settle"] = settle(st, tree, p, a.vtol, a.budget)
         out["runs"][fr] = run
+    if a.welded:
+        log("rigid KKT, base welded, no contact ...")
+        out["runs"]["welded"] = {"rigid": Rigid(st, tree, "welded").solve()}
     text = json.dumps(out, indent=1)
     print(text)
     if a.json:

@@ -294,6 +294,13 @@ def main() -> int:
                 _, rr = compare(matched, s_roll, joints, feet, stick, lambda k, v: 1.0)
                 extra = {n: d for n, _, _, d, _ in rr}
             fail |= ratio_rp > 1
+            key = {"frictionless": "rigid", "centre held": "rigid",
+                   "material point held": "rigid_material", "rolling": "rigid_rolling"}[which]
+            if "potential_energy" in rp:
+                dv = abs(rp["potential_energy"] - runs[key]["potential_energy"])
+                print(f"potential energy: restpose {rp['potential_energy']:.12f} J, rigid ({which}) "
+                      f"{runs[key]['potential_energy']:.12f} J, |ΔV| = {dv:.1e} J (bound 1e-7)\n")
+                fail |= dv > 1e-7
         ratio_x, rows_x = compare(s_rp, s_mj, joints, feet, stick,
                                   lambda k, v: settle_bound(k, delta, v), extra)
         fail |= s_rp is not None and ratio_x > 1

@@ -211,7 +211,6 @@ def main() -> int:
         mj = json.loads(p.stdout)
 
     # the ground and root as solo12_mujoco.py read them (same file)
-    sys.path.insert(0, str(Path(__file__).parent))
     import xml.etree.ElementTree as ET
     robot = ET.parse(urdf).getroot()
     g = robot.find("{urn:urdf-mech:1}ground")

@@ -118,9 +118,7 @@ def read_statics(path: Path) -> tuple[Statics, ET.ElementTree]:
             sph = col.find("geometry/sphere")
             if sph is None:
                 raise SystemExit(f"{path}: contact link {ln} has a non-sphere <collision>")
-            o = col.find("origin")
-            if o is not None and any(abs(x) > 0 for x in floats(o.get("rpy"), 3, [0, 0, 0])):
-                pass  # a sphere's orientation does not matter
+            o = col.find("origin")  # its rpy does not matter for a sphere
             spheres.append(Foot(ln, float(sph.get("radius")),
                                 np.array(floats(o.get("xyz") if o is not None else None, 3, [0, 0, 0]))))
         if len(spheres) != 1:
@@ -542,8 +540,6 @@ class Rigid:
                          "centre_world": self.d.geom_xpos[self.gids[i]].tolist(),
                          "initial_gap": self.gaps0[i]})
         pins = lam[nf:].tolist() if self.friction == "none" else []
-        if self.friction == "welded":
-            nf = 0
         return {"converged": bool(history[-1] < tol), "iterations": len(history) - 1,
                 "kkt_residual": float(max(np.max(np.abs(g)), np.max(np.abs(c)))),
                 "wall_time_s": wall, "base": base_summary(self.m, self.d, self.st),

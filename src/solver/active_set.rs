@@ -254,12 +254,13 @@ pub(crate) fn solve(
     let tol = options.gap_tolerance;
     let threshold = options.force_tolerance * force_scale(model);
     let mut state = start;
-    // Inequalities violated at the start are met first, as equalities.
+    // Inequalities violated or touching at the start are active from the start (a sticking
+    // contact that touches at the start is held where it is).
     let mut active: Vec<Active> = all
         .iter()
         .filter(|u| {
             unilateral::gap(model, u, &state.q, &state.branches)
-                .is_some_and(|g| dimensionless(model, u, g) < -tol)
+                .is_some_and(|g| dimensionless(model, u, g) <= tol)
         })
         .map(|&u| activate(model, options, u, &state.q))
         .collect();

@@ -5,9 +5,9 @@
 use super::parse;
 use anyhow::{bail, Context};
 use clap::{Parser, Subcommand, ValueEnum};
+use restpose::model::Friction;
 use restpose::urdf::ImportOptions;
 use restpose::verify::Tolerances;
-use restpose::model::Friction;
 use restpose::{Limits, LinearAlgebra, Method, Options};
 use std::path::PathBuf;
 

@@ -158,7 +158,12 @@ pub(crate) fn point_world(model: &Model, point: usize, q: &DVector<f64>) -> Vect
 
 /// The rows of `a` as jets over the pair of `bodies(model, &a.row)`: `g`, then the two
 /// tangential rows of a sticking contact. `None` where a joint coordinate is undefined.
-pub(crate) fn rows(model: &Model, a: &Active, pair: &Pair, branches: &Branches) -> Option<Vec<Scalar>> {
+pub(crate) fn rows(
+    model: &Model,
+    a: &Active,
+    pair: &Pair,
+    branches: &Branches,
+) -> Option<Vec<Scalar>> {
     match a.row {
         Unilateral::Limit {
             joint,
@@ -181,7 +186,9 @@ pub(crate) fn rows(model: &Model, a: &Active, pair: &Pair, branches: &Branches) 
                 .dot(&x.sub(&pair.point(1, &gr.origin)), &n)
                 .minus(c.radius)];
             if let Some(anchor) = a.anchor {
-                let d = pair.point(0, &anchor.body).sub(&pair.point(1, &anchor.world));
+                let d = pair
+                    .point(0, &anchor.body)
+                    .sub(&pair.point(1, &anchor.world));
                 for t in tangents(&gr.normal) {
                     out.push(pair.dot(&d, &pair.vector(1, &t)));
                 }
@@ -192,7 +199,12 @@ pub(crate) fn rows(model: &Model, a: &Active, pair: &Pair, branches: &Branches) 
 }
 
 /// `g(q)` (value only); `None` where a joint coordinate is undefined.
-pub(crate) fn gap(model: &Model, u: &Unilateral, q: &DVector<f64>, branches: &Branches) -> Option<f64> {
+pub(crate) fn gap(
+    model: &Model,
+    u: &Unilateral,
+    q: &DVector<f64>,
+    branches: &Branches,
+) -> Option<f64> {
     let pair = pair_of(&bodies(model, u), q, false);
     rows(
         model,
@@ -219,8 +231,12 @@ mod tests {
     fn contact_rows_match_finite_differences() {
         let mut b = ModelBuilder::new("t");
         let body = b.add_rigid_body("b", 1.0, Vector3::zeros(), Matrix3::identity());
-        b.add_ground("g", Vector3::new(0.1, -0.2, 0.3), Vector3::new(0.2, 0.3, 1.0))
-            .unwrap();
+        b.add_ground(
+            "g",
+            Vector3::new(0.1, -0.2, 0.3),
+            Vector3::new(0.2, 0.3, 1.0),
+        )
+        .unwrap();
         let mut m = b.build().unwrap();
         m.contact_points.push(ContactPoint {
             link: "b".into(),

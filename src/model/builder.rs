@@ -10,8 +10,8 @@
 //! and coordinate index it was given, so a made-up id is an error, never a panic later.
 
 use super::{
-    Body, BodyId, ContactPoint, ContactSettings, Ground, Effort, ForceLaw, Initial, Joint, JointId, JointKind, JointSpring, Link, Load,
-    Lock, Mimic, Model, Spring,
+    Body, BodyId, ContactPoint, ContactSettings, Effort, ForceLaw, Ground, Initial, Joint, JointId,
+    JointKind, JointSpring, Link, Load, Lock, Mimic, Model, Spring,
 };
 use crate::error::{Error, Result};
 use crate::geometry::Geometry;
@@ -373,8 +373,9 @@ impl ModelBuilder {
                 )));
             }
             for g in &l.collisions {
-                let pts = crate::geometry::contact_points(g)
-                    .map_err(|e| Error::Model(format!("contact points of link `{}`: {e}", l.name)))?;
+                let pts = crate::geometry::contact_points(g).map_err(|e| {
+                    Error::Model(format!("contact points of link `{}`: {e}", l.name))
+                })?;
                 for (p, radius) in pts {
                     out.push(ContactPoint {
                         link: l.name.clone(),

@@ -14,8 +14,8 @@ mod joint;
 
 pub use body::{Body, BodyId, Link};
 pub use builder::{Inertial, ModelBuilder};
-pub use contact::{ContactPoint, ContactSettings, Friction, Ground};
 pub use check::{LARGEST_GRAVITY, LARGEST_LENGTH, LARGEST_MAGNITUDE};
+pub use contact::{ContactPoint, ContactSettings, Friction, Ground};
 pub use force::{
     Effort, ForceLaw, Initial, JointSpring, Load, Lock, Mimic, Spring, SpringEnd, SpringMode,
 };

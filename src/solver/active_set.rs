@@ -174,9 +174,11 @@ pub(crate) fn activate(
 /// Force scale `F` of the mechanism \[N\]: its weight plus the dead loads, and the joint
 /// efforts divided by the characteristic length (at least 1e-12).
 pub(crate) fn force_scale(model: &Model) -> f64 {
-    let weight: f64 = model.bodies.iter().map(|b| b.gravity_mass).sum::<f64>() * model.gravity.norm();
+    let weight: f64 =
+        model.bodies.iter().map(|b| b.gravity_mass).sum::<f64>() * model.gravity.norm();
     let loads: f64 = model.loads.iter().map(|l| l.force.norm()).sum();
-    let efforts: f64 = model.efforts.iter().map(|e| e.value.abs()).sum::<f64>() / model.length_scale;
+    let efforts: f64 =
+        model.efforts.iter().map(|e| e.value.abs()).sum::<f64>() / model.length_scale;
     (weight + loads + efforts).max(1e-12)
 }
 
@@ -195,10 +197,9 @@ pub(crate) fn active_multipliers(
     cons.blocks
         .iter()
         .filter_map(|b| match &b.kind {
-            crate::constraints::BlockKind::Unilateral(a) => Some((
-                *a,
-                (0..a.row_count()).map(|k| full[b.first + k]).collect(),
-            )),
+            crate::constraints::BlockKind::Unilateral(a) => {
+                Some((*a, (0..a.row_count()).map(|k| full[b.first + k]).collect()))
+            }
             _ => None,
         })
         .collect()
@@ -378,7 +379,11 @@ fn describe(
                     gap,
                     normal_force: fnorm,
                     tangential_force: ft.into(),
-                    required_friction: if required.is_finite() { required } else { f64::MAX },
+                    required_friction: if required.is_finite() {
+                        required
+                    } else {
+                        f64::MAX
+                    },
                     state: contact_state,
                 });
             }

@@ -18,12 +18,12 @@
 //! - R. Fletcher, M. J. D. Powell, A rapidly convergent descent method for minimization,
 //!   *Computer Journal* 6 (1963) 163–168.
 
+use super::active_set::Guard;
 use super::options::{Method, Options};
 use super::partition::Partition;
 use super::report::{Diagnostics, Iterate, Termination};
 use super::sparse::kkt::Factored;
 use super::spectrum::{spectrum, Spectrum};
-use super::active_set::Guard;
 use super::system::{Eval, System};
 use nalgebra::{DMatrix, DVector};
 
@@ -324,8 +324,7 @@ pub(crate) fn minimize(
             }
             if let Some(guard) = guard.filter(|g| g.violated(sys, &qt)) {
                 // Cut the step where the first inequality reaches its boundary.
-                if let Some((qb, k)) = guard.boundary(sys, &q, &dq, alpha, &part, options, &eval)
-                {
+                if let Some((qb, k)) = guard.boundary(sys, &q, &dq, alpha, &part, options, &eval) {
                     if let Some(eb) = sys.evaluate(&qb, &part) {
                         diag.function_evaluations += 1;
                         if eb.merit <= f + roundoff_of(&eval, &eb) {

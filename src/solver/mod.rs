@@ -29,7 +29,8 @@ mod unbounded;
 
 pub use options::{Limits, LinearAlgebra, Method, Options};
 pub use report::{
-    ActiveLimit, Contact, ContactState, Diagnostics, Iterate, Reaction, Report, Sizes, Stability, Termination, Timings, Verdict,
+    ActiveLimit, Contact, ContactState, Diagnostics, Iterate, Reaction, Report, Sizes, Stability,
+    Termination, Timings, Verdict,
 };
 
 use crate::constraints::unilateral::Active;

@@ -9,8 +9,8 @@ use super::xml::{child, Source};
 use super::ImportOptions;
 use crate::error::Result;
 use crate::model::{
-    ContactSettings, Effort, ForceLaw, Friction, Ground, Initial, JointId, JointKind, JointSpring, Load, Lock, Mimic, Spring,
-    SpringEnd, SpringMode,
+    ContactSettings, Effort, ForceLaw, Friction, Ground, Initial, JointId, JointKind, JointSpring,
+    Load, Lock, Mimic, Spring, SpringEnd, SpringMode,
 };
 use nalgebra::Vector3;
 use roxmltree::Node;

@@ -67,6 +67,13 @@ impl<'m> Guard<'m> {
             .min_by(|a, b| a.1.total_cmp(&b.1))
     }
 
+    /// Whether the step from `from` to `to` brings one of the inequalities closer to its
+    /// boundary (a linear descent may then end on it, and is not unbounded).
+    pub(crate) fn approaching(&self, sys: &System, from: &DVector<f64>, to: &DVector<f64>) -> bool {
+        let b = &sys.cons.branches;
+        (0..self.inactive.len()).any(|k| self.gap(k, to, b) < self.gap(k, from, b) - self.tol)
+    }
+
     /// Whether `q` violates one of the inequalities by more than the tolerance.
     pub(crate) fn violated(&self, sys: &System, q: &DVector<f64>) -> bool {
         self.lowest(q, &sys.cons.branches)

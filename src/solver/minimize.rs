@@ -393,13 +393,13 @@ pub(crate) fn minimize(
                 quasi_newton_update(options.method, &mut qn.binv, &s, &y, qn.fresh);
                 qn.fresh = false;
                 let linear = descent.record(slope * alpha, &(&dq * alpha), l);
+                // A linear descent toward an inequality may end on it.
+                let may_be_stopped = guard.is_some_and(|g| g.approaching(sys, &q, &qt));
                 q = qt;
                 sys.cons.branches.follow(sys.model, &q);
                 eval = et;
                 iteration += 1;
                 just_repartitioned = false;
-                // With inequalities left to meet, a linear descent may end on one of them.
-                let may_be_stopped = guard.is_some_and(|g| !g.is_empty());
                 if (!may_be_stopped && (linear || linear_steps >= 5))
                     || eval.energy.total < -1e15
                     || (0..q.len()).any(|i| i % 7 < 3 && q[i].abs() > 1e6 * sys.model.length_scale)

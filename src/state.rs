@@ -80,7 +80,14 @@ impl State {
         for b in 0..model.bodies.len() {
             s.q[7 * b + 3] = 1.0;
         }
-        let mut placed = vec![false; model.bodies.len()];
+        // A body that is no tree joint's child (a floating base) stays at the world origin and
+        // places its subtree.
+        let mut placed = vec![true; model.bodies.len()];
+        for j in model.joints.iter().filter(|j| j.tree && !j.merged) {
+            if let Some(child) = j.bodies[1] {
+                placed[child.0] = false;
+            }
+        }
         let mut changed = true;
         while changed {
             changed = false;

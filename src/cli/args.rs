@@ -5,9 +5,10 @@
 use super::parse;
 use anyhow::{bail, Context};
 use clap::{Parser, Subcommand, ValueEnum};
+use restpose::model::Friction;
 use restpose::urdf::ImportOptions;
 use restpose::verify::Tolerances;
-use restpose::{LinearAlgebra, Method, Options};
+use restpose::{Limits, LinearAlgebra, Method, Options};
 use std::path::PathBuf;
 
 #[derive(Parser)]
@@ -52,6 +53,9 @@ pub(crate) struct InputArgs {
     /// Leave the root link free instead of welding it to the world.
     #[arg(long)]
     pub(crate) floating_base: bool,
+    /// Add the ground plane z = 0 (+z up): links with collision geometry rest on it.
+    #[arg(long)]
+    pub(crate) ground: bool,
 }
 
 impl InputArgs {
@@ -59,6 +63,7 @@ impl InputArgs {
     pub(crate) fn options(&self) -> anyhow::Result<ImportOptions> {
         let mut opts = ImportOptions {
             floating_base: self.floating_base,
+            ground: self.ground,
             inertia_density: self.inertia_from_geometry,
             ..Default::default()
         };
@@ -191,6 +196,18 @@ pub(crate) struct AnalyzeArgs {
     /// Stop at an unstable stationary point instead of leaving it.
     #[arg(long)]
     pub(crate) allow_unstable: bool,
+    /// URDF joint limits: enforce (joints can rest on their stops) or ignore (only report a
+    /// rest pose outside them).
+    #[arg(long, value_enum, default_value_t = Options::default().limits)]
+    pub(crate) limits: Limits,
+    /// Contacts without a friction setting in <mech:contact>: none (frictionless) or stick
+    /// (held where they first touch; the needed friction coefficient is reported).
+    #[arg(long, value_enum, default_value_t = Options::default().friction)]
+    pub(crate) friction: Friction,
+    /// Friction coefficient of sticking contacts without `mu` in <mech:contact>: a contact
+    /// needing more is reported as slipping.
+    #[arg(long, value_name = "MU", value_parser = parse::positive)]
+    pub(crate) mu: Option<f64>,
     /// Print only errors.
     #[arg(long, short)]
     pub(crate) quiet: bool,
@@ -242,6 +259,9 @@ impl AnalyzeArgs {
             max_iterations: self.max_iterations,
             allow_unstable: self.allow_unstable,
             load_steps: self.load_steps,
+            limits: self.limits,
+            friction: self.friction,
+            mu: self.mu,
             ..Default::default()
         }
     }

@@ -141,6 +141,44 @@ pub(crate) fn analysis(r: &AnalysisResult) {
             v.joint, v.position, v.limits[0], v.limits[1]
         );
     }
+    if !r.active_limits.is_empty() {
+        out!();
+        out!("  joint resting on a stop          bound     position       effort [N m or N]");
+        for l in &r.active_limits {
+            out!(
+                "  {:<32} {:<9} {:>12.6}   {:>12.4}",
+                l.joint,
+                l.bound,
+                l.value,
+                l.effort
+            );
+        }
+    }
+    if !r.contacts.is_empty() {
+        out!();
+        out!("  contact (link @ ground)          point [m]                              normal force [N]  needs μ   state");
+        for c in &r.contacts {
+            let p = c.point_world;
+            out!(
+                "  {:<32} [{:>10.5}, {:>10.5}, {:>10.5}]   {:>14.4}  {:>8.4}   {}",
+                format!("{} @ {}", c.link, c.ground),
+                p[0],
+                p[1],
+                p[2],
+                c.normal_force,
+                c.required_friction,
+                serde_json::to_value(c.state)
+                    .ok()
+                    .and_then(|v| v.as_str().map(str::to_owned))
+                    .unwrap_or_default()
+            );
+        }
+        let total: f64 = r.contacts.iter().map(|c| c.normal_force).sum();
+        out!("  total normal force {total:.6} N");
+    }
+    if r.slipping {
+        out!("  warning: a sticking contact needs more friction than its coefficient mu: the mechanism would slide from this pose");
+    }
     if !r.reactions.is_empty() {
         out!();
         out!("  reaction on child at joint origin (world)   force [N]                          torque [N m]");

@@ -6,6 +6,7 @@
 //! `θ_a(q) − m θ_b(q) − c = 0`.
 
 pub(crate) mod joint;
+pub(crate) mod unilateral;
 
 use crate::jet::{pair_of, HessianSink, LMat, Scalar};
 use crate::kinematics::{coordinate, Branches};
@@ -46,6 +47,8 @@ pub(crate) enum BlockKind {
     },
     /// A mimic coupling (index into `Model::mimics`).
     Mimic(usize),
+    /// An active inequality: a joint stop or a touching contact (1 or 3 rows).
+    Unilateral(unilateral::Active),
 }
 
 /// A block of consecutive rows.
@@ -121,6 +124,29 @@ impl Constraints {
         }
     }
 
+    /// The same rows plus the active inequalities `active`, in their order.
+    pub(crate) fn with_active(mut self, model: &Model, active: &[unilateral::Active]) -> Self {
+        for a in active {
+            self.blocks.push(Block {
+                kind: BlockKind::Unilateral(*a),
+                first: self.len,
+            });
+            let name = unilateral::name(model, &a.row);
+            let power = unilateral::length_power(model, &a.row);
+            let suffixes: &[&str] = if a.anchor.is_some() {
+                &["", ".t1", ".t2"]
+            } else {
+                &[""]
+            };
+            for s in suffixes {
+                self.names.push(format!("{name}{s}"));
+                self.length_power.push(power);
+            }
+            self.len += a.row_count();
+        }
+        self
+    }
+
     /// The same rows with joint angles read on `branches`.
     pub(crate) fn on_branches(mut self, branches: Branches) -> Self {
         self.branches = branches;
@@ -171,6 +197,15 @@ impl Constraints {
                     let pair = pair_of(&j.bodies, q, hess);
                     if let Some(s) = coordinate(j, &pair, *dof, self.branches.get(*id, *dof)) {
                         visit(block.first, Term::Jet(&j.bodies, &s.minus(*value), 1.0));
+                    }
+                }
+                BlockKind::Unilateral(a) => {
+                    let bodies = unilateral::bodies(model, &a.row);
+                    let pair = pair_of(&bodies, q, hess);
+                    if let Some(rows) = unilateral::rows(model, a, &pair, &self.branches) {
+                        for (k, s) in rows.iter().enumerate() {
+                            visit(block.first + k, Term::Jet(&bodies, s, 1.0));
+                        }
                     }
                 }
                 BlockKind::Mimic(i) => {

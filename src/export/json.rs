@@ -2,7 +2,9 @@
 
 use crate::forces::Energy;
 use crate::model::{JointKind, Model};
-use crate::solver::{Diagnostics, Iterate, Reaction, Report, Stability};
+use crate::solver::{
+    ActiveLimit, Contact, ContactState, Diagnostics, Iterate, Reaction, Report, Stability,
+};
 use crate::state::State;
 use serde::ser::SerializeMap;
 use serde::{Serialize, Serializer};
@@ -104,8 +106,17 @@ pub struct AnalysisResult {
     pub energy: Energy,
     /// Solver counters.
     pub diagnostics: Diagnostics,
-    /// Joints resting outside their URDF limits (not enforced).
+    /// Joints resting outside their URDF limits (with `--limits ignore`; empty when limits
+    /// are enforced and the solve converged).
     pub limit_violations: Vec<LimitViolation>,
+    /// Contact points resting on a ground: `{link, ground, point_world, normal_world, gap,
+    /// normal_force, tangential_force, required_friction, state}`.
+    pub contacts: Vec<Contact>,
+    /// Joints resting on a stop: `{joint, bound, value, effort}`.
+    pub active_limits: Vec<ActiveLimit>,
+    /// Whether some sticking contact needs more friction than its coefficient `mu` (it would
+    /// slide: the pose is not a rest pose the contacts can hold).
+    pub slipping: bool,
     /// Bodies, coordinates, constraint rows.
     pub bodies: usize,
     /// Cartesian coordinates (7 per body).
@@ -173,6 +184,12 @@ impl AnalysisResult {
             .collect();
         AnalysisResult {
             limit_violations,
+            contacts: report.contacts.clone(),
+            active_limits: report.active_limits.clone(),
+            slipping: report
+                .contacts
+                .iter()
+                .any(|c| c.state == ContactState::Slipping),
             robot: model.name.clone(),
             converged: report.converged(),
             termination: report.termination.as_str().to_string(),

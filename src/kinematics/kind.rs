@@ -22,6 +22,12 @@ impl JointKind {
         }
     }
 
+    /// Whether `<limit lower upper>` bounds coordinate 0 of a joint of this kind (every kind
+    /// with a scalar coordinate but continuous, which has no position limits).
+    pub fn has_limits(&self) -> bool {
+        self.scalar_coordinates() > 0 && *self != JointKind::Continuous
+    }
+
     /// Whether scalar coordinate `dof` is an angle \[rad\] (otherwise a length \[m\]). Angles
     /// are real numbers, never wrapped into (−π, π].
     pub fn is_angle(&self, dof: usize) -> bool {

@@ -8,6 +8,7 @@
 mod body;
 mod builder;
 mod check;
+mod contact;
 mod force;
 mod joint;
 mod site;
@@ -15,6 +16,7 @@ mod site;
 pub use body::{Body, BodyId, Link};
 pub use builder::{Inertial, ModelBuilder};
 pub use check::{LARGEST_GRAVITY, LARGEST_LENGTH, LARGEST_MAGNITUDE};
+pub use contact::{ContactPoint, ContactSettings, Friction, Ground};
 pub use force::{
     Effort, ForceLaw, Initial, JointSpring, Load, Lock, Mimic, Spring, SpringEnd, SpringMode,
 };
@@ -51,6 +53,10 @@ pub struct Model {
     pub initial: Vec<Initial>,
     /// Gravity in the world frame \[m/s²\].
     pub gravity: Vector3<f64>,
+    /// Ground planes (`mech:ground`).
+    pub grounds: Vec<Ground>,
+    /// Points of the links that touch the grounds (from their collision shapes).
+    pub contact_points: Vec<ContactPoint>,
     /// Characteristic length of the mechanism \[m\], used to scale position coordinates.
     pub length_scale: f64,
     /// Joint ids by name, built once by [`Model::index_names`].

@@ -7,6 +7,7 @@
 
 use super::options::Options;
 use super::system::System;
+use crate::constraints::unilateral::Active;
 use crate::constraints::Constraints;
 use crate::error::{Error, Result};
 use crate::kinematics::Branches;
@@ -110,19 +111,22 @@ pub(crate) fn assemble(
             }
         }
     }
-    project(model, q, branches, locks, options)
+    project(model, q, branches, locks, &[], options)
 }
 
-/// Damped Newton onto `Φ = 0` with the given locks only.
+/// Damped Newton onto `Φ = 0` with the given locks and active inequalities only.
 pub(crate) fn project(
     model: &Model,
     q: DVector<f64>,
     branches: &mut Branches,
     locks: &[(JointId, usize, f64)],
+    active: &[Active],
     options: &Options,
 ) -> Result<DVector<f64>> {
     let tol = options.constraint_tolerance;
-    let cons = Constraints::new(model, locks).on_branches(branches.clone());
+    let cons = Constraints::new(model, locks)
+        .with_active(model, active)
+        .on_branches(branches.clone());
     let mut sys = System::with_options(model, cons, options);
     let q0 = q.clone();
     match newton(&mut sys, q, tol) {

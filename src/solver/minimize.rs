@@ -18,6 +18,7 @@
 //! - R. Fletcher, M. J. D. Powell, A rapidly convergent descent method for minimization,
 //!   *Computer Journal* 6 (1963) 163–168.
 
+use super::active_set::Guard;
 use super::options::{Method, Options};
 use super::partition::Partition;
 use super::report::{Diagnostics, Iterate, Termination};
@@ -39,6 +40,9 @@ pub(crate) struct Outcome {
     pub(crate) termination: Termination,
     pub(crate) history: Vec<Iterate>,
     pub(crate) diagnostics: Diagnostics,
+    /// The inactive inequalities (indices into the guard's list) that stopped the last step: `q`
+    /// is on its boundary.
+    pub(crate) blocked: Option<Vec<usize>>,
 }
 
 /// Relative rounding floor of the reduced gradient: the convergence test uses
@@ -178,11 +182,15 @@ fn kkt_direction(
     -g.clone()
 }
 
+/// Minimizes from `q`; with a `guard`, a step that would violate one of its inequalities is
+/// cut where the first one reaches its boundary, and the minimization stops there
+/// (`Outcome::blocked`).
 pub(crate) fn minimize(
     sys: &mut System,
     mut q: DVector<f64>,
     mut part: Partition,
     options: &Options,
+    guard: Option<&Guard>,
 ) -> Option<Outcome> {
     let mut diag = Diagnostics {
         load_steps: 1,
@@ -199,6 +207,7 @@ pub(crate) fn minimize(
     let mut descent = super::unbounded::LinearDescent::default();
     let mut eigen = None;
     let mut iterates = Vec::new();
+    let mut blocked = None;
     loop {
         let f = eval.merit;
         let gnorm = eval.grad_v.amax();
@@ -313,6 +322,22 @@ pub(crate) fn minimize(
                 alpha *= 0.5;
                 continue;
             }
+            if let Some(guard) = guard.filter(|g| g.violated(sys, &qt)) {
+                // Cut the step where the first inequality reaches its boundary.
+                if let Some((qb, k)) = guard.boundary(sys, &q, &dq, alpha, &part, options, &eval) {
+                    if let Some(eb) = sys.evaluate(&qb, &part) {
+                        diag.function_evaluations += 1;
+                        if eb.merit <= f + roundoff_of(&eval, &eb) {
+                            accepted = Some((qb, eb, 0.0));
+                            blocked = Some(k);
+                            break;
+                        }
+                    }
+                }
+                diag.step_halvings += 1;
+                alpha *= 0.5;
+                continue;
+            }
             let Some(et) = sys.evaluate(&qt, &part) else {
                 diag.step_halvings += 1;
                 alpha *= 0.5;
@@ -340,6 +365,21 @@ pub(crate) fn minimize(
             diag.step_halvings += 1;
         }
         match accepted {
+            Some((qt, et, _)) if blocked.is_some() => {
+                q = qt;
+                sys.cons.branches.follow(sys.model, &q);
+                eval = et;
+                iteration += 1;
+                history.push(Iterate {
+                    iteration,
+                    potential_energy: eval.energy.total,
+                    gradient_norm: eval.grad_v.amax(),
+                });
+                if options.record_iterates {
+                    iterates.push(q.clone());
+                }
+                break;
+            }
             Some((qt, et, alpha)) => {
                 let s = &d * alpha;
                 let y = &et.grad_v - &eval.grad_v;
@@ -353,13 +393,14 @@ pub(crate) fn minimize(
                 quasi_newton_update(options.method, &mut qn.binv, &s, &y, qn.fresh);
                 qn.fresh = false;
                 let linear = descent.record(slope * alpha, &(&dq * alpha), l);
+                // A linear descent toward an inequality may end on it.
+                let may_be_stopped = guard.is_some_and(|g| g.approaching(sys, &q, &qt));
                 q = qt;
                 sys.problem.cons.branches.follow(sys.problem.model, &q);
                 eval = et;
                 iteration += 1;
                 just_repartitioned = false;
-                if linear
-                    || linear_steps >= 5
+                if (!may_be_stopped && (linear || linear_steps >= 5))
                     || eval.energy.total < -1e15
                     || (0..q.len())
                         .any(|i| i % 7 < 3 && q[i].abs() > 1e6 * sys.problem.model.length_scale)
@@ -403,5 +444,12 @@ pub(crate) fn minimize(
         termination,
         history,
         diagnostics: diag,
+        blocked,
     })
+}
+
+/// Rounding error of the merit function between two evaluations: relative to the size of the
+/// energy's terms, not of their sum.
+fn roundoff_of(a: &Eval, b: &Eval) -> f64 {
+    1e-12 * a.energy.magnitude.max(b.energy.magnitude) + f64::MIN_POSITIVE
 }

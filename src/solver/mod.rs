@@ -14,6 +14,7 @@
 //!   equilibrium analysis of large-scale mechanical systems, *Int. J. Numer. Meth. Eng.* 21
 //!   (1985) 451–464 (`shared/paper/`).
 
+mod active_set;
 mod assemble;
 mod eigen;
 mod minimize;
@@ -26,11 +27,13 @@ mod spectrum;
 pub(crate) mod system;
 mod unbounded;
 
-pub use options::{LinearAlgebra, Method, Options};
+pub use options::{Limits, LinearAlgebra, Method, Options};
 pub use report::{
-    Diagnostics, Iterate, Reaction, Report, Sizes, Stability, Termination, Timings, Verdict,
+    ActiveLimit, Contact, ContactState, Diagnostics, Iterate, Reaction, Report, Sizes, Stability,
+    Termination, Timings, Verdict,
 };
 
+use crate::constraints::unilateral::Active;
 use crate::constraints::Constraints;
 use crate::error::{Error, Result};
 use crate::kinematics::Branches;
@@ -75,7 +78,7 @@ pub(crate) fn assemble_only(
     branches: &mut Branches,
     locks: &[(JointId, usize, f64)],
 ) -> Result<nalgebra::DVector<f64>> {
-    assemble::project(model, q, branches, locks, &Options::default())
+    assemble::project(model, q, branches, locks, &[], &Options::default())
 }
 
 /// The stability verdict from the reduced-Hessian eigenvalues (ascending, at least one) and
@@ -246,8 +249,37 @@ fn solve_assembled(
     locks: &[(JointId, usize, f64)],
     options: &Options,
 ) -> Result<(State, Report)> {
+    if !active_set::inequalities(model, options).is_empty() {
+        return active_set::solve(model, start, locks, options);
+    }
+    let round = solve_round(model, start, locks, &[], None, options)?;
+    Ok((round.state, round.report))
+}
+
+/// One equality-constrained solve of the active-set iteration (module `active_set`).
+pub(crate) struct Round {
+    pub(crate) state: State,
+    pub(crate) report: Report,
+    /// The inactive inequalities (indices into the guard's list) that stopped the last step.
+    pub(crate) blocked: Option<Vec<usize>>,
+    /// Multipliers of the rows of each active inequality.
+    pub(crate) multipliers: Vec<(Active, Vec<f64>)>,
+}
+
+/// Minimizes from an assembled `q` with the active inequalities `active` as rows, stopping
+/// where a step meets an inequality of `guard`.
+pub(crate) fn solve_round(
+    model: &Model,
+    start: State,
+    locks: &[(JointId, usize, f64)],
+    active: &[Active],
+    guard: Option<&active_set::Guard>,
+    options: &Options,
+) -> Result<Round> {
     let q = start.q;
-    let cons = Constraints::new(model, locks).on_branches(start.branches.clone());
+    let cons = Constraints::new(model, locks)
+        .with_active(model, active)
+        .on_branches(start.branches.clone());
     let mut sys = System::with_options(model, cons, options);
     let part = sys.partition(&q);
     let dof0 = part.independent.len();
@@ -269,7 +301,7 @@ fn solve_assembled(
         });
     }
     let rank = part.rows.len();
-    let Some(out) = minimize::minimize(&mut sys, q.clone(), part, options) else {
+    let Some(out) = minimize::minimize(&mut sys, q.clone(), part, options, guard) else {
         return Err(
             crate::forces::undefined_term(model, &start.branches, &q).unwrap_or(
                 Error::SingularPartition {
@@ -309,6 +341,8 @@ fn solve_assembled(
         stability(&sys, &out.q, &out.part, &out.eval, &eig)
     });
     let reactions = reactions::reactions(&sys, &out.q, &out.part, &out.eval);
+    let multipliers = active_set::active_multipliers(&sys.cons, &out.part, &out.eval.mu);
+    let blocked = out.blocked;
     diagnostics.timings.stability = stability_started.elapsed().as_secs_f64();
     let report = Report {
         termination: out.termination,
@@ -349,6 +383,14 @@ fn solve_assembled(
                 })
                 .collect()
         },
+        contacts: Vec::new(),
+        active_limits: Vec::new(),
+        active_set_changes: 0,
     };
-    Ok((state, report))
+    Ok(Round {
+        state,
+        report,
+        blocked,
+        multipliers,
+    })
 }

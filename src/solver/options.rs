@@ -30,6 +30,18 @@ pub enum LinearAlgebra {
     Sparse,
 }
 
+/// Whether URDF joint limits hold the joints.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[serde(rename_all = "lowercase")]
+pub enum Limits {
+    /// `lower ≤ θ ≤ upper` are inequality constraints: a joint can rest on its stop (default).
+    #[default]
+    Enforce,
+    /// Limits are read and a rest pose outside them is reported, not prevented.
+    Ignore,
+}
+
 /// Options of [`crate::solve`].
 #[derive(Clone, Debug)]
 pub struct Options {
@@ -63,6 +75,20 @@ pub struct Options {
     /// Keep the configuration of every accepted iterate in [`crate::Report::iterates`] (for the
     /// viewer's iteration timeline; default: false).
     pub record_iterates: bool,
+    /// Joint limits as inequality constraints, or only reported (default: enforce).
+    pub limits: Limits,
+    /// Tangential behaviour of contacts whose `mech:contact` does not say (default: none,
+    /// frictionless).
+    pub friction: crate::model::Friction,
+    /// Friction coefficient of contacts whose `mech:contact` does not say (default: none: the
+    /// needed coefficient is reported, never judged).
+    pub mu: Option<f64>,
+    /// Gap below which an inequality counts as violated \[m or rad\] (default: 1e-9, relative
+    /// to the characteristic length for gaps in m).
+    pub gap_tolerance: f64,
+    /// Complementarity tolerance: a contact force or stop effort of the wrong sign smaller
+    /// than this fraction of the largest applied force does not release it (default: 1e-9).
+    pub force_tolerance: f64,
 }
 
 impl Default for Options {
@@ -78,6 +104,11 @@ impl Default for Options {
             allow_unstable: false,
             record_iterates: false,
             linear_algebra: LinearAlgebra::Auto,
+            limits: Limits::Enforce,
+            friction: crate::model::Friction::None,
+            mu: None,
+            gap_tolerance: 1e-9,
+            force_tolerance: 1e-9,
         }
     }
 }

@@ -15,6 +15,8 @@ pub enum Termination {
     /// The energy decreases without bound (for example a prismatic joint along gravity with
     /// no spring or limit).
     Unbounded,
+    /// The active set of joint stops and contacts kept changing (`max_iterations` changes).
+    ActiveSetCycling,
 }
 
 impl Termination {
@@ -25,6 +27,7 @@ impl Termination {
             Termination::MaxIterations => "max_iterations",
             Termination::LineSearchFailed => "line_search_failed",
             Termination::Unbounded => "unbounded",
+            Termination::ActiveSetCycling => "active_set_cycling",
         }
     }
 }
@@ -172,6 +175,57 @@ pub struct Sizes {
     pub constraint_rows: usize,
 }
 
+/// How a contact point holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ContactState {
+    /// Frictionless contact: pushes along the normal only.
+    Touching,
+    /// Held tangentially where it first touched, within its friction coefficient (or none is
+    /// given).
+    Sticking,
+    /// Held tangentially, but needing more friction than its coefficient `mu`: the rest pose
+    /// found is not one the contact can hold; it would slide.
+    Slipping,
+}
+
+/// A contact point resting on a ground.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Contact {
+    /// The link whose collision shape touches.
+    pub link: String,
+    /// The ground it rests on.
+    pub ground: String,
+    /// The touching point (on the shape's surface), world frame \[m\].
+    pub point_world: [f64; 3],
+    /// The ground's normal (out of the ground), world frame.
+    pub normal_world: [f64; 3],
+    /// Gap `g` at the rest pose (0 up to the constraint tolerance) \[m\].
+    pub gap: f64,
+    /// Normal force the ground exerts on the link \[N\] (≥ 0).
+    pub normal_force: f64,
+    /// Tangential (friction) force the ground exerts on the link, world frame \[N\].
+    pub tangential_force: [f64; 3],
+    /// Friction coefficient the contact needs, `|f_t| / f_n` (0 when frictionless).
+    pub required_friction: f64,
+    /// Touching, sticking or slipping.
+    pub state: ContactState,
+}
+
+/// A joint resting on one of its stops.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ActiveLimit {
+    /// Joint name.
+    pub joint: String,
+    /// `lower` or `upper`.
+    pub bound: String,
+    /// The stop's position \[rad or m\].
+    pub value: f64,
+    /// Generalized force the stop exerts on the joint coordinate \[N m or N\]: positive on a
+    /// lower stop, negative on an upper one.
+    pub effort: f64,
+}
+
 /// The solve's report.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Report {
@@ -200,6 +254,12 @@ pub struct Report {
     /// The configuration at each entry of `history` (only with `Options::record_iterates`;
     /// with load stepping, the last stage's).
     pub iterates: Vec<crate::State>,
+    /// Contact points resting on the grounds.
+    pub contacts: Vec<Contact>,
+    /// Joints resting on a stop.
+    pub active_limits: Vec<ActiveLimit>,
+    /// Changes of the set of active stops and contacts (additions and releases).
+    pub active_set_changes: usize,
 }
 
 impl Report {

@@ -125,9 +125,9 @@ pub(crate) fn free_directions(model: &Model, q: &DVector<f64>, dq: &DVector<f64>
             out.push(format!(
                 "body `{}` translating along ({:.3}, {:.3}, {:.3})",
                 body.name,
-                t[0] / tn,
-                t[1] / tn,
-                t[2] / tn
+                shown(t[0] / tn),
+                shown(t[1] / tn),
+                shown(t[2] / tn)
             ));
         }
     }
@@ -163,4 +163,9 @@ mod tests {
             assert!(!run.record(5.886, &dq, 1.0));
         }
     }
+}
+
+/// `x` rounded to the 3 decimals shown, without a sign on zero (no "-0.000").
+fn shown(x: f64) -> f64 {
+    (x * 1000.0).round() / 1000.0 + 0.0
 }

@@ -9,8 +9,8 @@ use super::xml::{child, Source};
 use super::ImportOptions;
 use crate::error::Result;
 use crate::model::{
-    Effort, ForceLaw, Initial, JointId, JointKind, JointSpring, Load, Lock, Mimic, Spring,
-    SpringEnd, SpringMode,
+    ContactSettings, Effort, ForceLaw, Friction, Ground, Initial, JointId, JointKind, JointSpring,
+    Load, Lock, Mimic, Spring, SpringEnd, SpringMode,
 };
 use nalgebra::Vector3;
 use roxmltree::Node;
@@ -307,6 +307,38 @@ pub(super) fn read(
                     .ok_or_else(|| src.error(n, format!("{what} needs `value`")))?;
                 b.model.add_effort(Effort { joint, dof, value });
             }
+            "ground" => {
+                let name = n.attribute("name").unwrap_or("floor");
+                let origin = src.vec3_or(n, "xyz", Vector3::zeros())?;
+                let normal = src.vec3_or(n, "normal", Vector3::z())?;
+                b.model
+                    .add_ground(name, origin, normal)
+                    .map_err(|e| src.error(n, e.to_string()))?;
+            }
+            "contact" => {
+                let name = src.req(n, "link")?;
+                let i = *b.link_index.get(name).ok_or_else(|| {
+                    src.error(n, format!("{what} refers to an unknown link `{name}`"))
+                })?;
+                let friction = match n.attribute("friction") {
+                    None => None,
+                    Some("none") => Some(Friction::None),
+                    Some("stick") => Some(Friction::Stick),
+                    Some(other) => {
+                        return Err(src.error(
+                            n,
+                            format!("{what}: friction=\"{other}\" is not none or stick"),
+                        ))
+                    }
+                };
+                let mu = src.f64_opt(n, "mu")?;
+                if mu.is_some_and(|m| m < 0.0) {
+                    return Err(src.error(n, format!("{what}: mu must not be negative")));
+                }
+                let touches = src.bool_opt(n, "enabled")?.unwrap_or(true);
+                b.model
+                    .set_contact(i, touches, ContactSettings { friction, mu });
+            }
             "lock" => {
                 let (joint, dof) = joint_coord(src, n, b)?;
                 locks.push(Lock {
@@ -364,6 +396,17 @@ pub(super) fn read(
     }
     if !b.gravity_set {
         b.model.set_gravity(options.gravity);
+    }
+    let default = Ground::default();
+    if options.ground
+        && !b
+            .model
+            .grounds()
+            .iter()
+            .any(|g| g.origin == default.origin && g.normal == default.normal)
+    {
+        b.model
+            .add_ground(default.name, default.origin, default.normal)?;
     }
     let resolve = |name: &str, dof: usize, what: &str| -> Result<JointId> {
         let id = b

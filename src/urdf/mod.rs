@@ -43,6 +43,8 @@ pub struct ImportOptions {
     /// `--inertia-from-geometry DENSITY` \[kg/m³\]: links without `<inertial>` get the mass
     /// properties of their collision geometry (or visual, if none) at this density.
     pub inertia_density: Option<f64>,
+    /// Add the default ground plane (z = 0, +z up) unless the file declares that plane.
+    pub ground: bool,
 }
 
 impl Default for ImportOptions {
@@ -54,6 +56,7 @@ impl Default for ImportOptions {
             initial: Vec::new(),
             packages: Vec::new(),
             inertia_density: None,
+            ground: false,
         }
     }
 }

@@ -142,6 +142,16 @@ const ELEMENTS: &[Element] = &[
         children: &[],
     },
     Element {
+        name: "ground",
+        attributes: &["name", "xyz", "normal"],
+        children: &[],
+    },
+    Element {
+        name: "contact",
+        attributes: &["link", "enabled", "friction", "mu"],
+        children: &[],
+    },
+    Element {
         name: "initial",
         attributes: &["joint", "value", "dof"],
         children: &[],

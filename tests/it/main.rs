@@ -6,6 +6,7 @@ mod angles;
 mod architecture;
 mod cli;
 mod common;
+mod contact;
 mod degenerate;
 mod engineering;
 mod golden;

@@ -1,0 +1,267 @@
+//! Inequality constraints `g(q) ≥ 0`: joint stops and contact with the grounds.
+//!
+//! - Joint stop on coordinate `θ` of a revolute or prismatic joint with URDF limits:
+//!   `g = θ − lower ≥ 0` and `g = upper − θ ≥ 0`.
+//! - Contact of point `s` (radius `ρ`) of body `i` with the ground `(o, n)`:
+//!   `g = n·(r_i + A(p_i) s − o) − ρ ≥ 0`.
+//!
+//! An active inequality joins `Φ` as the row `g(q) = 0` (module docs of the solver's
+//! `active_set`); its multiplier `λ` (`V_qᵀ = Φ_qᵀ μ`) is the stop's holding effort or the
+//! contact's normal force, and must not be negative. A sticking contact adds the two tangential
+//! rows `t_k·(r_i + A(p_i) c − a) = 0`: `c` the material point that touched (body frame), `a`
+//! the world point where it touched, `t_1, t_2` an orthonormal basis of the ground plane; their
+//! multipliers are the friction force. (A sphere held at its material point can roll, as a real
+//! foot does; holding its centre would forbid rolling.)
+
+use crate::jet::{pair_of, Pair, Scalar};
+use crate::kinematics::{coordinate, Branches};
+use crate::model::{BodyId, JointId, Model};
+use nalgebra::{DVector, Vector3};
+
+/// Which side of a joint's range a stop holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Bound {
+    Lower,
+    Upper,
+}
+
+impl Bound {
+    /// `lower` or `upper`.
+    pub(crate) fn name(self) -> &'static str {
+        match self {
+            Bound::Lower => "lower",
+            Bound::Upper => "upper",
+        }
+    }
+}
+
+/// One inequality `g(q) ≥ 0`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Unilateral {
+    /// A stop of coordinate 0 of a joint at `value`.
+    Limit {
+        joint: JointId,
+        bound: Bound,
+        value: f64,
+    },
+    /// Contact point `point` (index into `Model::contact_points`) against ground `ground`.
+    Contact { point: usize, ground: usize },
+}
+
+/// Where a sticking contact is held: the material point of the shape that touched (body
+/// frame, on the shape's surface: a sphere's centre minus its radius along the normal at first
+/// touch) stays at the world point where it touched, tangentially. A sphere can still roll.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Anchor {
+    /// The world point where it first touched \[m\].
+    pub(crate) world: Vector3<f64>,
+    /// The material point that touched, body frame \[m\].
+    pub(crate) body: Vector3<f64>,
+}
+
+/// An inequality held as an equality: a stop the joint rests on, a contact that touches.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Active {
+    pub(crate) row: Unilateral,
+    /// Sticking contact: where it is held (tangential rows).
+    pub(crate) anchor: Option<Anchor>,
+}
+
+impl Active {
+    /// Number of constraint rows: 1, or 3 for a sticking contact.
+    pub(crate) fn row_count(&self) -> usize {
+        if self.anchor.is_some() {
+            3
+        } else {
+            1
+        }
+    }
+}
+
+/// Every inequality of `model`: both stops of each revolute or prismatic joint (tree or loop)
+/// with `<limit>` when `limits` is set, and every contact point against every ground.
+pub(crate) fn inequalities(model: &Model, limits: bool) -> Vec<Unilateral> {
+    let mut out = Vec::new();
+    if limits {
+        for (i, j) in model.joints.iter().enumerate() {
+            if j.merged || !j.kind.has_limits() {
+                continue;
+            }
+            if let Some([lo, hi]) = j.limits {
+                out.push(Unilateral::Limit {
+                    joint: JointId(i),
+                    bound: Bound::Lower,
+                    value: lo,
+                });
+                out.push(Unilateral::Limit {
+                    joint: JointId(i),
+                    bound: Bound::Upper,
+                    value: hi,
+                });
+            }
+        }
+    }
+    for point in 0..model.contact_points.len() {
+        for ground in 0..model.grounds.len() {
+            out.push(Unilateral::Contact { point, ground });
+        }
+    }
+    out
+}
+
+/// The bodies a row of `u` depends on.
+pub(crate) fn bodies(model: &Model, u: &Unilateral) -> [Option<BodyId>; 2] {
+    match *u {
+        Unilateral::Limit { joint, .. } => model.joints[joint.0].bodies,
+        Unilateral::Contact { point, .. } => [Some(model.contact_points[point].body), None],
+    }
+}
+
+/// Power of length in the unit of `g` (0 for an angle).
+pub(crate) fn length_power(model: &Model, u: &Unilateral) -> i32 {
+    match *u {
+        Unilateral::Limit { joint, .. } => i32::from(!model.joints[joint.0].kind.is_angle(0)),
+        Unilateral::Contact { .. } => 1,
+    }
+}
+
+/// Name of the inequality: `joint.lower_limit`, `link.contact[k]@ground`.
+pub(crate) fn name(model: &Model, u: &Unilateral) -> String {
+    match *u {
+        Unilateral::Limit { joint, bound, .. } => {
+            format!("{}.{}_limit", model.joints[joint.0].name, bound.name())
+        }
+        Unilateral::Contact { point, ground } => format!(
+            "{}.contact[{point}]@{}",
+            model.contact_points[point].link, model.grounds[ground].name
+        ),
+    }
+}
+
+/// An orthonormal basis `t_1, t_2` of the plane with unit normal `n`.
+pub(crate) fn tangents(n: &Vector3<f64>) -> [Vector3<f64>; 2] {
+    let helper = if n.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    let t1 = n.cross(&helper).normalize();
+    [t1, n.cross(&t1)]
+}
+
+/// World position of a contact point at `q` (value only).
+pub(crate) fn point_world(model: &Model, point: usize, q: &DVector<f64>) -> Vector3<f64> {
+    let c = &model.contact_points[point];
+    let pair = pair_of(&[Some(c.body), None], q, false);
+    pair.point(0, &c.point).v
+}
+
+/// The rows of `a` as jets over the pair of `bodies(model, &a.row)`: `g`, then the two
+/// tangential rows of a sticking contact. `None` where a joint coordinate is undefined.
+pub(crate) fn rows(
+    model: &Model,
+    a: &Active,
+    pair: &Pair,
+    branches: &Branches,
+) -> Option<Vec<Scalar>> {
+    match a.row {
+        Unilateral::Limit {
+            joint,
+            bound,
+            value,
+        } => {
+            let j = &model.joints[joint.0];
+            let theta = coordinate(j, pair, 0, branches.get(joint, 0))?;
+            Some(vec![match bound {
+                Bound::Lower => theta.minus(value),
+                Bound::Upper => theta.minus(value).scale(-1.0),
+            }])
+        }
+        Unilateral::Contact { point, ground } => {
+            let c = &model.contact_points[point];
+            let gr = &model.grounds[ground];
+            let x = pair.point(0, &c.point);
+            let n = pair.vector(1, &gr.normal);
+            let mut out = vec![pair
+                .dot(&x.sub(&pair.point(1, &gr.origin)), &n)
+                .minus(c.radius)];
+            if let Some(anchor) = a.anchor {
+                let d = pair
+                    .point(0, &anchor.body)
+                    .sub(&pair.point(1, &anchor.world));
+                for t in tangents(&gr.normal) {
+                    out.push(pair.dot(&d, &pair.vector(1, &t)));
+                }
+            }
+            Some(out)
+        }
+    }
+}
+
+/// `g(q)` (value only); `None` where a joint coordinate is undefined.
+pub(crate) fn gap(
+    model: &Model,
+    u: &Unilateral,
+    q: &DVector<f64>,
+    branches: &Branches,
+) -> Option<f64> {
+    let pair = pair_of(&bodies(model, u), q, false);
+    rows(
+        model,
+        &Active {
+            row: *u,
+            anchor: None,
+        },
+        &pair,
+        branches,
+    )
+    .map(|r| r[0].v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::jet::testing::{check_scalar, sample_pair};
+    use crate::model::{ContactPoint, ContactSettings, Ground, ModelBuilder};
+    use nalgebra::Matrix3;
+
+    /// The gap and tangential rows of a contact match finite differences (gradient and
+    /// Hessian).
+    #[test]
+    fn contact_rows_match_finite_differences() {
+        let mut b = ModelBuilder::new("t");
+        let body = b.add_rigid_body("b", 1.0, Vector3::zeros(), Matrix3::identity());
+        b.add_ground(
+            "g",
+            Vector3::new(0.1, -0.2, 0.3),
+            Vector3::new(0.2, 0.3, 1.0),
+        )
+        .unwrap();
+        let mut m = b.build().unwrap();
+        m.contact_points.push(ContactPoint {
+            link: "b".into(),
+            body,
+            point: Vector3::new(0.3, -0.1, 0.2),
+            radius: 0.05,
+            settings: ContactSettings::default(),
+        });
+        let _ = Ground::default();
+        let a = Active {
+            row: Unilateral::Contact {
+                point: 0,
+                ground: 0,
+            },
+            anchor: Some(Anchor {
+                world: Vector3::new(0.5, 0.4, -0.1),
+                body: Vector3::new(0.2, -0.3, 0.1),
+            }),
+        };
+        for k in 0..3 {
+            check_scalar(
+                &sample_pair(7),
+                &|p: &Pair| rows(&m, &a, p, &Branches::default()).unwrap()[k].clone(),
+                "contact row",
+            );
+        }
+    }
+}

@@ -1,0 +1,399 @@
+//! Joint stops and ground contact: minimize `V(q)` subject to `Φ(q) = 0` and `g(q) ≥ 0` by an
+//! active-set extension of coordinate partitioning.
+//!
+//! The active inequalities `A` join `Φ` as rows `g_k(q) = 0`, and the equality-constrained
+//! problem is solved as any other (partition, reduced Newton, corrector). Then:
+//! - a step that would make an inactive `g_k` negative is cut by bisection on the step length
+//!   (through the corrector) where the first one reaches `|g_k| ≤ tol`; every inequality within
+//!   `tol` of its boundary there joins `A`, and the partition is recomputed;
+//! - at a stationary point, the multipliers `λ_k` of the active rows (`V_qᵀ = Φ_qᵀ μ`) are the
+//!   stops' efforts and the contacts' normal forces; the one most negative below
+//!   `−force_tolerance · F` (`F` the weight and loads of the mechanism) leaves `A`;
+//! - it stops when every `λ_k ≥ −force_tolerance · F` and every `g_k ≥ −tol`
+//!   (complementarity `g_k λ_k = 0` holds by construction: active rows have `g = 0`, inactive
+//!   ones `λ = 0`), or after `max_iterations` changes of `A` (reported as cycling).
+//!
+//! Gaps are compared dimensionless: lengths divided by the characteristic length `L`, angles
+//! as they are; `tol = gap_tolerance`. Redundant active rows (a box flat on the ground has four
+//! supporting vertices for three degrees of freedom) are handled by the partition, which gives
+//! them no multiplier: the force distribution reported is then one admissible distribution of a
+//! statically indeterminate support. Stability is judged on the tangent space of all active
+//! rows.
+//!
+//! ## References
+//! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §16.5
+//!   (active-set methods), §15.4 (handling inequalities in reduced-gradient methods).
+
+use super::options::{Limits, Options};
+use super::partition::Partition;
+use super::system::{Eval, System};
+use crate::constraints::unilateral::{self, Active, Unilateral};
+use crate::kinematics::Branches;
+use crate::model::{Friction, Model};
+use nalgebra::{DVector, Vector3};
+
+/// The inactive inequalities that a step must not violate.
+pub(crate) struct Guard<'m> {
+    model: &'m Model,
+    pub(crate) inactive: Vec<Unilateral>,
+    tol: f64,
+}
+
+impl<'m> Guard<'m> {
+    pub(crate) fn new(model: &'m Model, inactive: Vec<Unilateral>, tol: f64) -> Self {
+        Guard {
+            model,
+            inactive,
+            tol,
+        }
+    }
+
+    /// No inequality to watch.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.inactive.is_empty()
+    }
+
+    /// Dimensionless gap of inequality `k`.
+    fn gap(&self, k: usize, q: &DVector<f64>, branches: &Branches) -> f64 {
+        let u = &self.inactive[k];
+        let g = unilateral::gap(self.model, u, q, branches).unwrap_or(f64::INFINITY);
+        dimensionless(self.model, u, g)
+    }
+
+    /// The lowest dimensionless gap and its inequality.
+    fn lowest(&self, q: &DVector<f64>, branches: &Branches) -> Option<(usize, f64)> {
+        (0..self.inactive.len())
+            .map(|k| (k, self.gap(k, q, branches)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+    }
+
+    /// Whether the step from `from` to `to` brings one of the inequalities closer to its
+    /// boundary (a linear descent may then end on it, and is not unbounded).
+    pub(crate) fn approaching(&self, sys: &System, from: &DVector<f64>, to: &DVector<f64>) -> bool {
+        let b = &sys.cons.branches;
+        (0..self.inactive.len()).any(|k| self.gap(k, to, b) < self.gap(k, from, b) - self.tol)
+    }
+
+    /// Whether `q` violates one of the inequalities by more than the tolerance.
+    pub(crate) fn violated(&self, sys: &System, q: &DVector<f64>) -> bool {
+        self.lowest(q, &sys.cons.branches)
+            .is_some_and(|(_, g)| g < -self.tol)
+    }
+
+    /// The corrected point `q(α) = correct(q + α dq)` on the boundary of the first inequality
+    /// met along `α ∈ [0, alpha]` (bisection), and the inequalities within the tolerance of
+    /// their boundary there.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn boundary(
+        &self,
+        sys: &mut System,
+        q: &DVector<f64>,
+        dq: &DVector<f64>,
+        alpha: f64,
+        part: &Partition,
+        options: &Options,
+        eval: &Eval,
+    ) -> Option<(DVector<f64>, Vec<usize>)> {
+        let (mut lo, mut hi) = (0.0, alpha);
+        let mut q_lo = q.clone();
+        for _ in 0..80 {
+            let mid = 0.5 * (lo + hi);
+            let mut qm = q + dq * mid;
+            if sys
+                .correct_from(
+                    &mut qm,
+                    part,
+                    options.constraint_tolerance,
+                    options.max_corrector_iterations,
+                    Some(&eval.factors),
+                )
+                .is_err()
+            {
+                hi = mid;
+                continue;
+            }
+            let (_, g) = self.lowest(&qm, &sys.cons.branches)?;
+            if g < -self.tol {
+                hi = mid;
+            } else {
+                lo = mid;
+                q_lo = qm;
+                if g <= self.tol {
+                    break;
+                }
+            }
+        }
+        let branches = &sys.cons.branches;
+        let touching: Vec<usize> = (0..self.inactive.len())
+            .filter(|&k| self.gap(k, &q_lo, branches) <= self.tol)
+            .collect();
+        if touching.is_empty() {
+            return None;
+        }
+        Some((q_lo, touching))
+    }
+}
+
+/// `g` divided by the characteristic length for a gap in m.
+fn dimensionless(model: &Model, u: &Unilateral, g: f64) -> f64 {
+    if unilateral::length_power(model, u) == 1 {
+        g / model.length_scale
+    } else {
+        g
+    }
+}
+
+/// Every inequality of the model under `options`.
+pub(crate) fn inequalities(model: &Model, options: &Options) -> Vec<Unilateral> {
+    unilateral::inequalities(model, options.limits == Limits::Enforce)
+}
+
+/// `u` made active at `q`: a sticking contact is anchored at the point's projection on the
+/// ground.
+pub(crate) fn activate(
+    model: &Model,
+    options: &Options,
+    u: Unilateral,
+    q: &DVector<f64>,
+) -> Active {
+    let anchor = match u {
+        Unilateral::Contact { point, ground } => {
+            let c = &model.contact_points[point];
+            let friction = c.settings.friction.unwrap_or(options.friction);
+            (friction == Friction::Stick).then(|| {
+                let gr = &model.grounds[ground];
+                let x = unilateral::point_world(model, point, q);
+                let g = gr.normal.dot(&(x - gr.origin)) - c.radius;
+                let i = 7 * c.body.0;
+                let p = nalgebra::Vector4::new(q[i + 3], q[i + 4], q[i + 5], q[i + 6]);
+                let a = crate::math::rotation(&p);
+                unilateral::Anchor {
+                    world: x - gr.normal * (g + c.radius),
+                    body: c.point - a.transpose() * gr.normal * c.radius,
+                }
+            })
+        }
+        Unilateral::Limit { .. } => None,
+    };
+    Active { row: u, anchor }
+}
+
+/// Force scale `F` of the mechanism \[N\]: its weight plus the dead loads, and the joint
+/// efforts divided by the characteristic length (at least 1e-12).
+pub(crate) fn force_scale(model: &Model) -> f64 {
+    let weight: f64 =
+        model.bodies.iter().map(|b| b.gravity_mass).sum::<f64>() * model.gravity.norm();
+    let loads: f64 = model.loads.iter().map(|l| l.force.norm()).sum();
+    let efforts: f64 =
+        model.efforts.iter().map(|e| e.value.abs()).sum::<f64>() / model.length_scale;
+    (weight + loads + efforts).max(1e-12)
+}
+
+/// Multipliers of the rows of each active inequality (`g` first, then the tangential rows),
+/// from the multipliers `mu` of the independent rows `part.rows` of `cons` (redundant rows:
+/// 0).
+pub(crate) fn active_multipliers(
+    cons: &crate::constraints::Constraints,
+    part: &Partition,
+    mu: &DVector<f64>,
+) -> Vec<(Active, Vec<f64>)> {
+    let mut full = vec![0.0; cons.len()];
+    for (k, &row) in part.rows.iter().enumerate() {
+        full[row] = mu[k];
+    }
+    cons.blocks
+        .iter()
+        .filter_map(|b| match &b.kind {
+            crate::constraints::BlockKind::Unilateral(a) => {
+                Some((*a, (0..a.row_count()).map(|k| full[b.first + k]).collect()))
+            }
+            _ => None,
+        })
+        .collect()
+}
+
+/// The inequality whose multiplier is most negative relative to `scale` (a stop's effort in
+/// N m divided by the characteristic length), if below `−threshold`.
+pub(crate) fn to_release(
+    model: &Model,
+    multipliers: &[(Active, Vec<f64>)],
+    threshold: f64,
+) -> Option<usize> {
+    multipliers
+        .iter()
+        .enumerate()
+        .map(|(i, (a, m))| {
+            let lambda = match a.row {
+                Unilateral::Limit { joint, .. } if model.joints[joint.0].kind.is_angle(0) => {
+                    m[0] / model.length_scale
+                }
+                _ => m[0],
+            };
+            (i, lambda)
+        })
+        .filter(|&(_, l)| l < -threshold)
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(i, _)| i)
+}
+
+/// The world point where a contact touches: the point minus its radius along the normal.
+pub(crate) fn touch_point(model: &Model, a: &Active, q: &DVector<f64>) -> Option<Vector3<f64>> {
+    match a.row {
+        Unilateral::Contact { point, ground } => {
+            let x = unilateral::point_world(model, point, q);
+            Some(x - model.grounds[ground].normal * model.contact_points[point].radius)
+        }
+        Unilateral::Limit { .. } => None,
+    }
+}
+
+/// The active-set iteration from an assembled state (module docs).
+///
+/// # Errors
+/// As [`crate::solve`]; [`crate::Error::Assembly`] if the initially violated inequalities
+/// cannot be met together with the joints.
+pub(crate) fn solve(
+    model: &Model,
+    start: crate::State,
+    locks: &[(crate::model::JointId, usize, f64)],
+    options: &Options,
+) -> crate::Result<(crate::State, super::Report)> {
+    let all = inequalities(model, options);
+    let tol = options.gap_tolerance;
+    let threshold = options.force_tolerance * force_scale(model);
+    let mut state = start;
+    // Inequalities violated or touching at the start are active from the start (a sticking
+    // contact that touches at the start is held where it is).
+    let mut active: Vec<Active> = all
+        .iter()
+        .filter(|u| {
+            unilateral::gap(model, u, &state.q, &state.branches)
+                .is_some_and(|g| dimensionless(model, u, g) <= tol)
+        })
+        .map(|&u| activate(model, options, u, &state.q))
+        .collect();
+    let mut changes = active.len();
+    let mut iterations = 0;
+    let mut counters = super::Diagnostics::default();
+    loop {
+        let mut branches = state.branches.clone();
+        let q = super::assemble::project(model, state.q, &mut branches, locks, &active, options)?;
+        let inactive: Vec<Unilateral> = all
+            .iter()
+            .filter(|u| !active.iter().any(|a| a.row == **u))
+            .copied()
+            .collect();
+        let guard = Guard::new(model, inactive, tol);
+        let round = super::solve_round(
+            model,
+            crate::State { q, branches },
+            locks,
+            &active,
+            Some(&guard),
+            options,
+        )?;
+        iterations += round.report.iterations;
+        counters.add_counts(&round.report.diagnostics);
+        state = round.state;
+        let mut report = round.report;
+        let cycling = changes >= options.max_iterations;
+        if let (Some(hit), false) = (&round.blocked, cycling) {
+            for &k in hit {
+                active.push(activate(model, options, guard.inactive[k], &state.q));
+                changes += 1;
+            }
+            continue;
+        }
+        if report.converged() && !cycling {
+            if let Some(i) = to_release(model, &round.multipliers, threshold) {
+                active.remove(i);
+                changes += 1;
+                continue;
+            }
+        }
+        if cycling {
+            report.termination = super::Termination::ActiveSetCycling;
+        }
+        report.iterations = iterations;
+        let own = report.diagnostics.clone();
+        report.diagnostics = counters;
+        report.diagnostics.gradient_norm = own.gradient_norm;
+        report.diagnostics.gradient_tolerance = own.gradient_tolerance;
+        report.diagnostics.constraint_residual = own.constraint_residual;
+        report.diagnostics.linear_algebra = own.linear_algebra;
+        report.diagnostics.eigenvalues_by = own.eigenvalues_by;
+        report.diagnostics.free_directions = own.free_directions;
+        report.diagnostics.load_steps = 1;
+        report.active_set_changes = changes;
+        describe(model, options, &state, &round.multipliers, &mut report);
+        return Ok((state, report));
+    }
+}
+
+/// Fills the report's `contacts` and `active_limits` from the multipliers of the active rows.
+fn describe(
+    model: &Model,
+    options: &Options,
+    state: &crate::State,
+    multipliers: &[(Active, Vec<f64>)],
+    report: &mut super::Report,
+) {
+    use super::report::{ActiveLimit, Contact, ContactState};
+    for (a, m) in multipliers {
+        match a.row {
+            Unilateral::Limit {
+                joint,
+                bound,
+                value,
+            } => report.active_limits.push(ActiveLimit {
+                joint: model.joints[joint.0].name.clone(),
+                bound: bound.name().into(),
+                value,
+                effort: match bound {
+                    unilateral::Bound::Lower => m[0],
+                    unilateral::Bound::Upper => -m[0],
+                },
+            }),
+            Unilateral::Contact { point, ground } => {
+                let c = &model.contact_points[point];
+                let gr = &model.grounds[ground];
+                let gap = unilateral::gap(model, &a.row, &state.q, &state.branches).unwrap_or(0.0);
+                let mut ft = Vector3::zeros();
+                if a.anchor.is_some() {
+                    let [t1, t2] = unilateral::tangents(&gr.normal);
+                    ft = t1 * m[1] + t2 * m[2];
+                }
+                let fnorm = m[0];
+                let required = if ft.norm() == 0.0 {
+                    0.0
+                } else if fnorm > 0.0 {
+                    ft.norm() / fnorm
+                } else {
+                    f64::INFINITY
+                };
+                let mu = c.settings.mu.or(options.mu);
+                let contact_state = match (a.anchor, mu) {
+                    (None, _) => ContactState::Touching,
+                    (Some(_), Some(mu)) if required > mu => ContactState::Slipping,
+                    (Some(_), _) => ContactState::Sticking,
+                };
+                let p = touch_point(model, a, &state.q).unwrap_or_default();
+                report.contacts.push(Contact {
+                    link: c.link.clone(),
+                    ground: gr.name.clone(),
+                    point_world: p.into(),
+                    normal_world: gr.normal.into(),
+                    gap,
+                    normal_force: fnorm,
+                    tangential_force: ft.into(),
+                    required_friction: if required.is_finite() {
+                        required
+                    } else {
+                        f64::MAX
+                    },
+                    state: contact_state,
+                });
+            }
+        }
+    }
+}

@@ -10,8 +10,8 @@
 //! and coordinate index it was given, so a made-up id is an error, never a panic later.
 
 use super::{
-    Body, BodyId, ContactPoint, ContactSettings, Effort, ForceLaw, Ground, Initial, Joint, JointId,
-    JointKind, JointSpring, Link, Load, Lock, Mimic, Model, Spring,
+    Body, BodyId, ContactSettings, Effort, ForceLaw, Initial, Joint, JointId, JointKind,
+    JointSpring, Link, Load, Lock, Mimic, Model, Spring,
 };
 use crate::error::{Error, Result, SourceLocation};
 use crate::geometry::Geometry;
@@ -62,13 +62,13 @@ impl Inertial {
 /// ```
 #[derive(Clone, Debug)]
 pub struct ModelBuilder {
-    model: Model,
+    pub(super) model: Model,
     inertials: Vec<Inertial>,
     no_gravity: Vec<bool>,
     joint_names: HashMap<String, JointId>,
     link_names: HashMap<String, usize>,
     /// `(link index, touches, settings)` from `mech:contact`.
-    contacts: Vec<(usize, bool, ContactSettings)>,
+    pub(super) contacts: Vec<(usize, bool, ContactSettings)>,
 }
 
 impl ModelBuilder {
@@ -99,45 +99,6 @@ impl ModelBuilder {
             link_names: HashMap::new(),
             contacts: Vec::new(),
         }
-    }
-
-    /// Adds a ground plane through `origin` with the normal `normal` (pointing out of the
-    /// ground; normalized here).
-    ///
-    /// # Errors
-    /// [`Error::Model`] for a zero or non-finite normal or a non-finite origin.
-    pub fn add_ground(
-        &mut self,
-        name: impl Into<String>,
-        origin: Vector3<f64>,
-        normal: Vector3<f64>,
-    ) -> Result<()> {
-        let name = name.into();
-        let len = normal.norm();
-        if !(len.is_finite() && len > 1e-12) || !origin.iter().all(|x| x.is_finite()) {
-            return Err(Error::Model(format!(
-                "ground `{name}` needs a finite origin and a non-zero normal (got normal {} {} {})",
-                normal.x, normal.y, normal.z
-            )));
-        }
-        self.model.grounds.push(Ground {
-            name,
-            origin,
-            normal: normal / len,
-        });
-        Ok(())
-    }
-
-    /// Selects whether the link with index `link` touches the grounds (`mech:contact`). With
-    /// no selection at all, every moving link with collision geometry does.
-    pub fn set_contact(&mut self, link: usize, touches: bool, settings: ContactSettings) {
-        self.contacts.retain(|c| c.0 != link);
-        self.contacts.push((link, touches, settings));
-    }
-
-    /// The grounds added so far.
-    pub fn grounds(&self) -> &[Ground] {
-        &self.model.grounds
     }
 
     /// Sets gravity in the world frame \[m/s²\].
@@ -350,52 +311,10 @@ impl ModelBuilder {
     pub fn build(mut self) -> Result<Model> {
         self.validate()?;
         aggregate_mass(&mut self.model, &self.inertials, &self.no_gravity);
-        self.model.contact_points = self.contact_points()?;
+        self.model.contact_points = super::contact::points(&self.model, &self.contacts)?;
         self.model.length_scale = length_scale(&self.model);
         self.model.index_names();
         Ok(self.model)
-    }
-
-    /// The contact points of the links that touch the grounds, in their body frames.
-    fn contact_points(&self) -> Result<Vec<ContactPoint>> {
-        let m = &self.model;
-        if m.grounds.is_empty() {
-            return Ok(Vec::new());
-        }
-        let explicit = self.contacts.iter().any(|c| c.1);
-        let mut out = Vec::new();
-        for (i, l) in m.links.iter().enumerate() {
-            let Some(body) = l.body else { continue };
-            let chosen = self.contacts.iter().find(|c| c.0 == i);
-            let (touches, settings) = match chosen {
-                Some(&(_, t, s)) => (t, s),
-                None => (!explicit, ContactSettings::default()),
-            };
-            if !touches {
-                continue;
-            }
-            if chosen.is_some() && l.collisions.is_empty() {
-                return Err(Error::Model(format!(
-                    "link `{}` is selected for contact but has no <collision> geometry",
-                    l.name
-                )));
-            }
-            for g in &l.collisions {
-                let pts = crate::geometry::contact_points(g).map_err(|e| {
-                    Error::Model(format!("contact points of link `{}`: {e}", l.name))
-                })?;
-                for (p, radius) in pts {
-                    out.push(ContactPoint {
-                        link: l.name.clone(),
-                        body,
-                        point: (l.body_from_link * Point3::from(p)).coords,
-                        radius,
-                        settings,
-                    });
-                }
-            }
-        }
-        Ok(out)
     }
 
     fn validate(&self) -> Result<()> {

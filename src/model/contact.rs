@@ -9,8 +9,9 @@
 //! linear in the body's position and quadratic in its Euler parameters: smooth everywhere, so
 //! Newton converges on an active contact as on any other constraint row.
 
-use super::BodyId;
-use nalgebra::Vector3;
+use super::{BodyId, Model, ModelBuilder};
+use crate::error::{Error, Result};
+use nalgebra::{Point3, Vector3};
 
 /// A ground plane (`mech:ground`, or the default plane z = 0 with +z up).
 #[derive(Clone, Debug, PartialEq)]
@@ -69,4 +70,94 @@ pub struct ContactPoint {
     pub radius: f64,
     /// Friction settings of the link.
     pub settings: ContactSettings,
+}
+
+/// The contact points of the links that touch the grounds, in their body frames: the links
+/// selected by `contacts` (`(link index, touches, settings)`), or with no selection every
+/// moving link with collision geometry.
+///
+/// # Errors
+/// [`Error::Model`] for a selected link without collision geometry, or a mesh that cannot be
+/// read.
+pub(crate) fn points(
+    m: &Model,
+    contacts: &[(usize, bool, ContactSettings)],
+) -> Result<Vec<ContactPoint>> {
+    if m.grounds.is_empty() {
+        return Ok(Vec::new());
+    }
+    let explicit = contacts.iter().any(|c| c.1);
+    let mut out = Vec::new();
+    for (i, l) in m.links.iter().enumerate() {
+        let Some(body) = l.body else { continue };
+        let chosen = contacts.iter().find(|c| c.0 == i);
+        let (touches, settings) = match chosen {
+            Some(&(_, t, s)) => (t, s),
+            None => (!explicit, ContactSettings::default()),
+        };
+        if !touches {
+            continue;
+        }
+        if chosen.is_some() && l.collisions.is_empty() {
+            return Err(Error::Model(format!(
+                "link `{}` is selected for contact but has no <collision> geometry",
+                l.name
+            )));
+        }
+        for g in &l.collisions {
+            let pts = crate::geometry::contact_points(g)
+                .map_err(|e| Error::Model(format!("contact points of link `{}`: {e}", l.name)))?;
+            for (p, radius) in pts {
+                out.push(ContactPoint {
+                    link: l.name.clone(),
+                    body,
+                    point: (l.body_from_link * Point3::from(p)).coords,
+                    radius,
+                    settings,
+                });
+            }
+        }
+    }
+    Ok(out)
+}
+
+impl ModelBuilder {
+    /// Adds a ground plane through `origin` with the normal `normal` (pointing out of the
+    /// ground; normalized here).
+    ///
+    /// # Errors
+    /// [`Error::Model`] for a zero or non-finite normal or a non-finite origin.
+    pub fn add_ground(
+        &mut self,
+        name: impl Into<String>,
+        origin: Vector3<f64>,
+        normal: Vector3<f64>,
+    ) -> Result<()> {
+        let name = name.into();
+        let len = normal.norm();
+        if !(len.is_finite() && len > 1e-12) || !origin.iter().all(|x| x.is_finite()) {
+            return Err(Error::Model(format!(
+                "ground `{name}` needs a finite origin and a non-zero normal (got normal {} {} {})",
+                normal.x, normal.y, normal.z
+            )));
+        }
+        self.model.grounds.push(Ground {
+            name,
+            origin,
+            normal: normal / len,
+        });
+        Ok(())
+    }
+
+    /// Selects whether the link with index `link` touches the grounds (`mech:contact`). With
+    /// no selection at all, every moving link with collision geometry does.
+    pub fn set_contact(&mut self, link: usize, touches: bool, settings: ContactSettings) {
+        self.contacts.retain(|c| c.0 != link);
+        self.contacts.push((link, touches, settings));
+    }
+
+    /// The grounds added so far.
+    pub fn grounds(&self) -> &[Ground] {
+        &self.model.grounds
+    }
 }

@@ -48,11 +48,6 @@ impl<'m> Guard<'m> {
         }
     }
 
-    /// No inequality to watch.
-    pub(crate) fn is_empty(&self) -> bool {
-        self.inactive.is_empty()
-    }
-
     /// Dimensionless gap of inequality `k`.
     fn gap(&self, k: usize, q: &DVector<f64>, branches: &Branches) -> f64 {
         let u = &self.inactive[k];
@@ -70,13 +65,13 @@ impl<'m> Guard<'m> {
     /// Whether the step from `from` to `to` brings one of the inequalities closer to its
     /// boundary (a linear descent may then end on it, and is not unbounded).
     pub(crate) fn approaching(&self, sys: &System, from: &DVector<f64>, to: &DVector<f64>) -> bool {
-        let b = &sys.cons.branches;
+        let b = &sys.problem.cons.branches;
         (0..self.inactive.len()).any(|k| self.gap(k, to, b) < self.gap(k, from, b) - self.tol)
     }
 
     /// Whether `q` violates one of the inequalities by more than the tolerance.
     pub(crate) fn violated(&self, sys: &System, q: &DVector<f64>) -> bool {
-        self.lowest(q, &sys.cons.branches)
+        self.lowest(q, &sys.problem.cons.branches)
             .is_some_and(|(_, g)| g < -self.tol)
     }
 
@@ -112,7 +107,7 @@ impl<'m> Guard<'m> {
                 hi = mid;
                 continue;
             }
-            let (_, g) = self.lowest(&qm, &sys.cons.branches)?;
+            let (_, g) = self.lowest(&qm, &sys.problem.cons.branches)?;
             if g < -self.tol {
                 hi = mid;
             } else {
@@ -123,7 +118,7 @@ impl<'m> Guard<'m> {
                 }
             }
         }
-        let branches = &sys.cons.branches;
+        let branches = &sys.problem.cons.branches;
         let touching: Vec<usize> = (0..self.inactive.len())
             .filter(|&k| self.gap(k, &q_lo, branches) <= self.tol)
             .collect();

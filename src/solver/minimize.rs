@@ -367,7 +367,7 @@ pub(crate) fn minimize(
         match accepted {
             Some((qt, et, _)) if blocked.is_some() => {
                 q = qt;
-                sys.cons.branches.follow(sys.model, &q);
+                sys.problem.cons.branches.follow(sys.problem.model, &q);
                 eval = et;
                 iteration += 1;
                 history.push(Iterate {

@@ -341,7 +341,7 @@ pub(crate) fn solve_round(
         stability(&sys, &out.q, &out.part, &out.eval, &eig)
     });
     let reactions = reactions::reactions(&sys, &out.q, &out.part, &out.eval);
-    let multipliers = active_set::active_multipliers(&sys.cons, &out.part, &out.eval.mu);
+    let multipliers = active_set::active_multipliers(&sys.problem.cons, &out.part, &out.eval.mu);
     let blocked = out.blocked;
     diagnostics.timings.stability = stability_started.elapsed().as_secs_f64();
     let report = Report {

@@ -135,7 +135,7 @@ impl ModelBuilder {
     ) -> Result<()> {
         let name = name.into();
         let len = normal.norm();
-        if !(len.is_finite() && len > 1e-12) || !origin.iter().all(|x| x.is_finite()) {
+        if !(len.is_finite() && len > 1e-12 && origin.iter().all(|x| x.is_finite())) {
             return Err(Error::Model(format!(
                 "ground `{name}` needs a finite origin and a non-zero normal (got normal {} {} {})",
                 normal.x, normal.y, normal.z

@@ -134,6 +134,11 @@ pub(crate) fn free_directions(model: &Model, q: &DVector<f64>, dq: &DVector<f64>
     out
 }
 
+/// `x` rounded to the 3 decimals shown, without a sign on zero (no "-0.000").
+fn shown(x: f64) -> f64 {
+    (x * 1000.0).round() / 1000.0 + 0.0
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -163,9 +168,4 @@ mod tests {
             assert!(!run.record(5.886, &dq, 1.0));
         }
     }
-}
-
-/// `x` rounded to the 3 decimals shown, without a sign on zero (no "-0.000").
-fn shown(x: f64) -> f64 {
-    (x * 1000.0).round() / 1000.0 + 0.0
 }

@@ -152,8 +152,10 @@ pub(crate) fn tangents(n: &Vector3<f64>) -> [Vector3<f64>; 2] {
 /// World position of a contact point at `q` (value only).
 pub(crate) fn point_world(model: &Model, point: usize, q: &DVector<f64>) -> Vector3<f64> {
     let c = &model.contact_points[point];
-    let pair = pair_of(&[Some(c.body), None], q, false);
-    pair.point(0, &c.point).v
+    let i = 7 * c.body.0;
+    let r = Vector3::new(q[i], q[i + 1], q[i + 2]);
+    let p = nalgebra::Vector4::new(q[i + 3], q[i + 4], q[i + 5], q[i + 6]);
+    r + crate::math::rotation(&p) * c.point
 }
 
 /// The rows of `a` as jets over the pair of `bodies(model, &a.row)`: `g`, then the two
@@ -205,17 +207,28 @@ pub(crate) fn gap(
     q: &DVector<f64>,
     branches: &Branches,
 ) -> Option<f64> {
-    let pair = pair_of(&bodies(model, u), q, false);
-    rows(
-        model,
-        &Active {
-            row: *u,
-            anchor: None,
-        },
-        &pair,
-        branches,
-    )
-    .map(|r| r[0].v)
+    // Values only: no jets, no allocation (called for every inactive inequality at every
+    // trial point of the line search).
+    match *u {
+        Unilateral::Limit {
+            joint,
+            bound,
+            value,
+        } => {
+            let j = &model.joints[joint.0];
+            let pair = pair_of(&j.bodies, q, false);
+            let theta = coordinate(j, &pair, 0, branches.get(joint, 0))?.v;
+            Some(match bound {
+                Bound::Lower => theta - value,
+                Bound::Upper => value - theta,
+            })
+        }
+        Unilateral::Contact { point, ground } => {
+            let gr = &model.grounds[ground];
+            let x = point_world(model, point, q);
+            Some(gr.normal.dot(&(x - gr.origin)) - model.contact_points[point].radius)
+        }
+    }
 }
 
 #[cfg(test)]

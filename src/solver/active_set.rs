@@ -158,7 +158,7 @@ pub(crate) fn activate(
             (friction == Friction::Stick).then(|| {
                 let gr = &model.grounds[ground];
                 let x = unilateral::point_world(model, point, q);
-                let g = gr.normal.dot(&(x - gr.origin)) - c.radius;
+                let g = unilateral::gap(model, &u, q, &Branches::default()).unwrap_or(0.0);
                 let i = 7 * c.body.0;
                 let p = nalgebra::Vector4::new(q[i + 3], q[i + 4], q[i + 5], q[i + 6]);
                 let a = crate::math::rotation(&p);

@@ -370,14 +370,6 @@ pub(crate) fn minimize(
                 sys.problem.cons.branches.follow(sys.problem.model, &q);
                 eval = et;
                 iteration += 1;
-                history.push(Iterate {
-                    iteration,
-                    potential_energy: eval.energy.total,
-                    gradient_norm: eval.grad_v.amax(),
-                });
-                if options.record_iterates {
-                    iterates.push(q.clone());
-                }
                 break;
             }
             Some((qt, et, alpha)) => {
@@ -408,14 +400,6 @@ pub(crate) fn minimize(
                     termination = Termination::Unbounded;
                     diag.free_directions =
                         super::unbounded::free_directions(sys.problem.model, &q, &(&dq * alpha));
-                    history.push(Iterate {
-                        iteration,
-                        potential_energy: eval.energy.total,
-                        gradient_norm: eval.grad_v.amax(),
-                    });
-                    if options.record_iterates {
-                        iterates.push(q.clone());
-                    }
                     break;
                 }
                 // Re-partition when Φ_u becomes ill-conditioned.
@@ -431,6 +415,17 @@ pub(crate) fn minimize(
                 termination = Termination::LineSearchFailed;
                 break;
             }
+        }
+    }
+    // A step accepted just before leaving the loop (blocked, unbounded) is recorded here.
+    if history.last().map(|h: &Iterate| h.iteration) != Some(iteration) {
+        history.push(Iterate {
+            iteration,
+            potential_energy: eval.energy.total,
+            gradient_norm: eval.grad_v.amax(),
+        });
+        if options.record_iterates {
+            iterates.push(q.clone());
         }
     }
     diag.gradient_norm = eval.grad_v.amax();

@@ -120,7 +120,14 @@ fn write_rrd(
     state: &restpose::State,
     report: &restpose::Report,
 ) -> anyhow::Result<()> {
-    restpose::view::write_recording(path, model, state, report)?;
+    // The softest mode as an oscillation about the rest pose (48 frames, 0.15 amplitude).
+    let mode_frames = report
+        .stability
+        .as_ref()
+        .and_then(|s| s.modes.first())
+        .map(|mode| restpose::solver::mode_animation(model, state, mode, 48, 0.15))
+        .unwrap_or_default();
+    restpose::view::write_recording(path, model, state, report, &mode_frames)?;
     Ok(())
 }
 

@@ -18,6 +18,7 @@ mod active_set;
 mod assemble;
 mod eigen;
 mod minimize;
+mod mode_animation;
 mod options;
 pub(crate) mod partition;
 mod reactions;
@@ -27,6 +28,7 @@ mod spectrum;
 pub(crate) mod system;
 mod unbounded;
 
+pub use mode_animation::mode_animation;
 pub use options::{Limits, LinearAlgebra, Method, Options};
 pub use report::{
     ActiveLimit, Contact, ContactState, Diagnostics, Iterate, Reaction, Report, Sizes, Stability,

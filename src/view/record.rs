@@ -1,122 +1,14 @@
 //! Writing the recording.
 
-use crate::error::{Error, Result};
-use crate::geometry::{Geometry, ShapeKind};
+use super::contact::{log_contacts, log_grounds, log_stops, STOP_COLOR};
+use super::shapes::{f3, link_paths, log_shape, rr_err, sanitize, transform};
+use crate::error::Result;
 use crate::model::Model;
 use crate::solver::Report;
 use crate::state::State;
 use nalgebra::{Isometry3, Point3, Vector3};
 use std::collections::HashMap;
 use std::path::Path;
-
-fn rr_err(path: &Path, e: impl std::fmt::Display) -> Error {
-    Error::Io {
-        path: path.display().to_string(),
-        cause: std::io::Error::other(e.to_string()),
-    }
-}
-
-fn f3(v: &Vector3<f64>) -> [f32; 3] {
-    [v.x as f32, v.y as f32, v.z as f32]
-}
-
-fn transform(iso: &Isometry3<f64>) -> rerun::Transform3D {
-    let q = iso.rotation;
-    rerun::Transform3D::from_translation_rotation(
-        f3(&iso.translation.vector),
-        rerun::Quaternion::from_xyzw([q.i as f32, q.j as f32, q.k as f32, q.w as f32]),
-    )
-}
-
-fn sanitize(name: &str) -> String {
-    name.chars()
-        .map(|c| {
-            if c.is_alphanumeric() || c == '_' || c == '-' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect()
-}
-
-/// Entity path of every link, nested along the spanning tree (merged fixed joints included).
-fn link_paths(model: &Model) -> (HashMap<String, String>, HashMap<String, String>) {
-    let mut parent: HashMap<String, String> = HashMap::new();
-    for j in model.joints.iter().filter(|j| j.tree) {
-        parent.insert(j.child_link.clone(), j.parent_link.clone());
-    }
-    let mut paths = HashMap::new();
-    for l in &model.links {
-        let mut chain = vec![sanitize(&l.name)];
-        let mut cur = l.name.clone();
-        while let Some(p) = parent.get(&cur) {
-            if chain.len() > model.links.len() {
-                break;
-            }
-            chain.push(sanitize(p));
-            cur = p.clone();
-        }
-        chain.reverse();
-        paths.insert(l.name.clone(), format!("world/robot/{}", chain.join("/")));
-    }
-    (paths, parent)
-}
-
-fn log_shape(
-    rec: &rerun::RecordingStream,
-    path: &str,
-    g: &Geometry,
-) -> std::result::Result<(), rerun::RecordingStreamError> {
-    let grey = rerun::Color::from_rgb(170, 170, 180);
-    rec.log_static(path, &transform(&g.link_from_shape))?;
-    match &g.shape {
-        ShapeKind::Box { size } => rec.log_static(
-            path,
-            &rerun::Boxes3D::from_sizes([f3(size)])
-                .with_colors([grey])
-                .with_fill_mode(rerun::FillMode::Solid),
-        ),
-        ShapeKind::Cylinder { radius, length } => rec.log_static(
-            path,
-            &rerun::Cylinders3D::from_lengths_and_radii([*length as f32], [*radius as f32])
-                .with_colors([grey])
-                .with_fill_mode(rerun::FillMode::Solid),
-        ),
-        ShapeKind::Sphere { radius } => rec.log_static(
-            path,
-            &rerun::Ellipsoids3D::from_radii([*radius as f32])
-                .with_colors([grey])
-                .with_fill_mode(rerun::FillMode::Solid),
-        ),
-        ShapeKind::Capsule { radius, length } => rec.log_static(
-            path,
-            &rerun::Capsules3D::from_lengths_and_radii([*length as f32], [*radius as f32])
-                .with_translations([[0.0, 0.0, -(*length as f32) / 2.0]])
-                .with_colors([grey]),
-        ),
-        ShapeKind::Mesh {
-            path: Some(file),
-            scale,
-            ..
-        } => match crate::geometry::load_mesh(file, scale) {
-            Ok((v, f)) => {
-                let v: Vec<[f32; 3]> = v
-                    .iter()
-                    .map(|p| [p[0] as f32, p[1] as f32, p[2] as f32])
-                    .collect();
-                rec.log_static(
-                    path,
-                    &rerun::Mesh3D::new(v)
-                        .with_triangle_indices(f)
-                        .with_albedo_factor(rerun::Rgba32::from_rgb(170, 170, 180)),
-                )
-            }
-            Err(_) => Ok(()),
-        },
-        ShapeKind::Mesh { path: None, .. } => Ok(()),
-    }
-}
 
 fn world_pose(model: &Model, state: &State, link: &str) -> Isometry3<f64> {
     state
@@ -192,11 +84,19 @@ fn log_pose(
 }
 
 /// Writes a recording of `report` (with `Options::record_iterates` for the iteration
-/// timeline) and the rest pose `state` to `path`.
+/// timeline) and the rest pose `state` to `path`; `mode_frames` (e.g. from
+/// [`solver::mode_animation`](crate::solver::mode_animation)) are shown on the `mode`
+/// timeline.
 ///
 /// # Errors
-/// [`Error::Io`] if the file cannot be written.
-pub fn write_recording(path: &Path, model: &Model, state: &State, report: &Report) -> Result<()> {
+/// [`Error::Io`](crate::Error::Io) if the file cannot be written.
+pub fn write_recording(
+    path: &Path,
+    model: &Model,
+    state: &State,
+    report: &Report,
+    mode_frames: &[State],
+) -> Result<()> {
     let rec = rerun::RecordingStreamBuilder::new("restpose")
         .save(path)
         .map_err(|e| rr_err(path, e))?;
@@ -209,6 +109,7 @@ pub fn write_recording(path: &Path, model: &Model, state: &State, report: &Repor
                 log_shape(&rec, &format!("{}/visual_{k}", paths[&link.name]), g)?;
             }
         }
+        let on_stop = |joint: &str| report.active_limits.iter().any(|a| a.joint == joint);
         for j in model.joints.iter().filter(|j| !j.merged) {
             let Some(link) = model.link(&j.child_link) else {
                 continue;
@@ -219,9 +120,14 @@ pub fn write_recording(path: &Path, model: &Model, state: &State, report: &Repor
                 format!("{}/joint_{}", paths[&j.child_link], sanitize(&j.name)),
                 &rerun::Arrows3D::from_vectors([f3(&axis)])
                     .with_origins([f3(&link_from_joint.translation.vector)])
-                    .with_colors([rerun::Color::from_rgb(60, 200, 90)]),
+                    .with_colors([if on_stop(&j.name) {
+                        STOP_COLOR
+                    } else {
+                        rerun::Color::from_rgb(60, 200, 90)
+                    }]),
             )?;
         }
+        log_grounds(&rec, model, state)?;
         let g = model.gravity;
         if g.norm() > 0.0 {
             rec.log_static(
@@ -274,26 +180,11 @@ pub fn write_recording(path: &Path, model: &Model, state: &State, report: &Repor
                     .with_colors([rerun::Color::from_rgb(200, 40, 200)]),
             )?;
         }
-        // The softest mode as an oscillation about the rest pose.
-        if let Some(mode) = report.stability.as_ref().and_then(|s| s.modes.first()) {
-            let rest: HashMap<String, Vec<f64>> = state.joint_values(model).into_iter().collect();
-            for k in 0..48 {
-                let a = 0.15 * (k as f64 / 48.0 * std::f64::consts::TAU).sin();
-                let mut values = rest.clone();
-                for (name, d) in mode {
-                    if let Some(v) = values.get_mut(name) {
-                        for (x, dx) in v.iter_mut().zip(d) {
-                            *x += a * dx;
-                        }
-                    }
-                }
-                let Ok((s, _)) = crate::verify::pose_state(model, &values) else {
-                    break;
-                };
-                let s = crate::verify::assemble(model, &s).unwrap_or(s);
-                rec.set_time_sequence("mode", k as i64);
-                log_pose(&rec, model, &s, &paths, &parent)?;
-            }
+        log_contacts(&rec, model, report)?;
+        log_stops(&rec, model, state, report)?;
+        for (k, s) in mode_frames.iter().enumerate() {
+            rec.set_time_sequence("mode", k as i64);
+            log_pose(&rec, model, s, &paths, &parent)?;
         }
         Ok(())
     };

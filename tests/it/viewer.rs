@@ -12,7 +12,14 @@ fn recording_holds_the_mechanism_the_search_and_the_forces() {
     assert_eq!(report.iterates.len(), report.history.len());
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("slider_crank.rrd");
-    restpose::view::write_recording(&path, &m, &state, &report).unwrap();
+    let mode = &report.stability.as_ref().unwrap().modes[0];
+    let frames = restpose::solver::mode_animation(&m, &state, mode, 12, 0.15);
+    assert_eq!(
+        frames.len(),
+        12,
+        "every pose along the mode closes its loop"
+    );
+    restpose::view::write_recording(&path, &m, &state, &report, &frames).unwrap();
     let rec = restpose::view::read_recording(&path).unwrap();
     for entity in [
         "world/robot/world/crank",
@@ -48,7 +55,7 @@ fn meshes_become_mesh_entities() {
     let (state, report) = restpose::solve(&l.model, &Default::default()).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("arm.rrd");
-    restpose::view::write_recording(&out, &l.model, &state, &report).unwrap();
+    restpose::view::write_recording(&out, &l.model, &state, &report, &[]).unwrap();
     let rec = restpose::view::read_recording(&out).unwrap();
     assert!(
         rec.entities.iter().any(|e| e.contains("visual_")),

@@ -1,7 +1,12 @@
 //! Force elements: springs, loads, efforts; and the coordinate-level inputs locks, mimics
-//! and initial guesses.
+//! and initial guesses; with the [`ModelBuilder`] calls that add them.
+//!
+//! Potentials (`δ` a deflection, `F(δ)` the force law positive in tension):
+//! spring `∫₀^{L−L₀} F(δ) dδ`, joint spring `∫₀^{θ−θ_ref} F(δ) dδ`, dead load `−fᵀ r_P`,
+//! effort `−τ θ`; a lock is the constraint `θ − value = 0`, a mimic
+//! `θ − (m θ_ref + offset) = 0`.
 
-use super::{BodyId, JointId};
+use super::{BodyId, JointId, ModelBuilder};
 use nalgebra::Vector3;
 
 /// Which sign of force a spring can carry.
@@ -130,4 +135,53 @@ pub struct Initial {
     pub dof: usize,
     /// Value \[rad or m\].
     pub value: f64,
+}
+
+impl ModelBuilder {
+    /// Adds a point-to-point spring.
+    pub fn add_spring(&mut self, spring: Spring) {
+        self.model.springs.push(spring);
+    }
+
+    /// Adds a spring on coordinate `dof` of `joint`, `reference` \[rad or m\] at zero force.
+    pub fn add_joint_spring(&mut self, joint: JointId, dof: usize, law: ForceLaw, reference: f64) {
+        self.model.joint_springs.push(JointSpring {
+            joint,
+            dof,
+            reference,
+            law,
+        });
+    }
+
+    /// Adds a joint spring given in full.
+    pub fn push_joint_spring(&mut self, spring: JointSpring) {
+        self.model.joint_springs.push(spring);
+    }
+
+    /// Adds a dead load.
+    pub fn add_load(&mut self, load: Load) {
+        self.model.loads.push(load);
+    }
+
+    /// Adds a constant generalized force on a joint coordinate.
+    pub fn add_effort(&mut self, effort: Effort) {
+        self.model.efforts.push(effort);
+    }
+
+    /// Holds a joint coordinate.
+    pub fn add_lock(&mut self, lock: Lock) {
+        self.model.locks.push(lock);
+    }
+
+    /// Adds a linear coupling between joint coordinates.
+    pub fn add_mimic(&mut self, mimic: Mimic) {
+        self.model.mimics.push(mimic);
+    }
+
+    /// Sets the initial guess of a joint coordinate (the last one given counts). `dof` indexes
+    /// the joint's values as in the result (a spherical joint's quaternion `w x y z`, a
+    /// floating joint's `x y z w qx qy qz`).
+    pub fn add_initial(&mut self, initial: Initial) {
+        self.model.initial.push(initial);
+    }
 }

@@ -8,19 +8,24 @@
 mod body;
 mod builder;
 mod check;
+mod connect;
 mod contact;
 mod force;
 mod joint;
+mod mass;
 mod site;
+mod validate;
 
 pub use body::{Body, BodyId, Link};
-pub use builder::{Inertial, ModelBuilder};
+pub use builder::ModelBuilder;
 pub use check::{LARGEST_GRAVITY, LARGEST_LENGTH, LARGEST_MAGNITUDE};
+pub use connect::axis_frame;
 pub use contact::{ContactPoint, ContactSettings, Friction, Ground};
 pub use force::{
     Effort, ForceLaw, Initial, JointSpring, Load, Lock, Mimic, Spring, SpringEnd, SpringMode,
 };
 pub use joint::{Joint, JointId, JointKind};
+pub use mass::Inertial;
 
 use nalgebra::Vector3;
 use std::collections::HashMap;

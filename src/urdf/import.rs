@@ -358,9 +358,9 @@ pub(super) fn import(
             b.model.set_child_frame(ji, f);
         }
     }
-    let model = b.model.build()?;
-    model
-        .check_numbers()
+    let model = b
+        .model
+        .build()
         .map_err(|e| locate_invalid(&src, robot, e))?;
     Ok(Loaded {
         model,

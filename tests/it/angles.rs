@@ -3,7 +3,10 @@
 //! joint is tracked through the solve (a torsion spring winds up over several turns). Every
 //! expectation is a hand computation written in the test.
 
+use crate::common::builders::{inertia, initial, linear, lock, pendulum};
 use approx::assert_abs_diff_eq;
+use nalgebra::Vector3;
+use restpose::model::{ForceLaw, JointId, JointKind, ModelBuilder};
 use restpose::{urdf, Options};
 use std::f64::consts::{PI, TAU};
 use std::process::Command;
@@ -12,20 +15,19 @@ const M: f64 = 2.0;
 const G: f64 = 9.81;
 const L: f64 = 1.0;
 
-/// A bar of mass `M` with its centre of mass `L` from a pivot about z, gravity along −y:
-/// `V_gravity = M G L sin θ`; extra `mech:` elements appended.
-fn pendulum(kind: &str, extra: &str) -> String {
-    format!(
-        r#"<robot name="p" xmlns:mech="urn:urdf-mech:1">
-  <link name="world"/>
-  <link name="bar"><inertial><origin xyz="{L} 0 0"/><mass value="{M}"/>
-    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
-  <joint name="pivot" type="{kind}"><parent link="world"/><child link="bar"/>
-    <axis xyz="0 0 1"/><limit lower="-20" upper="20" effort="1" velocity="1"/></joint>
-  <mech:gravity xyz="0 -{G} 0"/>
-  {extra}
-</robot>"#
-    )
+/// A bar of mass `M` with its centre of mass `L` from a pivot about z (limits ±20), gravity
+/// along −y: `V_gravity = M G L sin θ`.
+fn bar(kind: JointKind) -> (ModelBuilder, JointId) {
+    let (mut b, pivot) = pendulum(
+        "p",
+        kind,
+        M,
+        Vector3::new(L, 0.0, 0.0),
+        inertia(0.01, 0.1, 0.1),
+    );
+    b.set_limits(pivot, -20.0, 20.0);
+    b.set_gravity(Vector3::new(0.0, -G, 0.0));
+    (b, pivot)
 }
 
 fn load(text: &str) -> restpose::Model {
@@ -39,13 +41,10 @@ fn load(text: &str) -> restpose::Model {
 #[test]
 fn spring_loaded_joint_locked_beyond_pi() {
     for theta in [3.5, -3.5] {
-        let m = load(&pendulum(
-            "revolute",
-            &format!(
-                r#"<mech:joint_spring joint="pivot" stiffness="3" reference="0"/>
-                   <mech:lock joint="pivot" value="{theta}"/>"#
-            ),
-        ));
+        let (mut b, pivot) = bar(JointKind::Revolute);
+        b.add_joint_spring(pivot, 0, linear(3.0), 0.0);
+        lock(&mut b, pivot, theta);
+        let m = b.build().unwrap();
         let (s, r) = restpose::solve(&m, &Options::default()).unwrap();
         assert_abs_diff_eq!(s.joint(&m, "pivot").unwrap()[0], theta, epsilon = 1e-9);
         let v = M * G * L * theta.sin() + 0.5 * 3.0 * theta * theta;
@@ -67,13 +66,10 @@ fn spring_loaded_joint_locked_beyond_pi() {
 #[test]
 fn spring_loaded_joint_started_beyond_pi() {
     for reference in [3.5, -3.5] {
-        let m = load(&pendulum(
-            "revolute",
-            &format!(
-                r#"<mech:joint_spring joint="pivot" stiffness="50" reference="{reference}"/>
-                   <mech:initial joint="pivot" value="{reference}"/>"#
-            ),
-        ));
+        let (mut b, pivot) = bar(JointKind::Revolute);
+        b.add_joint_spring(pivot, 0, linear(50.0), reference);
+        initial(&mut b, pivot, 0, reference);
+        let m = b.build().unwrap();
         let mut t: f64 = reference;
         for _ in 0..50 {
             t -= (50.0 * (t - reference) + M * G * L * t.cos()) / (50.0 - M * G * L * t.sin());
@@ -93,13 +89,13 @@ fn spring_loaded_joint_started_beyond_pi() {
 fn continuous_spring_winds_up_two_and_a_half_turns() {
     let k = 200.0;
     let rest = 5.0 * PI;
-    let m = load(&pendulum(
-        "continuous",
-        &format!(
-            r#"<mech:joint_spring joint="pivot" stiffness="{k}" reference="0" preload="{}"/>"#,
-            -k * rest
-        ),
-    ));
+    let (mut b, pivot) = bar(JointKind::Continuous);
+    let law = ForceLaw::Linear {
+        stiffness: k,
+        preload: -k * rest,
+    };
+    b.add_joint_spring(pivot, 0, law, 0.0);
+    let m = b.build().unwrap();
     let mut t: f64 = rest;
     for _ in 0..50 {
         t -= (k * (t - rest) + M * G * L * t.cos()) / (k - M * G * L * t.sin());

@@ -2,6 +2,9 @@
 //! (issue 12 §3): constant energy, a floating base nothing holds, an effort on a free joint,
 //! negative or absurd numbers, unknown joint names.
 
+use crate::common::builders::{initial, linear, pendulum};
+use nalgebra::{Matrix3, Vector3};
+use restpose::model::{Effort, ForceLaw, JointId, JointKind, ModelBuilder};
 use restpose::{urdf, Error, Options, Termination};
 use std::process::Command;
 
@@ -23,6 +26,15 @@ fn one_joint(kind: &str, link: &str, extra: &str) -> String {
     )
 }
 
+/// A bar on joint `pivot` (about z at the origin) of `kind`, limits ±1: massless, or 1 kg
+/// at the pivot with inertia 0.1 𝟙 (what [`one_joint`] writes in URDF).
+fn one_joint_built(kind: JointKind, mass: f64) -> (ModelBuilder, JointId) {
+    let inertia = Matrix3::identity() * if mass > 0.0 { 0.1 } else { 0.0 };
+    let (mut b, pivot) = pendulum("d", kind, mass, Vector3::zeros(), inertia);
+    b.set_limits(pivot, -1.0, 1.0);
+    (b, pivot)
+}
+
 fn run(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_restpose"))
         .args(args)
@@ -32,8 +44,7 @@ fn run(args: &[&str]) -> std::process::Output {
 
 #[test]
 fn massless_links_without_springs_are_refused() {
-    let text = one_joint("revolute", r#"<link name="bar"/>"#, "");
-    let m = load(&text).unwrap();
+    let m = one_joint_built(JointKind::Revolute, 0.0).0.build().unwrap();
     match restpose::solve(&m, &Options::default()) {
         Err(e @ Error::ConstantEnergy { dof: 1, .. }) => {
             let msg = e.to_string();
@@ -46,15 +57,15 @@ fn massless_links_without_springs_are_refused() {
         other => panic!("expected ConstantEnergy, got {other:?}"),
     }
     // The same mechanism with a spring is well posed.
-    let sprung = one_joint(
-        "revolute",
-        r#"<link name="bar"/>"#,
-        r#"<mech:joint_spring joint="pivot" stiffness="1" reference="0.25"/>"#,
-    );
-    let (s, r) = restpose::solve(&load(&sprung).unwrap(), &Options::default()).unwrap();
+    let (mut sprung, pivot) = one_joint_built(JointKind::Revolute, 0.0);
+    sprung.add_joint_spring(pivot, 0, linear(1.0), 0.25);
+    let sprung = sprung.build().unwrap();
+    let (s, r) = restpose::solve(&sprung, &Options::default()).unwrap();
     assert!(r.converged());
-    assert!((s.joint(&load(&sprung).unwrap(), "pivot").unwrap()[0] - 0.25).abs() < 1e-9);
-    // The CLI exits 1 and adds the option that gives links masses from their geometry.
+    assert!((s.joint(&sprung, "pivot").unwrap()[0] - 0.25).abs() < 1e-9);
+    // The CLI, given the mechanism as URDF, exits 1 and adds the option that gives links
+    // masses from their geometry.
+    let text = one_joint("revolute", r#"<link name="bar"/>"#, "");
     let dir = tempfile::tempdir().unwrap();
     let f = dir.path().join("m.urdf");
     std::fs::write(&f, &text).unwrap();
@@ -100,14 +111,13 @@ fn floating_base_held_by_nothing_is_unbounded() {
 
 #[test]
 fn effort_on_a_free_continuous_joint_is_unbounded() {
-    let link =
-        format!(r#"<link name="bar"><inertial><mass value="1"/>{INERTIA}</inertial></link>"#);
-    let m = load(&one_joint(
-        "continuous",
-        &link,
-        r#"<mech:joint_effort joint="pivot" value="2"/>"#,
-    ))
-    .unwrap();
+    let (mut b, pivot) = one_joint_built(JointKind::Continuous, 1.0);
+    b.add_effort(Effort {
+        joint: pivot,
+        dof: 0,
+        value: 2.0,
+    });
+    let m = b.clone().build().unwrap();
     let (_, r) = restpose::solve(&m, &Options::default()).unwrap();
     assert_eq!(r.termination, Termination::Unbounded);
     assert!(r.iterations < 50, "{} iterations", r.iterations);
@@ -116,13 +126,8 @@ fn effort_on_a_free_continuous_joint_is_unbounded() {
         vec!["joint `pivot` coordinate 0 increasing".to_string()]
     );
     // Resisted by a spring it rests where 3 θ = 2.
-    let m = load(&one_joint(
-        "continuous",
-        &link,
-        r#"<mech:joint_effort joint="pivot" value="2"/>
-           <mech:joint_spring joint="pivot" stiffness="3" reference="0"/>"#,
-    ))
-    .unwrap();
+    b.add_joint_spring(pivot, 0, linear(3.0), 0.0);
+    let m = b.build().unwrap();
     let (s, r) = restpose::solve(&m, &Options::default()).unwrap();
     assert!(r.converged(), "{:?}", r.termination);
     assert!((s.joint(&m, "pivot").unwrap()[0] - 2.0 / 3.0).abs() < 1e-9);
@@ -232,17 +237,15 @@ fn unknown_joint_names_get_a_suggestion() {
 
 #[test]
 fn force_table_out_of_range_names_the_spring_and_the_deflection() {
-    let link =
-        format!(r#"<link name="bar"><inertial><mass value="1"/>{INERTIA}</inertial></link>"#);
-    let m = load(&one_joint(
-        "continuous",
-        &link,
-        r#"<mech:joint_spring joint="pivot"><force_deflection extrapolate="error">
-             <point deflection="-0.1" force="-1"/><point deflection="0.1" force="1"/>
-           </force_deflection></mech:joint_spring>
-           <mech:initial joint="pivot" value="0.5"/>"#,
-    ))
-    .unwrap();
+    let (mut b, pivot) = one_joint_built(JointKind::Continuous, 1.0);
+    let table = ForceLaw::Table {
+        points: vec![(-0.1, -1.0), (0.1, 1.0)],
+        extrapolate_linear: false,
+        bounded: true,
+    };
+    b.add_joint_spring(pivot, 0, table, 0.0);
+    initial(&mut b, pivot, 0, 0.5);
+    let m = b.build().unwrap();
     match restpose::solve(&m, &Options::default()) {
         Err(Error::ForceTableOutOfRange {
             element,
@@ -256,7 +259,9 @@ fn force_table_out_of_range_names_the_spring_and_the_deflection() {
         }
         other => panic!("expected ForceTableOutOfRange, got {other:?}"),
     }
-    // A lock on a coordinate the joint does not have.
+    // A lock on a coordinate the joint does not have, asked of the importer.
+    let link =
+        format!(r#"<link name="bar"><inertial><mass value="1"/>{INERTIA}</inertial></link>"#);
     let text = one_joint("continuous", &link, "");
     let e = urdf::load_str(
         &text,

@@ -1,32 +1,28 @@
 //! Stability, reactions, locks, units and unbounded energy.
+use crate::common::builders::{chain, inertia, initial, linear, lock, pendulum};
 use crate::common::*;
 use approx::assert_abs_diff_eq;
-use restpose::urdf::{load_str, ImportOptions};
+use nalgebra::{Isometry3, Matrix3, Vector3};
+use restpose::model::{JointId, JointKind, ModelBuilder, Spring, SpringEnd, SpringMode};
+use restpose::urdf::{load_file, ImportOptions};
 use restpose::Options;
 
-const BAR: &str = r#"<robot name="bar" xmlns:mech="urn:urdf-mech:1">
-  <link name="world"/>
-  <link name="bar"><inertial><origin xyz="SCALE 0 0"/><mass value="2"/>
-    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.6" iyz="0" izz="0.6"/></inertial></link>
-  <joint name="pivot" type="continuous"><parent link="world"/><child link="bar"/><axis xyz="0 0 1"/></joint>
-  <mech:gravity xyz="0 -GRAV 0"/>
-  EXTRA
-</robot>"#;
-
-fn bar(scale: f64, extra: &str) -> String {
-    BAR.replace("SCALE", &scale.to_string())
-        .replace("GRAV", &(9.81 * scale).to_string())
-        .replace("EXTRA", extra)
+/// A 2 kg bar with its centre of mass `scale` from a pivot about z, gravity `9.81 scale`
+/// along −y (lengths in metres for `scale` 1, millimetres for 1000).
+fn bar(scale: f64, kind: JointKind) -> (ModelBuilder, JointId) {
+    let com = Vector3::new(scale, 0.0, 0.0);
+    let (mut b, pivot) = pendulum("bar", kind, 2.0, com, inertia(0.01, 0.6, 0.6));
+    b.set_gravity(Vector3::new(0.0, -9.81 * scale, 0.0));
+    (b, pivot)
 }
 
 /// Started exactly upright (a maximum, zero gradient), the pendulum leaves along the negative
 /// curvature and ends hanging down; with `allow_unstable` it stays and says `unstable`.
 #[test]
 fn inverted_start_ends_at_the_stable_equilibrium() {
-    let m = model_from(&bar(
-        1.0,
-        r#"<mech:initial joint="pivot" value="1.5707963267948966"/>"#,
-    ));
+    let (mut b, pivot) = bar(1.0, JointKind::Continuous);
+    initial(&mut b, pivot, 0, std::f64::consts::FRAC_PI_2);
+    let m = b.build().unwrap();
     let (s, r) = solve(&m);
     assert_abs_diff_eq!(
         s.joint(&m, "pivot").unwrap()[0],
@@ -60,10 +56,9 @@ fn inverted_start_ends_at_the_stable_equilibrium() {
 #[test]
 fn lock_holding_torque_equals_gravity_torque() {
     let angle: f64 = -0.4;
-    let m = model_from(&bar(
-        1.0,
-        &format!(r#"<mech:lock joint="pivot" value="{angle}"/>"#),
-    ));
+    let (mut b, pivot) = bar(1.0, JointKind::Continuous);
+    lock(&mut b, pivot, angle);
+    let m = b.build().unwrap();
     let (s, r) = solve(&m);
     assert_eq!(r.dof, 0);
     assert_abs_diff_eq!(s.joint(&m, "pivot").unwrap()[0], angle, epsilon = 1e-12);
@@ -79,18 +74,25 @@ fn lock_holding_torque_equals_gravity_torque() {
 /// energy × 10⁶.
 #[test]
 fn metres_and_millimetres_agree() {
-    let spring = |s: f64| {
-        format!(
-            r#"<mech:spring name="k" stiffness="30" free_length="{}"><end link="bar" xyz="{} 0 0"/><end link="world" xyz="{} {} 0"/></mech:spring>
-               <mech:initial joint="pivot" value="-0.3"/>"#,
-            0.5 * s,
-            2.0 * s,
-            -s,
-            -2.0 * s
-        )
+    let sprung = |s: f64| {
+        let (mut b, pivot) = bar(s, JointKind::Continuous);
+        let body = b.joint(pivot).unwrap().bodies[1];
+        let end = |body, x: f64, y: f64| SpringEnd {
+            body,
+            point: Vector3::new(x, y, 0.0),
+        };
+        b.add_spring(Spring {
+            name: "k".into(),
+            ends: [end(body, 2.0 * s, 0.0), end(None, -s, -2.0 * s)],
+            free_length: 0.5 * s,
+            law: linear(30.0),
+            mode: SpringMode::Both,
+        });
+        initial(&mut b, pivot, 0, -0.3);
+        b.build().unwrap()
     };
-    let m1 = model_from(&bar(1.0, &spring(1.0)));
-    let m2 = model_from(&bar(1000.0, &spring(1000.0)));
+    let m1 = sprung(1.0);
+    let m2 = sprung(1000.0);
     let (s1, r1) = solve(&m1);
     let (s2, r2) = restpose::solve(
         &m2,
@@ -114,10 +116,11 @@ fn metres_and_millimetres_agree() {
 /// A prismatic joint along gravity with nothing holding it: reported, not iterated forever.
 #[test]
 fn unbounded_energy_is_detected() {
-    let text = r#"<robot name="drop" xmlns:mech="urn:urdf-mech:1"><link name="world"/>
-      <link name="box"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
-      <joint name="slide" type="prismatic"><parent link="world"/><child link="box"/><axis xyz="0 0 1"/></joint></robot>"#;
-    let m = model_from(text);
+    let mut b = ModelBuilder::new("drop");
+    let body = b.add_rigid_body("box", 1.0, Vector3::zeros(), Matrix3::identity());
+    let id = Isometry3::identity();
+    b.add_joint("slide", JointKind::Prismatic, None, id, Some(body), id);
+    let m = b.build().unwrap();
     let (_, r) = restpose::solve(&m, &Options::default()).unwrap();
     assert_eq!(r.termination, restpose::Termination::Unbounded);
 }
@@ -145,19 +148,19 @@ fn energy_breakdown_sums_and_spring_energy_by_hand() {
 
 #[test]
 fn cli_lock_overrides_and_unknown_joint_is_an_error() {
-    let text = bar(1.0, "");
     let opts = ImportOptions {
         locks: vec![("nope".into(), 0, Some(0.0))],
         ..Default::default()
     };
-    let err = load_str(&text, "t.urdf", &opts).unwrap_err().to_string();
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/robots/pendulum.urdf");
+    let err = load_file(path, &opts).unwrap_err().to_string();
     assert!(err.contains("nope"), "{err}");
 }
 
-/// Links welded by fixed joints share one body but keep their own reported poses; a floating
-/// base held by springs finds its rest pose.
+/// Links welded by fixed joints share one body but keep their own reported poses (the
+/// importer's welding: the mechanism is URDF text).
 #[test]
-fn merged_fixed_links_report_their_poses_and_floating_base_solves() {
+fn merged_fixed_links_report_their_poses() {
     let text = r#"<robot name="flange" xmlns:mech="urn:urdf-mech:1">
       <link name="base"/>
       <link name="arm"><inertial><origin xyz="0.5 0 0"/><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
@@ -181,21 +184,31 @@ fn merged_fixed_links_report_their_poses_and_floating_base_solves() {
     assert_abs_diff_eq!(tip.translation.y, 0.1, epsilon = 1e-12);
     assert_abs_diff_eq!(tip.translation.z, -th.sin(), epsilon = 1e-12);
     assert_verified_minimum(&m, &s);
+}
 
-    let hung = r#"<robot name="hung" xmlns:mech="urn:urdf-mech:1">
-      <link name="box"><inertial><mass value="2"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
-      <mech:spring name="a" stiffness="400" free_length="1"><end link="box" xyz="0.1 0 0"/><end link="world" xyz="0.1 0 2"/></mech:spring>
-      <mech:spring name="b" stiffness="400" free_length="1"><end link="box" xyz="-0.05 0.08660254037844387 0"/><end link="world" xyz="-0.05 0.08660254037844387 2"/></mech:spring>
-      <mech:spring name="c" stiffness="400" free_length="1"><end link="box" xyz="-0.05 -0.08660254037844387 0"/><end link="world" xyz="-0.05 -0.08660254037844387 2"/></mech:spring>
-    </robot>"#;
-    let opts = restpose::urdf::ImportOptions {
-        floating_base: true,
-        ..Default::default()
-    };
-    let m = restpose::urdf::load_str(hung, "h.urdf", &opts)
-        .unwrap()
-        .model;
-    assert_eq!(m.bodies.len(), 1);
+/// A floating body hung from the world by three springs finds its rest pose.
+#[test]
+fn floating_body_hung_on_springs_solves() {
+    let mut b = ModelBuilder::new("hung");
+    let body = b.add_rigid_body("box", 2.0, Vector3::zeros(), Matrix3::identity());
+    for (name, x, y) in [
+        ("a", 0.1, 0.0),
+        ("b", -0.05, 0.08660254037844387),
+        ("c", -0.05, -0.08660254037844387),
+    ] {
+        let end = |body, z: f64| SpringEnd {
+            body,
+            point: Vector3::new(x, y, z),
+        };
+        b.add_spring(Spring {
+            name: name.into(),
+            ends: [end(Some(body), 0.0), end(None, 2.0)],
+            free_length: 1.0,
+            law: linear(400.0),
+            mode: SpringMode::Both,
+        });
+    }
+    let m = b.build().unwrap();
     let (s, r) = solve(&m);
     assert_eq!(r.dof, 6);
     // Three parallel springs of 400 N/m, 120° apart around the centre of mass, carry 2 kg
@@ -228,12 +241,11 @@ fn mode_shapes_are_feasible_joint_motions() {
 #[test]
 fn locked_arm_holding_torques_equal_gravity_torques() {
     let n = 5;
-    let mut text = restpose::generate::chain(n, true);
-    let locks: String = (0..n)
-        .map(|i| format!("<mech:lock joint=\"joint{i}\" value=\"0\"/>"))
-        .collect();
-    text = text.replace("</robot>", &format!("{locks}</robot>"));
-    let m = model_from(&text);
+    let (mut b, joints) = chain(n, true);
+    for j in joints {
+        lock(&mut b, j, 0.0);
+    }
+    let m = b.build().unwrap();
     let (_, r) = solve(&m);
     assert_eq!(r.dof, 0);
     for i in 0..n {
@@ -254,11 +266,9 @@ fn locked_arm_holding_torques_equal_gravity_torques() {
 /// With limits ignored, a rest pose outside them is reported.
 #[test]
 fn rest_outside_limits_is_reported() {
-    let text = bar(1.0, "").replace(
-        r#"<joint name="pivot" type="continuous">"#,
-        r#"<joint name="pivot" type="revolute"><limit lower="0" upper="0.5"/>"#,
-    );
-    let m = model_from(&text);
+    let (mut b, pivot) = bar(1.0, JointKind::Revolute);
+    b.set_limits(pivot, 0.0, 0.5);
+    let m = b.build().unwrap();
     let ignore = Options {
         limits: restpose::Limits::Ignore,
         ..Default::default()
@@ -273,7 +283,7 @@ fn rest_outside_limits_is_reported() {
         -std::f64::consts::FRAC_PI_2,
         epsilon = 1e-8
     );
-    let fine = model_from(&bar(1.0, ""));
+    let fine = bar(1.0, JointKind::Continuous).0.build().unwrap();
     let (s, r) = solve(&fine);
     assert!(restpose::export::json::AnalysisResult::new(&fine, &s, &r)
         .limit_violations

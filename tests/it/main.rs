@@ -4,6 +4,7 @@
 
 mod angles;
 mod architecture;
+mod builder;
 mod cli;
 mod common;
 mod contact;

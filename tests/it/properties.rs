@@ -6,8 +6,11 @@
 //! the mechanism together with gravity, and expressing it in millimetres, leave the joint
 //! angles unchanged; the same input gives byte-identical JSON (apart from `diagnostics.timings`). 24 cases per property here
 //! (`PROPTEST_CASES` raises it).
+use crate::common::builders::{four_bar, hinge, linear};
+use nalgebra::{Isometry3, Matrix3, Translation3, Unit, UnitQuaternion, Vector3};
 use proptest::prelude::*;
 use restpose::export::json::AnalysisResult;
+use restpose::model::{JointKind, ModelBuilder};
 use restpose::verify::{pose_state, verify, Tolerances};
 use restpose::{Model, Options};
 
@@ -55,93 +58,52 @@ fn tree() -> impl Strategy<Value = Vec<Link>> {
     })
 }
 
-fn f3(a: [f64; 3], s: f64) -> String {
-    format!("{} {} {}", a[0] * s, a[1] * s, a[2] * s)
-}
-
-/// URDF of a tree; lengths × `scale`, gravity `gravity`, the whole tree turned about the
+/// A tree built in code; lengths × `scale`, gravity `gravity`, the whole tree turned about the
 /// world origin by `rpy` (root joint origins rotated, root joint frames turned).
-fn tree_urdf(links: &[Link], scale: f64, gravity: [f64; 3], rpy: [f64; 3]) -> String {
+fn tree_model(links: &[Link], scale: f64, gravity: [f64; 3], rpy: [f64; 3]) -> Model {
     let n = links.len() as f64;
-    let mut s = String::from(
-        "<robot name=\"tree\" xmlns:mech=\"urn:urdf-mech:1\"><link name=\"world\"/>\n",
-    );
+    let v = |a: [f64; 3], s: f64| Vector3::new(a[0] * s, a[1] * s, a[2] * s);
+    let mut b = ModelBuilder::new("tree");
+    let mut bodies = Vec::new();
     for (i, l) in links.iter().enumerate() {
-        s += &format!(
-            "<link name=\"l{i}\"><inertial><origin xyz=\"{}\"/><mass value=\"{}\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>\n",
-            f3(l.com, scale),
-            l.mass
+        let body = b.add_rigid_body(
+            format!("l{i}"),
+            l.mass,
+            v(l.com, scale),
+            Matrix3::identity(),
         );
-        let parent = if l.parent == 0 {
-            "world".to_string()
+        let (parent, origin) = if l.parent == 0 {
+            let r = UnitQuaternion::from_euler_angles(rpy[0], rpy[1], rpy[2]);
+            let at = Translation3::from(r * v(l.offset, scale));
+            (None, Isometry3::from_parts(at, r))
         } else {
-            format!("l{}", l.parent - 1)
+            let at = Translation3::from(v(l.offset, scale));
+            (
+                Some(bodies[l.parent - 1]),
+                Isometry3::from_parts(at, UnitQuaternion::identity()),
+            )
         };
-        let (rot, offset) = if l.parent == 0 {
-            let r = nalgebra::UnitQuaternion::from_euler_angles(rpy[0], rpy[1], rpy[2]);
-            (f3(rpy, 1.0), (r * nalgebra::Vector3::from(l.offset)).into())
-        } else {
-            ("0 0 0".into(), l.offset)
-        };
-        s += &format!(
-            "<joint name=\"j{i}\" type=\"continuous\"><parent link=\"{parent}\"/><child link=\"l{i}\"/><origin xyz=\"{}\" rpy=\"{rot}\"/><axis xyz=\"{}\"/></joint>\n",
-            f3(offset, scale),
-            f3(l.axis, 1.0)
+        let axis = Unit::new_normalize(v(l.axis, 1.0));
+        let j = hinge(
+            &mut b,
+            &format!("j{i}"),
+            JointKind::Continuous,
+            parent,
+            origin,
+            axis,
+            body,
         );
         // Torque scale: total weight × 0.5 m × links; units follow the length scale squared.
         let k = (20.0 + 80.0 * l.stiffness) * n * 9.81 * scale * scale;
-        s += &format!("<mech:joint_spring joint=\"j{i}\" stiffness=\"{k}\"/>\n");
+        b.add_joint_spring(j, 0, linear(k), 0.0);
+        bodies.push(body);
     }
-    s += &format!("<mech:gravity xyz=\"{}\"/></robot>\n", f3(gravity, scale));
-    s
-}
-
-fn load(text: &str) -> Model {
-    restpose::urdf::load_str(text, "gen.urdf", &Default::default())
-        .unwrap()
-        .model
+    b.set_gravity(v(gravity, scale));
+    b.build().unwrap()
 }
 
 fn angles(m: &Model, s: &restpose::State) -> Vec<f64> {
     s.joint_values(m).into_iter().map(|(_, v)| v[0]).collect()
-}
-
-/// A planar four-bar (ground 1 m, crank a, coupler b, rocker c) assembled at crank angle t,
-/// with random masses and a crank spring; gravity −y.
-fn four_bar_urdf(a: f64, b: f64, c: f64, t: f64, masses: [f64; 3], k: f64) -> Option<String> {
-    let (bx, by) = (a * t.cos(), a * t.sin());
-    let (dx, dy) = (1.0, 0.0);
-    let (ex, ey) = (dx - bx, dy - by);
-    let d = (ex * ex + ey * ey).sqrt();
-    if d >= b + c || d <= (b - c).abs() {
-        return None;
-    }
-    let along = (b * b - c * c + d * d) / (2.0 * d);
-    let h = (b * b - along * along).sqrt();
-    let (cx, cy) = (
-        bx + along * ex / d - h * ey / d,
-        by + along * ey / d + h * ex / d,
-    );
-    let coupler = (cy - by).atan2(cx - bx);
-    let rocker = (cy - dy).atan2(cx - dx);
-    let inertial = |m: f64, x: f64| {
-        format!("<inertial><origin xyz=\"{x} 0 0\"/><mass value=\"{m}\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial>")
-    };
-    Some(format!(
-        r#"<robot name="fourbar" xmlns:mech="urn:urdf-mech:1"><link name="world"/>
-<link name="crank">{}</link><link name="coupler">{}</link><link name="rocker">{}</link>
-<joint name="crank_j" type="continuous"><parent link="world"/><child link="crank"/><axis xyz="0 0 1"/></joint>
-<joint name="coupler_j" type="continuous"><parent link="crank"/><child link="coupler"/><origin xyz="{a} 0 0"/><axis xyz="0 0 1"/></joint>
-<joint name="rocker_j" type="continuous"><parent link="world"/><child link="rocker"/><origin xyz="1 0 0"/><axis xyz="0 0 1"/></joint>
-<mech:loop_joint name="close" type="revolute"><parent link="coupler"/><origin xyz="{b} 0 0"/><child link="rocker"/><child_origin xyz="{c} 0 0"/><axis xyz="0 0 1"/></mech:loop_joint>
-<mech:initial joint="crank_j" value="{t}"/><mech:initial joint="coupler_j" value="{}"/><mech:initial joint="rocker_j" value="{rocker}"/>
-<mech:joint_spring joint="crank_j" stiffness="{k}" reference="{t}"/>
-<mech:gravity xyz="0 -9.81 0"/></robot>"#,
-        inertial(masses[0], a / 2.0),
-        inertial(masses[1], b / 2.0),
-        inertial(masses[2], c / 2.0),
-        coupler - t
-    ))
 }
 
 /// 24 cases per property, or `PROPTEST_CASES`.
@@ -164,13 +126,9 @@ proptest! {
 
     #[test]
     fn random_trees_rest_verify_and_perturbations_fail(links in tree(), which in 0..100usize, sign in prop::bool::ANY) {
-        let text = tree_urdf(&links, 1.0, [0.0, 0.0, -9.81], [0.0; 3]);
-        let m = load(&text);
+        let m = tree_model(&links, 1.0, [0.0, 0.0, -9.81], [0.0; 3]);
         let (s, r) = restpose::solve(&m, &Options::default()).unwrap();
         prop_assert!(r.converged(), "{:?}", r.termination);
-        if std::env::var("DUMP").is_ok() && !verify(&m, &s, &Tolerances::default()).unwrap().passed {
-            std::fs::write("/tmp/dbg/case.urdf", &text).unwrap();
-        }
         check_rest(&m, &s);
         let k = which % links.len();
         let mut values: restpose::state::JointValues = s.joint_values(&m).into_iter().collect();
@@ -187,8 +145,8 @@ proptest! {
         let g = nalgebra::Vector3::new(0.0, 0.0, -9.81);
         let rot = nalgebra::UnitQuaternion::from_euler_angles(rpy[0], rpy[1], rpy[2]);
         let gr = rot * g;
-        let m1 = load(&tree_urdf(&links, 1.0, [g.x, g.y, g.z], [0.0; 3]));
-        let m2 = load(&tree_urdf(&links, 1.0, [gr.x, gr.y, gr.z], rpy));
+        let m1 = tree_model(&links, 1.0, [g.x, g.y, g.z], [0.0; 3]);
+        let m2 = tree_model(&links, 1.0, [gr.x, gr.y, gr.z], rpy);
         let (s1, r1) = restpose::solve(&m1, &Options::default()).unwrap();
         let (s2, r2) = restpose::solve(&m2, &Options::default()).unwrap();
         prop_assert!(r1.converged() && r2.converged());
@@ -200,16 +158,12 @@ proptest! {
 
     #[test]
     fn millimetres_give_the_same_angles(links in tree()) {
-        let m1 = load(&tree_urdf(&links, 1.0, [0.0, 0.0, -9.81], [0.0; 3]));
-        let m2 = load(&tree_urdf(&links, 1000.0, [0.0, 0.0, -9.81], [0.0; 3]));
+        let m1 = tree_model(&links, 1.0, [0.0, 0.0, -9.81], [0.0; 3]);
+        let m2 = tree_model(&links, 1000.0, [0.0, 0.0, -9.81], [0.0; 3]);
         let (s1, r1) = restpose::solve(&m1, &Options::default()).unwrap();
         // Energies are 10⁶ times larger in kg mm² / s²: the gradient tolerance scales with them.
         let opts = Options { gradient_tolerance: 1e-2, ..Options::default() };
         let (s2, r2) = restpose::solve(&m2, &opts).unwrap();
-        if std::env::var("DUMP").is_ok() && !(r1.converged() && r2.converged()) {
-            std::fs::write("/tmp/dbg/m.urdf", tree_urdf(&links, 1.0, [0.0, 0.0, -9.81], [0.0; 3])).unwrap();
-            std::fs::write("/tmp/dbg/mm.urdf", tree_urdf(&links, 1000.0, [0.0, 0.0, -9.81], [0.0; 3])).unwrap();
-        }
         prop_assert!(r1.converged() && r2.converged(), "{:?} {:?}", r1.termination, r2.termination);
         for (a, b) in angles(&m1, &s1).iter().zip(angles(&m2, &s2)) {
             prop_assert!((a - b).abs() < 1e-7, "{} vs {}", a, b);
@@ -222,8 +176,8 @@ proptest! {
         a in 0.15..0.35f64, b in 0.9..1.2f64, c in 0.5..0.9f64, t in 0.3..2.5f64,
         masses in prop::array::uniform3(0.2..2.0f64), k in 5.0..50.0f64,
     ) {
-        let Some(text) = four_bar_urdf(a, b, c, t, masses, k) else { return Ok(()) };
-        let m = load(&text);
+        let Some((m, _)) = four_bar([a, b, c], t, masses, k) else { return Ok(()) };
+        let m = m.build().unwrap();
         let (s, mut r) = restpose::solve(&m, &Options::default()).unwrap();
         prop_assert!(r.converged(), "{:?}", r.termination);
         prop_assert_eq!(r.dof, 1);

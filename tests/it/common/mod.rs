@@ -1,5 +1,6 @@
 //! Shared helpers of the integration tests.
 
+pub(crate) mod builders;
 pub(crate) mod energies;
 
 use restpose::state::State;

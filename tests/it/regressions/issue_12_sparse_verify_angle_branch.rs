@@ -5,25 +5,19 @@
 //! has only joint springs `k_i (θ_i − 0)`: the effort to hold joint `i` is exactly
 //! `∂V/∂θ_i = k_i θ_i`, zero at every other joint.
 
+use crate::common::builders::chain;
 use restpose::verify::{parse_pose, pose_state, verify, Tolerances};
 
 fn chain_without_gravity(n: usize) -> restpose::Model {
-    let text = restpose::generate::chain(n, false).replace(
-        r#"<mech:gravity xyz="0 0 -9.81"/>"#,
-        r#"<mech:gravity xyz="0 0 0"/>"#,
-    );
-    assert!(text.contains(r#"<mech:gravity xyz="0 0 0"/>"#));
-    restpose::urdf::load_str(&text, "chain.urdf", &Default::default())
-        .unwrap()
-        .model
+    let (mut b, _) = chain(n, false);
+    b.set_gravity(nalgebra::Vector3::zeros());
+    b.build().unwrap()
 }
 
-/// The stiffness of `joint` as written in the generated file.
+/// The stiffness of the spring on `joint{i}` of an `n`-link chain: `10 (n − i)²` N m/rad.
 fn stiffness(n: usize, joint: &str) -> f64 {
-    let text = restpose::generate::chain(n, false);
-    let key = format!(r#"<mech:joint_spring joint="{joint}" stiffness=""#);
-    let at = text.find(&key).unwrap() + key.len();
-    text[at..].split('"').next().unwrap().parse().unwrap()
+    let i: usize = joint.trim_start_matches("joint").parse().unwrap();
+    10.0 * ((n - i) * (n - i)) as f64
 }
 
 #[test]

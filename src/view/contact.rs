@@ -16,7 +16,9 @@ use nalgebra::{Point3, Vector3};
 type Logged = std::result::Result<(), rerun::RecordingStreamError>;
 
 /// Colour of a joint axis resting on a stop.
-pub(super) const STOP_COLOR: rerun::Color = rerun::Color::from_rgb(255, 120, 0);
+pub(super) fn stop_color() -> rerun::Color {
+    rerun::Color::from_rgb(255, 120, 0)
+}
 
 /// A unit vector perpendicular to `n` (unit).
 fn perpendicular(n: &Vector3<f64>) -> Vector3<f64> {
@@ -151,7 +153,7 @@ pub(super) fn log_stops(
         rec.log(
             format!("world/stops/{}", sanitize(&stop.joint)),
             &rerun::Points3D::new([f3(&p.coords)])
-                .with_colors([STOP_COLOR])
+                .with_colors([stop_color()])
                 .with_radii([0.03 * model.length_scale as f32])
                 .with_labels([format!(
                     "{} on its {} stop {:.4}, effort {:.4}",

@@ -1,6 +1,6 @@
 //! Writing the recording.
 
-use super::contact::{log_contacts, log_grounds, log_stops, STOP_COLOR};
+use super::contact::{log_contacts, log_grounds, log_stops, stop_color};
 use super::shapes::{f3, link_paths, log_shape, rr_err, sanitize, transform};
 use crate::error::Result;
 use crate::model::Model;
@@ -121,7 +121,7 @@ pub fn write_recording(
                 &rerun::Arrows3D::from_vectors([f3(&axis)])
                     .with_origins([f3(&link_from_joint.translation.vector)])
                     .with_colors([if on_stop(&j.name) {
-                        STOP_COLOR
+                        stop_color()
                     } else {
                         rerun::Color::from_rgb(60, 200, 90)
                     }]),

@@ -33,6 +33,7 @@ use faer::sparse::linalg::cholesky::{
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::{Conj, MatMut, Par, Side};
+use std::cell::RefCell;
 
 /// The KKT matrix's structure under one partition, its values and its factors.
 pub(crate) struct Kkt {
@@ -63,6 +64,18 @@ pub(crate) struct Kkt {
     kind: Factored,
     /// LDLᵀ solves were not accurate on this structure: LU from now on.
     lu_only: bool,
+    /// faer's scratch for the numeric LDLᵀ, allocated once per structure.
+    factor_scratch: Option<MemBuffer>,
+    /// Scratch of the solves (faer's stack, right side, residual), allocated once.
+    solve_scratch: RefCell<SolveScratch>,
+}
+
+/// Buffers reused by every [`Kkt::solve`].
+#[derive(Default)]
+struct SolveScratch {
+    stack: Option<MemBuffer>,
+    b: Vec<f64>,
+    r: Vec<f64>,
 }
 
 /// What the last [`Kkt::factor`] produced.
@@ -171,6 +184,19 @@ impl Kkt {
         )
         .ok();
         let ldlt_values = vec![0.0; ldlt.as_ref().map_or(0, |l| l.len_val())];
+        let factor_scratch = ldlt.as_ref().and_then(|sym| {
+            MemBuffer::try_new(
+                sym.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()),
+            )
+            .ok()
+        });
+        let solve_scratch = RefCell::new(SolveScratch {
+            stack: ldlt.as_ref().and_then(|sym| {
+                MemBuffer::try_new(sym.solve_in_place_scratch::<f64>(1, Par::Seq)).ok()
+            }),
+            b: Vec::with_capacity(dim),
+            r: Vec::with_capacity(dim),
+        });
         Some(Kkt {
             n,
             id: part.id,
@@ -190,6 +216,8 @@ impl Kkt {
             ldlt_values,
             kind: Factored::None,
             lu_only: false,
+            factor_scratch,
+            solve_scratch,
         })
     }
 
@@ -289,16 +317,14 @@ impl Kkt {
     fn factor_ldlt(&mut self) -> Option<usize> {
         let sym = self.ldlt.as_ref()?;
         let par = Par::Seq;
-        let mut buf =
-            MemBuffer::try_new(sym.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()))
-                .ok()?;
+        let buf = self.factor_scratch.as_mut()?;
         sym.factorize_numeric_ldlt(
             &mut self.ldlt_values,
             self.pattern.matrix(&self.values),
             Side::Lower,
             LdltRegularization::default(),
             par,
-            MemStack::new(&mut buf),
+            MemStack::new(buf),
             Default::default(),
         )
         .ok()?;
@@ -319,20 +345,19 @@ impl Kkt {
         Some(negative)
     }
 
-    fn solve_once(&self, x: &mut [f64]) {
+    fn solve_once(&self, x: &mut [f64], stack: &mut Option<MemBuffer>) {
         let len = x.len();
         let m = MatMut::from_column_major_slice_mut(x, len, 1);
-        match (self.kind, &self.lu, &self.ldlt) {
-            (Factored::Ldlt { .. }, _, Some(sym)) => {
-                let mut buf = MemBuffer::new(sym.solve_in_place_scratch::<f64>(1, Par::Seq));
+        match (self.kind, &self.lu, &self.ldlt, stack) {
+            (Factored::Ldlt { .. }, _, Some(sym), Some(buf)) => {
                 LdltRef::new(sym, &self.ldlt_values).solve_in_place_with_conj(
                     Conj::No,
                     m,
                     Par::Seq,
-                    MemStack::new(&mut buf),
+                    MemStack::new(buf),
                 );
             }
-            (Factored::Lu, Some(lu), _) => lu.solve_in_place_with_conj(Conj::No, m),
+            (Factored::Lu, Some(lu), _, _) => lu.solve_in_place_with_conj(Conj::No, m),
             _ => x.iter_mut().for_each(|v| *v = f64::NAN),
         }
     }
@@ -342,15 +367,19 @@ impl Kkt {
     /// until the normwise backward error `ω = ‖b − K x‖∞ / (‖K‖∞ ‖x‖∞ + ‖b‖∞)` is below
     /// `target` (at most three steps); `false` if singular or if `ω` stays above 10⁻¹⁰.
     pub(crate) fn solve(&self, rhs: &mut [f64], target: f64) -> bool {
-        let b = rhs.to_vec();
+        let mut scratch = self.solve_scratch.borrow_mut();
+        let SolveScratch { stack, b, r } = &mut *scratch;
+        b.clear();
+        b.extend_from_slice(rhs);
         let bnorm = b.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        self.solve_once(rhs);
+        self.solve_once(rhs, stack);
         let sym = self.pattern.symbolic();
         let (ptr, idx) = (sym.col_ptr(), sym.row_idx());
         let knorm = self.knorm;
         let mut omega = f64::INFINITY;
         for _ in 0..3 {
-            let mut r = b.clone();
+            r.clear();
+            r.extend_from_slice(b);
             for c in 0..rhs.len() {
                 for k in ptr[c] as usize..ptr[c + 1] as usize {
                     r[idx[k] as usize] -= self.values[k] * rhs[c];
@@ -362,8 +391,8 @@ impl Kkt {
             if !omega.is_finite() || omega <= target {
                 break;
             }
-            self.solve_once(&mut r);
-            for (x, d) in rhs.iter_mut().zip(&r) {
+            self.solve_once(r, stack);
+            for (x, d) in rhs.iter_mut().zip(r.iter()) {
                 *x += d;
             }
         }

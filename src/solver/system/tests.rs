@@ -1,10 +1,12 @@
 //! The assembled global derivatives against central differences, on real robots at
 //! random (non-assembled, non-unit) configurations.
 use super::*;
+use crate::constraints::Constraints;
 use crate::forces::potential;
 use crate::jet::HessianSink;
+use crate::model::Model;
 use crate::urdf::{load_str, ImportOptions};
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 
 /// Analytic value against a central difference, relative to `1 + |value|`.
 fn assert_fd(analytic: f64, fd: f64, tol: f64, what: impl Fn() -> String) {

@@ -25,7 +25,6 @@ use crate::solver::partition::Partition;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::solvers::SolveCore;
-use faer::perm::PermRef;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, SymbolicCholesky,
     SymbolicCholeskyRaw, SymmetricOrdering,
@@ -36,6 +35,10 @@ use faer::{Conj, MatMut, Par, Side};
 use std::cell::RefCell;
 
 /// The KKT matrix's structure under one partition, its values and its factors.
+///
+/// The matrix is stored permuted into the elimination order (see [`elimination_order`]) and as
+/// its upper triangle only: faer's LDLᵀ then factors the stored values as they are (no
+/// permuted copy per factorization, half the memory of the full pattern).
 pub(crate) struct Kkt {
     n: usize,
     /// Id of the partition.
@@ -44,18 +47,24 @@ pub(crate) struct Kkt {
     rows: usize,
     triplets: usize,
     blocks: usize,
+    /// Upper triangle of the permuted matrix.
     pattern: Pattern,
-    /// faer's symbolic LU (COLAMD ordering), computed on the first LU fallback.
-    symbolic: Option<SymbolicLu<Ix>>,
+    /// `perm[k]`: the original index of permuted position `k`.
+    perm: Vec<usize>,
+    /// Slot of each entry of each block of `W` (`Ix::MAX`: in the lower triangle, whose
+    /// mirror entry of the transposed block holds it).
     block_slots: Vec<[Ix; 49]>,
-    /// Slots of `(n + p, c)` and `(c, n + p)` for each Jacobian triplet in an independent row.
-    jac_slots: Vec<(Ix, Ix)>,
+    /// Slot of `(n + p, c)` (or of its mirror) for each Jacobian triplet in an independent row.
+    jac_slots: Vec<Ix>,
     diag_slots: Vec<usize>,
     values: Vec<f64>,
     /// The shift `δ` now added to the diagonal of the `W` block in `values`.
     delta: f64,
     /// `‖K‖∞` of the factored matrix (for the backward error of solves).
     knorm: f64,
+    /// The full (both triangles) permuted matrix for the LU fallback, built on its first use:
+    /// its pattern, its values, the two full slots of each upper slot, faer's symbolic LU.
+    full: Option<Full>,
     lu: Option<Lu<Ix, f64>>,
     /// Symmetric LDLᵀ in the elimination order of the partition (see [`Kkt::factor`]).
     ldlt: Option<SymbolicCholesky<Ix>>,
@@ -66,14 +75,27 @@ pub(crate) struct Kkt {
     lu_only: bool,
     /// faer's scratch for the numeric LDLᵀ, allocated once per structure.
     factor_scratch: Option<MemBuffer>,
+    /// Row sums of `|K|` (scratch of [`Kkt::factor`]).
+    row_sums: Vec<f64>,
     /// Scratch of the solves (faer's stack, right side, residual), allocated once.
     solve_scratch: RefCell<SolveScratch>,
+}
+
+/// The full matrix of the LU fallback.
+struct Full {
+    pattern: Pattern,
+    values: Vec<f64>,
+    /// Full slots `(r, c)` and `(c, r)` of each upper slot.
+    slots: Vec<(Ix, Ix)>,
+    symbolic: Option<SymbolicLu<Ix>>,
 }
 
 /// Buffers reused by every [`Kkt::solve`].
 #[derive(Default)]
 struct SolveScratch {
     stack: Option<MemBuffer>,
+    /// The solution in permuted order.
+    x: Vec<f64>,
     b: Vec<f64>,
     r: Vec<f64>,
 }
@@ -126,28 +148,42 @@ impl Kkt {
             row_pos[r] = k;
         }
         let dim = n + part.rows.len();
+        let perm = elimination_order(part, n);
+        let mut inv = vec![0usize; dim];
+        for (k, &o) in perm.iter().enumerate() {
+            inv[o] = k;
+        }
+        // Position (i, j) of the original matrix in the stored upper triangle.
+        let upper = |i: usize, j: usize| {
+            let (a, b) = (inv[i], inv[j]);
+            (a.min(b), a.max(b))
+        };
         let blocks = hess
             .keys
             .iter()
-            .flat_map(|&(a, b)| (0..49).map(move |k| (7 * a + k / 7, 7 * b + k % 7)));
+            .flat_map(|&(a, b)| (0..49).map(move |k| (7 * a + k / 7, 7 * b + k % 7)))
+            .map(|(i, j)| upper(i, j));
         let jacobian = entries
             .iter()
             .filter(|e| row_pos[e.0] != NONE)
-            .flat_map(|e| [(n + row_pos[e.0], e.1), (e.1, n + row_pos[e.0])]);
+            .map(|e| upper(n + row_pos[e.0], e.1));
         let pattern = Pattern::new(
             dim,
             dim,
-            blocks.chain(jacobian).chain((0..n).map(|i| (i, i))),
+            blocks.chain(jacobian).chain((0..n).map(|i| upper(i, i))),
         );
         let block_slots = hess
             .keys
             .iter()
             .map(|&(a, b)| {
-                let mut s = [0 as Ix; 49];
+                let mut s = [Ix::MAX; 49];
                 for i in 0..7 {
                     for j in 0..7 {
-                        // Every block position is in the pattern (it was built from them).
-                        s[7 * i + j] = pattern.slot(7 * a + i, 7 * b + j) as Ix;
+                        let (pi, pj) = (inv[7 * a + i], inv[7 * b + j]);
+                        if pi <= pj {
+                            // Every block position is in the pattern (it was built from them).
+                            s[7 * i + j] = pattern.slot(pi, pj) as Ix;
+                        }
                     }
                 }
                 s
@@ -156,27 +192,19 @@ impl Kkt {
         let jac_slots = entries
             .iter()
             .map(|e| match row_pos[e.0] {
-                NONE => (Ix::MAX, Ix::MAX),
-                p => (
-                    pattern.slot(n + p, e.1) as Ix,
-                    pattern.slot(e.1, n + p) as Ix,
-                ),
+                NONE => Ix::MAX,
+                p => {
+                    let (a, b) = upper(n + p, e.1);
+                    pattern.slot(a, b) as Ix
+                }
             })
             .collect();
-        let diag_slots = (0..n).map(|i| pattern.slot(i, i)).collect();
+        let diag_slots = (0..n).map(|i| pattern.slot(inv[i], inv[i])).collect();
         let nnz = pattern.nnz();
-        let order: Vec<Ix> = elimination_order(part, n)
-            .into_iter()
-            .map(|i| i as Ix)
-            .collect();
-        let mut inverse: Vec<Ix> = vec![0; dim];
-        for (i, &o) in order.iter().enumerate() {
-            inverse[o as usize] = i as Ix;
-        }
         let ldlt = factorize_symbolic_cholesky(
             pattern.symbolic(),
-            Side::Lower,
-            SymmetricOrdering::Custom(PermRef::new_checked(&order, &inverse, dim)),
+            Side::Upper,
+            SymmetricOrdering::Identity,
             CholeskySymbolicParams {
                 supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SIMPLICIAL,
                 ..Default::default()
@@ -194,6 +222,7 @@ impl Kkt {
             stack: ldlt.as_ref().and_then(|sym| {
                 MemBuffer::try_new(sym.solve_in_place_scratch::<f64>(1, Par::Seq)).ok()
             }),
+            x: Vec::with_capacity(dim),
             b: Vec::with_capacity(dim),
             r: Vec::with_capacity(dim),
         });
@@ -204,19 +233,21 @@ impl Kkt {
             triplets: entries.len(),
             blocks: hess.keys.len(),
             pattern,
-            symbolic: None,
+            perm,
             block_slots,
             jac_slots,
             diag_slots,
             values: vec![0.0; nnz],
             delta: 0.0,
             knorm: 0.0,
+            full: None,
             lu: None,
             ldlt,
             ldlt_values,
             kind: Factored::None,
             lu_only: false,
             factor_scratch,
+            row_sums: vec![0.0; dim],
             solve_scratch,
         })
     }
@@ -239,16 +270,17 @@ impl Kkt {
         for ((&(a, b), blk), slots) in hess.keys.iter().zip(&hess.values).zip(&self.block_slots) {
             for i in 0..7 {
                 for j in 0..7 {
-                    self.values[slots[7 * i + j] as usize] +=
-                        blk[7 * i + j] * scale[7 * a + i] * scale[7 * b + j];
+                    let slot = slots[7 * i + j];
+                    if slot != Ix::MAX {
+                        self.values[slot as usize] +=
+                            blk[7 * i + j] * scale[7 * a + i] * scale[7 * b + j];
+                    }
                 }
             }
         }
-        for (e, &(s1, s2)) in entries.iter().zip(&self.jac_slots) {
-            if s1 != Ix::MAX {
-                let v = e.2 * row_scale[e.0] * scale[e.1];
-                self.values[s1 as usize] += v;
-                self.values[s2 as usize] += v;
+        for (e, &slot) in entries.iter().zip(&self.jac_slots) {
+            if slot != Ix::MAX {
+                self.values[slot as usize] += e.2 * row_scale[e.0] * scale[e.1];
             }
         }
     }
@@ -272,16 +304,20 @@ impl Kkt {
             self.values[s] += delta - self.delta;
         }
         self.delta = delta;
+        // ‖K‖∞: row sums of |K| from the upper triangle (each off-diagonal entry twice).
         let sym = self.pattern.symbolic();
-        let ptr = sym.col_ptr();
-        // ‖K‖∞ (the pattern is symmetric: column sums are row sums).
-        self.knorm = (0..ptr.len() - 1)
-            .map(|c| {
-                (ptr[c] as usize..ptr[c + 1] as usize)
-                    .map(|k| self.values[k].abs())
-                    .sum::<f64>()
-            })
-            .fold(0.0f64, f64::max);
+        let (ptr, idx) = (sym.col_ptr(), sym.row_idx());
+        self.row_sums.iter_mut().for_each(|x| *x = 0.0);
+        for c in 0..ptr.len() - 1 {
+            for k in ptr[c] as usize..ptr[c + 1] as usize {
+                let (r, v) = (idx[k] as usize, self.values[k].abs());
+                self.row_sums[r] += v;
+                if r != c {
+                    self.row_sums[c] += v;
+                }
+            }
+        }
+        self.knorm = self.row_sums.iter().fold(0.0f64, |a, &x| a.max(x));
         self.kind = Factored::None;
         if !self.lu_only {
             if let Some(negative) = self.factor_ldlt() {
@@ -301,11 +337,39 @@ impl Kkt {
 
     fn factor_lu(&mut self) -> Factored {
         self.kind = Factored::None;
-        if self.symbolic.is_none() {
-            self.symbolic = SymbolicLu::try_new(self.pattern.symbolic()).ok();
+        let full = self.full.get_or_insert_with(|| {
+            let sym = self.pattern.symbolic();
+            let (ptr, idx) = (sym.col_ptr(), sym.row_idx());
+            let upper = || {
+                (0..ptr.len() - 1)
+                    .flat_map(move |c| (ptr[c] as usize..ptr[c + 1] as usize).map(move |k| (k, c)))
+            };
+            let pattern = Pattern::new(
+                ptr.len() - 1,
+                ptr.len() - 1,
+                upper().flat_map(|(k, c)| [(idx[k] as usize, c), (c, idx[k] as usize)]),
+            );
+            let slots = upper()
+                .map(|(k, c)| {
+                    let r = idx[k] as usize;
+                    (pattern.slot(r, c) as Ix, pattern.slot(c, r) as Ix)
+                })
+                .collect();
+            let symbolic = SymbolicLu::try_new(pattern.symbolic()).ok();
+            Full {
+                values: vec![0.0; pattern.nnz()],
+                pattern,
+                slots,
+                symbolic,
+            }
+        });
+        full.values.iter_mut().for_each(|v| *v = 0.0);
+        for (&(a, b), &v) in full.slots.iter().zip(&self.values) {
+            full.values[a as usize] = v;
+            full.values[b as usize] = v;
         }
-        self.lu = self.symbolic.as_ref().and_then(|sym| {
-            Lu::try_new_with_symbolic(sym.clone(), self.pattern.matrix(&self.values)).ok()
+        self.lu = full.symbolic.as_ref().and_then(|sym| {
+            Lu::try_new_with_symbolic(sym.clone(), full.pattern.matrix(&full.values)).ok()
         });
         if self.lu.is_some() {
             self.kind = Factored::Lu;
@@ -321,7 +385,7 @@ impl Kkt {
         sym.factorize_numeric_ldlt(
             &mut self.ldlt_values,
             self.pattern.matrix(&self.values),
-            Side::Lower,
+            Side::Upper,
             LdltRegularization::default(),
             par,
             MemStack::new(buf),
@@ -368,11 +432,14 @@ impl Kkt {
     /// `target` (at most three steps); `false` if singular or if `ω` stays above 10⁻¹⁰.
     pub(crate) fn solve(&self, rhs: &mut [f64], target: f64) -> bool {
         let mut scratch = self.solve_scratch.borrow_mut();
-        let SolveScratch { stack, b, r } = &mut *scratch;
+        let SolveScratch { stack, x, b, r } = &mut *scratch;
+        // Into the permuted order of the stored matrix.
         b.clear();
-        b.extend_from_slice(rhs);
+        b.extend(self.perm.iter().map(|&o| rhs[o]));
+        x.clear();
+        x.extend_from_slice(b);
         let bnorm = b.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        self.solve_once(rhs, stack);
+        self.solve_once(x, stack);
         let sym = self.pattern.symbolic();
         let (ptr, idx) = (sym.col_ptr(), sym.row_idx());
         let knorm = self.knorm;
@@ -380,21 +447,28 @@ impl Kkt {
         for _ in 0..3 {
             r.clear();
             r.extend_from_slice(b);
-            for c in 0..rhs.len() {
+            for c in 0..x.len() {
                 for k in ptr[c] as usize..ptr[c + 1] as usize {
-                    r[idx[k] as usize] -= self.values[k] * rhs[c];
+                    let (i, v) = (idx[k] as usize, self.values[k]);
+                    r[i] -= v * x[c];
+                    if i != c {
+                        r[c] -= v * x[i];
+                    }
                 }
             }
             let rnorm = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-            let xnorm = rhs.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            let xnorm = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
             omega = rnorm / (knorm * xnorm + bnorm).max(f64::MIN_POSITIVE);
             if !omega.is_finite() || omega <= target {
                 break;
             }
             self.solve_once(r, stack);
-            for (x, d) in rhs.iter_mut().zip(r.iter()) {
+            for (x, d) in x.iter_mut().zip(r.iter()) {
                 *x += d;
             }
+        }
+        for (k, &o) in self.perm.iter().enumerate() {
+            rhs[o] = x[k];
         }
         rhs.iter().all(|x| x.is_finite()) && omega <= 1e-10
     }

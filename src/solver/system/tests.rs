@@ -186,6 +186,20 @@ fn kkt_step_is_the_reduced_newton_step() {
             "{}: KKT step {d} vs reduced Newton step {expected}",
             model.name
         );
+        // The LU fallback (the full matrix rebuilt from the stored upper triangle) gives the
+        // same step.
+        assert_eq!(
+            sparse.kkt_fall_back_to_lu(),
+            crate::solver::sparse::kkt::Factored::Lu,
+            "{}",
+            model.name
+        );
+        let dq_lu = sparse.kkt_solve(&b).unwrap();
+        assert!(
+            (&dq_lu - &dq).amax() < 1e-8 * (1.0 + dq.amax()),
+            "{}: LU step differs from the LDLT step",
+            model.name
+        );
         // δq is the tangent step of δv: Φ_q δq = 0 on the independent rows.
         let full = sparse.tangent_step(&part, &es, &d);
         let dq_unscaled = DVector::from_iterator(

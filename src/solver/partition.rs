@@ -51,35 +51,59 @@ pub(crate) fn partition(jac: &DMatrix<f64>, row_scale: &[f64], scale: &[f64]) ->
     let mut col_perm: Vec<usize> = (0..n).collect();
     let amax = a.amax();
     let mut rank = 0;
-    for k in 0..m.min(n) {
-        let mut best = (k, k, 0.0);
+    // Rows and columns are swapped in place (position `i` holds row `row_perm[i]`), so that the
+    // pivot search and the elimination run down contiguous columns; the search order, the
+    // pivots and every update are those of the permuted-index formulation.
+    // The pivot search of step `k + 1` runs inside the elimination of step `k` (same order:
+    // columns, then rows, from `k + 1`), so the matrix is read once per step.
+    let mut factor = vec![0.0; m];
+    let search = |a: &DMatrix<f64>, k: usize| {
+        let (mut best, mut threshold) = ((k, k, 0.0), 0.0);
         for jj in k..n {
-            let c = col_perm[jj];
+            let col = a.column(jj);
             for ii in k..m {
-                let v = a[(row_perm[ii], c)].abs();
-                if v > best.2 * (1.0 + 1e-9) {
+                let v = col[ii].abs();
+                if v > threshold {
                     best = (ii, jj, v);
+                    threshold = v * (1.0 + 1e-9);
                 }
             }
         }
+        best
+    };
+    let mut best = search(&a, 0);
+    for k in 0..m.min(n) {
         if best.2 <= RANK_TOLERANCE * amax || best.2 == 0.0 {
             break;
         }
         row_perm.swap(k, best.0);
+        a.swap_rows(k, best.0);
         col_perm.swap(k, best.1);
-        let (pr, pc) = (row_perm[k], col_perm[k]);
-        let piv = a[(pr, pc)];
+        a.swap_columns(k, best.1);
+        let piv = a[(k, k)];
         for ii in k + 1..m {
-            let r = row_perm[ii];
-            let f = a[(r, pc)] / piv;
-            if f != 0.0 {
-                for jj in k..n {
-                    let c = col_perm[jj];
-                    a[(r, c)] -= f * a[(pr, c)];
+            factor[ii] = a[(ii, k)] / piv;
+        }
+        rank = k + 1;
+        let mut next = (k + 1, k + 1, 0.0);
+        let mut threshold = 0.0;
+        for jj in k..n {
+            let p = a[(k, jj)];
+            let mut col = a.column_mut(jj);
+            for ii in k + 1..m {
+                if factor[ii] != 0.0 {
+                    col[ii] -= factor[ii] * p;
+                }
+                if jj > k {
+                    let v = col[ii].abs();
+                    if v > threshold {
+                        next = (ii, jj, v);
+                        threshold = v * (1.0 + 1e-9);
+                    }
                 }
             }
         }
-        rank = k + 1;
+        best = next;
     }
     let mut independent = col_perm[rank..].to_vec();
     independent.sort_unstable();

@@ -447,14 +447,22 @@ impl Kkt {
         for _ in 0..3 {
             r.clear();
             r.extend_from_slice(b);
+            // r −= K x from the upper triangle: column c gives `K[i, c] x[c]` to rows `i` and,
+            // by symmetry, `Σ_i K[i, c] x[i]` to row `c` (the diagonal, the column's last
+            // entry when present, only once).
             for c in 0..x.len() {
-                for k in ptr[c] as usize..ptr[c + 1] as usize {
+                let (a, b) = (ptr[c] as usize, ptr[c + 1] as usize);
+                let xc = x[c];
+                let mut sum = 0.0;
+                for k in a..b {
                     let (i, v) = (idx[k] as usize, self.values[k]);
-                    r[i] -= v * x[c];
-                    if i != c {
-                        r[c] -= v * x[i];
-                    }
+                    r[i] -= v * xc;
+                    sum += v * x[i];
                 }
+                if b > a && idx[b - 1] as usize == c {
+                    sum -= self.values[b - 1] * xc;
+                }
+                r[c] -= sum;
             }
             let rnorm = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
             let xnorm = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));

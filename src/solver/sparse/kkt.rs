@@ -26,7 +26,7 @@ use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::solvers::SolveCore;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, SymbolicCholesky,
+    factorize_symbolic_cholesky, simplicial, CholeskySymbolicParams, LdltRef, SymbolicCholesky,
     SymbolicCholeskyRaw, SymmetricOrdering,
 };
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
@@ -212,12 +212,12 @@ impl Kkt {
         )
         .ok();
         let ldlt_values = vec![0.0; ldlt.as_ref().map_or(0, |l| l.len_val())];
-        let factor_scratch = ldlt.as_ref().and_then(|sym| {
-            MemBuffer::try_new(
-                sym.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()),
-            )
-            .ok()
-        });
+        let factor_scratch =
+            MemBuffer::try_new(simplicial::factorize_simplicial_numeric_ldlt_scratch::<
+                Ix,
+                f64,
+            >(dim))
+            .ok();
         let solve_scratch = RefCell::new(SolveScratch {
             stack: ldlt.as_ref().and_then(|sym| {
                 MemBuffer::try_new(sym.solve_in_place_scratch::<f64>(1, Par::Seq)).ok()
@@ -380,21 +380,21 @@ impl Kkt {
     /// The LDLᵀ factorization; the number of negative pivots, or `None` on a zero pivot.
     fn factor_ldlt(&mut self) -> Option<usize> {
         let sym = self.ldlt.as_ref()?;
-        let par = Par::Seq;
-        let buf = self.factor_scratch.as_mut()?;
-        sym.factorize_numeric_ldlt(
-            &mut self.ldlt_values,
-            self.pattern.matrix(&self.values),
-            Side::Upper,
-            LdltRegularization::default(),
-            par,
-            MemStack::new(buf),
-            Default::default(),
-        )
-        .ok()?;
         let SymbolicCholeskyRaw::Simplicial(simplicial) = sym.raw() else {
             return None;
         };
+        let buf = self.factor_scratch.as_mut()?;
+        // The simplicial kernel itself: the stored values are already the upper triangle in
+        // the elimination order, and its workspace is `O(dim)` (the general entry point sizes
+        // one for a permuted copy of the matrix).
+        simplicial::factorize_simplicial_numeric_ldlt(
+            &mut self.ldlt_values,
+            self.pattern.matrix(&self.values),
+            LdltRegularization::default(),
+            simplicial,
+            MemStack::new(buf),
+        )
+        .ok()?;
         let ptr = simplicial.col_ptr();
         let mut negative = 0;
         for j in 0..ptr.len() - 1 {

@@ -11,6 +11,8 @@
 //! This makes every analytic Jacobian and Hessian of the model exact (not finite differences);
 //! each is checked against central differences in the tests of the modules using it.
 
+pub(crate) mod closed;
+
 use crate::math::{b_matrix, rotation};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3, Vector4};
 

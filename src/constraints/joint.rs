@@ -154,6 +154,9 @@ pub(crate) fn rows(joint: &Joint, pair: &Pair, reference: f64, out: &mut Vec<Sca
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::jet::closed;
+    use crate::jet::closed::tests::assert_same;
+    use crate::jet::hess_or_zero;
     use crate::jet::testing::{check_scalar, sample_pair};
     use crate::model::BodyId;
     use nalgebra::{Isometry3, Translation3, UnitQuaternion};
@@ -194,6 +197,58 @@ mod tests {
         JointKind::Distance { length: 0.7 },
         JointKind::PointOnLine,
     ];
+
+    /// One closed-form row as a scalar: value and gradient from [`closed::rows`], Hessian from
+    /// [`closed::add_weighted_hessian`] with the unit weight on row `r`.
+    fn closed_row(j: &Joint, pair: &Pair, r: usize) -> Scalar {
+        let mut out = Vec::new();
+        closed::rows(j, pair, &mut out);
+        let mut w = vec![0.0; out.len()];
+        w[r] = 1.0;
+        let mut h = Box::new(crate::jet::LMat::zeros());
+        closed::add_weighted_hessian(j, pair, &w, &mut h);
+        let mut values = Vec::new();
+        closed::values(j, pair, &mut values);
+        assert_eq!(values[r], out[r].v);
+        Scalar {
+            h: Some(h),
+            ..out[r].clone()
+        }
+    }
+
+    /// The closed-form rows equal the generic jets (value, gradient, Hessian contracted with
+    /// multipliers) to rounding, and their derivatives match central differences.
+    #[test]
+    fn closed_form_rows_equal_the_jets_and_finite_differences() {
+        for kind in KINDS {
+            let j = joint(kind);
+            if !closed::supports(&j) {
+                assert!(matches!(kind, JointKind::Screw { .. }));
+                continue;
+            }
+            for seed in 0..4 {
+                let pair = sample_pair(seed);
+                let mut jets = Vec::new();
+                rows(&j, &pair, 0.0, &mut jets);
+                assert_eq!(jets.len(), row_count(&j));
+                for r in 0..jets.len() {
+                    let what = format!("{} row {} seed {seed}", kind.name(), row_names(&j)[r]);
+                    assert_same(&jets[r], &closed_row(&j, &pair, r), &what);
+                    check_scalar(&pair, &|q| closed_row(&j, q, r), &what);
+                }
+                // Multipliers: Σ w_r ∇²Φ_r at once.
+                let w: Vec<f64> = (0..jets.len()).map(|r| 0.7 - 0.45 * r as f64).collect();
+                let mut expected = crate::jet::LMat::zeros();
+                for (s, c) in jets.iter().zip(&w) {
+                    expected += hess_or_zero(&s.h) * *c;
+                }
+                let mut got = crate::jet::LMat::zeros();
+                closed::add_weighted_hessian(&j, &pair, &w, &mut got);
+                let d = (got - expected).amax();
+                assert!(d <= 1e-12 * (1.0 + expected.amax()), "{}: {d}", kind.name());
+            }
+        }
+    }
 
     #[test]
     fn every_row_jacobian_and_hessian_match_finite_differences() {

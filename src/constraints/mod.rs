@@ -62,6 +62,9 @@ pub(crate) struct Block {
 enum Term<'a> {
     Jet(&'a [Option<BodyId>; 2], &'a Scalar, f64),
     Normalization(BodyId),
+    /// The rows of a joint with closed-form derivatives ([`crate::jet::closed`]), from
+    /// `row` on.
+    Closed(&'a crate::model::Joint, &'a crate::jet::Pair),
 }
 
 /// The full set of constraint rows of a model, with locks resolved to values.
@@ -75,6 +78,9 @@ pub(crate) struct Constraints {
     /// The branch each joint angle is read on (lock, mimic and screw rows); the solver moves
     /// it along with the configuration.
     pub(crate) branches: Branches,
+    /// Joint rows by their closed-form derivatives where one exists (else by the generic
+    /// jets, the reference the closed forms are tested against).
+    pub(crate) closed_form: bool,
 }
 
 impl Constraints {
@@ -121,6 +127,7 @@ impl Constraints {
             names,
             length_power,
             branches: Branches::default(),
+            closed_form: true,
         }
     }
 
@@ -182,6 +189,10 @@ impl Constraints {
                 BlockKind::Joint(id) => {
                     let j = &model.joints[id.0];
                     let pair = pair_of(&j.bodies, q, hess);
+                    if self.closed_form && crate::jet::closed::supports(j) {
+                        visit(block.first, Term::Closed(j, &pair));
+                        continue;
+                    }
                     joint::rows(j, &pair, self.branches.get(*id, 0), &mut buf);
                     for (k, s) in buf.iter().enumerate() {
                         visit(block.first + k, Term::Jet(&j.bodies, s, 1.0));
@@ -245,16 +256,38 @@ impl Constraints {
                 t.entries.reserve_exact(14 * self.len);
             }
         }
-        self.for_each_row(model, q, false, |row, term| match term {
-            Term::Jet(bodies, s, c) => {
-                phi[row] += c * s.v;
-                if let Some(t) = jac.as_deref_mut() {
-                    for i in 0..crate::jet::NL {
-                        if let Some(gi) = crate::jet::global_index(bodies, i) {
-                            // Zeros too: the sparsity pattern must not depend on `q`.
-                            t.entries.push((row, gi, c * s.g[i]));
-                        }
+        let mut closed = Vec::with_capacity(6);
+        let mut closed_values = Vec::with_capacity(6);
+        fn push(
+            phi: &mut DVector<f64>,
+            jac: Option<&mut Triplets>,
+            row: usize,
+            bodies: &[Option<BodyId>; 2],
+            s: &Scalar,
+            c: f64,
+        ) {
+            phi[row] += c * s.v;
+            if let Some(t) = jac {
+                for i in 0..crate::jet::NL {
+                    if let Some(gi) = crate::jet::global_index(bodies, i) {
+                        // Zeros too: the sparsity pattern must not depend on `q`.
+                        t.entries.push((row, gi, c * s.g[i]));
                     }
+                }
+            }
+        }
+        self.for_each_row(model, q, false, |row, term| match term {
+            Term::Jet(bodies, s, c) => push(phi, jac.as_deref_mut(), row, bodies, s, c),
+            Term::Closed(j, pair) if jac.is_none() => {
+                crate::jet::closed::values(j, pair, &mut closed_values);
+                for (k, v) in closed_values.iter().enumerate() {
+                    phi[row + k] += v;
+                }
+            }
+            Term::Closed(j, pair) => {
+                crate::jet::closed::rows(j, pair, &mut closed);
+                for (k, s) in closed.iter().enumerate() {
+                    push(phi, jac.as_deref_mut(), row + k, &j.bodies, s, 1.0);
                 }
             }
             Term::Normalization(b) => {
@@ -299,6 +332,23 @@ impl Constraints {
                     }
                     if let (Some((_, acc)), Some(sh)) = (pending.as_mut(), s.h.as_deref()) {
                         *acc += sh * (c * w[row]);
+                    }
+                }
+            }
+            Term::Closed(j, pair) => {
+                let ws = &w.as_slice()[row..row + joint::row_count(j)];
+                if ws.iter().any(|&x| x != 0.0) {
+                    let same = pending.as_ref().is_some_and(|(b, _)| {
+                        b.iter()
+                            .map(|x| x.map(|y| y.0))
+                            .eq(j.bodies.iter().map(|x| x.map(|y| y.0)))
+                    });
+                    if !same {
+                        flush(&mut pending, h);
+                        pending = Some((j.bodies, LMat::zeros()));
+                    }
+                    if let Some((_, acc)) = pending.as_mut() {
+                        crate::jet::closed::add_weighted_hessian(j, pair, ws, acc);
                     }
                 }
             }

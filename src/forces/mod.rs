@@ -9,10 +9,10 @@
 
 pub(crate) mod law;
 
-use crate::jet::{pair_of, scatter, Pair, Scalar, Vec3Jet};
+use crate::jet::{closed, pair_of, scatter, Pair, Scalar};
 use crate::kinematics::{coordinate, Branches};
 use crate::model::{BodyId, Model, SpringMode};
-use nalgebra::{DVector, Vector3};
+use nalgebra::DVector;
 
 /// Potential energy split by source \[J\].
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
@@ -32,13 +32,22 @@ pub struct Energy {
     pub(crate) magnitude: f64,
 }
 
-/// `wᵀ f` for a constant `w`.
-fn weighted(pair: &Pair, f: &Vec3Jet, w: &Vector3<f64>) -> Scalar {
-    let h = pair.hess.then(|| Box::new(f.contract(w)));
-    Scalar {
-        v: w.dot(&f.v),
-        g: f.j.transpose() * w,
-        h,
+/// The joint coordinate `dof` read on the branch `reference`: a revolute angle in closed form
+/// ([`closed::revolute_angle`]), any other by the generic jets of
+/// [`crate::kinematics::coordinate`].
+fn joint_coordinate(
+    joint: &crate::model::Joint,
+    pair: &Pair,
+    dof: usize,
+    reference: f64,
+) -> Option<Scalar> {
+    use crate::model::JointKind;
+    match (joint.kind, dof) {
+        (JointKind::Revolute | JointKind::Continuous, 0) => Some(crate::kinematics::on_branch(
+            closed::revolute_angle(joint, pair),
+            reference,
+        )),
+        _ => coordinate(joint, pair, dof, reference),
     }
 }
 
@@ -67,20 +76,15 @@ pub(crate) fn potential(
         }
         let bodies = [Some(BodyId(i)), None];
         let pair = pair_of(&bodies, q, want_h);
-        let p = pair.point(0, &b.gravity_com);
-        let s = weighted(&pair, &p, &(-b.gravity_mass * model.gravity));
+        let w = -b.gravity_mass * model.gravity;
+        let s = closed::weighted_point(&pair, 0, &b.gravity_com, &w);
         add(&bodies, &s, 1.0, &mut e.gravity);
     }
     for l in &model.loads {
         let bodies = [Some(l.body), None];
         let pair = pair_of(&bodies, q, want_h);
-        let p = pair.point(0, &l.point);
-        add(
-            &bodies,
-            &weighted(&pair, &p, &(-l.force)),
-            1.0,
-            &mut e.loads,
-        );
+        let s = closed::weighted_point(&pair, 0, &l.point, &(-l.force));
+        add(&bodies, &s, 1.0, &mut e.loads);
     }
     for s in &model.springs {
         let bodies = [s.ends[0].body, s.ends[1].body];
@@ -102,7 +106,7 @@ pub(crate) fn potential(
     for js in &model.joint_springs {
         let j = &model.joints[js.joint.0];
         let pair = pair_of(&j.bodies, q, want_h);
-        let theta = coordinate(j, &pair, js.dof, branches.get(js.joint, js.dof))?;
+        let theta = joint_coordinate(j, &pair, js.dof, branches.get(js.joint, js.dof))?;
         let (u, f, k) = law::evaluate(&js.law, SpringMode::Both, theta.v - js.reference)?;
         add(
             &j.bodies,
@@ -114,7 +118,7 @@ pub(crate) fn potential(
     for ef in &model.efforts {
         let j = &model.joints[ef.joint.0];
         let pair = pair_of(&j.bodies, q, want_h);
-        let theta = coordinate(j, &pair, ef.dof, branches.get(ef.joint, ef.dof))?;
+        let theta = joint_coordinate(j, &pair, ef.dof, branches.get(ef.joint, ef.dof))?;
         add(&j.bodies, &theta, -ef.value, &mut e.loads);
     }
     e.total = e.gravity + e.springs + e.joint_springs + e.loads;
@@ -176,4 +180,54 @@ pub(crate) fn has_energy(model: &Model) -> bool {
             .iter()
             .any(|l| l.force != nalgebra::Vector3::zeros())
         || model.efforts.iter().any(|e| e.value != 0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::jet::closed::tests::assert_same;
+    use crate::jet::testing::{check_scalar, sample_pair};
+    use crate::model::{Joint, JointKind};
+    use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+
+    /// The closed-form revolute angle equals the generic jets' (value, gradient, Hessian) and
+    /// matches central differences.
+    #[test]
+    fn closed_form_revolute_angle_equals_the_jets() {
+        let joint = Joint {
+            name: "j".into(),
+            kind: JointKind::Revolute,
+            parent_link: "a".into(),
+            child_link: "b".into(),
+            bodies: [Some(BodyId(0)), Some(BodyId(1))],
+            body_from_joint: [
+                Isometry3::from_parts(
+                    Translation3::new(0.1, 0.2, -0.3),
+                    UnitQuaternion::from_euler_angles(0.3, -0.2, 0.9),
+                ),
+                Isometry3::from_parts(
+                    Translation3::new(-0.2, 0.05, 0.4),
+                    UnitQuaternion::from_euler_angles(-0.5, 0.4, 0.1),
+                ),
+            ],
+            tree: false,
+            merged: false,
+            limits: None,
+            source: None,
+        };
+        for seed in 0..5 {
+            let pair = sample_pair(seed);
+            for reference in [0.0, 7.0] {
+                let what = format!("seed {seed}, branch {reference}");
+                let jet = coordinate(&joint, &pair, 0, reference).unwrap();
+                let closed = joint_coordinate(&joint, &pair, 0, reference).unwrap();
+                assert_same(&jet, &closed, &what);
+                check_scalar(
+                    &pair,
+                    &|q| joint_coordinate(&joint, q, 0, reference).unwrap(),
+                    &what,
+                );
+            }
+        }
+    }
 }

@@ -51,35 +51,59 @@ pub(crate) fn partition(jac: &DMatrix<f64>, row_scale: &[f64], scale: &[f64]) ->
     let mut col_perm: Vec<usize> = (0..n).collect();
     let amax = a.amax();
     let mut rank = 0;
-    for k in 0..m.min(n) {
-        let mut best = (k, k, 0.0);
+    // Rows and columns are swapped in place (position `i` holds row `row_perm[i]`), so that the
+    // pivot search and the elimination run down contiguous columns; the search order, the
+    // pivots and every update are those of the permuted-index formulation.
+    // The pivot search of step `k + 1` runs inside the elimination of step `k` (same order:
+    // columns, then rows, from `k + 1`), so the matrix is read once per step.
+    let mut factor = vec![0.0; m];
+    let search = |a: &DMatrix<f64>, k: usize| {
+        let (mut best, mut threshold) = ((k, k, 0.0), 0.0);
         for jj in k..n {
-            let c = col_perm[jj];
+            let col = a.column(jj);
             for ii in k..m {
-                let v = a[(row_perm[ii], c)].abs();
-                if v > best.2 * (1.0 + 1e-9) {
+                let v = col[ii].abs();
+                if v > threshold {
                     best = (ii, jj, v);
+                    threshold = v * (1.0 + 1e-9);
                 }
             }
         }
+        best
+    };
+    let mut best = search(&a, 0);
+    for k in 0..m.min(n) {
         if best.2 <= RANK_TOLERANCE * amax || best.2 == 0.0 {
             break;
         }
         row_perm.swap(k, best.0);
+        a.swap_rows(k, best.0);
         col_perm.swap(k, best.1);
-        let (pr, pc) = (row_perm[k], col_perm[k]);
-        let piv = a[(pr, pc)];
+        a.swap_columns(k, best.1);
+        let piv = a[(k, k)];
         for ii in k + 1..m {
-            let r = row_perm[ii];
-            let f = a[(r, pc)] / piv;
-            if f != 0.0 {
-                for jj in k..n {
-                    let c = col_perm[jj];
-                    a[(r, c)] -= f * a[(pr, c)];
+            factor[ii] = a[(ii, k)] / piv;
+        }
+        rank = k + 1;
+        let mut next = (k + 1, k + 1, 0.0);
+        let mut threshold = 0.0;
+        for jj in k..n {
+            let p = a[(k, jj)];
+            let mut col = a.column_mut(jj);
+            for ii in k + 1..m {
+                if factor[ii] != 0.0 {
+                    col[ii] -= factor[ii] * p;
+                }
+                if jj > k {
+                    let v = col[ii].abs();
+                    if v > threshold {
+                        next = (ii, jj, v);
+                        threshold = v * (1.0 + 1e-9);
+                    }
                 }
             }
         }
-        rank = k + 1;
+        best = next;
     }
     let mut independent = col_perm[rank..].to_vec();
     independent.sort_unstable();
@@ -119,5 +143,106 @@ mod tests {
         let p = partition(&j, &[1.0; 1], &[1.0; 3]);
         assert_eq!(p.dependent, vec![1]);
         assert_eq!(p.independent, vec![0, 2]);
+    }
+
+    /// The permuted-index formulation this module used before the in-place swaps and the
+    /// fused pivot search (kept as the reference the faster one must equal exactly).
+    fn reference(jac: &DMatrix<f64>, row_scale: &[f64], scale: &[f64]) -> Partition {
+        let (m, n) = jac.shape();
+        let mut a = jac.clone();
+        for j in 0..n {
+            a.column_mut(j).scale_mut(scale[j]);
+        }
+        for i in 0..m {
+            a.row_mut(i).scale_mut(row_scale[i]);
+        }
+        let mut row_perm: Vec<usize> = (0..m).collect();
+        let mut col_perm: Vec<usize> = (0..n).collect();
+        let amax = a.amax();
+        let mut rank = 0;
+        for k in 0..m.min(n) {
+            let mut best = (k, k, 0.0);
+            for jj in k..n {
+                let c = col_perm[jj];
+                for ii in k..m {
+                    let v = a[(row_perm[ii], c)].abs();
+                    if v > best.2 * (1.0 + 1e-9) {
+                        best = (ii, jj, v);
+                    }
+                }
+            }
+            if best.2 <= RANK_TOLERANCE * amax || best.2 == 0.0 {
+                break;
+            }
+            row_perm.swap(k, best.0);
+            col_perm.swap(k, best.1);
+            let (pr, pc) = (row_perm[k], col_perm[k]);
+            let piv = a[(pr, pc)];
+            for ii in k + 1..m {
+                let r = row_perm[ii];
+                let f = a[(r, pc)] / piv;
+                if f != 0.0 {
+                    for jj in k..n {
+                        let c = col_perm[jj];
+                        a[(r, c)] -= f * a[(pr, c)];
+                    }
+                }
+            }
+            rank = k + 1;
+        }
+        let mut independent = col_perm[rank..].to_vec();
+        independent.sort_unstable();
+        let mut redundant = row_perm[rank..].to_vec();
+        redundant.sort_unstable();
+        Partition {
+            id: next_id(),
+            dependent: col_perm[..rank].to_vec(),
+            independent,
+            rows: row_perm[..rank].to_vec(),
+            redundant,
+        }
+    }
+
+    /// The in-place, fused elimination picks exactly the pivots of the reference (same rank,
+    /// same order of dependent columns and rows) on random matrices with ties, zero columns,
+    /// redundant rows and scaling.
+    #[test]
+    fn equals_the_permuted_index_reference() {
+        let mut seed = 12345u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for trial in 0..200 {
+            let m = 1 + trial % 9;
+            let n = 1 + (trial * 7) % 13;
+            let mut j = DMatrix::from_fn(m, n, |_, _| {
+                let x = next();
+                // Many exact zeros and repeated magnitudes (pivot ties).
+                if x < 0.3 {
+                    0.0
+                } else if x < 0.5 {
+                    1.0
+                } else {
+                    (x - 0.75) * 4.0
+                }
+            });
+            if m > 2 {
+                // A redundant row.
+                let r = j.row(0) * 2.0 - j.row(1);
+                j.set_row(m - 1, &r);
+            }
+            let rows: Vec<f64> = (0..m).map(|_| 0.5 + next()).collect();
+            let cols: Vec<f64> = (0..n)
+                .map(|_| if next() < 0.5 { 1.0 } else { 0.3 })
+                .collect();
+            let (a, b) = (partition(&j, &rows, &cols), reference(&j, &rows, &cols));
+            assert_eq!(a.dependent, b.dependent, "trial {trial}");
+            assert_eq!(a.independent, b.independent, "trial {trial}");
+            assert_eq!(a.rows, b.rows, "trial {trial}");
+            assert_eq!(a.redundant, b.redundant, "trial {trial}");
+        }
     }
 }

@@ -2,16 +2,17 @@
 //!
 //! Every energy term and constraint row depends on at most two bodies, so `W` has a dense
 //! 7 × 7 block `(a, b)` exactly where bodies `a` and `b` share a term: `O(N)` blocks for `N`
-//! bodies. Blocks are found by a hash lookup once per term and accumulated in place.
+//! bodies. Blocks are found through a short list per row body (the bodies it shares a term
+//! with: a handful) and accumulated in place.
 
 use crate::jet::{HessianSink, LMat};
 use crate::model::BodyId;
-use std::collections::HashMap;
 
 /// A symmetric matrix over `7 N` coordinates stored as dense 7 × 7 body blocks.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct BlockHessian {
-    index: HashMap<(usize, usize), usize>,
+    /// For each row body `a`, the `(column body, block index)` of its blocks, sorted.
+    index: Vec<Vec<(usize, usize)>>,
     /// `(row body, column body)` of each block, in creation order.
     pub(crate) keys: Vec<(usize, usize)>,
     /// Row-major 7 × 7 values of each block.
@@ -25,12 +26,20 @@ impl BlockHessian {
     }
 
     fn block(&mut self, a: usize, b: usize) -> &mut [f64; 49] {
-        let next = self.keys.len();
-        let k = *self.index.entry((a, b)).or_insert(next);
-        if k == next {
-            self.keys.push((a, b));
-            self.values.push([0.0; 49]);
+        if a >= self.index.len() {
+            self.index.resize_with(a + 1, Vec::new);
         }
+        // Sorted by column body: `O(log k)` for a body sharing terms with `k` others.
+        let k = match self.index[a].binary_search_by_key(&b, |e| e.0) {
+            Ok(i) => self.index[a][i].1,
+            Err(i) => {
+                let k = self.keys.len();
+                self.index[a].insert(i, (b, k));
+                self.keys.push((a, b));
+                self.values.push([0.0; 49]);
+                k
+            }
+        };
         &mut self.values[k]
     }
 

@@ -25,16 +25,20 @@ use crate::solver::partition::Partition;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::solvers::SolveCore;
-use faer::perm::PermRef;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, SymbolicCholesky,
+    factorize_symbolic_cholesky, simplicial, CholeskySymbolicParams, LdltRef, SymbolicCholesky,
     SymbolicCholeskyRaw, SymmetricOrdering,
 };
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::{Conj, MatMut, Par, Side};
+use std::cell::RefCell;
 
 /// The KKT matrix's structure under one partition, its values and its factors.
+///
+/// The matrix is stored permuted into the elimination order (see [`elimination_order`]) and as
+/// its upper triangle only: faer's LDLᵀ then factors the stored values as they are (no
+/// permuted copy per factorization, half the memory of the full pattern).
 pub(crate) struct Kkt {
     n: usize,
     /// Id of the partition.
@@ -43,18 +47,24 @@ pub(crate) struct Kkt {
     rows: usize,
     triplets: usize,
     blocks: usize,
+    /// Upper triangle of the permuted matrix.
     pattern: Pattern,
-    /// faer's symbolic LU (COLAMD ordering), computed on the first LU fallback.
-    symbolic: Option<SymbolicLu<Ix>>,
+    /// `perm[k]`: the original index of permuted position `k`.
+    perm: Vec<usize>,
+    /// Slot of each entry of each block of `W` (`Ix::MAX`: in the lower triangle, whose
+    /// mirror entry of the transposed block holds it).
     block_slots: Vec<[Ix; 49]>,
-    /// Slots of `(n + p, c)` and `(c, n + p)` for each Jacobian triplet in an independent row.
-    jac_slots: Vec<(Ix, Ix)>,
+    /// Slot of `(n + p, c)` (or of its mirror) for each Jacobian triplet in an independent row.
+    jac_slots: Vec<Ix>,
     diag_slots: Vec<usize>,
     values: Vec<f64>,
     /// The shift `δ` now added to the diagonal of the `W` block in `values`.
     delta: f64,
     /// `‖K‖∞` of the factored matrix (for the backward error of solves).
     knorm: f64,
+    /// The full (both triangles) permuted matrix for the LU fallback, built on its first use:
+    /// its pattern, its values, the two full slots of each upper slot, faer's symbolic LU.
+    full: Option<Full>,
     lu: Option<Lu<Ix, f64>>,
     /// Symmetric LDLᵀ in the elimination order of the partition (see [`Kkt::factor`]).
     ldlt: Option<SymbolicCholesky<Ix>>,
@@ -63,6 +73,31 @@ pub(crate) struct Kkt {
     kind: Factored,
     /// LDLᵀ solves were not accurate on this structure: LU from now on.
     lu_only: bool,
+    /// faer's scratch for the numeric LDLᵀ, allocated once per structure.
+    factor_scratch: Option<MemBuffer>,
+    /// Row sums of `|K|` (scratch of [`Kkt::factor`]).
+    row_sums: Vec<f64>,
+    /// Scratch of the solves (faer's stack, right side, residual), allocated once.
+    solve_scratch: RefCell<SolveScratch>,
+}
+
+/// The full matrix of the LU fallback.
+struct Full {
+    pattern: Pattern,
+    values: Vec<f64>,
+    /// Full slots `(r, c)` and `(c, r)` of each upper slot.
+    slots: Vec<(Ix, Ix)>,
+    symbolic: Option<SymbolicLu<Ix>>,
+}
+
+/// Buffers reused by every [`Kkt::solve`].
+#[derive(Default)]
+struct SolveScratch {
+    stack: Option<MemBuffer>,
+    /// The solution in permuted order.
+    x: Vec<f64>,
+    b: Vec<f64>,
+    r: Vec<f64>,
 }
 
 /// What the last [`Kkt::factor`] produced.
@@ -113,28 +148,42 @@ impl Kkt {
             row_pos[r] = k;
         }
         let dim = n + part.rows.len();
+        let perm = elimination_order(part, n);
+        let mut inv = vec![0usize; dim];
+        for (k, &o) in perm.iter().enumerate() {
+            inv[o] = k;
+        }
+        // Position (i, j) of the original matrix in the stored upper triangle.
+        let upper = |i: usize, j: usize| {
+            let (a, b) = (inv[i], inv[j]);
+            (a.min(b), a.max(b))
+        };
         let blocks = hess
             .keys
             .iter()
-            .flat_map(|&(a, b)| (0..49).map(move |k| (7 * a + k / 7, 7 * b + k % 7)));
+            .flat_map(|&(a, b)| (0..49).map(move |k| (7 * a + k / 7, 7 * b + k % 7)))
+            .map(|(i, j)| upper(i, j));
         let jacobian = entries
             .iter()
             .filter(|e| row_pos[e.0] != NONE)
-            .flat_map(|e| [(n + row_pos[e.0], e.1), (e.1, n + row_pos[e.0])]);
+            .map(|e| upper(n + row_pos[e.0], e.1));
         let pattern = Pattern::new(
             dim,
             dim,
-            blocks.chain(jacobian).chain((0..n).map(|i| (i, i))),
+            blocks.chain(jacobian).chain((0..n).map(|i| upper(i, i))),
         );
         let block_slots = hess
             .keys
             .iter()
             .map(|&(a, b)| {
-                let mut s = [0 as Ix; 49];
+                let mut s = [Ix::MAX; 49];
                 for i in 0..7 {
                     for j in 0..7 {
-                        // Every block position is in the pattern (it was built from them).
-                        s[7 * i + j] = pattern.slot(7 * a + i, 7 * b + j) as Ix;
+                        let (pi, pj) = (inv[7 * a + i], inv[7 * b + j]);
+                        if pi <= pj {
+                            // Every block position is in the pattern (it was built from them).
+                            s[7 * i + j] = pattern.slot(pi, pj) as Ix;
+                        }
                     }
                 }
                 s
@@ -143,27 +192,19 @@ impl Kkt {
         let jac_slots = entries
             .iter()
             .map(|e| match row_pos[e.0] {
-                NONE => (Ix::MAX, Ix::MAX),
-                p => (
-                    pattern.slot(n + p, e.1) as Ix,
-                    pattern.slot(e.1, n + p) as Ix,
-                ),
+                NONE => Ix::MAX,
+                p => {
+                    let (a, b) = upper(n + p, e.1);
+                    pattern.slot(a, b) as Ix
+                }
             })
             .collect();
-        let diag_slots = (0..n).map(|i| pattern.slot(i, i)).collect();
+        let diag_slots = (0..n).map(|i| pattern.slot(inv[i], inv[i])).collect();
         let nnz = pattern.nnz();
-        let order: Vec<Ix> = elimination_order(part, n)
-            .into_iter()
-            .map(|i| i as Ix)
-            .collect();
-        let mut inverse: Vec<Ix> = vec![0; dim];
-        for (i, &o) in order.iter().enumerate() {
-            inverse[o as usize] = i as Ix;
-        }
         let ldlt = factorize_symbolic_cholesky(
             pattern.symbolic(),
-            Side::Lower,
-            SymmetricOrdering::Custom(PermRef::new_checked(&order, &inverse, dim)),
+            Side::Upper,
+            SymmetricOrdering::Identity,
             CholeskySymbolicParams {
                 supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SIMPLICIAL,
                 ..Default::default()
@@ -171,6 +212,20 @@ impl Kkt {
         )
         .ok();
         let ldlt_values = vec![0.0; ldlt.as_ref().map_or(0, |l| l.len_val())];
+        let factor_scratch =
+            MemBuffer::try_new(simplicial::factorize_simplicial_numeric_ldlt_scratch::<
+                Ix,
+                f64,
+            >(dim))
+            .ok();
+        let solve_scratch = RefCell::new(SolveScratch {
+            stack: ldlt.as_ref().and_then(|sym| {
+                MemBuffer::try_new(sym.solve_in_place_scratch::<f64>(1, Par::Seq)).ok()
+            }),
+            x: Vec::with_capacity(dim),
+            b: Vec::with_capacity(dim),
+            r: Vec::with_capacity(dim),
+        });
         Some(Kkt {
             n,
             id: part.id,
@@ -178,18 +233,22 @@ impl Kkt {
             triplets: entries.len(),
             blocks: hess.keys.len(),
             pattern,
-            symbolic: None,
+            perm,
             block_slots,
             jac_slots,
             diag_slots,
             values: vec![0.0; nnz],
             delta: 0.0,
             knorm: 0.0,
+            full: None,
             lu: None,
             ldlt,
             ldlt_values,
             kind: Factored::None,
             lu_only: false,
+            factor_scratch,
+            row_sums: vec![0.0; dim],
+            solve_scratch,
         })
     }
 
@@ -211,16 +270,17 @@ impl Kkt {
         for ((&(a, b), blk), slots) in hess.keys.iter().zip(&hess.values).zip(&self.block_slots) {
             for i in 0..7 {
                 for j in 0..7 {
-                    self.values[slots[7 * i + j] as usize] +=
-                        blk[7 * i + j] * scale[7 * a + i] * scale[7 * b + j];
+                    let slot = slots[7 * i + j];
+                    if slot != Ix::MAX {
+                        self.values[slot as usize] +=
+                            blk[7 * i + j] * scale[7 * a + i] * scale[7 * b + j];
+                    }
                 }
             }
         }
-        for (e, &(s1, s2)) in entries.iter().zip(&self.jac_slots) {
-            if s1 != Ix::MAX {
-                let v = e.2 * row_scale[e.0] * scale[e.1];
-                self.values[s1 as usize] += v;
-                self.values[s2 as usize] += v;
+        for (e, &slot) in entries.iter().zip(&self.jac_slots) {
+            if slot != Ix::MAX {
+                self.values[slot as usize] += e.2 * row_scale[e.0] * scale[e.1];
             }
         }
     }
@@ -244,16 +304,20 @@ impl Kkt {
             self.values[s] += delta - self.delta;
         }
         self.delta = delta;
+        // ‖K‖∞: row sums of |K| from the upper triangle (each off-diagonal entry twice).
         let sym = self.pattern.symbolic();
-        let ptr = sym.col_ptr();
-        // ‖K‖∞ (the pattern is symmetric: column sums are row sums).
-        self.knorm = (0..ptr.len() - 1)
-            .map(|c| {
-                (ptr[c] as usize..ptr[c + 1] as usize)
-                    .map(|k| self.values[k].abs())
-                    .sum::<f64>()
-            })
-            .fold(0.0f64, f64::max);
+        let (ptr, idx) = (sym.col_ptr(), sym.row_idx());
+        self.row_sums.iter_mut().for_each(|x| *x = 0.0);
+        for c in 0..ptr.len() - 1 {
+            for k in ptr[c] as usize..ptr[c + 1] as usize {
+                let (r, v) = (idx[k] as usize, self.values[k].abs());
+                self.row_sums[r] += v;
+                if r != c {
+                    self.row_sums[c] += v;
+                }
+            }
+        }
+        self.knorm = self.row_sums.iter().fold(0.0f64, |a, &x| a.max(x));
         self.kind = Factored::None;
         if !self.lu_only {
             if let Some(negative) = self.factor_ldlt() {
@@ -273,11 +337,39 @@ impl Kkt {
 
     fn factor_lu(&mut self) -> Factored {
         self.kind = Factored::None;
-        if self.symbolic.is_none() {
-            self.symbolic = SymbolicLu::try_new(self.pattern.symbolic()).ok();
+        let full = self.full.get_or_insert_with(|| {
+            let sym = self.pattern.symbolic();
+            let (ptr, idx) = (sym.col_ptr(), sym.row_idx());
+            let upper = || {
+                (0..ptr.len() - 1)
+                    .flat_map(move |c| (ptr[c] as usize..ptr[c + 1] as usize).map(move |k| (k, c)))
+            };
+            let pattern = Pattern::new(
+                ptr.len() - 1,
+                ptr.len() - 1,
+                upper().flat_map(|(k, c)| [(idx[k] as usize, c), (c, idx[k] as usize)]),
+            );
+            let slots = upper()
+                .map(|(k, c)| {
+                    let r = idx[k] as usize;
+                    (pattern.slot(r, c) as Ix, pattern.slot(c, r) as Ix)
+                })
+                .collect();
+            let symbolic = SymbolicLu::try_new(pattern.symbolic()).ok();
+            Full {
+                values: vec![0.0; pattern.nnz()],
+                pattern,
+                slots,
+                symbolic,
+            }
+        });
+        full.values.iter_mut().for_each(|v| *v = 0.0);
+        for (&(a, b), &v) in full.slots.iter().zip(&self.values) {
+            full.values[a as usize] = v;
+            full.values[b as usize] = v;
         }
-        self.lu = self.symbolic.as_ref().and_then(|sym| {
-            Lu::try_new_with_symbolic(sym.clone(), self.pattern.matrix(&self.values)).ok()
+        self.lu = full.symbolic.as_ref().and_then(|sym| {
+            Lu::try_new_with_symbolic(sym.clone(), full.pattern.matrix(&full.values)).ok()
         });
         if self.lu.is_some() {
             self.kind = Factored::Lu;
@@ -288,23 +380,21 @@ impl Kkt {
     /// The LDLᵀ factorization; the number of negative pivots, or `None` on a zero pivot.
     fn factor_ldlt(&mut self) -> Option<usize> {
         let sym = self.ldlt.as_ref()?;
-        let par = Par::Seq;
-        let mut buf =
-            MemBuffer::try_new(sym.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()))
-                .ok()?;
-        sym.factorize_numeric_ldlt(
-            &mut self.ldlt_values,
-            self.pattern.matrix(&self.values),
-            Side::Lower,
-            LdltRegularization::default(),
-            par,
-            MemStack::new(&mut buf),
-            Default::default(),
-        )
-        .ok()?;
         let SymbolicCholeskyRaw::Simplicial(simplicial) = sym.raw() else {
             return None;
         };
+        let buf = self.factor_scratch.as_mut()?;
+        // The simplicial kernel itself: the stored values are already the upper triangle in
+        // the elimination order, and its workspace is `O(dim)` (the general entry point sizes
+        // one for a permuted copy of the matrix).
+        simplicial::factorize_simplicial_numeric_ldlt(
+            &mut self.ldlt_values,
+            self.pattern.matrix(&self.values),
+            LdltRegularization::default(),
+            simplicial,
+            MemStack::new(buf),
+        )
+        .ok()?;
         let ptr = simplicial.col_ptr();
         let mut negative = 0;
         for j in 0..ptr.len() - 1 {
@@ -319,20 +409,19 @@ impl Kkt {
         Some(negative)
     }
 
-    fn solve_once(&self, x: &mut [f64]) {
+    fn solve_once(&self, x: &mut [f64], stack: &mut Option<MemBuffer>) {
         let len = x.len();
         let m = MatMut::from_column_major_slice_mut(x, len, 1);
-        match (self.kind, &self.lu, &self.ldlt) {
-            (Factored::Ldlt { .. }, _, Some(sym)) => {
-                let mut buf = MemBuffer::new(sym.solve_in_place_scratch::<f64>(1, Par::Seq));
+        match (self.kind, &self.lu, &self.ldlt, stack) {
+            (Factored::Ldlt { .. }, _, Some(sym), Some(buf)) => {
                 LdltRef::new(sym, &self.ldlt_values).solve_in_place_with_conj(
                     Conj::No,
                     m,
                     Par::Seq,
-                    MemStack::new(&mut buf),
+                    MemStack::new(buf),
                 );
             }
-            (Factored::Lu, Some(lu), _) => lu.solve_in_place_with_conj(Conj::No, m),
+            (Factored::Lu, Some(lu), _, _) => lu.solve_in_place_with_conj(Conj::No, m),
             _ => x.iter_mut().for_each(|v| *v = f64::NAN),
         }
     }
@@ -342,30 +431,52 @@ impl Kkt {
     /// until the normwise backward error `ω = ‖b − K x‖∞ / (‖K‖∞ ‖x‖∞ + ‖b‖∞)` is below
     /// `target` (at most three steps); `false` if singular or if `ω` stays above 10⁻¹⁰.
     pub(crate) fn solve(&self, rhs: &mut [f64], target: f64) -> bool {
-        let b = rhs.to_vec();
+        let mut scratch = self.solve_scratch.borrow_mut();
+        let SolveScratch { stack, x, b, r } = &mut *scratch;
+        // Into the permuted order of the stored matrix.
+        b.clear();
+        b.extend(self.perm.iter().map(|&o| rhs[o]));
+        x.clear();
+        x.extend_from_slice(b);
         let bnorm = b.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        self.solve_once(rhs);
+        self.solve_once(x, stack);
         let sym = self.pattern.symbolic();
         let (ptr, idx) = (sym.col_ptr(), sym.row_idx());
         let knorm = self.knorm;
         let mut omega = f64::INFINITY;
         for _ in 0..3 {
-            let mut r = b.clone();
-            for c in 0..rhs.len() {
-                for k in ptr[c] as usize..ptr[c + 1] as usize {
-                    r[idx[k] as usize] -= self.values[k] * rhs[c];
+            r.clear();
+            r.extend_from_slice(b);
+            // r −= K x from the upper triangle: column c gives `K[i, c] x[c]` to rows `i` and,
+            // by symmetry, `Σ_i K[i, c] x[i]` to row `c` (the diagonal, the column's last
+            // entry when present, only once).
+            for c in 0..x.len() {
+                let (a, b) = (ptr[c] as usize, ptr[c + 1] as usize);
+                let xc = x[c];
+                let mut sum = 0.0;
+                for k in a..b {
+                    let (i, v) = (idx[k] as usize, self.values[k]);
+                    r[i] -= v * xc;
+                    sum += v * x[i];
                 }
+                if b > a && idx[b - 1] as usize == c {
+                    sum -= self.values[b - 1] * xc;
+                }
+                r[c] -= sum;
             }
             let rnorm = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-            let xnorm = rhs.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            let xnorm = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
             omega = rnorm / (knorm * xnorm + bnorm).max(f64::MIN_POSITIVE);
             if !omega.is_finite() || omega <= target {
                 break;
             }
-            self.solve_once(&mut r);
-            for (x, d) in rhs.iter_mut().zip(&r) {
+            self.solve_once(r, stack);
+            for (x, d) in x.iter_mut().zip(r.iter()) {
                 *x += d;
             }
+        }
+        for (k, &o) in self.perm.iter().enumerate() {
+            rhs[o] = x[k];
         }
         rhs.iter().all(|x| x.is_finite()) && omega <= 1e-10
     }

@@ -117,6 +117,25 @@ impl System<'_> {
         let n = self.problem.model.coordinate_count();
         let dof = part.independent.len();
         let mut z = DMatrix::zeros(n, dof);
+        if let Factors::Dense { lu, phi_v } = &eval.factors {
+            // All columns at once: `H S = −Φ_u⁻¹ (Φ_v S)`, one solve with `dof` right sides.
+            let scale = |b: usize| self.problem.scaling.columns[part.independent[b]];
+            for (b, &c) in part.independent.iter().enumerate() {
+                z[(c, b)] = scale(b);
+            }
+            if !part.rows.is_empty() {
+                let mut rhs = phi_v.clone();
+                for b in 0..dof {
+                    rhs.column_mut(b).scale_mut(-scale(b));
+                }
+                if lu.solve_mut(&mut rhs) {
+                    for (k, &c) in part.dependent.iter().enumerate() {
+                        z.row_mut(c).copy_from(&rhs.row(k));
+                    }
+                }
+            }
+            return z;
+        }
         for b in 0..dof {
             let mut e = DVector::zeros(dof);
             e[b] = 1.0;

@@ -1,10 +1,12 @@
 //! The assembled global derivatives against central differences, on real robots at
 //! random (non-assembled, non-unit) configurations.
 use super::*;
+use crate::constraints::Constraints;
 use crate::forces::potential;
 use crate::jet::HessianSink;
+use crate::model::Model;
 use crate::urdf::{load_str, ImportOptions};
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 
 /// Analytic value against a central difference, relative to `1 + |value|`.
 fn assert_fd(analytic: f64, fd: f64, tol: f64, what: impl Fn() -> String) {
@@ -182,6 +184,20 @@ fn kkt_step_is_the_reduced_newton_step() {
         assert!(
             (&d - &expected).amax() < 1e-8 * expected.amax(),
             "{}: KKT step {d} vs reduced Newton step {expected}",
+            model.name
+        );
+        // The LU fallback (the full matrix rebuilt from the stored upper triangle) gives the
+        // same step.
+        assert_eq!(
+            sparse.kkt_fall_back_to_lu(),
+            crate::solver::sparse::kkt::Factored::Lu,
+            "{}",
+            model.name
+        );
+        let dq_lu = sparse.kkt_solve(&b).unwrap();
+        assert!(
+            (&dq_lu - &dq).amax() < 1e-8 * (1.0 + dq.amax()),
+            "{}: LU step differs from the LDLT step",
             model.name
         );
         // δq is the tangent step of δv: Φ_q δq = 0 on the independent rows.

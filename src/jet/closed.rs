@@ -1,0 +1,480 @@
+//! Closed-form first and second derivatives of the constraint primitives, without generic
+//! 14-coordinate jets.
+//!
+//! Every joint row but a screw's thread is a component of `d` or a dot product `aᵀb` of two
+//! 3-vectors of the form `u = Σ_k t_k r_k + A(p_k) s_k` (a point: `t_k = 1`; a direction:
+//! `t_k = 0`; `d = o₁ − o₀`: `t = (−1, 1)`, `s = (−s₀, s₁)`). Their derivatives are
+//!
+//! - `∂u/∂r_k = t_k I`, `∂u/∂p_k = B_k = B(p_k, s_k)` ([`crate::math::b_matrix`]);
+//! - `∇(aᵀb)`: `t^a_k b + t^b_k a` over `r_k`, `B^a_kᵀ b + B^b_kᵀ a` over `p_k`;
+//! - `∇²(aᵀb) = J_aᵀ J_b + J_bᵀ J_a + C(a, b) + C(b, a)` with `J_k = [t_k I, B_k]` and the
+//!   curvature of `A(p)`: `wᵀ A(p) s = pᵀ M(s, w) p` is a quadratic form (homogeneous
+//!   `A(p)`), so `C(a, w)` is `2 M(s^a_k, w)` on the `p_k p_k` block, with
+//!
+//!   `M(s, w) = [ wᵀs      (s × w)ᵀ          ]`
+//!   `          [ s × w    w sᵀ + s wᵀ − wᵀs I ]`.
+//!
+//! Rows are weighted before their Hessians are formed (`Σ_r w_r ∇²Φ_r` in one 14 × 14 local
+//! matrix, only the blocks a primitive touches), and the three components of `d` weighted by
+//! `w` are `∇²(wᵀd) = C(d, w)`. The generic jets of [`crate::jet`] stay the reference: the
+//! tests check every row here against them and against central differences.
+
+use super::{LMat, LVec, Pair, Scalar};
+use crate::math::{b_matrix, rotation};
+use crate::model::{Joint, JointKind};
+use nalgebra::{Matrix3, Matrix3x4, Matrix4, Vector3};
+
+/// `Σ_k t_k r_k + A(p_k) s_k` with `B_k = B(p_k, s_k)`; `on[k]` whether side `k` enters.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Lin {
+    pub(crate) v: Vector3<f64>,
+    t: [f64; 2],
+    s: [Vector3<f64>; 2],
+    b: [Matrix3x4<f64>; 2],
+    on: [bool; 2],
+}
+
+/// `M(s, w)` of the module docs: `wᵀ A(p) s = pᵀ M p`.
+pub(crate) fn quadratic_form(s: &Vector3<f64>, w: &Vector3<f64>) -> Matrix4<f64> {
+    let ws = w.dot(s);
+    let c = s.cross(w);
+    let mut m = Matrix4::zeros();
+    m[(0, 0)] = ws;
+    for i in 0..3 {
+        m[(0, i + 1)] = c[i];
+        m[(i + 1, 0)] = c[i];
+        for j in 0..3 {
+            m[(i + 1, j + 1)] = w[i] * s[j] + s[i] * w[j];
+        }
+        m[(i + 1, i + 1)] -= ws;
+    }
+    m
+}
+
+/// The rotation matrices of the two sides of a pair.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Rotations([Matrix3<f64>; 2]);
+
+impl Rotations {
+    /// The rotations of `pair`.
+    pub(crate) fn of(pair: &Pair) -> Self {
+        Rotations([rotation(&pair.p[0]), rotation(&pair.p[1])])
+    }
+}
+
+impl Lin {
+    /// The constant zero vector.
+    const ZERO: Lin = Lin {
+        v: Vector3::new(0.0, 0.0, 0.0),
+        t: [0.0; 2],
+        s: [Vector3::new(0.0, 0.0, 0.0); 2],
+        b: [Matrix3x4::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0); 2],
+        on: [false; 2],
+    };
+
+    /// The world point of the body-frame point `s` of side `k`.
+    pub(crate) fn point(pair: &Pair, rot: &Rotations, k: usize, s: &Vector3<f64>) -> Lin {
+        let mut l = Lin::vector(pair, rot, k, s);
+        l.v += pair.r[k];
+        l.t[k] = 1.0;
+        l
+    }
+
+    /// The world direction of the body-frame vector `a` of side `k`.
+    pub(crate) fn vector(pair: &Pair, rot: &Rotations, k: usize, a: &Vector3<f64>) -> Lin {
+        let mut l = Lin {
+            v: rot.0[k] * a,
+            t: [0.0; 2],
+            s: [Vector3::zeros(); 2],
+            b: [Matrix3x4::zeros(); 2],
+            on: [false; 2],
+        };
+        l.s[k] = *a;
+        l.b[k] = b_matrix(&pair.p[k], a);
+        l.on[k] = true;
+        l
+    }
+
+    /// `self − o` for two points of different sides (`d = o₁ − o₀`).
+    pub(crate) fn minus(&self, o: &Lin) -> Lin {
+        let mut l = *self;
+        l.v -= o.v;
+        for k in 0..2 {
+            if o.on[k] {
+                l.t[k] -= o.t[k];
+                l.s[k] -= o.s[k];
+                l.b[k] -= o.b[k];
+                l.on[k] = true;
+            }
+        }
+        l
+    }
+}
+
+/// `∇(aᵀb)` added into `g` with weight `c`.
+pub(crate) fn dot_gradient(a: &Lin, b: &Lin, c: f64, g: &mut LVec) {
+    for k in 0..2 {
+        let o = 7 * k;
+        if a.on[k] {
+            if a.t[k] != 0.0 {
+                for i in 0..3 {
+                    g[o + i] += c * a.t[k] * b.v[i];
+                }
+            }
+            let gp = a.b[k].tr_mul(&b.v);
+            for i in 0..4 {
+                g[o + 3 + i] += c * gp[i];
+            }
+        }
+        if b.on[k] {
+            if b.t[k] != 0.0 {
+                for i in 0..3 {
+                    g[o + i] += c * b.t[k] * a.v[i];
+                }
+            }
+            let gp = b.b[k].tr_mul(&a.v);
+            for i in 0..4 {
+                g[o + 3 + i] += c * gp[i];
+            }
+        }
+    }
+}
+
+/// `∇(wᵀa)` for a constant `w` added into `g`.
+pub(crate) fn linear_gradient(a: &Lin, w: &Vector3<f64>, g: &mut LVec) {
+    for k in 0..2 {
+        if a.on[k] {
+            let o = 7 * k;
+            for i in 0..3 {
+                g[o + i] += a.t[k] * w[i];
+            }
+            let gp = a.b[k].tr_mul(w);
+            for i in 0..4 {
+                g[o + 3 + i] += gp[i];
+            }
+        }
+    }
+}
+
+/// `∇²(wᵀa) = C(a, w)` for a constant `w` added into `h`.
+pub(crate) fn linear_hessian(a: &Lin, w: &Vector3<f64>, h: &mut LMat) {
+    for k in 0..2 {
+        if a.on[k] {
+            let m = quadratic_form(&a.s[k], w) * 2.0;
+            let o = 7 * k + 3;
+            for i in 0..4 {
+                for j in 0..4 {
+                    h[(o + i, o + j)] += m[(i, j)];
+                }
+            }
+        }
+    }
+}
+
+/// `c ∇²(aᵀb)` added into `h`.
+pub(crate) fn dot_hessian(a: &Lin, b: &Lin, c: f64, h: &mut LMat) {
+    for k in 0..2 {
+        if !a.on[k] {
+            continue;
+        }
+        for l in 0..2 {
+            if !b.on[l] {
+                continue;
+            }
+            // c J^a_kᵀ J^b_l at (k, l) and its transpose at (l, k).
+            let (ok, ol) = (7 * k, 7 * l);
+            let tt = c * a.t[k] * b.t[l];
+            if tt != 0.0 {
+                for i in 0..3 {
+                    h[(ok + i, ol + i)] += tt;
+                    h[(ol + i, ok + i)] += tt;
+                }
+            }
+            if a.t[k] != 0.0 {
+                // r_k × p_l: t^a_k B^b_l.
+                let s = c * a.t[k];
+                for i in 0..3 {
+                    for j in 0..4 {
+                        let v = s * b.b[l][(i, j)];
+                        h[(ok + i, ol + 3 + j)] += v;
+                        h[(ol + 3 + j, ok + i)] += v;
+                    }
+                }
+            }
+            if b.t[l] != 0.0 {
+                // p_k × r_l: B^a_kᵀ t^b_l.
+                let s = c * b.t[l];
+                for i in 0..4 {
+                    for j in 0..3 {
+                        let v = s * a.b[k][(j, i)];
+                        h[(ok + 3 + i, ol + j)] += v;
+                        h[(ol + j, ok + 3 + i)] += v;
+                    }
+                }
+            }
+            let pp = a.b[k].tr_mul(&b.b[l]) * c;
+            for i in 0..4 {
+                for j in 0..4 {
+                    h[(ok + 3 + i, ol + 3 + j)] += pp[(i, j)];
+                    h[(ol + 3 + j, ok + 3 + i)] += pp[(i, j)];
+                }
+            }
+        }
+    }
+    linear_hessian(a, &(b.v * c), h);
+    linear_hessian(b, &(a.v * c), h);
+}
+
+/// The joint frames of both sides as far as a joint's rows need them: origin difference
+/// `d = o₁ − o₀` and axes (`None` where not needed).
+pub(crate) struct Frames {
+    /// The vectors in [`V`] order; those not needed are the constant zero.
+    vectors: [Lin; 6],
+}
+
+impl Frames {
+    /// The vectors `layout` uses, for the frames of `joint` at `pair`.
+    fn of(joint: &Joint, pair: &Pair, layout: &[Row]) -> Self {
+        let rot = Rotations::of(pair);
+        let mut need = [false; 6];
+        for row in layout {
+            match *row {
+                Row::Component(_) => need[V::D as usize] = true,
+                Row::Dot(a, b) => {
+                    need[a as usize] = true;
+                    need[b as usize] = true;
+                }
+            }
+        }
+        let axis = |k: usize, i: usize| {
+            let r = joint.body_from_joint[k].rotation.to_rotation_matrix();
+            Lin::vector(pair, &rot, k, &r.matrix().column(i).into_owned())
+        };
+        let mut vectors = [Lin::ZERO; 6];
+        for (v, slot) in vectors.iter_mut().enumerate() {
+            if !need[v] {
+                continue;
+            }
+            *slot = match v {
+                0 => {
+                    let o = |k: usize| {
+                        Lin::point(pair, &rot, k, &joint.body_from_joint[k].translation.vector)
+                    };
+                    o(1).minus(&o(0))
+                }
+                1 => axis(0, 0),
+                2 => axis(0, 1),
+                3 => axis(0, 2),
+                4 => axis(1, 0),
+                _ => axis(1, 1),
+            };
+        }
+        Frames { vectors }
+    }
+
+    fn get(&self, v: V) -> &Lin {
+        &self.vectors[v as usize]
+    }
+}
+
+/// The 3-vectors joint rows are made of (in the order of `Frames::vectors`).
+#[derive(Clone, Copy, Debug)]
+enum V {
+    D,
+    X0,
+    Y0,
+    Z0,
+    X1,
+    Y1,
+}
+
+/// One joint row: a component of `d` or a dot product.
+#[derive(Clone, Copy, Debug)]
+enum Row {
+    Component(usize),
+    Dot(V, V),
+}
+
+const POS: [Row; 3] = [Row::Component(0), Row::Component(1), Row::Component(2)];
+const PARALLEL: [Row; 2] = [Row::Dot(V::Z0, V::X1), Row::Dot(V::Z0, V::Y1)];
+
+/// The rows of a joint in [`crate::constraints::joint::rows`] order, or `None` for a joint
+/// evaluated by the generic jets (a screw's thread row reads its angle) or without rows.
+fn layout(joint: &Joint) -> Option<&'static [Row]> {
+    use Row::*;
+    use V::*;
+    if joint.merged {
+        return None;
+    }
+    Some(match joint.kind {
+        JointKind::Revolute | JointKind::Continuous => {
+            &[POS[0], POS[1], POS[2], PARALLEL[0], PARALLEL[1]]
+        }
+        JointKind::Prismatic => &[
+            PARALLEL[0],
+            PARALLEL[1],
+            Dot(Y0, X1),
+            Dot(X0, D),
+            Dot(Y0, D),
+        ],
+        JointKind::Fixed => &[
+            POS[0],
+            POS[1],
+            POS[2],
+            PARALLEL[0],
+            PARALLEL[1],
+            Dot(Y0, X1),
+        ],
+        JointKind::Planar => &[PARALLEL[0], PARALLEL[1], Dot(Z0, D)],
+        JointKind::Spherical => &POS,
+        JointKind::Universal => &[POS[0], POS[1], POS[2], PARALLEL[0]],
+        JointKind::Cylindrical => &[PARALLEL[0], PARALLEL[1], Dot(X0, D), Dot(Y0, D)],
+        JointKind::Distance { .. } => &[Dot(D, D)],
+        JointKind::PointOnLine => &[Dot(X0, D), Dot(Y0, D)],
+        JointKind::Screw { .. } | JointKind::Floating => return None,
+    })
+}
+
+/// Whether the rows of `joint` have a closed form here.
+pub(crate) fn supports(joint: &Joint) -> bool {
+    layout(joint).is_some()
+}
+
+/// The constant subtracted from a row (`L²` of a distance joint).
+fn offset(joint: &Joint) -> f64 {
+    match joint.kind {
+        JointKind::Distance { length } => length * length,
+        _ => 0.0,
+    }
+}
+
+/// Values and gradients of the rows of `joint` into `out` (cleared first; no Hessians).
+pub(crate) fn rows(joint: &Joint, pair: &Pair, out: &mut Vec<Scalar>) {
+    out.clear();
+    let Some(layout) = layout(joint) else {
+        return;
+    };
+    let f = Frames::of(joint, pair, layout);
+    for row in layout {
+        let mut g = LVec::zeros();
+        let v = match *row {
+            Row::Component(m) => {
+                linear_gradient(f.get(V::D), &Vector3::ith(m, 1.0), &mut g);
+                f.get(V::D).v[m]
+            }
+            Row::Dot(a, b) => {
+                let (a, b) = (f.get(a), f.get(b));
+                dot_gradient(a, b, 1.0, &mut g);
+                a.v.dot(&b.v)
+            }
+        };
+        out.push(Scalar {
+            v: v - offset(joint),
+            g,
+            h: None,
+        });
+    }
+}
+
+/// Values of the rows of `joint` into `out` (cleared first): the vectors alone, without
+/// derivatives.
+pub(crate) fn values(joint: &Joint, pair: &Pair, out: &mut Vec<f64>) {
+    out.clear();
+    let Some(layout) = layout(joint) else {
+        return;
+    };
+    let a = [rotation(&pair.p[0]), rotation(&pair.p[1])];
+    let f = &joint.body_from_joint;
+    // The same arithmetic as `Frames::of`: values equal those of `rows` to the last bit.
+    let axis = |k: usize, i: usize| {
+        let r = f[k].rotation.to_rotation_matrix();
+        a[k] * r.matrix().column(i).into_owned()
+    };
+    let point = |k: usize| a[k] * f[k].translation.vector + pair.r[k];
+    let vector = |v: V| match v {
+        V::D => point(1) - point(0),
+        V::X0 => axis(0, 0),
+        V::Y0 => axis(0, 1),
+        V::Z0 => axis(0, 2),
+        V::X1 => axis(1, 0),
+        V::Y1 => axis(1, 1),
+    };
+    let mut d = None;
+    for row in layout {
+        out.push(
+            match *row {
+                Row::Component(m) => d.get_or_insert_with(|| vector(V::D))[m],
+                Row::Dot(a, b) => vector(a).dot(&vector(b)),
+            } - offset(joint),
+        );
+    }
+}
+
+/// `Σ_r w_r ∇²Φ_r` over the rows of `joint` added into `h` (`w` one weight per row).
+pub(crate) fn add_weighted_hessian(joint: &Joint, pair: &Pair, w: &[f64], h: &mut LMat) {
+    let Some(layout) = layout(joint) else {
+        return;
+    };
+    let f = Frames::of(joint, pair, layout);
+    let mut wd = Vector3::zeros();
+    for (row, &c) in layout.iter().zip(w) {
+        if c == 0.0 {
+            continue;
+        }
+        match *row {
+            Row::Component(m) => wd[m] += c,
+            Row::Dot(a, b) => dot_hessian(f.get(a), f.get(b), c, h),
+        }
+    }
+    if wd != Vector3::zeros() {
+        linear_hessian(f.get(V::D), &wd, h);
+    }
+}
+
+/// The revolute angle `atan2(y₀·x₁, x₀·x₁)` about the parent's `z` (as
+/// [`crate::kinematics::angle`], in (−π, π]), with the Hessian when `pair.hess`.
+pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair) -> Scalar {
+    let rot = Rotations::of(pair);
+    let axis = |k: usize, i: usize| {
+        let r = joint.body_from_joint[k].rotation.to_rotation_matrix();
+        Lin::vector(pair, &rot, k, &r.matrix().column(i).into_owned())
+    };
+    let (x0, y0, x1) = (axis(0, 0), axis(0, 1), axis(1, 0));
+    let scalar = |a: &Lin, b: &Lin| {
+        let mut g = LVec::zeros();
+        dot_gradient(a, b, 1.0, &mut g);
+        let h = pair.hess.then(|| {
+            let mut h = Box::new(LMat::zeros());
+            dot_hessian(a, b, 1.0, &mut h);
+            h
+        });
+        Scalar {
+            v: a.v.dot(&b.v),
+            g,
+            h,
+        }
+    };
+    pair.atan2(&scalar(&y0, &x1), &scalar(&x0, &x1))
+}
+
+/// The weighted point `wᵀ (r_k + A(p_k) s)` of side `k` (gravity, dead loads), with the
+/// Hessian when `pair.hess`.
+pub(crate) fn weighted_point(pair: &Pair, k: usize, s: &Vector3<f64>, w: &Vector3<f64>) -> Scalar {
+    let rot = Rotations::of(pair);
+    let p = Lin::point(pair, &rot, k, s);
+    let mut g = LVec::zeros();
+    linear_gradient(&p, w, &mut g);
+    let h = pair.hess.then(|| {
+        let mut h = Box::new(LMat::zeros());
+        linear_hessian(&p, w, &mut h);
+        h
+    });
+    Scalar {
+        v: w.dot(&p.v),
+        g,
+        h,
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests;

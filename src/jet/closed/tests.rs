@@ -1,0 +1,115 @@
+//! The closed forms against the generic jets (to rounding) and against central differences.
+
+use super::*;
+use crate::jet::testing::{check_scalar, sample_pair};
+use crate::jet::{hess_or_zero, Vec3Jet};
+
+/// Relative agreement of two scalars' value, gradient and Hessian.
+pub(crate) fn assert_same(a: &Scalar, b: &Scalar, what: &str) {
+    let scale = 1.0 + a.v.abs() + a.g.amax() + hess_or_zero(&a.h).amax();
+    assert!(
+        (a.v - b.v).abs() <= 1e-12 * scale,
+        "{what}: value {} vs {}",
+        a.v,
+        b.v
+    );
+    assert!((a.g - b.g).amax() <= 1e-12 * scale, "{what}: gradient");
+    let d = (hess_or_zero(&a.h) - hess_or_zero(&b.h)).amax();
+    assert!(d <= 1e-12 * scale, "{what}: hessian differs by {d}");
+}
+
+fn dot_scalar(pair: &Pair, a: &Lin, b: &Lin) -> Scalar {
+    let mut g = LVec::zeros();
+    dot_gradient(a, b, 1.0, &mut g);
+    let mut h = Box::new(LMat::zeros());
+    dot_hessian(a, b, 1.0, &mut h);
+    Scalar {
+        v: a.v.dot(&b.v),
+        g,
+        h: pair.hess.then_some(h),
+    }
+}
+
+fn s0() -> Vector3<f64> {
+    Vector3::new(0.3, -0.2, 0.5)
+}
+fn s1() -> Vector3<f64> {
+    Vector3::new(-0.1, 0.4, 0.2)
+}
+
+/// The jets of `d = o₁ − o₀`, `a₀` and `a₁`, generic and closed-form.
+fn vectors(q: &Pair) -> ([Vec3Jet; 3], [Lin; 3]) {
+    let rot = Rotations::of(q);
+    (
+        [
+            q.point(1, &s1()).sub(&q.point(0, &s0())),
+            q.vector(0, &Vector3::new(0.6, 0.0, -0.8)),
+            q.vector(1, &Vector3::y()),
+        ],
+        [
+            Lin::point(q, &rot, 1, &s1()).minus(&Lin::point(q, &rot, 0, &s0())),
+            Lin::vector(q, &rot, 0, &Vector3::new(0.6, 0.0, -0.8)),
+            Lin::vector(q, &rot, 1, &Vector3::y()),
+        ],
+    )
+}
+
+#[test]
+fn quadratic_form_is_the_curvature_of_a_rotated_vector() {
+    let pair = sample_pair(1);
+    let w = Vector3::new(0.7, -1.1, 0.4);
+    let jet = pair.vector(0, &s0()).contract(&w);
+    let m = quadratic_form(&s0(), &w) * 2.0;
+    for i in 0..4 {
+        for j in 0..4 {
+            assert!((jet[(3 + i, 3 + j)] - m[(i, j)]).abs() < 1e-14);
+        }
+    }
+    // wᵀ A(p) s = pᵀ M p off the unit sphere too.
+    let p = pair.p[0];
+    let lhs = w.dot(&(rotation(&p) * s0()));
+    assert!((lhs - (p.transpose() * quadratic_form(&s0(), &w) * p)[0]).abs() < 1e-14);
+}
+
+#[test]
+fn dot_products_equal_the_jets_and_finite_differences() {
+    for seed in 0..6 {
+        let pair = sample_pair(seed);
+        for (i, j) in [(0, 0), (0, 1), (1, 0), (1, 2), (0, 2), (2, 2)] {
+            let (jets, lins) = vectors(&pair);
+            let what = format!("seed {seed} dot({i}, {j})");
+            assert_same(
+                &pair.dot(&jets[i], &jets[j]),
+                &dot_scalar(&pair, &lins[i], &lins[j]),
+                &what,
+            );
+            check_scalar(
+                &pair,
+                &|q| {
+                    let (_, l) = vectors(q);
+                    dot_scalar(q, &l[i], &l[j])
+                },
+                &what,
+            );
+        }
+    }
+}
+
+#[test]
+fn weighted_points_equal_the_jets_and_finite_differences() {
+    let w = Vector3::new(0.0, -3.0, -9.81);
+    for seed in 0..4 {
+        let pair = sample_pair(seed);
+        for k in 0..2 {
+            let p = pair.point(k, &s1());
+            let jet = Scalar {
+                v: w.dot(&p.v),
+                g: p.j.transpose() * w,
+                h: Some(Box::new(p.contract(&w))),
+            };
+            let what = format!("seed {seed} side {k}");
+            assert_same(&jet, &weighted_point(&pair, k, &s1(), &w), &what);
+            check_scalar(&pair, &|q| weighted_point(q, k, &s1(), &w), &what);
+        }
+    }
+}

@@ -1,0 +1,91 @@
+//! The [`System`]: a [`Problem`], its [`Workspace`] and its [`Backend`], with the cache of
+//! `Φ(q)` and the triplets of `Φ_q(q)` at the last configuration they were taken at (every
+//! other evaluation in this module's siblings starts from them).
+
+use super::{Backend, Problem, Workspace};
+use crate::constraints::Constraints;
+use crate::model::Model;
+use crate::solver::partition::Partition;
+use nalgebra::DVector;
+
+/// The problem, its scratch space and its linear algebra.
+pub(crate) struct System<'a> {
+    pub(crate) problem: Problem<'a>,
+    pub(crate) work: Workspace,
+    pub(crate) backend: Backend,
+}
+
+impl<'a> System<'a> {
+    /// The system with the automatic choice of linear algebra (by size).
+    pub(crate) fn new(model: &'a Model, cons: Constraints) -> Self {
+        Self::with_backend(
+            model,
+            cons,
+            Backend::choose(model, crate::solver::LinearAlgebra::Auto),
+        )
+    }
+
+    /// The system with the linear algebra of `options` (automatic: by size).
+    pub(crate) fn with_options(
+        model: &'a Model,
+        cons: Constraints,
+        options: &crate::solver::Options,
+    ) -> Self {
+        Self::with_backend(model, cons, Backend::choose(model, options.linear_algebra))
+    }
+
+    /// The system with the given linear algebra.
+    pub(crate) fn with_backend(model: &'a Model, cons: Constraints, backend: Backend) -> Self {
+        System {
+            work: Workspace::new(cons.len()),
+            problem: Problem::new(model, cons),
+            backend,
+        }
+    }
+
+    /// `Φ(q)` (invalidates the triplets' `Φ`).
+    pub(crate) fn residual(&mut self, q: &DVector<f64>) -> &DVector<f64> {
+        self.work.jac_at = DVector::zeros(0);
+        self.problem
+            .cons
+            .evaluate(self.problem.model, q, &mut self.work.phi, None);
+        &self.work.phi
+    }
+
+    /// `‖D Φ‖∞` at the point of the last evaluation: the residual with each row in m^k divided
+    /// by `L^k`, so that one tolerance means the same in any length unit.
+    pub(crate) fn dimensionless_residual(&self) -> f64 {
+        self.problem.scaling.residual(&self.work.phi)
+    }
+
+    /// `Φ` at the point of the last [`System::jacobian`] or [`System::residual`] call.
+    pub(crate) fn phi(&self) -> &DVector<f64> {
+        &self.work.phi
+    }
+
+    /// `Φ(q)` and the triplets of `Φ_q(q)` into the scratch (kept if they are at `q`).
+    pub(super) fn triplets(&mut self, q: &DVector<f64>) {
+        let work = &mut self.work;
+        if work.jac_at.len() == q.len() && work.jac_at == *q {
+            return;
+        }
+        self.problem
+            .cons
+            .evaluate(self.problem.model, q, &mut work.phi, Some(&mut work.jac));
+        work.jac_at.clone_from(q);
+    }
+
+    /// Dense `Φ_q(q)` (and `Φ(q)` into the scratch).
+    #[cfg(test)]
+    pub(crate) fn jacobian(&mut self, q: &DVector<f64>) -> nalgebra::DMatrix<f64> {
+        self.triplets(q);
+        self.work.jac.to_dense()
+    }
+
+    /// Partition at `q` (see [`Backend::partition`]).
+    pub(crate) fn partition(&mut self, q: &DVector<f64>) -> Partition {
+        self.triplets(q);
+        self.backend
+            .partition(&self.problem, &self.work.jac, q.len())
+    }
+}

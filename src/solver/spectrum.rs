@@ -25,8 +25,10 @@ use nalgebra::{DMatrix, DVector};
 
 /// Up to this many degrees of freedom the reduced Hessian is formed and decomposed exactly.
 pub(crate) const EXACT_UP_TO: usize = 200;
-/// Lanczos steps.
+/// Lanczos steps at most.
 const STEPS: usize = 24;
+/// Eigenvalues reported (the smallest).
+const WANTED: usize = 6;
 
 /// Eigenvalues of the reduced Hessian (ascending) with their eigenvectors (columns).
 #[derive(Clone, Debug)]
@@ -156,7 +158,10 @@ fn lanczos(sys: &mut System, q: &DVector<f64>, part: &Partition, eval: &Eval) ->
         }
         let bnorm = w.norm();
         beta.push(bnorm);
-        if bnorm <= 1e-14 * a.abs().max(1e-300) || k + 1 == k_max {
+        if bnorm <= 1e-14 * a.abs().max(1e-300)
+            || k + 1 == k_max
+            || (negative_by_inertia == Some(0) && low_end_converged(&alpha, &beta))
+        {
             break;
         }
         basis.push(w / bnorm);
@@ -184,7 +189,7 @@ fn lanczos(sys: &mut System, q: &DVector<f64>, part: &Partition, eval: &Eval) ->
         })
         .collect();
     pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    pairs.truncate(6);
+    pairs.truncate(WANTED);
     if pairs.is_empty() {
         return None;
     }
@@ -200,6 +205,32 @@ fn lanczos(sys: &mut System, q: &DVector<f64>, part: &Partition, eval: &Eval) ->
         exact: false,
         negative_by_inertia,
     })
+}
+
+/// Whether the `WANTED` largest Ritz values of the tridiagonal `T_k` (`alpha`, `beta`; the
+/// smallest eigenvalues of `Ĥ` when all are positive) pass the residual test of the kept
+/// pairs, `|β_k s_ki| ≤ 10⁻⁸ |θ_i|`: then further steps would change the reported values in
+/// their last digits only. Checked once `k ≥ WANTED + 2`; the cost is one `k × k` symmetric
+/// eigendecomposition, far below a KKT solve.
+fn low_end_converged(alpha: &[f64], beta: &[f64]) -> bool {
+    let k = alpha.len();
+    if k < WANTED + 2 {
+        return false;
+    }
+    let t = DMatrix::from_fn(k, k, |i, j| {
+        if i == j {
+            alpha[i]
+        } else if i + 1 == j || j + 1 == i {
+            beta[i.min(j)]
+        } else {
+            0.0
+        }
+    });
+    let (theta, s) = symmetric_eigen(&t);
+    let last_beta = beta[k - 1];
+    // Ascending: the largest θ (smallest positive eigenvalues of Ĥ) last.
+    (k - WANTED..k)
+        .all(|i| theta[i] > 0.0 && (last_beta * s[(k - 1, i)]).abs() <= 1e-8 * theta[i].abs())
 }
 
 #[cfg(test)]

@@ -232,7 +232,15 @@ pub(crate) fn parse_document<'a>(text: &'a str, file: &str) -> Result<roxmltree:
         allow_dtd: true,
         ..Default::default()
     };
-    roxmltree::Document::parse_with_options(text, opts).map_err(|e| {
+    located(roxmltree::Document::parse_with_options(text, opts), file)
+}
+
+/// The parser's result with its error located in `file`.
+pub(crate) fn located<'a>(
+    parsed: std::result::Result<roxmltree::Document<'a>, roxmltree::Error>,
+    file: &str,
+) -> Result<roxmltree::Document<'a>> {
+    parsed.map_err(|e| {
         let p = e.pos();
         Error::Input {
             file: file.to_string(),

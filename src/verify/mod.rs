@@ -327,85 +327,74 @@ fn tree_coordinates(
 
 /// [`verify`] on the dense (`sparse = false`) or the sparse path.
 ///
-/// On the sparse path the stability verdict (a Lanczos run through KKT factors, the largest
-/// cost at 10,000 links) is computed on a second thread while the balance is checked, and kept
-/// only when the pose passes; both only read the model and the state.
+/// On the sparse path the stability verdict reuses the partition and evaluation of the
+/// balance check, and is computed on a second thread while the efforts are (kept only when
+/// the pose passes); both only read the model and the state.
 fn verify_on(model: &Model, state: &State, tol: &Tolerances, sparse: bool) -> Result<Verification> {
-    if !sparse {
-        return verify_with(model, state, tol, false, None);
-    }
-    std::thread::scope(|s| {
-        let stability = s.spawn(|| crate::solver::stability_at(model, state));
-        verify_with(model, state, tol, true, Some(stability))
-    })
-}
-
-/// The checks of [`verify_on`]; the stability comes from `stability` when given (joined only
-/// when the pose passes), else it is computed here.
-fn verify_with(
-    model: &Model,
-    state: &State,
-    tol: &Tolerances,
-    sparse: bool,
-    stability: Option<std::thread::ScopedJoinHandle<'_, Option<Stability>>>,
-) -> Result<Verification> {
     let coords = tree_coordinates(model, state);
-    let (phi, energy, projected_gradient, force_scale, closure, efforts, unassigned) = if sparse {
-        let locks = crate::solver::lock_values(model);
-        let r = reduced::reduced(model, state, &locks, locks.len())?;
-        let closure = closures(model, &r.cons, &r.phi, tol.constraint);
-        let values: Vec<_> = coords.iter().map(|c| (c.0, c.1, c.2.v)).collect();
-        let (efforts, unassigned) =
-            reduced::efforts(model, state, &locks, &values, r.redundant.len())?;
-        (
-            r.phi,
-            r.energy,
-            r.reduced_gradient,
-            r.force_scale,
-            closure,
-            DVector::from_vec(efforts),
-            unassigned,
-        )
-    } else {
-        let p = project(model, state)?;
-        let n = state.q.len();
-        let closure = closures(model, &p.cons, &p.phi, tol.constraint);
-        // The (scaled) gradients of the scalar coordinates.
-        let b_cols: Vec<DVector<f64>> = coords
-            .iter()
-            .map(|(id, _, s)| {
-                let mut g = DVector::zeros(n);
-                scatter(&model.joint(*id).bodies, s, 1.0, &mut g, None);
-                for c in 0..n {
-                    g[c] *= p.scale[c];
-                }
-                g
-            })
-            .collect();
-        let rhs = p.null.transpose() * &p.grad_s;
-        let (efforts, unassigned) = if b_cols.is_empty() || p.null.ncols() == 0 {
-            (DVector::zeros(b_cols.len()), rhs.amax())
+    let (phi, energy, projected_gradient, force_scale, closure, efforts, unassigned, stability) =
+        if sparse {
+            let locks = crate::solver::lock_values(model);
+            let r = reduced::reduced(model, state, &locks, locks.len())?;
+            let closure = closures(model, &r.sys.problem.cons, &r.phi, tol.constraint);
+            let values: Vec<_> = coords.iter().map(|c| (c.0, c.1, c.2.v)).collect();
+            let reduced::Reduced {
+                phi,
+                energy,
+                reduced_gradient,
+                force_scale,
+                redundant,
+                mut sys,
+                part,
+                eval,
+                ..
+            } = r;
+            let assembled = phi.amax() <= tol.constraint;
+            let (efforts, unassigned, stability) = std::thread::scope(|s| {
+                let verdict = assembled.then(|| {
+                    s.spawn(|| crate::solver::stability_of(&mut sys, &state.q, &part, &eval))
+                });
+                let (efforts, unassigned) =
+                    reduced::efforts(model, state, &locks, &values, redundant.len())?;
+                let passed = passes(phi.amax(), &efforts, unassigned, force_scale, tol);
+                // A panic there is re-raised here, as if the verdict had been computed on
+                // this thread.
+                let stability = match verdict {
+                    Some(h) if passed => h
+                        .join()
+                        .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
+                    _ => None,
+                };
+                Ok::<_, Error>((efforts, unassigned, stability))
+            })?;
+            (
+                phi,
+                energy,
+                reduced_gradient,
+                force_scale,
+                closure,
+                DVector::from_vec(efforts),
+                unassigned,
+                stability,
+            )
         } else {
-            let b = DMatrix::from_columns(&b_cols);
-            let m = p.null.transpose() * b;
-            let svd = m.clone().svd(true, true);
-            let eps = 1e-10 * svd.singular_values.max();
-            let tau = svd
-                .solve(&rhs, eps)
-                .unwrap_or_else(|_| DVector::zeros(b_cols.len()));
-            let rest = (&rhs - m * &tau).amax();
-            (tau, rest)
+            let (phi, energy, pg, force_scale, closure, efforts, unassigned) =
+                dense_checks(model, state, tol, &coords)?;
+            let passed = passes(phi.amax(), efforts.as_slice(), unassigned, force_scale, tol);
+            let stability = passed
+                .then(|| crate::solver::stability_at(model, state))
+                .flatten();
+            (
+                phi,
+                energy,
+                pg,
+                force_scale,
+                closure,
+                efforts,
+                unassigned,
+                stability,
+            )
         };
-        (
-            p.phi,
-            p.energy,
-            rhs.amax(),
-            p.grad_s.amax(),
-            closure,
-            efforts,
-            unassigned,
-        )
-    };
     let imbalance: Vec<Imbalance> = coords
         .iter()
         .zip(efforts.iter())
@@ -420,18 +409,13 @@ fn verify_with(
         .max_by(|a, b| a.effort.abs().total_cmp(&b.effort.abs()))
         .cloned();
     let constraint_residual = phi.amax();
-    let effort_tolerance = tol.force + tol.relative * force_scale;
-    let passed = constraint_residual <= tol.constraint
-        && imbalance.iter().all(|i| i.effort.abs() <= effort_tolerance)
-        && unassigned <= effort_tolerance;
-    let stability = match (passed, stability) {
-        (false, _) => None,
-        // A panic there is re-raised here, as if the verdict had been computed on this thread.
-        (true, Some(handle)) => handle
-            .join()
-            .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
-        (true, None) => crate::solver::stability_at(model, state),
-    };
+    let passed = passes(
+        constraint_residual,
+        efforts.as_slice(),
+        unassigned,
+        force_scale,
+        tol,
+    );
     Ok(Verification {
         passed,
         constraint_residual,
@@ -444,8 +428,72 @@ fn verify_with(
         stability,
         tolerances: *tol,
         force_scale,
-        effort_tolerance,
+        effort_tolerance: tol.force + tol.relative * force_scale,
     })
+}
+
+/// Whether a pose passes: `‖Φ‖∞` within the constraint tolerance, every effort and the
+/// unassigned force within `force + relative · force_scale`.
+fn passes(
+    residual: f64,
+    efforts: &[f64],
+    unassigned: f64,
+    force_scale: f64,
+    tol: &Tolerances,
+) -> bool {
+    let effort_tolerance = tol.force + tol.relative * force_scale;
+    residual <= tol.constraint
+        && efforts.iter().all(|e| e.abs() <= effort_tolerance)
+        && unassigned <= effort_tolerance
+}
+
+/// The dense path's `Φ`, energy, projected gradient, force scale, closures, minimum-norm
+/// efforts and unassigned force.
+#[allow(clippy::type_complexity)]
+fn dense_checks(
+    model: &Model,
+    state: &State,
+    tol: &Tolerances,
+    coords: &[(crate::model::JointId, usize, crate::jet::Scalar)],
+) -> Result<(DVector<f64>, f64, f64, f64, Vec<Closure>, DVector<f64>, f64)> {
+    let p = project(model, state)?;
+    let n = state.q.len();
+    let closure = closures(model, &p.cons, &p.phi, tol.constraint);
+    // The (scaled) gradients of the scalar coordinates.
+    let b_cols: Vec<DVector<f64>> = coords
+        .iter()
+        .map(|(id, _, s)| {
+            let mut g = DVector::zeros(n);
+            scatter(&model.joint(*id).bodies, s, 1.0, &mut g, None);
+            for c in 0..n {
+                g[c] *= p.scale[c];
+            }
+            g
+        })
+        .collect();
+    let rhs = p.null.transpose() * &p.grad_s;
+    let (efforts, unassigned) = if b_cols.is_empty() || p.null.ncols() == 0 {
+        (DVector::zeros(b_cols.len()), rhs.amax())
+    } else {
+        let b = DMatrix::from_columns(&b_cols);
+        let m = p.null.transpose() * b;
+        let svd = m.clone().svd(true, true);
+        let eps = 1e-10 * svd.singular_values.max();
+        let tau = svd
+            .solve(&rhs, eps)
+            .unwrap_or_else(|_| DVector::zeros(b_cols.len()));
+        let rest = (&rhs - m * &tau).amax();
+        (tau, rest)
+    };
+    Ok((
+        p.phi,
+        p.energy,
+        rhs.amax(),
+        p.grad_s.amax(),
+        closure,
+        efforts,
+        unassigned,
+    ))
 }
 
 /// Brings `state` onto `Φ = 0` by a damped Newton iteration that changes the dependent

@@ -103,7 +103,8 @@ fn stability(
     let shown = vals.len().min(6);
     // The gradients of every joint coordinate, once for all modes: (joint, per coordinate the
     // (global index, derivative) pairs).
-    let gradients: Vec<(&str, Vec<Vec<(usize, f64)>>)> = if shown == 0 {
+    type Gradient = Vec<(usize, f64)>;
+    let gradients: Vec<(&str, Vec<Gradient>)> = if shown == 0 {
         Vec::new()
     } else {
         sys.problem

@@ -29,8 +29,7 @@ pub fn check(model: &Model) -> ModelCheck {
     let start = crate::solver::initial_state(model);
     let cons = Constraints::new(model, &crate::solver::lock_values(model));
     let constraint_rows = cons.len();
-    let (dof, assembly_error) = match assemble(model, &start).and_then(|s| dof(model, &s, cons))
-    {
+    let (dof, assembly_error) = match assemble(model, &start).and_then(|s| dof(model, &s, cons)) {
         Ok(d) => (Some(d), None),
         Err(e) => (None, Some(e.to_string())),
     };

@@ -294,6 +294,15 @@ mod tests {
                     "{lo} vs {}",
                     exact[0]
                 );
+                // Stopped once converged (no negative pivot): the six smallest, in order.
+                assert_eq!(lz.values.len(), WANTED);
+                for (i, &l) in lz.values.iter().enumerate() {
+                    assert!(
+                        (l - exact[i]).abs() <= 1e-8 * exact[i].abs(),
+                        "eigenvalue {i}: {l} vs {}",
+                        exact[i]
+                    );
+                }
             }
             assert_eq!(lo < 0.0, flip);
             assert_eq!(exact[0] < 0.0, flip);

@@ -257,70 +257,82 @@ fn tree_coordinates(
 /// balance check, and is computed on a second thread while the efforts are (kept only when
 /// the pose passes); both only read the model and the state.
 fn verify_on(model: &Model, state: &State, tol: &Tolerances, sparse: bool) -> Result<Verification> {
-    let coords = tree_coordinates(model, state);
-    let (phi, energy, projected_gradient, force_scale, closure, efforts, unassigned, stability) =
-        if sparse {
-            let locks = crate::solver::lock_values(model);
-            let r = reduced::reduced(model, state, &locks, locks.len())?;
-            let closure = closures(model, &r.sys.problem.cons, &r.phi, tol.constraint);
+    let (
+        coords,
+        phi,
+        energy,
+        projected_gradient,
+        force_scale,
+        closure,
+        efforts,
+        unassigned,
+        stability,
+    ) = if sparse {
+        let locks = crate::solver::lock_values(model);
+        let r = reduced::reduced(model, state, &locks, locks.len())?;
+        let closure = closures(model, &r.sys.problem.cons, &r.phi, tol.constraint);
+        let reduced::Reduced {
+            phi,
+            energy,
+            reduced_gradient,
+            force_scale,
+            redundant,
+            mut sys,
+            part,
+            eval,
+            ..
+        } = r;
+        let assembled = phi.amax() <= tol.constraint;
+        let (coords, efforts, unassigned, stability) = std::thread::scope(|s| {
+            let verdict = assembled
+                .then(|| s.spawn(|| crate::solver::stability_of(&mut sys, &state.q, &part, &eval)));
+            // The joint coordinates here, off the verdict's path.
+            let coords = tree_coordinates(model, state);
             let values: Vec<_> = coords.iter().map(|c| (c.0, c.1, c.2.v)).collect();
-            let reduced::Reduced {
-                phi,
-                energy,
-                reduced_gradient,
-                force_scale,
-                redundant,
-                mut sys,
-                part,
-                eval,
-                ..
-            } = r;
-            let assembled = phi.amax() <= tol.constraint;
-            let (efforts, unassigned, stability) = std::thread::scope(|s| {
-                let verdict = assembled.then(|| {
-                    s.spawn(|| crate::solver::stability_of(&mut sys, &state.q, &part, &eval))
-                });
-                let (efforts, unassigned) =
-                    reduced::efforts(model, state, &locks, &values, redundant.len())?;
-                let passed = passes(phi.amax(), &efforts, unassigned, force_scale, tol);
-                // A panic there is re-raised here, as if the verdict had been computed on
-                // this thread.
-                let stability = match verdict {
-                    Some(h) if passed => h
-                        .join()
-                        .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
-                    _ => None,
-                };
-                Ok::<_, Error>((efforts, unassigned, stability))
-            })?;
-            (
-                phi,
-                energy,
-                reduced_gradient,
-                force_scale,
-                closure,
-                DVector::from_vec(efforts),
-                unassigned,
-                stability,
-            )
-        } else {
-            let (phi, energy, pg, force_scale, closure, efforts, unassigned) =
-                dense::dense_checks(model, state, tol, &coords)?;
-            let passed = passes(phi.amax(), efforts.as_slice(), unassigned, force_scale, tol);
-            let stability = passed
-                .then(|| crate::solver::stability_at(model, state))
-                .flatten();
-            (
-                phi,
-                energy,
-                pg,
-                force_scale,
-                closure,
-                efforts,
-                unassigned,
-                stability,
-            )
-        };
+            let (efforts, unassigned) =
+                reduced::efforts(model, state, &locks, &values, redundant.len())?;
+            let passed = passes(phi.amax(), &efforts, unassigned, force_scale, tol);
+            // A panic there is re-raised here, as if the verdict had been computed on
+            // this thread.
+            let stability = match verdict {
+                Some(h) if passed => h
+                    .join()
+                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
+                _ => None,
+            };
+            Ok::<_, Error>((coords, efforts, unassigned, stability))
+        })?;
+        (
+            coords,
+            phi,
+            energy,
+            reduced_gradient,
+            force_scale,
+            closure,
+            DVector::from_vec(efforts),
+            unassigned,
+            stability,
+        )
+    } else {
+        let coords = tree_coordinates(model, state);
+        let (phi, energy, pg, force_scale, closure, efforts, unassigned) =
+            dense::dense_checks(model, state, tol, &coords)?;
+        let passed = passes(phi.amax(), efforts.as_slice(), unassigned, force_scale, tol);
+        let stability = passed
+            .then(|| crate::solver::stability_at(model, state))
+            .flatten();
+        (
+            coords,
+            phi,
+            energy,
+            pg,
+            force_scale,
+            closure,
+            efforts,
+            unassigned,
+            stability,
+        )
+    };
     let imbalance: Vec<Imbalance> = coords
         .iter()
         .zip(efforts.iter())

@@ -211,6 +211,15 @@ fn units(u: &[&str]) -> String {
 
 /// The model as understood (`check`).
 pub(crate) fn model(s: &ModelSummary) {
+    use std::io::Write;
+    // One buffered writer for the whole listing (standard output is line-buffered: a write
+    // per line would be 20,000 system calls for a 10,000-joint model).
+    let mut w = std::io::BufWriter::new(std::io::stdout().lock());
+    macro_rules! out {
+        ($($arg:tt)*) => {{
+            let _ = writeln!(w, $($arg)*);
+        }};
+    }
     out!(
         "robot `{}`: {} bodies, {} coordinates, {} constraint rows, {}",
         s.robot,

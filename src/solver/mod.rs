@@ -103,24 +103,44 @@ fn stability(
         Verdict::Stable
     };
     let shown = vals.len().min(6);
-    let modes = (0..shown)
-        .map(|k| {
-            let dq = sys.tangent_step(part, eval, &vecs.column(k).into_owned());
-            let mut mode = std::collections::BTreeMap::new();
-            for j in sys.problem.model.joints.iter().filter(|j| !j.merged) {
+    // The gradients of every joint coordinate, once for all modes: (joint, per coordinate the
+    // (global index, derivative) pairs).
+    type Gradient = Vec<(usize, f64)>;
+    let gradients: Vec<(&str, Vec<Gradient>)> = if shown == 0 {
+        Vec::new()
+    } else {
+        sys.problem
+            .model
+            .joints
+            .iter()
+            .filter(|j| !j.merged)
+            .map(|j| {
                 let pair = crate::jet::pair_of(&j.bodies, q, false);
-                let d: Vec<f64> = (0..j.kind.scalar_coordinates())
+                let g = (0..j.kind.scalar_coordinates())
                     .filter_map(|dof| crate::kinematics::coordinate(j, &pair, dof, 0.0))
                     .map(|s| {
                         (0..crate::jet::NL)
                             .filter_map(|i| {
-                                crate::jet::global_index(&j.bodies, i).map(|g| s.g[i] * dq[g])
+                                crate::jet::global_index(&j.bodies, i).map(|g| (g, s.g[i]))
                             })
-                            .sum()
+                            .collect()
                     })
                     .collect();
+                (j.name.as_str(), g)
+            })
+            .collect()
+    };
+    let modes = (0..shown)
+        .map(|k| {
+            let dq = sys.tangent_step(part, eval, &vecs.column(k).into_owned());
+            let mut mode = std::collections::BTreeMap::new();
+            for (name, coords) in &gradients {
+                let d: Vec<f64> = coords
+                    .iter()
+                    .map(|c| c.iter().map(|&(g, x)| x * dq[g]).sum())
+                    .collect();
                 if !d.is_empty() {
-                    mode.insert(j.name.clone(), d);
+                    mode.insert(name.to_string(), d);
                 }
             }
             let big = mode.values().flatten().fold(0.0f64, |a, &b| a.max(b.abs()));
@@ -149,8 +169,22 @@ pub(crate) fn stability_at(model: &Model, state: &State) -> Option<Stability> {
         return None;
     }
     let eval = sys.evaluate(q, &part)?;
-    let eig = spectrum::spectrum(&mut sys, q, &part, &eval);
-    Some(stability(&sys, q, &part, &eval, &eig))
+    stability_of(&mut sys, q, &part, &eval)
+}
+
+/// [`stability_at`] with the system of the model's rows already partitioned and evaluated at
+/// `q` (what `verify` has made for its balance check); `None` with no degree of freedom.
+pub(crate) fn stability_of(
+    sys: &mut System,
+    q: &nalgebra::DVector<f64>,
+    part: &partition::Partition,
+    eval: &system::Eval,
+) -> Option<Stability> {
+    if part.independent.is_empty() {
+        return None;
+    }
+    let eig = spectrum::spectrum(sys, q, part, eval);
+    Some(stability(sys, q, part, eval, &eig))
 }
 
 /// Finds the stable static equilibrium of `model` from its initial guess.

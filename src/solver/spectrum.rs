@@ -25,8 +25,10 @@ use nalgebra::{DMatrix, DVector};
 
 /// Up to this many degrees of freedom the reduced Hessian is formed and decomposed exactly.
 pub(crate) const EXACT_UP_TO: usize = 200;
-/// Lanczos steps.
+/// Lanczos steps at most.
 const STEPS: usize = 24;
+/// Eigenvalues reported (the smallest).
+const WANTED: usize = 6;
 
 /// Eigenvalues of the reduced Hessian (ascending) with their eigenvectors (columns).
 #[derive(Clone, Debug)]
@@ -111,56 +113,19 @@ fn lanczos(sys: &mut System, q: &DVector<f64>, part: &Partition, eval: &Eval) ->
             None
         }
     };
-    let apply_inverse = |sys: &System, x: &DVector<f64>| -> Option<DVector<f64>> {
-        let mut b = DVector::zeros(n);
-        for (k, &c) in part.independent.iter().enumerate() {
-            b[c] = x[k];
-        }
-        // Lanczos needs the solves to about 10⁻¹¹, not to the last digit.
-        let dq = sys.kkt_solve_to(&b, 1e-11)?;
-        Some(DVector::from_iterator(
-            dof,
-            part.independent.iter().map(|&c| dq[c]),
-        ))
-    };
-    // Largest eigenvalue by power iteration on Ĥ.
-    let mut x = DVector::from_fn(dof, |i, _| 1.0 + 0.1 * ((i * 7919 % 101) as f64 / 101.0));
-    x /= x.norm();
-    let mut largest = 0.0f64;
-    for _ in 0..12 {
-        let y = sys.reduced_apply(part, eval, &x);
-        largest = y.norm();
-        if largest == 0.0 || !largest.is_finite() {
-            break;
-        }
-        x = y / largest;
-    }
-    // Lanczos on Ĥ⁻¹ with full reorthogonalization.
-    let k_max = STEPS.min(dof);
-    let mut basis: Vec<DVector<f64>> = Vec::with_capacity(k_max + 1);
-    let mut v = DVector::from_fn(dof, |i, _| {
-        ((i as f64 + 1.0) * 0.618_033_988_749).fract() - 0.5
+    // From here the factors are only read: the largest eigenvalue (power iteration on `Ĥ`,
+    // products through `Φ_u`'s factors and `W`) is found on a second thread while Lanczos runs
+    // through the KKT factors. The results do not depend on the threads.
+    let sys: &System = sys;
+    let (largest, steps) = std::thread::scope(|s| {
+        let power = s.spawn(|| largest_eigenvalue(sys, part, eval));
+        let steps = lanczos_steps(sys, part, n, negative_by_inertia);
+        let largest = power
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (largest, steps)
     });
-    v /= v.norm();
-    basis.push(v);
-    let (mut alpha, mut beta) = (Vec::new(), Vec::new());
-    for k in 0..k_max {
-        let mut w = apply_inverse(sys, &basis[k])?;
-        let a = w.dot(&basis[k]);
-        alpha.push(a);
-        for _ in 0..2 {
-            for b in &basis {
-                let c = w.dot(b);
-                w.axpy(-c, b, 1.0);
-            }
-        }
-        let bnorm = w.norm();
-        beta.push(bnorm);
-        if bnorm <= 1e-14 * a.abs().max(1e-300) || k + 1 == k_max {
-            break;
-        }
-        basis.push(w / bnorm);
-    }
+    let (alpha, beta, basis) = steps?;
     let k = alpha.len();
     let t = DMatrix::from_fn(k, k, |i, j| {
         if i == j {
@@ -184,7 +149,7 @@ fn lanczos(sys: &mut System, q: &DVector<f64>, part: &Partition, eval: &Eval) ->
         })
         .collect();
     pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    pairs.truncate(6);
+    pairs.truncate(WANTED);
     if pairs.is_empty() {
         return None;
     }
@@ -200,6 +165,105 @@ fn lanczos(sys: &mut System, q: &DVector<f64>, part: &Partition, eval: &Eval) ->
         exact: false,
         negative_by_inertia,
     })
+}
+
+/// The largest eigenvalue of `Ĥ` by 12 steps of power iteration (a few per cent suffice for
+/// the tolerance it scales).
+fn largest_eigenvalue(sys: &System, part: &Partition, eval: &Eval) -> f64 {
+    let dof = part.independent.len();
+    let mut x = DVector::from_fn(dof, |i, _| 1.0 + 0.1 * ((i * 7919 % 101) as f64 / 101.0));
+    x /= x.norm();
+    let mut largest = 0.0f64;
+    for _ in 0..12 {
+        let y = sys.reduced_apply(part, eval, &x);
+        largest = y.norm();
+        if largest == 0.0 || !largest.is_finite() {
+            break;
+        }
+        x = y / largest;
+    }
+    largest
+}
+
+/// The Lanczos recurrence on `Ĥ⁻¹` (applied by the KKT factors) with full
+/// reorthogonalization: the diagonal `α`, off-diagonal `β` of `T_k` and the basis; `None` if a
+/// solve fails. Stops early once the low end has converged when `negative_by_inertia` shows no
+/// negative eigenvalue ([`low_end_converged`]).
+#[allow(clippy::type_complexity)]
+fn lanczos_steps(
+    sys: &System,
+    part: &Partition,
+    n: usize,
+    negative_by_inertia: Option<usize>,
+) -> Option<(Vec<f64>, Vec<f64>, Vec<DVector<f64>>)> {
+    let dof = part.independent.len();
+    let apply_inverse = |x: &DVector<f64>| -> Option<DVector<f64>> {
+        let mut b = DVector::zeros(n);
+        for (k, &c) in part.independent.iter().enumerate() {
+            b[c] = x[k];
+        }
+        // Lanczos needs the solves to about 10⁻¹¹, not to the last digit.
+        let dq = sys.kkt_solve_to(&b, 1e-11)?;
+        Some(DVector::from_iterator(
+            dof,
+            part.independent.iter().map(|&c| dq[c]),
+        ))
+    };
+    let k_max = STEPS.min(dof);
+    let mut basis: Vec<DVector<f64>> = Vec::with_capacity(k_max + 1);
+    let mut v = DVector::from_fn(dof, |i, _| {
+        ((i as f64 + 1.0) * 0.618_033_988_749).fract() - 0.5
+    });
+    v /= v.norm();
+    basis.push(v);
+    let (mut alpha, mut beta) = (Vec::new(), Vec::new());
+    for k in 0..k_max {
+        let mut w = apply_inverse(&basis[k])?;
+        let a = w.dot(&basis[k]);
+        alpha.push(a);
+        for _ in 0..2 {
+            for b in &basis {
+                let c = w.dot(b);
+                w.axpy(-c, b, 1.0);
+            }
+        }
+        let bnorm = w.norm();
+        beta.push(bnorm);
+        if bnorm <= 1e-14 * a.abs().max(1e-300)
+            || k + 1 == k_max
+            || (negative_by_inertia == Some(0) && low_end_converged(&alpha, &beta))
+        {
+            break;
+        }
+        basis.push(w / bnorm);
+    }
+    Some((alpha, beta, basis))
+}
+
+/// Whether the `WANTED` largest Ritz values of the tridiagonal `T_k` (`alpha`, `beta`; the
+/// smallest eigenvalues of `Ĥ` when all are positive) pass the residual test of the kept
+/// pairs, `|β_k s_ki| ≤ 10⁻⁸ |θ_i|`: then further steps would change the reported values in
+/// their last digits only. Checked once `k ≥ WANTED + 2`; the cost is one `k × k` symmetric
+/// eigendecomposition, far below a KKT solve.
+fn low_end_converged(alpha: &[f64], beta: &[f64]) -> bool {
+    let k = alpha.len();
+    if k < WANTED + 2 {
+        return false;
+    }
+    let t = DMatrix::from_fn(k, k, |i, j| {
+        if i == j {
+            alpha[i]
+        } else if i + 1 == j || j + 1 == i {
+            beta[i.min(j)]
+        } else {
+            0.0
+        }
+    });
+    let (theta, s) = symmetric_eigen(&t);
+    let last_beta = beta[k - 1];
+    // Ascending: the largest θ (smallest positive eigenvalues of Ĥ) last.
+    (k - WANTED..k)
+        .all(|i| theta[i] > 0.0 && (last_beta * s[(k - 1, i)]).abs() <= 1e-8 * theta[i].abs())
 }
 
 #[cfg(test)]
@@ -263,6 +327,15 @@ mod tests {
                     "{lo} vs {}",
                     exact[0]
                 );
+                // Stopped once converged (no negative pivot): the six smallest, in order.
+                assert_eq!(lz.values.len(), WANTED);
+                for (i, &l) in lz.values.iter().enumerate() {
+                    assert!(
+                        (l - exact[i]).abs() <= 1e-8 * exact[i].abs(),
+                        "eigenvalue {i}: {l} vs {}",
+                        exact[i]
+                    );
+                }
             }
             assert_eq!(lo < 0.0, flip);
             assert_eq!(exact[0] < 0.0, flip);

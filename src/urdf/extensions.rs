@@ -15,7 +15,7 @@ use crate::model::{
 use nalgebra::Vector3;
 use roxmltree::Node;
 
-fn force_law(src: &Source, node: Node, what: &str) -> Result<ForceLaw> {
+fn force_law(src: &Source, node: Node, what: &dyn std::fmt::Display) -> Result<ForceLaw> {
     let stiffness = src.f64_opt(node, "stiffness")?;
     let preload = src.f64_or(node, "preload", 0.0)?;
     match (child(node, "force_deflection"), stiffness) {
@@ -184,7 +184,8 @@ pub(super) fn read(
     let mut locks: Vec<Lock> = Vec::new();
     let mut initial: Vec<Initial> = Vec::new();
     for &n in ext {
-        let what = src.describe(n);
+        // Described only when a message needs it (most files need none).
+        let what = src.described(n);
         match n.tag_name().name() {
             "gravity" => {
                 let g = src

@@ -94,8 +94,8 @@ pub(super) fn import(
         urdf_dir,
     };
     let mut warnings = Vec::new();
-    let text = super::text::repair(text, file, &mut warnings)?;
-    let doc = super::xml::parse_document(&text, file)?;
+    let mut repaired = None;
+    let doc = super::text::parse(text, file, &mut warnings, &mut repaired)?;
     let src = Source::new(file, &doc);
     let robot = doc.root_element();
     if robot.tag_name().name() != "robot" {

@@ -124,39 +124,43 @@ fn line_col(text: &str, at: usize) -> (u32, u32) {
     (line as u32, before[start..].chars().count() as u32 + 1)
 }
 
-/// Blanks an XML declaration that follows leading whitespace or comments (TinyXML2 accepts
-/// it there; XML does not), keeping offsets. Returns whether it did.
-fn blank_late_declaration(text: &mut String) -> bool {
+/// The byte range of an XML declaration that follows leading whitespace or comments (TinyXML2
+/// accepts it there; XML does not).
+fn late_declaration(text: &str) -> Option<std::ops::Range<usize>> {
     let mut at = 0;
     let b = text.as_bytes();
     if b.starts_with(b"<?xml") {
-        return false;
+        return None;
     }
     loop {
         while at < b.len() && b[at].is_ascii_whitespace() {
             at += 1;
         }
         if b[at..].starts_with(b"<!--") {
-            match text[at..].find("-->") {
-                Some(e) => at += e + 3,
-                None => return false,
-            }
+            at += text[at..].find("-->")? + 3;
         } else if b[at..].starts_with(b"<?xml")
             && b.get(at + 5).is_some_and(|c| c.is_ascii_whitespace())
         {
-            let Some(e) = text[at..].find("?>") else {
-                return false;
-            };
-            let blank: String = text[at..at + e + 2]
-                .chars()
-                .map(|c| if c == '\n' { '\n' } else { ' ' })
-                .collect();
-            text.replace_range(at..at + e + 2, &blank);
-            return true;
+            let e = text[at..].find("?>")?;
+            return Some(at..at + e + 2);
         } else {
-            return false;
+            return None;
         }
     }
+}
+
+/// Blanks a late XML declaration ([`late_declaration`]), keeping offsets. Returns whether it
+/// did.
+fn blank_late_declaration(text: &mut String) -> bool {
+    let Some(r) = late_declaration(text) else {
+        return false;
+    };
+    let blank: String = text[r.clone()]
+        .chars()
+        .map(|c| if c == '\n' { '\n' } else { ' ' })
+        .collect();
+    text.replace_range(r, &blank);
+    true
 }
 
 /// Refuses text nested deeper than [`MAX_DEPTH`], by a scan that skips comments, CDATA,
@@ -237,48 +241,81 @@ fn undeclared_uri(prefix: &str) -> String {
     format!("urn:restpose:undeclared:{prefix}")
 }
 
-/// Makes `text` parseable the way urdfdom reads it: checks the nesting depth, blanks a late
-/// XML declaration, declares prefixes used without a declaration (`mech:` and `drake:` to
-/// their namespaces, others to a placeholder) on `<robot>`, and refuses xacro. Each repair
-/// adds a warning.
+/// Parses `text` the way urdfdom reads it: checks the nesting depth, blanks a late XML
+/// declaration, declares prefixes used without a declaration (`mech:` and `drake:` to their
+/// namespaces, others to a placeholder) on `<robot>`, and refuses xacro. Each repair adds a
+/// warning.
+///
+/// A file that needs no repair is parsed once, in place; a repaired copy is kept in `store`
+/// (which the document then borrows).
 ///
 /// # Errors
-/// [`Error::Input`] for text nested too deeply or a xacro file.
-pub(crate) fn repair(text: &str, file: &str, warnings: &mut Vec<String>) -> Result<String> {
+/// [`Error::Input`] for text nested too deeply, not well-formed XML or a xacro file.
+pub(crate) fn parse<'a>(
+    text: &'a str,
+    file: &str,
+    warnings: &mut Vec<String>,
+    store: &'a mut Option<String>,
+) -> Result<roxmltree::Document<'a>> {
     check_depth(text, file)?;
-    let mut out = text.to_string();
-    if blank_late_declaration(&mut out) {
+    let late = late_declaration(text).is_some();
+    let doc = if late {
+        let mut out = text.to_string();
+        blank_late_declaration(&mut out);
         warnings.push(format!(
             "{file}: the XML declaration is not at the start of the file; read as if it were"
         ));
-    }
-    let popts = roxmltree::ParsingOptions {
+        let out = declare_prefixes(out, file, warnings)?;
+        super::xml::parse_document(store.insert(out), file)?
+    } else {
+        match roxmltree::Document::parse_with_options(text, options()) {
+            Err(roxmltree::Error::UnknownNamespace(..)) => {
+                let out = declare_prefixes(text.to_string(), file, warnings)?;
+                super::xml::parse_document(store.insert(out), file)?
+            }
+            parsed => super::xml::located(parsed, file)?,
+        }
+    };
+    refuse_xacro(&doc, file)?;
+    Ok(doc)
+}
+
+/// The parser's options (a DTD is allowed, as TinyXML2 skips it).
+fn options() -> roxmltree::ParsingOptions {
+    roxmltree::ParsingOptions {
         allow_dtd: true,
         ..Default::default()
-    };
+    }
+}
+
+/// Refuses a xacro file: an element in a xacro namespace or an attribute with `${`.
+fn refuse_xacro(doc: &roxmltree::Document, file: &str) -> Result<()> {
+    for n in doc.descendants().filter(|n| n.is_element()) {
+        let xacro = n
+            .tag_name()
+            .namespace()
+            .is_some_and(|u| u.contains("xacro"));
+        if xacro || n.attributes().any(|a| a.value().contains("${")) {
+            let p = doc.text_pos_at(n.range().start);
+            return Err(Error::Input {
+                file: file.to_string(),
+                line: p.row,
+                col: p.col,
+                message: XACRO.into(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Declares on `<robot>` each prefix the parser finds used without a declaration, until it
+/// finds none (the text may still be malformed otherwise: the caller's parse reports that).
+fn declare_prefixes(mut out: String, file: &str, warnings: &mut Vec<String>) -> Result<String> {
     // Each round declares one prefix; a file uses a handful.
     for _ in 0..64 {
-        let (prefix, pos) = match roxmltree::Document::parse_with_options(&out, popts) {
+        let (prefix, pos) = match roxmltree::Document::parse_with_options(&out, options()) {
             Err(roxmltree::Error::UnknownNamespace(prefix, pos)) => (prefix, pos),
-            Err(_) => return Ok(out),
-            Ok(doc) => {
-                for n in doc.descendants().filter(|n| n.is_element()) {
-                    let xacro = n
-                        .tag_name()
-                        .namespace()
-                        .is_some_and(|u| u.contains("xacro"));
-                    if xacro || n.attributes().any(|a| a.value().contains("${")) {
-                        let p = doc.text_pos_at(n.range().start);
-                        return Err(Error::Input {
-                            file: file.to_string(),
-                            line: p.row,
-                            col: p.col,
-                            message: XACRO.into(),
-                        });
-                    }
-                }
-                return Ok(out);
-            }
+            _ => return Ok(out),
         };
         let uri = match prefix.as_str() {
             "mech" => super::xml::MECH_NS.to_string(),

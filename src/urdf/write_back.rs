@@ -19,8 +19,9 @@ use std::fmt::Write;
 /// [`crate::Error::Input`] if `text` is not well-formed XML.
 pub fn with_initial_pose(text: &str, file: &str, model: &Model, state: &State) -> Result<String> {
     let mut warnings = Vec::new();
-    let text = super::text::repair(text, file, &mut warnings)?;
-    let doc = super::xml::parse_document(&text, file)?;
+    let mut repaired = None;
+    let doc = super::text::parse(text, file, &mut warnings, &mut repaired)?;
+    let text = doc.input_text();
     let robot = doc.root_element();
     let prefix = robot.lookup_prefix(MECH_NS).map(str::to_string);
     let tag = prefix.clone().map_or("mech".to_string(), |p| p);

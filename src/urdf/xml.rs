@@ -95,6 +95,11 @@ impl<'a> Source<'a> {
         }
     }
 
+    /// [`Source::describe`], formatted only when displayed.
+    pub(crate) fn described<'s, 'n>(&'s self, node: Node<'n, 'n>) -> Described<'s, 'a, 'n> {
+        Described { src: self, node }
+    }
+
     /// A required attribute.
     pub(crate) fn req<'n>(&self, node: Node<'n, 'n>, attr: &str) -> Result<&'n str> {
         node.attribute(attr).ok_or_else(|| {
@@ -232,7 +237,15 @@ pub(crate) fn parse_document<'a>(text: &'a str, file: &str) -> Result<roxmltree:
         allow_dtd: true,
         ..Default::default()
     };
-    roxmltree::Document::parse_with_options(text, opts).map_err(|e| {
+    located(roxmltree::Document::parse_with_options(text, opts), file)
+}
+
+/// The parser's result with its error located in `file`.
+pub(crate) fn located<'a>(
+    parsed: std::result::Result<roxmltree::Document<'a>, roxmltree::Error>,
+    file: &str,
+) -> Result<roxmltree::Document<'a>> {
+    parsed.map_err(|e| {
         let p = e.pos();
         Error::Input {
             file: file.to_string(),
@@ -241,6 +254,18 @@ pub(crate) fn parse_document<'a>(text: &'a str, file: &str) -> Result<roxmltree:
             message: format!("not well-formed XML: {e}"),
         }
     })
+}
+
+/// An element's description for messages ([`Source::described`]).
+pub(crate) struct Described<'s, 'a, 'n> {
+    src: &'s Source<'a>,
+    node: Node<'n, 'n>,
+}
+
+impl std::fmt::Display for Described<'_, '_, '_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.src.describe(self.node))
+    }
 }
 
 /// Parses a finite number.

@@ -1,10 +1,17 @@
 //! What `restpose check` reports beyond the model itself: the number of constraint rows, and
 //! whether the initial guess assembles (`Φ(q) = 0` reached by Newton from the initial joint
 //! values) with how many degrees of freedom there, `n − rank(Φ_q)`.
+//!
+//! On the sparse path the rank is that of the solver's sparse partition of `Φ_q` at the
+//! assembled guess (one `O(N)` elimination; no energy gradient or multipliers are needed for
+//! a count), on the dense path that of [`super::balance`].
 
-use super::{assemble, balance};
+use super::{assemble, balance, sparse_path};
 use crate::constraints::Constraints;
+use crate::error::{Error, Result};
 use crate::model::Model;
+use crate::solver::system::{Backend, System};
+use crate::state::State;
 
 /// Constraint rows and assembly of a model at its initial guess.
 #[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
@@ -20,13 +27,39 @@ pub struct ModelCheck {
 /// Counts the constraint rows and assembles the initial guess.
 pub fn check(model: &Model) -> ModelCheck {
     let start = crate::solver::initial_state(model);
-    let (dof, assembly_error) = match assemble(model, &start).and_then(|s| balance(model, &s)) {
-        Ok(b) => (Some(b.dof), None),
+    let cons = Constraints::new(model, &crate::solver::lock_values(model));
+    let constraint_rows = cons.len();
+    let (dof, assembly_error) = match assemble(model, &start).and_then(|s| dof(model, &s, cons)) {
+        Ok(d) => (Some(d), None),
         Err(e) => (None, Some(e.to_string())),
     };
     ModelCheck {
-        constraint_rows: Constraints::new(model, &crate::solver::lock_values(model)).len(),
+        constraint_rows,
         dof,
         assembly_error,
     }
+}
+
+/// Degrees of freedom at the feasible `state` with the rows `cons`.
+///
+/// # Errors
+/// [`Error::ForceTableOutOfRange`] (or another undefined term) if the energy cannot be
+/// evaluated there, [`Error::SingularPartition`] if the dense partition fails.
+fn dof(model: &Model, state: &State, cons: Constraints) -> Result<usize> {
+    if !sparse_path(model) {
+        return balance(model, state).map(|b| b.dof);
+    }
+    if super::potential_energy(model, state).is_none() {
+        return Err(
+            crate::forces::undefined_term(model, &state.branches, &state.q).unwrap_or(
+                Error::SingularPartition {
+                    at: "the assembled initial guess".into(),
+                    rows: 0,
+                },
+            ),
+        );
+    }
+    let cons = cons.on_branches(state.branches.clone());
+    let mut sys = System::with_backend(model, cons, Backend::Sparse);
+    Ok(sys.partition(&state.q).independent.len())
 }

@@ -13,7 +13,8 @@
 //! joint coordinate can carry (a spherical or floating joint) is reported as `unassigned`.
 //!
 //! Models above 40 bodies' coordinates (the solver's automatic switch to sparse linear
-//! algebra) are verified in `O(N)` by the solver's sparse partition instead (module `reduced`).
+//! algebra) are verified in `O(N)` by the solver's sparse partition instead (module `reduced`);
+//! smaller ones by the dense basis `N` (module `dense`).
 //!
 //! ## Tolerances
 //! A pose passes when `‖Φ‖∞ ≤ constraint` and every effort (and the unassigned force) is at
@@ -23,6 +24,7 @@
 //! exact answers of large models.
 
 mod check;
+mod dense;
 mod pose;
 mod reduced;
 
@@ -32,12 +34,12 @@ pub use pose::{parse_pose, pose_state, read_pose};
 use crate::constraints::{joint, BlockKind, Constraints};
 use crate::error::{Error, Result};
 use crate::forces::potential;
-use crate::jet::{pair_of, scatter};
+use crate::jet::pair_of;
 use crate::model::Model;
-use crate::solver::system::{Backend, Scaling};
+use crate::solver::system::Backend;
 use crate::solver::Stability;
 use crate::state::State;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 
 /// Residuals of a configuration.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -135,82 +137,6 @@ fn sparse_path(model: &Model) -> bool {
     Backend::choose(model, crate::solver::LinearAlgebra::Auto) == Backend::Sparse
 }
 
-/// Everything the checks share: `Φ`, the scaled gradient and the null-space basis.
-struct Projection {
-    phi: DVector<f64>,
-    grad_s: DVector<f64>,
-    scale: Vec<f64>,
-    null: DMatrix<f64>,
-    energy: f64,
-    cons: Constraints,
-}
-
-fn project(model: &Model, state: &State) -> Result<Projection> {
-    let cons = Constraints::new(model, &crate::solver::lock_values(model))
-        .on_branches(state.branches.clone());
-    let mut phi = DVector::zeros(cons.len());
-    let mut jac = crate::constraints::Triplets::default();
-    cons.evaluate(model, &state.q, &mut phi, Some(&mut jac));
-    let n = state.q.len();
-    let Scaling {
-        columns: scale,
-        rows: row_scale,
-    } = Scaling::new(model, &cons);
-    let mut j = jac.to_dense();
-    for c in 0..n {
-        j.column_mut(c).scale_mut(scale[c]);
-    }
-    let mut g = DVector::zeros(n);
-    let e = potential(model, &state.branches, &state.q, &mut g, None).ok_or_else(|| {
-        crate::forces::undefined_term(model, &state.branches, &state.q).unwrap_or(
-            Error::SingularPartition {
-                at: "the given pose".into(),
-                rows: 0,
-            },
-        )
-    })?;
-    for c in 0..n {
-        g[c] *= scale[c];
-    }
-    // Null space of the dimensionless Jacobian D Φ_q S: Z = [−Φ_u⁻¹ Φ_v; I] for the rows and
-    // columns that full pivoting finds independent, made orthonormal by a QR factorization.
-    // The subspace does not depend on that choice.
-    for r in 0..cons.len() {
-        j.row_mut(r).scale_mut(row_scale[r]);
-    }
-    let part = crate::solver::partition::partition(&j, &vec![1.0; cons.len()], &vec![1.0; n]);
-    let (r, dof) = (part.rows.len(), part.independent.len());
-    let phi_u = DMatrix::from_fn(r, r, |a, b| j[(part.rows[a], part.dependent[b])]);
-    let phi_v = DMatrix::from_fn(r, dof, |a, b| j[(part.rows[a], part.independent[b])]);
-    let h = if r > 0 {
-        phi_u
-            .lu()
-            .solve(&(-phi_v))
-            .ok_or_else(|| Error::SingularPartition {
-                at: "the given pose".into(),
-                rows: r,
-            })?
-    } else {
-        DMatrix::zeros(0, dof)
-    };
-    let mut z = DMatrix::zeros(n, dof);
-    for b in 0..dof {
-        z[(part.independent[b], b)] = 1.0;
-        for (k, &c) in part.dependent.iter().enumerate() {
-            z[(c, b)] = h[(k, b)];
-        }
-    }
-    let null = if dof > 0 { z.qr().q() } else { z };
-    Ok(Projection {
-        phi,
-        grad_s: g,
-        scale,
-        null,
-        energy: e.total,
-        cons,
-    })
-}
-
 /// Potential energy of a state \[J\], `None` where a force table is out of its range.
 pub fn potential_energy(model: &Model, state: &State) -> Option<f64> {
     let mut g = DVector::zeros(state.q.len());
@@ -236,7 +162,7 @@ pub fn balance(model: &Model, state: &State) -> Result<Balance> {
             dof: r.dof,
         });
     }
-    let p = project(model, state)?;
+    let p = dense::project(model, state)?;
     let pg = p.null.transpose() * &p.grad_s;
     Ok(Balance {
         constraint_residual: p.phi.amax(),
@@ -327,83 +253,84 @@ fn tree_coordinates(
 
 /// [`verify`] on the dense (`sparse = false`) or the sparse path.
 ///
-/// On the sparse path the stability verdict (a Lanczos run through KKT factors, the largest
-/// cost at 10,000 links) is computed on a second thread while the balance is checked, and kept
-/// only when the pose passes; both only read the model and the state.
+/// On the sparse path the stability verdict reuses the partition and evaluation of the
+/// balance check, and is computed on a second thread while the efforts are (kept only when
+/// the pose passes); both only read the model and the state.
 fn verify_on(model: &Model, state: &State, tol: &Tolerances, sparse: bool) -> Result<Verification> {
-    if !sparse {
-        return verify_with(model, state, tol, false, None);
-    }
-    std::thread::scope(|s| {
-        let stability = s.spawn(|| crate::solver::stability_at(model, state));
-        verify_with(model, state, tol, true, Some(stability))
-    })
-}
-
-/// The checks of [`verify_on`]; the stability comes from `stability` when given (joined only
-/// when the pose passes), else it is computed here.
-fn verify_with(
-    model: &Model,
-    state: &State,
-    tol: &Tolerances,
-    sparse: bool,
-    stability: Option<std::thread::ScopedJoinHandle<'_, Option<Stability>>>,
-) -> Result<Verification> {
-    let coords = tree_coordinates(model, state);
-    let (phi, energy, projected_gradient, force_scale, closure, efforts, unassigned) = if sparse {
+    let (
+        coords,
+        phi,
+        energy,
+        projected_gradient,
+        force_scale,
+        closure,
+        efforts,
+        unassigned,
+        stability,
+    ) = if sparse {
         let locks = crate::solver::lock_values(model);
         let r = reduced::reduced(model, state, &locks, locks.len())?;
-        let closure = closures(model, &r.cons, &r.phi, tol.constraint);
-        let values: Vec<_> = coords.iter().map(|c| (c.0, c.1, c.2.v)).collect();
-        let (efforts, unassigned) =
-            reduced::efforts(model, state, &locks, &values, r.redundant.len())?;
+        let closure = closures(model, &r.sys.problem.cons, &r.phi, tol.constraint);
+        let reduced::Reduced {
+            phi,
+            energy,
+            reduced_gradient,
+            force_scale,
+            redundant,
+            mut sys,
+            part,
+            eval,
+            ..
+        } = r;
+        let assembled = phi.amax() <= tol.constraint;
+        let (coords, efforts, unassigned, stability) = std::thread::scope(|s| {
+            let verdict = assembled
+                .then(|| s.spawn(|| crate::solver::stability_of(&mut sys, &state.q, &part, &eval)));
+            // The joint coordinates here, off the verdict's path.
+            let coords = tree_coordinates(model, state);
+            let values: Vec<_> = coords.iter().map(|c| (c.0, c.1, c.2.v)).collect();
+            let (efforts, unassigned) =
+                reduced::efforts(model, state, &locks, &values, redundant.len())?;
+            let passed = passes(phi.amax(), &efforts, unassigned, force_scale, tol);
+            // A panic there is re-raised here, as if the verdict had been computed on
+            // this thread.
+            let stability = match verdict {
+                Some(h) if passed => h
+                    .join()
+                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
+                _ => None,
+            };
+            Ok::<_, Error>((coords, efforts, unassigned, stability))
+        })?;
         (
-            r.phi,
-            r.energy,
-            r.reduced_gradient,
-            r.force_scale,
+            coords,
+            phi,
+            energy,
+            reduced_gradient,
+            force_scale,
             closure,
             DVector::from_vec(efforts),
             unassigned,
+            stability,
         )
     } else {
-        let p = project(model, state)?;
-        let n = state.q.len();
-        let closure = closures(model, &p.cons, &p.phi, tol.constraint);
-        // The (scaled) gradients of the scalar coordinates.
-        let b_cols: Vec<DVector<f64>> = coords
-            .iter()
-            .map(|(id, _, s)| {
-                let mut g = DVector::zeros(n);
-                scatter(&model.joint(*id).bodies, s, 1.0, &mut g, None);
-                for c in 0..n {
-                    g[c] *= p.scale[c];
-                }
-                g
-            })
-            .collect();
-        let rhs = p.null.transpose() * &p.grad_s;
-        let (efforts, unassigned) = if b_cols.is_empty() || p.null.ncols() == 0 {
-            (DVector::zeros(b_cols.len()), rhs.amax())
-        } else {
-            let b = DMatrix::from_columns(&b_cols);
-            let m = p.null.transpose() * b;
-            let svd = m.clone().svd(true, true);
-            let eps = 1e-10 * svd.singular_values.max();
-            let tau = svd
-                .solve(&rhs, eps)
-                .unwrap_or_else(|_| DVector::zeros(b_cols.len()));
-            let rest = (&rhs - m * &tau).amax();
-            (tau, rest)
-        };
+        let coords = tree_coordinates(model, state);
+        let (phi, energy, pg, force_scale, closure, efforts, unassigned) =
+            dense::dense_checks(model, state, tol, &coords)?;
+        let passed = passes(phi.amax(), efforts.as_slice(), unassigned, force_scale, tol);
+        let stability = passed
+            .then(|| crate::solver::stability_at(model, state))
+            .flatten();
         (
-            p.phi,
-            p.energy,
-            rhs.amax(),
-            p.grad_s.amax(),
+            coords,
+            phi,
+            energy,
+            pg,
+            force_scale,
             closure,
             efforts,
             unassigned,
+            stability,
         )
     };
     let imbalance: Vec<Imbalance> = coords
@@ -420,18 +347,13 @@ fn verify_with(
         .max_by(|a, b| a.effort.abs().total_cmp(&b.effort.abs()))
         .cloned();
     let constraint_residual = phi.amax();
-    let effort_tolerance = tol.force + tol.relative * force_scale;
-    let passed = constraint_residual <= tol.constraint
-        && imbalance.iter().all(|i| i.effort.abs() <= effort_tolerance)
-        && unassigned <= effort_tolerance;
-    let stability = match (passed, stability) {
-        (false, _) => None,
-        // A panic there is re-raised here, as if the verdict had been computed on this thread.
-        (true, Some(handle)) => handle
-            .join()
-            .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
-        (true, None) => crate::solver::stability_at(model, state),
-    };
+    let passed = passes(
+        constraint_residual,
+        efforts.as_slice(),
+        unassigned,
+        force_scale,
+        tol,
+    );
     Ok(Verification {
         passed,
         constraint_residual,
@@ -444,8 +366,23 @@ fn verify_with(
         stability,
         tolerances: *tol,
         force_scale,
-        effort_tolerance,
+        effort_tolerance: tol.force + tol.relative * force_scale,
     })
+}
+
+/// Whether a pose passes: `‖Φ‖∞` within the constraint tolerance, every effort and the
+/// unassigned force within `force + relative · force_scale`.
+fn passes(
+    residual: f64,
+    efforts: &[f64],
+    unassigned: f64,
+    force_scale: f64,
+    tol: &Tolerances,
+) -> bool {
+    let effort_tolerance = tol.force + tol.relative * force_scale;
+    residual <= tol.constraint
+        && efforts.iter().all(|e| e.abs() <= effort_tolerance)
+        && unassigned <= effort_tolerance
 }
 
 /// Brings `state` onto `Φ = 0` by a damped Newton iteration that changes the dependent

@@ -39,6 +39,14 @@ fn numbers(v: &serde_json::Value) -> Option<Vec<f64>> {
 /// # Errors
 /// [`Error::Pose`] if the text is not one of the accepted formats.
 pub fn parse_pose(text: &str, file: &str) -> Result<JointValues> {
+    match result_joints(text) {
+        Some(values) => Ok(values),
+        None => parse_general(text, file),
+    }
+}
+
+/// [`parse_pose`] for every accepted format, through a tree of the whole document.
+fn parse_general(text: &str, file: &str) -> Result<JointValues> {
     let bad = |why: String| Error::Pose {
         file: file.into(),
         message: why,
@@ -99,6 +107,42 @@ pub fn parse_pose(text: &str, file: &str) -> Result<JointValues> {
         return Err(bad("non-finite joint value".into()));
     }
     Ok(out)
+}
+
+/// The shape of restpose's result JSON, as far as a pose needs it: the other fields (links,
+/// reactions, …: most of a large result's bytes) are skipped without being built.
+#[derive(serde::Deserialize)]
+struct ResultShape {
+    name: Option<serde::de::IgnoredAny>,
+    position: Option<serde::de::IgnoredAny>,
+    joints: Option<std::collections::HashMap<String, JointPosition>>,
+}
+
+/// One joint of a result: its coordinate values.
+#[derive(serde::Deserialize)]
+struct JointPosition {
+    position: Vec<f64>,
+}
+
+/// The joint values of a restpose result JSON by a typed parse; `None` for anything else (or
+/// anything wrong), which the general path then reads or reports. Same answer as the general
+/// path (`joints.NAME.position`, unless `name` and `position` lists are present), without
+/// building a tree of the whole document.
+fn result_joints(text: &str) -> Option<JointValues> {
+    let r: ResultShape = serde_json::from_str(text).ok()?;
+    if r.name.is_some() && r.position.is_some() {
+        return None;
+    }
+    let values: JointValues = r
+        .joints?
+        .into_iter()
+        .map(|(name, j)| (name, j.position))
+        .collect();
+    values
+        .values()
+        .flatten()
+        .all(|x| x.is_finite())
+        .then_some(values)
 }
 
 /// The last non-empty YAML document of `text`: documents are separated or ended by `---`
@@ -171,4 +215,34 @@ pub fn pose_state(model: &Model, values: &JointValues) -> Result<(State, Vec<Str
         .map(|j| j.name.clone())
         .collect();
     Ok((State::from_joint_values(model, &all), missing))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The typed parse of a result JSON gives what the general path gives, and declines the
+    /// other formats (and results it cannot read), which the general path then handles.
+    #[test]
+    fn typed_result_parse_equals_the_general_path() {
+        let result = r#"{"robot": "r", "links": {"a": {"position": [1, 2, 3]}},
+            "joints": {"j1": {"position": [0.5], "unit": "rad"}, "s": {"position": [1, 0, 0, 0]},
+                       "k": {"position": [2]}},
+            "stability": {"verdict": "stable", "eigenvalues": [1.0]}}"#;
+        let typed = result_joints(result).expect("a result is read by the typed parse");
+        assert_eq!(typed, parse_general(result, "f").unwrap());
+        assert_eq!(typed["s"], vec![1.0, 0.0, 0.0, 0.0]);
+        for other in [
+            r#"{"name": ["a"], "position": [1.0], "joints": {"a": {"position": [2.0]}}}"#,
+            r#"{"a": 1.0, "b": [1, 2]}"#,
+            r#"{"joints": {"a": {"position": null}}}"#,
+            r#"{"joints": [1, 2]}"#,
+            "name: [a]\nposition: [1.0]\n",
+        ] {
+            assert!(result_joints(other).is_none(), "{other}");
+        }
+        let ros = r#"{"name": ["a"], "position": [1.0], "joints": {"a": {"position": [2.0]}}}"#;
+        assert_eq!(parse_pose(ros, "f").unwrap()["a"], vec![1.0]);
+        assert!(parse_pose(r#"{"joints": {"a": {"position": null}}}"#, "f").is_err());
+    }
 }

@@ -25,7 +25,8 @@ use crate::constraints::{BlockKind, Constraints};
 use crate::error::{Error, Result};
 use crate::forces::potential;
 use crate::model::{JointId, Model};
-use crate::solver::system::{coordinate_scale, Backend, System};
+use crate::solver::partition::Partition;
+use crate::solver::system::{coordinate_scale, Backend, Eval, System};
 use crate::state::State;
 use nalgebra::DVector;
 
@@ -34,7 +35,7 @@ use nalgebra::DVector;
 const LOCK_PREFERENCE: f64 = 1e-3;
 
 /// The quantities of one sparse partition at a configuration.
-pub(super) struct Reduced {
+pub(super) struct Reduced<'a> {
     /// `Φ(q)` over all rows.
     pub(super) phi: DVector<f64>,
     /// Potential energy \[J\].
@@ -49,18 +50,21 @@ pub(super) struct Reduced {
     pub(super) multipliers: Vec<f64>,
     /// Redundant rows, ascending.
     pub(super) redundant: Vec<usize>,
-    /// The rows.
-    pub(super) cons: Constraints,
+    /// The system (rows included), its partition and evaluation at the configuration: what
+    /// the stability verdict needs too.
+    pub(super) sys: System<'a>,
+    pub(super) part: Partition,
+    pub(super) eval: Eval,
 }
 
 /// Partitions and evaluates the rows of `model` plus `locks` at `q` on the sparse path; the
 /// locks from index `preferred` on are the added ones, kept only where no model row can be.
-pub(super) fn reduced(
-    model: &Model,
+pub(super) fn reduced<'a>(
+    model: &'a Model,
     state: &State,
     locks: &[(JointId, usize, f64)],
     preferred: usize,
-) -> Result<Reduced> {
+) -> Result<Reduced<'a>> {
     let q = &state.q;
     let mut g = DVector::zeros(q.len());
     potential(model, &state.branches, q, &mut g, None).ok_or_else(|| {
@@ -104,7 +108,9 @@ pub(super) fn reduced(
         dof: part.independent.len(),
         multipliers,
         redundant: part.redundant.clone(),
-        cons: sys.problem.cons,
+        sys,
+        part,
+        eval,
     })
 }
 
@@ -130,7 +136,8 @@ pub(super) fn efforts(
         }
     }
     let r = reduced(model, state, &all, locks.len())?;
-    let first_added = r.cons.len() - model.mimics.len() - (all.len() - locks.len());
+    let cons = &r.sys.problem.cons;
+    let first_added = cons.len() - model.mimics.len() - (all.len() - locks.len());
     let dropped = r.redundant.iter().filter(|&&i| i < first_added).count();
     if dropped > base {
         return Err(Error::InseparableEfforts {
@@ -138,8 +145,7 @@ pub(super) fn efforts(
             without: base,
         });
     }
-    let first_lock = r
-        .cons
+    let first_lock = cons
         .blocks
         .iter()
         .find(|b| matches!(b.kind, BlockKind::Lock { .. }))

@@ -205,6 +205,26 @@ fn verify_accepts_analyze_answers_at_1000_links() {
         );
         let b = restpose::verify::balance(&m, &s).unwrap();
         assert_eq!(b.dof, report.dof, "{family}");
+        // `check`'s count (the sparse partition's rank at the assembled initial guess) is the
+        // same number.
+        assert_eq!(
+            restpose::verify::check(&m).dof,
+            Some(report.dof),
+            "{family}"
+        );
+        // verify's stability verdict (from its balance check's partition, Lanczos above 200
+        // degrees of freedom) is analyze's, with the same smallest eigenvalues.
+        let (vs, rs) = (
+            v.stability.as_ref().unwrap(),
+            report.stability.as_ref().unwrap(),
+        );
+        assert_eq!(vs.verdict, rs.verdict, "{family}");
+        assert_eq!(vs.verdict, restpose::solver::Verdict::Stable, "{family}");
+        assert!(!vs.eigenvalues.is_empty(), "{family}");
+        assert_eq!(vs.eigenvalues.len(), rs.eigenvalues.len(), "{family}");
+        for (a, b) in vs.eigenvalues.iter().zip(&rs.eigenvalues) {
+            assert!((a - b).abs() <= 1e-8 * b.abs(), "{family}: {a} vs {b}");
+        }
         // One joint turned by 0.01 rad needs an effort there.
         let name = if family == "chain1000" {
             "joint500"

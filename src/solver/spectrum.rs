@@ -113,18 +113,10 @@ fn lanczos(sys: &mut System, q: &DVector<f64>, part: &Partition, eval: &Eval) ->
             None
         }
     };
-    // From here the factors are only read: the largest eigenvalue (power iteration on `Ĥ`,
-    // products through `Φ_u`'s factors and `W`) is found on a second thread while Lanczos runs
-    // through the KKT factors. The results do not depend on the threads.
-    let sys: &System = sys;
-    let (largest, steps) = std::thread::scope(|s| {
-        let power = s.spawn(|| largest_eigenvalue(sys, part, eval));
-        let steps = lanczos_steps(sys, part, n, negative_by_inertia);
-        let largest = power
-            .join()
-            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-        (largest, steps)
-    });
+    // The largest eigenvalue: power iteration on `Ĥ` (products through `Φ_u`'s factors and
+    // `W`); the smallest: Lanczos through the KKT factors.
+    let largest = largest_eigenvalue(sys, part, eval);
+    let steps = lanczos_steps(sys, part, n, negative_by_inertia);
     let (alpha, beta, basis) = steps?;
     let k = alpha.len();
     let t = DMatrix::from_fn(k, k, |i, j| {

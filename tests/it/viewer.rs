@@ -112,6 +112,10 @@ fn recording_shows_the_ground_the_contacts_and_the_stops() {
     let out = tmp.path().join("stop.rrd");
     restpose::view::write_recording(&out, &stop, &state, &report, &[]).unwrap();
     let rec = restpose::view::read_recording(&out).unwrap();
-    assert!(rec.entities.contains("world/stops/pivot"), "{:?}", rec.entities);
+    assert!(
+        rec.entities.contains("world/stops/pivot"),
+        "{:?}",
+        rec.entities
+    );
     assert!(!rec.entities.iter().any(|e| e.starts_with("world/contacts")));
 }

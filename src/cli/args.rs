@@ -130,6 +130,18 @@ pub(crate) struct VerifyArgs {
     pub(crate) json: Option<PathBuf>,
     #[command(flatten)]
     pub(crate) input: InputArgs,
+    /// URDF joint limits: enforce (the pose may rest on a stop, which carries an effort, and
+    /// may not go beyond one) or ignore.
+    #[arg(long, value_enum, default_value_t = Options::default().limits)]
+    pub(crate) limits: Limits,
+    /// Contacts without a friction setting in <mech:contact>: none (frictionless) or stick
+    /// (they may carry a tangential force).
+    #[arg(long, value_enum, default_value_t = Options::default().friction)]
+    pub(crate) friction: Friction,
+    /// Friction coefficient of sticking contacts without `mu` in <mech:contact>: a contact
+    /// needing more fails the pose.
+    #[arg(long, value_name = "MU", value_parser = parse::positive)]
+    pub(crate) mu: Option<f64>,
     /// Print only errors and the verdict.
     #[arg(long, short)]
     pub(crate) quiet: bool,

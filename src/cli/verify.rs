@@ -50,7 +50,12 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
         constraint: a.constraint_tolerance,
         ..Default::default()
     };
-    let v = restpose::verify::verify(model, &state, &tol)?;
+    let uni = restpose::verify::Unilaterals {
+        limits: a.limits,
+        friction: a.friction,
+        mu: a.mu,
+    };
+    let v = restpose::verify::verify_with_options(model, &state, &tol, &uni)?;
     if let Some(path) = &a.json {
         print::write_json(path, &serde_json::to_string_pretty(&v)?)?;
     }
@@ -59,6 +64,9 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
     }
     if v.passed {
         return Ok(0);
+    }
+    for f in &v.unilateral.failures {
+        eprintln!("{}: not a rest pose: {f}", a.file.display());
     }
     if let Some(m) = &v.max_imbalance {
         eprintln!(

@@ -13,6 +13,14 @@
 //!   (complementarity `g_k λ_k = 0` holds by construction: active rows have `g = 0`, inactive
 //!   ones `λ = 0`), or after `max_iterations` changes of `A` (reported as cycling).
 //!
+//! - a sticking contact with a radius (a sphere) is held at the material point that touched;
+//!   when the sphere has rolled so that another point touches at the stationary point, the
+//!   anchor moves to the touching point (and its projection on the ground) and the round is
+//!   solved again. At the end the friction force acts at the touching point, with no slip
+//!   there: the sphere sticks and may roll, as MuJoCo's condim-3 contact. Where no such rest
+//!   exists (a ball on a sloping plane rolls down) it gives up after `MAX_ROLLS` re-anchorings
+//!   and reports `unbounded`.
+//!
 //! Gaps are compared dimensionless: lengths divided by the characteristic length `L`, angles
 //! as they are; `tol = gap_tolerance`. Redundant active rows (a box flat on the ground has four
 //! supporting vertices for three degrees of freedom) are handled by the partition, which gives
@@ -242,6 +250,39 @@ pub(crate) fn touch_point(model: &Model, a: &Active, q: &DVector<f64>) -> Option
     }
 }
 
+/// Re-anchorings of rolling sticking contacts before the search gives up (module docs).
+const MAX_ROLLS: usize = 50;
+
+/// Moves the anchors of the sticking contacts with a radius to where they touch now (the
+/// material point at the bottom of the sphere, and its projection on the ground), when the
+/// shape rolled away from its anchor by more than the gap tolerance; returns whether any
+/// moved. At a rest pose where no anchor moves, the friction force acts at the touching point,
+/// as for a sphere that sticks and may roll (no slip at the contact point).
+pub(crate) fn reanchor(
+    model: &Model,
+    options: &Options,
+    active: &mut [Active],
+    q: &DVector<f64>,
+) -> bool {
+    let mut moved = false;
+    for a in active.iter_mut() {
+        let (Some(old), Unilateral::Contact { point, .. }) = (a.anchor, a.row) else {
+            continue;
+        };
+        if model.contact_points[point].radius == 0.0 {
+            continue;
+        }
+        let new = activate(model, options, a.row, q);
+        let Some(anchor) = new.anchor else { continue };
+        let shift = (anchor.body - old.body).norm();
+        if shift > options.gap_tolerance * model.length_scale {
+            a.anchor = Some(anchor);
+            moved = true;
+        }
+    }
+    moved
+}
+
 /// The active-set iteration from an assembled state (module docs).
 ///
 /// # Errors
@@ -268,6 +309,7 @@ pub(crate) fn solve(
         .map(|&u| activate(model, options, u, &state.q))
         .collect();
     let mut changes = active.len();
+    let mut rolls = 0;
     let mut iterations = 0;
     let mut counters = super::Diagnostics::default();
     loop {
@@ -304,6 +346,13 @@ pub(crate) fn solve(
                 active.remove(i);
                 changes += 1;
                 continue;
+            }
+            if reanchor(model, options, &mut active, &state.q) {
+                rolls += 1;
+                if rolls <= MAX_ROLLS {
+                    continue;
+                }
+                report.termination = super::Termination::Unbounded;
             }
         }
         if cycling {

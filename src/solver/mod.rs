@@ -139,8 +139,16 @@ fn stability(
 /// Stability verdict at a state that is feasible and balanced (`None` with no degree of
 /// freedom or where the energy is undefined).
 pub(crate) fn stability_at(model: &Model, state: &State) -> Option<Stability> {
+    stability_on(model, state, &[])
+}
+
+/// [`stability_at`] on the tangent space of the equality rows and the inequalities `active`
+/// (the stops and contacts that carry a force).
+pub(crate) fn stability_on(model: &Model, state: &State, active: &[Active]) -> Option<Stability> {
     let q = &state.q;
-    let sys_cons = Constraints::new(model, &lock_values(model)).on_branches(state.branches.clone());
+    let sys_cons = Constraints::new(model, &lock_values(model))
+        .with_active(model, active)
+        .on_branches(state.branches.clone());
     let mut sys = System::new(model, sys_cons);
     let part = sys.partition(q);
     if part.independent.is_empty() {

@@ -25,9 +25,11 @@
 mod check;
 mod pose;
 mod reduced;
+mod unilateral;
 
 pub use check::{check, ModelCheck};
 pub use pose::{parse_pose, pose_state, read_pose};
+pub use unilateral::{UnilateralCheck, Unilaterals};
 
 use crate::constraints::{joint, BlockKind, Constraints};
 use crate::error::{Error, Result};
@@ -128,6 +130,9 @@ pub struct Verification {
     pub force_scale: f64,
     /// The effort tolerance applied: `force + relative · force_scale` \[N m or N\].
     pub effort_tolerance: f64,
+    /// Stops and contacts at the pose (module `unilateral`), flattened into the JSON.
+    #[serde(flatten)]
+    pub unilateral: UnilateralCheck,
 }
 
 /// Whether `model` is verified on the sparse path (module `reduced`).
@@ -266,7 +271,21 @@ pub fn balance(model: &Model, state: &State) -> Result<Balance> {
 /// # Ok::<(), restpose::Error>(())
 /// ```
 pub fn verify(model: &Model, state: &State, tol: &Tolerances) -> Result<Verification> {
-    verify_on(model, state, tol, sparse_path(model))
+    verify_with_options(model, state, tol, &Unilaterals::default())
+}
+
+/// [`verify`] with stops and contacts as `uni` says: they carry the forces (module `unilateral`).
+/// # Errors
+/// As [`verify`]; [`Error::Model`] for a pose touching them on too large a model.
+pub fn verify_with_options(
+    model: &Model,
+    state: &State,
+    tol: &Tolerances,
+    uni: &Unilaterals,
+) -> Result<Verification> {
+    let sparse =
+        sparse_path(model) && !unilateral::dense_needed(model, state, uni, tol.constraint)?;
+    verify_on(model, state, tol, uni, sparse)
 }
 
 /// Closure errors per joint from the rows `cons` and their values `phi`.
@@ -330,13 +349,19 @@ fn tree_coordinates(
 /// On the sparse path the stability verdict (a Lanczos run through KKT factors, the largest
 /// cost at 10,000 links) is computed on a second thread while the balance is checked, and kept
 /// only when the pose passes; both only read the model and the state.
-fn verify_on(model: &Model, state: &State, tol: &Tolerances, sparse: bool) -> Result<Verification> {
+fn verify_on(
+    model: &Model,
+    state: &State,
+    tol: &Tolerances,
+    uni: &Unilaterals,
+    sparse: bool,
+) -> Result<Verification> {
     if !sparse {
-        return verify_with(model, state, tol, false, None);
+        return verify_with(model, state, tol, uni, false, None);
     }
     std::thread::scope(|s| {
         let stability = s.spawn(|| crate::solver::stability_at(model, state));
-        verify_with(model, state, tol, true, Some(stability))
+        verify_with(model, state, tol, uni, true, Some(stability))
     })
 }
 
@@ -346,10 +371,12 @@ fn verify_with(
     model: &Model,
     state: &State,
     tol: &Tolerances,
+    uni: &Unilaterals,
     sparse: bool,
     stability: Option<std::thread::ScopedJoinHandle<'_, Option<Stability>>>,
 ) -> Result<Verification> {
     let coords = tree_coordinates(model, state);
+    let (mut contact, mut strong) = (UnilateralCheck::default(), Vec::new());
     let (phi, energy, projected_gradient, force_scale, closure, efforts, unassigned) = if sparse {
         let locks = crate::solver::lock_values(model);
         let r = reduced::reduced(model, state, &locks, locks.len())?;
@@ -367,9 +394,16 @@ fn verify_with(
             unassigned,
         )
     } else {
-        let p = project(model, state)?;
+        let mut p = project(model, state)?;
         let n = state.q.len();
         let closure = closures(model, &p.cons, &p.phi, tol.constraint);
+        let raw_gradient = (p.null.transpose() * &p.grad_s).amax();
+        let force_scale = p.grad_s.amax();
+        // The stops and contacts take their share of the load first (module `unilateral`).
+        let tau = tol.force + tol.relative * force_scale;
+        let (c, carried, s) = unilateral::check(model, state, uni, &p, tol.constraint, tau);
+        (contact, strong) = (c, s);
+        p.grad_s -= carried;
         // The (scaled) gradients of the scalar coordinates.
         let b_cols: Vec<DVector<f64>> = coords
             .iter()
@@ -399,8 +433,8 @@ fn verify_with(
         (
             p.phi,
             p.energy,
-            rhs.amax(),
-            p.grad_s.amax(),
+            raw_gradient,
+            force_scale,
             closure,
             efforts,
             unassigned,
@@ -421,11 +455,13 @@ fn verify_with(
         .cloned();
     let constraint_residual = phi.amax();
     let effort_tolerance = tol.force + tol.relative * force_scale;
-    let passed = constraint_residual <= tol.constraint
+    let balanced = constraint_residual <= tol.constraint
         && imbalance.iter().all(|i| i.effort.abs() <= effort_tolerance)
         && unassigned <= effort_tolerance;
+    let passed = contact.settle(tol.constraint, balanced) && balanced;
     let stability = match (passed, stability) {
         (false, _) => None,
+        (true, _) if !strong.is_empty() => crate::solver::stability_on(model, state, &strong),
         // A panic there is re-raised here, as if the verdict had been computed on this thread.
         (true, Some(handle)) => handle
             .join()
@@ -445,6 +481,7 @@ fn verify_with(
         tolerances: *tol,
         force_scale,
         effort_tolerance,
+        unilateral: contact,
     })
 }
 
@@ -465,6 +502,10 @@ mod tests {
     //! The sparse path against the dense path on the same poses.
     use super::*;
     use crate::urdf::{load_str, ImportOptions};
+
+    fn verify_on(m: &Model, s: &State, tol: &Tolerances, sparse: bool) -> Result<Verification> {
+        super::verify_on(m, s, tol, &Unilaterals::default(), sparse)
+    }
 
     fn load(text: &str) -> Model {
         load_str(text, "m.urdf", &ImportOptions::default())

@@ -143,42 +143,69 @@ fn a_tilted_box_falls_and_rests_flat_on_a_face() {
     assert_eq!(r.stability.unwrap().verdict, Verdict::Neutral);
 }
 
-/// A sphere on a tilted frictionless plane slides away (unbounded); with sticking friction it
-/// rests, needing `tan(slope)` of friction, and is reported slipping when `mu` is below that.
-#[test]
-fn friction_holds_a_ball_on_a_slope_and_says_when_it_cannot() {
-    let slope = 0.3f64;
-    let text = format!(
-        r#"<robot name="ball" xmlns:mech="urn:urdf-mech:1">
-  <link name="ball">
-    <inertial><mass value="1"/><inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><geometry><sphere radius="0.1"/></geometry></collision>
+/// A body on a plane sloping by `slope` about y: a uniform ball of radius 0.1 m
+/// (`box = false`) or the 0.4 × 0.3 × 0.2 m box.
+fn on_slope(slope: f64, box_: bool) -> restpose::Model {
+    let shape = if box_ {
+        r#"<box size="0.4 0.3 0.2"/>"#
+    } else {
+        r#"<sphere radius="0.1"/>"#
+    };
+    floating(&format!(
+        r#"<robot name="slope" xmlns:mech="urn:urdf-mech:1">
+  <link name="body">
+    <inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry>{shape}</geometry></collision>
   </link>
   <mech:ground normal="{} 0 {}" xyz="0 0 -0.1"/>
 </robot>"#,
         slope.sin(),
         slope.cos()
-    );
-    let m = floating(&text);
+    ))
+}
+
+/// A box on a frictionless slope slides away (unbounded). With sticking friction it rests
+/// on its face: the ground's force balances the weight, `Σ f_n = m g cos(slope)` and
+/// `|Σ f_t| = m g sin(slope)` (closed form); with `mu` below `tan(slope)` a contact slips. A
+/// uniform ball does not rest even with sticking friction: it rolls (no slip at the touching
+/// point), and the search gives up.
+#[test]
+fn friction_holds_a_box_on_a_slope_and_says_when_it_cannot() {
+    let slope = 0.3f64;
+    let m = on_slope(slope, true);
     let stick = Options {
         friction: Friction::Stick,
         ..Default::default()
     };
-    let (_, r) = restpose::solve(&m, &stick).unwrap();
-    assert!(r.converged(), "{:?}", r.termination);
-    assert_eq!(r.contacts.len(), 1);
-    let c = &r.contacts[0];
-    assert_abs_diff_eq!(c.normal_force, 9.81 * slope.cos(), epsilon = 1e-8);
-    assert_abs_diff_eq!(c.required_friction, slope.tan(), epsilon = 1e-8);
-    assert_eq!(c.state, ContactState::Sticking);
+    let (s, rep) = restpose::solve(&m, &stick).unwrap();
+    assert!(rep.converged(), "{:?}", rep.termination);
+    assert!(rep.contacts.len() >= 3, "{:?}", rep.contacts);
+    let fnorm: f64 = rep.contacts.iter().map(|c| c.normal_force).sum();
+    let ft: Vector3<f64> = rep
+        .contacts
+        .iter()
+        .map(|c| Vector3::from(c.tangential_force))
+        .sum();
+    assert_abs_diff_eq!(fnorm, 9.81 * slope.cos(), epsilon = 1e-8);
+    assert_abs_diff_eq!(ft.norm(), 9.81 * slope.sin(), epsilon = 1e-8);
+    assert!(rep
+        .contacts
+        .iter()
+        .all(|c| c.state == ContactState::Sticking));
+    assert_verified_contacts(&m, &s, Friction::Stick);
     let weak = Options {
         mu: Some(0.2),
         ..stick.clone()
     };
-    let (_, r) = restpose::solve(&m, &weak).unwrap();
-    assert_eq!(r.contacts[0].state, ContactState::Slipping);
-    let (_, r) = restpose::solve(&m, &Options::default()).unwrap();
-    assert!(!r.converged());
+    let (_, rep) = restpose::solve(&m, &weak).unwrap();
+    assert!(rep
+        .contacts
+        .iter()
+        .any(|c| c.state == ContactState::Slipping));
+    let (_, rep) = restpose::solve(&m, &Options::default()).unwrap();
+    assert!(!rep.converged());
+    let (_, rep) = restpose::solve(&on_slope(slope, false), &stick).unwrap();
+    assert!(!rep.converged(), "{:?}", rep.termination);
 }
 
 /// The Solo-12 quadruped (published file, foot spheres and joint springs added) standing on
@@ -198,11 +225,19 @@ fn solo12_stands_like_the_independent_rigid_contact_solution() {
     let m = load_file(format!("{dir}/robots/solo12/solo12_ground.urdf"), &opts)
         .unwrap()
         .model;
-    for (run, key, friction) in [
-        ("none", "rigid", Friction::None),
-        ("stick", "rigid_material", Friction::Stick),
+    // Sticking: restpose holds a foot at the material point that touched, then moves the
+    // anchor to the point touching at the rest pose until it stays (module docs of
+    // `active_set`): its balance is the rolling model's (no slip at the touching point), and
+    // its path the material-point model's up to the last re-anchoring, so its energy is
+    // compared with the material-point reference and its pose and forces with the rolling one
+    // (the two references differ by up to 2.8e-6 rad: the rest pose of a sticking foot depends
+    // on the path by r (ψ − sin ψ)).
+    for (run, key, energy_key, friction) in [
+        ("none", "rigid", "rigid", Friction::None),
+        ("stick", "rigid_rolling", "rigid_material", Friction::Stick),
     ] {
         let rigid = &reference["runs"][run][key];
+        let energy = &reference["runs"][run][energy_key];
         let options = Options {
             friction,
             ..Default::default()
@@ -211,7 +246,7 @@ fn solo12_stands_like_the_independent_rigid_contact_solution() {
         assert!(r.converged(), "{run}: {:?}", r.termination);
         assert_abs_diff_eq!(
             r.energy.total,
-            rigid["potential_energy"].as_f64().unwrap(),
+            energy["potential_energy"].as_f64().unwrap(),
             epsilon = 1e-7
         );
         for (joint, value) in rigid["joints"].as_object().unwrap() {
@@ -244,5 +279,224 @@ fn solo12_stands_like_the_independent_rigid_contact_solution() {
             rigid["base"]["height"].as_f64().unwrap(),
             epsilon = 1e-6
         );
+    }
+}
+
+// ---- verify: poses resting on stops and grounds -----------------------------------------
+
+use restpose::verify::{verify_with_options, Tolerances, Unilaterals};
+
+/// Asserts that `verify` accepts `s` (with `friction`).
+fn assert_verified_contacts(m: &restpose::Model, s: &State, friction: Friction) {
+    let v = check(m, s, friction);
+    assert!(v.passed, "{}: {v:?}", m.name);
+}
+
+fn check(m: &restpose::Model, s: &State, friction: Friction) -> restpose::verify::Verification {
+    let uni = Unilaterals {
+        friction,
+        ..Default::default()
+    };
+    verify_with_options(m, s, &Tolerances::default(), &uni).unwrap()
+}
+
+/// analyze's answer on a stop passes verify, which finds the stop's effort itself (closed
+/// form `m g cos θ + k θ`); with limits ignored the same pose needs that effort from the joint
+/// and fails.
+#[test]
+fn verify_accepts_a_pose_on_a_stop_and_finds_its_effort() {
+    let (k, lower) = (5.0, -0.5);
+    let m = pendulum(k, lower, 1.0, 0.3);
+    let (s, _) = solve(&m);
+    let v = check(&m, &s, Friction::None);
+    assert!(v.passed, "{v:?}");
+    assert_eq!(v.unilateral.active_limits.len(), 1);
+    let l = &v.unilateral.active_limits[0];
+    assert_eq!(l.bound, "lower");
+    assert_abs_diff_eq!(l.effort, MG * lower.cos() + k * lower, epsilon = 1e-8);
+    assert!(v.unilateral.failures.is_empty() && v.unilateral.penetration == 0.0);
+    assert!(v.unilateral.complementarity <= 1e-8 * l.effort.abs());
+    let ignore = Unilaterals {
+        limits: Limits::Ignore,
+        ..Default::default()
+    };
+    let v = verify_with_options(&m, &s, &Tolerances::default(), &ignore).unwrap();
+    assert!(!v.passed);
+    let worst = v.max_imbalance.unwrap();
+    assert_eq!(worst.joint, "pivot");
+    assert_abs_diff_eq!(worst.effort, MG * lower.cos() + k * lower, epsilon = 1e-8);
+}
+
+/// A bar on its lower stop whose spring lifts it off: the stop would have to pull, so the pose
+/// fails, naming the stop and the pulling effort `m g cos θ + k θ < 0`; a pose beyond the stop
+/// fails as well.
+#[test]
+fn verify_refuses_a_stop_that_would_have_to_pull_and_a_pose_beyond_a_stop() {
+    let (k, lower) = (20.0, -1.2);
+    let m = pendulum(k, lower, 1.0, lower);
+    let pulling = MG * lower.cos() + k * lower;
+    assert!(pulling < -1.0);
+    let on_stop = State::from_joint_values(&m, &[("pivot".to_string(), vec![lower])].into());
+    let v = check(&m, &on_stop, Friction::None);
+    assert!(!v.passed);
+    assert_eq!(
+        v.unilateral.failures.len(),
+        1,
+        "{:?}",
+        v.unilateral.failures
+    );
+    assert!(v.unilateral.failures[0].contains("pivot.lower_limit"));
+    assert!(v.unilateral.failures[0].contains(&format!("{pulling:.3e}")));
+    // The stop carries nothing; the joint needs the whole effort.
+    assert_abs_diff_eq!(v.unilateral.active_limits[0].effort, 0.0, epsilon = 1e-12);
+    assert_abs_diff_eq!(v.max_imbalance.unwrap().effort, pulling, epsilon = 1e-8);
+    let beyond = State::from_joint_values(&m, &[("pivot".to_string(), vec![lower - 0.01])].into());
+    let v = check(&m, &beyond, Friction::None);
+    assert!(!v.passed);
+    assert_abs_diff_eq!(v.unilateral.penetration, 0.01, epsilon = 1e-12);
+    assert!(v
+        .unilateral
+        .failures
+        .iter()
+        .any(|f| f.contains("beyond its stop")));
+}
+
+/// The box flat on the ground passes with `m g / 4` on each vertex (the minimum-norm
+/// distribution); pushed 1 mm into the ground it fails (penetration), lifted 1 mm it fails
+/// (nothing holds it: the floating base's unassigned force is its weight).
+#[test]
+fn verify_accepts_the_flat_box_and_refuses_it_in_or_above_the_ground() {
+    let m = floating(BOX);
+    let mut q = DVector::zeros(7);
+    q[2] = 0.1;
+    q[3] = 1.0;
+    let flat = State {
+        q,
+        branches: Default::default(),
+    };
+    let v = check(&m, &flat, Friction::None);
+    assert!(v.passed, "{v:?}");
+    assert_eq!(v.unilateral.contacts.len(), 4);
+    for c in &v.unilateral.contacts {
+        assert_abs_diff_eq!(c.normal_force, MG / 4.0, epsilon = 1e-9);
+    }
+    assert_eq!(v.stability.unwrap().verdict, Verdict::Neutral);
+    let mut sunk = flat.clone();
+    sunk.q[2] -= 1e-3;
+    let v = check(&m, &sunk, Friction::None);
+    assert!(!v.passed);
+    assert_abs_diff_eq!(v.unilateral.penetration, 1e-3, epsilon = 1e-12);
+    assert_eq!(
+        v.unilateral.failures.len(),
+        4,
+        "{:?}",
+        v.unilateral.failures
+    );
+    let mut lifted = flat.clone();
+    lifted.q[2] += 1e-3;
+    let v = check(&m, &lifted, Friction::None);
+    assert!(!v.passed && v.unilateral.contacts.is_empty());
+    assert!(v.unassigned > 0.1 * MG, "{}", v.unassigned);
+    // analyze's own answer from a tilted start passes too.
+    let (s, _) = restpose::solve_from(&m, flat, &Options::default()).unwrap();
+    assert!(check(&m, &s, Friction::None).passed);
+}
+
+/// The box on the slope: analyze's sticking answer passes verify with friction, whose
+/// forces balance the weight (closed form); frictionless the same pose fails (it would slide),
+/// and with `mu` below `tan(slope)` it fails as slipping. A uniform ball resting where the
+/// box's face is fails: it would roll.
+#[test]
+fn verify_checks_friction_on_the_slope() {
+    let slope = 0.3f64;
+    let m = on_slope(slope, true);
+    let stick = Options {
+        friction: Friction::Stick,
+        ..Default::default()
+    };
+    let (s, _) = restpose::solve(&m, &stick).unwrap();
+    let v = check(&m, &s, Friction::Stick);
+    assert!(v.passed, "{v:?}");
+    let fnorm: f64 = v.unilateral.contacts.iter().map(|c| c.normal_force).sum();
+    let ft: Vector3<f64> = v
+        .unilateral
+        .contacts
+        .iter()
+        .map(|c| Vector3::from(c.tangential_force))
+        .sum();
+    assert_abs_diff_eq!(fnorm, 9.81 * slope.cos(), epsilon = 1e-8);
+    assert_abs_diff_eq!(ft.norm(), 9.81 * slope.sin(), epsilon = 1e-8);
+    assert!(!check(&m, &s, Friction::None).passed);
+    let weak = Unilaterals {
+        friction: Friction::Stick,
+        mu: Some(0.2),
+        ..Default::default()
+    };
+    let v = verify_with_options(&m, &s, &Tolerances::default(), &weak).unwrap();
+    assert!(!v.passed);
+    assert!(v
+        .unilateral
+        .contacts
+        .iter()
+        .any(|c| c.state == ContactState::Slipping));
+    assert!(v.unilateral.failures[0].contains("friction coefficient"));
+    // A ball touching the slope with its centre 0.1 m above it: the friction at the touching
+    // point cannot stop it rolling.
+    let ball = on_slope(slope, false);
+    let mut q = DVector::zeros(7);
+    q[3] = 1.0;
+    let n = Vector3::new(slope.sin(), 0.0, slope.cos());
+    let c = Vector3::new(0.0, 0.0, -0.1) + n * 0.1;
+    q[0] = c.x;
+    q[2] = c.z;
+    let v = check(
+        &ball,
+        &State {
+            q,
+            branches: Default::default(),
+        },
+        Friction::Stick,
+    );
+    assert_eq!(v.unilateral.contacts.len(), 1);
+    assert!(!v.passed && v.unassigned > 0.01, "{v:?}");
+}
+
+/// analyze's Solo-12 answers (frictionless and sticking) pass verify with the same friction
+/// setting; the frictionless verify refuses the sticking pose (its feet need friction), and a
+/// pose with the base pushed 2 mm down (feet into the ground) fails.
+#[test]
+fn verify_accepts_solo12_standing_and_refuses_it_sunk() {
+    let dir = env!("CARGO_MANIFEST_DIR");
+    let opts = ImportOptions {
+        floating_base: true,
+        ..Default::default()
+    };
+    let m = load_file(format!("{dir}/robots/solo12/solo12_ground.urdf"), &opts)
+        .unwrap()
+        .model;
+    for friction in [Friction::None, Friction::Stick] {
+        let options = Options {
+            friction,
+            ..Default::default()
+        };
+        let (s, r) = restpose::solve(&m, &options).unwrap();
+        let v = check(&m, &s, friction);
+        assert!(v.passed, "{friction:?}: {v:?}");
+        assert_eq!(v.unilateral.contacts.len(), 4);
+        for c in &v.unilateral.contacts {
+            let a = r.contacts.iter().find(|a| a.link == c.link).unwrap();
+            assert_abs_diff_eq!(c.normal_force, a.normal_force, epsilon = 1e-6);
+            assert_abs_diff_eq!(c.required_friction, a.required_friction, epsilon = 1e-6);
+        }
+        if friction == Friction::Stick {
+            assert!(!check(&m, &s, Friction::None).passed);
+        }
+        let mut sunk = s.clone();
+        for b in 0..m.bodies.len() {
+            sunk.q[7 * b + 2] -= 2e-3;
+        }
+        let v = check(&m, &sunk, friction);
+        assert!(!v.passed);
+        assert_abs_diff_eq!(v.unilateral.penetration, 2e-3, epsilon = 1e-9);
     }
 }

@@ -24,9 +24,9 @@
 //! Gaps are compared dimensionless: lengths divided by the characteristic length `L`, angles
 //! as they are; `tol = gap_tolerance`. Redundant active rows (a box flat on the ground has four
 //! supporting vertices for three degrees of freedom) are handled by the partition, which gives
-//! them no multiplier: the force distribution reported is then one admissible distribution of a
-//! statically indeterminate support. Stability is judged on the tangent space of all active
-//! rows.
+//! them no multiplier; the force distribution reported is then the least-norm one over the
+//! stops and contacts (module `distribution`: a box flat on four vertices gets `m g / 4` on
+//! each). Stability is judged on the tangent space of all active rows.
 //!
 //! ## References
 //! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §16.5
@@ -193,17 +193,11 @@ pub(crate) fn force_scale(model: &Model) -> f64 {
 }
 
 /// Multipliers of the rows of each active inequality (`g` first, then the tangential rows),
-/// from the multipliers `mu` of the independent rows `part.rows` of `cons` (redundant rows:
-/// 0).
+/// from the multipliers `full` of every row of `cons`.
 pub(crate) fn active_multipliers(
     cons: &crate::constraints::Constraints,
-    part: &Partition,
-    mu: &DVector<f64>,
+    full: &DVector<f64>,
 ) -> Vec<(Active, Vec<f64>)> {
-    let mut full = vec![0.0; cons.len()];
-    for (k, &row) in part.rows.iter().enumerate() {
-        full[row] = mu[k];
-    }
     cons.blocks
         .iter()
         .filter_map(|b| match &b.kind {

@@ -16,6 +16,7 @@
 
 mod active_set;
 mod assemble;
+mod distribution;
 mod eigen;
 mod minimize;
 mod options;
@@ -39,6 +40,7 @@ use crate::error::{Error, Result};
 use crate::kinematics::Branches;
 use crate::model::{JointId, Model};
 use crate::state::{JointValues, State};
+use nalgebra::DVector;
 use system::System;
 
 /// Initial guess: forward kinematics with every joint at its `mech:initial` / `--initial`
@@ -348,8 +350,16 @@ pub(crate) fn solve_round(
         diagnostics.eigenvalues_by = if eig.exact { "exact" } else { "lanczos" }.into();
         stability(&sys, &out.q, &out.part, &out.eval, &eig)
     });
-    let reactions = reactions::reactions(&sys, &out.q, &out.part, &out.eval);
-    let multipliers = active_set::active_multipliers(&sys.problem.cons, &out.part, &out.eval.mu);
+    let mut mu = DVector::zeros(sys.problem.cons.len());
+    for (k, &row) in out.part.rows.iter().enumerate() {
+        mu[row] = out.eval.mu[k];
+    }
+    if !active.is_empty() && !out.part.redundant.is_empty() {
+        let threshold = options.force_tolerance * active_set::force_scale(model);
+        distribution::spread(model, &sys.problem.cons, &out.q, &mut mu, threshold);
+    }
+    let reactions = reactions::reactions(&sys, &out.q, &mu);
+    let multipliers = active_set::active_multipliers(&sys.problem.cons, &mu);
     let blocked = out.blocked;
     diagnostics.timings.stability = stability_started.elapsed().as_secs_f64();
     let report = Report {

@@ -152,7 +152,7 @@ pub(crate) struct GenerateArgs {
     /// Family.
     #[arg(value_enum)]
     pub(crate) family: restpose::generate::Family,
-    /// Number of links (chains) or loops (ladder), 1 to 1,000,000.
+    /// Number of links (chains, rope) or loops (ladder), 1 to 1,000,000.
     #[arg(long, default_value_t = 20, value_parser = parse::generate_size)]
     pub(crate) size: usize,
 }

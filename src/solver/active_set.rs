@@ -11,7 +11,8 @@
 //!   `−force_tolerance · F` (`F` the weight and loads of the mechanism) leaves `A`;
 //! - it stops when every `λ_k ≥ −force_tolerance · F` and every `g_k ≥ −tol`
 //!   (complementarity `g_k λ_k = 0` holds by construction: active rows have `g = 0`, inactive
-//!   ones `λ = 0`), or after `max_iterations` changes of `A` (reported as cycling).
+//!   ones `λ = 0`), or after `max_iterations` changes of `A` after the start (reported as
+//!   cycling).
 //!
 //! - a sticking contact with a radius (a sphere) is held at the material point that touched;
 //!   when the sphere has rolled so that another point touches at the stationary point, the
@@ -302,7 +303,10 @@ pub(crate) fn solve(
         })
         .map(|&u| activate(model, options, u, &state.q))
         .collect();
+    // The inequalities active from the start count as changes in the report, not towards the
+    // cycling guard (a rope lying on the ground starts with hundreds).
     let mut changes = active.len();
+    let initial = changes;
     let mut rolls = 0;
     let mut iterations = 0;
     let mut counters = super::Diagnostics::default();
@@ -327,7 +331,7 @@ pub(crate) fn solve(
         counters.add_counts(&round.report.diagnostics);
         state = round.state;
         let mut report = round.report;
-        let cycling = changes >= options.max_iterations;
+        let cycling = changes - initial >= options.max_iterations;
         if let (Some(hit), false) = (&round.blocked, cycling) {
             for &k in hit {
                 active.push(activate(model, options, guard.inactive[k], &state.q));

@@ -503,3 +503,153 @@ fn verify_accepts_solo12_standing_and_refuses_it_sunk() {
         assert_abs_diff_eq!(v.unilateral.penetration, 2e-3, epsilon = 1e-9);
     }
 }
+
+// ---- a spring-loaded arm folding onto the floor, a rope lying on the ground --------------
+
+/// A two-link arm on a hinge 0.5 m above the floor, both joints about y with springs
+/// (`k₁ = 5`, `k₂ = 3` N m/rad, reference straight along +x), links 0.4 m and 1 kg with their
+/// centres of mass at mid-length, a sphere of radius 0.02 m at the tip. A turn `θ` about y
+/// takes +x to `(cos θ, 0, −sin θ)`.
+const ARM: &str = r#"<robot name="arm" xmlns:mech="urn:urdf-mech:1">
+  <link name="world"/>
+  <link name="upper"><inertial><origin xyz="0.2 0 0"/><mass value="1"/>
+    <inertia ixx="1e-4" ixy="0" ixz="0" iyy="0.0134" iyz="0" izz="0.0134"/></inertial></link>
+  <link name="fore"><inertial><origin xyz="0.2 0 0"/><mass value="1"/>
+    <inertia ixx="1e-4" ixy="0" ixz="0" iyy="0.0134" iyz="0" izz="0.0134"/></inertial>
+    <collision><origin xyz="0.4 0 0"/><geometry><sphere radius="0.02"/></geometry></collision></link>
+  <joint name="shoulder" type="continuous"><parent link="world"/><child link="upper"/>
+    <origin xyz="0 0 0.5"/><axis xyz="0 1 0"/></joint>
+  <joint name="elbow" type="continuous"><parent link="upper"/><child link="fore"/>
+    <origin xyz="0.4 0 0"/><axis xyz="0 1 0"/></joint>
+  <mech:joint_spring joint="shoulder" stiffness="5"/>
+  <mech:joint_spring joint="elbow" stiffness="3"/>
+  <mech:initial joint="shoulder" value="0.3"/>
+  <mech:initial joint="elbow" value="0.3"/>
+  <mech:ground/>
+</robot>"#;
+
+/// The arm's energy in joint coordinates, and its tip height.
+fn arm_energy(t1: f64, t2: f64) -> (f64, f64) {
+    let (h, l, g) = (0.5, 0.4, 9.81);
+    let z1 = h - 0.5 * l * t1.sin();
+    let z2 = h - l * t1.sin() - 0.5 * l * (t1 + t2).sin();
+    let tip = h - l * t1.sin() - l * (t1 + t2).sin();
+    (
+        g * (z1 + z2) + 0.5 * 5.0 * t1 * t1 + 0.5 * 3.0 * t2 * t2,
+        tip,
+    )
+}
+
+/// Gravity folds the arm until its tip rests on the floor. Independent answer: on the contact
+/// (`tip = 0.02`) the elbow angle is a function of the shoulder angle,
+/// `θ₁ + θ₂ = asin((0.5 − 0.4 sin θ₁ − 0.02)/0.4)` (the branch with the forearm pointing down),
+/// and the energy is minimized over `θ₁` by golden-section search; the free minimum would put
+/// the tip through the floor, so the contact is active.
+#[test]
+fn a_spring_loaded_arm_folds_onto_the_floor() {
+    let m = model_from(ARM);
+    let (s, r) = solve(&m);
+    // Without the floor: Newton on the joint-space gradient from the same start.
+    let free = {
+        let (mut t1, mut t2) = (0.3f64, 0.3f64);
+        for _ in 0..100 {
+            let h = 1e-5;
+            let v = |a: f64, b: f64| arm_energy(a, b).0;
+            let g1 = (v(t1 + h, t2) - v(t1 - h, t2)) / (2.0 * h);
+            let g2 = (v(t1, t2 + h) - v(t1, t2 - h)) / (2.0 * h);
+            t1 -= 0.02 * g1;
+            t2 -= 0.02 * g2;
+        }
+        (t1, t2)
+    };
+    assert!(
+        arm_energy(free.0, free.1).1 < 0.0,
+        "the free arm would go through the floor"
+    );
+    // On the floor, both branches of the asin are scanned and the lower energy kept.
+    let branch = |t1: f64, first: bool| {
+        let s12 = ((0.5 - 0.4 * t1.sin() - 0.02) / 0.4).clamp(-1.0, 1.0);
+        let t12 = if first {
+            s12.asin()
+        } else {
+            std::f64::consts::PI - s12.asin()
+        };
+        (t12 - t1, arm_energy(t1, t12 - t1).0)
+    };
+    let mut best = (f64::INFINITY, 0.0, 0.0);
+    for first in [true, false] {
+        let (mut a, mut b) = (-0.5f64, 1.5f64);
+        // Coarse scan, then golden section around the best sample.
+        let mut t = a;
+        let mut arg = a;
+        let mut low = f64::INFINITY;
+        while t <= b {
+            let v = branch(t, first).1;
+            if v < low {
+                low = v;
+                arg = t;
+            }
+            t += 1e-3;
+        }
+        a = arg - 2e-3;
+        b = arg + 2e-3;
+        let gr = (5f64.sqrt() - 1.0) / 2.0;
+        for _ in 0..200 {
+            let c = b - gr * (b - a);
+            let d = a + gr * (b - a);
+            if branch(c, first).1 < branch(d, first).1 {
+                b = d;
+            } else {
+                a = c;
+            }
+        }
+        let t1 = 0.5 * (a + b);
+        let (t2, v) = branch(t1, first);
+        if v < best.0 {
+            best = (v, t1, t2);
+        }
+    }
+    let (v, t1, t2) = best;
+    assert_abs_diff_eq!(r.energy.total, v, epsilon = 1e-9);
+    assert_abs_diff_eq!(s.joint(&m, "shoulder").unwrap()[0], t1, epsilon = 1e-6);
+    assert_abs_diff_eq!(s.joint(&m, "elbow").unwrap()[0], t2, epsilon = 1e-6);
+    assert_eq!(r.contacts.len(), 1);
+    assert!(r.contacts[0].normal_force > 0.1, "{:?}", r.contacts);
+    assert_verified_contacts(&m, &s, Friction::None);
+}
+
+/// The generated 100-link rope hangs from the world onto the ground: converges; every contact
+/// reported touches (`|g| ≤ 1e-9` m) and pushes; `verify` finds no penetration and balances it
+/// with non-negative forces; the energy equals the one written here in joint coordinates; the
+/// vertical forces balance the weight (anchor reaction plus normal forces = `n m g`).
+#[test]
+fn a_rope_lies_partly_on_the_ground() {
+    let n = 100;
+    let m = model_from(&restpose::generate::rope(n));
+    let (s, r) = solve(&m);
+    assert!(r.contacts.len() > n / 2, "{} contacts", r.contacts.len());
+    for c in &r.contacts {
+        assert!(c.gap.abs() <= 1e-9 && c.normal_force >= 0.0, "{c:?}");
+    }
+    let v = check(&m, &s, Friction::None);
+    assert!(v.passed, "{:?}", v.unilateral.failures);
+    assert_eq!(v.unilateral.penetration, 0.0);
+    // Joint-space energy: link i leaves p_i along (cos φ_i, 0, −sin φ_i), φ_i = Σ_{j ≤ i} θ_j.
+    let (l, mass, g, k) = (0.05, 0.05, 9.81, 2.0);
+    let h = n.div_ceil(3) as f64 * l * 0.3f64.cos() + 0.01;
+    let (mut z, mut phi, mut energy) = (h, 0.0, 0.0);
+    for i in 0..n {
+        let th = s.joint(&m, &format!("joint{i}")).unwrap()[0];
+        phi += th;
+        energy += mass * g * (z - 0.5 * l * phi.sin()) + 0.5 * k * th * th;
+        z -= l * phi.sin();
+    }
+    assert_abs_diff_eq!(r.energy.total, energy, epsilon = 1e-9);
+    let anchor = r.reactions.iter().find(|(j, _)| j == "joint0").unwrap();
+    let normal: f64 = r.contacts.iter().map(|c| c.normal_force).sum();
+    assert_abs_diff_eq!(
+        anchor.1.force_world[2] + normal,
+        n as f64 * mass * g,
+        epsilon = 1e-8
+    );
+}

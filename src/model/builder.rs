@@ -91,6 +91,7 @@ impl ModelBuilder {
                 grounds: Vec::new(),
                 contact_points: Vec::new(),
                 length_scale: 1.0,
+                base_pose: None,
                 joint_names: HashMap::new(),
             },
             inertials: Vec::new(),

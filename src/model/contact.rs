@@ -156,6 +156,13 @@ impl ModelBuilder {
         self.contacts.push((link, touches, settings));
     }
 
+    /// Sets the start pose of the root link in the world, used when the base floats
+    /// (`mech:base`): the first guess of the floating base, which the joints' initial values
+    /// then extend to the whole tree.
+    pub fn set_base_pose(&mut self, pose: nalgebra::Isometry3<f64>) {
+        self.model.base_pose = Some(pose);
+    }
+
     /// The grounds added so far.
     pub fn grounds(&self) -> &[Ground] {
         &self.model.grounds

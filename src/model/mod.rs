@@ -59,6 +59,9 @@ pub struct Model {
     pub contact_points: Vec<ContactPoint>,
     /// Characteristic length of the mechanism \[m\], used to scale position coordinates.
     pub length_scale: f64,
+    /// Start pose of the root link in the world when the base floats (`mech:base`; `None`:
+    /// the identity).
+    pub base_pose: Option<nalgebra::Isometry3<f64>>,
     /// Joint ids by name, built once by [`Model::index_names`].
     pub(crate) joint_names: HashMap<String, JointId>,
 }

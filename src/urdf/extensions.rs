@@ -307,6 +307,10 @@ pub(super) fn read(
                     .ok_or_else(|| src.error(n, format!("{what} needs `value`")))?;
                 b.model.add_effort(Effort { joint, dof, value });
             }
+            "base" => {
+                let pose = src.frame(Some(n))?;
+                b.model.set_base_pose(pose);
+            }
             "ground" => {
                 let name = n.attribute("name").unwrap_or("floor");
                 let origin = src.vec3_or(n, "xyz", Vector3::zeros())?;
@@ -396,6 +400,9 @@ pub(super) fn read(
     }
     if !b.gravity_set {
         b.model.set_gravity(options.gravity);
+    }
+    if let Some(pose) = options.base_pose {
+        b.model.set_base_pose(pose);
     }
     let default = Ground::default();
     if options.ground

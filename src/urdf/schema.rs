@@ -147,6 +147,11 @@ const ELEMENTS: &[Element] = &[
         children: &[],
     },
     Element {
+        name: "base",
+        attributes: FRAME,
+        children: &[],
+    },
+    Element {
         name: "contact",
         attributes: &["link", "enabled", "friction", "mu"],
         children: &[],

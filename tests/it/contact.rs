@@ -653,3 +653,104 @@ fn a_rope_lies_partly_on_the_ground() {
         epsilon = 1e-8
     );
 }
+
+// ---- the start pose of a floating base ---------------------------------------------------
+
+/// `<mech:base xyz rpy/>` starts the floating box 0.5 m up, turned 90° about x: it falls onto
+/// its 0.4 × 0.2 m face (`V = m g · 0.15`, closed form). From the default start (at the origin,
+/// half in the ground) it rests on its largest face (`V = m g · 0.1`). The importer option
+/// (the CLI's `--base-xyz` / `--base-rpy`) overrides the file.
+#[test]
+fn a_floating_base_starts_at_its_base_pose() {
+    let text = BOX.replace(
+        "<mech:ground/>",
+        r#"<mech:ground/><mech:base xyz="0 0 0.5" rpy="1.5707963267948966 0 0"/>"#,
+    );
+    let m = floating(&text);
+    let start = restpose::solver::initial_state(&m);
+    let pose = start.link_pose(&m, "box").unwrap();
+    assert_abs_diff_eq!(pose.translation.vector.z, 0.5, epsilon = 1e-12);
+    assert_abs_diff_eq!((pose.rotation * Vector3::y()).z, 1.0, epsilon = 1e-12);
+    let (s, r) = solve(&m);
+    // The height of the centre of mass to 1 nm (the contacts' rows hold to the corrector's
+    // tolerance).
+    assert_abs_diff_eq!(r.energy.total, MG * 0.15, epsilon = MG * 1e-9);
+    assert_eq!(r.contacts.len(), 4);
+    assert_verified_contacts(&m, &s, Friction::None);
+    let (_, r) = solve(&floating(BOX));
+    assert_abs_diff_eq!(r.energy.total, MG * 0.1, epsilon = MG * 1e-9);
+    let opts = ImportOptions {
+        floating_base: true,
+        base_pose: Some(nalgebra::Isometry3::translation(0.0, 0.0, 0.3)),
+        ..Default::default()
+    };
+    let m = load_str(&text, "test.urdf", &opts).unwrap().model;
+    let start = restpose::solver::initial_state(&m);
+    let pose = start.link_pose(&m, "box").unwrap();
+    assert_abs_diff_eq!(pose.translation.vector.z, 0.3, epsilon = 1e-12);
+    assert_abs_diff_eq!(pose.rotation.angle(), 0.0, epsilon = 1e-12);
+    let (_, r) = solve(&m);
+    assert_abs_diff_eq!(r.energy.total, MG * 0.1, epsilon = MG * 1e-9);
+}
+
+/// The command line: `verify --pose` reads analyze's result JSON of the Solo-12 with sticking
+/// feet, including the floating base's pose (`links`), and passes it with `--friction stick`
+/// (exit 0, the contacts in its JSON); frictionless it fails (exit 4, the feet need friction).
+#[test]
+fn verify_command_accepts_analyze_json_of_a_robot_standing_on_the_ground() {
+    let dir = env!("CARGO_MANIFEST_DIR");
+    let file = format!("{dir}/robots/solo12/solo12_ground.urdf");
+    let tmp = std::env::temp_dir().join(format!("restpose-contact-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).unwrap();
+    let (result, checked) = (tmp.join("r.json"), tmp.join("v.json"));
+    let run = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_restpose"))
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let a = run(&[
+        "analyze",
+        &file,
+        "--floating-base",
+        "--friction",
+        "stick",
+        "-q",
+        "--json",
+        result.to_str().unwrap(),
+    ]);
+    assert!(a.status.success(), "{}", String::from_utf8_lossy(&a.stderr));
+    let v = run(&[
+        "verify",
+        &file,
+        "--floating-base",
+        "--friction",
+        "stick",
+        "-q",
+        "--pose",
+        result.to_str().unwrap(),
+        "--json",
+        checked.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        v.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&v.stderr)
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&checked).unwrap()).unwrap();
+    assert_eq!(json["passed"], true);
+    assert_eq!(json["contacts"].as_array().unwrap().len(), 4);
+    assert_eq!(json["penetration"], 0.0);
+    let v = run(&[
+        "verify",
+        &file,
+        "--floating-base",
+        "-q",
+        "--pose",
+        result.to_str().unwrap(),
+    ]);
+    assert_eq!(v.status.code(), Some(4));
+    let _ = std::fs::remove_dir_all(&tmp);
+}

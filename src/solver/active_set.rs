@@ -15,10 +15,11 @@
 //!   cycling).
 //!
 //! - a sticking contact with a radius (a sphere) is held at the material point that touched;
-//!   when the sphere has rolled so that another point touches at the stationary point, the
-//!   anchor moves to the touching point (and its projection on the ground) and the round is
-//!   solved again. At the end the friction force acts at the touching point, with no slip
-//!   there: the sphere sticks and may roll, as MuJoCo's condim-3 contact. Where no such rest
+//!   when the sphere has turned by `ψ` (rotation vector since its first touch) so that another
+//!   point touches at the stationary point, the anchor moves to that material point, and to the
+//!   world point `a₀ + ρ ψ × n` where rolling from the first touch `a₀` would have brought it,
+//!   and the round is solved again. At the end the friction force acts at the touching point,
+//!   with no slip there: the sphere sticks and rolls, as MuJoCo's condim-3 contact. Where no such rest
 //!   exists (a ball on a sloping plane rolls down) it gives up after `MAX_ROLLS` re-anchorings
 //!   and reports `unbounded`.
 //!
@@ -257,25 +258,79 @@ pub(crate) fn reanchor(
     model: &Model,
     options: &Options,
     active: &mut [Active],
+    touched: &[Touch],
     q: &DVector<f64>,
 ) -> bool {
     let mut moved = false;
     for a in active.iter_mut() {
-        let (Some(old), Unilateral::Contact { point, .. }) = (a.anchor, a.row) else {
+        let (Some(old), Unilateral::Contact { point, ground }) = (a.anchor, a.row) else {
             continue;
         };
-        if model.contact_points[point].radius == 0.0 {
+        let c = &model.contact_points[point];
+        let Some(first) = touched.iter().find(|t| t.row == a.row) else {
+            continue;
+        };
+        if c.radius == 0.0 {
             continue;
         }
-        let new = activate(model, options, a.row, q);
-        let Some(anchor) = new.anchor else { continue };
-        let shift = (anchor.body - old.body).norm();
-        if shift > options.gap_tolerance * model.length_scale {
+        let n = model.grounds[ground].normal;
+        let rot = body_rotation(model, c.body, q);
+        // Rolling from the first touch by the rotation vector ψ moves the touching point by
+        // ρ ψ × n along the ground.
+        let psi = nalgebra::Rotation3::from_matrix_unchecked(rot * first.rotation.transpose())
+            .scaled_axis();
+        let anchor = unilateral::Anchor {
+            world: first.world + psi.cross(&n) * c.radius,
+            body: c.point - rot.transpose() * n * c.radius,
+        };
+        let tol = options.gap_tolerance * model.length_scale;
+        if (anchor.body - old.body).norm() > tol || (anchor.world - old.world).norm() > tol {
             a.anchor = Some(anchor);
             moved = true;
         }
     }
     moved
+}
+
+/// Where and how a sticking sphere first touched: the world point, and the body's rotation.
+pub(crate) struct Touch {
+    row: Unilateral,
+    world: Vector3<f64>,
+    rotation: nalgebra::Matrix3<f64>,
+}
+
+/// The rotation matrix of body `body` at `q`.
+fn body_rotation(
+    model: &Model,
+    body: crate::model::BodyId,
+    q: &DVector<f64>,
+) -> nalgebra::Matrix3<f64> {
+    let _ = model;
+    let i = 7 * body.0;
+    crate::math::rotation(&nalgebra::Vector4::new(
+        q[i + 3],
+        q[i + 4],
+        q[i + 5],
+        q[i + 6],
+    ))
+}
+
+/// Records the first touch of the sticking contacts among `active` not yet recorded (module
+/// docs: the sphere then rolls from there).
+fn record_touches(model: &Model, active: &[Active], q: &DVector<f64>, touched: &mut Vec<Touch>) {
+    touched.retain(|t| active.iter().any(|a| a.row == t.row));
+    for a in active {
+        let (Some(anchor), Unilateral::Contact { point, .. }) = (a.anchor, a.row) else {
+            continue;
+        };
+        if !touched.iter().any(|t| t.row == a.row) {
+            touched.push(Touch {
+                row: a.row,
+                world: anchor.world,
+                rotation: body_rotation(model, model.contact_points[point].body, q),
+            });
+        }
+    }
 }
 
 /// The active-set iteration from an assembled state (module docs).
@@ -308,6 +363,8 @@ pub(crate) fn solve(
     let mut changes = active.len();
     let initial = changes;
     let mut rolls = 0;
+    let mut touched = Vec::new();
+    record_touches(model, &active, &state.q, &mut touched);
     let mut iterations = 0;
     let mut counters = super::Diagnostics::default();
     loop {
@@ -337,15 +394,17 @@ pub(crate) fn solve(
                 active.push(activate(model, options, guard.inactive[k], &state.q));
                 changes += 1;
             }
+            record_touches(model, &active, &state.q, &mut touched);
             continue;
         }
         if report.converged() && !cycling {
             if let Some(i) = to_release(model, &round.multipliers, threshold) {
                 active.remove(i);
+                record_touches(model, &active, &state.q, &mut touched);
                 changes += 1;
                 continue;
             }
-            if reanchor(model, options, &mut active, &state.q) {
+            if reanchor(model, options, &mut active, &touched, &state.q) {
                 rolls += 1;
                 if rolls <= MAX_ROLLS {
                     continue;

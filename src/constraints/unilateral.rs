@@ -11,7 +11,8 @@
 //! rows `t_k·(r_i + A(p_i) c − a) = 0`: `c` the material point that touched (body frame), `a`
 //! the world point where it touched, `t_1, t_2` an orthonormal basis of the ground plane; their
 //! multipliers are the friction force. (A sphere held at its material point can roll, as a real
-//! foot does; holding its centre would forbid rolling.)
+//! foot does; holding its centre would forbid rolling. The solver then moves the anchor as the
+//! sphere rolls: module `solver::active_set`.)
 
 use crate::jet::{pair_of, Pair, Scalar};
 use crate::kinematics::{coordinate, Branches};

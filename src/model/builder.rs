@@ -89,6 +89,7 @@ impl ModelBuilder {
                 initial: Vec::new(),
                 gravity: Vector3::new(0.0, 0.0, -9.81),
                 grounds: Vec::new(),
+                obstacles: Vec::new(),
                 contact_points: Vec::new(),
                 length_scale: 1.0,
                 base_pose: None,

@@ -11,6 +11,7 @@ mod check;
 mod contact;
 mod force;
 mod joint;
+mod obstacle;
 mod site;
 
 pub use body::{Body, BodyId, Link};
@@ -21,6 +22,7 @@ pub use force::{
     Effort, ForceLaw, Initial, JointSpring, Load, Lock, Mimic, Spring, SpringEnd, SpringMode,
 };
 pub use joint::{Joint, JointId, JointKind};
+pub use obstacle::Obstacle;
 
 use nalgebra::Vector3;
 use std::collections::HashMap;
@@ -55,6 +57,8 @@ pub struct Model {
     pub gravity: Vector3<f64>,
     /// Ground planes (`mech:ground`).
     pub grounds: Vec<Ground>,
+    /// Collision shapes of world-fixed links that contact points rest on (`mech:obstacle`).
+    pub obstacles: Vec<Obstacle>,
     /// Points of the links that touch the grounds (from their collision shapes).
     pub contact_points: Vec<ContactPoint>,
     /// Characteristic length of the mechanism \[m\], used to scale position coordinates.

@@ -47,21 +47,46 @@ pub(crate) struct Guard<'m> {
     model: &'m Model,
     pub(crate) inactive: Vec<Unilateral>,
     tol: f64,
+    /// For contacts with an obstacle: its tangent plane `(o, n)` at the round's start. A step
+    /// is guarded against that plane (a finite obstacle could otherwise be stepped through).
+    planes: Vec<Option<(Vector3<f64>, Vector3<f64>)>>,
 }
 
 impl<'m> Guard<'m> {
-    pub(crate) fn new(model: &'m Model, inactive: Vec<Unilateral>, tol: f64) -> Self {
+    /// The guard of the inequalities `inactive` from the configuration `q`.
+    pub(crate) fn new(
+        model: &'m Model,
+        inactive: Vec<Unilateral>,
+        tol: f64,
+        q: &DVector<f64>,
+    ) -> Self {
+        let planes = inactive
+            .iter()
+            .map(|u| match *u {
+                Unilateral::Contact { point, ground } if ground >= model.grounds.len() => Some(
+                    unilateral::surface(model, ground, &unilateral::point_world(model, point, q)),
+                ),
+                _ => None,
+            })
+            .collect();
         Guard {
             model,
             inactive,
             tol,
+            planes,
         }
     }
 
-    /// Dimensionless gap of inequality `k`.
+    /// Dimensionless gap of inequality `k` (against an obstacle: to its plane of `planes`).
     fn gap(&self, k: usize, q: &DVector<f64>, branches: &Branches) -> f64 {
         let u = &self.inactive[k];
-        let g = unilateral::gap(self.model, u, q, branches).unwrap_or(f64::INFINITY);
+        let g = match (self.planes[k], u) {
+            (Some((o, n)), Unilateral::Contact { point, .. }) => {
+                n.dot(&(unilateral::point_world(self.model, *point, q) - o))
+                    - self.model.contact_points[*point].radius
+            }
+            _ => unilateral::gap(self.model, u, q, branches).unwrap_or(f64::INFINITY),
+        };
         dimensionless(self.model, u, g)
     }
 
@@ -166,15 +191,15 @@ pub(crate) fn activate(
             let c = &model.contact_points[point];
             let friction = c.settings.friction.unwrap_or(options.friction);
             (friction == Friction::Stick).then(|| {
-                let gr = &model.grounds[ground];
                 let x = unilateral::point_world(model, point, q);
+                let (_, normal) = unilateral::surface(model, ground, &x);
                 let g = unilateral::gap(model, &u, q, &Branches::default()).unwrap_or(0.0);
                 let i = 7 * c.body.0;
                 let p = nalgebra::Vector4::new(q[i + 3], q[i + 4], q[i + 5], q[i + 6]);
                 let a = crate::math::rotation(&p);
                 unilateral::Anchor {
-                    world: x - gr.normal * (g + c.radius),
-                    body: c.point - a.transpose() * gr.normal * c.radius,
+                    world: x - normal * (g + c.radius),
+                    body: c.point - a.transpose() * normal * c.radius,
                 }
             })
         }
@@ -240,7 +265,8 @@ pub(crate) fn touch_point(model: &Model, a: &Active, q: &DVector<f64>) -> Option
     match a.row {
         Unilateral::Contact { point, ground } => {
             let x = unilateral::point_world(model, point, q);
-            Some(x - model.grounds[ground].normal * model.contact_points[point].radius)
+            let (_, normal) = unilateral::surface(model, ground, &x);
+            Some(x - normal * model.contact_points[point].radius)
         }
         Unilateral::Limit { .. } => None,
     }
@@ -273,7 +299,7 @@ pub(crate) fn reanchor(
         if c.radius == 0.0 {
             continue;
         }
-        let n = model.grounds[ground].normal;
+        let (_, n) = unilateral::surface(model, ground, &unilateral::point_world(model, point, q));
         let rot = body_rotation(model, c.body, q);
         // Rolling from the first touch by the rotation vector ψ moves the touching point by
         // ρ ψ × n along the ground.
@@ -375,7 +401,7 @@ pub(crate) fn solve(
             .filter(|u| !active.iter().any(|a| a.row == **u))
             .copied()
             .collect();
-        let guard = Guard::new(model, inactive, tol);
+        let guard = Guard::new(model, inactive, tol, &q);
         let round = super::solve_round(
             model,
             crate::State { q, branches },
@@ -457,11 +483,12 @@ fn describe(
             }),
             Unilateral::Contact { point, ground } => {
                 let c = &model.contact_points[point];
-                let gr = &model.grounds[ground];
+                let x = unilateral::point_world(model, point, &state.q);
+                let (_, normal) = unilateral::surface(model, ground, &x);
                 let gap = unilateral::gap(model, &a.row, &state.q, &state.branches).unwrap_or(0.0);
                 let mut ft = Vector3::zeros();
                 if a.anchor.is_some() {
-                    let [t1, t2] = unilateral::tangents(&gr.normal);
+                    let [t1, t2] = unilateral::tangents(&normal);
                     ft = t1 * m[1] + t2 * m[2];
                 }
                 let fnorm = m[0];
@@ -481,9 +508,9 @@ fn describe(
                 let p = touch_point(model, a, &state.q).unwrap_or_default();
                 report.contacts.push(Contact {
                     link: c.link.clone(),
-                    ground: gr.name.clone(),
+                    ground: unilateral::surface_name(model, ground).to_string(),
                     point_world: p.into(),
-                    normal_world: gr.normal.into(),
+                    normal_world: normal.into(),
                     gap,
                     normal_force: fnorm,
                     tangential_force: ft.into(),

@@ -307,6 +307,15 @@ pub(super) fn read(
                     .ok_or_else(|| src.error(n, format!("{what} needs `value`")))?;
                 b.model.add_effort(Effort { joint, dof, value });
             }
+            "obstacle" => {
+                let name = src.req(n, "link")?;
+                let i = *b.link_index.get(name).ok_or_else(|| {
+                    src.error(n, format!("{what} refers to an unknown link `{name}`"))
+                })?;
+                b.model
+                    .add_obstacle(i)
+                    .map_err(|e| src.error(n, e.to_string()))?;
+            }
             "base" => {
                 let pose = src.frame(Some(n))?;
                 b.model.set_base_pose(pose);

@@ -147,6 +147,11 @@ const ELEMENTS: &[Element] = &[
         children: &[],
     },
     Element {
+        name: "obstacle",
+        attributes: &["link"],
+        children: &[],
+    },
+    Element {
         name: "base",
         attributes: FRAME,
         children: &[],

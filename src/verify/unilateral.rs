@@ -142,7 +142,8 @@ fn touching(
                 let c = &model.contact_points[point];
                 let stick = c.settings.friction.unwrap_or(opts.friction) == Friction::Stick;
                 let anchor = stick.then(|| {
-                    let gr = &model.grounds[ground];
+                    let x = unilateral::point_world(model, point, &state.q);
+                    let (_, normal) = unilateral::surface(model, ground, &x);
                     let i = 7 * c.body.0;
                     let p = nalgebra::Vector4::new(
                         state.q[i + 3],
@@ -151,10 +152,9 @@ fn touching(
                         state.q[i + 6],
                     );
                     let a = crate::math::rotation(&p);
-                    let x = unilateral::point_world(model, point, &state.q);
                     Anchor {
-                        world: x - gr.normal * c.radius,
-                        body: c.point - a.transpose() * gr.normal * c.radius,
+                        world: x - normal * c.radius,
+                        body: c.point - a.transpose() * normal * c.radius,
                     }
                 });
                 (anchor, c.settings.mu.or(opts.mu).filter(|_| stick))
@@ -210,7 +210,7 @@ pub(super) fn dense_needed(
         return Err(Error::Model(format!(
             "verify: the pose of `{}` touches a stop or a ground, and such poses are verified only \
              up to {DENSE_LIMIT} coordinates ({} bodies here, {} coordinates); \
-             give --limits ignore if no stop should hold it",
+             ignore the limits if no stop should hold it",
             model.name,
             model.bodies.len(),
             state.q.len()
@@ -412,10 +412,11 @@ fn describe(
         }),
         Unilateral::Contact { point, ground } => {
             let c = &model.contact_points[point];
-            let gr = &model.grounds[ground];
+            let x = unilateral::point_world(model, point, &state.q);
+            let (_, normal) = unilateral::surface(model, ground, &x);
             let mut ft = Vector3::zeros();
             if t.active.anchor.is_some() {
-                let [t1, t2] = unilateral::tangents(&gr.normal);
+                let [t1, t2] = unilateral::tangents(&normal);
                 ft = t1 * lambda[1] + t2 * lambda[2];
             }
             let fnorm = lambda[0];
@@ -439,12 +440,12 @@ fn describe(
                     t.mu.unwrap_or_default()
                 ));
             }
-            let x = unilateral::point_world(model, point, &state.q) - gr.normal * c.radius;
+            let x = x - normal * c.radius;
             out.contacts.push(Contact {
                 link: c.link.clone(),
-                ground: gr.name.clone(),
+                ground: unilateral::surface_name(model, ground).to_string(),
                 point_world: x.into(),
-                normal_world: gr.normal.into(),
+                normal_world: normal.into(),
                 gap: t.gap,
                 normal_force: fnorm,
                 tangential_force: ft.into(),

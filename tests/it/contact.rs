@@ -748,3 +748,79 @@ fn verify_command_accepts_analyze_json_of_a_robot_standing_on_the_ground() {
     assert_eq!(v.status.code(), Some(4));
     let _ = std::fs::remove_dir_all(&tmp);
 }
+
+// ---- obstacles: collision shapes of world-fixed links -----------------------------------
+
+/// A 1 kg ball (radius 0.1 m) on a hinge: a massless arm of 0.5 m from a pivot at the origin
+/// (about y), the ball's centre at its end, resting on a world-fixed box obstacle whose top is
+/// at `z = −0.3`. Closed form: the ball touches when its centre is at `z = −0.2`, i.e. the arm
+/// at `θ = asin(0.2/0.5)` below the horizontal; the contact force is vertical (the box's top
+/// face) and acts below the ball's centre, so moments about the pivot give
+/// `f_n · 0.5 cos θ = m g · 0.5 cos θ`, `f_n = m g = 9.81 N`; `V = m g z = −1.962 J`.
+const BALL_ON_BOX: &str = r#"<robot name="ball_on_box" xmlns:mech="urn:urdf-mech:1">
+  <link name="world"/>
+  <link name="table">
+    <collision><origin xyz="0.5 0 -0.8"/><geometry><box size="1 1 1"/></geometry></collision>
+  </link>
+  <joint name="mount" type="fixed"><parent link="world"/><child link="table"/></joint>
+  <link name="arm">
+    <inertial><origin xyz="0.5 0 0"/><mass value="1"/><inertia ixx="0.004" iyy="0.004" izz="0.004" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><origin xyz="0.5 0 0"/><geometry><sphere radius="0.1"/></geometry></collision>
+  </link>
+  <joint name="pivot" type="continuous"><parent link="world"/><child link="arm"/><axis xyz="0 1 0"/></joint>
+  <mech:obstacle link="table"/>
+  <mech:contact link="arm"/>
+</robot>"#;
+
+#[test]
+fn a_ball_rests_on_a_fixed_box() {
+    let m = model_from(BALL_ON_BOX);
+    assert_eq!(m.obstacles.len(), 1);
+    let (s, r) = solve(&m);
+    let th = s.joint(&m, "pivot").unwrap()[0];
+    assert_abs_diff_eq!(th, (0.2f64 / 0.5).asin(), epsilon = 1e-9);
+    assert_eq!(r.contacts.len(), 1, "{:?}", r.contacts);
+    let c = &r.contacts[0];
+    assert_eq!(c.ground, "table");
+    assert_abs_diff_eq!(c.normal_force, 9.81, epsilon = 1e-8);
+    assert_abs_diff_eq!(c.point_world[2], -0.3, epsilon = 1e-9);
+    assert_abs_diff_eq!(r.energy.total, -9.81 * 0.2, epsilon = 1e-8);
+    assert_verified_contacts(&m, &s, Friction::None);
+    // Pushed 1 mm into the box, verify refuses it.
+    let deeper = State::from_joint_values(&m, &[("pivot".to_string(), vec![th + 0.002])].into());
+    let v = check(&m, &deeper, Friction::None);
+    assert!(!v.passed && v.unilateral.penetration > 5e-4, "{v:?}");
+}
+
+/// A floating 2 kg box (0.4 × 0.3 × 0.2 m) released tilted above a world-fixed table link
+/// (a 1 × 1 × 0.1 m slab whose top is at `z = 0.75`): it rests flat on the table, four vertices
+/// carrying `m g / 4` each, `V = m g (0.75 + 0.1)` (closed form).
+#[test]
+fn a_box_rests_on_a_fixed_table_link() {
+    let text = r#"<robot name="box_on_table" xmlns:mech="urn:urdf-mech:1">
+  <link name="world"/>
+  <link name="table">
+    <collision><origin xyz="0 0 0.7"/><geometry><box size="1 1 0.1"/></geometry></collision>
+  </link>
+  <joint name="table_mount" type="fixed"><parent link="world"/><child link="table"/></joint>
+  <link name="box">
+    <inertial><mass value="2"/><inertia ixx="0.02" iyy="0.03" izz="0.04" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="0.4 0.3 0.2"/></geometry></collision>
+  </link>
+  <joint name="free" type="floating"><parent link="world"/><child link="box"/></joint>
+  <mech:obstacle link="table"/>
+  <mech:contact link="box"/>
+  <mech:initial joint="free" value="0.05 -0.02 1.0 0.9950 0.0600 -0.0500 0.0500"/>
+</robot>"#;
+    let m = model_from(text);
+    let (s, r) = solve(&m);
+    assert!(r.converged(), "{:?}", r.termination);
+    assert_abs_diff_eq!(r.energy.total, MG * 0.85, epsilon = MG * 1e-9);
+    assert_eq!(r.contacts.len(), 4, "{:?}", r.contacts);
+    for c in &r.contacts {
+        assert_eq!(c.ground, "table");
+        assert_abs_diff_eq!(c.normal_force, MG / 4.0, epsilon = 1e-8);
+        assert_abs_diff_eq!(c.point_world[2], 0.75, epsilon = 1e-9);
+    }
+    assert_verified_contacts(&m, &s, Friction::None);
+}

@@ -81,11 +81,7 @@ fn unit_or_z(v: &Vector3<f64>) -> Vector3<f64> {
 fn box_plane(p: &Vector3<f64>, h: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
     let excess = p.abs() - h;
     let scale = 1e-12 * h.amax();
-    let (k, e) =
-        excess.iter().enumerate().fold(
-            (0, f64::NEG_INFINITY),
-            |a, (i, &e)| if e > a.1 { (i, e) } else { a },
-        );
+    let k = excess.imax();
     let outside: Vec<usize> = (0..3).filter(|&i| excess[i] > scale).collect();
     if outside.len() <= 1 {
         // On a face (or inside): the face `k`.
@@ -93,7 +89,6 @@ fn box_plane(p: &Vector3<f64>, h: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>)
         n[k] = p[k].signum();
         let mut c = *p;
         c[k] = p[k].signum() * h[k];
-        let _ = e;
         return (c, n);
     }
     let c = Vector3::from_fn(|i, _| p[i].clamp(-h[i], h[i]));

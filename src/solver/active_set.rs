@@ -14,14 +14,9 @@
 //!   ones `λ = 0`), or after `max_iterations` changes of `A` after the start (reported as
 //!   cycling).
 //!
-//! - a sticking contact with a radius (a sphere) is held at the material point that touched;
-//!   when the sphere has turned by `ψ` (rotation vector since its first touch) so that another
-//!   point touches at the stationary point, the anchor moves to that material point, and to the
-//!   world point `a₀ + ρ ψ × n` where rolling from the first touch `a₀` would have brought it,
-//!   and the round is solved again. At the end the friction force acts at the touching point,
-//!   with no slip there: the sphere sticks and rolls, as MuJoCo's condim-3 contact. Where no such rest
-//!   exists (a ball on a sloping plane rolls down) it gives up after `MAX_ROLLS` re-anchorings
-//!   and reports `unbounded`.
+//! - a sticking sphere that has rolled at a stationary point is re-anchored where it touches
+//!   and the round solved again (module `rolling`); where no rest exists this way (a ball on a
+//!   sloping plane rolls down) it gives up after `MAX_ROLLS` re-anchorings (`unbounded`).
 //!
 //! Gaps are compared dimensionless: lengths divided by the characteristic length `L`, angles
 //! as they are; `tol = gap_tolerance`. Redundant active rows (a box flat on the ground has four
@@ -272,93 +267,6 @@ pub(crate) fn touch_point(model: &Model, a: &Active, q: &DVector<f64>) -> Option
     }
 }
 
-/// Re-anchorings of rolling sticking contacts before the search gives up (module docs).
-const MAX_ROLLS: usize = 50;
-
-/// Moves the anchors of the sticking contacts with a radius to where they touch now (the
-/// material point at the bottom of the sphere, and its projection on the ground), when the
-/// shape rolled away from its anchor by more than the gap tolerance; returns whether any
-/// moved. At a rest pose where no anchor moves, the friction force acts at the touching point,
-/// as for a sphere that sticks and may roll (no slip at the contact point).
-pub(crate) fn reanchor(
-    model: &Model,
-    options: &Options,
-    active: &mut [Active],
-    touched: &[Touch],
-    q: &DVector<f64>,
-) -> bool {
-    let mut moved = false;
-    for a in active.iter_mut() {
-        let (Some(old), Unilateral::Contact { point, ground }) = (a.anchor, a.row) else {
-            continue;
-        };
-        let c = &model.contact_points[point];
-        let Some(first) = touched.iter().find(|t| t.row == a.row) else {
-            continue;
-        };
-        if c.radius == 0.0 {
-            continue;
-        }
-        let (_, n) = unilateral::surface(model, ground, &unilateral::point_world(model, point, q));
-        let rot = body_rotation(model, c.body, q);
-        // Rolling from the first touch by the rotation vector ψ moves the touching point by
-        // ρ ψ × n along the ground.
-        let psi = nalgebra::Rotation3::from_matrix_unchecked(rot * first.rotation.transpose())
-            .scaled_axis();
-        let anchor = unilateral::Anchor {
-            world: first.world + psi.cross(&n) * c.radius,
-            body: c.point - rot.transpose() * n * c.radius,
-        };
-        let tol = options.gap_tolerance * model.length_scale;
-        if (anchor.body - old.body).norm() > tol || (anchor.world - old.world).norm() > tol {
-            a.anchor = Some(anchor);
-            moved = true;
-        }
-    }
-    moved
-}
-
-/// Where and how a sticking sphere first touched: the world point, and the body's rotation.
-pub(crate) struct Touch {
-    row: Unilateral,
-    world: Vector3<f64>,
-    rotation: nalgebra::Matrix3<f64>,
-}
-
-/// The rotation matrix of body `body` at `q`.
-fn body_rotation(
-    model: &Model,
-    body: crate::model::BodyId,
-    q: &DVector<f64>,
-) -> nalgebra::Matrix3<f64> {
-    let _ = model;
-    let i = 7 * body.0;
-    crate::math::rotation(&nalgebra::Vector4::new(
-        q[i + 3],
-        q[i + 4],
-        q[i + 5],
-        q[i + 6],
-    ))
-}
-
-/// Records the first touch of the sticking contacts among `active` not yet recorded (module
-/// docs: the sphere then rolls from there).
-fn record_touches(model: &Model, active: &[Active], q: &DVector<f64>, touched: &mut Vec<Touch>) {
-    touched.retain(|t| active.iter().any(|a| a.row == t.row));
-    for a in active {
-        let (Some(anchor), Unilateral::Contact { point, .. }) = (a.anchor, a.row) else {
-            continue;
-        };
-        if !touched.iter().any(|t| t.row == a.row) {
-            touched.push(Touch {
-                row: a.row,
-                world: anchor.world,
-                rotation: body_rotation(model, model.contact_points[point].body, q),
-            });
-        }
-    }
-}
-
 /// The active-set iteration from an assembled state (module docs).
 ///
 /// # Errors
@@ -390,7 +298,7 @@ pub(crate) fn solve(
     let initial = changes;
     let mut rolls = 0;
     let mut touched = Vec::new();
-    record_touches(model, &active, &state.q, &mut touched);
+    super::rolling::record_touches(model, &active, &state.q, &mut touched);
     let mut iterations = 0;
     let mut counters = super::Diagnostics::default();
     loop {
@@ -420,19 +328,19 @@ pub(crate) fn solve(
                 active.push(activate(model, options, guard.inactive[k], &state.q));
                 changes += 1;
             }
-            record_touches(model, &active, &state.q, &mut touched);
+            super::rolling::record_touches(model, &active, &state.q, &mut touched);
             continue;
         }
         if report.converged() && !cycling {
             if let Some(i) = to_release(model, &round.multipliers, threshold) {
                 active.remove(i);
-                record_touches(model, &active, &state.q, &mut touched);
+                super::rolling::record_touches(model, &active, &state.q, &mut touched);
                 changes += 1;
                 continue;
             }
-            if reanchor(model, options, &mut active, &touched, &state.q) {
+            if super::rolling::reanchor(model, options, &mut active, &touched, &state.q) {
                 rolls += 1;
-                if rolls <= MAX_ROLLS {
+                if rolls <= super::rolling::MAX_ROLLS {
                     continue;
                 }
                 report.termination = super::Termination::Unbounded;

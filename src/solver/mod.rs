@@ -23,6 +23,7 @@ mod options;
 pub(crate) mod partition;
 mod reactions;
 mod report;
+mod rolling;
 pub(crate) mod sparse;
 mod spectrum;
 pub(crate) mod system;

@@ -7,8 +7,8 @@
 #   2. `restpose analyze` on a copy of FILE with a `mech:joint_spring` (reference 0) on every
 #      revolute, continuous and prismatic joint, so that the rest pose is well posed;
 #   3. `restpose verify` of analyze's result JSON against the same file (independent equations).
-#   Joint limits are ignored in step 2 (`--limits ignore`): `verify` does not yet check a pose
-#   resting on a stop, so a pose held by stops would be refused there.
+#   Joint limits are enforced in both (the default): a rest pose may lean on joint stops, and
+#   `verify` then finds the stops' efforts from the balance and checks their signs.
 # Prints a table and `N passed, M failed`; exits 1 if any file fails, 2 if the corpus cannot be
 # downloaded (PyPI unreachable), 0 otherwise.
 #
@@ -103,7 +103,7 @@ for f in "${files[@]}"; do
         sprung="${f%.urdf}.restpose-springs.urdf"
         if ! with_springs "$f" "$sprung" 2>"$work/gen.err"; then
             a="FAIL"; why="spring generation: $(tail -n 1 "$work/gen.err")"
-        elif timeout "$TIMEOUT" "$RESTPOSE" analyze -q --limits ignore "$sprung" --json "$work/r.json" \
+        elif timeout "$TIMEOUT" "$RESTPOSE" analyze -q "$sprung" --json "$work/r.json" \
             >"$work/a.out" 2>"$work/a.err"; then
             a="ok"
             if timeout "$TIMEOUT" "$RESTPOSE" verify -q "$sprung" --pose "$work/r.json" \

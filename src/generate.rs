@@ -5,6 +5,14 @@
 //! `k_i = 10 (n − i)²` N m/rad on joint `i` (about ten times the gravity torque per radian of
 //! the links it carries, so the chain sags about 0.1 rad per joint). Joint axes alternate between y and z
 //! (spatial chain), or are all y (planar chain, gravity in its plane). Gravity `0 0 −9.81`.
+//!
+//! `rope(n)`: `n` links of 0.05 m and 0.05 kg (1 kg/m) joined by revolute joints about y with
+//! a bending spring of 2 N m/rad each (reference straight), a sphere of radius 0.01 m at the
+//! end of each link (its contact with the ground `mech:ground`, z = 0), hung from the world at
+//! height `H = m · 0.05 cos 0.3 + 0.01`, `m = ⌈n/3⌉`: it starts with `m` links hanging straight,
+//! 0.3 rad from the vertical, and the rest lying straight along +x on the ground (gaps 0 at the
+//! start: those contacts are active from the start, and the ones near the bend lift off). A
+//! vertical start would be degenerate: a straight chain between two heights it spans exactly.
 
 use std::fmt::Write;
 
@@ -18,6 +26,8 @@ pub enum Family {
     PlanarChain,
     /// Ladder of N closed four-bar loops.
     Ladder,
+    /// N-link planar rope hanging from the world onto the ground (sphere contacts).
+    Rope,
 }
 
 /// URDF text of a mechanism of `family` with `n` links (chains) or loops (ladder).
@@ -26,6 +36,7 @@ pub fn family(family: Family, n: usize) -> String {
         Family::Chain => chain(n, false),
         Family::PlanarChain => chain(n, true),
         Family::Ladder => ladder(n),
+        Family::Rope => rope(n),
     }
 }
 
@@ -153,6 +164,54 @@ pub fn ladder(n: usize) -> String {
         );
     }
     let _ = writeln!(s, "  <mech:gravity xyz=\"0 -9.81 0\"/>");
+    let _ = writeln!(s, "</robot>");
+    s
+}
+
+/// URDF text of an `n`-link rope hanging from the world onto the ground (module docs).
+pub fn rope(n: usize) -> String {
+    let (l, r) = (0.05, 0.01);
+    let (m, slant) = (n.div_ceil(3), 0.3f64);
+    let h = m as f64 * l * slant.cos() + r;
+    let mut s = String::new();
+    let _ = writeln!(s, "<?xml version=\"1.0\"?>");
+    let _ = writeln!(s, "<robot name=\"rope{n}\" xmlns:mech=\"urn:urdf-mech:1\">");
+    let _ = writeln!(s, "  <link name=\"world\"/>");
+    for i in 0..n {
+        let _ = writeln!(
+            s,
+            "  <link name=\"link{i}\"><inertial><origin xyz=\"{} 0 0\"/><mass value=\"0.05\"/><inertia ixx=\"1e-6\" ixy=\"0\" ixz=\"0\" iyy=\"1.1e-5\" iyz=\"0\" izz=\"1.1e-5\"/></inertial><collision><origin xyz=\"{l} 0 0\"/><geometry><sphere radius=\"{r}\"/></geometry></collision></link>",
+            l / 2.0
+        );
+    }
+    for i in 0..n {
+        let (parent, origin) = if i == 0 {
+            ("world".to_string(), format!("0 0 {h}"))
+        } else {
+            (format!("link{}", i - 1), format!("{l} 0 0"))
+        };
+        let _ = writeln!(
+            s,
+            "  <joint name=\"joint{i}\" type=\"continuous\"><parent link=\"{parent}\"/><child link=\"link{i}\"/><origin xyz=\"{origin}\"/><axis xyz=\"0 1 0\"/></joint>"
+        );
+        let _ = writeln!(
+            s,
+            "  <mech:joint_spring joint=\"joint{i}\" stiffness=\"2\" reference=\"0\"/>"
+        );
+    }
+    // Hanging 0.3 rad off the vertical (a turn of +π/2 about y takes +x to −z), then lying
+    // along +x.
+    let down = std::f64::consts::FRAC_PI_2 - slant;
+    let _ = writeln!(s, "  <mech:initial joint=\"joint0\" value=\"{down}\"/>");
+    if m < n {
+        let _ = writeln!(
+            s,
+            "  <mech:initial joint=\"joint{m}\" value=\"{}\"/>",
+            -down
+        );
+    }
+    let _ = writeln!(s, "  <mech:ground/>");
+    let _ = writeln!(s, "  <mech:gravity xyz=\"0 0 -9.81\"/>");
     let _ = writeln!(s, "</robot>");
     s
 }

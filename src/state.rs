@@ -80,12 +80,24 @@ impl State {
         for b in 0..model.bodies.len() {
             s.q[7 * b + 3] = 1.0;
         }
-        // A body that is no tree joint's child (a floating base) stays at the world origin and
-        // places its subtree.
+        // A body that is no tree joint's child (a floating base) stays at the world origin, or
+        // at the base pose, and places its subtree.
         let mut placed = vec![true; model.bodies.len()];
         for j in model.joints.iter().filter(|j| j.tree && !j.merged) {
             if let Some(child) = j.bodies[1] {
                 placed[child.0] = false;
+            }
+        }
+        // The floating base starts at the model's base pose (`mech:base`): its root link there.
+        if let Some(base) = model.base_pose {
+            for (b, body) in model.bodies.iter().enumerate() {
+                let root_link = model.links.iter().find(|l| l.name == body.name);
+                if let (true, Some(l)) = (placed[b], root_link) {
+                    s.set_body_pose(
+                        crate::model::BodyId(b),
+                        &(base * l.body_from_link.inverse()),
+                    );
+                }
             }
         }
         let mut changed = true;

@@ -56,6 +56,15 @@ pub(crate) struct InputArgs {
     /// Add the ground plane z = 0 (+z up): links with collision geometry rest on it.
     #[arg(long)]
     pub(crate) ground: bool,
+    /// Start position of the floating root link [m] (overrides <mech:base xyz>).
+    #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_hyphen_values = true,
+          value_parser = parse::finite)]
+    pub(crate) base_xyz: Option<Vec<f64>>,
+    /// Start orientation of the floating root link, roll pitch yaw [rad] (overrides
+    /// <mech:base rpy>).
+    #[arg(long, num_args = 3, value_names = ["ROLL", "PITCH", "YAW"], allow_hyphen_values = true,
+          value_parser = parse::finite)]
+    pub(crate) base_rpy: Option<Vec<f64>>,
 }
 
 impl InputArgs {
@@ -67,6 +76,14 @@ impl InputArgs {
             inertia_density: self.inertia_from_geometry,
             ..Default::default()
         };
+        if self.base_xyz.is_some() || self.base_rpy.is_some() {
+            let t = self.base_xyz.clone().unwrap_or_else(|| vec![0.0; 3]);
+            let r = self.base_rpy.clone().unwrap_or_else(|| vec![0.0; 3]);
+            opts.base_pose = Some(nalgebra::Isometry3::from_parts(
+                nalgebra::Translation3::new(t[0], t[1], t[2]),
+                nalgebra::UnitQuaternion::from_euler_angles(r[0], r[1], r[2]),
+            ));
+        }
         if let Some(g) = &self.gravity {
             opts.gravity = nalgebra::Vector3::new(g[0], g[1], g[2]);
         }
@@ -130,6 +147,18 @@ pub(crate) struct VerifyArgs {
     pub(crate) json: Option<PathBuf>,
     #[command(flatten)]
     pub(crate) input: InputArgs,
+    /// URDF joint limits: enforce (the pose may rest on a stop, which carries an effort, and
+    /// may not go beyond one) or ignore.
+    #[arg(long, value_enum, default_value_t = Options::default().limits)]
+    pub(crate) limits: Limits,
+    /// Contacts without a friction setting in <mech:contact>: none (frictionless) or stick
+    /// (they may carry a tangential force).
+    #[arg(long, value_enum, default_value_t = Options::default().friction)]
+    pub(crate) friction: Friction,
+    /// Friction coefficient of sticking contacts without `mu` in <mech:contact>: a contact
+    /// needing more fails the pose.
+    #[arg(long, value_name = "MU", value_parser = parse::positive)]
+    pub(crate) mu: Option<f64>,
     /// Print only errors and the verdict.
     #[arg(long, short)]
     pub(crate) quiet: bool,
@@ -140,7 +169,7 @@ pub(crate) struct GenerateArgs {
     /// Family.
     #[arg(value_enum)]
     pub(crate) family: restpose::generate::Family,
-    /// Number of links (chains) or loops (ladder), 1 to 1,000,000.
+    /// Number of links (chains, rope) or loops (ladder), 1 to 1,000,000.
     #[arg(long, default_value_t = 20, value_parser = parse::generate_size)]
     pub(crate) size: usize,
 }

@@ -141,41 +141,7 @@ pub(crate) fn analysis(r: &AnalysisResult) {
             v.joint, v.position, v.limits[0], v.limits[1]
         );
     }
-    if !r.active_limits.is_empty() {
-        out!();
-        out!("  joint resting on a stop          bound     position       effort [N m or N]");
-        for l in &r.active_limits {
-            out!(
-                "  {:<32} {:<9} {:>12.6}   {:>12.4}",
-                l.joint,
-                l.bound,
-                l.value,
-                l.effort
-            );
-        }
-    }
-    if !r.contacts.is_empty() {
-        out!();
-        out!("  contact (link @ ground)          point [m]                              normal force [N]  needs μ   state");
-        for c in &r.contacts {
-            let p = c.point_world;
-            out!(
-                "  {:<32} [{:>10.5}, {:>10.5}, {:>10.5}]   {:>14.4}  {:>8.4}   {}",
-                format!("{} @ {}", c.link, c.ground),
-                p[0],
-                p[1],
-                p[2],
-                c.normal_force,
-                c.required_friction,
-                serde_json::to_value(c.state)
-                    .ok()
-                    .and_then(|v| v.as_str().map(str::to_owned))
-                    .unwrap_or_default()
-            );
-        }
-        let total: f64 = r.contacts.iter().map(|c| c.normal_force).sum();
-        out!("  total normal force {total:.6} N");
-    }
+    stops_and_contacts(&r.active_limits, &r.contacts);
     if r.slipping {
         out!("  warning: a sticking contact needs more friction than its coefficient mu: the mechanism would slide from this pose");
     }
@@ -201,6 +167,48 @@ pub(crate) fn analysis(r: &AnalysisResult) {
 
 /// The units of a joint's coordinates after its values: ` rad` when they share one, ` [rad, m]`
 /// when they differ, nothing for a joint without coordinates.
+/// The joints resting on a stop and the contacts, with their forces (analyze and verify).
+fn stops_and_contacts(
+    limits: &[restpose::solver::ActiveLimit],
+    contacts: &[restpose::solver::Contact],
+) {
+    if !limits.is_empty() {
+        out!();
+        out!("  joint resting on a stop          bound     position       effort [N m or N]");
+        for l in limits {
+            out!(
+                "  {:<32} {:<9} {:>12.6}   {:>12.4}",
+                l.joint,
+                l.bound,
+                l.value,
+                l.effort
+            );
+        }
+    }
+    if !contacts.is_empty() {
+        out!();
+        out!("  contact (link @ ground)          point [m]                              normal force [N]  needs μ   state");
+        for c in contacts {
+            let p = c.point_world;
+            out!(
+                "  {:<32} [{:>10.5}, {:>10.5}, {:>10.5}]   {:>14.4}  {:>8.4}   {}",
+                format!("{} @ {}", c.link, c.ground),
+                p[0],
+                p[1],
+                p[2],
+                c.normal_force,
+                c.required_friction,
+                serde_json::to_value(c.state)
+                    .ok()
+                    .and_then(|v| v.as_str().map(str::to_owned))
+                    .unwrap_or_default()
+            );
+        }
+        let total: f64 = contacts.iter().map(|c| c.normal_force).sum();
+        out!("  total normal force {total:.6} N");
+    }
+}
+
 fn units(u: &[&str]) -> String {
     match u.first() {
         None => String::new(),
@@ -312,6 +320,14 @@ pub(crate) fn verification(robot: &str, v: &Verification, tol: &Tolerances) {
         out!(
             "  unassigned generalized force {:.3e} (spherical or floating joints)",
             v.unassigned
+        );
+    }
+    stops_and_contacts(&v.unilateral.active_limits, &v.unilateral.contacts);
+    if v.unilateral.contacts.len() + v.unilateral.active_limits.len() > 0 {
+        out!(
+            "  penetration {:.3e}, complementarity max |g λ| {:.3e} J",
+            v.unilateral.penetration,
+            v.unilateral.complementarity
         );
     }
     if let Some(s) = &v.stability {

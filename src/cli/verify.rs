@@ -38,6 +38,18 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
     if values.is_empty() && a.pose.is_none() {
         bail!("give the pose with --pose FILE or --joint NAME=VALUE");
     }
+    // A floating base: its pose comes from the result JSON's `links` (the root link's
+    // `position` and `orientation_wxyz`), else from `mech:base` / `--base-xyz`.
+    let based;
+    let model = match a.pose.as_deref().and_then(|p| base_pose(model, p)) {
+        Some(pose) => {
+            let mut m = model.clone();
+            m.base_pose = Some(pose);
+            based = m;
+            &based
+        }
+        None => model,
+    };
     let (state, missing) = restpose::verify::pose_state(model, &values)?;
     if !a.quiet && !missing.is_empty() {
         eprintln!(
@@ -50,7 +62,12 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
         constraint: a.constraint_tolerance,
         ..Default::default()
     };
-    let v = restpose::verify::verify(model, &state, &tol)?;
+    let uni = restpose::verify::Unilaterals {
+        limits: a.limits,
+        friction: a.friction,
+        mu: a.mu,
+    };
+    let v = restpose::verify::verify_with_options(model, &state, &tol, &uni)?;
     if let Some(path) = &a.json {
         print::write_json(path, &serde_json::to_string_pretty(&v)?)?;
     }
@@ -59,6 +76,9 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
     }
     if v.passed {
         return Ok(0);
+    }
+    for f in &v.unilateral.failures {
+        eprintln!("{}: not a rest pose: {f}", a.file.display());
     }
     if let Some(m) = &v.max_imbalance {
         eprintln!(
@@ -77,4 +97,32 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
         );
     }
     Ok(exit::NOT_BALANCED)
+}
+
+/// The pose of the floating root link in a result JSON `path` (`links.ROOT.position` and
+/// `orientation_wxyz`), when the model's base floats (a body that no tree joint moves).
+fn base_pose(model: &restpose::Model, path: &std::path::Path) -> Option<nalgebra::Isometry3<f64>> {
+    let root = model.bodies.iter().find(|b| {
+        !model.joints.iter().any(|j| {
+            j.tree
+                && !j.merged
+                && j.bodies[1].is_some_and(|c| model.bodies[c.index()].name == b.name)
+        })
+    })?;
+    let text = std::fs::read_to_string(path).ok()?;
+    let json: serde_json::Value = serde_json::from_str(&text).ok()?;
+    let link = json.get("links")?.get(&root.name)?;
+    let v = |key: &str, n: usize| -> Option<Vec<f64>> {
+        let a = link.get(key)?.as_array()?;
+        let v: Option<Vec<f64>> = a.iter().map(|x| x.as_f64()).collect();
+        v.filter(|v| v.len() == n && v.iter().all(|x| x.is_finite()))
+    };
+    let (p, o) = (v("position", 3)?, v("orientation_wxyz", 4)?);
+    let q = nalgebra::Quaternion::new(o[0], o[1], o[2], o[3]);
+    (q.norm() > 0.0).then(|| {
+        nalgebra::Isometry3::from_parts(
+            nalgebra::Translation3::new(p[0], p[1], p[2]),
+            nalgebra::UnitQuaternion::from_quaternion(q),
+        )
+    })
 }

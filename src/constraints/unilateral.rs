@@ -11,7 +11,8 @@
 //! rows `t_k·(r_i + A(p_i) c − a) = 0`: `c` the material point that touched (body frame), `a`
 //! the world point where it touched, `t_1, t_2` an orthonormal basis of the ground plane; their
 //! multipliers are the friction force. (A sphere held at its material point can roll, as a real
-//! foot does; holding its centre would forbid rolling.)
+//! foot does; holding its centre would forbid rolling. The solver then moves the anchor as the
+//! sphere rolls: module `solver::active_set`.)
 
 use crate::jet::{pair_of, Pair, Scalar};
 use crate::kinematics::{coordinate, Branches};
@@ -102,11 +103,33 @@ pub(crate) fn inequalities(model: &Model, limits: bool) -> Vec<Unilateral> {
         }
     }
     for point in 0..model.contact_points.len() {
-        for ground in 0..model.grounds.len() {
+        for ground in 0..model.grounds.len() + model.obstacles.len() {
             out.push(Unilateral::Contact { point, ground });
         }
     }
     out
+}
+
+/// The surface `ground` of a contact near the world point `x`, as a plane `(o, n)`: a ground
+/// itself (`ground < grounds.len()`), or an obstacle's tangent plane at the point of its
+/// surface closest to `x` (module `model::obstacle`).
+pub(crate) fn surface(
+    model: &Model,
+    ground: usize,
+    x: &Vector3<f64>,
+) -> (Vector3<f64>, Vector3<f64>) {
+    match model.grounds.get(ground) {
+        Some(g) => (g.origin, g.normal),
+        None => model.obstacles[ground - model.grounds.len()].tangent_plane(x),
+    }
+}
+
+/// Name of the surface `ground`: the ground's, or the obstacle's link.
+pub(crate) fn surface_name(model: &Model, ground: usize) -> &str {
+    match model.grounds.get(ground) {
+        Some(g) => &g.name,
+        None => &model.obstacles[ground - model.grounds.len()].link,
+    }
 }
 
 /// The bodies a row of `u` depends on.
@@ -133,7 +156,8 @@ pub(crate) fn name(model: &Model, u: &Unilateral) -> String {
         }
         Unilateral::Contact { point, ground } => format!(
             "{}.contact[{point}]@{}",
-            model.contact_points[point].link, model.grounds[ground].name
+            model.contact_points[point].link,
+            surface_name(model, ground)
         ),
     }
 }
@@ -181,17 +205,18 @@ pub(crate) fn rows(
         }
         Unilateral::Contact { point, ground } => {
             let c = &model.contact_points[point];
-            let gr = &model.grounds[ground];
+            let at = pair.r[0] + crate::math::rotation(&pair.p[0]) * c.point;
+            let (origin, normal) = surface(model, ground, &at);
             let x = pair.point(0, &c.point);
-            let n = pair.vector(1, &gr.normal);
+            let n = pair.vector(1, &normal);
             let mut out = vec![pair
-                .dot(&x.sub(&pair.point(1, &gr.origin)), &n)
+                .dot(&x.sub(&pair.point(1, &origin)), &n)
                 .minus(c.radius)];
             if let Some(anchor) = a.anchor {
                 let d = pair
                     .point(0, &anchor.body)
                     .sub(&pair.point(1, &anchor.world));
-                for t in tangents(&gr.normal) {
+                for t in tangents(&normal) {
                     out.push(pair.dot(&d, &pair.vector(1, &t)));
                 }
             }
@@ -224,9 +249,9 @@ pub(crate) fn gap(
             })
         }
         Unilateral::Contact { point, ground } => {
-            let gr = &model.grounds[ground];
             let x = point_world(model, point, q);
-            Some(gr.normal.dot(&(x - gr.origin)) - model.contact_points[point].radius)
+            let (origin, normal) = surface(model, ground, &x);
+            Some(normal.dot(&(x - origin)) - model.contact_points[point].radius)
         }
     }
 }
@@ -275,6 +300,76 @@ mod tests {
                 &|p: &Pair| rows(&m, &a, p, &Branches::default()).unwrap()[k].clone(),
                 "contact row",
             );
+        }
+    }
+
+    /// Against an obstacle the gap row's value equals the gap and its gradient equals central
+    /// differences of the gap (a box's face and edge, a sphere); the Hessian leaves out the
+    /// surface's curvature by design (module docs of `model::obstacle`), so it is not compared.
+    #[test]
+    fn obstacle_gap_rows_match_finite_differences() {
+        use crate::geometry::ShapeKind;
+        use crate::model::Obstacle;
+        for (shape, at) in [
+            (
+                ShapeKind::Box {
+                    size: Vector3::new(1.0, 0.8, 0.6),
+                },
+                Vector3::new(0.1, 0.0, 0.9),
+            ),
+            (
+                ShapeKind::Box {
+                    size: Vector3::new(1.0, 0.8, 0.6),
+                },
+                Vector3::new(0.9, 0.0, 0.9),
+            ),
+            (
+                ShapeKind::Sphere { radius: 0.4 },
+                Vector3::new(0.3, 0.2, 0.9),
+            ),
+        ] {
+            let mut b = ModelBuilder::new("t");
+            let body = b.add_rigid_body("b", 1.0, Vector3::zeros(), Matrix3::identity());
+            let mut m = b.build().unwrap();
+            m.obstacles.push(Obstacle {
+                link: "o".into(),
+                world_from_shape: nalgebra::Isometry3::rotation(Vector3::new(0.1, -0.2, 0.05)),
+                shape,
+            });
+            m.contact_points.push(ContactPoint {
+                link: "b".into(),
+                body,
+                point: Vector3::new(0.05, -0.02, 0.03),
+                radius: 0.05,
+                settings: ContactSettings::default(),
+            });
+            let a = Active {
+                row: Unilateral::Contact {
+                    point: 0,
+                    ground: 0,
+                },
+                anchor: None,
+            };
+            let tilt = nalgebra::UnitQuaternion::from_scaled_axis(Vector3::new(0.2, 0.1, -0.3));
+            let q = DVector::from_vec(vec![at.x, at.y, at.z, tilt.w, tilt.i, tilt.j, tilt.k]);
+            let pair = pair_of(&[Some(body), None], &q, false);
+            let row = rows(&m, &a, &pair, &Branches::default()).unwrap()[0].clone();
+            let g = gap(&m, &a.row, &q, &Branches::default()).unwrap();
+            assert!((row.v - g).abs() < 1e-14, "{} {g}", row.v);
+            for i in 0..7 {
+                let h = 1e-6;
+                let (mut up, mut down) = (q.clone(), q.clone());
+                up[i] += h;
+                down[i] -= h;
+                let fd = (gap(&m, &a.row, &up, &Branches::default()).unwrap()
+                    - gap(&m, &a.row, &down, &Branches::default()).unwrap())
+                    / (2.0 * h);
+                assert!(
+                    (row.g[i] - fd).abs() < 1e-8,
+                    "coordinate {i}: {} vs {fd}",
+                    row.g[i]
+                );
+            }
         }
     }
 }

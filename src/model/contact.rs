@@ -83,7 +83,7 @@ pub(crate) fn points(
     m: &Model,
     contacts: &[(usize, bool, ContactSettings)],
 ) -> Result<Vec<ContactPoint>> {
-    if m.grounds.is_empty() {
+    if m.grounds.is_empty() && m.obstacles.is_empty() {
         return Ok(Vec::new());
     }
     let explicit = contacts.iter().any(|c| c.1);
@@ -154,6 +154,54 @@ impl ModelBuilder {
     pub fn set_contact(&mut self, link: usize, touches: bool, settings: ContactSettings) {
         self.contacts.retain(|c| c.0 != link);
         self.contacts.push((link, touches, settings));
+    }
+
+    /// Sets the start pose of the root link in the world, used when the base floats
+    /// (`mech:base`): the first guess of the floating base, which the joints' initial values
+    /// then extend to the whole tree.
+    pub fn set_base_pose(&mut self, pose: nalgebra::Isometry3<f64>) {
+        self.model.base_pose = Some(pose);
+    }
+
+    /// Makes the collision shapes of the world-fixed link with index `link` obstacles
+    /// (`mech:obstacle`): boxes, spheres and capsules.
+    ///
+    /// # Errors
+    /// [`Error::Model`] for a moving link, a link without collision geometry or another shape.
+    pub fn add_obstacle(&mut self, link: usize) -> Result<()> {
+        let l = self
+            .model
+            .links
+            .get(link)
+            .ok_or_else(|| Error::Model(format!("no link with index {link}")))?;
+        if l.body.is_some() {
+            return Err(Error::Model(format!(
+                "link `{}` is an obstacle but is not fixed to the world",
+                l.name
+            )));
+        }
+        if l.collisions.is_empty() {
+            return Err(Error::Model(format!(
+                "link `{}` is an obstacle but has no <collision> geometry",
+                l.name
+            )));
+        }
+        let mut found = Vec::new();
+        for g in &l.collisions {
+            if !super::Obstacle::supported(&g.shape) {
+                return Err(Error::Model(format!(
+                    "link `{}`: only boxes, spheres and capsules can be obstacles",
+                    l.name
+                )));
+            }
+            found.push(super::Obstacle {
+                link: l.name.clone(),
+                world_from_shape: l.body_from_link * g.link_from_shape,
+                shape: g.shape.clone(),
+            });
+        }
+        self.model.obstacles.extend(found);
+        Ok(())
     }
 
     /// The grounds added so far.

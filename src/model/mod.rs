@@ -13,6 +13,7 @@ mod contact;
 mod force;
 mod joint;
 mod mass;
+mod obstacle;
 mod site;
 mod validate;
 
@@ -26,6 +27,7 @@ pub use force::{
 };
 pub use joint::{Joint, JointId, JointKind};
 pub use mass::Inertial;
+pub use obstacle::Obstacle;
 
 use nalgebra::Vector3;
 use std::collections::HashMap;
@@ -60,10 +62,15 @@ pub struct Model {
     pub gravity: Vector3<f64>,
     /// Ground planes (`mech:ground`).
     pub grounds: Vec<Ground>,
+    /// Collision shapes of world-fixed links that contact points rest on (`mech:obstacle`).
+    pub obstacles: Vec<Obstacle>,
     /// Points of the links that touch the grounds (from their collision shapes).
     pub contact_points: Vec<ContactPoint>,
     /// Characteristic length of the mechanism \[m\], used to scale position coordinates.
     pub length_scale: f64,
+    /// Start pose of the root link in the world when the base floats (`mech:base`; `None`:
+    /// the identity).
+    pub base_pose: Option<nalgebra::Isometry3<f64>>,
     /// Joint ids by name, built once by [`Model::index_names`].
     pub(crate) joint_names: HashMap<String, JointId>,
 }

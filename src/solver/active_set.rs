@@ -11,14 +11,19 @@
 //!   `−force_tolerance · F` (`F` the weight and loads of the mechanism) leaves `A`;
 //! - it stops when every `λ_k ≥ −force_tolerance · F` and every `g_k ≥ −tol`
 //!   (complementarity `g_k λ_k = 0` holds by construction: active rows have `g = 0`, inactive
-//!   ones `λ = 0`), or after `max_iterations` changes of `A` (reported as cycling).
+//!   ones `λ = 0`), or after `max_iterations` changes of `A` after the start (reported as
+//!   cycling).
+//!
+//! - a sticking sphere that has rolled at a stationary point is re-anchored where it touches
+//!   and the round solved again (module `rolling`); where no rest exists this way (a ball on a
+//!   sloping plane rolls down) it gives up after `MAX_ROLLS` re-anchorings (`unbounded`).
 //!
 //! Gaps are compared dimensionless: lengths divided by the characteristic length `L`, angles
 //! as they are; `tol = gap_tolerance`. Redundant active rows (a box flat on the ground has four
 //! supporting vertices for three degrees of freedom) are handled by the partition, which gives
-//! them no multiplier: the force distribution reported is then one admissible distribution of a
-//! statically indeterminate support. Stability is judged on the tangent space of all active
-//! rows.
+//! them no multiplier; the force distribution reported is then the least-norm one over the
+//! stops and contacts (module `distribution`: a box flat on four vertices gets `m g / 4` on
+//! each). Stability is judged on the tangent space of all active rows.
 //!
 //! ## References
 //! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §16.5
@@ -37,21 +42,46 @@ pub(crate) struct Guard<'m> {
     model: &'m Model,
     pub(crate) inactive: Vec<Unilateral>,
     tol: f64,
+    /// For contacts with an obstacle: its tangent plane `(o, n)` at the round's start. A step
+    /// is guarded against that plane (a finite obstacle could otherwise be stepped through).
+    planes: Vec<Option<(Vector3<f64>, Vector3<f64>)>>,
 }
 
 impl<'m> Guard<'m> {
-    pub(crate) fn new(model: &'m Model, inactive: Vec<Unilateral>, tol: f64) -> Self {
+    /// The guard of the inequalities `inactive` from the configuration `q`.
+    pub(crate) fn new(
+        model: &'m Model,
+        inactive: Vec<Unilateral>,
+        tol: f64,
+        q: &DVector<f64>,
+    ) -> Self {
+        let planes = inactive
+            .iter()
+            .map(|u| match *u {
+                Unilateral::Contact { point, ground } if ground >= model.grounds.len() => Some(
+                    unilateral::surface(model, ground, &unilateral::point_world(model, point, q)),
+                ),
+                _ => None,
+            })
+            .collect();
         Guard {
             model,
             inactive,
             tol,
+            planes,
         }
     }
 
-    /// Dimensionless gap of inequality `k`.
+    /// Dimensionless gap of inequality `k` (against an obstacle: to its plane of `planes`).
     fn gap(&self, k: usize, q: &DVector<f64>, branches: &Branches) -> f64 {
         let u = &self.inactive[k];
-        let g = unilateral::gap(self.model, u, q, branches).unwrap_or(f64::INFINITY);
+        let g = match (self.planes[k], u) {
+            (Some((o, n)), Unilateral::Contact { point, .. }) => {
+                n.dot(&(unilateral::point_world(self.model, *point, q) - o))
+                    - self.model.contact_points[*point].radius
+            }
+            _ => unilateral::gap(self.model, u, q, branches).unwrap_or(f64::INFINITY),
+        };
         dimensionless(self.model, u, g)
     }
 
@@ -156,15 +186,15 @@ pub(crate) fn activate(
             let c = &model.contact_points[point];
             let friction = c.settings.friction.unwrap_or(options.friction);
             (friction == Friction::Stick).then(|| {
-                let gr = &model.grounds[ground];
                 let x = unilateral::point_world(model, point, q);
+                let (_, normal) = unilateral::surface(model, ground, &x);
                 let g = unilateral::gap(model, &u, q, &Branches::default()).unwrap_or(0.0);
                 let i = 7 * c.body.0;
                 let p = nalgebra::Vector4::new(q[i + 3], q[i + 4], q[i + 5], q[i + 6]);
                 let a = crate::math::rotation(&p);
                 unilateral::Anchor {
-                    world: x - gr.normal * (g + c.radius),
-                    body: c.point - a.transpose() * gr.normal * c.radius,
+                    world: x - normal * (g + c.radius),
+                    body: c.point - a.transpose() * normal * c.radius,
                 }
             })
         }
@@ -185,17 +215,11 @@ pub(crate) fn force_scale(model: &Model) -> f64 {
 }
 
 /// Multipliers of the rows of each active inequality (`g` first, then the tangential rows),
-/// from the multipliers `mu` of the independent rows `part.rows` of `cons` (redundant rows:
-/// 0).
+/// from the multipliers `full` of every row of `cons`.
 pub(crate) fn active_multipliers(
     cons: &crate::constraints::Constraints,
-    part: &Partition,
-    mu: &DVector<f64>,
+    full: &DVector<f64>,
 ) -> Vec<(Active, Vec<f64>)> {
-    let mut full = vec![0.0; cons.len()];
-    for (k, &row) in part.rows.iter().enumerate() {
-        full[row] = mu[k];
-    }
     cons.blocks
         .iter()
         .filter_map(|b| match &b.kind {
@@ -236,7 +260,8 @@ pub(crate) fn touch_point(model: &Model, a: &Active, q: &DVector<f64>) -> Option
     match a.row {
         Unilateral::Contact { point, ground } => {
             let x = unilateral::point_world(model, point, q);
-            Some(x - model.grounds[ground].normal * model.contact_points[point].radius)
+            let (_, normal) = unilateral::surface(model, ground, &x);
+            Some(x - normal * model.contact_points[point].radius)
         }
         Unilateral::Limit { .. } => None,
     }
@@ -267,7 +292,13 @@ pub(crate) fn solve(
         })
         .map(|&u| activate(model, options, u, &state.q))
         .collect();
+    // The inequalities active from the start count as changes in the report, not towards the
+    // cycling guard (a rope lying on the ground starts with hundreds).
     let mut changes = active.len();
+    let initial = changes;
+    let mut rolls = 0;
+    let mut touched = Vec::new();
+    super::rolling::record_touches(model, &active, &state.q, &mut touched);
     let mut iterations = 0;
     let mut counters = super::Diagnostics::default();
     loop {
@@ -278,7 +309,7 @@ pub(crate) fn solve(
             .filter(|u| !active.iter().any(|a| a.row == **u))
             .copied()
             .collect();
-        let guard = Guard::new(model, inactive, tol);
+        let guard = Guard::new(model, inactive, tol, &q);
         let round = super::solve_round(
             model,
             crate::State { q, branches },
@@ -291,19 +322,28 @@ pub(crate) fn solve(
         counters.add_counts(&round.report.diagnostics);
         state = round.state;
         let mut report = round.report;
-        let cycling = changes >= options.max_iterations;
+        let cycling = changes - initial >= options.max_iterations;
         if let (Some(hit), false) = (&round.blocked, cycling) {
             for &k in hit {
                 active.push(activate(model, options, guard.inactive[k], &state.q));
                 changes += 1;
             }
+            super::rolling::record_touches(model, &active, &state.q, &mut touched);
             continue;
         }
         if report.converged() && !cycling {
             if let Some(i) = to_release(model, &round.multipliers, threshold) {
                 active.remove(i);
+                super::rolling::record_touches(model, &active, &state.q, &mut touched);
                 changes += 1;
                 continue;
+            }
+            if super::rolling::reanchor(model, options, &mut active, &touched, &state.q) {
+                rolls += 1;
+                if rolls <= super::rolling::MAX_ROLLS {
+                    continue;
+                }
+                report.termination = super::Termination::Unbounded;
             }
         }
         if cycling {
@@ -351,11 +391,12 @@ fn describe(
             }),
             Unilateral::Contact { point, ground } => {
                 let c = &model.contact_points[point];
-                let gr = &model.grounds[ground];
+                let x = unilateral::point_world(model, point, &state.q);
+                let (_, normal) = unilateral::surface(model, ground, &x);
                 let gap = unilateral::gap(model, &a.row, &state.q, &state.branches).unwrap_or(0.0);
                 let mut ft = Vector3::zeros();
                 if a.anchor.is_some() {
-                    let [t1, t2] = unilateral::tangents(&gr.normal);
+                    let [t1, t2] = unilateral::tangents(&normal);
                     ft = t1 * m[1] + t2 * m[2];
                 }
                 let fnorm = m[0];
@@ -375,9 +416,9 @@ fn describe(
                 let p = touch_point(model, a, &state.q).unwrap_or_default();
                 report.contacts.push(Contact {
                     link: c.link.clone(),
-                    ground: gr.name.clone(),
+                    ground: unilateral::surface_name(model, ground).to_string(),
                     point_world: p.into(),
-                    normal_world: gr.normal.into(),
+                    normal_world: normal.into(),
                     gap,
                     normal_force: fnorm,
                     tangential_force: ft.into(),

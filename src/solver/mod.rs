@@ -16,6 +16,7 @@
 
 mod active_set;
 mod assemble;
+mod distribution;
 mod eigen;
 mod minimize;
 mod mode_animation;
@@ -23,6 +24,7 @@ mod options;
 pub(crate) mod partition;
 mod reactions;
 mod report;
+mod rolling;
 pub(crate) mod sparse;
 mod spectrum;
 pub(crate) mod system;
@@ -41,6 +43,7 @@ use crate::error::{Error, Result};
 use crate::kinematics::Branches;
 use crate::model::{JointId, Model};
 use crate::state::{JointValues, State};
+use nalgebra::DVector;
 use system::System;
 
 /// Initial guess: forward kinematics with every joint at its `mech:initial` / `--initial`
@@ -161,8 +164,16 @@ fn stability(
 /// Stability verdict at a state that is feasible and balanced (`None` with no degree of
 /// freedom or where the energy is undefined).
 pub(crate) fn stability_at(model: &Model, state: &State) -> Option<Stability> {
+    stability_on(model, state, &[])
+}
+
+/// [`stability_at`] on the tangent space of the equality rows and the inequalities `active`
+/// (the stops and contacts that carry a force).
+pub(crate) fn stability_on(model: &Model, state: &State, active: &[Active]) -> Option<Stability> {
     let q = &state.q;
-    let sys_cons = Constraints::new(model, &lock_values(model)).on_branches(state.branches.clone());
+    let sys_cons = Constraints::new(model, &lock_values(model))
+        .with_active(model, active)
+        .on_branches(state.branches.clone());
     let mut sys = System::new(model, sys_cons);
     let part = sys.partition(q);
     if part.independent.is_empty() {
@@ -376,8 +387,16 @@ pub(crate) fn solve_round(
         diagnostics.eigenvalues_by = if eig.exact { "exact" } else { "lanczos" }.into();
         stability(&sys, &out.q, &out.part, &out.eval, &eig)
     });
-    let reactions = reactions::reactions(&sys, &out.q, &out.part, &out.eval);
-    let multipliers = active_set::active_multipliers(&sys.problem.cons, &out.part, &out.eval.mu);
+    let mut mu = DVector::zeros(sys.problem.cons.len());
+    for (k, &row) in out.part.rows.iter().enumerate() {
+        mu[row] = out.eval.mu[k];
+    }
+    if !active.is_empty() && !out.part.redundant.is_empty() {
+        let threshold = options.force_tolerance * active_set::force_scale(model);
+        distribution::spread(model, &sys.problem.cons, &out.q, &mut mu, threshold);
+    }
+    let reactions = reactions::reactions(&sys, &out.q, &mu);
+    let multipliers = active_set::active_multipliers(&sys.problem.cons, &mu);
     let blocked = out.blocked;
     diagnostics.timings.stability = stability_started.elapsed().as_secs_f64();
     let report = Report {

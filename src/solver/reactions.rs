@@ -4,27 +4,23 @@
 //! (and of locks on it); `Q = [F; Q_p]` is a force `F` through the body origin and a body-frame
 //! torque `n' = ½ G(p) Q_p` (`G = [−e, −ẽ + e0 I]`, which also removes the component along `p`).
 //! The torque about the joint origin `P` is `n_P = A n' + (r − r_P) × F`. Rows found redundant
-//! carry no multiplier, so for over-constrained models this is one admissible distribution.
+//! carry no multiplier, so for over-constrained models this is one admissible distribution (with
+//! stops and contacts, the one of module `distribution`).
 
-use super::partition::Partition;
 use super::report::Reaction;
-use super::system::{Eval, System};
+use super::system::System;
 use crate::constraints::{joint, BlockKind};
 use crate::jet::pair_of;
 use crate::math::{rotation, skew};
 use nalgebra::{DVector, Matrix3x4, Vector3, Vector4};
 
+/// The reactions from the multipliers `mu` of every row of `sys` (zero on redundant rows).
 pub(crate) fn reactions(
     sys: &System,
     q: &DVector<f64>,
-    part: &Partition,
-    eval: &Eval,
+    mu: &DVector<f64>,
 ) -> Vec<(String, Reaction)> {
     let model = sys.problem.model;
-    let mut mu = DVector::zeros(sys.problem.cons.len());
-    for (k, &row) in part.rows.iter().enumerate() {
-        mu[row] = eval.mu[k];
-    }
     let mut out = Vec::new();
     let mut rows_buf = Vec::new();
     // The joint and lock blocks of each joint (one pass: `O(N)`, not joints × blocks).

@@ -308,6 +308,19 @@ pub(super) fn read(
                     .ok_or_else(|| src.error(n, format!("{what} needs `value`")))?;
                 b.model.add_effort(Effort { joint, dof, value });
             }
+            "obstacle" => {
+                let name = src.req(n, "link")?;
+                let i = *b.link_index.get(name).ok_or_else(|| {
+                    src.error(n, format!("{what} refers to an unknown link `{name}`"))
+                })?;
+                b.model
+                    .add_obstacle(i)
+                    .map_err(|e| src.error(n, e.to_string()))?;
+            }
+            "base" => {
+                let pose = src.frame(Some(n))?;
+                b.model.set_base_pose(pose);
+            }
             "ground" => {
                 let name = n.attribute("name").unwrap_or("floor");
                 let origin = src.vec3_or(n, "xyz", Vector3::zeros())?;
@@ -397,6 +410,9 @@ pub(super) fn read(
     }
     if !b.gravity_set {
         b.model.set_gravity(options.gravity);
+    }
+    if let Some(pose) = options.base_pose {
+        b.model.set_base_pose(pose);
     }
     let default = Ground::default();
     if options.ground

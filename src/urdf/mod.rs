@@ -45,6 +45,8 @@ pub struct ImportOptions {
     pub inertia_density: Option<f64>,
     /// Add the default ground plane (z = 0, +z up) unless the file declares that plane.
     pub ground: bool,
+    /// Start pose of the root link in the world when the base floats; overrides `mech:base`.
+    pub base_pose: Option<nalgebra::Isometry3<f64>>,
 }
 
 impl Default for ImportOptions {
@@ -57,6 +59,7 @@ impl Default for ImportOptions {
             packages: Vec::new(),
             inertia_density: None,
             ground: false,
+            base_pose: None,
         }
     }
 }

@@ -147,6 +147,16 @@ const ELEMENTS: &[Element] = &[
         children: &[],
     },
     Element {
+        name: "obstacle",
+        attributes: &["link"],
+        children: &[],
+    },
+    Element {
+        name: "base",
+        attributes: FRAME,
+        children: &[],
+    },
+    Element {
         name: "contact",
         attributes: &["link", "enabled", "friction", "mu"],
         children: &[],

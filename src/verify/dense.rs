@@ -3,7 +3,9 @@
 //! the projected gradient `Nᵀ S ∇V`, and the minimum-norm efforts `τ` of
 //! `Nᵀ S B τ = Nᵀ S ∇V` (by SVD), as described in the parent module.
 
-use super::{closures, Closure, Tolerances};
+use super::unilateral::UnilateralCheck;
+use super::{closures, Closure, Tolerances, Unilaterals};
+use crate::constraints::unilateral::Active;
 use crate::constraints::Constraints;
 use crate::error::{Error, Result};
 use crate::forces::potential;
@@ -89,18 +91,47 @@ pub(super) fn project(model: &Model, state: &State) -> Result<Projection> {
     })
 }
 
-/// The dense path's `Φ`, energy, projected gradient, force scale, closures, minimum-norm
-/// efforts and unassigned force.
-#[allow(clippy::type_complexity)]
+/// What the dense checks find at a pose.
+pub(super) struct DenseChecks {
+    /// `Φ` at the pose.
+    pub(super) phi: DVector<f64>,
+    /// Potential energy \[J\].
+    pub(super) energy: f64,
+    /// `‖Nᵀ S ∇V‖∞` before the stops and contacts carry their share \[J\].
+    pub(super) projected_gradient: f64,
+    /// `‖S ∇V‖∞`, the scale of the forces \[J\].
+    pub(super) force_scale: f64,
+    /// Closure errors per joint.
+    pub(super) closure: Vec<Closure>,
+    /// Minimum-norm efforts of the scalar tree coordinates.
+    pub(super) efforts: DVector<f64>,
+    /// What no coordinate's effort can take.
+    pub(super) unassigned: f64,
+    /// The stops and contacts at the pose (module `unilateral`).
+    pub(super) unilateral: UnilateralCheck,
+    /// The stops and contacts that carry a force (the stability's tangent space).
+    pub(super) strong: Vec<Active>,
+}
+
+/// The dense checks: closure, the share of the load the stops and contacts carry (module
+/// `unilateral`), then the minimum-norm efforts `τ` of `Nᵀ S B τ = Nᵀ S (∇V − carried)`.
 pub(super) fn dense_checks(
     model: &Model,
     state: &State,
     tol: &Tolerances,
+    uni: &Unilaterals,
     coords: &[(crate::model::JointId, usize, crate::jet::Scalar)],
-) -> Result<(DVector<f64>, f64, f64, f64, Vec<Closure>, DVector<f64>, f64)> {
-    let p = project(model, state)?;
+) -> Result<DenseChecks> {
+    let mut p = project(model, state)?;
     let n = state.q.len();
     let closure = closures(model, &p.cons, &p.phi, tol.constraint);
+    let projected_gradient = (p.null.transpose() * &p.grad_s).amax();
+    let force_scale = p.grad_s.amax();
+    // The stops and contacts take their share of the load first.
+    let tau = tol.force + tol.relative * force_scale;
+    let (unilateral, carried, strong) =
+        super::unilateral::check(model, state, uni, &p, tol.constraint, tau);
+    p.grad_s -= carried;
     // The (scaled) gradients of the scalar coordinates.
     let b_cols: Vec<DVector<f64>> = coords
         .iter()
@@ -127,13 +158,15 @@ pub(super) fn dense_checks(
         let rest = (&rhs - m * &tau).amax();
         (tau, rest)
     };
-    Ok((
-        p.phi,
-        p.energy,
-        rhs.amax(),
-        p.grad_s.amax(),
+    Ok(DenseChecks {
+        phi: p.phi,
+        energy: p.energy,
+        projected_gradient,
+        force_scale,
         closure,
         efforts,
         unassigned,
-    ))
+        unilateral,
+        strong,
+    })
 }

@@ -27,9 +27,11 @@ mod check;
 mod dense;
 mod pose;
 mod reduced;
+mod unilateral;
 
 pub use check::{check, ModelCheck};
 pub use pose::{parse_pose, pose_state, read_pose};
+pub use unilateral::{UnilateralCheck, Unilaterals};
 
 use crate::constraints::{joint, BlockKind, Constraints};
 use crate::error::{Error, Result};
@@ -130,6 +132,9 @@ pub struct Verification {
     pub force_scale: f64,
     /// The effort tolerance applied: `force + relative · force_scale` \[N m or N\].
     pub effort_tolerance: f64,
+    /// Stops and contacts at the pose (module `unilateral`), flattened into the JSON.
+    #[serde(flatten)]
+    pub unilateral: UnilateralCheck,
 }
 
 /// Whether `model` is verified on the sparse path (module `reduced`).
@@ -192,7 +197,21 @@ pub fn balance(model: &Model, state: &State) -> Result<Balance> {
 /// # Ok::<(), restpose::Error>(())
 /// ```
 pub fn verify(model: &Model, state: &State, tol: &Tolerances) -> Result<Verification> {
-    verify_on(model, state, tol, sparse_path(model))
+    verify_with_options(model, state, tol, &Unilaterals::default())
+}
+
+/// [`verify`] with stops and contacts as `uni` says: they carry the forces (module `unilateral`).
+/// # Errors
+/// As [`verify`]; [`Error::Model`] for a pose touching them on too large a model.
+pub fn verify_with_options(
+    model: &Model,
+    state: &State,
+    tol: &Tolerances,
+    uni: &Unilaterals,
+) -> Result<Verification> {
+    let sparse =
+        sparse_path(model) && !unilateral::dense_needed(model, state, uni, tol.constraint)?;
+    verify_on(model, state, tol, uni, sparse)
 }
 
 /// Closure errors per joint from the rows `cons` and their values `phi`.
@@ -256,7 +275,13 @@ fn tree_coordinates(
 /// On the sparse path the stability verdict reuses the partition and evaluation of the
 /// balance check, and is computed on a second thread while the efforts are (kept only when
 /// the pose passes); both only read the model and the state.
-fn verify_on(model: &Model, state: &State, tol: &Tolerances, sparse: bool) -> Result<Verification> {
+fn verify_on(
+    model: &Model,
+    state: &State,
+    tol: &Tolerances,
+    uni: &Unilaterals,
+    sparse: bool,
+) -> Result<Verification> {
     let (
         coords,
         phi,
@@ -267,6 +292,8 @@ fn verify_on(model: &Model, state: &State, tol: &Tolerances, sparse: bool) -> Re
         efforts,
         unassigned,
         stability,
+        contact,
+        strong,
     ) = if sparse {
         let locks = crate::solver::lock_values(model);
         let r = reduced::reduced(model, state, &locks, locks.len())?;
@@ -312,25 +339,25 @@ fn verify_on(model: &Model, state: &State, tol: &Tolerances, sparse: bool) -> Re
             DVector::from_vec(efforts),
             unassigned,
             stability,
+            UnilateralCheck::default(),
+            Vec::new(),
         )
     } else {
         let coords = tree_coordinates(model, state);
-        let (phi, energy, pg, force_scale, closure, efforts, unassigned) =
-            dense::dense_checks(model, state, tol, &coords)?;
-        let passed = passes(phi.amax(), efforts.as_slice(), unassigned, force_scale, tol);
-        let stability = passed
-            .then(|| crate::solver::stability_at(model, state))
-            .flatten();
+        let d = dense::dense_checks(model, state, tol, uni, &coords)?;
+        // The stability is judged below, once the stops and contacts have settled.
         (
             coords,
-            phi,
-            energy,
-            pg,
-            force_scale,
-            closure,
-            efforts,
-            unassigned,
-            stability,
+            d.phi,
+            d.energy,
+            d.projected_gradient,
+            d.force_scale,
+            d.closure,
+            d.efforts,
+            d.unassigned,
+            None,
+            d.unilateral,
+            d.strong,
         )
     };
     let imbalance: Vec<Imbalance> = coords
@@ -347,13 +374,25 @@ fn verify_on(model: &Model, state: &State, tol: &Tolerances, sparse: bool) -> Re
         .max_by(|a, b| a.effort.abs().total_cmp(&b.effort.abs()))
         .cloned();
     let constraint_residual = phi.amax();
-    let passed = passes(
+    let effort_tolerance = tol.force + tol.relative * force_scale;
+    let balanced = passes(
         constraint_residual,
         efforts.as_slice(),
         unassigned,
         force_scale,
         tol,
     );
+    let mut contact = contact;
+    let passed = contact.settle(tol.constraint, balanced) && balanced;
+    // The sparse path judged the stability beside the efforts (only where no stop or contact
+    // touches: see `verify_with_options`); the dense path judges it here, on the tangent space
+    // of the stops and contacts that carry a force.
+    let stability = match (passed, sparse) {
+        (false, _) => None,
+        (true, true) => stability,
+        (true, false) if !strong.is_empty() => crate::solver::stability_on(model, state, &strong),
+        (true, false) => crate::solver::stability_at(model, state),
+    };
     Ok(Verification {
         passed,
         constraint_residual,
@@ -366,7 +405,8 @@ fn verify_on(model: &Model, state: &State, tol: &Tolerances, sparse: bool) -> Re
         stability,
         tolerances: *tol,
         force_scale,
-        effort_tolerance: tol.force + tol.relative * force_scale,
+        effort_tolerance,
+        unilateral: contact,
     })
 }
 
@@ -402,6 +442,10 @@ mod tests {
     //! The sparse path against the dense path on the same poses.
     use super::*;
     use crate::urdf::{load_str, ImportOptions};
+
+    fn verify_on(m: &Model, s: &State, tol: &Tolerances, sparse: bool) -> Result<Verification> {
+        super::verify_on(m, s, tol, &Unilaterals::default(), sparse)
+    }
 
     fn load(text: &str) -> Model {
         load_str(text, "m.urdf", &ImportOptions::default())

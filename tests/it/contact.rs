@@ -111,7 +111,7 @@ fn floating(text: &str) -> restpose::Model {
 }
 
 /// A box released tilted 0.5 m above the ground rests on its largest face: `V = m g h/2`,
-/// four supporting vertices, normal forces summing to `m g`; sliding and yaw are neutral.
+/// four supporting vertices carrying `m g / 4` each; sliding and yaw are neutral.
 #[test]
 fn a_tilted_box_falls_and_rests_flat_on_a_face() {
     let m = floating(BOX);
@@ -133,7 +133,10 @@ fn a_tilted_box_falls_and_rests_flat_on_a_face() {
     let total: f64 = r.contacts.iter().map(|c| c.normal_force).sum();
     assert_abs_diff_eq!(total, MG, epsilon = 1e-9);
     for c in &r.contacts {
-        assert!(c.normal_force >= -1e-9 && c.gap.abs() < 1e-9);
+        // Statically indeterminate (four rows, three degrees of freedom): the least-norm
+        // distribution, by symmetry `m g / 4` on each vertex.
+        assert_abs_diff_eq!(c.normal_force, MG / 4.0, epsilon = 1e-9);
+        assert!(c.gap.abs() < 1e-9);
         assert_abs_diff_eq!(c.point_world[2], 0.0, epsilon = 1e-9);
         assert_eq!(c.state, ContactState::Touching);
     }
@@ -143,42 +146,69 @@ fn a_tilted_box_falls_and_rests_flat_on_a_face() {
     assert_eq!(r.stability.unwrap().verdict, Verdict::Neutral);
 }
 
-/// A sphere on a tilted frictionless plane slides away (unbounded); with sticking friction it
-/// rests, needing `tan(slope)` of friction, and is reported slipping when `mu` is below that.
-#[test]
-fn friction_holds_a_ball_on_a_slope_and_says_when_it_cannot() {
-    let slope = 0.3f64;
-    let text = format!(
-        r#"<robot name="ball" xmlns:mech="urn:urdf-mech:1">
-  <link name="ball">
-    <inertial><mass value="1"/><inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><geometry><sphere radius="0.1"/></geometry></collision>
+/// A body on a plane sloping by `slope` about y: a uniform ball of radius 0.1 m
+/// (`box = false`) or the 0.4 × 0.3 × 0.2 m box.
+fn on_slope(slope: f64, box_: bool) -> restpose::Model {
+    let shape = if box_ {
+        r#"<box size="0.4 0.3 0.2"/>"#
+    } else {
+        r#"<sphere radius="0.1"/>"#
+    };
+    floating(&format!(
+        r#"<robot name="slope" xmlns:mech="urn:urdf-mech:1">
+  <link name="body">
+    <inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry>{shape}</geometry></collision>
   </link>
   <mech:ground normal="{} 0 {}" xyz="0 0 -0.1"/>
 </robot>"#,
         slope.sin(),
         slope.cos()
-    );
-    let m = floating(&text);
+    ))
+}
+
+/// A box on a frictionless slope slides away (unbounded). With sticking friction it rests
+/// on its face: the ground's force balances the weight, `Σ f_n = m g cos(slope)` and
+/// `|Σ f_t| = m g sin(slope)` (closed form); with `mu` below `tan(slope)` a contact slips. A
+/// uniform ball does not rest even with sticking friction: it rolls (no slip at the touching
+/// point), and the search gives up.
+#[test]
+fn friction_holds_a_box_on_a_slope_and_says_when_it_cannot() {
+    let slope = 0.3f64;
+    let m = on_slope(slope, true);
     let stick = Options {
         friction: Friction::Stick,
         ..Default::default()
     };
-    let (_, r) = restpose::solve(&m, &stick).unwrap();
-    assert!(r.converged(), "{:?}", r.termination);
-    assert_eq!(r.contacts.len(), 1);
-    let c = &r.contacts[0];
-    assert_abs_diff_eq!(c.normal_force, 9.81 * slope.cos(), epsilon = 1e-8);
-    assert_abs_diff_eq!(c.required_friction, slope.tan(), epsilon = 1e-8);
-    assert_eq!(c.state, ContactState::Sticking);
+    let (s, rep) = restpose::solve(&m, &stick).unwrap();
+    assert!(rep.converged(), "{:?}", rep.termination);
+    assert!(rep.contacts.len() >= 3, "{:?}", rep.contacts);
+    let fnorm: f64 = rep.contacts.iter().map(|c| c.normal_force).sum();
+    let ft: Vector3<f64> = rep
+        .contacts
+        .iter()
+        .map(|c| Vector3::from(c.tangential_force))
+        .sum();
+    assert_abs_diff_eq!(fnorm, 9.81 * slope.cos(), epsilon = 1e-8);
+    assert_abs_diff_eq!(ft.norm(), 9.81 * slope.sin(), epsilon = 1e-8);
+    assert!(rep
+        .contacts
+        .iter()
+        .all(|c| c.state == ContactState::Sticking));
+    assert_verified_contacts(&m, &s, Friction::Stick);
     let weak = Options {
         mu: Some(0.2),
         ..stick.clone()
     };
-    let (_, r) = restpose::solve(&m, &weak).unwrap();
-    assert_eq!(r.contacts[0].state, ContactState::Slipping);
-    let (_, r) = restpose::solve(&m, &Options::default()).unwrap();
-    assert!(!r.converged());
+    let (_, rep) = restpose::solve(&m, &weak).unwrap();
+    assert!(rep
+        .contacts
+        .iter()
+        .any(|c| c.state == ContactState::Slipping));
+    let (_, rep) = restpose::solve(&m, &Options::default()).unwrap();
+    assert!(!rep.converged());
+    let (_, rep) = restpose::solve(&on_slope(slope, false), &stick).unwrap();
+    assert!(!rep.converged(), "{:?}", rep.termination);
 }
 
 /// The Solo-12 quadruped (published file, foot spheres and joint springs added) standing on
@@ -198,9 +228,11 @@ fn solo12_stands_like_the_independent_rigid_contact_solution() {
     let m = load_file(format!("{dir}/robots/solo12/solo12_ground.urdf"), &opts)
         .unwrap()
         .model;
+    // Sticking: the foot rolls from where it first touched (module docs of `active_set`), as
+    // in the rolling-contact reference.
     for (run, key, friction) in [
         ("none", "rigid", Friction::None),
-        ("stick", "rigid_material", Friction::Stick),
+        ("stick", "rigid_rolling", Friction::Stick),
     ] {
         let rigid = &reference["runs"][run][key];
         let options = Options {
@@ -245,4 +277,550 @@ fn solo12_stands_like_the_independent_rigid_contact_solution() {
             epsilon = 1e-6
         );
     }
+}
+
+// ---- verify: poses resting on stops and grounds -----------------------------------------
+
+use restpose::verify::{verify_with_options, Tolerances, Unilaterals};
+
+/// Asserts that `verify` accepts `s` (with `friction`).
+fn assert_verified_contacts(m: &restpose::Model, s: &State, friction: Friction) {
+    let v = check(m, s, friction);
+    assert!(v.passed, "{}: {v:?}", m.name);
+}
+
+fn check(m: &restpose::Model, s: &State, friction: Friction) -> restpose::verify::Verification {
+    let uni = Unilaterals {
+        friction,
+        ..Default::default()
+    };
+    verify_with_options(m, s, &Tolerances::default(), &uni).unwrap()
+}
+
+/// analyze's answer on a stop passes verify, which finds the stop's effort itself (closed
+/// form `m g cos θ + k θ`); with limits ignored the same pose needs that effort from the joint
+/// and fails.
+#[test]
+fn verify_accepts_a_pose_on_a_stop_and_finds_its_effort() {
+    let (k, lower) = (5.0, -0.5);
+    let m = pendulum(k, lower, 1.0, 0.3);
+    let (s, _) = solve(&m);
+    let v = check(&m, &s, Friction::None);
+    assert!(v.passed, "{v:?}");
+    assert_eq!(v.unilateral.active_limits.len(), 1);
+    let l = &v.unilateral.active_limits[0];
+    assert_eq!(l.bound, "lower");
+    assert_abs_diff_eq!(l.effort, MG * lower.cos() + k * lower, epsilon = 1e-8);
+    assert!(v.unilateral.failures.is_empty() && v.unilateral.penetration == 0.0);
+    assert!(v.unilateral.complementarity <= 1e-8 * l.effort.abs());
+    let ignore = Unilaterals {
+        limits: Limits::Ignore,
+        ..Default::default()
+    };
+    let v = verify_with_options(&m, &s, &Tolerances::default(), &ignore).unwrap();
+    assert!(!v.passed);
+    let worst = v.max_imbalance.unwrap();
+    assert_eq!(worst.joint, "pivot");
+    assert_abs_diff_eq!(worst.effort, MG * lower.cos() + k * lower, epsilon = 1e-8);
+}
+
+/// A bar on its lower stop whose spring lifts it off: the stop would have to pull, so the pose
+/// fails, naming the stop and the pulling effort `m g cos θ + k θ < 0`; a pose beyond the stop
+/// fails as well.
+#[test]
+fn verify_refuses_a_stop_that_would_have_to_pull_and_a_pose_beyond_a_stop() {
+    let (k, lower) = (20.0, -1.2);
+    let m = pendulum(k, lower, 1.0, lower);
+    let pulling = MG * lower.cos() + k * lower;
+    assert!(pulling < -1.0);
+    let on_stop = State::from_joint_values(&m, &[("pivot".to_string(), vec![lower])].into());
+    let v = check(&m, &on_stop, Friction::None);
+    assert!(!v.passed);
+    assert_eq!(
+        v.unilateral.failures.len(),
+        1,
+        "{:?}",
+        v.unilateral.failures
+    );
+    assert!(v.unilateral.failures[0].contains("pivot.lower_limit"));
+    assert!(v.unilateral.failures[0].contains(&format!("{pulling:.3e}")));
+    // The stop carries nothing; the joint needs the whole effort.
+    assert_abs_diff_eq!(v.unilateral.active_limits[0].effort, 0.0, epsilon = 1e-12);
+    assert_abs_diff_eq!(v.max_imbalance.unwrap().effort, pulling, epsilon = 1e-8);
+    let beyond = State::from_joint_values(&m, &[("pivot".to_string(), vec![lower - 0.01])].into());
+    let v = check(&m, &beyond, Friction::None);
+    assert!(!v.passed);
+    assert_abs_diff_eq!(v.unilateral.penetration, 0.01, epsilon = 1e-12);
+    assert!(v
+        .unilateral
+        .failures
+        .iter()
+        .any(|f| f.contains("beyond its stop")));
+}
+
+/// The box flat on the ground passes with `m g / 4` on each vertex (the minimum-norm
+/// distribution); pushed 1 mm into the ground it fails (penetration), lifted 1 mm it fails
+/// (nothing holds it: the floating base's unassigned force is its weight).
+#[test]
+fn verify_accepts_the_flat_box_and_refuses_it_in_or_above_the_ground() {
+    let m = floating(BOX);
+    let mut q = DVector::zeros(7);
+    q[2] = 0.1;
+    q[3] = 1.0;
+    let flat = State {
+        q,
+        branches: Default::default(),
+    };
+    let v = check(&m, &flat, Friction::None);
+    assert!(v.passed, "{v:?}");
+    assert_eq!(v.unilateral.contacts.len(), 4);
+    for c in &v.unilateral.contacts {
+        assert_abs_diff_eq!(c.normal_force, MG / 4.0, epsilon = 1e-9);
+    }
+    assert_eq!(v.stability.unwrap().verdict, Verdict::Neutral);
+    let mut sunk = flat.clone();
+    sunk.q[2] -= 1e-3;
+    let v = check(&m, &sunk, Friction::None);
+    assert!(!v.passed);
+    assert_abs_diff_eq!(v.unilateral.penetration, 1e-3, epsilon = 1e-12);
+    assert_eq!(
+        v.unilateral.failures.len(),
+        4,
+        "{:?}",
+        v.unilateral.failures
+    );
+    let mut lifted = flat.clone();
+    lifted.q[2] += 1e-3;
+    let v = check(&m, &lifted, Friction::None);
+    assert!(!v.passed && v.unilateral.contacts.is_empty());
+    assert!(v.unassigned > 0.1 * MG, "{}", v.unassigned);
+    // analyze's own answer from a tilted start passes too.
+    let (s, _) = restpose::solve_from(&m, flat, &Options::default()).unwrap();
+    assert!(check(&m, &s, Friction::None).passed);
+}
+
+/// The box on the slope: analyze's sticking answer passes verify with friction, whose
+/// forces balance the weight (closed form); frictionless the same pose fails (it would slide),
+/// and with `mu` below `tan(slope)` it fails as slipping. A uniform ball resting where the
+/// box's face is fails: it would roll.
+#[test]
+fn verify_checks_friction_on_the_slope() {
+    let slope = 0.3f64;
+    let m = on_slope(slope, true);
+    let stick = Options {
+        friction: Friction::Stick,
+        ..Default::default()
+    };
+    let (s, _) = restpose::solve(&m, &stick).unwrap();
+    let v = check(&m, &s, Friction::Stick);
+    assert!(v.passed, "{v:?}");
+    let fnorm: f64 = v.unilateral.contacts.iter().map(|c| c.normal_force).sum();
+    let ft: Vector3<f64> = v
+        .unilateral
+        .contacts
+        .iter()
+        .map(|c| Vector3::from(c.tangential_force))
+        .sum();
+    assert_abs_diff_eq!(fnorm, 9.81 * slope.cos(), epsilon = 1e-8);
+    assert_abs_diff_eq!(ft.norm(), 9.81 * slope.sin(), epsilon = 1e-8);
+    assert!(!check(&m, &s, Friction::None).passed);
+    let weak = Unilaterals {
+        friction: Friction::Stick,
+        mu: Some(0.2),
+        ..Default::default()
+    };
+    let v = verify_with_options(&m, &s, &Tolerances::default(), &weak).unwrap();
+    assert!(!v.passed);
+    assert!(v
+        .unilateral
+        .contacts
+        .iter()
+        .any(|c| c.state == ContactState::Slipping));
+    assert!(v.unilateral.failures[0].contains("friction coefficient"));
+    // A ball touching the slope with its centre 0.1 m above it: the friction at the touching
+    // point cannot stop it rolling.
+    let ball = on_slope(slope, false);
+    let mut q = DVector::zeros(7);
+    q[3] = 1.0;
+    let n = Vector3::new(slope.sin(), 0.0, slope.cos());
+    let c = Vector3::new(0.0, 0.0, -0.1) + n * 0.1;
+    q[0] = c.x;
+    q[2] = c.z;
+    let v = check(
+        &ball,
+        &State {
+            q,
+            branches: Default::default(),
+        },
+        Friction::Stick,
+    );
+    assert_eq!(v.unilateral.contacts.len(), 1);
+    assert!(!v.passed && v.unassigned > 0.01, "{v:?}");
+}
+
+/// analyze's Solo-12 answers (frictionless and sticking) pass verify with the same friction
+/// setting; the frictionless verify refuses the sticking pose (its feet need friction), and a
+/// pose with the base pushed 2 mm down (feet into the ground) fails.
+#[test]
+fn verify_accepts_solo12_standing_and_refuses_it_sunk() {
+    let dir = env!("CARGO_MANIFEST_DIR");
+    let opts = ImportOptions {
+        floating_base: true,
+        ..Default::default()
+    };
+    let m = load_file(format!("{dir}/robots/solo12/solo12_ground.urdf"), &opts)
+        .unwrap()
+        .model;
+    for friction in [Friction::None, Friction::Stick] {
+        let options = Options {
+            friction,
+            ..Default::default()
+        };
+        let (s, r) = restpose::solve(&m, &options).unwrap();
+        let v = check(&m, &s, friction);
+        assert!(v.passed, "{friction:?}: {v:?}");
+        assert_eq!(v.unilateral.contacts.len(), 4);
+        for c in &v.unilateral.contacts {
+            let a = r.contacts.iter().find(|a| a.link == c.link).unwrap();
+            assert_abs_diff_eq!(c.normal_force, a.normal_force, epsilon = 1e-6);
+            assert_abs_diff_eq!(c.required_friction, a.required_friction, epsilon = 1e-6);
+        }
+        if friction == Friction::Stick {
+            assert!(!check(&m, &s, Friction::None).passed);
+        }
+        let mut sunk = s.clone();
+        for b in 0..m.bodies.len() {
+            sunk.q[7 * b + 2] -= 2e-3;
+        }
+        let v = check(&m, &sunk, friction);
+        assert!(!v.passed);
+        assert_abs_diff_eq!(v.unilateral.penetration, 2e-3, epsilon = 1e-9);
+    }
+}
+
+// ---- a spring-loaded arm folding onto the floor, a rope lying on the ground --------------
+
+/// A two-link arm on a hinge 0.5 m above the floor, both joints about y with springs
+/// (`k₁ = 5`, `k₂ = 3` N m/rad, reference straight along +x), links 0.4 m and 1 kg with their
+/// centres of mass at mid-length, a sphere of radius 0.02 m at the tip. A turn `θ` about y
+/// takes +x to `(cos θ, 0, −sin θ)`.
+const ARM: &str = r#"<robot name="arm" xmlns:mech="urn:urdf-mech:1">
+  <link name="world"/>
+  <link name="upper"><inertial><origin xyz="0.2 0 0"/><mass value="1"/>
+    <inertia ixx="1e-4" ixy="0" ixz="0" iyy="0.0134" iyz="0" izz="0.0134"/></inertial></link>
+  <link name="fore"><inertial><origin xyz="0.2 0 0"/><mass value="1"/>
+    <inertia ixx="1e-4" ixy="0" ixz="0" iyy="0.0134" iyz="0" izz="0.0134"/></inertial>
+    <collision><origin xyz="0.4 0 0"/><geometry><sphere radius="0.02"/></geometry></collision></link>
+  <joint name="shoulder" type="continuous"><parent link="world"/><child link="upper"/>
+    <origin xyz="0 0 0.5"/><axis xyz="0 1 0"/></joint>
+  <joint name="elbow" type="continuous"><parent link="upper"/><child link="fore"/>
+    <origin xyz="0.4 0 0"/><axis xyz="0 1 0"/></joint>
+  <mech:joint_spring joint="shoulder" stiffness="5"/>
+  <mech:joint_spring joint="elbow" stiffness="3"/>
+  <mech:initial joint="shoulder" value="0.3"/>
+  <mech:initial joint="elbow" value="0.3"/>
+  <mech:ground/>
+</robot>"#;
+
+/// The arm's energy in joint coordinates, and its tip height.
+fn arm_energy(t1: f64, t2: f64) -> (f64, f64) {
+    let (h, l, g) = (0.5, 0.4, 9.81);
+    let z1 = h - 0.5 * l * t1.sin();
+    let z2 = h - l * t1.sin() - 0.5 * l * (t1 + t2).sin();
+    let tip = h - l * t1.sin() - l * (t1 + t2).sin();
+    (
+        g * (z1 + z2) + 0.5 * 5.0 * t1 * t1 + 0.5 * 3.0 * t2 * t2,
+        tip,
+    )
+}
+
+/// Gravity folds the arm until its tip rests on the floor. Independent answer: on the contact
+/// (`tip = 0.02`) the elbow angle is a function of the shoulder angle,
+/// `θ₁ + θ₂ = asin((0.5 − 0.4 sin θ₁ − 0.02)/0.4)` (the branch with the forearm pointing down),
+/// and the energy is minimized over `θ₁` by golden-section search; the free minimum would put
+/// the tip through the floor, so the contact is active.
+#[test]
+fn a_spring_loaded_arm_folds_onto_the_floor() {
+    let m = model_from(ARM);
+    let (s, r) = solve(&m);
+    // Without the floor: Newton on the joint-space gradient from the same start.
+    let free = {
+        let (mut t1, mut t2) = (0.3f64, 0.3f64);
+        for _ in 0..100 {
+            let h = 1e-5;
+            let v = |a: f64, b: f64| arm_energy(a, b).0;
+            let g1 = (v(t1 + h, t2) - v(t1 - h, t2)) / (2.0 * h);
+            let g2 = (v(t1, t2 + h) - v(t1, t2 - h)) / (2.0 * h);
+            t1 -= 0.02 * g1;
+            t2 -= 0.02 * g2;
+        }
+        (t1, t2)
+    };
+    assert!(
+        arm_energy(free.0, free.1).1 < 0.0,
+        "the free arm would go through the floor"
+    );
+    // On the floor, both branches of the asin are scanned and the lower energy kept.
+    let branch = |t1: f64, first: bool| {
+        let s12 = ((0.5 - 0.4 * t1.sin() - 0.02) / 0.4).clamp(-1.0, 1.0);
+        let t12 = if first {
+            s12.asin()
+        } else {
+            std::f64::consts::PI - s12.asin()
+        };
+        (t12 - t1, arm_energy(t1, t12 - t1).0)
+    };
+    let mut best = (f64::INFINITY, 0.0, 0.0);
+    for first in [true, false] {
+        let (mut a, mut b) = (-0.5f64, 1.5f64);
+        // Coarse scan, then golden section around the best sample.
+        let mut t = a;
+        let mut arg = a;
+        let mut low = f64::INFINITY;
+        while t <= b {
+            let v = branch(t, first).1;
+            if v < low {
+                low = v;
+                arg = t;
+            }
+            t += 1e-3;
+        }
+        a = arg - 2e-3;
+        b = arg + 2e-3;
+        let gr = (5f64.sqrt() - 1.0) / 2.0;
+        for _ in 0..200 {
+            let c = b - gr * (b - a);
+            let d = a + gr * (b - a);
+            if branch(c, first).1 < branch(d, first).1 {
+                b = d;
+            } else {
+                a = c;
+            }
+        }
+        let t1 = 0.5 * (a + b);
+        let (t2, v) = branch(t1, first);
+        if v < best.0 {
+            best = (v, t1, t2);
+        }
+    }
+    let (v, t1, t2) = best;
+    assert_abs_diff_eq!(r.energy.total, v, epsilon = 1e-9);
+    assert_abs_diff_eq!(s.joint(&m, "shoulder").unwrap()[0], t1, epsilon = 1e-6);
+    assert_abs_diff_eq!(s.joint(&m, "elbow").unwrap()[0], t2, epsilon = 1e-6);
+    assert_eq!(r.contacts.len(), 1);
+    assert!(r.contacts[0].normal_force > 0.1, "{:?}", r.contacts);
+    assert_verified_contacts(&m, &s, Friction::None);
+}
+
+/// The generated 100-link rope hangs from the world onto the ground: converges; every contact
+/// reported touches (`|g| ≤ 1e-9` m) and pushes; `verify` finds no penetration and balances it
+/// with non-negative forces; the energy equals the one written here in joint coordinates; the
+/// vertical forces balance the weight (anchor reaction plus normal forces = `n m g`).
+#[test]
+fn a_rope_lies_partly_on_the_ground() {
+    let n = 100;
+    let m = model_from(&restpose::generate::rope(n));
+    let (s, r) = solve(&m);
+    assert!(r.contacts.len() > n / 2, "{} contacts", r.contacts.len());
+    for c in &r.contacts {
+        assert!(c.gap.abs() <= 1e-9 && c.normal_force >= 0.0, "{c:?}");
+    }
+    let v = check(&m, &s, Friction::None);
+    assert!(v.passed, "{:?}", v.unilateral.failures);
+    assert_eq!(v.unilateral.penetration, 0.0);
+    // Joint-space energy: link i leaves p_i along (cos φ_i, 0, −sin φ_i), φ_i = Σ_{j ≤ i} θ_j.
+    let (l, mass, g, k) = (0.05, 0.05, 9.81, 2.0);
+    let h = n.div_ceil(3) as f64 * l * 0.3f64.cos() + 0.01;
+    let (mut z, mut phi, mut energy) = (h, 0.0, 0.0);
+    for i in 0..n {
+        let th = s.joint(&m, &format!("joint{i}")).unwrap()[0];
+        phi += th;
+        energy += mass * g * (z - 0.5 * l * phi.sin()) + 0.5 * k * th * th;
+        z -= l * phi.sin();
+    }
+    assert_abs_diff_eq!(r.energy.total, energy, epsilon = 1e-9);
+    let anchor = r.reactions.iter().find(|(j, _)| j == "joint0").unwrap();
+    let normal: f64 = r.contacts.iter().map(|c| c.normal_force).sum();
+    assert_abs_diff_eq!(
+        anchor.1.force_world[2] + normal,
+        n as f64 * mass * g,
+        epsilon = 1e-8
+    );
+}
+
+// ---- the start pose of a floating base ---------------------------------------------------
+
+/// `<mech:base xyz rpy/>` starts the floating box 0.5 m up, turned 90° about x: it falls onto
+/// its 0.4 × 0.2 m face (`V = m g · 0.15`, closed form). From the default start (at the origin,
+/// half in the ground) it rests on its largest face (`V = m g · 0.1`). The importer option
+/// (the CLI's `--base-xyz` / `--base-rpy`) overrides the file.
+#[test]
+fn a_floating_base_starts_at_its_base_pose() {
+    let text = BOX.replace(
+        "<mech:ground/>",
+        r#"<mech:ground/><mech:base xyz="0 0 0.5" rpy="1.5707963267948966 0 0"/>"#,
+    );
+    let m = floating(&text);
+    let start = restpose::solver::initial_state(&m);
+    let pose = start.link_pose(&m, "box").unwrap();
+    assert_abs_diff_eq!(pose.translation.vector.z, 0.5, epsilon = 1e-12);
+    assert_abs_diff_eq!((pose.rotation * Vector3::y()).z, 1.0, epsilon = 1e-12);
+    let (s, r) = solve(&m);
+    // The height of the centre of mass to 1 nm (the contacts' rows hold to the corrector's
+    // tolerance).
+    assert_abs_diff_eq!(r.energy.total, MG * 0.15, epsilon = MG * 1e-9);
+    assert_eq!(r.contacts.len(), 4);
+    assert_verified_contacts(&m, &s, Friction::None);
+    let (_, r) = solve(&floating(BOX));
+    assert_abs_diff_eq!(r.energy.total, MG * 0.1, epsilon = MG * 1e-9);
+    let opts = ImportOptions {
+        floating_base: true,
+        base_pose: Some(nalgebra::Isometry3::translation(0.0, 0.0, 0.3)),
+        ..Default::default()
+    };
+    let m = load_str(&text, "test.urdf", &opts).unwrap().model;
+    let start = restpose::solver::initial_state(&m);
+    let pose = start.link_pose(&m, "box").unwrap();
+    assert_abs_diff_eq!(pose.translation.vector.z, 0.3, epsilon = 1e-12);
+    assert_abs_diff_eq!(pose.rotation.angle(), 0.0, epsilon = 1e-12);
+    let (_, r) = solve(&m);
+    assert_abs_diff_eq!(r.energy.total, MG * 0.1, epsilon = MG * 1e-9);
+}
+
+/// The command line: `verify --pose` reads analyze's result JSON of the Solo-12 with sticking
+/// feet, including the floating base's pose (`links`), and passes it with `--friction stick`
+/// (exit 0, the contacts in its JSON); frictionless it fails (exit 4, the feet need friction).
+#[test]
+fn verify_command_accepts_analyze_json_of_a_robot_standing_on_the_ground() {
+    let dir = env!("CARGO_MANIFEST_DIR");
+    let file = format!("{dir}/robots/solo12/solo12_ground.urdf");
+    let tmp = std::env::temp_dir().join(format!("restpose-contact-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).unwrap();
+    let (result, checked) = (tmp.join("r.json"), tmp.join("v.json"));
+    let run = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_restpose"))
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let a = run(&[
+        "analyze",
+        &file,
+        "--floating-base",
+        "--friction",
+        "stick",
+        "-q",
+        "--json",
+        result.to_str().unwrap(),
+    ]);
+    assert!(a.status.success(), "{}", String::from_utf8_lossy(&a.stderr));
+    let v = run(&[
+        "verify",
+        &file,
+        "--floating-base",
+        "--friction",
+        "stick",
+        "-q",
+        "--pose",
+        result.to_str().unwrap(),
+        "--json",
+        checked.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        v.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&v.stderr)
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&checked).unwrap()).unwrap();
+    assert_eq!(json["passed"], true);
+    assert_eq!(json["contacts"].as_array().unwrap().len(), 4);
+    assert_eq!(json["penetration"], 0.0);
+    let v = run(&[
+        "verify",
+        &file,
+        "--floating-base",
+        "-q",
+        "--pose",
+        result.to_str().unwrap(),
+    ]);
+    assert_eq!(v.status.code(), Some(4));
+    let _ = std::fs::remove_dir_all(&tmp);
+}
+
+// ---- obstacles: collision shapes of world-fixed links -----------------------------------
+
+/// A 1 kg ball (radius 0.1 m) on a hinge: a massless arm of 0.5 m from a pivot at the origin
+/// (about y), the ball's centre at its end, resting on a world-fixed box obstacle whose top is
+/// at `z = −0.3`. Closed form: the ball touches when its centre is at `z = −0.2`, i.e. the arm
+/// at `θ = asin(0.2/0.5)` below the horizontal; the contact force is vertical (the box's top
+/// face) and acts below the ball's centre, so moments about the pivot give
+/// `f_n · 0.5 cos θ = m g · 0.5 cos θ`, `f_n = m g = 9.81 N`; `V = m g z = −1.962 J`.
+const BALL_ON_BOX: &str = r#"<robot name="ball_on_box" xmlns:mech="urn:urdf-mech:1">
+  <link name="world"/>
+  <link name="table">
+    <collision><origin xyz="0.5 0 -0.8"/><geometry><box size="1 1 1"/></geometry></collision>
+  </link>
+  <joint name="mount" type="fixed"><parent link="world"/><child link="table"/></joint>
+  <link name="arm">
+    <inertial><origin xyz="0.5 0 0"/><mass value="1"/><inertia ixx="0.004" iyy="0.004" izz="0.004" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><origin xyz="0.5 0 0"/><geometry><sphere radius="0.1"/></geometry></collision>
+  </link>
+  <joint name="pivot" type="continuous"><parent link="world"/><child link="arm"/><axis xyz="0 1 0"/></joint>
+  <mech:obstacle link="table"/>
+  <mech:contact link="arm"/>
+</robot>"#;
+
+#[test]
+fn a_ball_rests_on_a_fixed_box() {
+    let m = model_from(BALL_ON_BOX);
+    assert_eq!(m.obstacles.len(), 1);
+    let (s, r) = solve(&m);
+    let th = s.joint(&m, "pivot").unwrap()[0];
+    assert_abs_diff_eq!(th, (0.2f64 / 0.5).asin(), epsilon = 1e-9);
+    assert_eq!(r.contacts.len(), 1, "{:?}", r.contacts);
+    let c = &r.contacts[0];
+    assert_eq!(c.ground, "table");
+    assert_abs_diff_eq!(c.normal_force, 9.81, epsilon = 1e-8);
+    assert_abs_diff_eq!(c.point_world[2], -0.3, epsilon = 1e-9);
+    assert_abs_diff_eq!(r.energy.total, -9.81 * 0.2, epsilon = 1e-8);
+    assert_verified_contacts(&m, &s, Friction::None);
+    // Pushed 1 mm into the box, verify refuses it.
+    let deeper = State::from_joint_values(&m, &[("pivot".to_string(), vec![th + 0.002])].into());
+    let v = check(&m, &deeper, Friction::None);
+    assert!(!v.passed && v.unilateral.penetration > 5e-4, "{v:?}");
+}
+
+/// A floating 2 kg box (0.4 × 0.3 × 0.2 m) released tilted above a world-fixed table link
+/// (a 1 × 1 × 0.1 m slab whose top is at `z = 0.75`): it rests flat on the table, four vertices
+/// carrying `m g / 4` each, `V = m g (0.75 + 0.1)` (closed form).
+#[test]
+fn a_box_rests_on_a_fixed_table_link() {
+    let text = r#"<robot name="box_on_table" xmlns:mech="urn:urdf-mech:1">
+  <link name="world"/>
+  <link name="table">
+    <collision><origin xyz="0 0 0.7"/><geometry><box size="1 1 0.1"/></geometry></collision>
+  </link>
+  <joint name="table_mount" type="fixed"><parent link="world"/><child link="table"/></joint>
+  <link name="box">
+    <inertial><mass value="2"/><inertia ixx="0.02" iyy="0.03" izz="0.04" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="0.4 0.3 0.2"/></geometry></collision>
+  </link>
+  <joint name="free" type="floating"><parent link="world"/><child link="box"/></joint>
+  <mech:obstacle link="table"/>
+  <mech:contact link="box"/>
+  <mech:initial joint="free" value="0.05 -0.02 1.0 0.9950 0.0600 -0.0500 0.0500"/>
+</robot>"#;
+    let m = model_from(text);
+    let (s, r) = solve(&m);
+    assert!(r.converged(), "{:?}", r.termination);
+    assert_abs_diff_eq!(r.energy.total, MG * 0.85, epsilon = MG * 1e-9);
+    assert_eq!(r.contacts.len(), 4, "{:?}", r.contacts);
+    for c in &r.contacts {
+        assert_eq!(c.ground, "table");
+        assert_abs_diff_eq!(c.normal_force, MG / 4.0, epsilon = 1e-8);
+        assert_abs_diff_eq!(c.point_world[2], 0.75, epsilon = 1e-9);
+    }
+    assert_verified_contacts(&m, &s, Friction::None);
 }

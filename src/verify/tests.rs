@@ -1,0 +1,93 @@
+//! The sparse path against the dense path on the same poses.
+use super::*;
+use crate::urdf::{load_str, ImportOptions};
+
+fn verify_on(m: &Model, s: &State, tol: &Tolerances, sparse: bool) -> Result<Verification> {
+    super::verify_on(m, s, tol, &Unilaterals::default(), sparse)
+}
+
+fn load(text: &str) -> Model {
+    load_str(text, "m.urdf", &ImportOptions::default())
+        .unwrap()
+        .model
+}
+
+/// A pose off equilibrium: every tree joint turned by a different angle.
+fn bent(model: &Model) -> State {
+    let values = model
+        .joints
+        .iter()
+        .filter(|j| j.tree && j.kind.scalar_coordinates() == 1)
+        .enumerate()
+        .map(|(k, j)| (j.name.clone(), vec![0.05 * ((k * 7 % 5) as f64 - 2.0)]))
+        .collect();
+    State::from_joint_values(model, &values)
+}
+
+/// On a tree the efforts are `∂V/∂θ_k` on both paths: the sparse lock multipliers equal the
+/// dense minimum-norm solution joint by joint, and the verdicts agree.
+#[test]
+fn sparse_efforts_equal_dense_efforts_on_a_tree() {
+    let model = load(&crate::generate::chain(12, false));
+    let state = bent(&model);
+    let tol = Tolerances::default();
+    let d = verify_on(&model, &state, &tol, false).unwrap();
+    let s = verify_on(&model, &state, &tol, true).unwrap();
+    assert!(!d.passed && !s.passed);
+    assert_eq!(d.imbalance.len(), s.imbalance.len());
+    let big = d
+        .imbalance
+        .iter()
+        .fold(0.0f64, |a, i| a.max(i.effort.abs()));
+    assert!(big > 1.0, "the bent chain needs efforts: {big}");
+    for (a, b) in d.imbalance.iter().zip(&s.imbalance) {
+        assert_eq!((&a.joint, a.dof), (&b.joint, b.dof));
+        assert!(
+            (a.effort - b.effort).abs() <= 1e-9 * big,
+            "{}: dense {} sparse {}",
+            a.joint,
+            a.effort,
+            b.effort
+        );
+    }
+    assert!((d.potential_energy - s.potential_energy).abs() <= 1e-12 * big);
+    assert!(d.unassigned <= 1e-9 * big && s.unassigned <= 1e-9 * big);
+    // Both projected gradients vanish together: at the rest pose both are tiny.
+    let (rest, _) = crate::solver::solve(&model, &Default::default()).unwrap();
+    let d = verify_on(&model, &rest, &tol, false).unwrap();
+    let s = verify_on(&model, &rest, &tol, true).unwrap();
+    assert!(d.passed && s.passed, "{d:?} {s:?}");
+    assert!(s.projected_gradient < 1e-6 && d.projected_gradient < 1e-6);
+}
+
+/// With closed loops the split of the effort among a loop's joints differs (basic against
+/// minimum-norm), but the verdict does not: a bent ladder fails on both, its rest pose passes
+/// on both; a spherical joint's load is unassigned on both.
+#[test]
+fn sparse_and_dense_verdicts_agree_with_loops_and_spherical_joints() {
+    let tol = Tolerances::default();
+    let ladder = load(&crate::generate::ladder(4));
+    let bent_ladder = crate::verify::assemble(&ladder, &bent(&ladder)).unwrap();
+    for sparse in [false, true] {
+        let v = verify_on(&ladder, &bent_ladder, &tol, sparse).unwrap();
+        assert!(!v.passed, "sparse {sparse}: {v:?}");
+        assert!(v.max_imbalance.unwrap().effort.abs() > 1e-3);
+    }
+    let (rest, _) = crate::solver::solve(&ladder, &Default::default()).unwrap();
+    for sparse in [false, true] {
+        let v = verify_on(&ladder, &rest, &tol, sparse).unwrap();
+        assert!(v.passed, "sparse {sparse}: {v:?}");
+    }
+    let text = include_str!("../../robots/stewart_platform.urdf");
+    let stewart = load(text);
+    let start = crate::solver::initial_state(&stewart);
+    let start = crate::verify::assemble(&stewart, &start).unwrap();
+    let d = verify_on(&stewart, &start, &tol, false).unwrap();
+    let s = verify_on(&stewart, &start, &tol, true).unwrap();
+    assert_eq!(d.passed, s.passed);
+    let (rest, _) = crate::solver::solve(&stewart, &Default::default()).unwrap();
+    for sparse in [false, true] {
+        let v = verify_on(&stewart, &rest, &tol, sparse).unwrap();
+        assert!(v.passed, "stewart, sparse {sparse}: {v:?}");
+    }
+}

@@ -119,16 +119,7 @@ fn lanczos(sys: &mut System, q: &DVector<f64>, part: &Partition, eval: &Eval) ->
     let steps = lanczos_steps(sys, part, n, negative_by_inertia);
     let (alpha, beta, basis) = steps?;
     let k = alpha.len();
-    let t = DMatrix::from_fn(k, k, |i, j| {
-        if i == j {
-            alpha[i]
-        } else if i + 1 == j || j + 1 == i {
-            beta[i.min(j)]
-        } else {
-            0.0
-        }
-    });
-    let (theta, s) = symmetric_eigen(&t);
+    let (theta, s) = ritz(&alpha, &beta);
     let last_beta = beta[k - 1];
     let mut pairs: Vec<(f64, DVector<f64>)> = (0..k)
         .filter(|&i| theta[i] != 0.0 && (last_beta * s[(k - 1, i)]).abs() <= 1e-8 * theta[i].abs())
@@ -232,6 +223,22 @@ fn lanczos_steps(
     Some((alpha, beta, basis))
 }
 
+/// The Ritz values `θ` (ascending) and vectors of the Lanczos tridiagonal matrix with diagonal
+/// `alpha` and off-diagonal `beta`.
+fn ritz(alpha: &[f64], beta: &[f64]) -> (DVector<f64>, DMatrix<f64>) {
+    let k = alpha.len();
+    let t = DMatrix::from_fn(k, k, |i, j| {
+        if i == j {
+            alpha[i]
+        } else if i + 1 == j || j + 1 == i {
+            beta[i.min(j)]
+        } else {
+            0.0
+        }
+    });
+    symmetric_eigen(&t)
+}
+
 /// Whether the `WANTED` largest Ritz values of the tridiagonal `T_k` (`alpha`, `beta`; the
 /// smallest eigenvalues of `Ĥ` when all are positive) pass the residual test of the kept
 /// pairs, `|β_k s_ki| ≤ 10⁻⁸ |θ_i|`: then further steps would change the reported values in
@@ -242,16 +249,7 @@ fn low_end_converged(alpha: &[f64], beta: &[f64]) -> bool {
     if k < WANTED + 2 {
         return false;
     }
-    let t = DMatrix::from_fn(k, k, |i, j| {
-        if i == j {
-            alpha[i]
-        } else if i + 1 == j || j + 1 == i {
-            beta[i.min(j)]
-        } else {
-            0.0
-        }
-    });
-    let (theta, s) = symmetric_eigen(&t);
+    let (theta, s) = ritz(alpha, beta);
     let last_beta = beta[k - 1];
     // Ascending: the largest θ (smallest positive eigenvalues of Ĥ) last.
     (k - WANTED..k)

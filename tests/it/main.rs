@@ -15,6 +15,7 @@ mod importer;
 mod importer_fuzz;
 mod input_errors;
 mod meshes;
+mod obstacle;
 mod mode_animation;
 mod paper_pendulum;
 mod properties;

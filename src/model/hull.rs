@@ -29,7 +29,8 @@ impl Hull {
     /// are turned away from the centroid). Degenerate (zero-area) triangles are skipped.
     ///
     /// # Errors
-    /// A message if fewer than four triangles span a volume.
+    /// A message if the triangles span no volume (less than 1e-9 of the cube of the hull's
+    /// size: a flat mesh).
     pub fn new(points: &[Vector3<f64>], faces: &[[u32; 3]]) -> Result<Self, String> {
         let get = |i: u32| points.get(i as usize).copied();
         let n_pts = points.len().max(1) as f64;
@@ -41,6 +42,7 @@ impl Hull {
         let mut planes = Vec::new();
         let mut edges: Vec<(Vector3<f64>, Vector3<f64>)> = Vec::new();
         let mut seen = std::collections::HashSet::new();
+        let mut volume = 0.0;
         for f in faces {
             let (Some(a), Some(b), Some(c)) = (get(f[0]), get(f[1]), get(f[2])) else {
                 return Err(format!("hull triangle {f:?} names a missing vertex"));
@@ -54,13 +56,15 @@ impl Hull {
                 n = -n;
             }
             planes.push((n, n.dot(&a)));
+            // The pyramid over the triangle from the centroid.
+            volume += cross.norm() / 6.0 * n.dot(&(a - centroid));
             for (i, j) in [(f[0], f[1]), (f[1], f[2]), (f[2], f[0])] {
                 if seen.insert((i.min(j), i.max(j))) {
                     edges.push((points[i as usize], points[j as usize]));
                 }
             }
         }
-        if planes.len() < 4 || !(size > 0.0) {
+        if planes.len() < 4 || !(size > 0.0 && volume > 1e-9 * size.powi(3)) {
             return Err("the convex hull spans no volume".into());
         }
         Ok(Self {

@@ -222,3 +222,35 @@ fn friction_holds_a_box_on_a_tilted_fixed_box() {
     assert!(r.converged(), "{:?}", r.termination);
     assert!(r.contacts.iter().all(|c| c.state == ContactState::Sticking));
 }
+
+/// A flat mesh (one square) has no volume to rest on: the import refuses it, naming the file,
+/// the line of `mech:obstacle`, the link and the mesh.
+#[test]
+fn a_flat_mesh_obstacle_is_refused_with_its_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let flat = dir.path().join("flat.obj");
+    std::fs::write(&flat, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n").unwrap();
+    let urdf = dir.path().join("flat.urdf");
+    std::fs::write(
+        &urdf,
+        format!(
+            r#"<robot name="flat" xmlns:mech="urn:urdf-mech:1">
+  <link name="world"/>
+  <link name="sheet">
+    <collision><geometry><mesh filename="file://{}"/></geometry></collision>
+  </link>
+  <joint name="mount" type="fixed"><parent link="world"/><child link="sheet"/></joint>
+  <mech:obstacle link="sheet"/>
+</robot>"#,
+            flat.display()
+        ),
+    )
+    .unwrap();
+    let e = load_file(&urdf, &ImportOptions::default())
+        .err()
+        .expect("a flat obstacle is refused")
+        .to_string();
+    for want in ["flat.urdf", ":7", "sheet", "flat.obj", "no volume"] {
+        assert!(e.contains(want), "`{want}` not in: {e}");
+    }
+}

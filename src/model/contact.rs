@@ -191,9 +191,8 @@ impl ModelBuilder {
         for g in &l.collisions {
             let world_from_shape = l.body_from_link * g.link_from_shape;
             found.push(
-                super::Obstacle::new(&l.name, world_from_shape, &g.shape).map_err(|e| {
-                    Error::Model(format!("link `{}` (obstacle): {e}", l.name))
-                })?,
+                super::Obstacle::new(&l.name, world_from_shape, &g.shape)
+                    .map_err(|e| Error::Model(format!("link `{}` (obstacle): {e}", l.name)))?,
             );
         }
         self.model.obstacles.extend(found);

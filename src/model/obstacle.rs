@@ -153,10 +153,7 @@ fn cylinder_plane(p: &Vector3<f64>, radius: f64, h: f64) -> (Vector3<f64>, Vecto
         (u * radius + Vector3::z() * p.z.clamp(-h, h), u)
     } else {
         let r = rho.min(radius);
-        (
-            u * r + Vector3::z() * (zs * h),
-            Vector3::z() * zs,
-        )
+        (u * r + Vector3::z() * (zs * h), Vector3::z() * zs)
     }
 }
 
@@ -274,7 +271,7 @@ mod tests {
         let hb = Vector3::new(0.25, 0.15, 0.1);
         let wedge = wedge();
         let box_pts = corners(hb);
-        let cases: Vec<(Obstacle, Box<dyn Fn(&Vector3<f64>) -> f64>)> = vec![
+        let cases: Vec<(Obstacle, Reference)> = vec![
             (
                 at(ShapeKind::Box { size: hb * 2.0 }, None),
                 Box::new(move |p| crate::geometry::parry_signed_distance(&box_pts, p).unwrap()),
@@ -301,9 +298,7 @@ mod tests {
                     },
                     None,
                 ),
-                Box::new(|p| {
-                    (p - Vector3::new(0.0, 0.0, p.z.clamp(-0.15, 0.15))).norm() - 0.1
-                }),
+                Box::new(|p| (p - Vector3::new(0.0, 0.0, p.z.clamp(-0.15, 0.15))).norm() - 0.1),
             ),
             (
                 at(mesh(), Some(hull_of(&wedge))),
@@ -311,16 +306,18 @@ mod tests {
             ),
             (
                 at(mesh(), Some(hull_of(&corners(hb)))),
-                Box::new(move |p| {
-                    crate::geometry::parry_signed_distance(&corners(hb), p).unwrap()
-                }),
+                Box::new(move |p| crate::geometry::parry_signed_distance(&corners(hb), p).unwrap()),
             ),
         ];
         for (o, reference) in &cases {
             for p in probes(0.3) {
                 let (d, _) = local(o, &p);
                 let want = reference(&p);
-                assert!((d - want).abs() < 1e-9, "{:?} at {p:?}: {d} vs parry {want}", o.shape);
+                assert!(
+                    (d - want).abs() < 1e-9,
+                    "{:?} at {p:?}: {d} vs parry {want}",
+                    o.shape
+                );
                 let x = o.world_from_shape.transform_point(&Point3::from(p)).coords;
                 let (c, n) = o.tangent_plane(&x);
                 assert!((n.norm() - 1.0).abs() < 1e-14);
@@ -337,11 +334,18 @@ mod tests {
                 });
                 // Within 1e-5 of an edge the one-sided normals differ; skip those.
                 if (fd.norm() - 1.0).abs() < 1e-6 {
-                    assert!((fd - n).norm() < 1e-6, "{:?} at {p:?}: {fd:?} vs {n:?}", o.shape);
+                    assert!(
+                        (fd - n).norm() < 1e-6,
+                        "{:?} at {p:?}: {fd:?} vs {n:?}",
+                        o.shape
+                    );
                 }
             }
         }
     }
+
+    /// An independent signed distance (shape frame).
+    type Reference = Box<dyn Fn(&Vector3<f64>) -> f64>;
 
     fn mesh() -> ShapeKind {
         ShapeKind::Mesh {

@@ -90,7 +90,15 @@ fn write_table(dir: &std::path::Path) -> std::path::PathBuf {
             [1, 3, 7, 5],
         ] {
             let v = |i: usize| n + q[i] + 1;
-            faces += &format!("f {} {} {}\nf {} {} {}\n", v(0), v(1), v(2), v(0), v(2), v(3));
+            faces += &format!(
+                "f {} {} {}\nf {} {} {}\n",
+                v(0),
+                v(1),
+                v(2),
+                v(0),
+                v(2),
+                v(3)
+            );
         }
         n += 8;
     };
@@ -229,7 +237,11 @@ fn friction_holds_a_box_on_a_tilted_fixed_box() {
 fn a_flat_mesh_obstacle_is_refused_with_its_file_and_line() {
     let dir = tempfile::tempdir().unwrap();
     let flat = dir.path().join("flat.obj");
-    std::fs::write(&flat, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n").unwrap();
+    std::fs::write(
+        &flat,
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n",
+    )
+    .unwrap();
     let urdf = dir.path().join("flat.urdf");
     std::fs::write(
         &urdf,
@@ -246,10 +258,10 @@ fn a_flat_mesh_obstacle_is_refused_with_its_file_and_line() {
         ),
     )
     .unwrap();
-    let e = load_file(&urdf, &ImportOptions::default())
-        .err()
-        .expect("a flat obstacle is refused")
-        .to_string();
+    let Err(e) = load_file(&urdf, &ImportOptions::default()) else {
+        panic!("a flat obstacle is refused");
+    };
+    let e = e.to_string();
     for want in ["flat.urdf", ":7", "sheet", "flat.obj", "no volume"] {
         assert!(e.contains(want), "`{want}` not in: {e}");
     }

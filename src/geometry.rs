@@ -233,13 +233,8 @@ pub fn contact_points(g: &Geometry) -> Result<Vec<(Vector3<f64>, f64)>, String> 
             scale,
             ..
         } => {
-            let (v, _) = load_mesh(path, scale)?;
-            let pts: Vec<Vector> = v.iter().map(|p| Vector::new(p[0], p[1], p[2])).collect();
-            let (hull, _) = parry3d_f64::transformation::try_convex_hull(&pts)
-                .map_err(|e| format!("{}: no convex hull ({e:?})", path.display()))?;
-            hull.iter()
-                .map(|p| (Vector3::new(p.x, p.y, p.z), 0.0))
-                .collect()
+            let (hull, _) = convex_hull(path, scale)?;
+            hull.into_iter().map(|p| (p, 0.0)).collect()
         }
         ShapeKind::Mesh {
             uri, path: None, ..
@@ -249,6 +244,61 @@ pub fn contact_points(g: &Geometry) -> Result<Vec<(Vector3<f64>, f64)>, String> 
         .into_iter()
         .map(|(p, r)| ((g.link_from_shape * nalgebra::Point3::from(p)).coords, r))
         .collect())
+}
+
+/// The convex hull (parry3d) of a mesh file's vertices, scaled: its vertices and its
+/// triangles (index triples, counter-clockwise seen from outside).
+///
+/// # Errors
+/// A message naming the mesh if it cannot be read or its vertices span no volume.
+pub fn convex_hull(path: &Path, scale: &Vector3<f64>) -> Result<Triangles3, String> {
+    let (v, _) = load_mesh(path, scale)?;
+    let pts: Vec<Vector3<f64>> = v.iter().map(|p| Vector3::new(p[0], p[1], p[2])).collect();
+    convex_hull_of(&pts).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// The convex hull (parry3d) of `points`: its vertices and triangles.
+///
+/// # Errors
+/// A message if parry finds no hull.
+pub fn convex_hull_of(points: &[Vector3<f64>]) -> Result<Triangles3, String> {
+    let pts: Vec<Vector> = points.iter().map(|p| Vector::new(p.x, p.y, p.z)).collect();
+    let (hull, faces) = parry3d_f64::transformation::try_convex_hull(&pts)
+        .map_err(|e| format!("no convex hull ({e:?})"))?;
+    Ok((
+        hull.iter().map(|p| Vector3::new(p.x, p.y, p.z)).collect(),
+        faces,
+    ))
+}
+
+/// Vertices and index triples of a convex hull.
+pub type Triangles3 = (Vec<Vector3<f64>>, Vec<[u32; 3]>);
+
+/// parry3d's projection of `p` on the convex hull of `points` (as a solid, GJK/EPA): the
+/// signed distance (negative inside). An independent check of the obstacles' closest points.
+pub fn parry_signed_distance(points: &[Vector3<f64>], p: &Vector3<f64>) -> Option<f64> {
+    use parry3d_f64::query::PointQuery;
+    let pts: Vec<Vector> = points.iter().map(|q| Vector::new(q.x, q.y, q.z)).collect();
+    let poly = parry3d_f64::shape::ConvexPolyhedron::from_convex_hull(&pts)?;
+    let x = Vector::new(p.x, p.y, p.z);
+    let proj = poly.project_local_point(x, false);
+    let d = (x - proj.point).length();
+    Some(if proj.is_inside { -d } else { d })
+}
+
+/// parry3d's signed distance from `p` to a cylinder of `radius` and `length` along z.
+pub fn parry_cylinder_signed_distance(radius: f64, length: f64, p: &Vector3<f64>) -> f64 {
+    use parry3d_f64::query::PointQuery;
+    // parry's cylinders are along y: turn the point by −90° about x (z onto y).
+    let c = Cylinder::new(length / 2.0, radius);
+    let x = Vector::new(p.x, p.z, -p.y);
+    let proj = c.project_local_point(x, false);
+    let d = (x - proj.point).length();
+    if proj.is_inside {
+        -d
+    } else {
+        d
+    }
 }
 
 fn pose(iso: &Isometry3<f64>) -> Pose {

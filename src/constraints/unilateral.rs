@@ -335,6 +335,7 @@ mod tests {
                 link: "o".into(),
                 world_from_shape: nalgebra::Isometry3::rotation(Vector3::new(0.1, -0.2, 0.05)),
                 shape,
+                hull: None,
             });
             m.contact_points.push(ContactPoint {
                 link: "b".into(),

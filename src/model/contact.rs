@@ -164,10 +164,11 @@ impl ModelBuilder {
     }
 
     /// Makes the collision shapes of the world-fixed link with index `link` obstacles
-    /// (`mech:obstacle`): boxes, spheres and capsules.
+    /// (`mech:obstacle`): boxes, spheres, capsules, cylinders and meshes (their convex hull).
     ///
     /// # Errors
-    /// [`Error::Model`] for a moving link, a link without collision geometry or another shape.
+    /// [`Error::Model`] for a moving link, a link without collision geometry, or a mesh that
+    /// cannot be read or spans no volume.
     pub fn add_obstacle(&mut self, link: usize) -> Result<()> {
         let l = self
             .model
@@ -188,17 +189,11 @@ impl ModelBuilder {
         }
         let mut found = Vec::new();
         for g in &l.collisions {
-            if !super::Obstacle::supported(&g.shape) {
-                return Err(Error::Model(format!(
-                    "link `{}`: only boxes, spheres and capsules can be obstacles",
-                    l.name
-                )));
-            }
-            found.push(super::Obstacle {
-                link: l.name.clone(),
-                world_from_shape: l.body_from_link * g.link_from_shape,
-                shape: g.shape.clone(),
-            });
+            let world_from_shape = l.body_from_link * g.link_from_shape;
+            found.push(
+                super::Obstacle::new(&l.name, world_from_shape, &g.shape)
+                    .map_err(|e| Error::Model(format!("link `{}` (obstacle): {e}", l.name)))?,
+            );
         }
         self.model.obstacles.extend(found);
         Ok(())

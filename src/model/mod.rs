@@ -11,6 +11,7 @@ mod check;
 mod connect;
 mod contact;
 mod force;
+mod hull;
 mod joint;
 mod mass;
 mod obstacle;
@@ -25,6 +26,7 @@ pub use contact::{ContactPoint, ContactSettings, Friction, Ground};
 pub use force::{
     Effort, ForceLaw, Initial, JointSpring, Load, Lock, Mimic, Spring, SpringEnd, SpringMode,
 };
+pub use hull::Hull;
 pub use joint::{Joint, JointId, JointKind};
 pub use mass::Inertial;
 pub use obstacle::Obstacle;

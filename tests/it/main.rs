@@ -16,6 +16,7 @@ mod importer_fuzz;
 mod input_errors;
 mod meshes;
 mod mode_animation;
+mod obstacle;
 mod paper_pendulum;
 mod properties;
 mod readme;

@@ -281,7 +281,8 @@ fn solo12_stands_like_the_independent_rigid_contact_solution() {
 
 // ---- verify: poses resting on stops and grounds -----------------------------------------
 
-use restpose::verify::{verify_with_options, Tolerances, Unilaterals};
+use restpose::verify::{verify_using, Tolerances, Unilaterals, Verification};
+use restpose::LinearAlgebra;
 
 /// Asserts that `verify` accepts `s` (with `friction`).
 fn assert_verified_contacts(m: &restpose::Model, s: &State, friction: Friction) {
@@ -289,12 +290,75 @@ fn assert_verified_contacts(m: &restpose::Model, s: &State, friction: Friction) 
     assert!(v.passed, "{}: {v:?}", m.name);
 }
 
-fn check(m: &restpose::Model, s: &State, friction: Friction) -> restpose::verify::Verification {
+fn check(m: &restpose::Model, s: &State, friction: Friction) -> Verification {
     let uni = Unilaterals {
         friction,
         ..Default::default()
     };
     verify_with_options(m, s, &Tolerances::default(), &uni).unwrap()
+}
+
+/// `verify` on the dense path, after asserting that the sparse path (module
+/// `verify::unilateral_sparse`) gives the same verdict, the same failures, the same stops and
+/// contacts with the same forces (to `1e-9` of the largest, where the pose passes: a failing
+/// pose's forces are a least-squares fit on the dense path and a basic solution on the
+/// sparse one), penetration and stability verdict.
+fn verify_with_options(
+    m: &restpose::Model,
+    s: &State,
+    tol: &Tolerances,
+    uni: &Unilaterals,
+) -> restpose::Result<Verification> {
+    let d = verify_using(m, s, tol, uni, LinearAlgebra::Dense)?;
+    let sp = verify_using(m, s, tol, uni, LinearAlgebra::Sparse)?;
+    assert_paths_agree(&m.name, &d, &sp);
+    Ok(d)
+}
+
+/// The assertions of [`verify_with_options`].
+fn assert_paths_agree(name: &str, d: &Verification, s: &Verification) {
+    let (du, su) = (&d.unilateral, &s.unilateral);
+    assert_eq!(d.passed, s.passed, "{name}: dense {d:?}\nsparse {s:?}");
+    assert_eq!(du.failures, su.failures, "{name}");
+    assert_eq!(du.penetration, su.penetration, "{name}");
+    assert_eq!(du.contacts.len(), su.contacts.len(), "{name}");
+    assert_eq!(du.active_limits.len(), su.active_limits.len(), "{name}");
+    assert_eq!(
+        d.stability.as_ref().map(|v| v.verdict),
+        s.stability.as_ref().map(|v| v.verdict),
+        "{name}"
+    );
+    if !d.passed {
+        return;
+    }
+    let big = du
+        .contacts
+        .iter()
+        .map(|c| c.normal_force.abs())
+        .chain(du.active_limits.iter().map(|l| l.effort.abs()))
+        .fold(1e-12f64, f64::max);
+    for (a, b) in du.contacts.iter().zip(&su.contacts) {
+        assert_eq!((&a.link, a.state), (&b.link, b.state), "{name}");
+        assert!(
+            (a.normal_force - b.normal_force).abs() <= 1e-9 * big,
+            "{name} `{}`: dense {} sparse {}",
+            a.link,
+            a.normal_force,
+            b.normal_force
+        );
+        let ft = Vector3::from(a.tangential_force) - Vector3::from(b.tangential_force);
+        assert!(ft.norm() <= 1e-9 * big, "{name} `{}`: {ft}", a.link);
+    }
+    for (a, b) in du.active_limits.iter().zip(&su.active_limits) {
+        assert_eq!((&a.joint, &a.bound), (&b.joint, &b.bound), "{name}");
+        assert!(
+            (a.effort - b.effort).abs() <= 1e-9 * big,
+            "{name} `{}`: dense {} sparse {}",
+            a.joint,
+            a.effort,
+            b.effort
+        );
+    }
 }
 
 /// analyze's answer on a stop passes verify, which finds the stop's effort itself (closed

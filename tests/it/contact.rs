@@ -888,3 +888,68 @@ fn a_box_rests_on_a_fixed_table_link() {
     }
     assert_verified_contacts(&m, &s, Friction::None);
 }
+
+/// A 400-link rope lying on the ground (266 links on it), verified on the sparse path (above
+/// 40 bodies): analyze's answer passes, with the closed-form contact forces of the straight
+/// lying part (each link's weight `w` at its middle, no spring torque where the rope is flat:
+/// every interior tip carries `w`, the free end `w / 2`); the same pose with the ground 1 mm
+/// higher fails (every lying tip 1 mm inside), and with a 2 N upward load on link 300's tip
+/// the contact there would have to pull, is named, and the pose fails.
+#[test]
+fn verify_checks_a_rope_of_400_links_on_the_ground_on_the_sparse_path() {
+    let text = restpose::generate::rope(400);
+    let m = model_from(&text);
+    let (s, _) = solve(&m);
+    let (tol, uni) = (Tolerances::default(), Unilaterals::default());
+    let v = verify_using(&m, &s, &tol, &uni, LinearAlgebra::Auto).unwrap();
+    assert!(v.passed, "{:?}", v.unilateral.failures);
+    let c = &v.unilateral.contacts;
+    assert!(c.len() > 250, "{} contacts", c.len());
+    let w = 0.05 * 9.81;
+    let force = |link: &str| {
+        c.iter()
+            .find(|c| c.link == link)
+            .unwrap_or_else(|| panic!("{link} does not touch"))
+            .normal_force
+    };
+    for k in 200..399 {
+        assert_abs_diff_eq!(force(&format!("link{k}")), w, epsilon = 1e-9);
+    }
+    assert_abs_diff_eq!(force("link399"), w / 2.0, epsilon = 1e-9);
+    assert!(v.stability.is_some());
+    // The same pose, the ground 1 mm higher.
+    let raised = model_from(&text.replace("<mech:ground/>", r#"<mech:ground xyz="0 0 0.001"/>"#));
+    let v = verify_using(&raised, &s, &tol, &uni, LinearAlgebra::Auto).unwrap();
+    assert!(!v.passed);
+    assert_abs_diff_eq!(v.unilateral.penetration, 1e-3, epsilon = 1e-9);
+    let inside = v
+        .unilateral
+        .failures
+        .iter()
+        .filter(|f| f.contains("inside the ground"))
+        .count();
+    assert_eq!(inside, c.len());
+    // The same pose, link 300's tip lifted by 2 N > w: its contact would have to pull.
+    let lifted = model_from(&text.replace(
+        "<mech:ground/>",
+        r#"<mech:ground/><mech:force name="lift" link="link300" xyz="0.05 0 0" force="0 0 2"/>"#,
+    ));
+    let v = verify_using(&lifted, &s, &tol, &uni, LinearAlgebra::Auto).unwrap();
+    assert!(!v.passed);
+    assert_eq!(v.unilateral.penetration, 0.0);
+    let f = &v.unilateral.failures;
+    assert_eq!(f.len(), 1, "{f:?}");
+    assert!(
+        f[0].starts_with("`link300.contact[") && f[0].contains("would have to pull"),
+        "{f:?}"
+    );
+    let pull: f64 = f[0]
+        .split("pull (")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|x| x.parse().ok())
+        .unwrap_or_else(|| panic!("{f:?}"));
+    // The load acts at the contact point itself: the contact would need `w − 2` N.
+    assert_abs_diff_eq!(pull, w - 2.0, epsilon = 1e-3);
+    assert!(v.max_imbalance.unwrap().effort.abs() > 0.01);
+}

@@ -14,7 +14,10 @@
 //!
 //! Models above 40 bodies' coordinates (the solver's automatic switch to sparse linear
 //! algebra) are verified in `O(N)` by the solver's sparse partition instead (module `reduced`);
-//! smaller ones by the dense basis `N` (module `dense`).
+//! smaller ones by the dense basis `N` (module `dense`). The stops and contacts a pose touches
+//! carry their share of the load first on both paths: by a least-squares balance on `N`
+//! (module `unilateral`) or by the multipliers of the sparse partition with the touching rows
+//! appended (module `unilateral_sparse`); the efforts then balance what they leave.
 //!
 //! ## Tolerances
 //! A pose passes when `‖Φ‖∞ ≤ constraint` and every effort (and the unassigned force) is at

@@ -25,6 +25,10 @@
 //! would need them to pull. What the forces leave, `Nᵀ S (∇V − G λ)`, goes to the joint
 //! imbalance check as before, so a pose the stops and contacts cannot hold fails there.
 //!
+//! That balance is the dense path's; the sparse path computes the forces from the solver's
+//! sparse partition instead (module `unilateral_sparse`) and shares the rest of this module
+//! (which rows touch, the report, the friction check).
+//!
 //! Complementarity `g_k λ_k = 0` holds to `|g_k λ_k| ≤ ε λ_k` by construction (only touching
 //! rows carry force); its largest value is reported. A sticking contact with a friction
 //! coefficient `μ` (its link's `mech:contact mu`, else `--mu`) fails when `|f_t| > μ f_n`.

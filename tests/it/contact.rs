@@ -889,7 +889,7 @@ fn a_box_rests_on_a_fixed_table_link() {
     assert_verified_contacts(&m, &s, Friction::None);
 }
 
-/// A 400-link rope lying on the ground (266 links on it), verified on the sparse path (above
+/// A 400-link rope lying on the ground (268 links on it), verified on the sparse path (above
 /// 40 bodies): analyze's answer passes, with the closed-form contact forces of the straight
 /// lying part (each link's weight `w` at its middle, no spring torque where the rope is flat:
 /// every interior tip carries `w`, the free end `w / 2`); the same pose with the ground 1 mm

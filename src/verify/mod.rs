@@ -335,8 +335,7 @@ fn verify_on(
         // The stops and contacts take their share of the load first (module
         // `unilateral_sparse`).
         let tau = tol.force + tol.relative * force_scale;
-        let contact =
-            unilateral_sparse::check(model, state, uni, &locks, tol.constraint, tau)?;
+        let contact = unilateral_sparse::check(model, state, uni, &locks, tol.constraint, tau)?;
         let carried = contact.touching.then_some(&contact.carried);
         // Without a stop or contact carrying a force, the verdict on this partition.
         let free = contact.strong.is_empty();

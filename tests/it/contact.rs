@@ -953,3 +953,75 @@ fn verify_checks_a_rope_of_400_links_on_the_ground_on_the_sparse_path() {
     assert_abs_diff_eq!(pull, w - 2.0, epsilon = 1e-3);
     assert!(v.max_imbalance.unwrap().effort.abs() > 0.01);
 }
+
+/// The flat box pressed down by 100 N near one corner of its top: the minimum-norm support
+/// would pull at the opposite corner (`F/4 (1 − x̄/a − ȳ/b) < 0`, `(x̄, ȳ)` where the total load
+/// acts, `a × b` the half sides), yet the pose rests on the other corners, and passes on both
+/// paths. The support is statically indeterminate (four corners, three balance equations), and
+/// the paths pick different non-negative supports: the sparse path drops the pulling corner
+/// and solves again, which gives the three-corner lever rule `F (a − x̄)/2a`, `F (b − ȳ)/2b`
+/// and the rest; the dense path's non-negative least squares stops at another corner of the
+/// set of non-negative balances. Both are checked as balances (total force and moments).
+#[test]
+fn verify_rests_the_pressed_box_on_its_corners_on_both_paths() {
+    let text = BOX.replace(
+        "<mech:ground/>",
+        r#"<mech:ground/><mech:force name="press" link="box" xyz="0.18 0.12 0.1" force="0 0 -100"/>"#,
+    );
+    let m = floating(&text);
+    let mut q = DVector::zeros(7);
+    q[2] = 0.1;
+    q[3] = 1.0;
+    let flat = State {
+        q,
+        branches: Default::default(),
+    };
+    let (a, b) = (0.2, 0.15);
+    let f = MG + 100.0;
+    let (x, y) = (100.0 * 0.12 / f * 0.18 / 0.12, 100.0 * 0.12 / f);
+    assert!(1.0 - x / a - y / b < -0.3, "the minimum-norm support pulls");
+    let uni = Unilaterals::default();
+    let tol = Tolerances::default();
+    let mut seen = Vec::new();
+    for la in [LinearAlgebra::Dense, LinearAlgebra::Sparse] {
+        let v = verify_using(&m, &flat, &tol, &uni, la).unwrap();
+        assert!(v.passed, "{la:?}: {v:?}");
+        assert!(v.unilateral.failures.is_empty(), "{la:?}");
+        assert!(
+            v.unassigned <= v.effort_tolerance,
+            "{la:?}: {}",
+            v.unassigned
+        );
+        let c = &v.unilateral.contacts;
+        assert_eq!(c.len(), 4);
+        let total: f64 = c.iter().map(|c| c.normal_force).sum();
+        let mx: f64 = c.iter().map(|c| c.normal_force * c.point_world[0]).sum();
+        let my: f64 = c.iter().map(|c| c.normal_force * c.point_world[1]).sum();
+        assert_abs_diff_eq!(total, f, epsilon = 1e-9);
+        assert_abs_diff_eq!(mx, f * x, epsilon = 1e-9);
+        assert_abs_diff_eq!(my, f * y, epsilon = 1e-9);
+        assert!(c.iter().all(|c| c.normal_force >= -1e-9), "{la:?}: {c:?}");
+        seen.push(v);
+    }
+    let at = |sx: f64, sy: f64| {
+        seen[1]
+            .unilateral
+            .contacts
+            .iter()
+            .find(|c| c.point_world[0] * sx > 0.0 && c.point_world[1] * sy > 0.0)
+            .unwrap()
+            .normal_force
+    };
+    assert_abs_diff_eq!(at(-1.0, -1.0), 0.0, epsilon = 1e-9);
+    assert_abs_diff_eq!(at(-1.0, 1.0), f * (a - x) / (2.0 * a), epsilon = 1e-9);
+    assert_abs_diff_eq!(at(1.0, -1.0), f * (b - y) / (2.0 * b), epsilon = 1e-9);
+    assert_abs_diff_eq!(
+        at(1.0, 1.0),
+        f - f * (a - x) / (2.0 * a) - f * (b - y) / (2.0 * b),
+        epsilon = 1e-9
+    );
+    // On three corners sliding and yaw are free and cost nothing; tipping lifts the load.
+    for v in &seen {
+        assert_eq!(v.stability.as_ref().unwrap().verdict, Verdict::Neutral);
+    }
+}

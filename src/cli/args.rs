@@ -159,6 +159,10 @@ pub(crate) struct VerifyArgs {
     /// needing more fails the pose.
     #[arg(long, value_name = "MU", value_parser = parse::positive)]
     pub(crate) mu: Option<f64>,
+    /// Verification path: dense (orthonormal null-space basis, O(n³)), sparse (the solver's
+    /// sparse partition, O(N)), or auto: sparse above 40 bodies.
+    #[arg(long, value_enum, default_value_t = Options::default().linear_algebra)]
+    pub(crate) linear_algebra: LinearAlgebra,
     /// Print only errors and the verdict.
     #[arg(long, short)]
     pub(crate) quiet: bool,

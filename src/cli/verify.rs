@@ -67,7 +67,7 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
         friction: a.friction,
         mu: a.mu,
     };
-    let v = restpose::verify::verify_with_options(model, &state, &tol, &uni)?;
+    let v = restpose::verify::verify_using(model, &state, &tol, &uni, a.linear_algebra)?;
     if let Some(path) = &a.json {
         print::write_json(path, &serde_json::to_string_pretty(&v)?)?;
     }

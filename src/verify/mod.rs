@@ -14,7 +14,10 @@
 //!
 //! Models above 40 bodies' coordinates (the solver's automatic switch to sparse linear
 //! algebra) are verified in `O(N)` by the solver's sparse partition instead (module `reduced`);
-//! smaller ones by the dense basis `N` (module `dense`).
+//! smaller ones by the dense basis `N` (module `dense`). The stops and contacts a pose touches
+//! carry their share of the load first on both paths: by a least-squares balance on `N`
+//! (module `unilateral`) or by the multipliers of the sparse partition with the touching rows
+//! appended (module `unilateral_sparse`); the efforts then balance what they leave.
 //!
 //! ## Tolerances
 //! A pose passes when `‖Φ‖∞ ≤ constraint` and every effort (and the unassigned force) is at
@@ -28,6 +31,7 @@ mod dense;
 mod pose;
 mod reduced;
 mod unilateral;
+mod unilateral_sparse;
 
 pub use check::{check, ModelCheck};
 pub use pose::{parse_pose, pose_state, read_pose};
@@ -202,15 +206,33 @@ pub fn verify(model: &Model, state: &State, tol: &Tolerances) -> Result<Verifica
 
 /// [`verify`] with stops and contacts as `uni` says: they carry the forces (module `unilateral`).
 /// # Errors
-/// As [`verify`]; [`Error::Model`] for a pose touching them on too large a model.
+/// As [`verify`].
 pub fn verify_with_options(
     model: &Model,
     state: &State,
     tol: &Tolerances,
     uni: &Unilaterals,
 ) -> Result<Verification> {
-    let sparse =
-        sparse_path(model) && !unilateral::dense_needed(model, state, uni, tol.constraint)?;
+    verify_on(model, state, tol, uni, sparse_path(model))
+}
+
+/// [`verify_with_options`] on the path `linear_algebra` says: `Auto` as
+/// [`verify_with_options`] (sparse above 40 bodies), `Dense` the dense null-space basis,
+/// `Sparse` the solver's sparse partition (modules `dense`, `reduced`).
+/// # Errors
+/// As [`verify`].
+pub fn verify_using(
+    model: &Model,
+    state: &State,
+    tol: &Tolerances,
+    uni: &Unilaterals,
+    linear_algebra: crate::solver::LinearAlgebra,
+) -> Result<Verification> {
+    let sparse = match linear_algebra {
+        crate::solver::LinearAlgebra::Auto => sparse_path(model),
+        crate::solver::LinearAlgebra::Dense => false,
+        crate::solver::LinearAlgebra::Sparse => true,
+    };
     verify_on(model, state, tol, uni, sparse)
 }
 
@@ -310,14 +332,21 @@ fn verify_on(
             ..
         } = r;
         let assembled = phi.amax() <= tol.constraint;
+        // The stops and contacts take their share of the load first (module
+        // `unilateral_sparse`).
+        let tau = tol.force + tol.relative * force_scale;
+        let contact = unilateral_sparse::check(model, state, uni, &locks, tol.constraint, tau)?;
+        let carried = contact.touching.then_some(&contact.carried);
+        // Without a stop or contact carrying a force, the verdict on this partition.
+        let free = contact.strong.is_empty();
         let (coords, efforts, unassigned, stability) = std::thread::scope(|s| {
-            let verdict = assembled
+            let verdict = (assembled && free)
                 .then(|| s.spawn(|| crate::solver::stability_of(&mut sys, &state.q, &part, &eval)));
             // The joint coordinates here, off the verdict's path.
             let coords = tree_coordinates(model, state);
             let values: Vec<_> = coords.iter().map(|c| (c.0, c.1, c.2.v)).collect();
             let (efforts, unassigned) =
-                reduced::efforts(model, state, &locks, &values, redundant.len())?;
+                reduced::efforts(model, state, &locks, &values, redundant.len(), carried)?;
             let passed = passes(phi.amax(), &efforts, unassigned, force_scale, tol);
             // A panic there is re-raised here, as if the verdict had been computed on
             // this thread.
@@ -339,8 +368,8 @@ fn verify_on(
             DVector::from_vec(efforts),
             unassigned,
             stability,
-            UnilateralCheck::default(),
-            Vec::new(),
+            contact.check,
+            contact.strong,
         )
     } else {
         let coords = tree_coordinates(model, state);
@@ -384,13 +413,12 @@ fn verify_on(
     );
     let mut contact = contact;
     let passed = contact.settle(tol.constraint, balanced) && balanced;
-    // The sparse path judged the stability beside the efforts (only where no stop or contact
-    // touches: see `verify_with_options`); the dense path judges it here, on the tangent space
-    // of the stops and contacts that carry a force.
+    // The sparse path judged the stability beside the efforts where no stop or contact
+    // carries a force; otherwise it is judged here, on the tangent space of those that do.
     let stability = match (passed, sparse) {
         (false, _) => None,
+        (true, _) if !strong.is_empty() => crate::solver::stability_on(model, state, &strong),
         (true, true) => stability,
-        (true, false) if !strong.is_empty() => crate::solver::stability_on(model, state, &strong),
         (true, false) => crate::solver::stability_at(model, state),
     };
     Ok(Verification {

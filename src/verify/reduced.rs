@@ -117,13 +117,15 @@ pub(super) fn reduced<'a>(
 /// The efforts of the tree joints' scalar coordinates `coords` (joint, dof, current value) and
 /// the unassigned generalized force, with the model's own `locks` (whose coordinates need no
 /// effort: their lock rows hold them). `base` is the number of redundant rows without the
-/// added locks.
+/// added locks. `carried` is the generalized force the touching stops and contacts take
+/// (`G λ`, unscaled; module `unilateral_sparse`): the efforts balance `∇V − G λ`.
 pub(super) fn efforts(
     model: &Model,
     state: &State,
     locks: &[(JointId, usize, f64)],
     coords: &[(JointId, usize, f64)],
     base: usize,
+    carried: Option<&DVector<f64>>,
 ) -> Result<(Vec<f64>, f64)> {
     let mut all = locks.to_vec();
     let mut row_of = Vec::with_capacity(coords.len());
@@ -135,7 +137,10 @@ pub(super) fn efforts(
             all.push((joint, dof, value));
         }
     }
-    let r = reduced(model, state, &all, locks.len())?;
+    let mut r = reduced(model, state, &all, locks.len())?;
+    if let Some(c) = carried {
+        take_off(&mut r, c)?;
+    }
     let cons = &r.sys.problem.cons;
     let first_added = cons.len() - model.mimics.len() - (all.len() - locks.len());
     let dropped = r.redundant.iter().filter(|&&i| i < first_added).count();
@@ -155,4 +160,31 @@ pub(super) fn efforts(
         .map(|k| k.map_or(0.0, |k| r.multipliers[first_lock + k]))
         .collect();
     Ok((tau, r.reduced_gradient))
+}
+
+/// Takes the generalized force `c` off the gradient of `r`: the multipliers and reduced
+/// gradient are linear in `∇V`, so `Φ_uᵀ δμ = −c_u` and `δ(∂V/∂v) = S (−c_v − Φ_vᵀ δμ)` are
+/// added to them (one more solve with the same factors).
+fn take_off(r: &mut Reduced<'_>, c: &DVector<f64>) -> Result<()> {
+    let (part, eval) = (&r.part, &mut r.eval);
+    let c_u = DVector::from_iterator(part.dependent.len(), part.dependent.iter().map(|&i| -c[i]));
+    let d_mu = eval
+        .factors
+        .solve_transpose(c_u)
+        .ok_or_else(|| Error::SingularPartition {
+            at: "the given pose".into(),
+            rows: part.rows.len(),
+        })?;
+    let dof = part.independent.len();
+    let d_v = eval.factors.phi_v_tr_mul(&d_mu, dof);
+    let scale = &r.sys.problem.scaling.columns;
+    for (b, &i) in part.independent.iter().enumerate() {
+        eval.grad_v[b] += (-c[i] - d_v[b]) * scale[i];
+    }
+    for (k, &row) in part.rows.iter().enumerate() {
+        eval.mu[k] += d_mu[k];
+        r.multipliers[row] = eval.mu[k];
+    }
+    r.reduced_gradient = eval.grad_v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    Ok(())
 }

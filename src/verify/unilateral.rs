@@ -25,6 +25,10 @@
 //! would need them to pull. What the forces leave, `Nᵀ S (∇V − G λ)`, goes to the joint
 //! imbalance check as before, so a pose the stops and contacts cannot hold fails there.
 //!
+//! That balance is the dense path's; the sparse path computes the forces from the solver's
+//! sparse partition instead (module `unilateral_sparse`) and shares the rest of this module
+//! (which rows touch, the report, the friction check).
+//!
 //! Complementarity `g_k λ_k = 0` holds to `|g_k λ_k| ≤ ε λ_k` by construction (only touching
 //! rows carry force); its largest value is reported. A sticking contact with a friction
 //! coefficient `μ` (its link's `mech:contact mu`, else `--mu`) fails when `|f_t| > μ f_n`.
@@ -34,7 +38,6 @@
 //!   (algorithm NNLS).
 
 use crate::constraints::unilateral::{self, Active, Anchor, Unilateral};
-use crate::error::{Error, Result};
 use crate::jet::{pair_of, scatter};
 use crate::model::{Friction, Model};
 use crate::solver::{ActiveLimit, Contact, ContactState, Limits};
@@ -97,26 +100,45 @@ impl UnilateralCheck {
     }
 }
 
-/// A touching inequality: its rows, their scaled gradients, and whether row 0 is a normal
-/// (sign-constrained) row followed by tangential ones.
-struct Touching {
-    active: Active,
-    gap: f64,
-    mu: Option<f64>,
-    columns: Vec<DVector<f64>>,
+/// A touching inequality: its rows as jets over its bodies' coordinates (`g`, then the
+/// tangential rows of a sticking contact).
+pub(super) struct Touching {
+    pub(super) active: Active,
+    pub(super) gap: f64,
+    pub(super) mu: Option<f64>,
+    pub(super) bodies: [Option<crate::model::BodyId>; 2],
+    pub(super) rows: Vec<crate::jet::Scalar>,
 }
 
-/// The touching inequalities at `state` (the gradients scaled by `scale`), the violations
-/// recorded in `out`.
-fn touching(
+impl Touching {
+    /// `∇` of row `k` into `g` times `c` (unscaled coordinates).
+    pub(super) fn add_gradient(&self, k: usize, c: f64, g: &mut DVector<f64>) {
+        scatter(&self.bodies, &self.rows[k], c, g, None);
+    }
+
+    /// The scaled gradients `S ∇g` of its rows.
+    fn columns(&self, n: usize, scale: &[f64]) -> Vec<DVector<f64>> {
+        (0..self.rows.len())
+            .map(|k| {
+                let mut g = DVector::zeros(n);
+                self.add_gradient(k, 1.0, &mut g);
+                for (c, &f) in scale.iter().enumerate() {
+                    g[c] *= f;
+                }
+                g
+            })
+            .collect()
+    }
+}
+
+/// The touching inequalities at `state`, the violations recorded in `out`.
+pub(super) fn touching(
     model: &Model,
     state: &State,
     opts: &Unilaterals,
     eps: f64,
-    scale: &[f64],
     out: &mut UnilateralCheck,
 ) -> Vec<Touching> {
-    let n = state.q.len();
     let mut list = Vec::new();
     for u in unilateral::inequalities(model, opts.limits == Limits::Enforce) {
         let Some(g) = unilateral::gap(model, &u, &state.q, &state.branches) else {
@@ -167,56 +189,15 @@ fn touching(
         let Some(rows) = unilateral::rows(model, &active, &pair, &state.branches) else {
             continue;
         };
-        let columns = rows
-            .iter()
-            .map(|s| {
-                let mut g = DVector::zeros(n);
-                scatter(&bodies, s, 1.0, &mut g, None);
-                for (c, &f) in scale.iter().enumerate() {
-                    g[c] *= f;
-                }
-                g
-            })
-            .collect();
         list.push(Touching {
             active,
             gap: g,
             mu,
-            columns,
+            bodies,
+            rows,
         });
     }
     list
-}
-
-/// Largest model (coordinates) verified with stops or contacts touching: their balance is
-/// computed on the dense path only.
-const DENSE_LIMIT: usize = 2100;
-
-/// Whether the pose touches a stop or a ground (within `eps`), so that it must be verified on
-/// the dense path.
-///
-/// # Errors
-/// [`Error::Model`] when it does and the model is above [`DENSE_LIMIT`] coordinates.
-pub(super) fn dense_needed(
-    model: &Model,
-    state: &State,
-    opts: &Unilaterals,
-    eps: f64,
-) -> Result<bool> {
-    let touches = unilateral::inequalities(model, opts.limits == Limits::Enforce)
-        .iter()
-        .any(|u| unilateral::gap(model, u, &state.q, &state.branches).is_some_and(|g| g <= eps));
-    if touches && state.q.len() > DENSE_LIMIT {
-        return Err(Error::Model(format!(
-            "verify: the pose of `{}` touches a stop or a ground, and such poses are verified only \
-             up to {DENSE_LIMIT} coordinates ({} bodies here, {} coordinates); \
-             ignore the limits if no stop should hold it",
-            model.name,
-            model.bodies.len(),
-            state.q.len()
-        )));
-    }
-    Ok(touches)
 }
 
 /// Minimizes `‖M x − b‖₂` subject to `x_i ≥ 0` for `signed[i]` (Lawson–Hanson, with the
@@ -291,8 +272,9 @@ pub(super) fn check(
 ) -> (UnilateralCheck, DVector<f64>, Vec<Active>) {
     let (null, grad_s, scale) = (&p.null, &p.grad_s, &p.scale[..]);
     let mut out = UnilateralCheck::default();
-    let list = touching(model, state, opts, eps, scale, &mut out);
+    let list = touching(model, state, opts, eps, &mut out);
     let n = state.q.len();
+    let columns: Vec<Vec<DVector<f64>>> = list.iter().map(|t| t.columns(n, scale)).collect();
     let mut carried = DVector::zeros(n);
     if list.is_empty() {
         return (out, carried, Vec::new());
@@ -301,8 +283,8 @@ pub(super) fn check(
     let mut cols = Vec::new();
     let mut signed = Vec::new();
     let mut norms = Vec::new();
-    for t in &list {
-        for (r, c) in t.columns.iter().enumerate() {
+    for t in &columns {
+        for (r, c) in t.iter().enumerate() {
             let projected = null.transpose() * c;
             let len = projected.norm();
             norms.push(len);
@@ -353,9 +335,9 @@ pub(super) fn check(
     // The generalized force the rows carry, in scaled coordinates.
     let mut k = 0;
     let mut strong = Vec::new();
-    for t in &list {
-        let lambda: Vec<f64> = (0..t.columns.len()).map(|r| forces[k + r]).collect();
-        for (r, c) in t.columns.iter().enumerate() {
+    for (t, cols) in list.iter().zip(&columns) {
+        let lambda: Vec<f64> = (0..cols.len()).map(|r| forces[k + r]).collect();
+        for (r, c) in cols.iter().enumerate() {
             carried.axpy(lambda[r], c, 1.0);
         }
         if lambda[0] > tau {
@@ -363,32 +345,38 @@ pub(super) fn check(
         }
         out.complementarity = out.complementarity.max((t.gap * lambda[0]).abs());
         describe(model, state, t, &lambda, tau, &mut out);
-        k += t.columns.len();
+        k += cols.len();
     }
     // Name the rows that would have to pull, for the failure message (only meaningful when
     // the non-negative forces then leave an imbalance: the caller decides).
     let mut k = 0;
     for t in &list {
         if negative.contains(&k) {
-            out.failures.push(format!(
-                "`{}` would have to pull ({:.3e} {}) to hold the pose",
-                unilateral::name(model, &t.active.row),
-                free_forces[k],
-                if unilateral::length_power(model, &t.active.row) == 0 {
-                    "N m"
-                } else {
-                    "N"
-                }
-            ));
+            out.failures
+                .push(pulling(model, &t.active.row, free_forces[k]));
         }
-        k += t.columns.len();
+        k += t.rows.len();
     }
     (out, carried, strong)
 }
 
+/// The failure of a stop or contact `u` that would have to pull with `force` to hold the pose.
+pub(super) fn pulling(model: &Model, u: &Unilateral, force: f64) -> String {
+    format!(
+        "`{}` would have to pull ({:.3e} {}) to hold the pose",
+        unilateral::name(model, u),
+        force,
+        if unilateral::length_power(model, u) == 0 {
+            "N m"
+        } else {
+            "N"
+        }
+    )
+}
+
 /// Adds the contact or stop `t` with its forces `lambda` to `out`, and a failure for a sticking
 /// contact needing more than its friction coefficient.
-fn describe(
+pub(super) fn describe(
     model: &Model,
     state: &State,
     t: &Touching,

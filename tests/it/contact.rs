@@ -281,7 +281,8 @@ fn solo12_stands_like_the_independent_rigid_contact_solution() {
 
 // ---- verify: poses resting on stops and grounds -----------------------------------------
 
-use restpose::verify::{verify_with_options, Tolerances, Unilaterals};
+use restpose::verify::{verify_using, Tolerances, Unilaterals, Verification};
+use restpose::LinearAlgebra;
 
 /// Asserts that `verify` accepts `s` (with `friction`).
 fn assert_verified_contacts(m: &restpose::Model, s: &State, friction: Friction) {
@@ -289,12 +290,75 @@ fn assert_verified_contacts(m: &restpose::Model, s: &State, friction: Friction) 
     assert!(v.passed, "{}: {v:?}", m.name);
 }
 
-fn check(m: &restpose::Model, s: &State, friction: Friction) -> restpose::verify::Verification {
+fn check(m: &restpose::Model, s: &State, friction: Friction) -> Verification {
     let uni = Unilaterals {
         friction,
         ..Default::default()
     };
     verify_with_options(m, s, &Tolerances::default(), &uni).unwrap()
+}
+
+/// `verify` on the dense path, after asserting that the sparse path (module
+/// `verify::unilateral_sparse`) gives the same verdict, the same failures, the same stops and
+/// contacts with the same forces (to `1e-9` of the largest, where the pose passes: a failing
+/// pose's forces are a least-squares fit on the dense path and a basic solution on the
+/// sparse one), penetration and stability verdict.
+fn verify_with_options(
+    m: &restpose::Model,
+    s: &State,
+    tol: &Tolerances,
+    uni: &Unilaterals,
+) -> restpose::Result<Verification> {
+    let d = verify_using(m, s, tol, uni, LinearAlgebra::Dense)?;
+    let sp = verify_using(m, s, tol, uni, LinearAlgebra::Sparse)?;
+    assert_paths_agree(&m.name, &d, &sp);
+    Ok(d)
+}
+
+/// The assertions of [`verify_with_options`].
+fn assert_paths_agree(name: &str, d: &Verification, s: &Verification) {
+    let (du, su) = (&d.unilateral, &s.unilateral);
+    assert_eq!(d.passed, s.passed, "{name}: dense {d:?}\nsparse {s:?}");
+    assert_eq!(du.failures, su.failures, "{name}");
+    assert_eq!(du.penetration, su.penetration, "{name}");
+    assert_eq!(du.contacts.len(), su.contacts.len(), "{name}");
+    assert_eq!(du.active_limits.len(), su.active_limits.len(), "{name}");
+    assert_eq!(
+        d.stability.as_ref().map(|v| v.verdict),
+        s.stability.as_ref().map(|v| v.verdict),
+        "{name}"
+    );
+    if !d.passed {
+        return;
+    }
+    let big = du
+        .contacts
+        .iter()
+        .map(|c| c.normal_force.abs())
+        .chain(du.active_limits.iter().map(|l| l.effort.abs()))
+        .fold(1e-12f64, f64::max);
+    for (a, b) in du.contacts.iter().zip(&su.contacts) {
+        assert_eq!((&a.link, a.state), (&b.link, b.state), "{name}");
+        assert!(
+            (a.normal_force - b.normal_force).abs() <= 1e-9 * big,
+            "{name} `{}`: dense {} sparse {}",
+            a.link,
+            a.normal_force,
+            b.normal_force
+        );
+        let ft = Vector3::from(a.tangential_force) - Vector3::from(b.tangential_force);
+        assert!(ft.norm() <= 1e-9 * big, "{name} `{}`: {ft}", a.link);
+    }
+    for (a, b) in du.active_limits.iter().zip(&su.active_limits) {
+        assert_eq!((&a.joint, &a.bound), (&b.joint, &b.bound), "{name}");
+        assert!(
+            (a.effort - b.effort).abs() <= 1e-9 * big,
+            "{name} `{}`: dense {} sparse {}",
+            a.joint,
+            a.effort,
+            b.effort
+        );
+    }
 }
 
 /// analyze's answer on a stop passes verify, which finds the stop's effort itself (closed
@@ -823,4 +887,141 @@ fn a_box_rests_on_a_fixed_table_link() {
         assert_abs_diff_eq!(c.point_world[2], 0.75, epsilon = 1e-9);
     }
     assert_verified_contacts(&m, &s, Friction::None);
+}
+
+/// A 400-link rope lying on the ground (268 links on it), verified on the sparse path (above
+/// 40 bodies): analyze's answer passes, with the closed-form contact forces of the straight
+/// lying part (each link's weight `w` at its middle, no spring torque where the rope is flat:
+/// every interior tip carries `w`, the free end `w / 2`); the same pose with the ground 1 mm
+/// higher fails (every lying tip 1 mm inside), and with a 2 N upward load on link 300's tip
+/// the contact there would have to pull, is named, and the pose fails.
+#[test]
+fn verify_checks_a_rope_of_400_links_on_the_ground_on_the_sparse_path() {
+    let text = restpose::generate::rope(400);
+    let m = model_from(&text);
+    let (s, _) = solve(&m);
+    let (tol, uni) = (Tolerances::default(), Unilaterals::default());
+    let v = verify_using(&m, &s, &tol, &uni, LinearAlgebra::Auto).unwrap();
+    assert!(v.passed, "{:?}", v.unilateral.failures);
+    let c = &v.unilateral.contacts;
+    assert!(c.len() > 250, "{} contacts", c.len());
+    let w = 0.05 * 9.81;
+    let force = |link: &str| {
+        c.iter()
+            .find(|c| c.link == link)
+            .unwrap_or_else(|| panic!("{link} does not touch"))
+            .normal_force
+    };
+    for k in 200..399 {
+        assert_abs_diff_eq!(force(&format!("link{k}")), w, epsilon = 1e-9);
+    }
+    assert_abs_diff_eq!(force("link399"), w / 2.0, epsilon = 1e-9);
+    assert!(v.stability.is_some());
+    // The same pose, the ground 1 mm higher.
+    let raised = model_from(&text.replace("<mech:ground/>", r#"<mech:ground xyz="0 0 0.001"/>"#));
+    let v = verify_using(&raised, &s, &tol, &uni, LinearAlgebra::Auto).unwrap();
+    assert!(!v.passed);
+    assert_abs_diff_eq!(v.unilateral.penetration, 1e-3, epsilon = 1e-9);
+    let inside = v
+        .unilateral
+        .failures
+        .iter()
+        .filter(|f| f.contains("inside the ground"))
+        .count();
+    assert_eq!(inside, c.len());
+    // The same pose, link 300's tip lifted by 2 N > w: its contact would have to pull.
+    let lifted = model_from(&text.replace(
+        "<mech:ground/>",
+        r#"<mech:ground/><mech:force name="lift" link="link300" xyz="0.05 0 0" force="0 0 2"/>"#,
+    ));
+    let v = verify_using(&lifted, &s, &tol, &uni, LinearAlgebra::Auto).unwrap();
+    assert!(!v.passed);
+    assert_eq!(v.unilateral.penetration, 0.0);
+    let f = &v.unilateral.failures;
+    assert_eq!(f.len(), 1, "{f:?}");
+    assert!(
+        f[0].starts_with("`link300.contact[") && f[0].contains("would have to pull"),
+        "{f:?}"
+    );
+    let pull: f64 = f[0]
+        .split("pull (")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|x| x.parse().ok())
+        .unwrap_or_else(|| panic!("{f:?}"));
+    // The load acts at the contact point itself: the contact would need `w − 2` N.
+    assert_abs_diff_eq!(pull, w - 2.0, epsilon = 1e-3);
+    assert!(v.max_imbalance.unwrap().effort.abs() > 0.01);
+}
+
+/// The flat box pressed down by 100 N near one corner of its top: the minimum-norm support
+/// would pull at the opposite corner (`F/4 (1 − x̄/a − ȳ/b) < 0`, `(x̄, ȳ)` where the total load
+/// acts, `a × b` the half sides), yet the pose rests on the other corners, and passes on both
+/// paths. The support is statically indeterminate (four corners, three balance equations), and
+/// the paths pick different non-negative supports: the sparse path drops the pulling corner
+/// and solves again, which gives the three-corner lever rule `F (a − x̄)/2a`, `F (b − ȳ)/2b`
+/// and the rest; the dense path's non-negative least squares stops at another corner of the
+/// set of non-negative balances. Both are checked as balances (total force and moments).
+#[test]
+fn verify_rests_the_pressed_box_on_its_corners_on_both_paths() {
+    let text = BOX.replace(
+        "<mech:ground/>",
+        r#"<mech:ground/><mech:force name="press" link="box" xyz="0.18 0.12 0.1" force="0 0 -100"/>"#,
+    );
+    let m = floating(&text);
+    let mut q = DVector::zeros(7);
+    q[2] = 0.1;
+    q[3] = 1.0;
+    let flat = State {
+        q,
+        branches: Default::default(),
+    };
+    let (a, b) = (0.2, 0.15);
+    let f = MG + 100.0;
+    let (x, y) = (100.0 * 0.12 / f * 0.18 / 0.12, 100.0 * 0.12 / f);
+    assert!(1.0 - x / a - y / b < -0.3, "the minimum-norm support pulls");
+    let uni = Unilaterals::default();
+    let tol = Tolerances::default();
+    let mut seen = Vec::new();
+    for la in [LinearAlgebra::Dense, LinearAlgebra::Sparse] {
+        let v = verify_using(&m, &flat, &tol, &uni, la).unwrap();
+        assert!(v.passed, "{la:?}: {v:?}");
+        assert!(v.unilateral.failures.is_empty(), "{la:?}");
+        assert!(
+            v.unassigned <= v.effort_tolerance,
+            "{la:?}: {}",
+            v.unassigned
+        );
+        let c = &v.unilateral.contacts;
+        assert_eq!(c.len(), 4);
+        let total: f64 = c.iter().map(|c| c.normal_force).sum();
+        let mx: f64 = c.iter().map(|c| c.normal_force * c.point_world[0]).sum();
+        let my: f64 = c.iter().map(|c| c.normal_force * c.point_world[1]).sum();
+        assert_abs_diff_eq!(total, f, epsilon = 1e-9);
+        assert_abs_diff_eq!(mx, f * x, epsilon = 1e-9);
+        assert_abs_diff_eq!(my, f * y, epsilon = 1e-9);
+        assert!(c.iter().all(|c| c.normal_force >= -1e-9), "{la:?}: {c:?}");
+        seen.push(v);
+    }
+    let at = |sx: f64, sy: f64| {
+        seen[1]
+            .unilateral
+            .contacts
+            .iter()
+            .find(|c| c.point_world[0] * sx > 0.0 && c.point_world[1] * sy > 0.0)
+            .unwrap()
+            .normal_force
+    };
+    assert_abs_diff_eq!(at(-1.0, -1.0), 0.0, epsilon = 1e-9);
+    assert_abs_diff_eq!(at(-1.0, 1.0), f * (a - x) / (2.0 * a), epsilon = 1e-9);
+    assert_abs_diff_eq!(at(1.0, -1.0), f * (b - y) / (2.0 * b), epsilon = 1e-9);
+    assert_abs_diff_eq!(
+        at(1.0, 1.0),
+        f - f * (a - x) / (2.0 * a) - f * (b - y) / (2.0 * b),
+        epsilon = 1e-9
+    );
+    // On three corners sliding and yaw are free and cost nothing; tipping lifts the load.
+    for v in &seen {
+        assert_eq!(v.stability.as_ref().unwrap().verdict, Verdict::Neutral);
+    }
 }

@@ -2,6 +2,9 @@
 //! forms, and for the Solo-12 quadruped a rigid-contact solution computed without restpose
 //! (`benches/peers/solo12_mujoco.py` on MuJoCo's import of the same file, saved in
 //! `benches/peers/solo12_reference.json`).
+use crate::common::contact::{
+    assert_sticks_on_slope, assert_verified_contacts, check, verify_with_options,
+};
 use crate::common::*;
 use approx::assert_abs_diff_eq;
 use nalgebra::{DVector, UnitQuaternion, Vector3};
@@ -181,20 +184,7 @@ fn friction_holds_a_box_on_a_slope_and_says_when_it_cannot() {
         ..Default::default()
     };
     let (s, rep) = restpose::solve(&m, &stick).unwrap();
-    assert!(rep.converged(), "{:?}", rep.termination);
-    assert!(rep.contacts.len() >= 3, "{:?}", rep.contacts);
-    let fnorm: f64 = rep.contacts.iter().map(|c| c.normal_force).sum();
-    let ft: Vector3<f64> = rep
-        .contacts
-        .iter()
-        .map(|c| Vector3::from(c.tangential_force))
-        .sum();
-    assert_abs_diff_eq!(fnorm, 9.81 * slope.cos(), epsilon = 1e-8);
-    assert_abs_diff_eq!(ft.norm(), 9.81 * slope.sin(), epsilon = 1e-8);
-    assert!(rep
-        .contacts
-        .iter()
-        .all(|c| c.state == ContactState::Sticking));
+    assert_sticks_on_slope(&rep, 9.81, slope);
     assert_verified_contacts(&m, &s, Friction::Stick);
     let weak = Options {
         mu: Some(0.2),
@@ -281,85 +271,8 @@ fn solo12_stands_like_the_independent_rigid_contact_solution() {
 
 // ---- verify: poses resting on stops and grounds -----------------------------------------
 
-use restpose::verify::{verify_using, Tolerances, Unilaterals, Verification};
+use restpose::verify::{verify_using, Tolerances, Unilaterals};
 use restpose::LinearAlgebra;
-
-/// Asserts that `verify` accepts `s` (with `friction`).
-fn assert_verified_contacts(m: &restpose::Model, s: &State, friction: Friction) {
-    let v = check(m, s, friction);
-    assert!(v.passed, "{}: {v:?}", m.name);
-}
-
-fn check(m: &restpose::Model, s: &State, friction: Friction) -> Verification {
-    let uni = Unilaterals {
-        friction,
-        ..Default::default()
-    };
-    verify_with_options(m, s, &Tolerances::default(), &uni).unwrap()
-}
-
-/// `verify` on the dense path, after asserting that the sparse path (module
-/// `verify::unilateral_sparse`) gives the same verdict, the same failures, the same stops and
-/// contacts with the same forces (to `1e-9` of the largest, where the pose passes: a failing
-/// pose's forces are a least-squares fit on the dense path and a basic solution on the
-/// sparse one), penetration and stability verdict.
-fn verify_with_options(
-    m: &restpose::Model,
-    s: &State,
-    tol: &Tolerances,
-    uni: &Unilaterals,
-) -> restpose::Result<Verification> {
-    let d = verify_using(m, s, tol, uni, LinearAlgebra::Dense)?;
-    let sp = verify_using(m, s, tol, uni, LinearAlgebra::Sparse)?;
-    assert_paths_agree(&m.name, &d, &sp);
-    Ok(d)
-}
-
-/// The assertions of [`verify_with_options`].
-fn assert_paths_agree(name: &str, d: &Verification, s: &Verification) {
-    let (du, su) = (&d.unilateral, &s.unilateral);
-    assert_eq!(d.passed, s.passed, "{name}: dense {d:?}\nsparse {s:?}");
-    assert_eq!(du.failures, su.failures, "{name}");
-    assert_eq!(du.penetration, su.penetration, "{name}");
-    assert_eq!(du.contacts.len(), su.contacts.len(), "{name}");
-    assert_eq!(du.active_limits.len(), su.active_limits.len(), "{name}");
-    assert_eq!(
-        d.stability.as_ref().map(|v| v.verdict),
-        s.stability.as_ref().map(|v| v.verdict),
-        "{name}"
-    );
-    if !d.passed {
-        return;
-    }
-    let big = du
-        .contacts
-        .iter()
-        .map(|c| c.normal_force.abs())
-        .chain(du.active_limits.iter().map(|l| l.effort.abs()))
-        .fold(1e-12f64, f64::max);
-    for (a, b) in du.contacts.iter().zip(&su.contacts) {
-        assert_eq!((&a.link, a.state), (&b.link, b.state), "{name}");
-        assert!(
-            (a.normal_force - b.normal_force).abs() <= 1e-9 * big,
-            "{name} `{}`: dense {} sparse {}",
-            a.link,
-            a.normal_force,
-            b.normal_force
-        );
-        let ft = Vector3::from(a.tangential_force) - Vector3::from(b.tangential_force);
-        assert!(ft.norm() <= 1e-9 * big, "{name} `{}`: {ft}", a.link);
-    }
-    for (a, b) in du.active_limits.iter().zip(&su.active_limits) {
-        assert_eq!((&a.joint, &a.bound), (&b.joint, &b.bound), "{name}");
-        assert!(
-            (a.effort - b.effort).abs() <= 1e-9 * big,
-            "{name} `{}`: dense {} sparse {}",
-            a.joint,
-            a.effort,
-            b.effort
-        );
-    }
-}
 
 /// analyze's answer on a stop passes verify, which finds the stop's effort itself (closed
 /// form `m g cos θ + k θ`); with limits ignored the same pose needs that effort from the joint

@@ -1,6 +1,7 @@
 //! Obstacles of every collision shape (issue 13): a ball on a fixed cylinder, a box on a
 //! fixed mesh (its convex hull) and a box held by friction on a tilted fixed box, each against
 //! a closed form and `verify`.
+use crate::common::contact::{assert_sticks_on_slope, assert_verified_contacts};
 use crate::common::*;
 use approx::assert_abs_diff_eq;
 use nalgebra::Vector3;
@@ -9,15 +10,6 @@ use restpose::solver::ContactState;
 use restpose::urdf::{load_file, ImportOptions};
 use restpose::verify::{verify_with_options, Tolerances, Unilaterals};
 use restpose::{Options, State};
-
-fn verified(m: &restpose::Model, s: &State, friction: Friction) {
-    let uni = Unilaterals {
-        friction,
-        ..Default::default()
-    };
-    let v = verify_with_options(m, s, &Tolerances::default(), &uni).unwrap();
-    assert!(v.passed, "{}: {v:?}", m.name);
-}
 
 /// A 1 kg ball (radius 0.1 m) at the end of a massless 0.5 m arm hinged about y at the
 /// origin falls onto a world-fixed cylinder (radius 0.2 m, 1 m long) lying on its side along y,
@@ -61,7 +53,7 @@ fn a_ball_rests_on_a_fixed_cylinder_lying_on_its_side() {
     let f = 9.81 * b.x / (b.x * n.z - b.z * n.x);
     assert_abs_diff_eq!(c.normal_force, f, epsilon = 1e-8);
     assert_abs_diff_eq!(r.energy.total, 9.81 * b.z, epsilon = 1e-8);
-    verified(&m, &s, Friction::None);
+    assert_verified_contacts(&m, &s, Friction::None);
     // Pushed into the cylinder, verify refuses it.
     let deeper = State::from_joint_values(&m, &[("pivot".to_string(), vec![th + 0.004])].into());
     let uni = Unilaterals::default();
@@ -152,7 +144,7 @@ fn a_box_rests_on_a_fixed_mesh_obstacle() {
         assert_abs_diff_eq!(c.point_world[2], 0.75, epsilon = 1e-9);
         assert!((Vector3::from(c.normal_world) - Vector3::z()).norm() < 1e-12);
     }
-    verified(&m, &s, Friction::None);
+    assert_verified_contacts(&m, &s, Friction::None);
 }
 
 /// A 1 kg box (0.4 × 0.3 × 0.2 m) on a fixed 2 × 2 × 0.2 m box tilted by `tilt` about y.
@@ -194,24 +186,13 @@ fn friction_holds_a_box_on_a_tilted_fixed_box() {
         ..Default::default()
     };
     let (s, r) = restpose::solve(&m, &stick).unwrap();
-    assert!(r.converged(), "{:?}", r.termination);
-    assert!(r.contacts.len() >= 3, "{:?}", r.contacts);
-    let fnorm: f64 = r.contacts.iter().map(|c| c.normal_force).sum();
-    let ft: Vector3<f64> = r
-        .contacts
-        .iter()
-        .map(|c| Vector3::from(c.tangential_force))
-        .sum();
-    assert_abs_diff_eq!(fnorm, 9.81 * tilt.cos(), epsilon = 1e-8);
-    assert_abs_diff_eq!(ft.norm(), 9.81 * tilt.sin(), epsilon = 1e-8);
-    assert_abs_diff_eq!(ft.norm() / fnorm, tilt.tan(), epsilon = 1e-9);
+    assert_sticks_on_slope(&r, 9.81, tilt);
     for c in &r.contacts {
         assert_eq!(c.ground, "ramp");
-        assert_eq!(c.state, ContactState::Sticking);
         let n = Vector3::from(c.normal_world);
         assert!((n - Vector3::new(tilt.sin(), 0.0, tilt.cos())).norm() < 1e-12);
     }
-    verified(&m, &s, Friction::Stick);
+    assert_verified_contacts(&m, &s, Friction::Stick);
     let weak = Options {
         mu: Some(0.8 * tilt.tan()),
         ..stick.clone()

@@ -1,6 +1,7 @@
 //! Shared helpers of the integration tests.
 
 pub(crate) mod builders;
+pub(crate) mod contact;
 pub(crate) mod energies;
 
 use restpose::state::State;

@@ -10,7 +10,10 @@
 //! `|a_rc| ≥ τ max_k |a_rk|` (τ = 0.1: the pivot is not small against the rest of its row); its
 //! column becomes a dependent coordinate, its row an independent row, and it is eliminated from
 //! the other active rows, `a_i ← a_i − (a_ic / a_rc) a_r`. Up to seven pivots are taken per
-//! body. A row whose entries all fall below `RANK_TOLERANCE · max|D Φ_q S|` is redundant. Rows
+//! body, then (second pass) the rows that started on that body alone (a contact's gap, a stop)
+//! on the body's largest remaining free entry with the rank test only: the joint rows pivoted
+//! before them move their large entries onto the parent, and left for later they would carry
+//! that fill up the whole chain (one dense row per contact). A row whose entries all fall below `RANK_TOLERANCE · max|D Φ_q S|` is redundant. Rows
 //! left at the end (loop rows whose bodies were all eliminated) are finished by full pivoting
 //! among themselves.
 //!

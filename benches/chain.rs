@@ -2,10 +2,13 @@
 //! families (plain harness, no criterion: the sizes span four decades and each large size is
 //! solved once, in its own process so that its peak memory can be read).
 //!
-//! `cargo bench --bench chain -- [--dense | --sparse] [--family chain|ladder|robots] [N …]`
+//! `cargo bench --bench chain -- [--dense | --sparse] [--family chain|ladder|rope|robots] [N …]`
 //!
 //! - `chain N`: `restpose generate chain --size N` (N bodies);
 //! - `ladder N`: `restpose generate ladder --size N` (N closed loops, 3N bodies);
+//! - `rope N`: `restpose generate rope --size N` (N links hanging from the world, about two
+//!   thirds of them lying on the ground: N sphere contacts are candidates); checked by
+//!   `verify_rope` (not in the default run: `--family rope`, default sizes 100, 300, 1000);
 //! - `robots`: the tractor-trailer and the 7-axis arm of `robots/`.
 //!
 //! Each row is measured in a child process (this executable again, with
@@ -23,6 +26,7 @@ fn model_text(family: &str, n: usize) -> (String, String) {
     match family {
         "chain" => (format!("chain{n}"), restpose::generate::chain(n, false)),
         "ladder" => (format!("ladder{n}"), restpose::generate::ladder(n)),
+        "rope" => (format!("rope{n}"), restpose::generate::rope(n)),
         _ => {
             let name = ["tractor_trailer", "panda_class", "stewart_platform"][n];
             let path = format!("{}/robots/{name}.urdf", env!("CARGO_MANIFEST_DIR"));
@@ -89,6 +93,59 @@ fn verify_family(family: &str, n: usize, model: &Model, state: &State, energy: f
     worst
 }
 
+/// Independent check of the rope on the ground: the energy equals the joint-space energy
+/// (`energies::rope`); each contact touches (`|g| ≤ 1e-9` m), pushes (`f_n ≥ 0`) and is
+/// complementary (`|g| f_n ≤ 1e-9 m · max f_n`); the anchor's vertical reaction plus the normal
+/// forces carry the weight `n m g` (to 1e-8 N). Returns the largest `|g| f_n`.
+fn verify_rope(n: usize, model: &Model, state: &State, report: &restpose::Report) -> f64 {
+    let values = state.joint_values(model);
+    let th: Vec<f64> = (0..n)
+        .map(|i| {
+            let name = format!("joint{i}");
+            values
+                .iter()
+                .find(|(j, _)| *j == name)
+                .map(|(_, v)| v[0])
+                .expect("joint")
+        })
+        .collect();
+    let v = energies::rope(n, &th);
+    let energy = report.energy.total;
+    assert!(
+        (v - energy).abs() <= 1e-9 * v.abs(),
+        "rope{n}: energy {v} vs {energy}"
+    );
+    let fmax = report
+        .contacts
+        .iter()
+        .fold(0.0f64, |a, c| a.max(c.normal_force));
+    let mut worst = 0.0f64;
+    for c in &report.contacts {
+        assert!(
+            c.gap.abs() <= 1e-9 && c.normal_force >= 0.0,
+            "rope{n}: {c:?}"
+        );
+        assert!(
+            c.gap.abs() * c.normal_force <= 1e-9 * fmax,
+            "rope{n}: {c:?}"
+        );
+        worst = worst.max(c.gap.abs() * c.normal_force);
+    }
+    let anchor = report
+        .reactions
+        .iter()
+        .find(|(j, _)| j == "joint0")
+        .expect("anchor");
+    let normal: f64 = report.contacts.iter().map(|c| c.normal_force).sum();
+    let weight = n as f64 * 0.05 * 9.81;
+    assert!(
+        (anchor.1.force_world[2] + normal - weight).abs() <= 1e-8,
+        "rope{n}: vertical forces {} + {normal} vs weight {weight}",
+        anchor.1.force_world[2]
+    );
+    worst
+}
+
 fn peak_rss_mb() -> f64 {
     std::fs::read_to_string("/proc/self/status")
         .ok()
@@ -135,6 +192,8 @@ fn child(spec: &str) {
     let peak = peak_rss_mb();
     let gradient = if family == "robots" {
         f64::NAN
+    } else if family == "rope" {
+        verify_rope(n, &model, &s, &r)
     } else {
         verify_family(family, n, &model, &s, r.energy.total)
     };
@@ -167,12 +226,18 @@ fn main() {
     let sizes: Vec<usize> = args.iter().filter_map(|a| a.parse().ok()).collect();
     let families: Vec<(&str, Vec<usize>)> = match family.as_deref() {
         Some("robots") => vec![("robots", vec![0, 1, 2])],
-        Some(f @ ("chain" | "ladder")) => vec![(
-            if f == "chain" { "chain" } else { "ladder" },
-            if sizes.is_empty() {
-                vec![10, 100, 1000]
-            } else {
+        Some(f @ ("chain" | "ladder" | "rope")) => vec![(
+            match f {
+                "chain" => "chain",
+                "ladder" => "ladder",
+                _ => "rope",
+            },
+            if !sizes.is_empty() {
                 sizes.clone()
+            } else if f == "rope" {
+                vec![100, 300, 1000]
+            } else {
+                vec![10, 100, 1000]
             },
         )],
         _ => {
@@ -189,7 +254,7 @@ fn main() {
         }
     };
     let exe = std::env::current_exe().expect("own path");
-    println!("| model | bodies | dof | algebra | iterations | solve [ms] | ms / iteration | peak RSS [MB] | joint-space check: max \\|∂V/∂θ\\| [N m] |");
+    println!("| model | bodies | dof | algebra | iterations | solve [ms] | ms / iteration | peak RSS [MB] | joint-space check: max \\|∂V/∂θ\\| [N m] (rope: max \\|g\\| f_n [N m]) |");
     println!("|---|---:|---:|---|---:|---:|---:|---:|---:|");
     for (family, sizes) in families {
         let mut fit = Vec::new();

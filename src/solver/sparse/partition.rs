@@ -10,7 +10,10 @@
 //! `|a_rc| ≥ τ max_k |a_rk|` (τ = 0.1: the pivot is not small against the rest of its row); its
 //! column becomes a dependent coordinate, its row an independent row, and it is eliminated from
 //! the other active rows, `a_i ← a_i − (a_ic / a_rc) a_r`. Up to seven pivots are taken per
-//! body. A row whose entries all fall below `RANK_TOLERANCE · max|D Φ_q S|` is redundant. Rows
+//! body, then (second pass) the rows that started on that body alone (a contact's gap, a stop)
+//! on the body's largest remaining free entry with the rank test only: the joint rows pivoted
+//! before them move their large entries onto the parent, and left for later they would carry
+//! that fill up the whole chain (one dense row per contact). A row whose entries all fall below `RANK_TOLERANCE · max|D Φ_q S|` is redundant. Rows
 //! left at the end (loop rows whose bodies were all eliminated) are finished by full pivoting
 //! among themselves.
 //!
@@ -126,7 +129,12 @@ impl Elimination {
     }
 
     /// The best threshold-passing pivot among active rows `cands` in the free columns `cols`.
-    fn best_pivot(&self, cands: &[usize], cols: impl Fn(usize) -> bool) -> Option<(usize, usize)> {
+    fn best_pivot(
+        &self,
+        cands: &[usize],
+        threshold: f64,
+        cols: impl Fn(usize) -> bool,
+    ) -> Option<(usize, usize)> {
         let mut best: Option<(usize, usize, f64)> = None;
         for &r in cands {
             if !self.active[r] {
@@ -142,7 +150,7 @@ impl Elimination {
             for (c, v) in entries {
                 let a = v.abs();
                 if a > self.tol
-                    && a >= THRESHOLD * rmax
+                    && a >= threshold * rmax
                     && best.is_none_or(|b| a > b.2 * (1.0 + 1e-9))
                 {
                     best = Some((r, c, a));
@@ -199,15 +207,42 @@ pub(crate) fn partition(
             el.redundant.push(r);
         }
     }
+    // Rows whose entries all lie on one body (their "own" body).
+    let mut own: Vec<Vec<usize>> = vec![Vec::new(); nb];
+    for (r, row) in el.rows.iter().enumerate() {
+        if let Some(&(c0, _)) = row.first() {
+            if el.active[r] && row.iter().all(|e| e.0 / 7 == c0 / 7) {
+                own[c0 / 7].push(r);
+            }
+        }
+    }
     for b in elimination_order(model) {
-        for _ in 0..7 {
+        let mut taken = 0;
+        while taken < 7 {
             let mut cands = el.body_rows[b].clone();
             cands.sort_unstable();
             cands.dedup();
-            match el.best_pivot(&cands, |c| c / 7 == b) {
+            match el.best_pivot(&cands, THRESHOLD, |c| c / 7 == b) {
                 Some((r, c)) => el.pivot(r, c),
                 None => break,
             }
+            taken += 1;
+        }
+        // Second pass: a row that started on body `b` alone (a contact's gap, a stop) but lost
+        // its large entries to the joint rows pivoted before it now reaches the parent bodies
+        // through that fill, with entries there far larger than the one left on `b` (the lever
+        // arm of the contact point about the joint). Left for later it would carry the fill
+        // up the whole chain: one dense row per contact, O(N²) work and an LDLᵀ of the KKT
+        // system with O(N²) fill. It is pivoted here on `b`'s largest remaining free entry,
+        // with the rank test `|a_rc| > tol` only: like a joint row, it is eliminated with its
+        // body. The dependent coordinate it takes (the joint angle that keeps the contact
+        // point on the ground) is well determined by it.
+        while taken < 7 {
+            match el.best_pivot(&own[b], 0.0, |c| c / 7 == b) {
+                Some((r, c)) => el.pivot(r, c),
+                None => break,
+            }
+            taken += 1;
         }
     }
     // Rows left over: full pivoting among them over all free columns.
@@ -217,7 +252,7 @@ pub(crate) fn partition(
         if left.is_empty() {
             break;
         }
-        match el.best_pivot(&left, |_| true) {
+        match el.best_pivot(&left, THRESHOLD, |_| true) {
             Some((r, c)) => el.pivot(r, c),
             None => {
                 // No entry passes the threshold test: plain full pivoting.

@@ -41,3 +41,19 @@ pub(crate) fn ladder(n: usize, phi: &[f64]) -> f64 {
     }
     v
 }
+
+/// `restpose::generate::rope(n)` at joint angles `th` (continuous joints about y, 0.05 m links
+/// of 0.05 kg with the centre of mass at mid-length, springs 2 N m/rad about 0, the anchor at
+/// height `⌈n/3⌉ · 0.05 cos 0.3 + 0.01`): link `i` leaves its joint along
+/// `(cos φ_i, 0, −sin φ_i)`, `φ_i = Σ_{j ≤ i} θ_j`.
+pub(crate) fn rope(n: usize, th: &[f64]) -> f64 {
+    let (l, mass, g, k) = (0.05, 0.05, 9.81, 2.0);
+    let h = n.div_ceil(3) as f64 * l * 0.3f64.cos() + 0.01;
+    let (mut z, mut phi, mut energy) = (h, 0.0, 0.0);
+    for &t in &th[..n] {
+        phi += t;
+        energy += mass * g * (z - 0.5 * l * phi.sin()) + 0.5 * k * t * t;
+        z -= l * phi.sin();
+    }
+    energy
+}

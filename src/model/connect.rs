@@ -39,11 +39,8 @@ impl ModelBuilder {
         child: Option<BodyId>,
         child_from_joint: Isometry3<f64>,
     ) -> JointId {
-        let joint = self.joint_between(name.into(), kind, [parent, child]);
-        self.push_joint(Joint {
-            body_from_joint: [parent_from_joint, child_from_joint],
-            ..joint
-        })
+        let frames = [parent_from_joint, child_from_joint];
+        self.add_joint_with(name.into(), kind, [parent, child], frames, true)
     }
 
     /// Adds a loop-closing joint: not a spanning-tree edge, its constraint rows close a loop
@@ -58,10 +55,24 @@ impl ModelBuilder {
         child: Option<BodyId>,
         child_from_joint: Isometry3<f64>,
     ) -> JointId {
-        let joint = self.joint_between(name.into(), kind, [parent, child]);
+        let frames = [parent_from_joint, child_from_joint];
+        self.add_joint_with(name.into(), kind, [parent, child], frames, false)
+    }
+
+    /// A joint between `bodies` with its frame given in each body, in the tree or closing a
+    /// loop.
+    fn add_joint_with(
+        &mut self,
+        name: String,
+        kind: JointKind,
+        bodies: [Option<BodyId>; 2],
+        body_from_joint: [Isometry3<f64>; 2],
+        tree: bool,
+    ) -> JointId {
+        let joint = self.joint_between(name, kind, bodies);
         self.push_joint(Joint {
-            body_from_joint: [parent_from_joint, child_from_joint],
-            tree: false,
+            body_from_joint,
+            tree,
             ..joint
         })
     }

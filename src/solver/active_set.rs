@@ -23,7 +23,8 @@
 //! supporting vertices for three degrees of freedom) are handled by the partition, which gives
 //! them no multiplier; the force distribution reported is then the least-norm one over the
 //! stops and contacts (module `distribution`: a box flat on four vertices gets `m g / 4` on
-//! each). Stability is judged on the tangent space of all active rows.
+//! each). Stability is judged on the tangent space of the active rows that carry a force and the
+//! critical cone of those that do not (module `cone`).
 //!
 //! ## References
 //! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §16.5
@@ -241,18 +242,40 @@ pub(crate) fn to_release(
     multipliers
         .iter()
         .enumerate()
-        .map(|(i, (a, m))| {
-            let lambda = match a.row {
-                Unilateral::Limit { joint, .. } if model.joints[joint.0].kind.is_angle(0) => {
-                    m[0] / model.length_scale
-                }
-                _ => m[0],
-            };
-            (i, lambda)
-        })
+        .map(|(i, (a, m))| (i, scaled_force(model, a, m)))
         .filter(|&(_, l)| l < -threshold)
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .map(|(i, _)| i)
+}
+
+/// The multiplier of an active row's inequality, a stop's torque divided by the
+/// characteristic length so that it compares with forces.
+fn scaled_force(model: &Model, a: &Active, m: &[f64]) -> f64 {
+    match a.row {
+        Unilateral::Limit { joint, .. } if model.joints[joint.0].kind.is_angle(0) => {
+            m[0] / model.length_scale
+        }
+        _ => m[0],
+    }
+}
+
+/// The active rows that carry a force above `threshold` (strongly active) and those that do
+/// not (weakly active), with the multipliers' scaling of [`to_release`].
+pub(crate) fn split(
+    model: &Model,
+    multipliers: &[(Active, Vec<f64>)],
+    threshold: f64,
+) -> (Vec<Active>, Vec<Active>) {
+    let mut strong = Vec::new();
+    let mut weak = Vec::new();
+    for (a, m) in multipliers {
+        if scaled_force(model, a, m) > threshold {
+            strong.push(*a);
+        } else {
+            weak.push(*a);
+        }
+    }
+    (strong, weak)
 }
 
 /// The world point where a contact touches: the point minus its radius along the normal.
@@ -361,6 +384,12 @@ pub(crate) fn solve(
         report.diagnostics.load_steps = 1;
         report.active_set_changes = changes;
         describe(model, options, &state, &round.multipliers, &mut report);
+        // Judged with every active row held; where some touch without a force, on the
+        // critical cone instead (module `cone`).
+        let (strong, weak) = split(model, &round.multipliers, threshold);
+        if report.converged() && !weak.is_empty() {
+            report.stability = super::cone::stability_touching(model, &state, &strong, &weak);
+        }
         return Ok((state, report));
     }
 }

@@ -16,6 +16,7 @@
 
 mod active_set;
 mod assemble;
+mod cone;
 mod distribution;
 mod eigen;
 mod minimize;
@@ -166,6 +167,8 @@ fn stability(
 pub(crate) fn stability_at(model: &Model, state: &State) -> Option<Stability> {
     stability_on(model, state, &[])
 }
+
+pub(crate) use cone::stability_touching;
 
 /// [`stability_at`] on the tangent space of the equality rows and the inequalities `active`
 /// (the stops and contacts that carry a force).

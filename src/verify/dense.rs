@@ -111,6 +111,8 @@ pub(super) struct DenseChecks {
     pub(super) unilateral: UnilateralCheck,
     /// The stops and contacts that carry a force (the stability's tangent space).
     pub(super) strong: Vec<Active>,
+    /// The touching stops and contacts that carry no force.
+    pub(super) weak: Vec<Active>,
 }
 
 /// The dense checks: closure, the share of the load the stops and contacts carry (module
@@ -129,7 +131,7 @@ pub(super) fn dense_checks(
     let force_scale = p.grad_s.amax();
     // The stops and contacts take their share of the load first.
     let tau = tol.force + tol.relative * force_scale;
-    let (unilateral, carried, strong) =
+    let (unilateral, carried, strong, weak) =
         super::unilateral::check(model, state, uni, &p, tol.constraint, tau);
     p.grad_s -= carried;
     // The (scaled) gradients of the scalar coordinates.
@@ -168,5 +170,6 @@ pub(super) fn dense_checks(
         unassigned,
         unilateral,
         strong,
+        weak,
     })
 }

@@ -315,7 +315,7 @@ fn verify_on(
         unassigned,
         stability,
         contact,
-        strong,
+        (strong, weak),
     ) = if sparse {
         let locks = crate::solver::lock_values(model);
         let r = reduced::reduced(model, state, &locks, locks.len())?;
@@ -338,7 +338,7 @@ fn verify_on(
         let contact = unilateral_sparse::check(model, state, uni, &locks, tol.constraint, tau)?;
         let carried = contact.touching.then_some(&contact.carried);
         // Without a stop or contact carrying a force, the verdict on this partition.
-        let free = contact.strong.is_empty();
+        let free = contact.strong.is_empty() && contact.weak.is_empty();
         let (coords, efforts, unassigned, stability) = std::thread::scope(|s| {
             let verdict = (assembled && free)
                 .then(|| s.spawn(|| crate::solver::stability_of(&mut sys, &state.q, &part, &eval)));
@@ -369,7 +369,7 @@ fn verify_on(
             unassigned,
             stability,
             contact.check,
-            contact.strong,
+            (contact.strong, contact.weak),
         )
     } else {
         let coords = tree_coordinates(model, state);
@@ -386,7 +386,7 @@ fn verify_on(
             d.unassigned,
             None,
             d.unilateral,
-            d.strong,
+            (d.strong, d.weak),
         )
     };
     let imbalance: Vec<Imbalance> = coords
@@ -414,10 +414,13 @@ fn verify_on(
     let mut contact = contact;
     let passed = contact.settle(tol.constraint, balanced) && balanced;
     // The sparse path judged the stability beside the efforts where no stop or contact
-    // carries a force; otherwise it is judged here, on the tangent space of those that do.
+    // touches; otherwise it is judged here, on the tangent space of those that carry a force
+    // and the critical cone of those that touch without one (`solver::cone`).
     let stability = match (passed, sparse) {
         (false, _) => None,
-        (true, _) if !strong.is_empty() => crate::solver::stability_on(model, state, &strong),
+        (true, _) if !strong.is_empty() || !weak.is_empty() => {
+            crate::solver::stability_touching(model, state, &strong, &weak)
+        }
         (true, true) => stability,
         (true, false) => crate::solver::stability_at(model, state),
     };

@@ -261,7 +261,7 @@ fn nnls(m: &DMatrix<f64>, b: &DVector<f64>, signed: &[bool]) -> DVector<f64> {
 /// `S ∇V` and the scaling `S`; `eps` the constraint tolerance, `tau` the effort
 /// tolerance. Returns the report and the scaled generalized force the touching rows carry
 /// (`S G λ`), to be taken off `S ∇V` before the joint imbalance is computed, and the rows that
-/// carry a force (the strongly active ones).
+/// carry a force (the strongly active ones) and those that touch without one (weakly active).
 pub(super) fn check(
     model: &Model,
     state: &State,
@@ -269,7 +269,7 @@ pub(super) fn check(
     p: &super::dense::Projection,
     eps: f64,
     tau: f64,
-) -> (UnilateralCheck, DVector<f64>, Vec<Active>) {
+) -> (UnilateralCheck, DVector<f64>, Vec<Active>, Vec<Active>) {
     let (null, grad_s, scale) = (&p.null, &p.grad_s, &p.scale[..]);
     let mut out = UnilateralCheck::default();
     let list = touching(model, state, opts, eps, &mut out);
@@ -277,7 +277,7 @@ pub(super) fn check(
     let columns: Vec<Vec<DVector<f64>>> = list.iter().map(|t| t.columns(n, scale)).collect();
     let mut carried = DVector::zeros(n);
     if list.is_empty() {
-        return (out, carried, Vec::new());
+        return (out, carried, Vec::new(), Vec::new());
     }
     // Columns of the balance, normalized; `signed` marks the normal rows.
     let mut cols = Vec::new();
@@ -334,7 +334,7 @@ pub(super) fn check(
     };
     // The generalized force the rows carry, in scaled coordinates.
     let mut k = 0;
-    let mut strong = Vec::new();
+    let (mut strong, mut weak) = (Vec::new(), Vec::new());
     for (t, cols) in list.iter().zip(&columns) {
         let lambda: Vec<f64> = (0..cols.len()).map(|r| forces[k + r]).collect();
         for (r, c) in cols.iter().enumerate() {
@@ -342,6 +342,8 @@ pub(super) fn check(
         }
         if lambda[0] > tau {
             strong.push(t.active);
+        } else {
+            weak.push(t.active);
         }
         out.complementarity = out.complementarity.max((t.gap * lambda[0]).abs());
         describe(model, state, t, &lambda, tau, &mut out);
@@ -357,7 +359,7 @@ pub(super) fn check(
         }
         k += t.rows.len();
     }
-    (out, carried, strong)
+    (out, carried, strong, weak)
 }
 
 /// The failure of a stop or contact `u` that would have to pull with `force` to hold the pose.

@@ -55,6 +55,8 @@ pub(super) struct SparseUnilateral {
     pub(super) carried: DVector<f64>,
     /// The inequalities that carry a force (`λ > τ`): the stability's tangent space.
     pub(super) strong: Vec<Active>,
+    /// The touching inequalities that carry no force (the critical cone's).
+    pub(super) weak: Vec<Active>,
     /// Whether any inequality touches.
     pub(super) touching: bool,
 }
@@ -82,6 +84,7 @@ pub(super) fn check(
             check: out,
             carried,
             strong: Vec::new(),
+            weak: Vec::new(),
             touching: false,
         });
     }
@@ -103,7 +106,7 @@ pub(super) fn check(
             on[i] = false;
         }
     }
-    let mut strong = Vec::new();
+    let (mut strong, mut weak) = (Vec::new(), Vec::new());
     for (i, t) in list.iter().enumerate() {
         let lambda: Vec<f64> = if forces[i][0] < -tau {
             vec![0.0; t.rows.len()]
@@ -115,6 +118,8 @@ pub(super) fn check(
         }
         if lambda[0] > tau {
             strong.push(t.active);
+        } else {
+            weak.push(t.active);
         }
         out.complementarity = out.complementarity.max((t.gap * lambda[0]).abs());
         describe(model, state, t, &lambda, tau, &mut out);
@@ -126,6 +131,7 @@ pub(super) fn check(
         check: out,
         carried,
         strong,
+        weak,
         touching: true,
     })
 }

@@ -959,3 +959,85 @@ fn verify_rests_the_pressed_box_on_its_corners_on_both_paths() {
         assert_eq!(v.stability.as_ref().unwrap().verdict, Verdict::Neutral);
     }
 }
+
+/// The flat box pressed down by 100 N on its top's diagonal: the load's line of action meets
+/// the ground on the diagonal through two corners, and the dense path's non-negative least
+/// squares rests it on those two alone, the other two touching without force. Held by the two
+/// loaded corners only, the box would tip about the diagonal (the load and the centre of mass
+/// drop: a negative eigenvalue); each way of tipping pushes one of the unloaded corners into
+/// the ground, so on the critical cone (module `solver::cone`) only sliding and yaw are free:
+/// neutral on both paths and in analyze, never unstable.
+#[test]
+fn a_box_pressed_on_its_diagonal_does_not_tip_over_its_unloaded_corners() {
+    let text = BOX.replace(
+        "<mech:ground/>",
+        r#"<mech:ground/><mech:force name="press" link="box" xyz="0.16 0.12 0.1" force="0 0 -100"/>"#,
+    );
+    let m = floating(&text);
+    let mut q = DVector::zeros(7);
+    q[2] = 0.1;
+    q[3] = 1.0;
+    let flat = State {
+        q,
+        branches: Default::default(),
+    };
+    let uni = Unilaterals::default();
+    let tol = Tolerances::default();
+    let mut unloaded = 0;
+    for la in [LinearAlgebra::Dense, LinearAlgebra::Sparse] {
+        let v = verify_using(&m, &flat, &tol, &uni, la).unwrap();
+        assert!(v.passed, "{la:?}: {v:?}");
+        let c = &v.unilateral.contacts;
+        assert_eq!(c.len(), 4);
+        unloaded += c.iter().filter(|c| c.normal_force <= 1e-9).count();
+        let s = v.stability.as_ref().unwrap();
+        assert_eq!(s.verdict, Verdict::Neutral, "{la:?}: {s:?}");
+    }
+    // The case this test is about: some corner touches without force.
+    assert!(unloaded >= 1, "every corner carries a force");
+    let (s, r) = restpose::solve_from(&m, flat, &Options::default()).unwrap();
+    assert!(r.converged());
+    assert_eq!(r.stability.unwrap().verdict, Verdict::Neutral);
+    for la in [LinearAlgebra::Dense, LinearAlgebra::Sparse] {
+        let v = verify_using(&m, &s, &tol, &uni, la).unwrap();
+        assert!(v.passed, "{la:?}: {v:?}");
+        assert_eq!(v.stability.unwrap().verdict, Verdict::Neutral, "{la:?}");
+    }
+}
+
+/// The bar balanced straight up (`θ = π/2`, spring neutral there, `k < m g`: the top of the
+/// energy `m g sin θ + ½ k (θ − π/2)²`) and resting on its lower stop at `π/2` with no effort:
+/// the stop blocks falling back but not falling forward, so the rest is unstable (before the
+/// critical cone, analyze judged it with the stop held, where nothing can move).
+#[test]
+fn a_bar_balanced_on_a_stop_that_carries_nothing_is_unstable() {
+    let half_pi = std::f64::consts::FRAC_PI_2;
+    let text = r#"<robot name="up" xmlns:mech="urn:urdf-mech:1">
+  <link name="world"/>
+  <link name="bar"><inertial><origin xyz="1 0 0"/><mass value="2"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.6" iyz="0" izz="0.6"/></inertial></link>
+  <joint name="pivot" type="revolute"><parent link="world"/><child link="bar"/><axis xyz="0 0 1"/>
+    <limit lower="1.5707963267948966" upper="3" effort="10" velocity="1"/></joint>
+  <mech:gravity xyz="0 -9.81 0"/>
+  <mech:joint_spring joint="pivot" stiffness="5" reference="1.5707963267948966"/>
+  <mech:initial joint="pivot" value="1.5707963267948966"/>
+</robot>"#;
+    let m = model_from(text);
+    let options = Options {
+        allow_unstable: true,
+        ..Default::default()
+    };
+    let (s, r) = restpose::solve(&m, &options).unwrap();
+    assert!(r.converged(), "{:?}", r.termination);
+    assert_abs_diff_eq!(s.joint(&m, "pivot").unwrap()[0], half_pi, epsilon = 1e-10);
+    assert_eq!(r.active_limits.len(), 1);
+    assert!(r.active_limits[0].effort.abs() < 1e-9);
+    let st = r.stability.unwrap();
+    assert_eq!(st.verdict, Verdict::Unstable, "{st:?}");
+    // verify agrees on both paths (the stop's effort is zero to rounding on each).
+    for la in [LinearAlgebra::Dense, LinearAlgebra::Sparse] {
+        let v = verify_using(&m, &s, &Tolerances::default(), &Unilaterals::default(), la).unwrap();
+        assert!(v.passed, "{la:?}: {v:?}");
+        assert_eq!(v.stability.unwrap().verdict, Verdict::Unstable, "{la:?}");
+    }
+}

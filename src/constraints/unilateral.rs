@@ -209,9 +209,22 @@ pub(crate) fn rows(
             let (origin, normal) = surface(model, ground, &at);
             let x = pair.point(0, &c.point);
             let n = pair.vector(1, &normal);
-            let mut out = vec![pair
+            let mut gap = pair
                 .dot(&x.sub(&pair.point(1, &origin)), &n)
-                .minus(c.radius)];
+                .minus(c.radius);
+            // An obstacle's curvature: `(∂x/∂q)ᵀ K (∂x/∂q)` (module `model::curvature`).
+            if let (Some(h), Some(o)) = (
+                gap.h.as_mut(),
+                ground
+                    .checked_sub(model.grounds.len())
+                    .and_then(|k| model.obstacles.get(k)),
+            ) {
+                let k = o.curvature(&at);
+                if k != nalgebra::Matrix3::zeros() {
+                    **h += x.j.transpose() * k * x.j;
+                }
+            }
+            let mut out = vec![gap];
             if let Some(anchor) = a.anchor {
                 let d = pair
                     .point(0, &anchor.body)
@@ -303,9 +316,10 @@ mod tests {
         }
     }
 
-    /// Against an obstacle the gap row's value equals the gap and its gradient equals central
-    /// differences of the gap (a box's face and edge, a sphere); the Hessian leaves out the
-    /// surface's curvature by design (module docs of `model::obstacle`), so it is not compared.
+    /// Against an obstacle the gap row's value equals the gap, its gradient equals central
+    /// differences of the gap and its Hessian (with the surface's curvature, module
+    /// `model::curvature`) central differences of the gradient (a box's face and edge, a
+    /// sphere, a cylinder's side).
     #[test]
     fn obstacle_gap_rows_match_finite_differences() {
         use crate::geometry::ShapeKind;
@@ -326,6 +340,13 @@ mod tests {
             (
                 ShapeKind::Sphere { radius: 0.4 },
                 Vector3::new(0.3, 0.2, 0.9),
+            ),
+            (
+                ShapeKind::Cylinder {
+                    radius: 0.3,
+                    length: 2.0,
+                },
+                Vector3::new(0.3, 0.2, 0.1),
             ),
         ] {
             let mut b = ModelBuilder::new("t");
@@ -370,6 +391,35 @@ mod tests {
                     "coordinate {i}: {} vs {fd}",
                     row.g[i]
                 );
+            }
+            let with_hessian = pair_of(&[Some(body), None], &q, true);
+            let row = rows(&m, &a, &with_hessian, &Branches::default()).unwrap()[0].clone();
+            let hess = row.h.expect("asked for");
+            let grad = |q: &DVector<f64>| {
+                rows(
+                    &m,
+                    &a,
+                    &pair_of(&[Some(body), None], q, false),
+                    &Branches::default(),
+                )
+                .unwrap()[0]
+                    .g
+            };
+            for i in 0..7 {
+                let h = 1e-6;
+                let (mut up, mut down) = (q.clone(), q.clone());
+                up[i] += h;
+                down[i] -= h;
+                let fd = (grad(&up) - grad(&down)) / (2.0 * h);
+                for j in 0..7 {
+                    assert!(
+                        (hess[(j, i)] - fd[j]).abs() < 1e-7,
+                        "{:?} H[{j},{i}]: {} vs {}",
+                        m.obstacles[0].shape,
+                        hess[(j, i)],
+                        fd[j]
+                    );
+                }
             }
         }
     }

@@ -10,6 +10,7 @@ mod builder;
 mod check;
 mod connect;
 mod contact;
+mod curvature;
 mod force;
 mod hull;
 mod joint;

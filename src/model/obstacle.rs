@@ -7,10 +7,10 @@
 //!
 //! with `∇g = nᵀ ∂x/∂q`, `n` the outward unit normal at the closest point `c` of the surface.
 //! The constraint row is evaluated as the plane through `c` with normal `n` (both taken at the
-//! current `x`): its value and gradient are exact; its Hessian leaves out the surface's
-//! curvature (zero on a face, `1/R` on a sphere or a cylinder's side), so Newton converges on a
-//! face as on a ground and linearly where the curvature counts. Near an edge or a vertex the
-//! normal turns (the gap is `C¹` there, not `C²`).
+//! current `x`): its value and gradient are exact, and its Hessian gets the surface's curvature
+//! `K = ∇²d` added (module `model::curvature`: zero on a face, `(I − n nᵀ)/r` near a sphere,
+//! …), so that Newton converges quadratically on curved surfaces too. A zero-radius point
+//! exactly on an edge or a vertex has a gap that is `C¹` there, not `C²`.
 //!
 //! Shapes: boxes, spheres, capsules and cylinders (closed forms in the shape's frame below) and
 //! meshes, by their convex hull (parry3d; closest points in `model::hull`). The closed forms are

@@ -46,13 +46,17 @@ pub(crate) struct Guard<'m> {
     /// For contacts with an obstacle: its tangent plane `(o, n)` at the round's start. A step
     /// is guarded against that plane (a finite obstacle could otherwise be stepped through).
     planes: Vec<Option<(Vector3<f64>, Vector3<f64>)>>,
+    /// The sticking spheres' roll limits, after the inequalities (module `rolling`).
+    rolls: Vec<super::rolling::RollLimit>,
 }
 
 impl<'m> Guard<'m> {
-    /// The guard of the inequalities `inactive` from the configuration `q`.
+    /// The guard of the inequalities `inactive` from the configuration `q`, and of the roll
+    /// limits of the sticking spheres among `active`.
     pub(crate) fn new(
         model: &'m Model,
         inactive: Vec<Unilateral>,
+        active: &[Active],
         tol: f64,
         q: &DVector<f64>,
     ) -> Self {
@@ -70,12 +74,26 @@ impl<'m> Guard<'m> {
             inactive,
             tol,
             planes,
+            rolls: super::rolling::limits(model, active),
         }
     }
 
-    /// Dimensionless gap of inequality `k` (against an obstacle: to its plane of `planes`).
+    /// Number of guarded inequalities: the inactive ones, then the roll limits.
+    fn len(&self) -> usize {
+        self.inactive.len() + self.rolls.len()
+    }
+
+    /// Whether guarded inequality `k` is a roll limit (not an inequality to activate).
+    pub(crate) fn is_roll_limit(&self, k: usize) -> bool {
+        k >= self.inactive.len()
+    }
+
+    /// Dimensionless gap of inequality `k` (against an obstacle: to its plane of `planes`; a
+    /// roll limit's margin after the inactive ones).
     fn gap(&self, k: usize, q: &DVector<f64>, branches: &Branches) -> f64 {
-        let u = &self.inactive[k];
+        let Some(u) = self.inactive.get(k) else {
+            return self.rolls[k - self.inactive.len()].margin(self.model, q);
+        };
         let g = match (self.planes[k], u) {
             (Some((o, n)), Unilateral::Contact { point, .. }) => {
                 n.dot(&(unilateral::point_world(self.model, *point, q) - o))
@@ -88,7 +106,7 @@ impl<'m> Guard<'m> {
 
     /// The lowest dimensionless gap and its inequality.
     fn lowest(&self, q: &DVector<f64>, branches: &Branches) -> Option<(usize, f64)> {
-        (0..self.inactive.len())
+        (0..self.len())
             .map(|k| (k, self.gap(k, q, branches)))
             .min_by(|a, b| a.1.total_cmp(&b.1))
     }
@@ -97,7 +115,7 @@ impl<'m> Guard<'m> {
     /// boundary (a linear descent may then end on it, and is not unbounded).
     pub(crate) fn approaching(&self, sys: &System, from: &DVector<f64>, to: &DVector<f64>) -> bool {
         let b = &sys.problem.cons.branches;
-        (0..self.inactive.len()).any(|k| self.gap(k, to, b) < self.gap(k, from, b) - self.tol)
+        (0..self.len()).any(|k| self.gap(k, to, b) < self.gap(k, from, b) - self.tol)
     }
 
     /// Whether `q` violates one of the inequalities by more than the tolerance.
@@ -150,7 +168,7 @@ impl<'m> Guard<'m> {
             }
         }
         let branches = &sys.problem.cons.branches;
-        let touching: Vec<usize> = (0..self.inactive.len())
+        let touching: Vec<usize> = (0..self.len())
             .filter(|&k| self.gap(k, &q_lo, branches) <= self.tol)
             .collect();
         if touching.is_empty() {
@@ -332,7 +350,7 @@ pub(crate) fn solve(
             .filter(|u| !active.iter().any(|a| a.row == **u))
             .copied()
             .collect();
-        let guard = Guard::new(model, inactive, tol, &q);
+        let guard = Guard::new(model, inactive, &active, tol, &q);
         let round = super::solve_round(
             model,
             crate::State { q, branches },
@@ -346,15 +364,25 @@ pub(crate) fn solve(
         state = round.state;
         let mut report = round.report;
         let cycling = changes - initial >= options.max_iterations;
+        let mut rolled_too_far = false;
         if let (Some(hit), false) = (&round.blocked, cycling) {
-            for &k in hit {
+            // A sphere that reached its roll limit is re-anchored where it touches now.
+            if hit.iter().any(|&k| guard.is_roll_limit(k)) {
+                super::rolling::reanchor(model, options, &mut active, &touched, &state.q);
+                rolls += 1;
+            }
+            for &k in hit.iter().filter(|&&k| !guard.is_roll_limit(k)) {
                 active.push(activate(model, options, guard.inactive[k], &state.q));
                 changes += 1;
             }
             super::rolling::record_touches(model, &active, &state.q, &mut touched);
-            continue;
+            if rolls <= super::rolling::MAX_ROLLS {
+                continue;
+            }
+            report.termination = super::Termination::Unbounded;
+            rolled_too_far = true;
         }
-        if report.converged() && !cycling {
+        if report.converged() && !cycling && !rolled_too_far {
             if let Some(i) = to_release(model, &round.multipliers, threshold) {
                 active.remove(i);
                 super::rolling::record_touches(model, &active, &state.q, &mut touched);

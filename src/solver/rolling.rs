@@ -100,3 +100,53 @@ pub(crate) fn record_touches(
         }
     }
 }
+
+/// How far a sticking sphere may roll within one round: its touching material point moves at
+/// most `ROLL_LIMIT · ρ` on the sphere from the anchor's (about `ROLL_LIMIT` rad of rolling).
+///
+/// Within a round the anchor's material point is held where it touched, so the sphere pivots
+/// about it rather than rolls: its centre moves by `ρ sin φ` where rolling moves it by `ρ φ`,
+/// and near `φ = π/2` the tangential rows lose their rank in the rotation (the held point is
+/// on the sphere's side). Cutting the round at this limit (a guarded inequality, module
+/// `active_set`) and re-anchoring keeps each round within `ρ (φ − sin φ) ≤ 0.003 ρ` of rolling
+/// and away from that singularity; the re-anchorings then converge to the rolling rest.
+pub(crate) const ROLL_LIMIT: f64 = 0.25;
+
+/// The roll limit of one sticking sphere (module docs of [`ROLL_LIMIT`]).
+pub(crate) struct RollLimit {
+    point: usize,
+    ground: usize,
+    /// The anchor's material point (body frame).
+    anchored: Vector3<f64>,
+}
+
+/// The roll limits of the sticking spheres (radius > 0) among `active`.
+pub(crate) fn limits(model: &Model, active: &[Active]) -> Vec<RollLimit> {
+    active
+        .iter()
+        .filter_map(|a| match (a.anchor, a.row) {
+            (Some(anchor), Unilateral::Contact { point, ground })
+                if model.contact_points[point].radius > 0.0 =>
+            {
+                Some(RollLimit {
+                    point,
+                    ground,
+                    anchored: anchor.body,
+                })
+            }
+            _ => None,
+        })
+        .collect()
+}
+
+impl RollLimit {
+    /// `(ROLL_LIMIT ρ − |s(q) − s_a|) / L`: `s(q)` the material point touching at `q`, `s_a`
+    /// the anchor's, `L` the characteristic length; negative past the limit.
+    pub(crate) fn margin(&self, model: &Model, q: &DVector<f64>) -> f64 {
+        let c = &model.contact_points[self.point];
+        let x = unilateral::point_world(model, self.point, q);
+        let (_, n) = unilateral::surface(model, self.ground, &x);
+        let touching = c.point - body_rotation(c.body, q).transpose() * n * c.radius;
+        (ROLL_LIMIT * c.radius - (touching - self.anchored).norm()) / model.length_scale
+    }
+}

@@ -1041,3 +1041,39 @@ fn a_bar_balanced_on_a_stop_that_carries_nothing_is_unstable() {
         assert_eq!(v.stability.unwrap().verdict, Verdict::Unstable, "{la:?}");
     }
 }
+
+/// A sticking 1 kg ball (radius 0.1 m) with its centre of mass 0.05 m to the side of its
+/// centre, on flat ground, rolls a quarter turn until the centre of mass is below the centre:
+/// the touching point moves by the rolled arc `ρ π/2` (closed form, rolling without slip),
+/// `V = −m g 0.05`. Each round stops at the roll limit (`solver::rolling::ROLL_LIMIT`) and the
+/// sphere is re-anchored, so that no round pivots a quarter turn about one material point.
+#[test]
+fn an_unbalanced_ball_rolls_a_quarter_turn_on_flat_ground() {
+    let m = floating(
+        r#"<robot name="flat" xmlns:mech="urn:urdf-mech:1">
+  <link name="body">
+    <inertial><origin xyz="0.05 0 0"/><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><sphere radius="0.1"/></geometry></collision>
+  </link>
+  <mech:ground xyz="0 0 -0.1"/>
+</robot>"#,
+    );
+    let options = Options {
+        friction: Friction::Stick,
+        ..Default::default()
+    };
+    let (s, r) = restpose::solve(&m, &options).unwrap();
+    assert!(r.converged(), "{:?}", r.termination);
+    assert_abs_diff_eq!(r.energy.total, -9.81 * 0.05, epsilon = 1e-9);
+    assert_eq!(r.contacts.len(), 1);
+    let c = &r.contacts[0];
+    assert_eq!(c.state, ContactState::Sticking);
+    assert_abs_diff_eq!(
+        c.point_world[0],
+        0.1 * std::f64::consts::FRAC_PI_2,
+        epsilon = 1e-9
+    );
+    assert_abs_diff_eq!(c.point_world[1], 0.0, epsilon = 1e-9);
+    assert_abs_diff_eq!(c.normal_force, 9.81, epsilon = 1e-9);
+    assert_verified_contacts(&m, &s, Friction::Stick);
+}

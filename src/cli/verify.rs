@@ -67,7 +67,19 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
         friction: a.friction,
         mu: a.mu,
     };
-    let v = restpose::verify::verify_using(model, &state, &tol, &uni, a.linear_algebra)?;
+    let eigenvalues = if a.eigenvalues {
+        restpose::verify::Eigenvalues::Always
+    } else {
+        restpose::verify::Eigenvalues::WhenCheap
+    };
+    let v = restpose::verify::verify_reporting(
+        model,
+        &state,
+        &tol,
+        &uni,
+        a.linear_algebra,
+        eigenvalues,
+    )?;
     if let Some(path) = &a.json {
         print::write_json(path, &serde_json::to_string_pretty(&v)?)?;
     }

@@ -213,7 +213,7 @@ pub fn verify_with_options(
     tol: &Tolerances,
     uni: &Unilaterals,
 ) -> Result<Verification> {
-    verify_on(model, state, tol, uni, sparse_path(model))
+    verify_on(model, state, tol, uni, sparse_path(model), false)
 }
 
 /// [`verify_with_options`] on the path `linear_algebra` says: `Auto` as
@@ -228,12 +228,40 @@ pub fn verify_using(
     uni: &Unilaterals,
     linear_algebra: crate::solver::LinearAlgebra,
 ) -> Result<Verification> {
+    verify_reporting(model, state, tol, uni, linear_algebra, Eigenvalues::WhenCheap)
+}
+
+/// What the stability verdict of [`verify`] reports besides the verdict.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Eigenvalues {
+    /// The lowest eigenvalues and their mode shapes where they are exact and cheap (the
+    /// reduced Hessian formed and decomposed: up to 200 degrees of freedom, or the dense
+    /// path); above, the verdict alone, from the inertia of the shifted KKT matrix
+    /// (`stability.eigenvalues` and `modes` empty).
+    #[default]
+    WhenCheap,
+    /// Always the lowest eigenvalues and mode shapes (above 200 degrees of freedom on the
+    /// sparse path, the low end found by Lanczos, as `analyze` reports them).
+    Always,
+}
+
+/// [`verify_using`] with the eigenvalues `eigenvalues` asks for.
+/// # Errors
+/// As [`verify`].
+pub fn verify_reporting(
+    model: &Model,
+    state: &State,
+    tol: &Tolerances,
+    uni: &Unilaterals,
+    linear_algebra: crate::solver::LinearAlgebra,
+    eigenvalues: Eigenvalues,
+) -> Result<Verification> {
     let sparse = match linear_algebra {
         crate::solver::LinearAlgebra::Auto => sparse_path(model),
         crate::solver::LinearAlgebra::Dense => false,
         crate::solver::LinearAlgebra::Sparse => true,
     };
-    verify_on(model, state, tol, uni, sparse)
+    verify_on(model, state, tol, uni, sparse, eigenvalues == Eigenvalues::Always)
 }
 
 /// Closure errors per joint from the rows `cons` and their values `phi`.
@@ -296,13 +324,15 @@ fn tree_coordinates(
 ///
 /// On the sparse path the stability verdict reuses the partition and evaluation of the
 /// balance check, and is computed on a second thread while the efforts are (kept only when
-/// the pose passes); both only read the model and the state.
+/// the pose passes); both only read the model and the state. `eigenvalues`: the lowest
+/// eigenvalues also where only Lanczos finds them ([`Eigenvalues::Always`]).
 fn verify_on(
     model: &Model,
     state: &State,
     tol: &Tolerances,
     uni: &Unilaterals,
     sparse: bool,
+    eigenvalues: bool,
 ) -> Result<Verification> {
     let (
         coords,
@@ -341,7 +371,7 @@ fn verify_on(
         let free = contact.strong.is_empty();
         let (coords, efforts, unassigned, stability) = std::thread::scope(|s| {
             let verdict = (assembled && free)
-                .then(|| s.spawn(|| crate::solver::stability_of(&mut sys, &state.q, &part, &eval)));
+                .then(|| s.spawn(|| crate::solver::stability_of(&mut sys, &state.q, &part, &eval, eigenvalues)));
             // The joint coordinates here, off the verdict's path.
             let coords = tree_coordinates(model, state);
             let values: Vec<_> = coords.iter().map(|c| (c.0, c.1, c.2.v)).collect();
@@ -417,9 +447,11 @@ fn verify_on(
     // carries a force; otherwise it is judged here, on the tangent space of those that do.
     let stability = match (passed, sparse) {
         (false, _) => None,
-        (true, _) if !strong.is_empty() => crate::solver::stability_on(model, state, &strong),
+        (true, _) if !strong.is_empty() => {
+            crate::solver::stability_on(model, state, &strong, eigenvalues)
+        }
         (true, true) => stability,
-        (true, false) => crate::solver::stability_at(model, state),
+        (true, false) => crate::solver::stability_at(model, state, eigenvalues),
     };
     Ok(Verification {
         passed,

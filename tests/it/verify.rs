@@ -212,17 +212,32 @@ fn verify_accepts_analyze_answers_at_1000_links() {
             Some(report.dof),
             "{family}"
         );
-        // verify's stability verdict (from its balance check's partition, Lanczos above 200
-        // degrees of freedom) is analyze's, with the same smallest eigenvalues.
-        let (vs, rs) = (
+        // verify's stability verdict (from its balance check's partition; above 200 degrees
+        // of freedom from the shifted KKT inertia by default, without eigenvalues) is
+        // analyze's; asked for, the smallest eigenvalues (Lanczos) are analyze's too, with the
+        // same verdict and tolerance.
+        let full = restpose::verify::verify_reporting(
+            &m,
+            &s,
+            &Tolerances::default(),
+            &Default::default(),
+            restpose::LinearAlgebra::Auto,
+            restpose::verify::Eigenvalues::Always,
+        )
+        .unwrap();
+        let (vs, fs, rs) = (
             v.stability.as_ref().unwrap(),
+            full.stability.as_ref().unwrap(),
             report.stability.as_ref().unwrap(),
         );
         assert_eq!(vs.verdict, rs.verdict, "{family}");
         assert_eq!(vs.verdict, restpose::solver::Verdict::Stable, "{family}");
-        assert!(!vs.eigenvalues.is_empty(), "{family}");
-        assert_eq!(vs.eigenvalues.len(), rs.eigenvalues.len(), "{family}");
-        for (a, b) in vs.eigenvalues.iter().zip(&rs.eigenvalues) {
+        assert!(vs.eigenvalues.is_empty() && vs.modes.is_empty(), "{family}");
+        assert_eq!(fs.verdict, vs.verdict, "{family}");
+        assert_eq!(fs.tolerance, vs.tolerance, "{family}");
+        assert!(!fs.eigenvalues.is_empty(), "{family}");
+        assert_eq!(fs.eigenvalues.len(), rs.eigenvalues.len(), "{family}");
+        for (a, b) in fs.eigenvalues.iter().zip(&rs.eigenvalues) {
             assert!((a - b).abs() <= 1e-8 * b.abs(), "{family}: {a} vs {b}");
         }
         // One joint turned by 0.01 rad needs an effort there.

@@ -18,6 +18,12 @@
 //! bodies below it). The system is solved in the scaled coordinates `q̂ = S⁻¹ q` with the rows
 //! scaled by `D`, like the partition. A shift `δ I` on the `W` block (`δ ≥ 0`) makes the
 //! reduced matrix `Zᵀ (W + δ S⁻²) Z` positive definite away from a minimum.
+//!
+//! A second shift `−σ` on the independent coordinates alone ([`Kkt::shift_independent`],
+//! `E_v` their selector) gives `Zᵀ (Ŵ − σ E_v) Z = Ĥ − σ I`, since `Z`'s independent block is
+//! the identity: by Sylvester's law of inertia (Haynsworth's inertia additivity over the
+//! constraint block) the LDLᵀ then has `rows + #{λ(Ĥ) < σ}` negative pivots, an exact count
+//! of the reduced Hessian's eigenvalues below `σ` (module `solver::stability_inertia`).
 
 use super::hessian::BlockHessian;
 use super::pattern::{Ix, Pattern, NONE};
@@ -60,6 +66,10 @@ pub(crate) struct Kkt {
     values: Vec<f64>,
     /// The shift `δ` now added to the diagonal of the `W` block in `values`.
     delta: f64,
+    /// The shift `−σ` on the independent coordinates' diagonal (see [`Kkt::shift_independent`])
+    /// and those coordinates.
+    sigma: f64,
+    sigma_columns: Vec<usize>,
     /// `‖K‖∞` of the factored matrix (for the backward error of solves).
     knorm: f64,
     /// The full (both triangles) permuted matrix for the LU fallback, built on its first use:
@@ -239,6 +249,8 @@ impl Kkt {
             diag_slots,
             values: vec![0.0; nnz],
             delta: 0.0,
+            sigma: 0.0,
+            sigma_columns: Vec::new(),
             knorm: 0.0,
             full: None,
             lu: None,
@@ -267,6 +279,8 @@ impl Kkt {
     ) {
         self.values.iter_mut().for_each(|v| *v = 0.0);
         self.delta = 0.0;
+        self.sigma = 0.0;
+        self.sigma_columns.clear();
         for ((&(a, b), blk), slots) in hess.keys.iter().zip(&hess.values).zip(&self.block_slots) {
             for i in 0..7 {
                 for j in 0..7 {
@@ -287,9 +301,33 @@ impl Kkt {
 
     /// The largest diagonal entry of the (scaled) `W` block.
     pub(crate) fn max_diagonal(&self) -> f64 {
+        let mut shifted = vec![0.0; self.diag_slots.len()];
+        for &c in &self.sigma_columns {
+            shifted[c] = self.sigma;
+        }
         self.diag_slots
             .iter()
-            .fold(0.0f64, |a, &s| a.max((self.values[s] - self.delta).abs()))
+            .zip(&shifted)
+            .fold(0.0f64, |a, (&s, &sigma)| {
+                a.max((self.values[s] - self.delta + sigma).abs())
+            })
+    }
+
+    /// Subtracts `σ` from the diagonal of the (scaled) `W` block at the coordinates `columns`
+    /// (the partition's independent ones), in place of the last such shift, for the next
+    /// [`Kkt::factor`]: the reduced matrix becomes `Ĥ − σ I` (module doc), so the LDLᵀ's
+    /// negative pivots minus `rows` count the eigenvalues of `Ĥ` below `σ`. Cleared by
+    /// [`Kkt::assemble`].
+    pub(crate) fn shift_independent(&mut self, columns: &[usize], sigma: f64) {
+        for &c in &self.sigma_columns {
+            self.values[self.diag_slots[c]] += self.sigma;
+        }
+        self.sigma_columns.clear();
+        self.sigma_columns.extend_from_slice(columns);
+        self.sigma = sigma;
+        for &c in &self.sigma_columns {
+            self.values[self.diag_slots[c]] -= sigma;
+        }
     }
 
     /// Factors the matrix with `δ` added to the diagonal of the `W` block: LDLᵀ without

@@ -177,9 +177,10 @@ impl Kkt {
             .iter()
             .filter(|e| row_pos[e.0] != NONE)
             .map(|e| upper(n + row_pos[e.0], e.1));
-        let pattern = Pattern::new(
+        let pattern = Pattern::with_capacity(
             dim,
             dim,
+            49 * hess.keys.len() + entries.len() + n,
             blocks.chain(jacobian).chain((0..n).map(|i| upper(i, i))),
         );
         let block_slots = hess

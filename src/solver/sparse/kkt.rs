@@ -168,11 +168,16 @@ impl Kkt {
             let (a, b) = (inv[i], inv[j]);
             (a.min(b), a.max(b))
         };
+        // Only the entries a block fills (those in the upper triangle after permutation, as in
+        // `block_slots` below): the mirrored ones come from the transposed block, so listing
+        // them too doubled the positions to sort.
+        let inv_ref = &inv;
         let blocks = hess
             .keys
             .iter()
             .flat_map(|&(a, b)| (0..49).map(move |k| (7 * a + k / 7, 7 * b + k % 7)))
-            .map(|(i, j)| upper(i, j));
+            .filter(move |&(i, j)| inv_ref[i] <= inv_ref[j])
+            .map(|(i, j)| (inv[i], inv[j]));
         let jacobian = entries
             .iter()
             .filter(|e| row_pos[e.0] != NONE)
@@ -180,7 +185,7 @@ impl Kkt {
         let pattern = Pattern::with_capacity(
             dim,
             dim,
-            49 * hess.keys.len() + entries.len() + n,
+            28 * hess.keys.len() + entries.len() + n,
             blocks.chain(jacobian).chain((0..n).map(|i| upper(i, i))),
         );
         let block_slots = hess

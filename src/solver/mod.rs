@@ -210,8 +210,7 @@ pub(crate) fn stability_of(
     let lanczos =
         sys.backend == system::Backend::Sparse && part.independent.len() > spectrum::EXACT_UP_TO;
     if lanczos && !eigenvalues {
-        if let Some((verdict, tolerance)) = stability_inertia::inertia_verdict(sys, q, part, eval)
-        {
+        if let Some((verdict, tolerance)) = stability_inertia::inertia_verdict(sys, q, part, eval) {
             return Some(Stability {
                 verdict,
                 tolerance,

@@ -67,7 +67,10 @@ fn counts_and_verdicts_match_the_dense_eigendecomposition() {
         let (verdict, tol) = inertia_verdict(&mut sys, &q, &part, &eval).unwrap();
         // The tolerance from power iteration: within a few per cent of the exact one.
         let exact_tol = 1e-10 * exact.amax().max(1.0);
-        assert!((tol - exact_tol).abs() <= 0.05 * exact_tol, "{tol} vs {exact_tol}");
+        assert!(
+            (tol - exact_tol).abs() <= 0.05 * exact_tol,
+            "{tol} vs {exact_tol}"
+        );
         assert_eq!(verdict, by_eigenvalues(&exact, tol), "n {n} flip {flip}");
         assert_eq!(verdict == Verdict::Unstable, flip);
         // Shifts in the gaps of the spectrum (midpoints) and beyond both ends.
@@ -78,7 +81,10 @@ fn counts_and_verdicts_match_the_dense_eigendecomposition() {
         for sigma in shifts {
             let expected = exact.iter().filter(|&&e| e < sigma).count();
             // A shift closer to an eigenvalue than rounding resolves is not a fair test.
-            let gap = exact.iter().map(|e| (e - sigma).abs()).fold(f64::INFINITY, f64::min);
+            let gap = exact
+                .iter()
+                .map(|e| (e - sigma).abs())
+                .fold(f64::INFINITY, f64::min);
             if gap <= 1e-8 * exact.amax() {
                 continue;
             }
@@ -134,7 +140,10 @@ fn verdicts_match_lanczos_on_large_chains() {
         let negative = eigenvalues_below(&mut sys, &part, 0.0);
         let spectrum = crate::solver::spectrum::spectrum(&mut sys, &q, &part, &eval);
         assert!(!spectrum.exact);
-        assert_eq!(verdict, by_eigenvalues(&spectrum.values, spectrum.tolerance()));
+        assert_eq!(
+            verdict,
+            by_eigenvalues(&spectrum.values, spectrum.tolerance())
+        );
         assert_eq!(tol, spectrum.tolerance(), "the same power iteration");
         assert_eq!(verdict == Verdict::Unstable, flip);
         assert_eq!(negative, spectrum.negative_by_inertia);

@@ -253,3 +253,56 @@ fn verify_accepts_analyze_answers_at_1000_links() {
         assert!(v.max_imbalance.unwrap().effort.abs() > 1e3 * v.effort_tolerance);
     }
 }
+
+/// Above 200 degrees of freedom `verify`'s stability verdict comes from the KKT inertia, with
+/// no eigenvalues in the JSON; `--eigenvalues` adds the lowest ones (Lanczos), with the same
+/// verdict and tolerance; the text report is the same either way.
+#[test]
+fn cli_verify_eigenvalues_on_request_above_200_dof() {
+    let dir = tempfile::tempdir().unwrap();
+    let urdf = dir.path().join("chain.urdf");
+    std::fs::write(&urdf, restpose::generate::chain(250, false)).unwrap();
+    let result = dir.path().join("r.json");
+    assert!(restpose()
+        .arg("analyze")
+        .arg(&urdf)
+        .args(["-q", "--json"])
+        .arg(&result)
+        .status()
+        .unwrap()
+        .success());
+    let run = |extra: &[&str]| {
+        let json = restpose()
+            .arg("verify")
+            .arg(&urdf)
+            .arg("--pose")
+            .arg(&result)
+            .args(["--json", "-"])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert_eq!(json.status.code(), Some(0));
+        let text = restpose()
+            .arg("verify")
+            .arg(&urdf)
+            .arg("--pose")
+            .arg(&result)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert_eq!(text.status.code(), Some(0));
+        let v: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+        (v["stability"].clone(), text.stdout)
+    };
+    let (fast, fast_text) = run(&[]);
+    let (full, full_text) = run(&["--eigenvalues"]);
+    assert_eq!(fast["verdict"], "stable");
+    assert_eq!(fast["verdict"], full["verdict"]);
+    assert_eq!(fast["tolerance"], full["tolerance"]);
+    assert_eq!(fast["eigenvalues"].as_array().unwrap().len(), 0);
+    assert_eq!(fast["modes"].as_array().unwrap().len(), 0);
+    assert_eq!(full["eigenvalues"].as_array().unwrap().len(), 6);
+    assert_eq!(full["modes"].as_array().unwrap().len(), 6);
+    assert_eq!(fast_text, full_text);
+    assert!(String::from_utf8_lossy(&fast_text).contains("stability: stable"));
+}

@@ -160,16 +160,28 @@ impl Kkt {
             let (a, b) = (inv[i], inv[j]);
             (a.min(b), a.max(b))
         };
-        // Only the entries a block fills (those in the upper triangle after permutation, as in
-        // `block_slots` below): the mirrored ones come from the transposed block, so listing
-        // them too doubled the positions to sort.
-        let inv_ref = &inv;
-        let blocks = hess
-            .keys
-            .iter()
-            .flat_map(|&(a, b)| (0..49).map(move |k| (7 * a + k / 7, 7 * b + k % 7)))
-            .filter(move |&(i, j)| inv_ref[i] <= inv_ref[j])
-            .map(|(i, j)| (inv[i], inv[j]));
+        // Each body's seven coordinates are consecutive in the elimination order, so the block
+        // of bodies `a`, `b` is the dense 7 × 7 block at `(inv[7a], inv[7b])`: in the stored
+        // upper triangle when `inv[7a] < inv[7b]`, mirrored (filled by the transposed block
+        // `(b, a)`) when above, its upper triangle when `a = b`.
+        assert!(
+            (0..n).all(|c| inv[c] == inv[c - c % 7] + c % 7),
+            "elimination order keeps each body's coordinates together"
+        );
+        // The (row, column) ranges a block fills: column `bb + j`, rows `ba .. ba + rows(j)`.
+        let filled = |a: usize, b: usize| {
+            let (ba, bb) = (inv[7 * a], inv[7 * b]);
+            let rows = move |j: usize| match (ba < bb, a == b) {
+                (_, true) => j + 1,
+                (true, false) => 7,
+                (false, false) => 0,
+            };
+            (ba, bb, rows)
+        };
+        let blocks = hess.keys.iter().flat_map(|&(a, b)| {
+            let (ba, bb, rows) = filled(a, b);
+            (0..7).flat_map(move |j| (0..rows(j)).map(move |i| (ba + i, bb + j)))
+        });
         let jacobian = entries
             .iter()
             .filter(|e| row_pos[e.0] != NONE)
@@ -180,17 +192,19 @@ impl Kkt {
             28 * hess.keys.len() + entries.len() + n,
             blocks.chain(jacobian).chain((0..n).map(|i| upper(i, i))),
         );
+        // The rows of a filled column range are consecutive, hence so are their slots.
         let block_slots = hess
             .keys
             .iter()
             .map(|&(a, b)| {
                 let mut s = [Ix::MAX; 49];
-                for i in 0..7 {
-                    for j in 0..7 {
-                        let (pi, pj) = (inv[7 * a + i], inv[7 * b + j]);
-                        if pi <= pj {
-                            // Every block position is in the pattern (it was built from them).
-                            s[7 * i + j] = pattern.slot(pi, pj) as Ix;
+                let (ba, bb, rows) = filled(a, b);
+                for j in 0..7 {
+                    if rows(j) > 0 {
+                        // Every block position is in the pattern (it was built from them).
+                        let first = pattern.slot(ba, bb + j) as Ix;
+                        for i in 0..rows(j) {
+                            s[7 * i + j] = first + i as Ix;
                         }
                     }
                 }

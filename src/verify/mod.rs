@@ -231,9 +231,9 @@ pub fn verify_using(
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Eigenvalues {
     /// The lowest eigenvalues and their mode shapes where they are exact and cheap (the
-    /// reduced Hessian formed and decomposed: up to 200 degrees of freedom, or the dense
-    /// path); above, the verdict alone, from the inertia of the shifted KKT matrix
-    /// (`stability.eigenvalues` and `modes` empty).
+    /// reduced Hessian formed and decomposed: up to 200 degrees of freedom, or up to 40
+    /// bodies, where the stability uses dense linear algebra); above, the verdict alone, from
+    /// the inertia of the shifted KKT matrix (`stability.eigenvalues` and `modes` empty).
     #[default]
     WhenCheap,
     /// Always the lowest eigenvalues and mode shapes (above 200 degrees of freedom on the

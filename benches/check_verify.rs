@@ -4,7 +4,9 @@
 //! `cargo bench --bench check_verify -- [N …]` (default: 1000 10000)
 //!
 //! For each N: `restpose generate chain --size N` into a temporary folder, one `analyze --json`
-//! for the pose, then `check` and `verify --pose` on it, best of 3 runs each. Every run is
+//! for the pose, then `check`, `verify --pose` (stability verdict from the KKT inertia above
+//! 200 degrees of freedom) and `verify --pose --eigenvalues` (the lowest eigenvalues by
+//! Lanczos, as before) on it, best of 3 runs each. Every run is
 //! checked: `check` and `verify` exit 0 (the pose analyze found passes `verify`). Peak resident
 //! memory is read with `/usr/bin/time -f %M` when that program exists. CPU time (user +
 //! system) is printed beside the wall time: on a shared machine it is the steadier number.
@@ -76,6 +78,10 @@ fn main() {
         for (name, args) in [
             ("check", vec!["check", urdf]),
             ("verify", vec!["verify", urdf, "--pose", pose, "--quiet"]),
+            (
+                "verify --eigenvalues",
+                vec!["verify", urdf, "--pose", pose, "--quiet", "--eigenvalues"],
+            ),
         ] {
             let (wall, cpu, mb) = best(3, &args);
             println!("| `{name}` | {n} | {wall:.2} | {cpu:.2} | {mb:.0} |");

@@ -163,6 +163,11 @@ pub(crate) struct VerifyArgs {
     /// sparse partition, O(N)), or auto: sparse above 40 bodies.
     #[arg(long, value_enum, default_value_t = Options::default().linear_algebra)]
     pub(crate) linear_algebra: LinearAlgebra,
+    /// Report the lowest eigenvalues and mode shapes of the stability verdict at any size.
+    /// Without it, above 200 degrees of freedom on the sparse path the verdict comes from the
+    /// inertia of the shifted KKT matrix alone (faster; `eigenvalues` and `modes` empty).
+    #[arg(long)]
+    pub(crate) eigenvalues: bool,
     /// Print only errors and the verdict.
     #[arg(long, short)]
     pub(crate) quiet: bool,

@@ -416,7 +416,7 @@ pub(crate) fn solve(
         // critical cone instead (module `cone`).
         let (strong, weak) = split(model, &round.multipliers, threshold);
         if report.converged() && !weak.is_empty() {
-            report.stability = super::cone::stability_touching(model, &state, &strong, &weak);
+            report.stability = super::cone::stability_touching(model, &state, &strong, &weak, true);
         }
         return Ok((state, report));
     }

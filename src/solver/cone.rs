@@ -114,15 +114,17 @@ pub(crate) fn minimum(h: &DMatrix<f64>, weak: &[DMatrix<f64>], eig_tol: f64) -> 
 /// The stability verdict at a balanced rest where the stops and contacts `strong` carry a
 /// force and `weak` touch without one: the reported eigenvalues and modes are those of the
 /// tangent space of all of them (every touching row held), the verdict is the critical
-/// cone's. `None` where there is no degree of freedom even without the weak ones.
+/// cone's. `None` where there is no degree of freedom even without the weak ones;
+/// `eigenvalues` as in `solver::stability_of`.
 pub(crate) fn stability_touching(
     model: &Model,
     state: &State,
     strong: &[Active],
     weak: &[Active],
+    eigenvalues: bool,
 ) -> Option<Stability> {
     if weak.is_empty() {
-        return super::stability_on(model, state, strong);
+        return super::stability_on(model, state, strong, eigenvalues);
     }
     let all: Vec<Active> = strong.iter().chain(weak).copied().collect();
     let q = &state.q;
@@ -133,10 +135,10 @@ pub(crate) fn stability_touching(
     let part = sys.partition(q);
     let dof = part.independent.len();
     if dof == 0 {
-        return super::stability_on(model, state, &all);
+        return super::stability_on(model, state, &all, eigenvalues);
     }
     if dof > EXACT_UP_TO || weak.len() > MAX_WEAK {
-        return super::stability_on(model, state, strong);
+        return super::stability_on(model, state, strong, eigenvalues);
     }
     let eval = sys.evaluate(q, &part)?;
     let h = sys.reduced_hessian(q, &part, &eval);
@@ -172,8 +174,8 @@ pub(crate) fn stability_touching(
     } else {
         Verdict::Stable
     };
-    let shown = super::stability_on(model, state, &all)
-        .or_else(|| super::stability_on(model, state, strong));
+    let shown = super::stability_on(model, state, &all, eigenvalues)
+        .or_else(|| super::stability_on(model, state, strong, eigenvalues));
     shown.map(|mut s| {
         s.verdict = verdict;
         s.tolerance = tol;

@@ -28,6 +28,7 @@ mod report;
 mod rolling;
 pub(crate) mod sparse;
 mod spectrum;
+mod stability_inertia;
 pub(crate) mod system;
 mod unbounded;
 
@@ -164,15 +165,21 @@ fn stability(
 
 /// Stability verdict at a state that is feasible and balanced (`None` with no degree of
 /// freedom or where the energy is undefined).
-pub(crate) fn stability_at(model: &Model, state: &State) -> Option<Stability> {
-    stability_on(model, state, &[])
+/// `eigenvalues` as in [`stability_of`].
+pub(crate) fn stability_at(model: &Model, state: &State, eigenvalues: bool) -> Option<Stability> {
+    stability_on(model, state, &[], eigenvalues)
 }
 
 pub(crate) use cone::stability_touching;
 
 /// [`stability_at`] on the tangent space of the equality rows and the inequalities `active`
-/// (the stops and contacts that carry a force).
-pub(crate) fn stability_on(model: &Model, state: &State, active: &[Active]) -> Option<Stability> {
+/// (the stops and contacts that carry a force); `eigenvalues` as in [`stability_of`].
+pub(crate) fn stability_on(
+    model: &Model,
+    state: &State,
+    active: &[Active],
+    eigenvalues: bool,
+) -> Option<Stability> {
     let q = &state.q;
     let sys_cons = Constraints::new(model, &lock_values(model))
         .with_active(model, active)
@@ -183,19 +190,37 @@ pub(crate) fn stability_on(model: &Model, state: &State, active: &[Active]) -> O
         return None;
     }
     let eval = sys.evaluate(q, &part)?;
-    stability_of(&mut sys, q, &part, &eval)
+    stability_of(&mut sys, q, &part, &eval, eigenvalues)
 }
 
 /// [`stability_at`] with the system of the model's rows already partitioned and evaluated at
 /// `q` (what `verify` has made for its balance check); `None` with no degree of freedom.
+///
+/// Where the eigenvalues would come from Lanczos (sparse path, more than
+/// `spectrum::EXACT_UP_TO` degrees of freedom) and `eigenvalues` is false, the verdict comes
+/// from the inertia of the shifted KKT matrix alone (module `stability_inertia`), without
+/// eigenvalues or mode shapes; Lanczos only if that inertia cannot be trusted.
 pub(crate) fn stability_of(
     sys: &mut System,
     q: &nalgebra::DVector<f64>,
     part: &partition::Partition,
     eval: &system::Eval,
+    eigenvalues: bool,
 ) -> Option<Stability> {
     if part.independent.is_empty() {
         return None;
+    }
+    let lanczos =
+        sys.backend == system::Backend::Sparse && part.independent.len() > spectrum::EXACT_UP_TO;
+    if lanczos && !eigenvalues {
+        if let Some((verdict, tolerance)) = stability_inertia::inertia_verdict(sys, q, part, eval) {
+            return Some(Stability {
+                verdict,
+                tolerance,
+                eigenvalues: Vec::new(),
+                modes: Vec::new(),
+            });
+        }
     }
     let eig = spectrum::spectrum(sys, q, part, eval);
     Some(stability(sys, q, part, eval, &eig))

@@ -80,7 +80,9 @@ pub struct Stability {
     pub verdict: Verdict,
     /// Eigenvalue tolerance used: `1e-10 · max(1, max |λ|)` \[J\].
     pub tolerance: f64,
-    /// Smallest eigenvalues of the scaled reduced Hessian, ascending (at most 6) \[J\].
+    /// Smallest eigenvalues of the scaled reduced Hessian, ascending (at most 6) \[J\]. Empty
+    /// from `verify` above 200 degrees of freedom on the sparse path unless asked for
+    /// (`verify::Eigenvalues::Always`): its verdict then comes from the KKT inertia alone.
     pub eigenvalues: Vec<f64>,
     /// Mode shape of each listed eigenvalue: the change of every joint coordinate along the
     /// eigenvector, scaled so that the largest is ±1 (a rotation in rad, a slide in m).

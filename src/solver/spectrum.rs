@@ -152,7 +152,7 @@ fn lanczos(sys: &mut System, q: &DVector<f64>, part: &Partition, eval: &Eval) ->
 
 /// The largest eigenvalue of `Ĥ` by 12 steps of power iteration (a few per cent suffice for
 /// the tolerance it scales).
-fn largest_eigenvalue(sys: &System, part: &Partition, eval: &Eval) -> f64 {
+pub(crate) fn largest_eigenvalue(sys: &System, part: &Partition, eval: &Eval) -> f64 {
     let dof = part.independent.len();
     let mut x = DVector::from_fn(dof, |i, _| 1.0 + 0.1 * ((i * 7919 % 101) as f64 / 101.0));
     x /= x.norm();

@@ -27,6 +27,7 @@
 //! exact answers of large models.
 
 mod check;
+mod closure;
 mod dense;
 mod pose;
 mod reduced;
@@ -34,10 +35,11 @@ mod unilateral;
 mod unilateral_sparse;
 
 pub use check::{check, ModelCheck};
+use closure::closures;
+pub use closure::Closure;
 pub use pose::{parse_pose, pose_state, read_pose};
 pub use unilateral::{UnilateralCheck, Unilaterals};
 
-use crate::constraints::{joint, BlockKind, Constraints};
 use crate::error::{Error, Result};
 use crate::forces::potential;
 use crate::jet::pair_of;
@@ -83,19 +85,6 @@ impl Default for Tolerances {
             relative: 1e-9,
         }
     }
-}
-
-/// Closure error of one joint.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct Closure {
-    /// Joint name.
-    pub joint: String,
-    /// Whether it closes a loop.
-    pub loop_joint: bool,
-    /// Largest violation of its position rows \[m\].
-    pub position_error: f64,
-    /// Largest violation of its orientation rows (sine of the angle error) \[rad\].
-    pub rotation_error: f64,
 }
 
 /// Effort a joint coordinate needs to hold the pose.
@@ -213,7 +202,7 @@ pub fn verify_with_options(
     tol: &Tolerances,
     uni: &Unilaterals,
 ) -> Result<Verification> {
-    verify_on(model, state, tol, uni, sparse_path(model))
+    verify_on(model, state, tol, uni, sparse_path(model), false)
 }
 
 /// [`verify_with_options`] on the path `linear_algebra` says: `Auto` as
@@ -228,43 +217,54 @@ pub fn verify_using(
     uni: &Unilaterals,
     linear_algebra: crate::solver::LinearAlgebra,
 ) -> Result<Verification> {
+    verify_reporting(
+        model,
+        state,
+        tol,
+        uni,
+        linear_algebra,
+        Eigenvalues::WhenCheap,
+    )
+}
+
+/// What the stability verdict of [`verify`] reports besides the verdict.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Eigenvalues {
+    /// The lowest eigenvalues and their mode shapes where they are exact and cheap (the
+    /// reduced Hessian formed and decomposed: up to 200 degrees of freedom, or up to 40
+    /// bodies, where the stability uses dense linear algebra); above, the verdict alone, from
+    /// the inertia of the shifted KKT matrix (`stability.eigenvalues` and `modes` empty).
+    #[default]
+    WhenCheap,
+    /// Always the lowest eigenvalues and mode shapes (above 200 degrees of freedom on the
+    /// sparse path, the low end found by Lanczos, as `analyze` reports them).
+    Always,
+}
+
+/// [`verify_using`] with the eigenvalues `eigenvalues` asks for.
+/// # Errors
+/// As [`verify`].
+pub fn verify_reporting(
+    model: &Model,
+    state: &State,
+    tol: &Tolerances,
+    uni: &Unilaterals,
+    linear_algebra: crate::solver::LinearAlgebra,
+    eigenvalues: Eigenvalues,
+) -> Result<Verification> {
     let sparse = match linear_algebra {
         crate::solver::LinearAlgebra::Auto => sparse_path(model),
         crate::solver::LinearAlgebra::Dense => false,
         crate::solver::LinearAlgebra::Sparse => true,
     };
-    verify_on(model, state, tol, uni, sparse)
-}
-
-/// Closure errors per joint from the rows `cons` and their values `phi`.
-fn closures(model: &Model, cons: &Constraints, phi: &DVector<f64>, tol: f64) -> Vec<Closure> {
-    let mut closure = Vec::new();
-    for block in &cons.blocks {
-        let BlockKind::Joint(id) = block.kind else {
-            continue;
-        };
-        let j = model.joint(id);
-        let (mut pos, mut rot) = (0.0f64, 0.0f64);
-        for k in 0..joint::row_count(j) {
-            let r = phi[block.first + k].abs();
-            match (cons.length_power(block.first + k), j.kind) {
-                (0, _) => rot = rot.max(r),
-                (2, crate::model::JointKind::Distance { length }) => {
-                    pos = pos.max(r / (2.0 * length.max(1e-12)));
-                }
-                _ => pos = pos.max(r),
-            }
-        }
-        if !j.tree || pos.max(rot) > tol {
-            closure.push(Closure {
-                joint: j.name.clone(),
-                loop_joint: !j.tree,
-                position_error: pos,
-                rotation_error: rot,
-            });
-        }
-    }
-    closure
+    verify_on(
+        model,
+        state,
+        tol,
+        uni,
+        sparse,
+        eigenvalues == Eigenvalues::Always,
+    )
 }
 
 /// The scalar coordinates of the tree joints: `(joint, dof, value)` and their gradients.
@@ -296,13 +296,15 @@ fn tree_coordinates(
 ///
 /// On the sparse path the stability verdict reuses the partition and evaluation of the
 /// balance check, and is computed on a second thread while the efforts are (kept only when
-/// the pose passes); both only read the model and the state.
+/// the pose passes); both only read the model and the state. `eigenvalues`: the lowest
+/// eigenvalues also where only Lanczos finds them ([`Eigenvalues::Always`]).
 fn verify_on(
     model: &Model,
     state: &State,
     tol: &Tolerances,
     uni: &Unilaterals,
     sparse: bool,
+    eigenvalues: bool,
 ) -> Result<Verification> {
     let (
         coords,
@@ -340,8 +342,11 @@ fn verify_on(
         // Without a stop or contact carrying a force, the verdict on this partition.
         let free = contact.strong.is_empty() && contact.weak.is_empty();
         let (coords, efforts, unassigned, stability) = std::thread::scope(|s| {
-            let verdict = (assembled && free)
-                .then(|| s.spawn(|| crate::solver::stability_of(&mut sys, &state.q, &part, &eval)));
+            let verdict = (assembled && free).then(|| {
+                s.spawn(|| {
+                    crate::solver::stability_of(&mut sys, &state.q, &part, &eval, eigenvalues)
+                })
+            });
             // The joint coordinates here, off the verdict's path.
             let coords = tree_coordinates(model, state);
             let values: Vec<_> = coords.iter().map(|c| (c.0, c.1, c.2.v)).collect();
@@ -419,10 +424,10 @@ fn verify_on(
     let stability = match (passed, sparse) {
         (false, _) => None,
         (true, _) if !strong.is_empty() || !weak.is_empty() => {
-            crate::solver::stability_touching(model, state, &strong, &weak)
+            crate::solver::stability_touching(model, state, &strong, &weak, eigenvalues)
         }
         (true, true) => stability,
-        (true, false) => crate::solver::stability_at(model, state),
+        (true, false) => crate::solver::stability_at(model, state, eigenvalues),
     };
     Ok(Verification {
         passed,

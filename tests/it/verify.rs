@@ -212,17 +212,32 @@ fn verify_accepts_analyze_answers_at_1000_links() {
             Some(report.dof),
             "{family}"
         );
-        // verify's stability verdict (from its balance check's partition, Lanczos above 200
-        // degrees of freedom) is analyze's, with the same smallest eigenvalues.
-        let (vs, rs) = (
+        // verify's stability verdict (from its balance check's partition; above 200 degrees
+        // of freedom from the shifted KKT inertia by default, without eigenvalues) is
+        // analyze's; asked for, the smallest eigenvalues (Lanczos) are analyze's too, with the
+        // same verdict and tolerance.
+        let full = restpose::verify::verify_reporting(
+            &m,
+            &s,
+            &Tolerances::default(),
+            &Default::default(),
+            restpose::LinearAlgebra::Auto,
+            restpose::verify::Eigenvalues::Always,
+        )
+        .unwrap();
+        let (vs, fs, rs) = (
             v.stability.as_ref().unwrap(),
+            full.stability.as_ref().unwrap(),
             report.stability.as_ref().unwrap(),
         );
         assert_eq!(vs.verdict, rs.verdict, "{family}");
         assert_eq!(vs.verdict, restpose::solver::Verdict::Stable, "{family}");
-        assert!(!vs.eigenvalues.is_empty(), "{family}");
-        assert_eq!(vs.eigenvalues.len(), rs.eigenvalues.len(), "{family}");
-        for (a, b) in vs.eigenvalues.iter().zip(&rs.eigenvalues) {
+        assert!(vs.eigenvalues.is_empty() && vs.modes.is_empty(), "{family}");
+        assert_eq!(fs.verdict, vs.verdict, "{family}");
+        assert_eq!(fs.tolerance, vs.tolerance, "{family}");
+        assert!(!fs.eigenvalues.is_empty(), "{family}");
+        assert_eq!(fs.eigenvalues.len(), rs.eigenvalues.len(), "{family}");
+        for (a, b) in fs.eigenvalues.iter().zip(&rs.eigenvalues) {
             assert!((a - b).abs() <= 1e-8 * b.abs(), "{family}: {a} vs {b}");
         }
         // One joint turned by 0.01 rad needs an effort there.
@@ -237,4 +252,57 @@ fn verify_accepts_analyze_answers_at_1000_links() {
         assert!(!v.passed, "{family}: turned {name}");
         assert!(v.max_imbalance.unwrap().effort.abs() > 1e3 * v.effort_tolerance);
     }
+}
+
+/// Above 200 degrees of freedom `verify`'s stability verdict comes from the KKT inertia, with
+/// no eigenvalues in the JSON; `--eigenvalues` adds the lowest ones (Lanczos), with the same
+/// verdict and tolerance; the text report is the same either way.
+#[test]
+fn cli_verify_eigenvalues_on_request_above_200_dof() {
+    let dir = tempfile::tempdir().unwrap();
+    let urdf = dir.path().join("chain.urdf");
+    std::fs::write(&urdf, restpose::generate::chain(250, false)).unwrap();
+    let result = dir.path().join("r.json");
+    assert!(restpose()
+        .arg("analyze")
+        .arg(&urdf)
+        .args(["-q", "--json"])
+        .arg(&result)
+        .status()
+        .unwrap()
+        .success());
+    let run = |extra: &[&str]| {
+        let json = restpose()
+            .arg("verify")
+            .arg(&urdf)
+            .arg("--pose")
+            .arg(&result)
+            .args(["--json", "-"])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert_eq!(json.status.code(), Some(0));
+        let text = restpose()
+            .arg("verify")
+            .arg(&urdf)
+            .arg("--pose")
+            .arg(&result)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert_eq!(text.status.code(), Some(0));
+        let v: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+        (v["stability"].clone(), text.stdout)
+    };
+    let (fast, fast_text) = run(&[]);
+    let (full, full_text) = run(&["--eigenvalues"]);
+    assert_eq!(fast["verdict"], "stable");
+    assert_eq!(fast["verdict"], full["verdict"]);
+    assert_eq!(fast["tolerance"], full["tolerance"]);
+    assert_eq!(fast["eigenvalues"].as_array().unwrap().len(), 0);
+    assert_eq!(fast["modes"].as_array().unwrap().len(), 0);
+    assert_eq!(full["eigenvalues"].as_array().unwrap().len(), 6);
+    assert_eq!(full["modes"].as_array().unwrap().len(), 6);
+    assert_eq!(fast_text, full_text);
+    assert!(String::from_utf8_lossy(&fast_text).contains("stability: stable"));
 }

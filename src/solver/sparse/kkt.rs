@@ -18,21 +18,29 @@
 //! bodies below it). The system is solved in the scaled coordinates `q̂ = S⁻¹ q` with the rows
 //! scaled by `D`, like the partition. A shift `δ I` on the `W` block (`δ ≥ 0`) makes the
 //! reduced matrix `Zᵀ (W + δ S⁻²) Z` positive definite away from a minimum.
+//!
+//! A second shift `−σ` on the independent coordinates alone ([`Kkt::shift_independent`],
+//! `E_v` their selector) gives `Zᵀ (Ŵ − σ E_v) Z = Ĥ − σ I`, since `Z`'s independent block is
+//! the identity: by Sylvester's law of inertia (Haynsworth's inertia additivity over the
+//! constraint block) the LDLᵀ then has `rows + #{λ(Ĥ) < σ}` negative pivots, an exact count
+//! of the reduced Hessian's eigenvalues below `σ` (module `solver::stability_inertia`).
 
 use super::hessian::BlockHessian;
 use super::pattern::{Ix, Pattern, NONE};
 use crate::solver::partition::Partition;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
-use faer::linalg::solvers::SolveCore;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, simplicial, CholeskySymbolicParams, LdltRef, SymbolicCholesky,
+    factorize_symbolic_cholesky, simplicial, CholeskySymbolicParams, SymbolicCholesky,
     SymbolicCholeskyRaw, SymmetricOrdering,
 };
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::linalg::SupernodalThreshold;
-use faer::{Conj, MatMut, Par, Side};
+use faer::{Par, Side};
+use refine::SolveScratch;
 use std::cell::RefCell;
+
+mod refine;
 
 /// The KKT matrix's structure under one partition, its values and its factors.
 ///
@@ -60,6 +68,10 @@ pub(crate) struct Kkt {
     values: Vec<f64>,
     /// The shift `δ` now added to the diagonal of the `W` block in `values`.
     delta: f64,
+    /// The shift `−σ` on the independent coordinates' diagonal (see [`Kkt::shift_independent`])
+    /// and those coordinates.
+    sigma: f64,
+    sigma_columns: Vec<usize>,
     /// `‖K‖∞` of the factored matrix (for the backward error of solves).
     knorm: f64,
     /// The full (both triangles) permuted matrix for the LU fallback, built on its first use:
@@ -88,16 +100,6 @@ struct Full {
     /// Full slots `(r, c)` and `(c, r)` of each upper slot.
     slots: Vec<(Ix, Ix)>,
     symbolic: Option<SymbolicLu<Ix>>,
-}
-
-/// Buffers reused by every [`Kkt::solve`].
-#[derive(Default)]
-struct SolveScratch {
-    stack: Option<MemBuffer>,
-    /// The solution in permuted order.
-    x: Vec<f64>,
-    b: Vec<f64>,
-    r: Vec<f64>,
 }
 
 /// What the last [`Kkt::factor`] produced.
@@ -158,31 +160,51 @@ impl Kkt {
             let (a, b) = (inv[i], inv[j]);
             (a.min(b), a.max(b))
         };
-        let blocks = hess
-            .keys
-            .iter()
-            .flat_map(|&(a, b)| (0..49).map(move |k| (7 * a + k / 7, 7 * b + k % 7)))
-            .map(|(i, j)| upper(i, j));
+        // Each body's seven coordinates are consecutive in the elimination order, so the block
+        // of bodies `a`, `b` is the dense 7 × 7 block at `(inv[7a], inv[7b])`: in the stored
+        // upper triangle when `inv[7a] < inv[7b]`, mirrored (filled by the transposed block
+        // `(b, a)`) when above, its upper triangle when `a = b`.
+        assert!(
+            (0..n).all(|c| inv[c] == inv[c - c % 7] + c % 7),
+            "elimination order keeps each body's coordinates together"
+        );
+        // The (row, column) ranges a block fills: column `bb + j`, rows `ba .. ba + rows(j)`.
+        let filled = |a: usize, b: usize| {
+            let (ba, bb) = (inv[7 * a], inv[7 * b]);
+            let rows = move |j: usize| match (ba < bb, a == b) {
+                (_, true) => j + 1,
+                (true, false) => 7,
+                (false, false) => 0,
+            };
+            (ba, bb, rows)
+        };
+        let blocks = hess.keys.iter().flat_map(|&(a, b)| {
+            let (ba, bb, rows) = filled(a, b);
+            (0..7).flat_map(move |j| (0..rows(j)).map(move |i| (ba + i, bb + j)))
+        });
         let jacobian = entries
             .iter()
             .filter(|e| row_pos[e.0] != NONE)
             .map(|e| upper(n + row_pos[e.0], e.1));
-        let pattern = Pattern::new(
+        let pattern = Pattern::with_capacity(
             dim,
             dim,
+            28 * hess.keys.len() + entries.len() + n,
             blocks.chain(jacobian).chain((0..n).map(|i| upper(i, i))),
         );
+        // The rows of a filled column range are consecutive, hence so are their slots.
         let block_slots = hess
             .keys
             .iter()
             .map(|&(a, b)| {
                 let mut s = [Ix::MAX; 49];
-                for i in 0..7 {
-                    for j in 0..7 {
-                        let (pi, pj) = (inv[7 * a + i], inv[7 * b + j]);
-                        if pi <= pj {
-                            // Every block position is in the pattern (it was built from them).
-                            s[7 * i + j] = pattern.slot(pi, pj) as Ix;
+                let (ba, bb, rows) = filled(a, b);
+                for j in 0..7 {
+                    if rows(j) > 0 {
+                        // Every block position is in the pattern (it was built from them).
+                        let first = pattern.slot(ba, bb + j) as Ix;
+                        for i in 0..rows(j) {
+                            s[7 * i + j] = first + i as Ix;
                         }
                     }
                 }
@@ -239,6 +261,8 @@ impl Kkt {
             diag_slots,
             values: vec![0.0; nnz],
             delta: 0.0,
+            sigma: 0.0,
+            sigma_columns: Vec::new(),
             knorm: 0.0,
             full: None,
             lu: None,
@@ -267,6 +291,8 @@ impl Kkt {
     ) {
         self.values.iter_mut().for_each(|v| *v = 0.0);
         self.delta = 0.0;
+        self.sigma = 0.0;
+        self.sigma_columns.clear();
         for ((&(a, b), blk), slots) in hess.keys.iter().zip(&hess.values).zip(&self.block_slots) {
             for i in 0..7 {
                 for j in 0..7 {
@@ -287,9 +313,33 @@ impl Kkt {
 
     /// The largest diagonal entry of the (scaled) `W` block.
     pub(crate) fn max_diagonal(&self) -> f64 {
+        let mut shifted = vec![0.0; self.diag_slots.len()];
+        for &c in &self.sigma_columns {
+            shifted[c] = self.sigma;
+        }
         self.diag_slots
             .iter()
-            .fold(0.0f64, |a, &s| a.max((self.values[s] - self.delta).abs()))
+            .zip(&shifted)
+            .fold(0.0f64, |a, (&s, &sigma)| {
+                a.max((self.values[s] - self.delta + sigma).abs())
+            })
+    }
+
+    /// Subtracts `σ` from the diagonal of the (scaled) `W` block at the coordinates `columns`
+    /// (the partition's independent ones), in place of the last such shift, for the next
+    /// [`Kkt::factor`]: the reduced matrix becomes `Ĥ − σ I` (module doc), so the LDLᵀ's
+    /// negative pivots minus `rows` count the eigenvalues of `Ĥ` below `σ`. Cleared by
+    /// [`Kkt::assemble`].
+    pub(crate) fn shift_independent(&mut self, columns: &[usize], sigma: f64) {
+        for &c in &self.sigma_columns {
+            self.values[self.diag_slots[c]] += self.sigma;
+        }
+        self.sigma_columns.clear();
+        self.sigma_columns.extend_from_slice(columns);
+        self.sigma = sigma;
+        for &c in &self.sigma_columns {
+            self.values[self.diag_slots[c]] -= sigma;
+        }
     }
 
     /// Factors the matrix with `δ` added to the diagonal of the `W` block: LDLᵀ without
@@ -407,78 +457,6 @@ impl Kkt {
             negative += usize::from(d < 0.0);
         }
         Some(negative)
-    }
-
-    fn solve_once(&self, x: &mut [f64], stack: &mut Option<MemBuffer>) {
-        let len = x.len();
-        let m = MatMut::from_column_major_slice_mut(x, len, 1);
-        match (self.kind, &self.lu, &self.ldlt, stack) {
-            (Factored::Ldlt { .. }, _, Some(sym), Some(buf)) => {
-                LdltRef::new(sym, &self.ldlt_values).solve_in_place_with_conj(
-                    Conj::No,
-                    m,
-                    Par::Seq,
-                    MemStack::new(buf),
-                );
-            }
-            (Factored::Lu, Some(lu), _, _) => lu.solve_in_place_with_conj(Conj::No, m),
-            _ => x.iter_mut().for_each(|v| *v = f64::NAN),
-        }
-    }
-
-    /// Solves with the last factors in place (`rhs` of length `n + rows`), with iterative
-    /// refinement (`x += K⁻¹ (b − K x)`, which recovers the digits lost to the pivot order)
-    /// until the normwise backward error `ω = ‖b − K x‖∞ / (‖K‖∞ ‖x‖∞ + ‖b‖∞)` is below
-    /// `target` (at most three steps); `false` if singular or if `ω` stays above 10⁻¹⁰.
-    pub(crate) fn solve(&self, rhs: &mut [f64], target: f64) -> bool {
-        let mut scratch = self.solve_scratch.borrow_mut();
-        let SolveScratch { stack, x, b, r } = &mut *scratch;
-        // Into the permuted order of the stored matrix.
-        b.clear();
-        b.extend(self.perm.iter().map(|&o| rhs[o]));
-        x.clear();
-        x.extend_from_slice(b);
-        let bnorm = b.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        self.solve_once(x, stack);
-        let sym = self.pattern.symbolic();
-        let (ptr, idx) = (sym.col_ptr(), sym.row_idx());
-        let knorm = self.knorm;
-        let mut omega = f64::INFINITY;
-        for _ in 0..3 {
-            r.clear();
-            r.extend_from_slice(b);
-            // r −= K x from the upper triangle: column c gives `K[i, c] x[c]` to rows `i` and,
-            // by symmetry, `Σ_i K[i, c] x[i]` to row `c` (the diagonal, the column's last
-            // entry when present, only once).
-            for c in 0..x.len() {
-                let (a, b) = (ptr[c] as usize, ptr[c + 1] as usize);
-                let xc = x[c];
-                let mut sum = 0.0;
-                for k in a..b {
-                    let (i, v) = (idx[k] as usize, self.values[k]);
-                    r[i] -= v * xc;
-                    sum += v * x[i];
-                }
-                if b > a && idx[b - 1] as usize == c {
-                    sum -= self.values[b - 1] * xc;
-                }
-                r[c] -= sum;
-            }
-            let rnorm = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-            let xnorm = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-            omega = rnorm / (knorm * xnorm + bnorm).max(f64::MIN_POSITIVE);
-            if !omega.is_finite() || omega <= target {
-                break;
-            }
-            self.solve_once(r, stack);
-            for (x, d) in x.iter_mut().zip(r.iter()) {
-                *x += d;
-            }
-        }
-        for (k, &o) in self.perm.iter().enumerate() {
-            rhs[o] = x[k];
-        }
-        rhs.iter().all(|x| x.is_finite()) && omega <= 1e-10
     }
 
     /// Number of constraint rows.

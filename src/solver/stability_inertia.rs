@@ -1,0 +1,93 @@
+//! The stability verdict from the inertia of the shifted KKT matrix, without eigenvalues.
+//!
+//! With `Ŵ` the scaled Lagrangian Hessian, `Â` the scaled Jacobian of the partition's
+//! independent rows (`m` of them, full row rank) and `Z = [−Â_u⁻¹ Â_v; I]` the null-space
+//! basis whose independent block is the identity, the reduced Hessian is `Ĥ = Zᵀ Ŵ Z` and
+//! `Zᵀ E_v Z = I` (`E_v` the selector of the independent coordinates). So the KKT matrix
+//! shifted on the independent coordinates only,
+//!
+//! ```text
+//! K(σ) = [ Ŵ − σ E_v   Âᵀ ]      In(K(σ)) = In(Zᵀ (Ŵ − σ E_v) Z) + (m, m, 0)
+//!        [ Â           0  ],                = In(Ĥ − σ I) + (m, m, 0)
+//! ```
+//!
+//! (Sylvester's law of inertia with Haynsworth's additivity over the constraint block): the
+//! number of negative pivots of its LDLᵀ minus `m` is exactly the number of eigenvalues of `Ĥ`
+//! below `σ`. The verdict of [`super::Stability`] with tolerance `t = 10⁻¹⁰ max(λ_max, 1)`
+//! (`λ_max` by power iteration, as on the Lanczos path) then needs one or two factorizations:
+//!
+//! - `#{λ < t} = 0`: **stable** (every eigenvalue above the tolerance);
+//! - else `#{λ < −t} > 0`: **unstable**;
+//! - else **neutral** (the lowest eigenvalue within `±t`).
+//!
+//! This is the definition the eigenvalue path applies to the lowest eigenvalue
+//! (`λ_min > t`, `λ_min < −t`, otherwise neutral), with the count exact instead of found by
+//! Lanczos. The `Φ_qᵀ D R D Φ_q` added to `W` before factoring (`System::factor_kkt`) vanishes
+//! on `Z` and changes nothing here. An LDLᵀ without pivoting may be inaccurate (a tiny pivot
+//! before the rows that would cure it): each factorization is accepted only when a probe solve
+//! with it reaches a backward error of `10⁻¹⁰` (as for the Lanczos path's inertia count);
+//! otherwise, or with a zero pivot (LU fall-back, no inertia), there is no inertia verdict and
+//! the caller computes the eigenvalues instead.
+//!
+//! ## References
+//! - E. V. Haynsworth, "Determination of the inertia of a partitioned Hermitian matrix",
+//!   *Linear Algebra Appl.* 1 (1968) 73–81.
+//! - N. I. M. Gould, "On practical conditions for the existence and uniqueness of solutions
+//!   to the general equality quadratic programming problem", *Math. Program.* 32 (1985).
+
+use super::partition::Partition;
+use super::report::Verdict;
+use super::sparse::kkt::Factored;
+use super::spectrum::largest_eigenvalue;
+use super::system::{Eval, System};
+use nalgebra::DVector;
+
+/// The verdict and its tolerance from the KKT inertia at a feasible `q` of the sparse path;
+/// `None` when the shifted LDLᵀ cannot be trusted (module doc).
+pub(crate) fn inertia_verdict(
+    sys: &mut System,
+    q: &DVector<f64>,
+    part: &Partition,
+    eval: &Eval,
+) -> Option<(Verdict, f64)> {
+    // Assembles `Ŵ` and the KKT matrix (and factors it unshifted, which is not needed here:
+    // singular when the pose is neutral).
+    sys.factor_kkt(q, part, eval, true, 0.0);
+    sys.work.kkt.as_ref()?;
+    let tol = 1e-10 * largest_eigenvalue(sys, part, eval).max(1.0);
+    if !tol.is_finite() {
+        return None;
+    }
+    if eigenvalues_below(sys, part, tol)? == 0 {
+        return Some((Verdict::Stable, tol));
+    }
+    let verdict = if eigenvalues_below(sys, part, -tol)? > 0 {
+        Verdict::Unstable
+    } else {
+        Verdict::Neutral
+    };
+    Some((verdict, tol))
+}
+
+/// The number of eigenvalues of the reduced Hessian below `sigma`, from the KKT matrix last
+/// assembled by `System::factor_kkt`, shifted by `−sigma` on the independent coordinates;
+/// `None` if its LDLᵀ fails or does not solve accurately.
+pub(crate) fn eigenvalues_below(sys: &mut System, part: &Partition, sigma: f64) -> Option<usize> {
+    let kkt = sys.work.kkt.as_mut()?;
+    kkt.shift_independent(&part.independent, sigma);
+    let Factored::Ldlt { negative } = kkt.factor(0.0) else {
+        return None;
+    };
+    let n = kkt.coordinates();
+    let mut probe = vec![0.0; n + kkt.rows()];
+    for &c in &part.independent {
+        probe[c] = 1.0;
+    }
+    if !kkt.solve(&mut probe, 1e-13) {
+        return None;
+    }
+    negative.checked_sub(kkt.rows())
+}
+
+#[cfg(test)]
+mod tests;

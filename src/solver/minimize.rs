@@ -230,7 +230,7 @@ pub(crate) fn minimize(
         let dof = part.independent.len();
         let dense_newton = options.method == Method::Newton && sys.backend == Backend::Dense;
         let eig =
-            (dof > 0 && (dense_newton || gnorm <= gtol)).then(|| spectrum(sys, &q, &part, &eval));
+            (dof > 0 && (dense_newton || gnorm <= gtol)).then(|| { let t0 = std::time::Instant::now(); let r = spectrum(sys, &q, &part, &eval); if std::env::var_os("RP_T").is_some() { eprintln!("T spectrum {:.2} ms", t0.elapsed().as_secs_f64()*1e3); } r });
         if gnorm <= gtol {
             match &eig {
                 Some(e) if !options.allow_unstable => match e.lowest() {
@@ -270,7 +270,12 @@ pub(crate) fn minimize(
                     }
                     d
                 }
-                (_, Method::Newton) => kkt_direction(sys, &q, &part, &eval),
+                (_, Method::Newton) => {
+                    let t0 = std::time::Instant::now();
+                    let d = kkt_direction(sys, &q, &part, &eval);
+                    if std::env::var_os("RP_T").is_some() { eprintln!("T kkt {:.2} ms", t0.elapsed().as_secs_f64()*1e3); }
+                    d
+                }
                 _ => -(&qn.binv * g),
             }
         };
@@ -302,6 +307,9 @@ pub(crate) fn minimize(
             dq *= factor;
         }
         let slope = g.dot(&d);
+        let dbg_cf = diag.corrector_failures;
+        let t_ls = std::time::Instant::now();
+        let dbg_sh = diag.step_halvings;
         // Backtracking line search.
         let mut alpha = 1.0;
         let mut accepted = None;
@@ -364,6 +372,16 @@ pub(crate) fn minimize(
             alpha = next.clamp(0.1 * alpha, 0.5 * alpha);
             diag.step_halvings += 1;
         }
+        if std::env::var_os("RP_T").is_some() { eprintln!("T ls {:.2} ms cf {}", t_ls.elapsed().as_secs_f64()*1e3, diag.corrector_failures - dbg_cf); }
+        if std::env::var_os("RP_DEBUG").is_some() {
+            eprintln!("it {iteration} dof {dof} E {:.12e} g {:.3e} factor {:.3e} rot {:.3e} pos {:.3e} cf {} sh {} acc {:?} blocked {}", eval.energy.total, gnorm, factor, rot, pos, diag.corrector_failures-dbg_cf, diag.step_halvings-dbg_sh, accepted.as_ref().map(|a: &(DVector<f64>, Eval, f64)| a.2), blocked.is_some());
+            if let Ok(bs) = std::env::var("RP_BODIES") {
+                for b in bs.split(',').filter_map(|x| x.parse::<usize>().ok()) {
+                    let th = 2.0 * q[7 * b + 5].atan2(q[7 * b + 3]);
+                    eprintln!("   body {b} x {:.4} z {:.4} theta {:.4}", q[7 * b], q[7 * b + 2], th);
+                }
+            }
+        }
         match accepted {
             Some((qt, et, _)) if blocked.is_some() => {
                 q = qt;
@@ -402,9 +420,23 @@ pub(crate) fn minimize(
                         super::unbounded::free_directions(sys.problem.model, &q, &(&dq * alpha));
                     break;
                 }
-                // Re-partition when Φ_u becomes ill-conditioned.
+                // Re-partition when Φ_u becomes ill-conditioned, or (a sparse partition with
+                // pivots of the second pass) when the partition at `q` is another one.
                 if eval.factors.ill_conditioned() {
                     (part, eval, qn) = repartition(sys, &q, options.method, &mut diag)?;
+                } else if part.revisable {
+                    let t0 = std::time::Instant::now();
+                    let fresh = sys.partition(&q);
+                    if std::env::var_os("RP_T").is_some() { eprintln!("T part {:.2} ms", t0.elapsed().as_secs_f64()*1e3); }
+                    if fresh.dependent != part.dependent || fresh.rows != part.rows {
+                        if std::env::var_os("RP_DEBUG").is_some() {
+                            eprintln!("   revised partition");
+                        }
+                        diag.repartitions += 1;
+                        eval = sys.evaluate(&q, &fresh)?;
+                        part = fresh;
+                        qn = QuasiNewton::new(part.independent.len(), options.method);
+                    }
                 }
             }
             None if !just_repartitioned => {

@@ -348,7 +348,10 @@ pub(crate) fn solve_round(
         });
     }
     let rank = part.rows.len();
-    let Some(out) = minimize::minimize(&mut sys, q.clone(), part, options, guard) else {
+    let t0 = std::time::Instant::now();
+    let out = minimize::minimize(&mut sys, q.clone(), part, options, guard);
+    if std::env::var_os("RP_T").is_some() { eprintln!("T minimize {:.2} ms", t0.elapsed().as_secs_f64()*1e3); }
+    let Some(out) = out else {
         return Err(
             crate::forces::undefined_term(model, &start.branches, &q).unwrap_or(
                 Error::SingularPartition {
@@ -379,7 +382,9 @@ pub(crate) fn solve_round(
     let mut diagnostics = out.diagnostics;
     diagnostics.linear_algebra = sys.backend.name().into();
     let stability_started = std::time::Instant::now();
-    let stability = (dof > 0).then(|| {
+    // A round stopped by an inequality is not a rest pose: the active-set iteration goes on
+    // from it (and judges stability itself if it ends there).
+    let stability = (dof > 0 && out.blocked.is_none()).then(|| {
         let eig = out
             .eigen
             .clone()

@@ -26,6 +26,10 @@ pub(crate) struct Partition {
     pub(crate) rows: Vec<usize>,
     /// Redundant constraint rows, ascending.
     pub(crate) redundant: Vec<usize>,
+    /// The sparse partition pivoted rows of one body (contacts, stops) in its second pass, on
+    /// entries that shrink as the body turns (module `sparse::partition`): the minimizer
+    /// re-partitions after a step that moves such a pivot below its threshold.
+    pub(crate) revisable: bool,
 }
 
 /// A fresh partition id.
@@ -115,6 +119,7 @@ pub(crate) fn partition(jac: &DMatrix<f64>, row_scale: &[f64], scale: &[f64]) ->
         independent,
         rows: row_perm[..rank].to_vec(),
         redundant,
+        revisable: false,
     }
 }
 
@@ -200,6 +205,7 @@ mod tests {
             independent,
             rows: row_perm[..rank].to_vec(),
             redundant,
+            revisable: false,
         }
     }
 

@@ -28,6 +28,9 @@ use crate::model::Model;
 /// Threshold of the pivot test against the largest entry of its row.
 const THRESHOLD: f64 = 0.1;
 
+/// Threshold of the second pass's pivot test against the row's reach on its own body.
+const OWN_THRESHOLD: f64 = 0.1;
+
 /// The bodies in elimination order: descending breadth-first depth from the ground over all
 /// joints (ties: higher index first); bodies not connected to the ground come last.
 fn elimination_order(model: &Model) -> Vec<usize> {
@@ -161,6 +164,43 @@ impl Elimination {
     }
 }
 
+impl Elimination {
+    /// The second pass's pivot at body `b` among the rows `cands` that started on one body:
+    /// the entry on a free column of `b` largest relative to the row's `reach` on its own body
+    /// in columns of the same kind (translations, Euler parameters), if at least `OWN_THRESHOLD`
+    /// of it.
+    fn best_own_pivot(
+        &self,
+        cands: &[usize],
+        b: usize,
+        reach: &[[f64; 2]],
+    ) -> Option<(usize, usize)> {
+        let mut best: Option<(usize, usize, f64)> = None;
+        for &r in cands {
+            if !self.active[r] {
+                continue;
+            }
+            let mut entries: Vec<(usize, f64)> = self.rows[r]
+                .iter()
+                .copied()
+                .filter(|&(c, _)| self.free[c] && c / 7 == b)
+                .collect();
+            entries.sort_unstable_by_key(|e| e.0);
+            for (c, v) in entries {
+                let reference = reach[r][usize::from(c % 7 >= 3)];
+                let ratio = v.abs() / reference.max(f64::MIN_POSITIVE);
+                if v.abs() > self.tol
+                    && ratio >= std::env::var("RP_TAU").ok().and_then(|x| x.parse().ok()).unwrap_or(OWN_THRESHOLD)
+                    && best.is_none_or(|x| ratio > x.2 * (1.0 + 1e-9))
+                {
+                    best = Some((r, c, ratio));
+                }
+            }
+        }
+        best.map(|(r, c, _)| (r, c))
+    }
+}
+
 /// Partitions the Jacobian given as triplets (`(row, col, value)`, duplicates summed) of an
 /// `m × n` matrix, with row scales `row_scale` and column scales `scale`.
 pub(crate) fn partition(
@@ -207,15 +247,22 @@ pub(crate) fn partition(
             el.redundant.push(r);
         }
     }
-    // Rows whose entries all lie on one body (their "own" body).
+    // Rows whose entries all lie on one body (their "own" body), and the size of their
+    // entries there, per kind of column (translations, Euler parameters).
     let mut own: Vec<Vec<usize>> = vec![Vec::new(); nb];
+    let mut reach = vec![[0.0f64; 2]; m];
     for (r, row) in el.rows.iter().enumerate() {
         if let Some(&(c0, _)) = row.first() {
             if el.active[r] && row.iter().all(|e| e.0 / 7 == c0 / 7) {
                 own[c0 / 7].push(r);
+                for &(c, v) in row {
+                    let k = usize::from(c % 7 >= 3);
+                    reach[r][k] = reach[r][k].max(v.abs());
+                }
             }
         }
     }
+    let revisable = own.iter().any(|o| !o.is_empty());
     for b in elimination_order(model) {
         let mut taken = 0;
         while taken < 7 {
@@ -238,11 +285,24 @@ pub(crate) fn partition(
         // body. The dependent coordinate it takes (the joint angle that keeps the contact
         // point on the ground) is well determined by it.
         while taken < 7 {
-            match el.best_pivot(&own[b], 0.0, |c| c / 7 == b) {
+            match el.best_own_pivot(&own[b], b, &reach) {
                 Some((r, c)) => el.pivot(r, c),
                 None => break,
             }
             taken += 1;
+        }
+        // A row whose entry on `b` is too small against its reach (a contact point straight
+        // below the joint of a vertical link) goes on to the bodies its fill reached.
+        for r in std::mem::take(&mut own[b]) {
+            if !el.active[r] {
+                continue;
+            }
+            let mut bodies: Vec<usize> = el.rows[r].iter().map(|e| e.0 / 7).collect();
+            bodies.sort_unstable();
+            bodies.dedup();
+            for a in bodies.into_iter().filter(|&a| a != b) {
+                own[a].push(r);
+            }
         }
     }
     // Rows left over: full pivoting among them over all free columns.
@@ -285,6 +345,7 @@ pub(crate) fn partition(
         independent,
         rows: el.pivot_rows,
         redundant: el.redundant,
+        revisable,
     }
 }
 

@@ -52,6 +52,7 @@ impl System<'_> {
     ) -> Result<usize, CorrectorFailure> {
         let mut first = f64::INFINITY;
         let mut last = f64::INFINITY;
+        let (mut newton, mut stalls) = (false, 0);
         for it in 0..=max_iterations {
             self.residual(q);
             let res = part
@@ -59,6 +60,9 @@ impl System<'_> {
                 .iter()
                 .map(|&i| self.work.phi[i].abs() * self.problem.scaling.rows[i])
                 .fold(0.0, f64::max);
+            if std::env::var_os("RP_DEBUG2").is_some() {
+                eprintln!("  corr it {it} res {res:.3e} chord {}", chord.is_some());
+            }
             if !res.is_finite() {
                 return Err(CorrectorFailure);
             }
@@ -68,6 +72,9 @@ impl System<'_> {
             let target = if chord.is_some() { 1e-3 * tol } else { tol };
             if res <= target || (res <= tol && it == max_iterations) {
                 let all = self.dimensionless_residual();
+                if std::env::var_os("RP_DEBUG2").is_some() {
+                    eprintln!("  corr done all {all:.3e}");
+                }
                 return if all <= tol.max(1e-8) {
                     Ok(it)
                 } else {
@@ -79,6 +86,14 @@ impl System<'_> {
             } else if res > 1e3 * first.max(tol) {
                 return Err(CorrectorFailure);
             }
+            // Newton steps that do not decrease the residual: outside Newton's region of
+            // convergence (or no solution for this `v`); the second one gives up.
+            if newton && res >= last {
+                stalls += 1;
+                if stalls >= 2 {
+                    return Err(CorrectorFailure);
+                }
+            }
             if it == max_iterations {
                 break;
             }
@@ -86,6 +101,7 @@ impl System<'_> {
                 chord = None;
             }
             last = res;
+            newton = chord.is_none();
             let du = match chord {
                 Some(f) => {
                     let rhs = DVector::from_iterator(

@@ -208,6 +208,9 @@ pub(crate) fn minimize(
     let mut eigen = None;
     let mut iterates = Vec::new();
     let mut blocked = None;
+    // The step length the line search starts from: 1, or after a step the corrector could
+    // not follow in full, the fraction that it could, doubled after each full success.
+    let mut reach = 1.0f64;
     loop {
         let f = eval.merit;
         let gnorm = eval.grad_v.amax();
@@ -310,8 +313,8 @@ pub(crate) fn minimize(
         let dbg_cf = diag.corrector_failures;
         let t_ls = std::time::Instant::now();
         let dbg_sh = diag.step_halvings;
-        // Backtracking line search.
-        let mut alpha = 1.0;
+        // Backtracking line search, from the step length the corrector last managed.
+        let mut alpha = reach;
         let mut accepted = None;
         for _ in 0..40 {
             let mut qt = &q + &dq * alpha;
@@ -391,6 +394,13 @@ pub(crate) fn minimize(
                 break;
             }
             Some((qt, et, alpha)) => {
+                reach = if diag.corrector_failures > dbg_cf {
+                    alpha
+                } else if alpha == reach {
+                    (2.0 * reach).min(1.0)
+                } else {
+                    reach
+                };
                 let s = &d * alpha;
                 let y = &et.grad_v - &eval.grad_v;
                 // Full capped steps that leave the gradient unchanged: the energy falls

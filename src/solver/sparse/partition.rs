@@ -29,7 +29,7 @@ use crate::model::Model;
 const THRESHOLD: f64 = 0.1;
 
 /// Threshold of the second pass's pivot test against the row's reach on its own body.
-const OWN_THRESHOLD: f64 = 0.1;
+const OWN_THRESHOLD: f64 = 0.5;
 
 /// The bodies in elimination order: descending breadth-first depth from the ground over all
 /// joints (ties: higher index first); bodies not connected to the ground come last.
@@ -190,7 +190,7 @@ impl Elimination {
                 let reference = reach[r][usize::from(c % 7 >= 3)];
                 let ratio = v.abs() / reference.max(f64::MIN_POSITIVE);
                 if v.abs() > self.tol
-                    && ratio >= std::env::var("RP_TAU").ok().and_then(|x| x.parse().ok()).unwrap_or(OWN_THRESHOLD)
+                    && ratio >= OWN_THRESHOLD
                     && best.is_none_or(|x| ratio > x.2 * (1.0 + 1e-9))
                 {
                     best = Some((r, c, ratio));

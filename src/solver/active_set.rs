@@ -106,9 +106,8 @@ impl<'m> Guard<'m> {
     }
 
     /// The corrected point `q(α) = correct(q + α dq)` on the boundary of the first inequality
-    /// met along `α ∈ [0, alpha]` (regula falsi on the lowest gap, Illinois variant, bisecting
-    /// where a gap is not known), and the inequalities within the tolerance of their boundary
-    /// there.
+    /// met along `α ∈ [0, alpha]` (bisection), and the inequalities within the tolerance of
+    /// their boundary there.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn boundary(
         &self,
@@ -122,19 +121,8 @@ impl<'m> Guard<'m> {
     ) -> Option<(DVector<f64>, Vec<usize>)> {
         let (mut lo, mut hi) = (0.0, alpha);
         let mut q_lo = q.clone();
-        // The lowest gaps at `lo` and `hi` (`None`: not known, bisect).
-        let mut g_lo = self.lowest(q, &sys.problem.cons.branches).map(|(_, g)| g);
-        let mut g_hi: Option<f64> = None;
-        // Illinois: the end kept twice in a row has its gap halved.
-        let mut kept = 0i8;
         for _ in 0..80 {
-            let mid = match (g_lo, g_hi) {
-                (Some(a), Some(b)) if a > b => {
-                    let t = (a / (a - b)).clamp(0.01, 0.99);
-                    lo + t * (hi - lo)
-                }
-                _ => 0.5 * (lo + hi),
-            };
+            let mid = 0.5 * (lo + hi);
             let mut qm = q + dq * mid;
             if sys
                 .correct_from(
@@ -147,28 +135,17 @@ impl<'m> Guard<'m> {
                 .is_err()
             {
                 hi = mid;
-                g_hi = None;
                 continue;
             }
             let (_, g) = self.lowest(&qm, &sys.problem.cons.branches)?;
             if g < -self.tol {
                 hi = mid;
-                g_hi = Some(g);
-                if kept == -1 {
-                    g_lo = g_lo.map(|x| 0.5 * x);
-                }
-                kept = -1;
             } else {
                 lo = mid;
                 q_lo = qm;
-                g_lo = Some(g);
                 if g <= self.tol {
                     break;
                 }
-                if kept == 1 {
-                    g_hi = g_hi.map(|x| 0.5 * x);
-                }
-                kept = 1;
             }
         }
         let branches = &sys.problem.cons.branches;
@@ -326,10 +303,7 @@ pub(crate) fn solve(
     let mut counters = super::Diagnostics::default();
     loop {
         let mut branches = state.branches.clone();
-        let t0 = std::time::Instant::now();
         let q = super::assemble::project(model, state.q, &mut branches, locks, &active, options)?;
-        if std::env::var_os("RP_T").is_some() { eprintln!("T project {:.2} ms", t0.elapsed().as_secs_f64()*1e3); }
-        let t0 = std::time::Instant::now();
         let inactive: Vec<Unilateral> = all
             .iter()
             .filter(|u| !active.iter().any(|a| a.row == **u))
@@ -344,7 +318,6 @@ pub(crate) fn solve(
             Some(&guard),
             options,
         )?;
-        if std::env::var_os("RP_T").is_some() { eprintln!("T round {:.2} ms blocked {}", t0.elapsed().as_secs_f64()*1e3, round.blocked.is_some()); }
         iterations += round.report.iterations;
         counters.add_counts(&round.report.diagnostics);
         state = round.state;

@@ -3,13 +3,19 @@
 //! Each iteration picks a direction `d` (Newton: `−Ĥ⁻¹ ∇f` with the eigenvalues of the exact
 //! reduced Hessian replaced by their magnitudes, floored; BFGS / DFP: `−B ∇f` with the inverse
 //! update), caps `‖d‖∞` at `max_step`, and backtracks from `α = 1` until the Armijo condition
-//! `f(v̂ + α d) ≤ f + 10⁻⁴ α ∇fᵀ d` holds. A trial point starts from the first-order prediction
+//! `f(v̂ + α d) ≤ f + 10⁻⁴ α ∇fᵀ d` holds. After a step on which the corrector failed, the next
+//! line search starts from the `α` that was accepted instead of 1, and that start doubles after
+//! each step taken in full (a trust radius for the corrector: a long rope's first steps swing
+//! its lower links far enough to leave the corrector's reach, and halving from 1 every time
+//! costs two or three failed corrections per iteration). A trial point starts from the first-order prediction
 //! `q + α Z d` and is brought back onto `Φ = 0` by the Newton corrector; trial energies are
 //! compared through the Lagrangian `V − μᵀΦ`, which removes the first-order effect of the
 //! corrector's remaining residual (otherwise `μ·Φ` can exceed the decrease a Newton step
 //! promises near the minimum); if the corrector fails
 //! the step is halved (paper step (f)). When no step is found, the coordinates are
-//! re-partitioned once at the current point. At a stationary point with a negative reduced
+//! re-partitioned once at the current point; a `revisable` sparse partition (second-pass
+//! pivots of contact or stop rows, module `sparse::partition`) is recomputed after every step
+//! and replaced when it has changed. At a stationary point with a negative reduced
 //! Hessian eigenvalue (a saddle or maximum) the search leaves along its eigenvector, unless
 //! `allow_unstable` is set.
 //!
@@ -233,7 +239,7 @@ pub(crate) fn minimize(
         let dof = part.independent.len();
         let dense_newton = options.method == Method::Newton && sys.backend == Backend::Dense;
         let eig =
-            (dof > 0 && (dense_newton || gnorm <= gtol)).then(|| { let t0 = std::time::Instant::now(); let r = spectrum(sys, &q, &part, &eval); if std::env::var_os("RP_T").is_some() { eprintln!("T spectrum {:.2} ms", t0.elapsed().as_secs_f64()*1e3); } r });
+            (dof > 0 && (dense_newton || gnorm <= gtol)).then(|| spectrum(sys, &q, &part, &eval));
         if gnorm <= gtol {
             match &eig {
                 Some(e) if !options.allow_unstable => match e.lowest() {
@@ -273,12 +279,7 @@ pub(crate) fn minimize(
                     }
                     d
                 }
-                (_, Method::Newton) => {
-                    let t0 = std::time::Instant::now();
-                    let d = kkt_direction(sys, &q, &part, &eval);
-                    if std::env::var_os("RP_T").is_some() { eprintln!("T kkt {:.2} ms", t0.elapsed().as_secs_f64()*1e3); }
-                    d
-                }
+                (_, Method::Newton) => kkt_direction(sys, &q, &part, &eval),
                 _ => -(&qn.binv * g),
             }
         };
@@ -310,9 +311,7 @@ pub(crate) fn minimize(
             dq *= factor;
         }
         let slope = g.dot(&d);
-        let dbg_cf = diag.corrector_failures;
-        let t_ls = std::time::Instant::now();
-        let dbg_sh = diag.step_halvings;
+        let failures_before = diag.corrector_failures;
         // Backtracking line search, from the step length the corrector last managed.
         let mut alpha = reach;
         let mut accepted = None;
@@ -375,16 +374,6 @@ pub(crate) fn minimize(
             alpha = next.clamp(0.1 * alpha, 0.5 * alpha);
             diag.step_halvings += 1;
         }
-        if std::env::var_os("RP_T").is_some() { eprintln!("T ls {:.2} ms cf {}", t_ls.elapsed().as_secs_f64()*1e3, diag.corrector_failures - dbg_cf); }
-        if std::env::var_os("RP_DEBUG").is_some() {
-            eprintln!("it {iteration} dof {dof} E {:.12e} g {:.3e} factor {:.3e} rot {:.3e} pos {:.3e} cf {} sh {} acc {:?} blocked {}", eval.energy.total, gnorm, factor, rot, pos, diag.corrector_failures-dbg_cf, diag.step_halvings-dbg_sh, accepted.as_ref().map(|a: &(DVector<f64>, Eval, f64)| a.2), blocked.is_some());
-            if let Ok(bs) = std::env::var("RP_BODIES") {
-                for b in bs.split(',').filter_map(|x| x.parse::<usize>().ok()) {
-                    let th = 2.0 * q[7 * b + 5].atan2(q[7 * b + 3]);
-                    eprintln!("   body {b} x {:.4} z {:.4} theta {:.4}", q[7 * b], q[7 * b + 2], th);
-                }
-            }
-        }
         match accepted {
             Some((qt, et, _)) if blocked.is_some() => {
                 q = qt;
@@ -394,7 +383,7 @@ pub(crate) fn minimize(
                 break;
             }
             Some((qt, et, alpha)) => {
-                reach = if diag.corrector_failures > dbg_cf {
+                reach = if diag.corrector_failures > failures_before {
                     alpha
                 } else if alpha == reach {
                     (2.0 * reach).min(1.0)
@@ -435,13 +424,8 @@ pub(crate) fn minimize(
                 if eval.factors.ill_conditioned() {
                     (part, eval, qn) = repartition(sys, &q, options.method, &mut diag)?;
                 } else if part.revisable {
-                    let t0 = std::time::Instant::now();
                     let fresh = sys.partition(&q);
-                    if std::env::var_os("RP_T").is_some() { eprintln!("T part {:.2} ms", t0.elapsed().as_secs_f64()*1e3); }
                     if fresh.dependent != part.dependent || fresh.rows != part.rows {
-                        if std::env::var_os("RP_DEBUG").is_some() {
-                            eprintln!("   revised partition");
-                        }
                         diag.repartitions += 1;
                         eval = sys.evaluate(&q, &fresh)?;
                         part = fresh;

@@ -348,10 +348,7 @@ pub(crate) fn solve_round(
         });
     }
     let rank = part.rows.len();
-    let t0 = std::time::Instant::now();
-    let out = minimize::minimize(&mut sys, q.clone(), part, options, guard);
-    if std::env::var_os("RP_T").is_some() { eprintln!("T minimize {:.2} ms", t0.elapsed().as_secs_f64()*1e3); }
-    let Some(out) = out else {
+    let Some(out) = minimize::minimize(&mut sys, q.clone(), part, options, guard) else {
         return Err(
             crate::forces::undefined_term(model, &start.branches, &q).unwrap_or(
                 Error::SingularPartition {

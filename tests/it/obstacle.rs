@@ -209,8 +209,6 @@ fn friction_holds_a_box_on_a_tilted_fixed_box() {
     };
     let (_, r) = restpose::solve(&m, &enough).unwrap();
     assert!(r.converged(), "{:?}", r.termination);
-    for c in &r.contacts { eprintln!("{:?} {} {:?} req {}", c.state, c.normal_force, c.tangential_force, c.required_friction); }
-    eprintln!("{:?}", r.diagnostics);
     assert!(r.contacts.iter().all(|c| c.state == ContactState::Sticking));
 }
 

@@ -11,9 +11,17 @@
 //! column becomes a dependent coordinate, its row an independent row, and it is eliminated from
 //! the other active rows, `a_i ← a_i − (a_ic / a_rc) a_r`. Up to seven pivots are taken per
 //! body, then (second pass) the rows that started on that body alone (a contact's gap, a stop)
-//! on the body's largest remaining free entry with the rank test only: the joint rows pivoted
-//! before them move their large entries onto the parent, and left for later they would carry
-//! that fill up the whole chain (one dense row per contact). A row whose entries all fall below `RANK_TOLERANCE · max|D Φ_q S|` is redundant. Rows
+//! on the body's free entry largest against the row's *reach* `ρ_r`, the largest of its
+//! starting entries on that body in columns of the same kind (translations or Euler
+//! parameters), if `|a_rc| ≥ τ₂ ρ_r` (τ₂ = 0.5): the joint rows pivoted before them move their
+//! large entries onto the parent, and left for later they would carry that fill up the whole
+//! chain (one dense row per contact). The entry left on the body is the lever of the body's
+//! free joint motion on the row (`l cos φ` for a contact at the end of a link of length `l`,
+//! `φ` off the horizontal), which vanishes as the link turns vertical: a row that fails the
+//! test there goes on to the bodies its fill has reached and is tried again at each (the next
+//! link up, with the lever of both links). Such a partition is marked `revisable`: the
+//! minimizer re-partitions when a step changes it. A row whose entries all fall below
+//! `RANK_TOLERANCE · max|D Φ_q S|` is redundant. Rows
 //! left at the end (loop rows whose bodies were all eliminated) are finished by full pivoting
 //! among themselves.
 //!
@@ -280,10 +288,13 @@ pub(crate) fn partition(
         // through that fill, with entries there far larger than the one left on `b` (the lever
         // arm of the contact point about the joint). Left for later it would carry the fill
         // up the whole chain: one dense row per contact, O(N²) work and an LDLᵀ of the KKT
-        // system with O(N²) fill. It is pivoted here on `b`'s largest remaining free entry,
-        // with the rank test `|a_rc| > tol` only: like a joint row, it is eliminated with its
-        // body. The dependent coordinate it takes (the joint angle that keeps the contact
-        // point on the ground) is well determined by it.
+        // system with O(N²) fill. It is pivoted here on `b`'s free entry largest against its
+        // reach, if at least `OWN_THRESHOLD` of it: like a joint row, it is eliminated with its
+        // body, and the dependent coordinate it takes (the joint angle that keeps the contact
+        // point on the ground) is well determined by it. A pivot on a small lever (a link near
+        // vertical above its contact) would leave `Φ_u` nearly singular and fold the manifold
+        // over `v` within a fraction of the link's length: the corrector then fails on all but
+        // tiny steps.
         while taken < 7 {
             match el.best_own_pivot(&own[b], b, &reach) {
                 Some((r, c)) => el.pivot(r, c),

@@ -1,5 +1,8 @@
 //! The corrector: Newton on `Φ(u; v) = 0` for fixed `v`, `Φ_u δu = −Φ` over the independent
-//! rows, optionally starting with chord steps on the factors of a nearby point.
+//! rows, optionally starting with chord steps on the factors of a nearby point. It gives up
+//! at the second Newton step that does not decrease the residual (outside Newton's region of
+//! convergence, or no solution for this `v`: the line search then halves the step) rather
+//! than after `max_iterations` refactorizations.
 
 use super::{Factors, System};
 use crate::solver::partition::Partition;
@@ -60,9 +63,6 @@ impl System<'_> {
                 .iter()
                 .map(|&i| self.work.phi[i].abs() * self.problem.scaling.rows[i])
                 .fold(0.0, f64::max);
-            if std::env::var_os("RP_DEBUG2").is_some() {
-                eprintln!("  corr it {it} res {res:.3e} chord {}", chord.is_some());
-            }
             if !res.is_finite() {
                 return Err(CorrectorFailure);
             }
@@ -72,9 +72,6 @@ impl System<'_> {
             let target = if chord.is_some() { 1e-3 * tol } else { tol };
             if res <= target || (res <= tol && it == max_iterations) {
                 let all = self.dimensionless_residual();
-                if std::env::var_os("RP_DEBUG2").is_some() {
-                    eprintln!("  corr done all {all:.3e}");
-                }
                 return if all <= tol.max(1e-8) {
                     Ok(it)
                 } else {

@@ -270,7 +270,8 @@ pub(crate) fn partition(
             }
         }
     }
-    let revisable = own.iter().any(|o| !o.is_empty());
+    // Whether a row was pivoted in the second pass or carried on from its body.
+    let mut revisable = false;
     for b in elimination_order(model) {
         let mut taken = 0;
         while taken < 7 {
@@ -297,7 +298,10 @@ pub(crate) fn partition(
         // tiny steps.
         while taken < 7 {
             match el.best_own_pivot(&own[b], b, &reach) {
-                Some((r, c)) => el.pivot(r, c),
+                Some((r, c)) => {
+                    el.pivot(r, c);
+                    revisable = true;
+                }
                 None => break,
             }
             taken += 1;
@@ -308,6 +312,7 @@ pub(crate) fn partition(
             if !el.active[r] {
                 continue;
             }
+            revisable = true;
             let mut bodies: Vec<usize> = el.rows[r].iter().map(|e| e.0 / 7).collect();
             bodies.sort_unstable();
             bodies.dedup();

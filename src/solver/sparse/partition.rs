@@ -307,9 +307,12 @@ pub(crate) fn partition(
             taken += 1;
         }
         // A row whose entry on `b` is too small against its reach (a contact point straight
-        // below the joint of a vertical link) goes on to the bodies its fill reached.
+        // below the joint of a vertical link) goes on to the bodies its fill reached. (A row
+        // left without entries on `b`'s free columns, all taken by the first pass, stays
+        // where it is, for the first pass at other bodies or the final full pivoting.)
         for r in std::mem::take(&mut own[b]) {
-            if !el.active[r] {
+            let on_b = |&(c, v): &(usize, f64)| c / 7 == b && el.free[c] && v.abs() > el.tol;
+            if !el.active[r] || !el.rows[r].iter().any(on_b) {
                 continue;
             }
             revisable = true;

@@ -18,8 +18,10 @@
 //! chain (one dense row per contact). The entry left on the body is the lever of the body's
 //! free joint motion on the row (`l cos φ` for a contact at the end of a link of length `l`,
 //! `φ` off the horizontal), which vanishes as the link turns vertical: a row that fails the
-//! test there goes on to the bodies its fill has reached and is tried again at each (the next
-//! link up, with the lever of both links). Such a partition is marked `revisable`: the
+//! test there goes on to the bodies its fill has reached and is tried again at each (up a
+//! chain, with each link's own lever: the coordinates are absolute, so the links below keep
+//! their orientation), else in the final full pivoting, on its largest entry. Such a
+//! partition is marked `revisable`: the
 //! minimizer re-partitions when a step changes it. A row whose entries all fall below
 //! `RANK_TOLERANCE · max|D Φ_q S|` is redundant. Rows
 //! left at the end (loop rows whose bodies were all eliminated) are finished by full pivoting
@@ -396,6 +398,75 @@ mod tests {
                     .model
             })
             .collect()
+    }
+
+    /// A rope of 60 links, 20 hanging 0.3 rad off the vertical, the rest lying on the ground,
+    /// with the contacts touching at the start active: the lowest hanging link's contact (at
+    /// its lower end, on the ground) has the lever `l cos φ` on its own angle, below half its
+    /// reach, so its row is carried on up the hanging links (each with the same lever here: the
+    /// rope is straight) instead of pivoting on the steep link's angle; the lying links' rows
+    /// are pivoted with their links. The partition is marked revisable and its `Φ_u` is as well
+    /// conditioned as the dense full-pivoting one's (within 10×).
+    #[test]
+    fn a_contact_below_a_steep_link_is_not_pivoted_on_its_angle() {
+        use crate::constraints::unilateral::{gap, Unilateral};
+        use crate::constraints::BlockKind;
+        let model = load_str(
+            &crate::generate::rope(60),
+            "rope.urdf",
+            &ImportOptions::default(),
+        )
+        .unwrap()
+        .model;
+        let q0 = crate::solver::initial_state(&model).q;
+        let q = crate::solver::assemble_only(&model, q0, &mut Default::default(), &[]).unwrap();
+        let options = crate::solver::Options::default();
+        let active: Vec<_> = crate::solver::active_set::inequalities(&model, &options)
+            .into_iter()
+            .filter(|u| gap(&model, u, &q, &Default::default()).is_some_and(|g| g.abs() < 1e-9))
+            .map(|u| crate::solver::active_set::activate(&model, &options, u, &q))
+            .collect();
+        // Links 19 (the lowest hanging one) to 59 touch.
+        assert_eq!(active.len(), 41);
+        let cons = || Constraints::new(&model, &[]).with_active(&model, &active);
+        let mut sparse = System::with_backend(&model, cons(), Backend::Sparse);
+        let mut dense = System::with_backend(&model, cons(), Backend::Dense);
+        let ps = sparse.partition(&q);
+        let pd = dense.partition(&q);
+        assert!(ps.revisable && !pd.revisable);
+        assert_eq!(ps.independent.len(), pd.independent.len());
+        assert_eq!(ps.independent.len(), 19);
+        // The body of the dependent coordinate each contact row was pivoted on.
+        let link_of = |name: &str| model.bodies.iter().position(|b| b.name == name).unwrap();
+        for block in &sparse.problem.cons.blocks {
+            let BlockKind::Unilateral(a) = &block.kind else {
+                continue;
+            };
+            let Unilateral::Contact { point, .. } = a.row else {
+                panic!("only contacts here");
+            };
+            let own = link_of(&model.contact_points[point].link);
+            let k = ps.rows.iter().position(|&r| r == block.first).unwrap();
+            let pivot_body = ps.dependent[k] / 7;
+            if own == link_of("link19") {
+                assert!(pivot_body < own, "{pivot_body}");
+            } else {
+                assert_eq!(pivot_body, own);
+            }
+        }
+        let j = sparse.jacobian(&q);
+        let cond = |p: &crate::solver::partition::Partition| {
+            let r = p.rows.len();
+            let a = nalgebra::DMatrix::from_fn(r, r, |i, k| {
+                j[(p.rows[i], p.dependent[k])]
+                    * sparse.problem.scaling.rows[p.rows[i]]
+                    * sparse.problem.scaling.columns[p.dependent[k]]
+            });
+            let sv = a.singular_values();
+            sv.max() / sv.min()
+        };
+        let (cs, cd) = (cond(&ps), cond(&pd));
+        assert!(cs < 10.0 * cd, "cond(Φ_u) sparse {cs:e} vs dense {cd:e}");
     }
 
     /// The body-by-body elimination finds the rank of the dense full-pivoting partition (same

@@ -13,9 +13,9 @@
 //! corrector's remaining residual (otherwise `μ·Φ` can exceed the decrease a Newton step
 //! promises near the minimum); if the corrector fails
 //! the step is halved (paper step (f)). When no step is found, the coordinates are
-//! re-partitioned once at the current point; a `revisable` sparse partition (second-pass
-//! pivots of contact or stop rows, module `sparse::partition`) is recomputed after every step
-//! and replaced when it has changed. At a stationary point with a negative reduced
+//! re-partitioned once at the current point; a sparse partition with second-pass choices for
+//! contact or stop rows (module `sparse::partition`) is recomputed after every step and
+//! replaced when those choices have changed. At a stationary point with a negative reduced
 //! Hessian eigenvalue (a saddle or maximum) the search leaves along its eigenvector, unless
 //! `allow_unstable` is set.
 //!
@@ -420,12 +420,14 @@ pub(crate) fn minimize(
                     break;
                 }
                 // Re-partition when Φ_u becomes ill-conditioned, or (a sparse partition with
-                // pivots of the second pass) when the partition at `q` is another one.
+                // second-pass choices) when the partition at `q` makes other ones. (Not on
+                // any change: where a carried row ends in the final full pivoting among
+                // nearly equal levers would flip from step to step.)
                 if eval.factors.ill_conditioned() {
                     (part, eval, qn) = repartition(sys, &q, options.method, &mut diag)?;
-                } else if part.revisable {
+                } else if !part.second_pass.is_empty() {
                     let fresh = sys.partition(&q);
-                    if fresh.dependent != part.dependent || fresh.rows != part.rows {
+                    if fresh.second_pass != part.second_pass {
                         diag.repartitions += 1;
                         eval = sys.evaluate(&q, &fresh)?;
                         part = fresh;

@@ -26,10 +26,12 @@ pub(crate) struct Partition {
     pub(crate) rows: Vec<usize>,
     /// Redundant constraint rows, ascending.
     pub(crate) redundant: Vec<usize>,
-    /// The sparse partition pivoted rows of one body (contacts, stops) in its second pass, on
-    /// entries that shrink as the body turns (module `sparse::partition`): the minimizer
-    /// re-partitions after a step that moves such a pivot below its threshold.
-    pub(crate) revisable: bool,
+    /// The sparse partition's choices for the rows of one body (contacts, stops) in its second
+    /// pass (module `sparse::partition`): `(row, body, true)` pivoted at `body`, `(row, body,
+    /// false)` refused at `body` and carried on; sorted. They rest on entries that shrink as
+    /// the bodies turn: the minimizer re-partitions after a step that changes them. Empty for
+    /// the dense partition.
+    pub(crate) second_pass: Vec<(usize, usize, bool)>,
 }
 
 /// A fresh partition id.
@@ -119,7 +121,7 @@ pub(crate) fn partition(jac: &DMatrix<f64>, row_scale: &[f64], scale: &[f64]) ->
         independent,
         rows: row_perm[..rank].to_vec(),
         redundant,
-        revisable: false,
+        second_pass: Vec::new(),
     }
 }
 
@@ -205,7 +207,7 @@ mod tests {
             independent,
             rows: row_perm[..rank].to_vec(),
             redundant,
-            revisable: false,
+            second_pass: Vec::new(),
         }
     }
 

@@ -21,8 +21,8 @@
 //! test there goes on to the bodies its fill has reached and is tried again at each (up a
 //! chain, with each link's own lever: the coordinates are absolute, so the links below keep
 //! their orientation), else in the final full pivoting, on its largest entry. Such a
-//! partition is marked `revisable`: the
-//! minimizer re-partitions when a step changes it. A row whose entries all fall below
+//! partition lists these choices (`Partition::second_pass`): the minimizer re-partitions
+//! when a step changes them. A row whose entries all fall below
 //! `RANK_TOLERANCE · max|D Φ_q S|` is redundant. Rows
 //! left at the end (loop rows whose bodies were all eliminated) are finished by full pivoting
 //! among themselves.
@@ -272,8 +272,9 @@ pub(crate) fn partition(
             }
         }
     }
-    // Whether a row was pivoted in the second pass or carried on from its body.
-    let mut revisable = false;
+    // The rows pivoted in the second pass and the bodies they were pivoted at, and the rows
+    // carried on and the bodies that refused them.
+    let mut second_pass = Vec::new();
     for b in elimination_order(model) {
         let mut taken = 0;
         while taken < 7 {
@@ -302,7 +303,7 @@ pub(crate) fn partition(
             match el.best_own_pivot(&own[b], b, &reach) {
                 Some((r, c)) => {
                     el.pivot(r, c);
-                    revisable = true;
+                    second_pass.push((r, b, true));
                 }
                 None => break,
             }
@@ -317,7 +318,7 @@ pub(crate) fn partition(
             if !el.active[r] || !el.rows[r].iter().any(on_b) {
                 continue;
             }
-            revisable = true;
+            second_pass.push((r, b, false));
             let mut bodies: Vec<usize> = el.rows[r].iter().map(|e| e.0 / 7).collect();
             bodies.sort_unstable();
             bodies.dedup();
@@ -366,6 +367,9 @@ pub(crate) fn partition(
         independent,
         rows: el.pivot_rows,
         redundant: el.redundant,
-        revisable,
+        second_pass: {
+            second_pass.sort_unstable();
+            second_pass
+        },
     }
 }

@@ -3,11 +3,14 @@
 //! Each iteration picks a direction `d` (Newton: `−Ĥ⁻¹ ∇f` with the eigenvalues of the exact
 //! reduced Hessian replaced by their magnitudes, floored; BFGS / DFP: `−B ∇f` with the inverse
 //! update), caps `‖d‖∞` at `max_step`, and backtracks from `α = 1` until the Armijo condition
-//! `f(v̂ + α d) ≤ f + 10⁻⁴ α ∇fᵀ d` holds. After a step on which the corrector failed, the next
-//! line search starts from the `α` that was accepted instead of 1, and that start doubles after
-//! each step taken in full (a trust radius for the corrector: a long rope's first steps swing
-//! its lower links far enough to leave the corrector's reach, and halving from 1 every time
-//! costs two or three failed corrections per iteration). A trial point starts from the first-order prediction
+//! `f(v̂ + α d) ≤ f + 10⁻⁴ α ∇fᵀ d` holds. With a sparse partition that has second-pass
+//! choices (contact or stop rows pivoted on their bodies, module `sparse::partition`), after a
+//! step on which the corrector failed the next line search starts from the `α` that was
+//! accepted instead of 1, and that start doubles after each step taken in full (a trust radius
+//! for the corrector: a long rope's first steps swing its lower links far enough to leave the
+//! corrector's reach, and halving from 1 every time costs two or three failed corrections per
+//! iteration). Elsewhere it starts from 1 (applied to every model, this heuristic sent a far
+//! start of the tractor-trailer, limits enforced, to another equilibrium). A trial point starts from the first-order prediction
 //! `q + α Z d` and is brought back onto `Φ = 0` by the Newton corrector; trial energies are
 //! compared through the Lagrangian `V − μᵀΦ`, which removes the first-order effect of the
 //! corrector's remaining residual (otherwise `μ·Φ` can exceed the decrease a Newton step
@@ -312,8 +315,13 @@ pub(crate) fn minimize(
         }
         let slope = g.dot(&d);
         let failures_before = diag.corrector_failures;
-        // Backtracking line search, from the step length the corrector last managed.
-        let mut alpha = reach;
+        // Backtracking line search, from the step length the corrector last managed (with
+        // second-pass choices in the partition; from 1 otherwise).
+        let mut alpha = if part.second_pass.is_empty() {
+            1.0
+        } else {
+            reach
+        };
         let mut accepted = None;
         for _ in 0..40 {
             let mut qt = &q + &dq * alpha;

@@ -400,6 +400,10 @@ pub(crate) fn solve(
         if cycling {
             report.termination = super::Termination::ActiveSetCycling;
         }
+        // A round stopped at an inequality or a roll limit has no verdict of its own.
+        if (cycling || rolled_too_far) && round.blocked.is_some() {
+            report.stability = super::stability_on(model, &state, &active, true);
+        }
         report.iterations = iterations;
         let own = report.diagnostics.clone();
         report.diagnostics = counters;

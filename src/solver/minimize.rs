@@ -3,13 +3,22 @@
 //! Each iteration picks a direction `d` (Newton: `−Ĥ⁻¹ ∇f` with the eigenvalues of the exact
 //! reduced Hessian replaced by their magnitudes, floored; BFGS / DFP: `−B ∇f` with the inverse
 //! update), caps `‖d‖∞` at `max_step`, and backtracks from `α = 1` until the Armijo condition
-//! `f(v̂ + α d) ≤ f + 10⁻⁴ α ∇fᵀ d` holds. A trial point starts from the first-order prediction
+//! `f(v̂ + α d) ≤ f + 10⁻⁴ α ∇fᵀ d` holds. With a sparse partition that has second-pass
+//! choices (contact or stop rows pivoted on their bodies, module `sparse::partition`), after a
+//! step on which the corrector failed the next line search starts from the `α` that was
+//! accepted instead of 1, and that start doubles after each step taken in full (a trust radius
+//! for the corrector: a long rope's first steps swing its lower links far enough to leave the
+//! corrector's reach, and halving from 1 every time costs two or three failed corrections per
+//! iteration). Elsewhere it starts from 1 (applied to every model, this heuristic sent a far
+//! start of the tractor-trailer, limits enforced, to another equilibrium). A trial point starts from the first-order prediction
 //! `q + α Z d` and is brought back onto `Φ = 0` by the Newton corrector; trial energies are
 //! compared through the Lagrangian `V − μᵀΦ`, which removes the first-order effect of the
 //! corrector's remaining residual (otherwise `μ·Φ` can exceed the decrease a Newton step
 //! promises near the minimum); if the corrector fails
 //! the step is halved (paper step (f)). When no step is found, the coordinates are
-//! re-partitioned once at the current point. At a stationary point with a negative reduced
+//! re-partitioned once at the current point; a sparse partition with second-pass choices for
+//! contact or stop rows (module `sparse::partition`) is recomputed after every step and
+//! replaced when those choices have changed. At a stationary point with a negative reduced
 //! Hessian eigenvalue (a saddle or maximum) the search leaves along its eigenvector, unless
 //! `allow_unstable` is set.
 //!
@@ -208,6 +217,9 @@ pub(crate) fn minimize(
     let mut eigen = None;
     let mut iterates = Vec::new();
     let mut blocked = None;
+    // The step length the line search starts from: 1, or after a step the corrector could
+    // not follow in full, the fraction that it could, doubled after each full success.
+    let mut reach = 1.0f64;
     loop {
         let f = eval.merit;
         let gnorm = eval.grad_v.amax();
@@ -302,8 +314,14 @@ pub(crate) fn minimize(
             dq *= factor;
         }
         let slope = g.dot(&d);
-        // Backtracking line search.
-        let mut alpha = 1.0;
+        let failures_before = diag.corrector_failures;
+        // Backtracking line search, from the step length the corrector last managed (with
+        // second-pass choices in the partition; from 1 otherwise).
+        let mut alpha = if part.second_pass.is_empty() {
+            1.0
+        } else {
+            reach
+        };
         let mut accepted = None;
         for _ in 0..40 {
             let mut qt = &q + &dq * alpha;
@@ -373,6 +391,13 @@ pub(crate) fn minimize(
                 break;
             }
             Some((qt, et, alpha)) => {
+                reach = if diag.corrector_failures > failures_before {
+                    alpha
+                } else if alpha == reach {
+                    (2.0 * reach).min(1.0)
+                } else {
+                    reach
+                };
                 let s = &d * alpha;
                 let y = &et.grad_v - &eval.grad_v;
                 // Full capped steps that leave the gradient unchanged: the energy falls
@@ -402,9 +427,20 @@ pub(crate) fn minimize(
                         super::unbounded::free_directions(sys.problem.model, &q, &(&dq * alpha));
                     break;
                 }
-                // Re-partition when Φ_u becomes ill-conditioned.
+                // Re-partition when Φ_u becomes ill-conditioned, or (a sparse partition with
+                // second-pass choices) when the partition at `q` makes other ones. (Not on
+                // any change: where a carried row ends in the final full pivoting among
+                // nearly equal levers would flip from step to step.)
                 if eval.factors.ill_conditioned() {
                     (part, eval, qn) = repartition(sys, &q, options.method, &mut diag)?;
+                } else if !part.second_pass.is_empty() {
+                    let fresh = sys.partition(&q);
+                    if fresh.second_pass != part.second_pass {
+                        diag.repartitions += 1;
+                        eval = sys.evaluate(&q, &fresh)?;
+                        part = fresh;
+                        qn = QuasiNewton::new(part.independent.len(), options.method);
+                    }
                 }
             }
             None if !just_repartitioned => {

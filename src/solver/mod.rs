@@ -407,7 +407,9 @@ pub(crate) fn solve_round(
     let mut diagnostics = out.diagnostics;
     diagnostics.linear_algebra = sys.backend.name().into();
     let stability_started = std::time::Instant::now();
-    let stability = (dof > 0).then(|| {
+    // A round stopped by an inequality is not a rest pose: the active-set iteration goes on
+    // from it (and judges stability itself if it ends there).
+    let stability = (dof > 0 && out.blocked.is_none()).then(|| {
         let eig = out
             .eigen
             .clone()

@@ -26,6 +26,12 @@ pub(crate) struct Partition {
     pub(crate) rows: Vec<usize>,
     /// Redundant constraint rows, ascending.
     pub(crate) redundant: Vec<usize>,
+    /// The sparse partition's choices for the rows of one body (contacts, stops) in its second
+    /// pass (module `sparse::partition`): `(row, body, true)` pivoted at `body`, `(row, body,
+    /// false)` refused at `body` and carried on; sorted. They rest on entries that shrink as
+    /// the bodies turn: the minimizer re-partitions after a step that changes them. Empty for
+    /// the dense partition.
+    pub(crate) second_pass: Vec<(usize, usize, bool)>,
 }
 
 /// A fresh partition id.
@@ -108,6 +114,7 @@ pub(crate) fn partition(jac: &DMatrix<f64>, row_scale: &[f64], scale: &[f64]) ->
         independent,
         rows: row_perm[..rank].to_vec(),
         redundant,
+        second_pass: Vec::new(),
     }
 }
 
@@ -230,6 +237,7 @@ mod tests {
             independent,
             rows: row_perm[..rank].to_vec(),
             redundant,
+            second_pass: Vec::new(),
         }
     }
 

@@ -595,8 +595,21 @@ fn a_spring_loaded_arm_folds_onto_the_floor() {
 /// the one written in joint coordinates (`energies::rope`); the vertical forces balance the
 /// weight (anchor reaction plus normal forces = `n m g`).
 fn rope_lies_partly_on_the_ground(n: usize) {
+    rope_on_the_ground_with(
+        n,
+        &Options::default(),
+        &[LinearAlgebra::Dense, LinearAlgebra::Sparse],
+    );
+}
+
+/// [`rope_lies_partly_on_the_ground`] solved with `options`, verified on the `paths` given.
+fn rope_on_the_ground_with(
+    n: usize,
+    options: &Options,
+    paths: &[LinearAlgebra],
+) -> restpose::Report {
     let m = model_from(&restpose::generate::rope(n));
-    let (s, r) = solve(&m);
+    let (s, r) = restpose::solve(&m, options).unwrap_or_else(|e| panic!("{e}"));
     assert!(r.converged(), "{:?}", r.termination);
     assert!(r.contacts.len() > n / 2, "{} contacts", r.contacts.len());
     let fmax = r.contacts.iter().fold(0.0f64, |a, c| a.max(c.normal_force));
@@ -609,7 +622,7 @@ fn rope_lies_partly_on_the_ground(n: usize) {
     // tolerance (1e-8 J), which through the 0.05 m links leaves the forces determined to about
     // 1e-8 N, and the dense least squares and the sparse basic solution place that residue
     // differently (1.5e-8 N at 300 links).
-    for path in [LinearAlgebra::Dense, LinearAlgebra::Sparse] {
+    for &path in paths {
         let v = verify_using(
             &m,
             &s,
@@ -632,11 +645,27 @@ fn rope_lies_partly_on_the_ground(n: usize) {
         n as f64 * 0.05 * 9.81,
         epsilon = 1e-8
     );
+    r
 }
 
 #[test]
 fn a_rope_lies_partly_on_the_ground() {
     rope_lies_partly_on_the_ground(100);
+}
+
+/// The 1,000-link rope (677 contacts at rest) converges by the direct solve, without the
+/// gravity ramp (`--load-steps 1`; issue 13: it failed there before, a contact row pivoted on
+/// the angle of a link turning vertical above its contact left `Φ_u` nearly singular).
+/// Verified on the sparse path only (the dense one takes minutes at this size).
+#[test]
+fn a_1000_link_rope_converges_by_the_direct_solve() {
+    let options = Options {
+        load_steps: 1,
+        ..Default::default()
+    };
+    let r = rope_on_the_ground_with(1000, &options, &[LinearAlgebra::Sparse]);
+    assert_eq!(r.diagnostics.load_steps, 1);
+    assert_eq!(r.contacts.len(), 677);
 }
 
 /// The 300-link rope (201 contacts): cheap since each contact row is eliminated with its link

@@ -17,4 +17,6 @@ pub(crate) mod factor;
 pub(crate) mod hessian;
 pub(crate) mod kkt;
 pub(crate) mod partition;
+#[cfg(test)]
+mod partition_tests;
 pub(crate) mod pattern;

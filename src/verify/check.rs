@@ -61,5 +61,22 @@ fn dof(model: &Model, state: &State, cons: Constraints) -> Result<usize> {
     }
     let cons = cons.on_branches(state.branches.clone());
     let mut sys = System::with_backend(model, cons, Backend::Sparse);
-    Ok(sys.partition(&state.q).independent.len())
+    let mut phi = nalgebra::DVector::zeros(sys.problem.cons.len());
+    let mut jac = crate::constraints::Triplets::default();
+    sys.problem
+        .cons
+        .evaluate(model, &state.q, &mut phi, Some(&mut jac));
+    let scaling = &sys.problem.scaling;
+    let fast = super::rank::free_columns(
+        model,
+        jac.rows,
+        jac.cols,
+        &jac.entries,
+        &scaling.rows,
+        &scaling.columns,
+    );
+    Ok(match fast {
+        Some(free) => free,
+        None => sys.partition(&state.q).independent.len(),
+    })
 }

@@ -32,9 +32,14 @@ pub(crate) fn run(a: &CheckArgs) -> anyhow::Result<u8> {
             }
         }
     }
-    Ok(if s.assembly_error.is_some() {
+    let code = if s.assembly_error.is_some() {
         exit::INPUT
     } else {
         0
-    })
+    };
+    // The process ends here: its memory goes back at exit, without freeing every name and
+    // row of a large model one by one (a few ms at 10,000 links).
+    std::mem::forget(s);
+    std::mem::forget(loaded);
+    Ok(code)
 }

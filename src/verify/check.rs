@@ -61,11 +61,13 @@ fn dof(model: &Model, state: &State, cons: Constraints) -> Result<usize> {
     }
     let cons = cons.on_branches(state.branches.clone());
     let mut sys = System::with_backend(model, cons, Backend::Sparse);
+    let t0 = std::time::Instant::now();
     let mut phi = nalgebra::DVector::zeros(sys.problem.cons.len());
     let mut jac = crate::constraints::Triplets::default();
     sys.problem
         .cons
         .evaluate(model, &state.q, &mut phi, Some(&mut jac));
+    eprint!("eval {:.1} ", t0.elapsed().as_secs_f64()*1e3);
     let scaling = &sys.problem.scaling;
     let fast = super::rank::free_columns(
         model,

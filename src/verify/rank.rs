@@ -84,12 +84,16 @@ impl Rows {
         let mut cols = vec![0usize; entries.len()];
         let mut vals = vec![0.0; entries.len()];
         let mut len = vec![0usize; m];
+        // Where column `c` sits in the row `seen[c].0` (an earlier entry of that row).
+        let n = entries.iter().map(|e| e.1 + 1).max().unwrap_or(0);
+        let mut seen = vec![(usize::MAX, 0usize); n];
         for &(r, c, v) in entries {
             let a = v * row_scale[r] * scale[c];
             let s = start[r];
-            match (s..s + len[r]).find(|&k| cols[k] == c) {
+            match (seen[c].0 == r).then_some(seen[c].1) {
                 Some(k) => vals[k] += a,
                 None => {
+                    seen[c] = (r, s + len[r]);
                     let k = s + len[r];
                     cols[k] = c;
                     vals[k] = a;
@@ -129,6 +133,8 @@ impl Rows {
 struct Local {
     cands: Vec<usize>,
     rows: Vec<Vec<(usize, f64)>>,
+    /// Scratch: one row's entries in the body's free columns.
+    entries: Vec<(usize, f64)>,
 }
 
 fn row_max(row: &[(usize, f64)]) -> f64 {
@@ -201,7 +207,9 @@ pub(super) fn free_columns(
     let mut local = Local {
         cands: Vec::new(),
         rows: Vec::new(),
+        entries: Vec::with_capacity(14),
     };
+    let (mut all, mut own) = (Vec::new(), Vec::new());
     for b in elimination_order(model) {
         local.cands.clear();
         local
@@ -217,21 +225,21 @@ pub(super) fn free_columns(
             local.rows[slot].extend(rows.row(r));
         }
         let in_b = |c: usize| c / 7 == b;
-        let all: Vec<usize> = (0..k).collect();
+        all.clear();
+        all.extend(0..k);
         let mut taken = 0;
         while taken < 7 {
-            match best_pivot(&local, &all, &active, &free, tol, THRESHOLD, in_b) {
+            match best_pivot(&mut local, &all, &active, &free, tol, THRESHOLD, in_b) {
                 Some((slot, c)) => pivot(&mut local, slot, c, &mut active, &mut free, tol),
                 None => break,
             }
             pivots += 1;
             taken += 1;
         }
-        let own: Vec<usize> = (0..k)
-            .filter(|&s| own_of[local.cands[s]] == b)
-            .collect();
+        own.clear();
+        own.extend((0..k).filter(|&s| own_of[local.cands[s]] == b));
         while taken < 7 {
-            match best_pivot(&local, &own, &active, &free, tol, 0.0, in_b) {
+            match best_pivot(&mut local, &own, &active, &free, tol, 0.0, in_b) {
                 Some((slot, c)) => pivot(&mut local, slot, c, &mut active, &mut free, tol),
                 None => break,
             }
@@ -252,7 +260,7 @@ pub(super) fn free_columns(
 /// `cols`: the largest `|a_rc| > tol` with `|a_rc| ≥ threshold · max_k |a_rk|`, a later one
 /// only if larger by a relative `1e-9`.
 fn best_pivot(
-    local: &Local,
+    local: &mut Local,
     slots: &[usize],
     active: &[bool],
     free: &[bool],
@@ -261,7 +269,7 @@ fn best_pivot(
     cols: impl Fn(usize) -> bool,
 ) -> Option<(usize, usize)> {
     let mut best: Option<(usize, usize, f64)> = None;
-    let mut entries: Vec<(usize, f64)> = Vec::with_capacity(14);
+    let entries = &mut local.entries;
     for &s in slots {
         if !active[local.cands[s]] {
             continue;
@@ -271,7 +279,7 @@ fn best_pivot(
         entries.clear();
         entries.extend(row.iter().copied().filter(|&(c, _)| free[c] && cols(c)));
         entries.sort_unstable_by_key(|e| e.0);
-        for &(c, v) in &entries {
+        for &(c, v) in entries.iter() {
             let a = v.abs();
             if a > tol && a >= threshold * rmax && best.is_none_or(|b| a > b.2 * (1.0 + 1e-9)) {
                 best = Some((s, c, a));

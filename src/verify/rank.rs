@@ -62,70 +62,67 @@ fn elimination_order(model: &Model) -> Vec<usize> {
     order
 }
 
-/// Rows in compressed form: row `r`'s entries are `cols/vals[start[r]..start[r] + len[r]]`.
-struct Rows {
+/// The rows of a Jacobian whose triplets are grouped by row: row `r` is
+/// `entries[start[r]..start[r + 1]]`, expanded on demand with its scales.
+struct Rows<'e> {
+    entries: &'e [(usize, usize, f64)],
     start: Vec<usize>,
-    len: Vec<usize>,
-    cols: Vec<usize>,
-    vals: Vec<f64>,
+    row_scale: &'e [f64],
+    scale: &'e [f64],
+    /// Where column `c` sits in the row being expanded: `(expansion, position)`.
+    seen: Vec<(usize, usize)>,
+    expansion: usize,
 }
 
-impl Rows {
-    /// The scaled entries `row_scale[r] · v · scale[c]` of the triplets, duplicates summed in
-    /// triplet order into the first one, zeros dropped (as the partition builds its rows).
-    fn new(m: usize, entries: &[(usize, usize, f64)], row_scale: &[f64], scale: &[f64]) -> Self {
+impl<'e> Rows<'e> {
+    /// The rows of `entries`, `None` unless they are grouped by ascending row.
+    fn new(
+        m: usize,
+        n: usize,
+        entries: &'e [(usize, usize, f64)],
+        row_scale: &'e [f64],
+        scale: &'e [f64],
+    ) -> Option<Self> {
         let mut start = vec![0usize; m + 1];
-        for &(r, _, _) in entries {
-            start[r + 1] += 1;
-        }
-        for r in 0..m {
-            start[r + 1] += start[r];
-        }
-        let mut cols = vec![0usize; entries.len()];
-        let mut vals = vec![0.0; entries.len()];
-        let mut len = vec![0usize; m];
-        // Where column `c` sits in the row `seen[c].0` (an earlier entry of that row).
-        let n = entries.iter().map(|e| e.1 + 1).max().unwrap_or(0);
-        let mut seen = vec![(usize::MAX, 0usize); n];
-        for &(r, c, v) in entries {
-            let a = v * row_scale[r] * scale[c];
-            let s = start[r];
-            match (seen[c].0 == r).then_some(seen[c].1) {
-                Some(k) => vals[k] += a,
-                None => {
-                    seen[c] = (r, s + len[r]);
-                    let k = s + len[r];
-                    cols[k] = c;
-                    vals[k] = a;
-                    len[r] += 1;
-                }
+        let mut last = 0;
+        for (k, &(r, c, _)) in entries.iter().enumerate() {
+            if r < last || r >= m || c >= n {
+                return None;
             }
-        }
-        // Drop zeros, keeping the order of the others.
-        for r in 0..m {
-            let s = start[r];
-            let mut kept = 0;
-            for k in s..s + len[r] {
-                if vals[k] != 0.0 {
-                    cols[s + kept] = cols[k];
-                    vals[s + kept] = vals[k];
-                    kept += 1;
-                }
+            for s in &mut start[last + 1..=r] {
+                *s = k;
             }
-            len[r] = kept;
+            last = r;
         }
-        start.truncate(m);
-        Rows {
+        for s in &mut start[last + 1..] {
+            *s = entries.len();
+        }
+        Some(Rows {
+            entries,
             start,
-            len,
-            cols,
-            vals,
-        }
+            row_scale,
+            scale,
+            seen: vec![(usize::MAX, 0); n],
+            expansion: 0,
+        })
     }
 
-    fn row(&self, r: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
-        let s = self.start[r];
-        (s..s + self.len[r]).map(|k| (self.cols[k], self.vals[k]))
+    /// Row `r` into `out` as the partition builds it: the scaled entries
+    /// `row_scale[r] · v · scale[c]`, duplicates summed in triplet order into the first one,
+    /// zeros dropped, the others in triplet order.
+    fn expand(&mut self, r: usize, out: &mut Vec<(usize, f64)>) {
+        out.clear();
+        self.expansion += 1;
+        for &(_, c, v) in &self.entries[self.start[r]..self.start[r + 1]] {
+            let a = v * self.row_scale[r] * self.scale[c];
+            if self.seen[c].0 == self.expansion {
+                out[self.seen[c].1].1 += a;
+            } else {
+                self.seen[c] = (self.expansion, out.len());
+                out.push((c, a));
+            }
+        }
+        out.retain(|e| e.1 != 0.0);
     }
 }
 
@@ -153,52 +150,50 @@ pub(super) fn free_columns(
     scale: &[f64],
 ) -> Option<usize> {
     let nb = n / 7;
-    let rows = Rows::new(m, entries, row_scale, scale);
-    let amax = (0..m)
-        .flat_map(|r| rows.row(r))
-        .fold(0.0f64, |a, e| a.max(e.1.abs()));
-    let tol = (RANK_TOLERANCE * amax).max(f64::MIN_POSITIVE);
-    let mut active: Vec<bool> = (0..m)
-        .map(|r| rows.len[r] > 0 && rows.row(r).fold(0.0f64, |a, (_, v)| a.max(v.abs())) > tol)
-        .collect();
-    // Rows touching each body (ascending, each once), and rows lying on one body alone.
+    let mut rows = Rows::new(m, n, entries, row_scale, scale)?;
+    let mut row = Vec::with_capacity(14);
+    // Each row's largest entry; the rows touching each body (ascending, each once, counted
+    // then filled); the body of the rows lying on one body alone.
+    let mut rmax = vec![0.0f64; m];
     let mut body_start = vec![0usize; nb + 1];
     let mut own_of = vec![usize::MAX; m];
     for r in 0..m {
+        rows.expand(r, &mut row);
+        rmax[r] = row_max(&row);
         let mut last = usize::MAX;
-        let mut first_body = usize::MAX;
-        let mut one_body = true;
-        for (c, _) in rows.row(r) {
-            let b = c / 7;
-            if first_body == usize::MAX {
-                first_body = b;
-            } else if b != first_body {
-                one_body = false;
-            }
-            if b != last {
-                body_start[b + 1] += 1;
-                last = b;
+        for &(c, _) in &row {
+            if c / 7 != last {
+                last = c / 7;
+                body_start[last + 1] += 1;
             }
         }
-        if one_body && first_body != usize::MAX && active[r] {
-            own_of[r] = first_body;
+        if let Some(&(c0, _)) = row.first() {
+            if row.iter().all(|e| e.0 / 7 == c0 / 7) {
+                own_of[r] = c0 / 7;
+            }
         }
     }
-    // The counts above may hold a body twice for a row whose entries alternate bodies; the
-    // lists below are deduplicated when used, so over-counting only reserves room.
+    let amax = rmax.iter().fold(0.0f64, |a, &x| a.max(x));
+    let tol = (RANK_TOLERANCE * amax).max(f64::MIN_POSITIVE);
+    let mut active: Vec<bool> = rmax.iter().map(|&x| x > tol).collect();
+    for (r, o) in own_of.iter_mut().enumerate() {
+        if !active[r] {
+            *o = usize::MAX;
+        }
+    }
     for b in 0..nb {
         body_start[b + 1] += body_start[b];
     }
     let mut body_rows = vec![usize::MAX; body_start[nb]];
     let mut body_fill = body_start.clone();
     for r in 0..m {
+        rows.expand(r, &mut row);
         let mut last = usize::MAX;
-        for (c, _) in rows.row(r) {
-            let b = c / 7;
-            if b != last {
-                body_rows[body_fill[b]] = r;
-                body_fill[b] += 1;
-                last = b;
+        for &(c, _) in &row {
+            if c / 7 != last {
+                last = c / 7;
+                body_rows[body_fill[last]] = r;
+                body_fill[last] += 1;
             }
         }
     }
@@ -221,8 +216,7 @@ pub(super) fn free_columns(
             local.rows.resize_with(k, Vec::new);
         }
         for (slot, &r) in local.cands.iter().enumerate() {
-            local.rows[slot].clear();
-            local.rows[slot].extend(rows.row(r));
+            rows.expand(r, &mut local.rows[slot]);
         }
         let in_b = |c: usize| c / 7 == b;
         all.clear();

@@ -15,7 +15,7 @@ use super::{Body, BodyId, ContactSettings, Joint, JointId, Link, Mimic, Model};
 use crate::error::Result;
 use crate::geometry::Geometry;
 use nalgebra::{Isometry3, Matrix3, Vector3};
-use std::collections::HashMap;
+use crate::names::NameMap;
 
 /// Builds a [`Model`]: add bodies (their mass comes from the links added on them), joints,
 /// force elements; [`ModelBuilder::build`] validates the ids and numbers and sums the mass.
@@ -43,8 +43,8 @@ pub struct ModelBuilder {
     pub(super) inertials: Vec<Inertial>,
     /// Whether `model.links[i]` is excluded from gravity.
     pub(super) no_gravity: Vec<bool>,
-    pub(super) joint_names: HashMap<String, JointId>,
-    link_names: HashMap<String, usize>,
+    pub(super) joint_names: NameMap<String, JointId>,
+    link_names: NameMap<String, usize>,
     /// `(link index, touches, settings)` from `mech:contact`.
     pub(super) contacts: Vec<(usize, bool, ContactSettings)>,
 }
@@ -71,12 +71,12 @@ impl ModelBuilder {
                 contact_points: Vec::new(),
                 length_scale: 1.0,
                 base_pose: None,
-                joint_names: HashMap::new(),
+                joint_names: NameMap::default(),
             },
             inertials: Vec::new(),
             no_gravity: Vec::new(),
-            joint_names: HashMap::new(),
-            link_names: HashMap::new(),
+            joint_names: NameMap::default(),
+            link_names: NameMap::default(),
             contacts: Vec::new(),
         }
     }

@@ -33,7 +33,6 @@ pub use mass::Inertial;
 pub use obstacle::Obstacle;
 
 use nalgebra::Vector3;
-use std::collections::HashMap;
 
 /// A validated mechanism (built by [`ModelBuilder`], which the URDF importer drives);
 /// immutable once built.
@@ -75,7 +74,7 @@ pub struct Model {
     /// the identity).
     pub base_pose: Option<nalgebra::Isometry3<f64>>,
     /// Joint ids by name, built once by [`Model::index_names`].
-    pub(crate) joint_names: HashMap<String, JointId>,
+    pub(crate) joint_names: crate::names::NameMap<String, JointId>,
 }
 
 impl Model {

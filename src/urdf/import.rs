@@ -24,14 +24,14 @@ use crate::model::{BodyId, Joint, JointKind, ModelBuilder};
 use crate::state::State;
 use nalgebra::{Isometry3, Matrix3, UnitQuaternion, Vector3};
 use roxmltree::Node;
-use std::collections::HashMap;
+use crate::names::NameMap;
 
 /// The import context shared with the extension readers: the model builder and the names
 /// it resolves.
 pub(super) struct Builder {
     pub(super) model: ModelBuilder,
     /// Link name → index in the model's links.
-    pub(super) link_index: HashMap<String, usize>,
+    pub(super) link_index: NameMap<String, usize>,
     /// `mech:frame` name → (link index or world, link_from_frame).
     pub(super) frames: FrameMap,
     pub(super) gravity_set: bool,
@@ -138,7 +138,8 @@ pub(super) fn import(
 
     // Links and named frames.
     let mut link_in = Vec::new();
-    let mut link_index: HashMap<String, usize> = HashMap::new();
+    let mut link_index: NameMap<String, usize> = NameMap::default();
+    link_index.reserve(link_nodes.len());
     for &n in &link_nodes {
         let l = read_link(&src, n, &packages, options.inertia_density, &mut warnings)?;
         if link_index.insert(l.name.clone(), link_in.len()).is_some() {
@@ -151,7 +152,7 @@ pub(super) fn import(
     }
     let mut frames = Frames {
         links: &link_index,
-        frames: HashMap::new(),
+        frames: NameMap::default(),
     };
     for &n in ext.iter().filter(|n| n.tag_name().name() == "frame") {
         let name = src.req(n, "name")?;
@@ -202,7 +203,8 @@ pub(super) fn import(
         ignored.push(format!("{row}:{col} <drake:{}>", n.tag_name().name()));
     }
     let frames_map = std::mem::take(&mut frames.frames);
-    let mut names: HashMap<&str, ()> = HashMap::new();
+    let mut names: NameMap<&str, ()> = NameMap::default();
+    names.reserve(edges.len());
     let mut preferred_parent: Vec<Option<usize>> = vec![None; link_in.len()];
     for (k, e) in edges.iter().enumerate() {
         if names.insert(e.name.as_str(), ()).is_some() {

@@ -202,7 +202,9 @@ impl ModelBuilder {
         aggregate_mass(&mut self.model, &self.inertials, &self.no_gravity);
         self.model.contact_points = super::contact::points(&self.model, &self.contacts)?;
         self.model.length_scale = length_scale(&self.model);
-        self.model.index_names();
+        // The builder's map of the joints pushed (the first of a name wins; joints are never
+        // renamed or removed once pushed), moved rather than rebuilt.
+        self.model.joint_names = std::mem::take(&mut self.joint_names);
         self.model.check_numbers()?;
         Ok(self.model)
     }

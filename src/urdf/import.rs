@@ -20,7 +20,7 @@ use super::{ImportOptions, Loaded};
 use crate::error::Result;
 use crate::geometry::PackagePaths;
 use crate::math::align_z;
-use crate::model::{BodyId, Joint, JointKind, ModelBuilder};
+use crate::model::{BodyId, Joint, JointId, JointKind, ModelBuilder};
 use crate::state::State;
 use nalgebra::{Isometry3, Matrix3, UnitQuaternion, Vector3};
 use roxmltree::Node;
@@ -297,7 +297,9 @@ pub(super) fn import(
 
     // Joints, in document order by kind of element.
     let mut auto_child = Vec::new();
-    for (k, e) in edges.iter().enumerate() {
+    // URDF joints (for their <mimic>), by id.
+    let mut urdf_joints: Vec<(JointId, Node)> = Vec::new();
+    for (k, e) in edges.into_iter().enumerate() {
         let place = |l: Option<usize>| {
             l.map_or((None, Isometry3::identity()), |l| {
                 (body_of(l), groups.body_from_link[l])
@@ -318,10 +320,10 @@ pub(super) fn import(
         }
         let rot = Isometry3::from_parts(Default::default(), joint_axes(e.kind, e.axis, e.axis2));
         let id = model.push_joint(Joint {
-            name: e.name.clone(),
+            name: e.name,
             kind: e.kind,
-            parent_link: e.parent_link.clone(),
-            child_link: e.child_link.clone(),
+            parent_link: e.parent_link,
+            child_link: e.child_link,
             bodies: [pb, cb],
             body_from_joint: [pf * e.origin * rot, cf * e.child_origin * rot],
             tree: tree_edge,
@@ -332,13 +334,11 @@ pub(super) fn import(
         if e.auto_child_origin {
             auto_child.push(id);
         }
+        if e.source == Source_::Urdf {
+            urdf_joints.push((id, e.node));
+        }
     }
 
-    let urdf_joints: Vec<(String, Node)> = edges
-        .iter()
-        .filter(|e| e.source == Source_::Urdf)
-        .map(|e| (e.name.clone(), e.node))
-        .collect();
     let mut b = Builder {
         model,
         link_index,

@@ -369,6 +369,7 @@ mod tests {
             crate::generate::chain(9, false),
             crate::generate::chain(120, false),
             crate::generate::chain(120, true),
+            crate::generate::chain(2000, false),
             crate::generate::rope(12),
         ];
         let loops = [

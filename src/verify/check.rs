@@ -82,20 +82,27 @@ fn sparse_dof(model: &Model, start: State, cons: Constraints) -> Result<usize> {
             ),
         );
     }
-    let mut phi = nalgebra::DVector::zeros(sys.problem.cons.len());
-    let mut jac = crate::constraints::Triplets::default();
-    sys.problem
-        .cons
-        .evaluate(model, &state.q, &mut phi, Some(&mut jac));
-    let scaling = &sys.problem.scaling;
-    let fast = super::rank::free_columns(
-        model,
-        jac.rows,
-        jac.cols,
-        &jac.entries,
-        &scaling.rows,
-        &scaling.columns,
-    );
+    // Closed loops and mimics couple bodies beyond a joint's two: their elimination has fill
+    // between bodies, where the fill-free route would give up; the partition counts them.
+    let coupled = model.joints.iter().any(|j| !j.tree && !j.merged) || !model.mimics.is_empty();
+    let fast = if coupled {
+        None
+    } else {
+        let mut phi = nalgebra::DVector::zeros(sys.problem.cons.len());
+        let mut jac = crate::constraints::Triplets::default();
+        sys.problem
+            .cons
+            .evaluate(model, &state.q, &mut phi, Some(&mut jac));
+        let scaling = &sys.problem.scaling;
+        super::rank::free_columns(
+            model,
+            jac.rows,
+            jac.cols,
+            &jac.entries,
+            &scaling.rows,
+            &scaling.columns,
+        )
+    };
     Ok(match fast {
         Some(free) => free,
         None => sys.partition(&state.q).independent.len(),

@@ -14,8 +14,8 @@ use super::mass::{aggregate_mass, Inertial};
 use super::{Body, BodyId, ContactSettings, Joint, JointId, Link, Mimic, Model};
 use crate::error::Result;
 use crate::geometry::Geometry;
-use nalgebra::{Isometry3, Matrix3, Vector3};
 use crate::names::NameMap;
+use nalgebra::{Isometry3, Matrix3, Vector3};
 
 /// Builds a [`Model`]: add bodies (their mass comes from the links added on them), joints,
 /// force elements; [`ModelBuilder::build`] validates the ids and numbers and sums the mass.

@@ -9,9 +9,9 @@
 use super::xml::{child, Source};
 use crate::error::Result;
 use crate::model::JointKind;
+use crate::names::NameMap;
 use nalgebra::{Isometry3, Vector3};
 use roxmltree::Node;
-use crate::names::NameMap;
 
 /// The namespace URI Drake uses for its URDF extensions.
 pub(super) const DRAKE_NS: &str = "http://drake.mit.edu";

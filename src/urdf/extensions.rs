@@ -164,7 +164,9 @@ pub(super) fn read(
         }
     }
     // Mimic cycles: the first mimic (in order) whose joint its reference leads back to.
-    if let Some(cur) = super::mimic::first_on_cycle(b.model.mimics(), b.model.partial().joints.len()) {
+    if let Some(cur) =
+        super::mimic::first_on_cycle(b.model.mimics(), b.model.partial().joints.len())
+    {
         let name = &b.model.partial().joints[cur.0].name;
         let node = urdf_joints.iter().find(|(j, _)| *j == cur).map(|(_, n)| *n);
         let at = node

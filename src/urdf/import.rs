@@ -21,10 +21,10 @@ use crate::error::Result;
 use crate::geometry::PackagePaths;
 use crate::math::align_z;
 use crate::model::{BodyId, Joint, JointId, JointKind, ModelBuilder};
+use crate::names::NameMap;
 use crate::state::State;
 use nalgebra::{Isometry3, Matrix3, UnitQuaternion, Vector3};
 use roxmltree::Node;
-use crate::names::NameMap;
 
 /// The import context shared with the extension readers: the model builder and the names
 /// it resolves.

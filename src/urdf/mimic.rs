@@ -89,10 +89,16 @@ mod tests {
     #[test]
     fn cycles_and_chains() {
         assert_eq!(first_on_cycle(&[m(0, 1), m(1, 2)], 3), None);
-        assert_eq!(first_on_cycle(&[m(5, 1), m(1, 2), m(2, 1)], 6), Some(JointId(1)));
+        assert_eq!(
+            first_on_cycle(&[m(5, 1), m(1, 2), m(2, 1)], 6),
+            Some(JointId(1))
+        );
         assert_eq!(first_on_cycle(&[m(3, 3)], 4), Some(JointId(3)));
         assert_eq!(first_on_cycle(&[m(0, 1), m(1, 2), m(0, 2)], 3), None);
-        assert_eq!(first_on_cycle(&[m(0, 1), m(1, 0), m(0, 2)], 3), Some(JointId(0)));
+        assert_eq!(
+            first_on_cycle(&[m(0, 1), m(1, 0), m(0, 2)], 3),
+            Some(JointId(0))
+        );
         // A long chain closed at its end: every joint on the cycle, the first mimic reported.
         let n = 100_000;
         let mut chain: Vec<Mimic> = (0..n - 1).map(|k| m(k, k + 1)).collect();

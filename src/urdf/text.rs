@@ -70,18 +70,18 @@ pub(crate) fn decode(mut bytes: Vec<u8>, file: &str) -> Result<String> {
 
 /// The error for bytes that are not UTF-8, at the first bad byte.
 fn not_utf8(bytes: &[u8], e: std::str::Utf8Error, encoding: Option<String>, file: &str) -> Error {
-            let at = e.valid_up_to();
-            let before = &bytes[..at];
-            let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
-            let line_start = before
-                .iter()
-                .rposition(|&b| b == b'\n')
-                .map_or(0, |p| p + 1);
-            let col = String::from_utf8_lossy(&before[line_start..])
-                .chars()
-                .count()
-                + 1;
-            Error::Input {
+    let at = e.valid_up_to();
+    let before = &bytes[..at];
+    let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+    let line_start = before
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |p| p + 1);
+    let col = String::from_utf8_lossy(&before[line_start..])
+        .chars()
+        .count()
+        + 1;
+    Error::Input {
                 file: file.to_string(),
                 line: line as u32,
                 col: col as u32,

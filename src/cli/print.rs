@@ -217,18 +217,15 @@ fn units(u: &[&str]) -> String {
     }
 }
 
-/// The model as understood (`check`).
-pub(crate) fn model(s: &ModelSummary) {
+/// The model as understood (`check`)'s text output with the body of the listing made beforehand by [`model_listing`]:
+/// the header line (rows and degrees of freedom), the listing, the assembly error.
+pub(crate) fn model_with_listing(s: &ModelSummary, listing: &[u8]) {
     use std::io::Write;
     // One buffered writer for the whole listing (standard output is line-buffered: a write
     // per line would be 20,000 system calls for a 10,000-joint model).
     let mut w = std::io::BufWriter::new(std::io::stdout().lock());
-    macro_rules! out {
-        ($($arg:tt)*) => {{
-            let _ = writeln!(w, $($arg)*);
-        }};
-    }
-    out!(
+    let _ = writeln!(
+        w,
         "robot `{}`: {} bodies, {} coordinates, {} constraint rows, {}",
         s.robot,
         s.bodies.len(),
@@ -239,6 +236,21 @@ pub(crate) fn model(s: &ModelSummary) {
             |d| format!("{d} degrees of freedom")
         )
     );
+    let _ = w.write_all(listing);
+    if let Some(e) = &s.assembly_error {
+        let _ = writeln!(w, "  assembly: {e}");
+    }
+}
+
+/// The part of `check`'s text output that does not depend on the check: gravity, links,
+/// bodies, joints, springs and forces.
+pub(crate) fn model_listing(s: &ModelSummary, w: &mut Vec<u8>) {
+    use std::io::Write;
+    macro_rules! out {
+        ($($arg:tt)*) => {{
+            let _ = writeln!(w, $($arg)*);
+        }};
+    }
     out!(
         "  gravity [{}, {}, {}] m/s²",
         s.gravity[0],
@@ -279,9 +291,6 @@ pub(crate) fn model(s: &ModelSummary) {
     }
     for f in &s.forces {
         out!("  {f}");
-    }
-    if let Some(e) = &s.assembly_error {
-        out!("  assembly: {e}");
     }
 }
 

@@ -74,6 +74,21 @@ fn law(l: &ForceLaw) -> String {
 impl ModelSummary {
     /// Summarizes a loaded model and its check ([`crate::verify::check`]).
     pub fn new(loaded: &crate::urdf::Loaded, check: &crate::verify::ModelCheck) -> Self {
+        Self::of_model(loaded).with_check(check)
+    }
+
+    /// The summary with the check's rows, degrees of freedom and assembly error.
+    pub fn with_check(mut self, check: &crate::verify::ModelCheck) -> Self {
+        self.constraints = check.constraint_rows;
+        self.dof = check.dof;
+        self.assembly_error.clone_from(&check.assembly_error);
+        self
+    }
+
+    /// Summarizes a loaded model before its check (no constraint rows, degrees of freedom or
+    /// assembly error yet: [`Self::with_check`] adds them), so that the two can be made at
+    /// the same time.
+    pub fn of_model(loaded: &crate::urdf::Loaded) -> Self {
         let m = &loaded.model;
         // Links by body in one pass (a scan of all links per body was O(N²)).
         let mut links_of: Vec<Vec<String>> = vec![Vec::new(); m.bodies.len()];
@@ -184,9 +199,9 @@ impl ModelSummary {
             forces,
             gravity: m.gravity.into(),
             coordinates: m.coordinate_count(),
-            constraints: check.constraint_rows,
-            dof: check.dof,
-            assembly_error: check.assembly_error.clone(),
+            constraints: 0,
+            dof: None,
+            assembly_error: None,
             warnings: loaded.warnings.clone(),
             ignored: loaded.ignored.clone(),
         }

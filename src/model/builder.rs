@@ -14,8 +14,8 @@ use super::mass::{aggregate_mass, Inertial};
 use super::{Body, BodyId, ContactSettings, Joint, JointId, Link, Mimic, Model};
 use crate::error::Result;
 use crate::geometry::Geometry;
+use crate::names::NameMap;
 use nalgebra::{Isometry3, Matrix3, Vector3};
-use std::collections::HashMap;
 
 /// Builds a [`Model`]: add bodies (their mass comes from the links added on them), joints,
 /// force elements; [`ModelBuilder::build`] validates the ids and numbers and sums the mass.
@@ -43,8 +43,8 @@ pub struct ModelBuilder {
     pub(super) inertials: Vec<Inertial>,
     /// Whether `model.links[i]` is excluded from gravity.
     pub(super) no_gravity: Vec<bool>,
-    pub(super) joint_names: HashMap<String, JointId>,
-    link_names: HashMap<String, usize>,
+    pub(super) joint_names: NameMap<String, JointId>,
+    link_names: NameMap<String, usize>,
     /// `(link index, touches, settings)` from `mech:contact`.
     pub(super) contacts: Vec<(usize, bool, ContactSettings)>,
 }
@@ -71,12 +71,12 @@ impl ModelBuilder {
                 contact_points: Vec::new(),
                 length_scale: 1.0,
                 base_pose: None,
-                joint_names: HashMap::new(),
+                joint_names: NameMap::default(),
             },
             inertials: Vec::new(),
             no_gravity: Vec::new(),
-            joint_names: HashMap::new(),
-            link_names: HashMap::new(),
+            joint_names: NameMap::default(),
+            link_names: NameMap::default(),
             contacts: Vec::new(),
         }
     }
@@ -202,7 +202,9 @@ impl ModelBuilder {
         aggregate_mass(&mut self.model, &self.inertials, &self.no_gravity);
         self.model.contact_points = super::contact::points(&self.model, &self.contacts)?;
         self.model.length_scale = length_scale(&self.model);
-        self.model.index_names();
+        // The builder's map of the joints pushed (the first of a name wins; joints are never
+        // renamed or removed once pushed), moved rather than rebuilt.
+        self.model.joint_names = std::mem::take(&mut self.joint_names);
         self.model.check_numbers()?;
         Ok(self.model)
     }

@@ -16,12 +16,15 @@ pub const LARGEST_LENGTH: f64 = 1e9;
 /// Largest gravity \[m/s²\].
 pub const LARGEST_GRAVITY: f64 = 1e4;
 
-fn within(element: &str, name: &str, attribute: &str, value: f64, bound: f64) -> Result<(), Error> {
+/// The description of the element a number belongs to, formatted only for an error.
+type El<'a> = &'a dyn Fn() -> String;
+
+fn within(element: El, name: &str, attribute: &str, value: f64, bound: f64) -> Result<(), Error> {
     if value.is_finite() && value.abs() <= bound {
         Ok(())
     } else {
         Err(Error::InvalidNumber {
-            element: element.into(),
+            element: element(),
             name: name.into(),
             attribute: attribute.into(),
             value,
@@ -30,14 +33,14 @@ fn within(element: &str, name: &str, attribute: &str, value: f64, bound: f64) ->
     }
 }
 
-fn law(element: &str, name: &str, law: &ForceLaw) -> Result<(), Error> {
+fn law(element: El, name: &str, law: &ForceLaw) -> Result<(), Error> {
     match law {
         ForceLaw::Linear { stiffness, preload } => {
             within(element, name, "stiffness", *stiffness, LARGEST_MAGNITUDE)?;
             within(element, name, "preload", *preload, LARGEST_MAGNITUDE)?;
             if *stiffness < 0.0 {
                 return Err(Error::InvalidNumber {
-                    element: element.into(),
+                    element: element(),
                     name: name.into(),
                     attribute: "stiffness".into(),
                     value: *stiffness,
@@ -66,11 +69,11 @@ impl Model {
     pub fn check_numbers(&self) -> Result<(), Error> {
         let g = self.gravity;
         for k in 0..3 {
-            within("gravity", "", "xyz", g[k], LARGEST_GRAVITY)?;
+            within(&|| "gravity".into(), "", "xyz", g[k], LARGEST_GRAVITY)?;
         }
-        within("gravity", "", "xyz", g.norm(), LARGEST_GRAVITY)?;
+        within(&|| "gravity".into(), "", "xyz", g.norm(), LARGEST_GRAVITY)?;
         for b in &self.bodies {
-            let e = format!("link `{}`", b.name);
+            let e = || format!("link `{}`", b.name);
             within(&e, &b.name, "mass", b.mass, LARGEST_MAGNITUDE)?;
             within(&e, &b.name, "mass", b.gravity_mass, LARGEST_MAGNITUDE)?;
             for x in b.inertia.iter() {
@@ -81,7 +84,7 @@ impl Model {
             }
         }
         for j in &self.joints {
-            let e = format!("joint `{}`", j.name);
+            let e = || format!("joint `{}`", j.name);
             for f in &j.body_from_joint {
                 for x in f.translation.vector.iter() {
                     within(&e, &j.name, "origin", *x, LARGEST_LENGTH)?;
@@ -89,18 +92,18 @@ impl Model {
             }
         }
         for s in &self.springs {
-            let e = format!("spring `{}`", s.name);
+            let e = || format!("spring `{}`", s.name);
             within(&e, &s.name, "free_length", s.free_length, LARGEST_LENGTH)?;
             law(&e, &s.name, &s.law)?;
         }
         for js in &self.joint_springs {
             let name = &self.joint(js.joint).name;
-            let e = format!("joint spring on `{name}`");
+            let e = || format!("joint spring on `{name}`");
             within(&e, name, "reference", js.reference, LARGEST_LENGTH)?;
             law(&e, name, &js.law)?;
         }
         for l in &self.loads {
-            let e = format!("load `{}`", l.name);
+            let e = || format!("load `{}`", l.name);
             for x in l.force.iter() {
                 within(&e, &l.name, "force", *x, LARGEST_MAGNITUDE)?;
             }
@@ -108,7 +111,7 @@ impl Model {
         for ef in &self.efforts {
             let name = &self.joint(ef.joint).name;
             within(
-                &format!("effort on `{name}`"),
+                &|| format!("effort on `{name}`"),
                 name,
                 "value",
                 ef.value,
@@ -119,7 +122,7 @@ impl Model {
             let name = &self.joint(l.joint).name;
             if let Some(v) = l.value {
                 within(
-                    &format!("lock on `{name}`"),
+                    &|| format!("lock on `{name}`"),
                     name,
                     "value",
                     v,
@@ -130,7 +133,7 @@ impl Model {
         for i in &self.initial {
             let name = &self.joint(i.joint).name;
             within(
-                &format!("initial value of `{name}`"),
+                &|| format!("initial value of `{name}`"),
                 name,
                 "value",
                 i.value,

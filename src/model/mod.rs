@@ -33,7 +33,6 @@ pub use mass::Inertial;
 pub use obstacle::Obstacle;
 
 use nalgebra::Vector3;
-use std::collections::HashMap;
 
 /// A validated mechanism (built by [`ModelBuilder`], which the URDF importer drives);
 /// immutable once built.
@@ -74,8 +73,8 @@ pub struct Model {
     /// Start pose of the root link in the world when the base floats (`mech:base`; `None`:
     /// the identity).
     pub base_pose: Option<nalgebra::Isometry3<f64>>,
-    /// Joint ids by name, built once by [`Model::index_names`].
-    pub(crate) joint_names: HashMap<String, JointId>,
+    /// Joint ids by name (the first joint of a name wins), built by the builder.
+    pub(crate) joint_names: crate::names::NameMap<String, JointId>,
 }
 
 impl Model {
@@ -114,15 +113,6 @@ impl Model {
             what: what.into(),
             name: name.into(),
             suggestion: self.closest_joint(name),
-        }
-    }
-
-    /// Builds the joint name map (the first joint of a name wins); called by the importer once
-    /// the joints are in place.
-    pub(crate) fn index_names(&mut self) {
-        self.joint_names.clear();
-        for (i, j) in self.joints.iter().enumerate() {
-            self.joint_names.entry(j.name.clone()).or_insert(JointId(i));
         }
     }
 

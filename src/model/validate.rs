@@ -15,10 +15,11 @@ fn bad<T>(what: String) -> Result<T> {
 }
 
 /// A force table has at least two rows, deflections strictly increasing.
-fn law_ok(law: &ForceLaw, what: &str) -> Result<()> {
+fn law_ok(law: &ForceLaw, what: impl Fn() -> String) -> Result<()> {
     let ForceLaw::Table { points, .. } = law else {
         return Ok(());
     };
+    let what = what();
     if points.len() < 2 {
         return bad(format!("{what}: a force table needs at least two rows"));
     }
@@ -90,10 +91,9 @@ impl ModelBuilder {
         };
         for s in &m.joint_springs {
             coordinate(s.joint, s.dof, "a joint spring")?;
-            law_ok(
-                &s.law,
-                &format!("joint spring on `{}`", m.joints[s.joint.0].name),
-            )?;
+            law_ok(&s.law, || {
+                format!("joint spring on `{}`", m.joints[s.joint.0].name)
+            })?;
         }
         for e in &m.efforts {
             coordinate(e.joint, e.dof, "an effort")?;
@@ -132,7 +132,7 @@ impl ModelBuilder {
                     s.name, s.free_length
                 ));
             }
-            law_ok(&s.law, &format!("spring `{}`", s.name))?;
+            law_ok(&s.law, || format!("spring `{}`", s.name))?;
         }
         for l in &m.loads {
             if l.body.0 >= nb {
@@ -173,8 +173,9 @@ impl ModelBuilder {
         }
         // 0: not seen, 1: on the current walk, 2: leads to the world or a floating body.
         let mut state = vec![0u8; m.bodies.len()];
+        let mut walk = Vec::new();
         for start in 0..m.bodies.len() {
-            let mut walk = Vec::new();
+            walk.clear();
             let mut b = Some(start);
             while let Some(i) = b {
                 match state[i] {
@@ -192,7 +193,7 @@ impl ModelBuilder {
                 walk.push(i);
                 b = parent[i].and_then(|k| m.joints[k].bodies[0]).map(|p| p.0);
             }
-            for i in walk {
+            for &i in &walk {
                 state[i] = 2;
             }
         }

@@ -9,9 +9,9 @@
 use super::xml::{child, Source};
 use crate::error::Result;
 use crate::model::JointKind;
+use crate::names::NameMap;
 use nalgebra::{Isometry3, Vector3};
 use roxmltree::Node;
-use std::collections::HashMap;
 
 /// The namespace URI Drake uses for its URDF extensions.
 pub(super) const DRAKE_NS: &str = "http://drake.mit.edu";
@@ -49,7 +49,7 @@ pub(super) struct Edge<'a> {
 
 /// Link names and named frames: name → (link index or world, link_from_frame).
 pub(super) struct Frames<'a> {
-    pub(super) links: &'a HashMap<String, usize>,
+    pub(super) links: &'a NameMap<String, usize>,
     pub(super) frames: FrameMap,
 }
 
@@ -66,11 +66,11 @@ impl Frames<'_> {
 }
 
 /// Named frames: name → (link index or world, link_from_frame).
-pub(super) type FrameMap = HashMap<String, (Option<usize>, Isometry3<f64>)>;
+pub(super) type FrameMap = NameMap<String, (Option<usize>, Isometry3<f64>)>;
 
 /// Resolves a link or frame name at `node`: a link, a `mech:frame`, or the world.
 pub(super) fn resolve(
-    links: &HashMap<String, usize>,
+    links: &NameMap<String, usize>,
     frames: &FrameMap,
     src: &Source,
     node: Node,

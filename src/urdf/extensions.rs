@@ -114,17 +114,18 @@ fn joint_coord(src: &Source, node: Node, b: &Builder) -> Result<(JointId, usize)
 pub(super) fn read(
     src: &Source,
     ext: &[Node],
-    urdf_joints: &[(String, Node)],
+    urdf_joints: &[(JointId, Node)],
     b: &mut Builder,
     options: &ImportOptions,
 ) -> Result<()> {
     // URDF mimic.
-    for (name, node) in urdf_joints {
-        if let Some(m) = child(*node, "mimic") {
+    for &(id, node) in urdf_joints {
+        if let Some(m) = child(node, "mimic") {
             let target = src.req(m, "joint")?;
-            let id = b
+            let name = b
                 .model
-                .joint_id(name)
+                .joint(id)
+                .map(|j| j.name.clone())
                 .ok_or_else(|| src.error(m, "mimic on an unknown joint"))?;
             // urdfdom loads a mimic of a missing joint, and a mimic on or of a joint without a
             // scalar coordinate: the joint is then independent.
@@ -162,24 +163,17 @@ pub(super) fn read(
             });
         }
     }
-    // Mimic cycles.
-    for start in 0..b.model.mimics().len() {
-        let mut cur = b.model.mimics()[start].reference;
-        for _ in 0..=b.model.mimics().len() {
-            if cur == b.model.mimics()[start].joint {
-                let name = &b.model.partial().joints[cur.0].name;
-                let node = urdf_joints.iter().find(|(n, _)| n == name).map(|(_, n)| *n);
-                let at = node
-                    .and_then(|n| child(n, "mimic"))
-                    .or(node)
-                    .unwrap_or(ext.first().copied().unwrap_or(src.doc.root_element()));
-                return Err(src.error(at, format!("mimic cycle through joint `{name}`")));
-            }
-            match b.model.mimics().iter().find(|m| m.joint == cur) {
-                Some(m) => cur = m.reference,
-                None => break,
-            }
-        }
+    // Mimic cycles: the first mimic (in order) whose joint its reference leads back to.
+    if let Some(cur) =
+        super::mimic::first_on_cycle(b.model.mimics(), b.model.partial().joints.len())
+    {
+        let name = &b.model.partial().joints[cur.0].name;
+        let node = urdf_joints.iter().find(|(j, _)| *j == cur).map(|(_, n)| *n);
+        let at = node
+            .and_then(|n| child(n, "mimic"))
+            .or(node)
+            .unwrap_or(ext.first().copied().unwrap_or(src.doc.root_element()));
+        return Err(src.error(at, format!("mimic cycle through joint `{name}`")));
     }
     let mut locks: Vec<Lock> = Vec::new();
     let mut initial: Vec<Initial> = Vec::new();

@@ -20,18 +20,18 @@ use super::{ImportOptions, Loaded};
 use crate::error::Result;
 use crate::geometry::PackagePaths;
 use crate::math::align_z;
-use crate::model::{BodyId, Joint, JointKind, ModelBuilder};
+use crate::model::{BodyId, Joint, JointId, JointKind, ModelBuilder};
+use crate::names::NameMap;
 use crate::state::State;
 use nalgebra::{Isometry3, Matrix3, UnitQuaternion, Vector3};
 use roxmltree::Node;
-use std::collections::HashMap;
 
 /// The import context shared with the extension readers: the model builder and the names
 /// it resolves.
 pub(super) struct Builder {
     pub(super) model: ModelBuilder,
     /// Link name → index in the model's links.
-    pub(super) link_index: HashMap<String, usize>,
+    pub(super) link_index: NameMap<String, usize>,
     /// `mech:frame` name → (link index or world, link_from_frame).
     pub(super) frames: FrameMap,
     pub(super) gravity_set: bool,
@@ -138,7 +138,8 @@ pub(super) fn import(
 
     // Links and named frames.
     let mut link_in = Vec::new();
-    let mut link_index: HashMap<String, usize> = HashMap::new();
+    let mut link_index: NameMap<String, usize> = NameMap::default();
+    link_index.reserve(link_nodes.len());
     for &n in &link_nodes {
         let l = read_link(&src, n, &packages, options.inertia_density, &mut warnings)?;
         if link_index.insert(l.name.clone(), link_in.len()).is_some() {
@@ -151,7 +152,7 @@ pub(super) fn import(
     }
     let mut frames = Frames {
         links: &link_index,
-        frames: HashMap::new(),
+        frames: NameMap::default(),
     };
     for &n in ext.iter().filter(|n| n.tag_name().name() == "frame") {
         let name = src.req(n, "name")?;
@@ -202,7 +203,8 @@ pub(super) fn import(
         ignored.push(format!("{row}:{col} <drake:{}>", n.tag_name().name()));
     }
     let frames_map = std::mem::take(&mut frames.frames);
-    let mut names: HashMap<&str, ()> = HashMap::new();
+    let mut names: NameMap<&str, ()> = NameMap::default();
+    names.reserve(edges.len());
     let mut preferred_parent: Vec<Option<usize>> = vec![None; link_in.len()];
     for (k, e) in edges.iter().enumerate() {
         if names.insert(e.name.as_str(), ()).is_some() {
@@ -295,7 +297,9 @@ pub(super) fn import(
 
     // Joints, in document order by kind of element.
     let mut auto_child = Vec::new();
-    for (k, e) in edges.iter().enumerate() {
+    // URDF joints (for their <mimic>), by id.
+    let mut urdf_joints: Vec<(JointId, Node)> = Vec::new();
+    for (k, e) in edges.into_iter().enumerate() {
         let place = |l: Option<usize>| {
             l.map_or((None, Isometry3::identity()), |l| {
                 (body_of(l), groups.body_from_link[l])
@@ -316,10 +320,10 @@ pub(super) fn import(
         }
         let rot = Isometry3::from_parts(Default::default(), joint_axes(e.kind, e.axis, e.axis2));
         let id = model.push_joint(Joint {
-            name: e.name.clone(),
+            name: e.name,
             kind: e.kind,
-            parent_link: e.parent_link.clone(),
-            child_link: e.child_link.clone(),
+            parent_link: e.parent_link,
+            child_link: e.child_link,
             bodies: [pb, cb],
             body_from_joint: [pf * e.origin * rot, cf * e.child_origin * rot],
             tree: tree_edge,
@@ -330,13 +334,11 @@ pub(super) fn import(
         if e.auto_child_origin {
             auto_child.push(id);
         }
+        if e.source == Source_::Urdf {
+            urdf_joints.push((id, e.node));
+        }
     }
 
-    let urdf_joints: Vec<(String, Node)> = edges
-        .iter()
-        .filter(|e| e.source == Source_::Urdf)
-        .map(|e| (e.name.clone(), e.node))
-        .collect();
     let mut b = Builder {
         model,
         link_index,

@@ -143,8 +143,9 @@ pub(super) fn read_link(
     warnings: &mut Vec<String>,
 ) -> Result<LinkIn> {
     let name = src.req(node, "name")?.to_string();
+    let inertial = child(node, "inertial");
     let mut l = LinkIn {
-        has_inertial: child(node, "inertial").is_some(),
+        has_inertial: inertial.is_some(),
         visuals: Vec::new(),
         collisions: Vec::new(),
         name,
@@ -163,7 +164,7 @@ pub(super) fn read_link(
             }
         }
     }
-    if let Some(inertial) = child(node, "inertial") {
+    if let Some(inertial) = inertial {
         let origin = src.frame(child(inertial, "origin"))?;
         if let Some(m) = child(inertial, "mass") {
             let mass = src.f64_opt(m, "value")?.ok_or_else(|| {
@@ -180,17 +181,10 @@ pub(super) fn read_link(
         l.inertial.com = origin.translation.vector;
         if let Some(i) = child(inertial, "inertia") {
             let g = |a: &str| src.f64_or(i, a, 0.0);
-            let local = Matrix3::new(
-                g("ixx")?,
-                g("ixy")?,
-                g("ixz")?,
-                g("ixy")?,
-                g("iyy")?,
-                g("iyz")?,
-                g("ixz")?,
-                g("iyz")?,
-                g("izz")?,
-            );
+            // Each attribute read once, in the order the symmetric matrix lists them.
+            let (xx, xy, xz) = (g("ixx")?, g("ixy")?, g("ixz")?);
+            let (yy, yz, zz) = (g("iyy")?, g("iyz")?, g("izz")?);
+            let local = Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
             let r = origin.rotation.to_rotation_matrix();
             l.inertial.inertia = r.matrix() * local * r.matrix().transpose();
             if let Some(why) = inertia_problem(&local) {

@@ -11,6 +11,7 @@ mod extensions;
 mod foreign;
 mod import;
 mod links;
+mod mimic;
 mod schema;
 mod text;
 mod tree;

@@ -49,35 +49,39 @@ fn declared_encoding(bytes: &[u8]) -> Option<String> {
 }
 
 /// Decodes the bytes of `file`: UTF-8 (with or without a byte-order mark), or Latin-1 when
-/// the declaration names it.
+/// the declaration names it. UTF-8 without a mark keeps the bytes' buffer (no copy).
 ///
 /// # Errors
 /// [`Error::Input`] if the bytes are neither valid UTF-8 nor in a declared encoding restpose
 /// reads.
-pub(crate) fn decode(bytes: &[u8], file: &str) -> Result<String> {
-    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
-    let encoding = declared_encoding(bytes);
+pub(crate) fn decode(mut bytes: Vec<u8>, file: &str) -> Result<String> {
+    if bytes.starts_with(b"\xEF\xBB\xBF") {
+        bytes.drain(..3);
+    }
+    let encoding = declared_encoding(&bytes);
     if encoding
         .as_deref()
         .is_some_and(|e| LATIN1.contains(&e) || e == "us-ascii" || e == "ascii")
     {
         return Ok(bytes.iter().map(|&b| b as char).collect());
     }
-    match std::str::from_utf8(bytes) {
-        Ok(s) => Ok(s.to_string()),
-        Err(e) => {
-            let at = e.valid_up_to();
-            let before = &bytes[..at];
-            let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
-            let line_start = before
-                .iter()
-                .rposition(|&b| b == b'\n')
-                .map_or(0, |p| p + 1);
-            let col = String::from_utf8_lossy(&before[line_start..])
-                .chars()
-                .count()
-                + 1;
-            Err(Error::Input {
+    String::from_utf8(bytes).map_err(|e| not_utf8(e.as_bytes(), e.utf8_error(), encoding, file))
+}
+
+/// The error for bytes that are not UTF-8, at the first bad byte.
+fn not_utf8(bytes: &[u8], e: std::str::Utf8Error, encoding: Option<String>, file: &str) -> Error {
+    let at = e.valid_up_to();
+    let before = &bytes[..at];
+    let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+    let line_start = before
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |p| p + 1);
+    let col = String::from_utf8_lossy(&before[line_start..])
+        .chars()
+        .count()
+        + 1;
+    Error::Input {
                 file: file.to_string(),
                 line: line as u32,
                 col: col as u32,
@@ -86,9 +90,7 @@ pub(crate) fn decode(bytes: &[u8], file: &str) -> Result<String> {
                     bytes[at],
                     encoding.map_or("no encoding".to_string(), |e| format!("encoding \"{e}\""))
                 ),
-            })
-        }
-    }
+            }
 }
 
 /// Reads and decodes a URDF file, refusing one larger than [`MAX_FILE_BYTES`].
@@ -113,7 +115,7 @@ pub fn read_file(path: &std::path::Path) -> Result<String> {
         });
     }
     let bytes = std::fs::read(path).map_err(io)?;
-    decode(&bytes, &path.display().to_string())
+    decode(bytes, &path.display().to_string())
 }
 
 /// Line and column (from 1, column in characters) of byte offset `at` of `text`.
@@ -173,7 +175,12 @@ fn check_depth(text: &str, file: &str) -> Result<()> {
     let skip_to = |from: usize, end: &str| text[from..].find(end).map(|e| from + e + end.len());
     while i < b.len() {
         if b[i] != b'<' {
-            i += 1;
+            // To the next `<` (a fast byte search; `i` is always at a character boundary).
+            match text.get(i..).map(|t| t.find('<')) {
+                Some(Some(k)) => i += k,
+                Some(None) => return Ok(()),
+                None => i += 1,
+            }
             continue;
         }
         let rest = &b[i..];
@@ -361,9 +368,9 @@ mod tests {
     #[test]
     fn latin1_is_decoded_when_declared() {
         let bytes = b"<?xml version=\"1.0\" encoding=\"ISO-8859-1\"?><robot name=\"r\xE9\"/>";
-        let s = decode(bytes, "f").unwrap();
+        let s = decode(bytes.to_vec(), "f").unwrap();
         assert!(s.contains("r\u{e9}"));
-        let err = decode(b"<robot name=\"r\xE9\"/>", "f").unwrap_err();
+        let err = decode(b"<robot name=\"r\xE9\"/>".to_vec(), "f").unwrap_err();
         assert!(err.to_string().starts_with("f:1:15:"), "{err}");
     }
 

@@ -4,13 +4,16 @@
 //!
 //! On the sparse path the rank is that of the solver's sparse partition of `Φ_q` at the
 //! assembled guess (one `O(N)` elimination; no energy gradient or multipliers are needed for
-//! a count), on the dense path that of [`super::balance`].
+//! a count), computed by the same pivots body by body where the elimination has no fill
+//! between bodies (module `rank`: every tree), and on the dense path that of
+//! [`super::balance`].
 
 use super::{assemble, balance, sparse_path};
 use crate::constraints::Constraints;
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::solver::system::{Backend, System};
+use crate::solver::Options;
 use crate::state::State;
 
 /// Constraint rows and assembly of a model at its initial guess.
@@ -29,7 +32,12 @@ pub fn check(model: &Model) -> ModelCheck {
     let start = crate::solver::initial_state(model);
     let cons = Constraints::new(model, &crate::solver::lock_values(model));
     let constraint_rows = cons.len();
-    let (dof, assembly_error) = match assemble(model, &start).and_then(|s| dof(model, &s, cons)) {
+    let counted = if sparse_path(model) {
+        sparse_dof(model, start, cons)
+    } else {
+        assemble(model, &start).and_then(|s| balance(model, &s).map(|b| b.dof))
+    };
+    let (dof, assembly_error) = match counted {
         Ok(d) => (Some(d), None),
         Err(e) => (None, Some(e.to_string())),
     };
@@ -40,16 +48,31 @@ pub fn check(model: &Model) -> ModelCheck {
     }
 }
 
-/// Degrees of freedom at the feasible `state` with the rows `cons`.
+/// Degrees of freedom on the sparse path: assembles `start` with the rows `cons` and counts.
+///
+/// The assembly's Newton iteration returns its start unchanged when the scaled residual is
+/// within the constraint tolerance there (a tree's forward kinematics); that test is made
+/// here with the rows already built, and the assembly runs only when it fails.
 ///
 /// # Errors
-/// [`Error::ForceTableOutOfRange`] (or another undefined term) if the energy cannot be
-/// evaluated there, [`Error::SingularPartition`] if the dense partition fails.
-fn dof(model: &Model, state: &State, cons: Constraints) -> Result<usize> {
-    if !sparse_path(model) {
-        return balance(model, state).map(|b| b.dof);
-    }
-    if super::potential_energy(model, state).is_none() {
+/// What the assembly reports, [`Error::ForceTableOutOfRange`] (or another undefined term) if
+/// the energy cannot be evaluated at the assembled guess.
+fn sparse_dof(model: &Model, start: State, cons: Constraints) -> Result<usize> {
+    let mut sys = System::with_backend(
+        model,
+        cons.on_branches(start.branches.clone()),
+        Backend::Sparse,
+    );
+    sys.residual(&start.q);
+    let state = if sys.dimensionless_residual() <= Options::default().constraint_tolerance {
+        start
+    } else {
+        let state = assemble(model, &start)?;
+        let cons = sys.problem.cons.on_branches(state.branches.clone());
+        sys = System::with_backend(model, cons, Backend::Sparse);
+        state
+    };
+    if super::potential_energy(model, &state).is_none() {
         return Err(
             crate::forces::undefined_term(model, &state.branches, &state.q).unwrap_or(
                 Error::SingularPartition {
@@ -59,7 +82,29 @@ fn dof(model: &Model, state: &State, cons: Constraints) -> Result<usize> {
             ),
         );
     }
-    let cons = cons.on_branches(state.branches.clone());
-    let mut sys = System::with_backend(model, cons, Backend::Sparse);
-    Ok(sys.partition(&state.q).independent.len())
+    // Closed loops and mimics couple bodies beyond a joint's two: their elimination has fill
+    // between bodies, where the fill-free route would give up; the partition counts them.
+    let coupled = model.joints.iter().any(|j| !j.tree && !j.merged) || !model.mimics.is_empty();
+    let fast = if coupled {
+        None
+    } else {
+        let mut phi = nalgebra::DVector::zeros(sys.problem.cons.len());
+        let mut jac = crate::constraints::Triplets::default();
+        sys.problem
+            .cons
+            .evaluate(model, &state.q, &mut phi, Some(&mut jac));
+        let scaling = &sys.problem.scaling;
+        super::rank::free_columns(
+            model,
+            jac.rows,
+            jac.cols,
+            &jac.entries,
+            &scaling.rows,
+            &scaling.columns,
+        )
+    };
+    Ok(match fast {
+        Some(free) => free,
+        None => sys.partition(&state.q).independent.len(),
+    })
 }

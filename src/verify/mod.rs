@@ -30,6 +30,7 @@ mod check;
 mod closure;
 mod dense;
 mod pose;
+mod rank;
 mod reduced;
 mod unilateral;
 mod unilateral_sparse;

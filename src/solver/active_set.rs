@@ -48,6 +48,9 @@ pub(crate) struct Guard<'m> {
     planes: Vec<Option<(Vector3<f64>, Vector3<f64>)>>,
     /// The sticking spheres' roll limits, after the inequalities (module `rolling`).
     rolls: Vec<super::rolling::RollLimit>,
+    /// Whether the boundary may be searched by regula falsi: no guarded inequality is a
+    /// sticking contact (anchored where it lands) and there is no roll limit.
+    falsi: bool,
 }
 
 impl<'m> Guard<'m> {
@@ -55,11 +58,23 @@ impl<'m> Guard<'m> {
     /// limits of the sticking spheres among `active`.
     pub(crate) fn new(
         model: &'m Model,
+        options: &Options,
         inactive: Vec<Unilateral>,
         active: &[Active],
         tol: f64,
         q: &DVector<f64>,
     ) -> Self {
+        let sticking = inactive.iter().any(|u| match *u {
+            Unilateral::Contact { point, .. } => {
+                model.contact_points[point]
+                    .settings
+                    .friction
+                    .unwrap_or(options.friction)
+                    == Friction::Stick
+            }
+            Unilateral::Limit { .. } => false,
+        });
+        let rolls = super::rolling::limits(model, active);
         let planes = inactive
             .iter()
             .map(|u| match *u {
@@ -74,7 +89,8 @@ impl<'m> Guard<'m> {
             inactive,
             tol,
             planes,
-            rolls: super::rolling::limits(model, active),
+            falsi: !sticking && rolls.is_empty(),
+            rolls,
         }
     }
 
@@ -125,14 +141,19 @@ impl<'m> Guard<'m> {
     }
 
     /// The corrected point `q(α) = correct(q + α dq)` on the boundary of the first inequality
-    /// met along `α ∈ [0, alpha]` (bisection), and the inequalities within the tolerance of
-    /// their boundary there. `q_alpha` is the corrected point at `alpha`, if known.
+    /// met along `α ∈ [0, alpha]`, and the inequalities within the tolerance of their boundary
+    /// there. `q_alpha` is the corrected point at `alpha`, if known.
     ///
-    /// The corrector at each midpoint starts from the chord between the corrected ends of the
-    /// bracket (from `q_lo + (α − lo) dq` while the upper end has none): its distance to the
+    /// The bracket `[lo, hi]` (`lo` within or above every boundary, `hi` beyond one or where
+    /// the corrector fails) shrinks by bisection, or, when the guard allows it (no sticking
+    /// contact, which would be anchored where it lands, and no roll limit), by regula falsi
+    /// (Illinois) on the lowest gap `g(α)` where both ends have one, clamped to the inner
+    /// `1 − 2·10⁻³` of the bracket. Either ends at the first point with `|g| ≤ tol`.
+    ///
+    /// The corrector at each trial point starts from the chord between the corrected ends of
+    /// the bracket (from `q_lo + (α − lo) dq` while the upper end has none): its distance to the
     /// manifold is second order in the bracket's width, not in `α`, so fewer corrector steps
-    /// reach the same point. The independent coordinates
-    /// are set to `q + mid dq` as they were.
+    /// reach the same point. The independent coordinates are `q + α dq`.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn boundary(
         &self,
@@ -148,37 +169,62 @@ impl<'m> Guard<'m> {
         let (mut lo, mut hi) = (0.0, alpha);
         let mut q_lo = q.clone();
         let mut q_hi = q_alpha.cloned();
+        // The lowest gap at each end (`None` at an end where the corrector failed), and the
+        // end that moved last (Illinois: the other end's gap is halved when it stays twice).
+        let (mut g_lo, mut g_hi) = (None, None);
+        if self.falsi {
+            let b = &sys.problem.cons.branches;
+            g_lo = self.lowest(q, b).map(|x| x.1);
+            g_hi = q_alpha.and_then(|qa| self.lowest(qa, b)).map(|x| x.1);
+        }
+        let mut last_moved_hi = None;
         for _ in 0..80 {
-            let mid = 0.5 * (lo + hi);
+            let w = hi - lo;
+            let mid = match (g_lo, g_hi) {
+                (Some(a), Some(b)) if a > b => {
+                    (lo + w * a / (a - b)).clamp(lo + 1e-3 * w, hi - 1e-3 * w)
+                }
+                _ => 0.5 * (lo + hi),
+            };
             let mut qm = match &q_hi {
-                Some(qh) => &q_lo + (qh - &q_lo) * ((mid - lo) / (hi - lo)),
+                Some(qh) => &q_lo + (qh - &q_lo) * ((mid - lo) / w),
                 None => &q_lo + dq * (mid - lo),
             };
             for &c in &part.independent {
                 qm[c] = q[c] + dq[c] * mid;
             }
-            let ok = sys.correct_from(
+            let corrected = sys.correct_from(
                 &mut qm,
                 part,
                 options.constraint_tolerance,
                 options.max_corrector_iterations,
                 Some(&eval.factors),
             );
-            if ok.is_err() {
+            if corrected.is_err() {
                 hi = mid;
-                q_hi = None;
+                (q_hi, g_hi) = (None, None);
                 continue;
             }
             let (_, g) = self.lowest(&qm, &sys.problem.cons.branches)?;
             if g < -self.tol {
                 hi = mid;
                 q_hi = Some(qm);
+                g_hi = self.falsi.then_some(g);
+                if last_moved_hi == Some(true) {
+                    g_lo = g_lo.map(|x| 0.5 * x);
+                }
+                last_moved_hi = Some(true);
             } else {
                 lo = mid;
                 q_lo = qm;
                 if g <= self.tol {
                     break;
                 }
+                g_lo = self.falsi.then_some(g);
+                if last_moved_hi == Some(false) {
+                    g_hi = g_hi.map(|x| 0.5 * x);
+                }
+                last_moved_hi = Some(false);
             }
         }
         let branches = &sys.problem.cons.branches;
@@ -364,7 +410,7 @@ pub(crate) fn solve(
             .filter(|u| !active.iter().any(|a| a.row == **u))
             .copied()
             .collect();
-        let guard = Guard::new(model, inactive, &active, tol, &q);
+        let guard = Guard::new(model, options, inactive, &active, tol, &q);
         let round = super::solve_round(
             model,
             crate::State { q, branches },

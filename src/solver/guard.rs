@@ -217,3 +217,122 @@ impl<'m> Guard<'m> {
         Some((q_lo, touching))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::constraints::Constraints;
+    use crate::solver::active_set::{activate, inequalities};
+    use crate::urdf::{load_str, ImportOptions};
+
+    /// A link on a hinge 0.04 m above the ground, from the horizontal, turned toward the
+    /// ground (the direction that closes its sphere's gap fastest): regula falsi and bisection
+    /// find the touchdown at the same boundary (the gap within `tol`, the contact touching,
+    /// the joint satisfied, the two points within `10 tol L` of each other); the guard of a
+    /// sticking contact keeps the bisection.
+    #[test]
+    fn regula_falsi_and_bisection_land_on_the_same_boundary() {
+        let text = r#"<robot name="tip" xmlns:mech="urn:urdf-mech:1">
+  <link name="world"/>
+  <link name="link0"><inertial><origin xyz="0.025 0 0"/><mass value="0.05"/><inertia ixx="1e-6" ixy="0" ixz="0" iyy="1.1e-5" iyz="0" izz="1.1e-5"/></inertial><collision><origin xyz="0.05 0 0"/><geometry><sphere radius="0.01"/></geometry></collision></link>
+  <joint name="joint0" type="continuous"><parent link="world"/><child link="link0"/><origin xyz="0 0 0.04"/><axis xyz="0 1 0"/></joint>
+  <mech:ground/>
+</robot>"#;
+        let model = load_str(text, "tip.urdf", &ImportOptions::default())
+            .unwrap()
+            .model;
+        let options = Options::default();
+        let tol = options.gap_tolerance;
+        let start = crate::State::initial(&model);
+        let mut branches = start.branches.clone();
+        let q = super::super::assemble::assemble(&model, start.q, &mut branches, &[], &options)
+            .unwrap();
+        let all = inequalities(&model, &options);
+        let touches = |u: &Unilateral| {
+            unilateral::gap(&model, u, &q, &branches)
+                .is_some_and(|g| dimensionless(&model, u, g) <= tol)
+        };
+        let active: Vec<Active> = all
+            .iter()
+            .filter(|u| touches(u))
+            .map(|&u| activate(&model, &options, u, &q))
+            .collect();
+        let inactive: Vec<Unilateral> = all.iter().filter(|u| !touches(u)).copied().collect();
+        assert!(active.is_empty() && inactive.len() == 1);
+        let q = super::super::assemble::project(&model, q, &mut branches, &[], &active, &options)
+            .unwrap();
+        let mut guard = Guard::new(&model, &options, inactive, &active, tol, &q);
+        assert!(guard.falsi);
+        let cons = Constraints::new(&model, &[])
+            .with_active(&model, &active)
+            .on_branches(branches);
+        let mut sys = System::with_options(&model, cons, &options);
+        let part = sys.partition(&q);
+        let eval = sys.evaluate(&q, &part).unwrap();
+        // The direction of the independent coordinates that closes the lowest gap fastest
+        // (its gradient by forward differences through the corrector).
+        let tolerance = options.constraint_tolerance;
+        let (k, g0) = guard.lowest(&q, &sys.problem.cons.branches).unwrap();
+        let mut dq = DVector::zeros(q.len());
+        for &c in &part.independent {
+            let mut qt = q.clone();
+            qt[c] += 1e-6;
+            sys.correct_from(&mut qt, &part, tolerance, 25, None)
+                .unwrap();
+            dq[c] = -(guard.gap(k, &qt, &sys.problem.cons.branches) - g0) / 1e-6;
+        }
+        dq *= 0.05 / dq.amax();
+        // The shortest step (doubling) that the corrector manages and that violates a gap.
+        let mut alpha = 0.125;
+        let q_alpha = loop {
+            let mut qt = &q + &dq * alpha;
+            let ok = sys.correct_from(&mut qt, &part, tolerance, 25, Some(&eval.factors));
+            if ok.is_ok() && guard.violated(&sys, &qt) {
+                break qt;
+            }
+            alpha *= 2.0;
+            assert!(alpha < 1e3, "no gap is reached along the descent");
+        };
+        let (qf, touching_f) = guard
+            .boundary(
+                &mut sys,
+                &q,
+                &dq,
+                alpha,
+                Some(&q_alpha),
+                &part,
+                &options,
+                &eval,
+            )
+            .unwrap();
+        guard.falsi = false;
+        let (qb, touching_b) = guard
+            .boundary(
+                &mut sys,
+                &q,
+                &dq,
+                alpha,
+                Some(&q_alpha),
+                &part,
+                &options,
+                &eval,
+            )
+            .unwrap();
+        assert_eq!(touching_f, vec![0]);
+        assert_eq!(touching_b, vec![0]);
+        let apart = (&qf - &qb).amax() / model.length_scale;
+        assert!(apart <= 10.0 * tol, "{apart}");
+        for qx in [&qf, &qb] {
+            let (_, lowest) = guard.lowest(qx, &sys.problem.cons.branches).unwrap();
+            assert!(lowest.abs() <= tol, "lowest gap {lowest}");
+            sys.residual(qx);
+            assert!(sys.dimensionless_residual() <= 1e-8);
+        }
+        let sticking = Options {
+            friction: Friction::Stick,
+            ..options
+        };
+        let g = Guard::new(&model, &sticking, guard.inactive.clone(), &active, tol, &q);
+        assert!(!g.falsi);
+    }
+}

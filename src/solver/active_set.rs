@@ -3,9 +3,10 @@
 //!
 //! The active inequalities `A` join `Φ` as rows `g_k(q) = 0`, and the equality-constrained
 //! problem is solved as any other (partition, reduced Newton, corrector). Then:
-//! - a step that would make an inactive `g_k` negative is cut by bisection on the step length
-//!   (through the corrector) where the first one reaches `|g_k| ≤ tol`; every inequality within
-//!   `tol` of its boundary there joins `A`, and the partition is recomputed;
+//! - a step that would make an inactive `g_k` negative is cut (bisection or regula falsi on the
+//!   step length through the corrector, module `guard`) where the first one reaches
+//!   `|g_k| ≤ tol`; every inequality within `tol` of its boundary there joins `A`, and the
+//!   partition is recomputed;
 //! - at a stationary point, the multipliers `λ_k` of the active rows (`V_qᵀ = Φ_qᵀ μ`) are the
 //!   stops' efforts and the contacts' normal forces; the one most negative below
 //!   `−force_tolerance · F` (`F` the weight and loads of the mechanism) leaves `A`;
@@ -30,156 +31,15 @@
 //! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §16.5
 //!   (active-set methods), §15.4 (handling inequalities in reduced-gradient methods).
 
+pub(crate) use super::guard::Guard;
 use super::options::{Limits, Options};
-use super::partition::Partition;
-use super::system::{Eval, System};
 use crate::constraints::unilateral::{self, Active, Unilateral};
 use crate::kinematics::Branches;
 use crate::model::{Friction, Model};
 use nalgebra::{DVector, Vector3};
 
-/// The inactive inequalities that a step must not violate.
-pub(crate) struct Guard<'m> {
-    model: &'m Model,
-    pub(crate) inactive: Vec<Unilateral>,
-    tol: f64,
-    /// For contacts with an obstacle: its tangent plane `(o, n)` at the round's start. A step
-    /// is guarded against that plane (a finite obstacle could otherwise be stepped through).
-    planes: Vec<Option<(Vector3<f64>, Vector3<f64>)>>,
-    /// The sticking spheres' roll limits, after the inequalities (module `rolling`).
-    rolls: Vec<super::rolling::RollLimit>,
-}
-
-impl<'m> Guard<'m> {
-    /// The guard of the inequalities `inactive` from the configuration `q`, and of the roll
-    /// limits of the sticking spheres among `active`.
-    pub(crate) fn new(
-        model: &'m Model,
-        inactive: Vec<Unilateral>,
-        active: &[Active],
-        tol: f64,
-        q: &DVector<f64>,
-    ) -> Self {
-        let planes = inactive
-            .iter()
-            .map(|u| match *u {
-                Unilateral::Contact { point, ground } if ground >= model.grounds.len() => Some(
-                    unilateral::surface(model, ground, &unilateral::point_world(model, point, q)),
-                ),
-                _ => None,
-            })
-            .collect();
-        Guard {
-            model,
-            inactive,
-            tol,
-            planes,
-            rolls: super::rolling::limits(model, active),
-        }
-    }
-
-    /// Number of guarded inequalities: the inactive ones, then the roll limits.
-    fn len(&self) -> usize {
-        self.inactive.len() + self.rolls.len()
-    }
-
-    /// Whether guarded inequality `k` is a roll limit (not an inequality to activate).
-    pub(crate) fn is_roll_limit(&self, k: usize) -> bool {
-        k >= self.inactive.len()
-    }
-
-    /// Dimensionless gap of inequality `k` (against an obstacle: to its plane of `planes`; a
-    /// roll limit's margin after the inactive ones).
-    fn gap(&self, k: usize, q: &DVector<f64>, branches: &Branches) -> f64 {
-        let Some(u) = self.inactive.get(k) else {
-            return self.rolls[k - self.inactive.len()].margin(self.model, q);
-        };
-        let g = match (self.planes[k], u) {
-            (Some((o, n)), Unilateral::Contact { point, .. }) => {
-                n.dot(&(unilateral::point_world(self.model, *point, q) - o))
-                    - self.model.contact_points[*point].radius
-            }
-            _ => unilateral::gap(self.model, u, q, branches).unwrap_or(f64::INFINITY),
-        };
-        dimensionless(self.model, u, g)
-    }
-
-    /// The lowest dimensionless gap and its inequality.
-    fn lowest(&self, q: &DVector<f64>, branches: &Branches) -> Option<(usize, f64)> {
-        (0..self.len())
-            .map(|k| (k, self.gap(k, q, branches)))
-            .min_by(|a, b| a.1.total_cmp(&b.1))
-    }
-
-    /// Whether the step from `from` to `to` brings one of the inequalities closer to its
-    /// boundary (a linear descent may then end on it, and is not unbounded).
-    pub(crate) fn approaching(&self, sys: &System, from: &DVector<f64>, to: &DVector<f64>) -> bool {
-        let b = &sys.problem.cons.branches;
-        (0..self.len()).any(|k| self.gap(k, to, b) < self.gap(k, from, b) - self.tol)
-    }
-
-    /// Whether `q` violates one of the inequalities by more than the tolerance.
-    pub(crate) fn violated(&self, sys: &System, q: &DVector<f64>) -> bool {
-        self.lowest(q, &sys.problem.cons.branches)
-            .is_some_and(|(_, g)| g < -self.tol)
-    }
-
-    /// The corrected point `q(α) = correct(q + α dq)` on the boundary of the first inequality
-    /// met along `α ∈ [0, alpha]` (bisection), and the inequalities within the tolerance of
-    /// their boundary there.
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn boundary(
-        &self,
-        sys: &mut System,
-        q: &DVector<f64>,
-        dq: &DVector<f64>,
-        alpha: f64,
-        part: &Partition,
-        options: &Options,
-        eval: &Eval,
-    ) -> Option<(DVector<f64>, Vec<usize>)> {
-        let (mut lo, mut hi) = (0.0, alpha);
-        let mut q_lo = q.clone();
-        for _ in 0..80 {
-            let mid = 0.5 * (lo + hi);
-            let mut qm = q + dq * mid;
-            if sys
-                .correct_from(
-                    &mut qm,
-                    part,
-                    options.constraint_tolerance,
-                    options.max_corrector_iterations,
-                    Some(&eval.factors),
-                )
-                .is_err()
-            {
-                hi = mid;
-                continue;
-            }
-            let (_, g) = self.lowest(&qm, &sys.problem.cons.branches)?;
-            if g < -self.tol {
-                hi = mid;
-            } else {
-                lo = mid;
-                q_lo = qm;
-                if g <= self.tol {
-                    break;
-                }
-            }
-        }
-        let branches = &sys.problem.cons.branches;
-        let touching: Vec<usize> = (0..self.len())
-            .filter(|&k| self.gap(k, &q_lo, branches) <= self.tol)
-            .collect();
-        if touching.is_empty() {
-            return None;
-        }
-        Some((q_lo, touching))
-    }
-}
-
 /// `g` divided by the characteristic length for a gap in m.
-fn dimensionless(model: &Model, u: &Unilateral, g: f64) -> f64 {
+pub(crate) fn dimensionless(model: &Model, u: &Unilateral, g: f64) -> f64 {
     if unilateral::length_power(model, u) == 1 {
         g / model.length_scale
     } else {
@@ -350,7 +210,7 @@ pub(crate) fn solve(
             .filter(|u| !active.iter().any(|a| a.row == **u))
             .copied()
             .collect();
-        let guard = Guard::new(model, inactive, &active, tol, &q);
+        let guard = Guard::new(model, options, inactive, &active, tol, &q);
         let round = super::solve_round(
             model,
             crate::State { q, branches },

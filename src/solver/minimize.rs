@@ -342,7 +342,9 @@ pub(crate) fn minimize(
             }
             if let Some(guard) = guard.filter(|g| g.violated(sys, &qt)) {
                 // Cut the step where the first inequality reaches its boundary.
-                if let Some((qb, k)) = guard.boundary(sys, &q, &dq, alpha, &part, options, &eval) {
+                if let Some((qb, k)) =
+                    guard.boundary(sys, &q, &dq, alpha, Some(&qt), &part, options, &eval)
+                {
                     if let Some(eb) = sys.evaluate(&qb, &part) {
                         diag.function_evaluations += 1;
                         if eb.merit <= f + roundoff_of(&eval, &eb) {

@@ -19,6 +19,7 @@ mod assemble;
 mod cone;
 mod distribution;
 mod eigen;
+mod guard;
 mod minimize;
 mod mode_animation;
 mod options;

@@ -1,0 +1,338 @@
+//! The guard of the inactive inequalities during one round of the active-set iteration
+//! (module `active_set`): the lowest dimensionless gap `min_k g_k(q)` over the inactive stops
+//! and contacts (and the sticking spheres' roll limits), and the point where a step first
+//! reaches a boundary: `α*` with `|g(correct(q + α* dq))| ≤ tol`, found by bisection or
+//! regula falsi on `α` through the corrector.
+//!
+//! ## References
+//! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §16.5.
+//! - M. Dowell, P. Jarratt, "A modified regula falsi method for computing the root of an
+//!   equation", *BIT* 11 (1971) 168–174 (the Illinois method).
+
+use super::active_set::dimensionless;
+use super::options::Options;
+use super::partition::Partition;
+use super::system::{Eval, System};
+use crate::constraints::unilateral::{self, Active, Unilateral};
+use crate::kinematics::Branches;
+use crate::model::{Friction, Model};
+use nalgebra::{DVector, Vector3};
+
+/// The inactive inequalities that a step must not violate.
+pub(crate) struct Guard<'m> {
+    model: &'m Model,
+    pub(crate) inactive: Vec<Unilateral>,
+    tol: f64,
+    /// For contacts with an obstacle: its tangent plane `(o, n)` at the round's start. A step
+    /// is guarded against that plane (a finite obstacle could otherwise be stepped through).
+    planes: Vec<Option<(Vector3<f64>, Vector3<f64>)>>,
+    /// The sticking spheres' roll limits, after the inequalities (module `rolling`).
+    rolls: Vec<super::rolling::RollLimit>,
+    /// Whether the boundary may be searched by regula falsi: no guarded inequality is a
+    /// sticking contact (anchored where it lands) and there is no roll limit.
+    falsi: bool,
+}
+
+impl<'m> Guard<'m> {
+    /// The guard of the inequalities `inactive` from the configuration `q`, and of the roll
+    /// limits of the sticking spheres among `active`.
+    pub(crate) fn new(
+        model: &'m Model,
+        options: &Options,
+        inactive: Vec<Unilateral>,
+        active: &[Active],
+        tol: f64,
+        q: &DVector<f64>,
+    ) -> Self {
+        let sticking = inactive.iter().any(|u| match *u {
+            Unilateral::Contact { point, .. } => {
+                model.contact_points[point]
+                    .settings
+                    .friction
+                    .unwrap_or(options.friction)
+                    == Friction::Stick
+            }
+            Unilateral::Limit { .. } => false,
+        });
+        let rolls = super::rolling::limits(model, active);
+        let planes = inactive
+            .iter()
+            .map(|u| match *u {
+                Unilateral::Contact { point, ground } if ground >= model.grounds.len() => Some(
+                    unilateral::surface(model, ground, &unilateral::point_world(model, point, q)),
+                ),
+                _ => None,
+            })
+            .collect();
+        Guard {
+            model,
+            inactive,
+            tol,
+            planes,
+            falsi: !sticking && rolls.is_empty(),
+            rolls,
+        }
+    }
+
+    /// Number of guarded inequalities: the inactive ones, then the roll limits.
+    fn len(&self) -> usize {
+        self.inactive.len() + self.rolls.len()
+    }
+
+    /// Whether guarded inequality `k` is a roll limit (not an inequality to activate).
+    pub(crate) fn is_roll_limit(&self, k: usize) -> bool {
+        k >= self.inactive.len()
+    }
+
+    /// Dimensionless gap of inequality `k` (against an obstacle: to its plane of `planes`; a
+    /// roll limit's margin after the inactive ones).
+    fn gap(&self, k: usize, q: &DVector<f64>, branches: &Branches) -> f64 {
+        let Some(u) = self.inactive.get(k) else {
+            return self.rolls[k - self.inactive.len()].margin(self.model, q);
+        };
+        let g = match (self.planes[k], u) {
+            (Some((o, n)), Unilateral::Contact { point, .. }) => {
+                n.dot(&(unilateral::point_world(self.model, *point, q) - o))
+                    - self.model.contact_points[*point].radius
+            }
+            _ => unilateral::gap(self.model, u, q, branches).unwrap_or(f64::INFINITY),
+        };
+        dimensionless(self.model, u, g)
+    }
+
+    /// The lowest dimensionless gap and its inequality.
+    fn lowest(&self, q: &DVector<f64>, branches: &Branches) -> Option<(usize, f64)> {
+        (0..self.len())
+            .map(|k| (k, self.gap(k, q, branches)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+    }
+
+    /// Whether the step from `from` to `to` brings one of the inequalities closer to its
+    /// boundary (a linear descent may then end on it, and is not unbounded).
+    pub(crate) fn approaching(&self, sys: &System, from: &DVector<f64>, to: &DVector<f64>) -> bool {
+        let b = &sys.problem.cons.branches;
+        (0..self.len()).any(|k| self.gap(k, to, b) < self.gap(k, from, b) - self.tol)
+    }
+
+    /// Whether `q` violates one of the inequalities by more than the tolerance.
+    pub(crate) fn violated(&self, sys: &System, q: &DVector<f64>) -> bool {
+        self.lowest(q, &sys.problem.cons.branches)
+            .is_some_and(|(_, g)| g < -self.tol)
+    }
+
+    /// The corrected point `q(α) = correct(q + α dq)` on the boundary of the first inequality
+    /// met along `α ∈ [0, alpha]`, and the inequalities within the tolerance of their boundary
+    /// there. `q_alpha` is the corrected point at `alpha`, if known.
+    ///
+    /// The bracket `[lo, hi]` (`lo` within or above every boundary, `hi` beyond one or where
+    /// the corrector fails) shrinks by bisection, or, when the guard allows it (no sticking
+    /// contact, which would be anchored where it lands, and no roll limit), by regula falsi
+    /// (Illinois) on the lowest gap `g(α)` where both ends have one, clamped to the inner
+    /// `1 − 2·10⁻³` of the bracket. Either ends at the first point with `|g| ≤ tol`.
+    ///
+    /// The corrector at each trial point starts from the chord between the corrected ends of
+    /// the bracket (from `q_lo + (α − lo) dq` while the upper end has none): its distance to the
+    /// manifold is second order in the bracket's width, not in `α`, so fewer corrector steps
+    /// reach the same point. The independent coordinates are `q + α dq`.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn boundary(
+        &self,
+        sys: &mut System,
+        q: &DVector<f64>,
+        dq: &DVector<f64>,
+        alpha: f64,
+        q_alpha: Option<&DVector<f64>>,
+        part: &Partition,
+        options: &Options,
+        eval: &Eval,
+    ) -> Option<(DVector<f64>, Vec<usize>)> {
+        let (mut lo, mut hi) = (0.0, alpha);
+        let mut q_lo = q.clone();
+        let mut q_hi = q_alpha.cloned();
+        // The lowest gap at each end (`None` at an end where the corrector failed), and the
+        // end that moved last (Illinois: the other end's gap is halved when it stays twice).
+        let (mut g_lo, mut g_hi) = (None, None);
+        if self.falsi {
+            let b = &sys.problem.cons.branches;
+            g_lo = self.lowest(q, b).map(|x| x.1);
+            g_hi = q_alpha.and_then(|qa| self.lowest(qa, b)).map(|x| x.1);
+        }
+        let mut last_moved_hi = None;
+        for _ in 0..80 {
+            let w = hi - lo;
+            let mid = match (g_lo, g_hi) {
+                (Some(a), Some(b)) if a > b => {
+                    (lo + w * a / (a - b)).clamp(lo + 1e-3 * w, hi - 1e-3 * w)
+                }
+                _ => 0.5 * (lo + hi),
+            };
+            let mut qm = match &q_hi {
+                Some(qh) => &q_lo + (qh - &q_lo) * ((mid - lo) / w),
+                None => &q_lo + dq * (mid - lo),
+            };
+            for &c in &part.independent {
+                qm[c] = q[c] + dq[c] * mid;
+            }
+            let corrected = sys.correct_from(
+                &mut qm,
+                part,
+                options.constraint_tolerance,
+                options.max_corrector_iterations,
+                Some(&eval.factors),
+            );
+            if corrected.is_err() {
+                hi = mid;
+                (q_hi, g_hi) = (None, None);
+                continue;
+            }
+            let (_, g) = self.lowest(&qm, &sys.problem.cons.branches)?;
+            if g < -self.tol {
+                hi = mid;
+                q_hi = Some(qm);
+                g_hi = self.falsi.then_some(g);
+                if last_moved_hi == Some(true) {
+                    g_lo = g_lo.map(|x| 0.5 * x);
+                }
+                last_moved_hi = Some(true);
+            } else {
+                lo = mid;
+                q_lo = qm;
+                if g <= self.tol {
+                    break;
+                }
+                g_lo = self.falsi.then_some(g);
+                if last_moved_hi == Some(false) {
+                    g_hi = g_hi.map(|x| 0.5 * x);
+                }
+                last_moved_hi = Some(false);
+            }
+        }
+        let branches = &sys.problem.cons.branches;
+        let touching: Vec<usize> = (0..self.len())
+            .filter(|&k| self.gap(k, &q_lo, branches) <= self.tol)
+            .collect();
+        if touching.is_empty() {
+            return None;
+        }
+        Some((q_lo, touching))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::constraints::Constraints;
+    use crate::solver::active_set::{activate, inequalities};
+    use crate::urdf::{load_str, ImportOptions};
+
+    /// A link on a hinge 0.04 m above the ground, from the horizontal, turned toward the
+    /// ground (the direction that closes its sphere's gap fastest): regula falsi and bisection
+    /// find the touchdown at the same boundary (the gap within `tol`, the contact touching,
+    /// the joint satisfied, the two points within `10 tol L` of each other); the guard of a
+    /// sticking contact keeps the bisection.
+    #[test]
+    fn regula_falsi_and_bisection_land_on_the_same_boundary() {
+        let text = r#"<robot name="tip" xmlns:mech="urn:urdf-mech:1">
+  <link name="world"/>
+  <link name="link0"><inertial><origin xyz="0.025 0 0"/><mass value="0.05"/><inertia ixx="1e-6" ixy="0" ixz="0" iyy="1.1e-5" iyz="0" izz="1.1e-5"/></inertial><collision><origin xyz="0.05 0 0"/><geometry><sphere radius="0.01"/></geometry></collision></link>
+  <joint name="joint0" type="continuous"><parent link="world"/><child link="link0"/><origin xyz="0 0 0.04"/><axis xyz="0 1 0"/></joint>
+  <mech:ground/>
+</robot>"#;
+        let model = load_str(text, "tip.urdf", &ImportOptions::default())
+            .unwrap()
+            .model;
+        let options = Options::default();
+        let tol = options.gap_tolerance;
+        let start = crate::State::initial(&model);
+        let mut branches = start.branches.clone();
+        let q = super::super::assemble::assemble(&model, start.q, &mut branches, &[], &options)
+            .unwrap();
+        let all = inequalities(&model, &options);
+        let touches = |u: &Unilateral| {
+            unilateral::gap(&model, u, &q, &branches)
+                .is_some_and(|g| dimensionless(&model, u, g) <= tol)
+        };
+        let active: Vec<Active> = all
+            .iter()
+            .filter(|u| touches(u))
+            .map(|&u| activate(&model, &options, u, &q))
+            .collect();
+        let inactive: Vec<Unilateral> = all.iter().filter(|u| !touches(u)).copied().collect();
+        assert!(active.is_empty() && inactive.len() == 1);
+        let q = super::super::assemble::project(&model, q, &mut branches, &[], &active, &options)
+            .unwrap();
+        let mut guard = Guard::new(&model, &options, inactive, &active, tol, &q);
+        assert!(guard.falsi);
+        let cons = Constraints::new(&model, &[])
+            .with_active(&model, &active)
+            .on_branches(branches);
+        let mut sys = System::with_options(&model, cons, &options);
+        let part = sys.partition(&q);
+        let eval = sys.evaluate(&q, &part).unwrap();
+        // The direction of the independent coordinates that closes the lowest gap fastest
+        // (its gradient by forward differences through the corrector).
+        let tolerance = options.constraint_tolerance;
+        let (k, g0) = guard.lowest(&q, &sys.problem.cons.branches).unwrap();
+        let mut dq = DVector::zeros(q.len());
+        for &c in &part.independent {
+            let mut qt = q.clone();
+            qt[c] += 1e-6;
+            sys.correct_from(&mut qt, &part, tolerance, 25, None)
+                .unwrap();
+            dq[c] = -(guard.gap(k, &qt, &sys.problem.cons.branches) - g0) / 1e-6;
+        }
+        dq *= 0.05 / dq.amax();
+        // The shortest step (doubling) that the corrector manages and that violates a gap.
+        let mut alpha = 0.125;
+        let q_alpha = loop {
+            let mut qt = &q + &dq * alpha;
+            let ok = sys.correct_from(&mut qt, &part, tolerance, 25, Some(&eval.factors));
+            if ok.is_ok() && guard.violated(&sys, &qt) {
+                break qt;
+            }
+            alpha *= 2.0;
+            assert!(alpha < 1e3, "no gap is reached along the descent");
+        };
+        let (qf, touching_f) = guard
+            .boundary(
+                &mut sys,
+                &q,
+                &dq,
+                alpha,
+                Some(&q_alpha),
+                &part,
+                &options,
+                &eval,
+            )
+            .unwrap();
+        guard.falsi = false;
+        let (qb, touching_b) = guard
+            .boundary(
+                &mut sys,
+                &q,
+                &dq,
+                alpha,
+                Some(&q_alpha),
+                &part,
+                &options,
+                &eval,
+            )
+            .unwrap();
+        assert_eq!(touching_f, vec![0]);
+        assert_eq!(touching_b, vec![0]);
+        let apart = (&qf - &qb).amax() / model.length_scale;
+        assert!(apart <= 10.0 * tol, "{apart}");
+        for qx in [&qf, &qb] {
+            let (_, lowest) = guard.lowest(qx, &sys.problem.cons.branches).unwrap();
+            assert!(lowest.abs() <= tol, "lowest gap {lowest}");
+            sys.residual(qx);
+            assert!(sys.dimensionless_residual() <= 1e-8);
+        }
+        let sticking = Options {
+            friction: Friction::Stick,
+            ..options
+        };
+        let g = Guard::new(&model, &sticking, guard.inactive.clone(), &active, tol, &q);
+        assert!(!g.falsi);
+    }
+}

@@ -6,7 +6,7 @@
 //! ignored). A candidate is suggested when `d ≤ max(2, ⌊|name| / 3⌋)` (the nearest; ties go
 //! to the first), else when it is the only candidate that starts with the name.
 //!
-//! Also the maps from names to indices ([`NameMap`]): hashed eight bytes at a time,
+//! Also the maps from names to indices (`NameMap`): hashed eight bytes at a time,
 //! `h ← (rotl(h, 5) ⊕ w) · K` (the multiply-rotate hash of rustc's `FxHasher`), about four times
 //! cheaper than the standard library's SipHash on short names. Input names are not an attack
 //! surface for a command-line tool, which is what SipHash's keyed hashing is for.

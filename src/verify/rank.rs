@@ -6,7 +6,9 @@
 //! order (deepest first); at body `b` it pivots up to seven times on the largest threshold-
 //! passing entry `|a_rc| ≥ τ max_k |a_rk|` (τ = 0.1) of `b`'s free columns among the active
 //! rows touching `b`, eliminating `a_i ← a_i − (a_ic / a_rc) a_r` from the other rows touching
-//! `b`, then pivots the rows that started on `b` alone with the rank test `|a_rc| > tol` only.
+//! `b`, then pivots the rows that started on `b` alone on the free entry of `b` largest against
+//! the row's reach there (its largest starting entry on `b` in columns of the same kind), if at
+//! least `OWN_THRESHOLD` of it.
 //! When every row touching `b` is a pivot row or redundant after that, the rows changed there
 //! are never read again: `b`'s step depends only on the original entries of its own rows. This
 //! module repeats exactly those steps body by body on copies of the rows touching `b` (so the
@@ -18,49 +20,7 @@
 
 use crate::model::Model;
 use crate::solver::partition::RANK_TOLERANCE;
-
-/// The partition's threshold of the pivot test against the largest entry of its row.
-const THRESHOLD: f64 = 0.1;
-
-/// The partition's elimination order: descending breadth-first depth from the ground over all
-/// joints (ties: higher index first); bodies not connected to the ground last.
-fn elimination_order(model: &Model) -> Vec<usize> {
-    let nb = model.bodies.len();
-    let mut adjacent = vec![Vec::new(); nb];
-    let mut depth = vec![usize::MAX; nb];
-    let mut queue = std::collections::VecDeque::new();
-    for j in model.joints.iter().filter(|j| !j.merged) {
-        match (j.bodies[0], j.bodies[1]) {
-            (Some(a), Some(b)) => {
-                adjacent[a.0].push(b.0);
-                adjacent[b.0].push(a.0);
-            }
-            (Some(a), None) | (None, Some(a)) => {
-                if depth[a.0] == usize::MAX {
-                    depth[a.0] = 1;
-                    queue.push_back(a.0);
-                }
-            }
-            (None, None) => {}
-        }
-    }
-    while let Some(b) = queue.pop_front() {
-        for &c in &adjacent[b] {
-            if depth[c] == usize::MAX {
-                depth[c] = depth[b] + 1;
-                queue.push_back(c);
-            }
-        }
-    }
-    let mut order: Vec<usize> = (0..nb).collect();
-    order.sort_by_key(|&b| {
-        (
-            std::cmp::Reverse(if depth[b] == usize::MAX { 0 } else { depth[b] }),
-            std::cmp::Reverse(b),
-        )
-    });
-    order
-}
+use crate::solver::sparse::partition::{elimination_order, OWN_THRESHOLD, THRESHOLD};
 
 /// The rows of a Jacobian whose triplets are grouped by row: row `r` is
 /// `entries[start[r]..start[r + 1]]`, expanded on demand with its scales.
@@ -157,6 +117,7 @@ pub(super) fn free_columns(
     let mut rmax = vec![0.0f64; m];
     let mut body_start = vec![0usize; nb + 1];
     let mut own_of = vec![usize::MAX; m];
+    let mut reach = vec![[0.0f64; 2]; m];
     for r in 0..m {
         rows.expand(r, &mut row);
         rmax[r] = row_max(&row);
@@ -170,6 +131,10 @@ pub(super) fn free_columns(
         if let Some(&(c0, _)) = row.first() {
             if row.iter().all(|e| e.0 / 7 == c0 / 7) {
                 own_of[r] = c0 / 7;
+                for &(c, v) in &row {
+                    let k = usize::from(c % 7 >= 3);
+                    reach[r][k] = reach[r][k].max(v.abs());
+                }
             }
         }
     }
@@ -233,7 +198,7 @@ pub(super) fn free_columns(
         own.clear();
         own.extend((0..k).filter(|&s| own_of[local.cands[s]] == b));
         while taken < 7 {
-            match best_pivot(&mut local, &own, &active, &free, tol, 0.0, in_b) {
+            match best_own_pivot(&mut local, &own, &active, &free, tol, b, &reach) {
                 Some((slot, c)) => pivot(&mut local, slot, c, &mut active, &mut free, tol),
                 None => break,
             }
@@ -277,6 +242,47 @@ fn best_pivot(
             let a = v.abs();
             if a > tol && a >= threshold * rmax && best.is_none_or(|b| a > b.2 * (1.0 + 1e-9)) {
                 best = Some((s, c, a));
+            }
+        }
+    }
+    best.map(|(s, c, _)| (s, c))
+}
+
+/// The partition's second-pass pivot at body `b` among the rows at `slots` (ascending) that
+/// started on `b` alone: the entry on a free column of `b` largest relative to the row's
+/// `reach` there (same kind of column), if at least `OWN_THRESHOLD` of it; a later one only
+/// if larger by a relative `1e-9`.
+fn best_own_pivot(
+    local: &mut Local,
+    slots: &[usize],
+    active: &[bool],
+    free: &[bool],
+    tol: f64,
+    b: usize,
+    reach: &[[f64; 2]],
+) -> Option<(usize, usize)> {
+    let mut best: Option<(usize, usize, f64)> = None;
+    let entries = &mut local.entries;
+    for &s in slots {
+        let r = local.cands[s];
+        if !active[r] {
+            continue;
+        }
+        entries.clear();
+        entries.extend(
+            local.rows[s]
+                .iter()
+                .copied()
+                .filter(|&(c, _)| free[c] && c / 7 == b),
+        );
+        entries.sort_unstable_by_key(|e| e.0);
+        for &(c, v) in entries.iter() {
+            let ratio = v.abs() / reach[r][usize::from(c % 7 >= 3)].max(f64::MIN_POSITIVE);
+            if v.abs() > tol
+                && ratio >= OWN_THRESHOLD
+                && best.is_none_or(|x| ratio > x.2 * (1.0 + 1e-9))
+            {
+                best = Some((s, c, ratio));
             }
         }
     }

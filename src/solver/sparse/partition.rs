@@ -36,14 +36,14 @@ use super::super::partition::{Partition, RANK_TOLERANCE};
 use crate::model::Model;
 
 /// Threshold of the pivot test against the largest entry of its row.
-const THRESHOLD: f64 = 0.1;
+pub(crate) const THRESHOLD: f64 = 0.1;
 
 /// Threshold of the second pass's pivot test against the row's reach on its own body.
-const OWN_THRESHOLD: f64 = 0.5;
+pub(crate) const OWN_THRESHOLD: f64 = 0.5;
 
 /// The bodies in elimination order: descending breadth-first depth from the ground over all
 /// joints (ties: higher index first); bodies not connected to the ground come last.
-fn elimination_order(model: &Model) -> Vec<usize> {
+pub(crate) fn elimination_order(model: &Model) -> Vec<usize> {
     let nb = model.bodies.len();
     let mut adjacent = vec![Vec::new(); nb];
     let mut depth = vec![usize::MAX; nb];

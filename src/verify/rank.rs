@@ -188,7 +188,7 @@ pub(super) fn free_columns(
         all.extend(0..k);
         let mut taken = 0;
         while taken < 7 {
-            match best_pivot(&mut local, &all, &active, &free, tol, THRESHOLD, in_b) {
+            match best_pivot(&mut local, &all, &active, &free, tol, in_b) {
                 Some((slot, c)) => pivot(&mut local, slot, c, &mut active, &mut free, tol),
                 None => break,
             }
@@ -216,7 +216,7 @@ pub(super) fn free_columns(
 }
 
 /// The partition's pivot choice among the rows at `slots` (ascending) in the free columns
-/// `cols`: the largest `|a_rc| > tol` with `|a_rc| ≥ threshold · max_k |a_rk|`, a later one
+/// `cols`: the largest `|a_rc| > tol` with `|a_rc| ≥ THRESHOLD · max_k |a_rk|`, a later one
 /// only if larger by a relative `1e-9`.
 fn best_pivot(
     local: &mut Local,
@@ -224,7 +224,6 @@ fn best_pivot(
     active: &[bool],
     free: &[bool],
     tol: f64,
-    threshold: f64,
     cols: impl Fn(usize) -> bool,
 ) -> Option<(usize, usize)> {
     let mut best: Option<(usize, usize, f64)> = None;
@@ -240,7 +239,7 @@ fn best_pivot(
         entries.sort_unstable_by_key(|e| e.0);
         for &(c, v) in entries.iter() {
             let a = v.abs();
-            if a > tol && a >= threshold * rmax && best.is_none_or(|b| a > b.2 * (1.0 + 1e-9)) {
+            if a > tol && a >= THRESHOLD * rmax && best.is_none_or(|b| a > b.2 * (1.0 + 1e-9)) {
                 best = Some((s, c, a));
             }
         }

@@ -70,6 +70,9 @@ pub enum Error {
         col: u32,
         /// What is wrong, naming the element.
         message: String,
+        /// The element's tag as written (`joint`, `mech:spring`); empty where the error is
+        /// not at an element (encoding, file size, XML syntax).
+        element: String,
     },
     /// A joint name that the model does not have.
     #[error("{what} `{name}`: the model has no joint of that name{}", suggestion.as_ref().map(|s| format!(" (did you mean `{s}`?)")).unwrap_or_default())]

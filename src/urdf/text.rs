@@ -90,6 +90,7 @@ fn not_utf8(bytes: &[u8], e: std::str::Utf8Error, encoding: Option<String>, file
                     bytes[at],
                     encoding.map_or("no encoding".to_string(), |e| format!("encoding \"{e}\""))
                 ),
+                element: String::new(),
             }
 }
 
@@ -112,6 +113,7 @@ pub fn read_file(path: &std::path::Path) -> Result<String> {
             message: format!(
                 "the file has {len} bytes, more than the {MAX_FILE_BYTES} bytes (256 MiB) restpose reads"
             ),
+            element: String::new(),
         });
     }
     let bytes = std::fs::read(path).map_err(io)?;
@@ -230,6 +232,7 @@ fn check_depth(text: &str, file: &str) -> Result<()> {
                         message: format!(
                             "elements are nested more than {MAX_DEPTH} levels deep (URDF needs about 6)"
                         ),
+                        element: String::new(),
                     });
                 }
             }
@@ -309,6 +312,7 @@ fn refuse_xacro(doc: &roxmltree::Document, file: &str) -> Result<()> {
                 line: p.row,
                 col: p.col,
                 message: XACRO.into(),
+                element: n.tag_name().name().to_string(),
             });
         }
     }
@@ -333,6 +337,7 @@ fn declare_prefixes(mut out: String, file: &str, warnings: &mut Vec<String>) -> 
                     line: pos.row,
                     col: pos.col,
                     message: XACRO.into(),
+                    element: String::new(),
                 })
             }
             other => undeclared_uri(other),

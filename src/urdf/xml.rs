@@ -62,12 +62,13 @@ impl<'a> Source<'a> {
 
     /// An input error at `node`.
     pub(crate) fn error(&self, node: Node, message: impl Into<String>) -> Error {
-        let (line, col) = self.pos(node);
+        let at = self.location(node);
         Error::Input {
-            file: self.file.to_string(),
-            line,
-            col,
+            file: at.file,
+            line: at.line,
+            col: at.col,
             message: message.into(),
+            element: at.element,
         }
     }
 
@@ -252,6 +253,7 @@ pub(crate) fn located<'a>(
             line: p.row,
             col: p.col,
             message: format!("not well-formed XML: {e}"),
+            element: String::new(),
         }
     })
 }

@@ -72,6 +72,7 @@ class Stability(Record):
     reduced Hessian (ascending) and their ``modes`` (``{joint: change of its coordinates}``,
     largest entry ±1)."""
 
+    _arrays = ("eigenvalues",)
     verdict: str
     tolerance: float
     eigenvalues: np.ndarray

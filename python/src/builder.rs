@@ -93,10 +93,7 @@ fn kind(kind: &str, pitch: Option<f64>, length: Option<f64>) -> PyResult<JointKi
 }
 
 fn law(stiffness: f64, preload: f64) -> ForceLaw {
-    ForceLaw::Linear {
-        stiffness,
-        preload,
-    }
+    ForceLaw::Linear { stiffness, preload }
 }
 
 #[pymethods]
@@ -131,7 +128,9 @@ impl ModelBuilder {
         }
         let i = inertia.unwrap_or([[0.0; 3]; 3]);
         let inertia = Matrix3::from_fn(|r, c| i[r][c]);
-        let id = self.b()?.add_rigid_body(name.clone(), mass, vector(com), inertia);
+        let id = self
+            .b()?
+            .add_rigid_body(name.clone(), mass, vector(com), inertia);
         self.bodies.insert(name, id);
         Ok(())
     }

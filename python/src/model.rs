@@ -322,7 +322,9 @@ impl Model {
             Pose::Values(values)
         } else {
             let path: PathBuf = pose.extract().map_err(|_| {
-                argument("pose: expected a restpose.Result, a {joint: value} dict or a pose file path")
+                argument(
+                    "pose: expected a restpose.Result, a {joint: value} dict or a pose file path",
+                )
             })?;
             Pose::Values(
                 py.detach(|| restpose::verify::read_pose(&path))

@@ -41,7 +41,9 @@ pub(crate) fn coordinates(
                 let dof = rest
                     .strip_suffix(']')
                     .and_then(|d| d.trim().parse::<usize>().ok())
-                    .ok_or_else(|| argument(format!("{what} `{key}`: expected JOINT or JOINT[DOF]")))?;
+                    .ok_or_else(|| {
+                        argument(format!("{what} `{key}`: expected JOINT or JOINT[DOF]"))
+                    })?;
                 (n.to_string(), dof)
             }
             None => (key.clone(), 0),
@@ -108,7 +110,9 @@ fn finite(v: &[f64], what: &str) -> PyResult<()> {
     if v.iter().all(|x| x.is_finite()) {
         Ok(())
     } else {
-        Err(argument(format!("{what}: values must be finite, got {v:?}")))
+        Err(argument(format!(
+            "{what}: values must be finite, got {v:?}"
+        )))
     }
 }
 

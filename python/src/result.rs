@@ -10,6 +10,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use restpose::export::json::AnalysisResult;
 
+/// A position and a quaternion.
+type Pair<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
+
 /// The outcome of ``Model.solve``: the rest pose (or where the solver stopped) and the
 /// solver's report.
 #[pyclass(frozen, module = "restpose")]
@@ -137,7 +140,10 @@ impl Result {
         let mut at = 0;
         for (n, j) in &self.result.joints {
             let end = at + j.position.len();
-            d.set_item(n, pyo3::types::PySlice::new(py, at as isize, end as isize, 1))?;
+            d.set_item(
+                n,
+                pyo3::types::PySlice::new(py, at as isize, end as isize, 1),
+            )?;
             at = end;
         }
         Ok(d)
@@ -205,7 +211,11 @@ impl Result {
     }
 
     /// The ``world_from_link`` homogeneous matrix (4×4) of link ``name``.
-    fn link_transform<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    fn link_transform<'py>(
+        &self,
+        py: Python<'py>,
+        name: &str,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let i = self.link_index(name)?;
         let m = homogeneous(&self.link_pose(i));
         let v: Vec<f64> = m.into_iter().flatten().collect();
@@ -215,11 +225,7 @@ impl Result {
     }
 
     /// The position [m] and quaternion ``w x y z`` of link ``name``.
-    fn link_pose_of<'py>(
-        &self,
-        py: Python<'py>,
-        name: &str,
-    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+    fn link_pose_of<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Pair<'py>> {
         let l = &self.result.links[self.link_index(name)?].1;
         Ok((
             PyArray1::from_slice(py, &l.position),

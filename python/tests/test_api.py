@@ -1,0 +1,309 @@
+"""The Python API: load, check, solve with the command line's options, results as numpy
+arrays and records, the JSON contract, the builder, verify and restpose.testing, threads."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import restpose
+from restpose.testing import assert_rest_pose
+
+# The pendulum of Nikravesh & Srinivasan (1985): closed-form rest angle and energy
+# (robots/pendulum.urdf's header).
+PENDULUM_PHI = -1.381577
+PENDULUM_V = -18.686957
+
+
+# A 1 kg point mass at 1 m on a hinge about y with a 10 N m/rad spring; no <mech:gravity>.
+ARM = """<robot name="arm" xmlns:mech="urn:urdf-mech:1"><link name="base"/>
+<link name="arm"><inertial><origin xyz="1 0 0"/><mass value="1"/>
+<inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link>
+<joint name="j" type="continuous"><parent link="base"/><child link="arm"/><axis xyz="0 1 0"/></joint>
+<mech:joint_spring joint="j" stiffness="10"/></robot>"""
+
+
+def without_timings(d: dict) -> dict:
+    d = json.loads(json.dumps(d))
+    d["diagnostics"].pop("timings")
+    return d
+
+
+def test_pendulum_solves_to_the_papers_answer(robots):
+    model = restpose.load(robots / "pendulum.urdf")
+    result = model.solve()
+    assert result.converged and result.termination == "converged"
+    assert result.joint("pivot").shape == (1,)
+    assert result.joint("pivot")[0] == pytest.approx(PENDULUM_PHI, abs=1e-6)
+    assert result.potential_energy == pytest.approx(PENDULUM_V, abs=1e-6)
+    assert result.energy.total == pytest.approx(result.potential_energy)
+    assert result.energy.gravity + result.energy.springs == pytest.approx(result.energy.total)
+    assert result.stability.verdict == "stable" and result.stability.stable
+    assert result.stability.eigenvalues.shape == (1,) and result.stability.eigenvalues[0] > 0
+    assert set(result.stability.modes[0]) == {"pivot"}
+    assert result.dof == 1 and result.sizes == (1, 7, 6)
+    # the independent equilibrium: spring torque balances gravity about the pivot
+    r = result.reactions["pivot"]
+    assert isinstance(r.force_world, np.ndarray) and r.force_world.shape == (3,)
+
+
+def test_arrays_agree_with_each_other(robots):
+    result = restpose.load(robots / "ur5_class.urdf").solve()
+    assert result.converged
+    names = result.link_names
+    pos, quat, tf = result.link_positions, result.link_quaternions, result.link_transforms
+    assert pos.shape == (len(names), 3) and quat.shape == (len(names), 4)
+    assert tf.shape == (len(names), 4, 4)
+    np.testing.assert_allclose(np.linalg.norm(quat, axis=1), 1.0, atol=1e-12)
+    assert (quat[:, 0] >= 0).all()
+    for i, name in enumerate(names):
+        t = result.link_transform(name)
+        np.testing.assert_array_equal(t, tf[i])
+        np.testing.assert_allclose(t[:3, 3], pos[i], atol=1e-15)
+        # rotation from the quaternion w x y z
+        w, x, y, z = quat[i]
+        rot = np.array(
+            [
+                [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+            ]
+        )
+        np.testing.assert_allclose(t[:3, :3], rot, atol=1e-12)
+        p, q = result.link_pose_of(name)
+        np.testing.assert_array_equal(p, pos[i])
+        np.testing.assert_array_equal(q, quat[i])
+    # q is the joints' values concatenated in model order
+    q = result.q
+    for name, sl in result.joint_slices.items():
+        np.testing.assert_array_equal(q[sl], result.joints[name])
+        np.testing.assert_array_equal(result.joint(name), result.joints[name])
+    assert list(result.joints) == result.joint_names == result.model.joint_names
+
+
+def test_to_json_is_the_command_lines_json(robots, tmp_path):
+    path = robots / "four_bar_spatial.urdf"
+    out = tmp_path / "r.json"
+    subprocess.run(
+        ["restpose", "analyze", "-q", str(path), "--json", str(out)], check=True
+    )
+    cli = json.loads(out.read_text())
+    py = json.loads(restpose.load(path).solve().to_json())
+    assert without_timings(py) == without_timings(cli)
+    # every field of the JSON is reachable from the result
+    r = restpose.load(path).solve()
+    assert r.redundant_constraints == cli["redundant_constraints"]
+    assert r.independent_coordinates == cli["independent_coordinates"]
+    assert [i.iteration for i in r.history] == [i["iteration"] for i in cli["history"]]
+    assert r.diagnostics.gradient_norm == cli["diagnostics"]["gradient_norm"]
+    assert r.iterations == cli["iterations"] and r.dof == cli["dof"]
+
+
+def test_check_is_the_command_lines_check(robots):
+    path = robots / "four_bar_spatial.urdf"
+    cli = subprocess.run(
+        ["restpose", "check", str(path), "--format", "json"],
+        check=True,
+        capture_output=True,
+        text=True,
+    ).stdout
+    report = restpose.load(path).check()
+    assert json.loads(report.to_json()) == json.loads(cli)
+    assert report.dof == json.loads(cli)["dof"] and report.assembly_error is None
+    assert {j["role"] for j in report.joints} >= {"tree", "loop"}
+
+
+def test_solver_options_change_the_solve(robots):
+    model = restpose.load(robots / "pendulum.urdf")
+    newton = model.solve()
+    for method in ("bfgs", "dfp"):
+        r = model.solve(method=method)
+        assert r.converged
+        assert r.joint("pivot")[0] == pytest.approx(newton.joint("pivot")[0], abs=1e-5)
+    dense = model.solve(linear_algebra="dense")
+    sparse = model.solve(linear_algebra="sparse")
+    assert dense.diagnostics.linear_algebra == "dense"
+    assert sparse.diagnostics.linear_algebra == "sparse"
+    assert sparse.joint("pivot")[0] == pytest.approx(dense.joint("pivot")[0], abs=1e-8)
+    stopped = model.solve(max_iterations=1)
+    assert not stopped.converged and stopped.termination == "max_iterations"
+    loose = model.solve(tolerance=1e-2)
+    assert loose.iterations <= newton.iterations
+    stepped = model.solve(load_steps=4)
+    assert stepped.converged and stepped.diagnostics.load_steps == 4
+    with pytest.raises(ValueError, match="method"):
+        model.solve(method="gradient")
+    with pytest.raises(ValueError, match="tolerance"):
+        model.solve(tolerance=-1.0)
+    with pytest.raises(ValueError, match="load_steps"):
+        model.solve(load_steps=5000)
+
+
+def test_input_options_locks_initial_gravity(robots):
+    path = robots / "pendulum.urdf"
+    locked = restpose.load(path, locks={"pivot": -0.5}).solve()
+    assert locked.joint("pivot")[0] == pytest.approx(-0.5, abs=1e-10)
+    # gravity applies only when the file has none: the pendulum's file has one
+    assert restpose.load(path, gravity=(0, 0, -1)).gravity == pytest.approx([0, -9.81, 0])
+    start = restpose.load(path, initial={"pivot": -1.3}).solve()
+    assert start.joint("pivot")[0] == pytest.approx(PENDULUM_PHI, abs=1e-6)
+    moon = restpose.load_string(ARM, gravity=(0, 0, -1.62))
+    assert moon.gravity == pytest.approx([0, 0, -1.62])
+    # k θ = m g L cos θ for the arm (1 kg at 1 m, 10 N m/rad about y)
+    for model, g in ((moon, 1.62), (restpose.load_string(ARM), 9.81)):
+        theta = model.solve().joint("j")[0]
+        assert 10.0 * theta == pytest.approx(g * 1.0 * math.cos(theta), abs=1e-8)
+    # the analyze shortcut: input and solver options in one call
+    r = restpose.analyze(path, locks={"pivot": -0.5}, method="bfgs")
+    assert r.joint("pivot")[0] == pytest.approx(-0.5, abs=1e-10)
+
+
+def test_floating_base_on_the_ground(robots):
+    solo = robots / "solo12"
+    urdf = next(solo.glob("*.urdf"))
+    model = restpose.load(urdf, floating_base=True, ground=True, base_xyz=(0, 0, 0.5))
+    result = model.solve()
+    assert result.converged
+    assert len(result.contacts) > 0
+    total = sum(c.normal_force for c in result.contacts)
+    mass = sum(b["mass"] for b in model.check().bodies)
+    # the ground carries the weight
+    assert total == pytest.approx(mass * 9.81, rel=1e-6)
+    assert all(c.gap > -1e-6 for c in result.contacts)
+
+
+def test_builder_pendulum_matches_the_closed_form():
+    b = restpose.ModelBuilder("pendulum")
+    b.add_rigid_body("arm", mass=1.0, com=(0.5, 0, 0), inertia=np.eye(3) * 1e-3)
+    b.add_joint("hinge", "revolute", parent=None, child="arm", axis=(0, 1, 0))
+    b.add_joint_spring("hinge", stiffness=10.0)
+    model = b.build()
+    r = model.solve()
+    theta = r.joint("hinge")[0]
+    # about y, gravity -z: k θ = m g L cos θ
+    assert r.converged and 10.0 * theta == pytest.approx(9.81 * 0.5 * math.cos(theta), abs=1e-8)
+    assert_rest_pose(model, r, stable=True)
+    with pytest.raises(ValueError, match="built already"):
+        b.build()
+
+
+def test_builder_validates_like_the_importer():
+    b = restpose.ModelBuilder("bad")
+    b.add_rigid_body("arm", mass=-1.0)
+    b.add_joint("hinge", "revolute", parent=None, child="arm")
+    with pytest.raises(restpose.ModelError) as e:
+        b.build()
+    assert "arm" in str(e.value)
+    b = restpose.ModelBuilder("x")
+    b.add_rigid_body("arm", mass=1.0)
+    with pytest.raises(restpose.UnknownJointError) as e:
+        b.add_joint_spring("hnge", stiffness=1.0)
+    with pytest.raises(ValueError, match="joint kind"):
+        b.add_joint("j", "hinge", parent=None, child="arm")
+    with pytest.raises(ValueError, match="no body named"):
+        b.add_joint("j", "revolute", parent="base", child="arm")
+    b.add_joint("hinge", "revolute", parent=None, child="arm", limits=(1.0, -1.0))
+    with pytest.raises(restpose.ModelError):
+        b.build()
+
+
+def test_verify_and_assert_rest_pose(robots):
+    model = restpose.load(robots / "pendulum.urdf")
+    result = model.solve()
+    v = model.verify(result)
+    assert v.passed and bool(v)
+    assert json.loads(v.to_json())["passed"] is True
+    assert v.stability.verdict == "stable"
+    # the same pose as joint values and as the command line's result file
+    assert model.verify({"pivot": float(result.joint("pivot")[0])}).passed
+    assert_rest_pose(model, result, stable=True)
+    # a pose off the rest pose fails, with the joint named in the message
+    with pytest.raises(AssertionError, match="pivot") as e:
+        assert_rest_pose(model, {"pivot": 0.0})
+    assert "needs effort" in str(e.value)
+    bad = model.verify({"pivot": 0.0})
+    assert not bad.passed and bad.max_imbalance.joint == "pivot"
+    assert abs(bad.max_imbalance.effort) > 1.0
+
+
+def test_verify_a_pose_file_like_the_command_line(robots, tmp_path):
+    path = robots / "pendulum.urdf"
+    out = tmp_path / "r.json"
+    subprocess.run(["restpose", "analyze", "-q", str(path), "--json", str(out)], check=True)
+    model = restpose.load(path)
+    v = model.verify(out)
+    cli = subprocess.run(
+        ["restpose", "verify", str(path), "--pose", str(out), "--json", "-"],
+        capture_output=True,
+        text=True,
+    )
+    assert cli.returncode == 0
+    assert json.loads(v.to_json()) == json.loads(cli.stdout)
+
+
+def test_solves_release_the_gil():
+    text = subprocess.run(
+        ["restpose", "generate", "chain", "--size", "400"],
+        check=True,
+        capture_output=True,
+        text=True,
+    ).stdout
+    model = restpose.load_string(text)
+    ticks = []
+    done = threading.Event()
+
+    def count():
+        while not done.is_set():
+            ticks.append(time.perf_counter())
+            time.sleep(0.001)
+
+    t = threading.Thread(target=count)
+    t.start()
+    time.sleep(0.01)
+    before = len(ticks)
+    started = time.perf_counter()
+    result = model.solve()
+    elapsed = time.perf_counter() - started
+    during = len([x for x in ticks if started <= x <= started + elapsed])
+    done.set()
+    t.join()
+    assert result.converged and before > 0
+    # with the GIL held the counter could not tick at all during the solve
+    assert elapsed > 0.02, "the solve is too short to tell"
+    assert during >= 5
+
+
+def test_models_are_independent_and_threads_can_share_them(robots):
+    a = restpose.load(robots / "pendulum.urdf")
+    b = restpose.load(robots / "pendulum.urdf", locks={"pivot": 0.2})
+    ra, rb = a.solve(), b.solve()
+    assert ra.joint("pivot")[0] != rb.joint("pivot")[0]
+    results = [None] * 4
+
+    def work(i):
+        results[i] = a.solve().joint("pivot")[0]
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert all(r == ra.joint("pivot")[0] for r in results)
+
+
+def test_docstrings_and_stubs():
+    assert "rest pose" in restpose.Model.solve.__doc__
+    assert "URDF" in restpose.load.__doc__
+    import pathlib
+
+    pkg = pathlib.Path(restpose.__file__).parent
+    assert (pkg / "py.typed").exists()
+    assert (pkg / "_native.pyi").exists()
+    assert restpose.__version__

@@ -146,7 +146,6 @@ impl ModelBuilder {
     /// the position limits of coordinate 0.
     #[pyo3(signature = (name, kind_name, *, parent, child, xyz=None, rpy=None, axis=[0.0, 0.0, 1.0],
         child_xyz=None, child_rpy=None, r#loop=false, limits=None, pitch=None, length=None))]
-    #[allow(clippy::too_many_arguments)]
     fn add_joint(
         &mut self,
         name: String,
@@ -208,7 +207,6 @@ impl ModelBuilder {
     /// ``free_length`` [m]; ``mode`` ``"both"``, ``"tension"`` (a cable) or ``"compression"``.
     #[pyo3(signature = (name, *, body_a, point_a, body_b, point_b, stiffness, free_length=0.0,
         preload=0.0, mode="both"))]
-    #[allow(clippy::too_many_arguments)]
     fn add_spring(
         &mut self,
         name: String,

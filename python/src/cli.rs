@@ -4,10 +4,6 @@
 //! installed by `pip` is the same program as `cargo install restpose`.
 
 #[path = "../../src/cli/mod.rs"]
-#[allow(
-    dead_code,
-    reason = "the binary's modules, compiled as the binary compiles them"
-)]
 mod commands;
 
 use clap::Parser;

@@ -56,7 +56,6 @@ impl Model {
 #[pyfunction]
 #[pyo3(signature = (path, *, packages=None, gravity=None, floating_base=false, ground=false,
     base_xyz=None, base_rpy=None, inertia_from_geometry=None, locks=None, initial=None))]
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn load(
     py: Python<'_>,
     path: PathBuf,
@@ -94,7 +93,6 @@ pub(crate) fn load(
 #[pyo3(signature = (text, *, file="<string>".to_string(), packages=None, gravity=None,
     floating_base=false, ground=false, base_xyz=None, base_rpy=None, inertia_from_geometry=None,
     locks=None, initial=None))]
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn load_string(
     py: Python<'_>,
     text: String,
@@ -218,7 +216,6 @@ impl Model {
     #[pyo3(signature = (*, method="newton", linear_algebra="auto", tolerance=1e-8,
         constraint_tolerance=1e-10, max_iterations=200, load_steps=0, allow_unstable=false,
         limits="enforce", friction="none", mu=None))]
-    #[allow(clippy::too_many_arguments)]
     fn solve(
         slf: &Bound<'_, Self>,
         method: &str,
@@ -270,7 +267,6 @@ impl Model {
     /// runs. Options as ``restpose verify``.
     #[pyo3(signature = (pose, *, force_tolerance=1e-6, constraint_tolerance=1e-8,
         limits="enforce", friction="none", mu=None, linear_algebra="auto", eigenvalues=false))]
-    #[allow(clippy::too_many_arguments)]
     fn verify<'py>(
         slf: &Bound<'py, Self>,
         pose: &Bound<'py, PyAny>,

@@ -58,17 +58,19 @@ pub(crate) fn coordinates(
                 }
             }
         }
-        if let Some((_, _, Some(v))) = out.last() {
-            if !v.is_finite() {
-                return Err(argument(format!("{what} `{key}`: value must be finite")));
-            }
-        }
+    }
+    if let Some((name, dof, Some(v))) = out
+        .iter()
+        .find(|(_, _, v)| v.is_some_and(|v| !v.is_finite()))
+    {
+        return Err(argument(format!(
+            "{what} `{name}[{dof}]` = {v}: values must be finite"
+        )));
     }
     Ok(out)
 }
 
 /// The importer's options from `load`'s keyword arguments.
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn import_options(
     packages: Option<HashMap<String, PathBuf>>,
     gravity: Option<[f64; 3]>,
@@ -173,7 +175,6 @@ pub(crate) fn friction(s: &str) -> PyResult<Friction> {
 }
 
 /// The solver's options from `solve`'s keyword arguments.
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn solver_options(
     method_name: &str,
     linear_algebra_name: &str,

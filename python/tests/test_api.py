@@ -160,6 +160,14 @@ def test_input_options_locks_initial_gravity(robots):
     for model, g in ((moon, 1.62), (restpose.load_string(ARM), 9.81)):
         theta = model.solve().joint("j")[0]
         assert 10.0 * theta == pytest.approx(g * 1.0 * math.cos(theta), abs=1e-8)
+    # several coordinates: a list (None = not given) or "joint[dof]" keys, as on the command line
+    with pytest.raises(restpose.CoordinateError):
+        restpose.load(path, locks={"pivot": [None, 0.3]})
+    with pytest.raises(restpose.CoordinateError):
+        restpose.load(path, initial={"pivot[1]": 0.3})
+    assert restpose.load(path, locks={"pivot[0]": -0.5}).solve().joint("pivot")[0] == pytest.approx(-0.5)
+    with pytest.raises(ValueError, match="finite"):
+        restpose.load(path, locks={"pivot": float("nan")})
     # the analyze shortcut: input and solver options in one call
     r = restpose.analyze(path, locks={"pivot": -0.5}, method="bfgs")
     assert r.joint("pivot")[0] == pytest.approx(-0.5, abs=1e-10)
@@ -221,8 +229,9 @@ def test_verify_and_assert_rest_pose(robots):
     assert v.passed and bool(v)
     assert json.loads(v.to_json())["passed"] is True
     assert v.stability.verdict == "stable"
-    # the same pose as joint values and as the command line's result file
+    # the same pose as joint values, and as a result of another model of the same file
     assert model.verify({"pivot": float(result.joint("pivot")[0])}).passed
+    assert restpose.load(robots / "pendulum.urdf").verify(result).passed
     assert_rest_pose(model, result, stable=True)
     # a pose off the rest pose fails, with the joint named in the message
     with pytest.raises(AssertionError, match="pivot") as e:

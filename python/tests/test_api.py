@@ -106,6 +106,20 @@ def test_to_json_is_the_command_lines_json(robots, tmp_path):
     assert r.iterations == cli["iterations"] and r.dof == cli["dof"]
 
 
+def test_joint_states_are_the_command_lines(robots, tmp_path):
+    path = robots / "ur5_class.urdf"
+    out = tmp_path / "js.yaml"
+    subprocess.run(
+        ["restpose", "analyze", "-q", str(path), "--write-joint-states", str(out)], check=True
+    )
+    result = restpose.load(path).solve()
+    assert result.to_joint_states() == out.read_text()
+    # and it is a pose that verify reads back as a rest pose
+    back = tmp_path / "back.yaml"
+    back.write_text(result.to_joint_states())
+    assert result.model.verify(back).passed
+
+
 def test_check_is_the_command_lines_check(robots):
     path = robots / "four_bar_spatial.urdf"
     cli = subprocess.run(

@@ -43,6 +43,25 @@ mod tests {
         );
     }
 
+    /// A "home" keyframe at the rest angle passes (the example of `docs/verify.md`).
+    #[test]
+    fn home_keyframe_is_a_rest_pose() {
+        let model = restpose::urdf::load_file("robots/pendulum.urdf", &Default::default())
+            .unwrap()
+            .model;
+        let home = [("pivot".to_string(), vec![-1.381577080])]
+            .into_iter()
+            .collect();
+        let (state, _) = pose_state(&model, &home).unwrap();
+        let tol = Tolerances {
+            force: 1e-6,
+            constraint: 1e-8,
+            ..Default::default()
+        };
+        let check = verify(&model, &state, &tol).unwrap();
+        assert!(check.passed, "largest imbalance: {:?}", check.max_imbalance);
+    }
+
     /// A "home" keyframe that is not a rest pose fails, and names the joint out of balance.
     #[test]
     fn pendulum_home_keyframe_is_not_at_rest() {

@@ -1,4 +1,4 @@
-//! Exit codes (documented in the README's "Command line" section; 2 is clap's usage error).
+//! Exit codes (documented in docs/cli.md; 2 is clap's usage error).
 
 /// Invalid input or another error (file, option, assembly).
 pub(crate) const INPUT: u8 = 1;

@@ -1,4 +1,4 @@
-//! The result JSON (field names are a contract; see the README).
+//! The result JSON (field names are a contract, documented in docs/json.md).
 
 use crate::forces::Energy;
 use crate::model::{JointKind, Model};

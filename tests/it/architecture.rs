@@ -1,6 +1,6 @@
 //! The layers of the library, held by a test: each top-level module of `src/` may use only
 //! the modules of lower layers (and, within its own layer, only itself), so the module graph
-//! has no cycle and no upward import. The table is the architecture of `docs/architecture.md`:
+//! has no cycle and no upward import. The table is the architecture of `docs/development.md`:
 //!
 //! ```text
 //! error, math  →  geometry  →  model  →  jet  →  kinematics  →  constraints | forces

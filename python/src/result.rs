@@ -313,7 +313,10 @@ impl Result {
     /// The rest pose as ROS joint_states-style YAML, as ``restpose analyze
     /// --write-joint-states`` writes it (``restpose verify --pose`` reads it back).
     fn to_joint_states(&self) -> String {
-        restpose::export::joint_states::joint_states_yaml(&self.model.get().loaded.model, &self.state)
+        restpose::export::joint_states::joint_states_yaml(
+            &self.model.get().loaded.model,
+            &self.state,
+        )
     }
 
     fn __repr__(&self) -> String {

@@ -59,6 +59,20 @@ pub(crate) struct Outcome {
 /// default 1e-8 J only for models whose energy terms add up to more than 10⁵ J.
 const GRADIENT_FLOOR: f64 = 1e-13;
 
+/// A dense partition whose smallest-to-largest pivot ratio of `Φ_u` has fallen below this
+/// fraction of its value where the partition was made is checked against a fresh one.
+const PIVOT_DRIFT: f64 = 0.85;
+
+/// Whether two partitions choose the same dependent coordinates and rows (in any order).
+fn same_split(a: &Partition, b: &Partition) -> bool {
+    let sorted = |x: &[usize]| {
+        let mut x = x.to_vec();
+        x.sort_unstable();
+        x
+    };
+    sorted(&a.dependent) == sorted(&b.dependent) && sorted(&a.rows) == sorted(&b.rows)
+}
+
 /// The inverse-Hessian approximation of BFGS / DFP in the current independent coordinates.
 struct QuasiNewton {
     binv: DMatrix<f64>,
@@ -220,6 +234,7 @@ pub(crate) fn minimize(
     // The step length the line search starts from: 1, or after a step the corrector could
     // not follow in full, the fraction that it could, doubled after each full success.
     let mut reach = 1.0f64;
+    let mut pivot_reference = eval.factors.pivot_ratio();
     loop {
         let f = eval.merit;
         let gnorm = eval.grad_v.amax();
@@ -236,6 +251,9 @@ pub(crate) fn minimize(
             });
             if options.record_iterates {
                 iterates.push(q.clone());
+            }
+            if let Some(report) = &options.progress.0 {
+                report(iteration, eval.energy.total, gnorm);
             }
         }
         let mut negative_curvature = None;
@@ -433,8 +451,24 @@ pub(crate) fn minimize(
                 // second-pass choices) when the partition at `q` makes other ones. (Not on
                 // any change: where a carried row ends in the final full pivoting among
                 // nearly equal levers would flip from step to step.)
+                let drifted = match (eval.factors.pivot_ratio(), pivot_reference) {
+                    (Some(now), Some(reference)) => now < PIVOT_DRIFT * reference,
+                    _ => false,
+                };
                 if eval.factors.ill_conditioned() {
                     (part, eval, qn) = repartition(sys, &q, options.method, &mut diag)?;
+                    pivot_reference = eval.factors.pivot_ratio();
+                } else if drifted {
+                    // The dependent coordinates chosen at the start of this partition are
+                    // losing their hold: a fresh full pivoting at `q`, adopted if it differs.
+                    let fresh = sys.partition(&q);
+                    if !same_split(&fresh, &part) {
+                        diag.repartitions += 1;
+                        eval = sys.evaluate(&q, &fresh)?;
+                        part = fresh;
+                        qn = QuasiNewton::new(part.independent.len(), options.method);
+                    }
+                    pivot_reference = eval.factors.pivot_ratio();
                 } else if !part.second_pass.is_empty() {
                     let fresh = sys.partition(&q);
                     if fresh.second_pass != part.second_pass {
@@ -447,6 +481,7 @@ pub(crate) fn minimize(
             }
             None if !just_repartitioned => {
                 (part, eval, qn) = repartition(sys, &q, options.method, &mut diag)?;
+                pivot_reference = eval.factors.pivot_ratio();
                 just_repartitioned = true;
             }
             None => {

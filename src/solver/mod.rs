@@ -34,7 +34,7 @@ pub(crate) mod system;
 mod unbounded;
 
 pub use mode_animation::mode_animation;
-pub use options::{Limits, LinearAlgebra, Method, Options};
+pub use options::{Limits, LinearAlgebra, Method, Options, Progress, ProgressFn};
 pub use report::{
     ActiveLimit, Contact, ContactState, Diagnostics, Iterate, Reaction, Report, Sizes, Stability,
     Termination, Timings, Verdict,
@@ -227,7 +227,9 @@ pub(crate) fn stability_of(
     Some(stability(sys, q, part, eval, &eig))
 }
 
-/// Finds the stable static equilibrium of `model` from its initial guess.
+/// Finds the stable static equilibrium of `model` from its initial guess (a floating
+/// mechanism with grounds and no base pose given starts with its lowest contact point on the
+/// grounds, module `assemble`).
 ///
 /// # Errors
 /// [`Error::Assembly`] if the loops cannot be closed from the initial guess,
@@ -247,7 +249,7 @@ pub(crate) fn stability_of(
 /// # let _ = state;
 /// ```
 pub fn solve(model: &Model, options: &Options) -> Result<(State, Report)> {
-    let start = initial_state(model);
+    let start = assemble::grounded_start(model, initial_state(model));
     solve_from(model, start, options)
 }
 
@@ -262,23 +264,41 @@ pub fn solve_from(model: &Model, start: State, options: &Options) -> Result<(Sta
     let q = assemble::assemble(model, start.q, &mut branches, &locks, options)?;
     let q = State { q, branches };
     let assembly = started.elapsed().as_secs_f64();
-    let (state, mut report) = match options.load_steps {
-        0 => {
-            let direct = solve_assembled(model, q.clone(), &locks, options)?;
-            if direct.1.converged() || direct.1.termination == Termination::Unbounded {
-                direct
-            } else {
-                let ramped = ramp(model, q, AUTOMATIC_LOAD_STEPS, &locks, options)?;
-                if ramped.1.converged() {
-                    ramped
-                } else {
-                    direct
+    let (state, mut report) =
+        if let Some(fall) = unbounded::fall_at_start(model, &q, &locks, options)? {
+            fall
+        } else {
+            match options.load_steps {
+                0 => {
+                    let direct = solve_assembled(model, q.clone(), &locks, options)?;
+                    // `max_iterations` bounds the whole solve: the ramp gets what the direct
+                    // attempt left (nothing if it ran out).
+                    let left = options.max_iterations.saturating_sub(direct.1.iterations);
+                    if direct.1.converged()
+                        || direct.1.termination == Termination::Unbounded
+                        || direct.1.termination == Termination::MaxIterations
+                        || left == 0
+                    {
+                        direct
+                    } else {
+                        let budget = Options {
+                            max_iterations: left,
+                            ..options.clone()
+                        };
+                        let mut ramped = ramp(model, q, AUTOMATIC_LOAD_STEPS, &locks, &budget)?;
+                        if ramped.1.converged() {
+                            ramped.1.iterations += direct.1.iterations;
+                            ramped.1.diagnostics.add_counts(&direct.1.diagnostics);
+                            ramped
+                        } else {
+                            direct
+                        }
+                    }
                 }
+                1 => solve_assembled(model, q, &locks, options)?,
+                n => ramp(model, q, n, &locks, options)?,
             }
-        }
-        1 => solve_assembled(model, q, &locks, options)?,
-        n => ramp(model, q, n, &locks, options)?,
-    };
+        };
     // Everything after the assembly that is not the final stability is iterations (load
     // stages and a direct attempt before a ramp included).
     let t = &mut report.diagnostics.timings;
@@ -306,12 +326,27 @@ fn ramp(
     let mut counters = Diagnostics::default();
     for k in 1..n {
         let stage = model.with_load_factor(k as f64 / n as f64);
-        let (s, r) = solve_assembled(&stage, q, locks, options)?;
+        let budget = Options {
+            max_iterations: options.max_iterations.saturating_sub(iterations),
+            ..options.clone()
+        };
+        let (s, mut r) = solve_assembled(&stage, q, locks, &budget)?;
         q = s;
+        if !r.converged() {
+            // A stage that did not come to rest ends the ramp (out of iterations, or no rest).
+            r.iterations += iterations;
+            r.diagnostics.add_counts(&counters);
+            r.diagnostics.load_steps = n;
+            return Ok((q, r));
+        }
         iterations += r.iterations;
         counters.add_counts(&r.diagnostics);
     }
-    let (s, mut r) = solve_assembled(model, q, locks, options)?;
+    let budget = Options {
+        max_iterations: options.max_iterations.saturating_sub(iterations),
+        ..options.clone()
+    };
+    let (s, mut r) = solve_assembled(model, q, locks, &budget)?;
     r.iterations += iterations;
     r.diagnostics.add_counts(&counters);
     r.diagnostics.load_steps = n;

@@ -49,6 +49,12 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
                  --inertia-from-geometry DENSITY"
             )
         }
+        restpose::Error::Assembly { ref remedy, .. } if remedy.contains("mech:base") => {
+            anyhow::anyhow!(
+                "{e}; on the command line: --base-xyz X Y Z (and --base-rpy) for the base, \
+                 --initial JOINT=VALUE for the joints"
+            )
+        }
         e => e.into(),
     })?;
     report.diagnostics.timings.import = import;

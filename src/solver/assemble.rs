@@ -210,8 +210,8 @@ pub(crate) fn project(
                 .is_some_and(|b| matches!(b.kind, crate::constraints::BlockKind::Unilateral(_)));
             let remedy = if unilateral {
                 "a contact or stop starts too far inside its bound to be pushed out together with \
-                 the joints: start the floating base above the ground with --base-xyz (or \
-                 `mech:base`), or the joints inside their limits with --initial"
+                 the joints: start the floating base above the ground (`mech:base`), or the \
+                 joints inside their limits (`mech:initial`)"
             } else {
                 "check the loop geometry or give `mech:initial` values near an assembled pose"
             };

@@ -16,7 +16,13 @@
 //! corrector's remaining residual (otherwise `μ·Φ` can exceed the decrease a Newton step
 //! promises near the minimum); if the corrector fails
 //! the step is halved (paper step (f)). When no step is found, the coordinates are
-//! re-partitioned once at the current point; a sparse partition with second-pass choices for
+//! re-partitioned once at the current point. A dense partition is also compared with a fresh
+//! full pivoting after a step where the smallest-to-largest pivot ratio of `Φ_u` has fallen
+//! below [`PIVOT_DRIFT`] of its value where the partition was made, and replaced if that one
+//! differs: as the mechanism moves, the dependent coordinates chosen at the start lose their
+//! hold (an Euler parameter near a turning point), `H = −Φ_u⁻¹ Φ_v` grows, the reduced
+//! Hessian's eigenvalues spread with it and its floor swallows the physical curvatures (a
+//! UR5 swinging down from horizontal stalled at ‖∇f‖ = 10⁻² for 200 iterations). a sparse partition with second-pass choices for
 //! contact or stop rows (module `sparse::partition`) is recomputed after every step and
 //! replaced when those choices have changed. At a stationary point with a negative reduced
 //! Hessian eigenvalue (a saddle or maximum) the search leaves along its eigenvector, unless
@@ -31,7 +37,6 @@ use super::active_set::Guard;
 use super::options::{Method, Options};
 use super::partition::Partition;
 use super::report::{Diagnostics, Iterate, Termination};
-use super::sparse::kkt::Factored;
 use super::spectrum::{spectrum, Spectrum};
 use super::system::{Backend, Eval, System};
 use nalgebra::{DMatrix, DVector};
@@ -154,57 +159,6 @@ fn extent(q: &DVector<f64>) -> f64 {
         .sqrt()
 }
 
-/// The Newton direction from the sparse KKT system (module `sparse::kkt`): the exact
-/// reduced Newton step if it is a descent direction, else the step with the `W` block shifted
-/// by `δ I`, `δ = 10⁻⁶ max|Ŵ_ii|` and growing a hundredfold until it is (a
-/// Levenberg–Marquardt-type modification of an indefinite reduced Hessian); the steepest
-/// descent direction if no shift works.
-fn kkt_direction(
-    sys: &mut System,
-    q: &DVector<f64>,
-    part: &Partition,
-    eval: &Eval,
-) -> DVector<f64> {
-    let g = &eval.grad_v;
-    // Right side `−S (V_qᵀ − Φ_qᵀ μ)`: zero on the dependent coordinates (`Φ_uᵀ μ = V_uᵀ`) and
-    // `−∇f` on the independent ones. It has the same projection `Zᵀ b = −∇f` as `−S V_qᵀ`,
-    // but is small near the minimum where `V_q` is not (the applied forces balanced by the
-    // constraint forces), so the solve's rounding error shrinks with the gradient.
-    let mut b = DVector::zeros(q.len());
-    for (k, &c) in part.independent.iter().enumerate() {
-        b[c] = -g[k];
-    }
-    let mut delta = 0.0;
-    for attempt in 0..12 {
-        let mut factored = sys.factor_kkt(q, part, eval, attempt == 0, delta);
-        let mut dq = sys.kkt_solve(&b);
-        if dq.is_none() && matches!(factored, Factored::Ldlt { .. }) {
-            // LDLᵀ without pivoting was not accurate enough here: LU with partial pivoting.
-            factored = sys.kkt_fall_back_to_lu();
-            dq = sys.kkt_solve(&b);
-        }
-        // The step is taken if it goes downhill, even where the reduced Hessian is indefinite
-        // (LDLᵀ would count its negative eigenvalues, but a global shift large enough to
-        // remove them slows the soft parts of a stiff mechanism down to a crawl; the line
-        // search and the final stability check handle what is left).
-        if let (false, Some(dq)) = (factored == Factored::None, dq) {
-            let d = DVector::from_iterator(
-                part.independent.len(),
-                part.independent.iter().map(|&c| dq[c]),
-            );
-            if d.dot(g) < -1e-12 * d.norm() * g.norm() {
-                return d;
-            }
-        }
-        delta = if delta == 0.0 {
-            1e-6 * sys.kkt_scale().max(1e-12)
-        } else {
-            delta * 100.0
-        };
-    }
-    -g.clone()
-}
-
 /// Minimizes from `q`; with a `guard`, a step that would violate one of its inequalities is
 /// cut where the first one reaches its boundary, and the minimization stops there
 /// (`Outcome::blocked`).
@@ -300,7 +254,7 @@ pub(crate) fn minimize(
                     }
                     d
                 }
-                (_, Method::Newton) => kkt_direction(sys, &q, &part, &eval),
+                (_, Method::Newton) => super::kkt_direction::kkt_direction(sys, &q, &part, &eval),
                 _ => -(&qn.binv * g),
             }
         };

@@ -20,6 +20,8 @@ mod cone;
 mod distribution;
 mod eigen;
 mod guard;
+mod kkt_direction;
+mod load_steps;
 mod minimize;
 mod mode_animation;
 mod options;
@@ -268,36 +270,7 @@ pub fn solve_from(model: &Model, start: State, options: &Options) -> Result<(Sta
         if let Some(fall) = unbounded::fall_at_start(model, &q, &locks, options)? {
             fall
         } else {
-            match options.load_steps {
-                0 => {
-                    let direct = solve_assembled(model, q.clone(), &locks, options)?;
-                    // `max_iterations` bounds the whole solve: the ramp gets what the direct
-                    // attempt left (nothing if it ran out).
-                    let left = options.max_iterations.saturating_sub(direct.1.iterations);
-                    if direct.1.converged()
-                        || direct.1.termination == Termination::Unbounded
-                        || direct.1.termination == Termination::MaxIterations
-                        || left == 0
-                    {
-                        direct
-                    } else {
-                        let budget = Options {
-                            max_iterations: left,
-                            ..options.clone()
-                        };
-                        let mut ramped = ramp(model, q, AUTOMATIC_LOAD_STEPS, &locks, &budget)?;
-                        if ramped.1.converged() {
-                            ramped.1.iterations += direct.1.iterations;
-                            ramped.1.diagnostics.add_counts(&direct.1.diagnostics);
-                            ramped
-                        } else {
-                            direct
-                        }
-                    }
-                }
-                1 => solve_assembled(model, q, &locks, options)?,
-                n => ramp(model, q, n, &locks, options)?,
-            }
+            load_steps::solve(model, q, &locks, options)?
         };
     // Everything after the assembly that is not the final stability is iterations (load
     // stages and a direct attempt before a ramp included).
@@ -310,51 +283,8 @@ pub fn solve_from(model: &Model, start: State, options: &Options) -> Result<(Sta
 /// BFGS / DFP store a dense `dof × dof` inverse-Hessian approximation: refused above this.
 const QUASI_NEWTON_DOF_LIMIT: usize = 2000;
 
-/// Load steps tried when a direct solve does not converge (`Options::load_steps = 0`).
-const AUTOMATIC_LOAD_STEPS: usize = 8;
-
-/// Load stepping: solves with gravity, loads and efforts scaled by `k / n`, `k = 1 … n`, each
-/// stage starting from the previous rest pose.
-fn ramp(
-    model: &Model,
-    mut q: State,
-    n: usize,
-    locks: &[(JointId, usize, f64)],
-    options: &Options,
-) -> Result<(State, Report)> {
-    let mut iterations = 0;
-    let mut counters = Diagnostics::default();
-    for k in 1..n {
-        let stage = model.with_load_factor(k as f64 / n as f64);
-        let budget = Options {
-            max_iterations: options.max_iterations.saturating_sub(iterations),
-            ..options.clone()
-        };
-        let (s, mut r) = solve_assembled(&stage, q, locks, &budget)?;
-        q = s;
-        if !r.converged() {
-            // A stage that did not come to rest ends the ramp (out of iterations, or no rest).
-            r.iterations += iterations;
-            r.diagnostics.add_counts(&counters);
-            r.diagnostics.load_steps = n;
-            return Ok((q, r));
-        }
-        iterations += r.iterations;
-        counters.add_counts(&r.diagnostics);
-    }
-    let budget = Options {
-        max_iterations: options.max_iterations.saturating_sub(iterations),
-        ..options.clone()
-    };
-    let (s, mut r) = solve_assembled(model, q, locks, &budget)?;
-    r.iterations += iterations;
-    r.diagnostics.add_counts(&counters);
-    r.diagnostics.load_steps = n;
-    Ok((s, r))
-}
-
 /// Minimizes from an assembled `q`: partition, minimize, stability, reactions.
-fn solve_assembled(
+pub(crate) fn solve_assembled(
     model: &Model,
     start: State,
     locks: &[(JointId, usize, f64)],

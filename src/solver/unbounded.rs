@@ -20,7 +20,10 @@
 //! joint, spring, lock or possible contact connects to the world (a floating base with no
 //! ground under it), pulled by a net constant force `F = Σ m_b g + Σ f_load ≠ 0`. Its energy
 //! falls as `−|F| s` along `s = F̂ · r` without bound, so the solve reports `unbounded` at the
-//! start, naming the bodies and the force.
+//! start, naming the bodies and the force. Likewise a group that rests only on frictionless
+//! grounds while the pull has a component `F·t > 0` along a direction `t` that no ground
+//! opposes (`n_g·t ≥ 0` for every ground `g`): it slides along `t` without bound (a robot on a
+//! frictionless slope).
 
 use crate::jet::{global_index, pair_of};
 use crate::model::{JointId, Model};
@@ -39,7 +42,7 @@ pub(crate) fn fall_at_start(
     locks: &[(JointId, usize, f64)],
     options: &super::Options,
 ) -> crate::Result<Option<(State, super::Report)>> {
-    let Some(directions) = falling(model) else {
+    let Some(directions) = falling(model, options) else {
         return Ok(None);
     };
     let options = super::Options {
@@ -175,7 +178,7 @@ pub(crate) fn free_directions(model: &Model, q: &DVector<f64>, dq: &DVector<f64>
 /// floating joint connects it to the world, or if it has contact points and the model has a
 /// ground or an obstacle below which they might come to rest (a ground whose normal points
 /// along the pull cannot hold it: the group falls away from it).
-pub(crate) fn falling(model: &Model) -> Option<Vec<String>> {
+pub(crate) fn falling(model: &Model, options: &super::Options) -> Option<Vec<String>> {
     let n = model.bodies.len();
     let (mut parent, world) = groups(model);
     // Net constant force per group.
@@ -208,6 +211,30 @@ pub(crate) fn falling(model: &Model) -> Option<Vec<String>> {
         let support =
             !model.obstacles.is_empty() || model.grounds.iter().any(|g| g.normal.dot(&dir) < 0.0);
         if touches && support {
+            // Resting on frictionless grounds only: a rigid translation along `t` with
+            // `n_g·t ≥ 0` for every ground keeps every gap open and lowers the energy by
+            // `F·t` per metre.
+            let frictionless = model.obstacles.is_empty()
+                && model
+                    .contact_points
+                    .iter()
+                    .filter(|c| find(&mut parent, c.body.0) == r)
+                    .all(|c| {
+                        c.settings.friction.unwrap_or(options.friction)
+                            == crate::model::Friction::None
+                    });
+            if let Some(t) = frictionless.then(|| slide(model, &f)).flatten() {
+                if f.dot(&t) > 1e-9 * scale {
+                    out.push(format!(
+                        "body `{}` sliding along ({:.3}, {:.3}, {:.3}) (its contacts are frictionless and no ground stops it; gravity and loads pull it with {:.4} N along the ground)",
+                        model.bodies[members[r][0]].name,
+                        shown(t.x),
+                        shown(t.y),
+                        shown(t.z),
+                        f.dot(&t)
+                    ));
+                }
+            }
             continue;
         }
         let why = if model.grounds.is_empty() && model.obstacles.is_empty() {
@@ -227,6 +254,30 @@ pub(crate) fn falling(model: &Model) -> Option<Vec<String>> {
         ));
     }
     (!out.is_empty()).then_some(out)
+}
+
+/// The unit direction `t` maximizing `f·t` subject to `n_g·t ≥ 0` for every ground (a cone
+/// in 3-D: its best direction is `f` itself, `f` projected on one ground plane, or the line
+/// where two planes meet), if one with `f·t > 0` exists.
+fn slide(model: &Model, f: &nalgebra::Vector3<f64>) -> Option<nalgebra::Vector3<f64>> {
+    let normals: Vec<_> = model.grounds.iter().map(|g| g.normal).collect();
+    let mut candidates = vec![*f];
+    for n in &normals {
+        candidates.push(f - n * n.dot(f));
+    }
+    for (i, a) in normals.iter().enumerate() {
+        for b in &normals[i + 1..] {
+            let l = a.cross(b);
+            candidates.push(l * l.dot(f).signum());
+        }
+    }
+    candidates
+        .into_iter()
+        .filter(|t| t.norm() > 1e-12 * f.norm())
+        .map(|t| t.normalize())
+        .filter(|t| normals.iter().all(|n| n.dot(t) >= -1e-12))
+        .max_by(|a, b| a.dot(f).total_cmp(&b.dot(f)))
+        .filter(|t| t.dot(f) > 0.0)
 }
 
 /// Union-find root of `i` in `p`.

@@ -30,7 +30,7 @@ pub(super) fn add(b: &mut Builder, options: &ImportOptions) -> Result<()> {
     for r in &options.servos {
         if !(r.stiffness.is_finite() && r.stiffness > 0.0) {
             return Err(Error::Pose {
-                file: "--servo".into(),
+                file: "servo".into(),
                 message: format!(
                     "servo {}: stiffness {} must be positive and finite",
                     r.joint.as_deref().unwrap_or("all"),
@@ -59,7 +59,7 @@ pub(super) fn add(b: &mut Builder, options: &ImportOptions) -> Result<()> {
                     .ok_or_else(|| model.unknown_joint("servo", name))?;
                 if !actuated(id.0) {
                     return Err(Error::Pose {
-                        file: "--servo".into(),
+                        file: "servo".into(),
                         message: format!(
                             "servo on joint `{name}`: a servo holds a revolute, continuous or prismatic joint, `{name}` is {}",
                             model.joints[id.0].kind.name()

@@ -132,3 +132,35 @@ fn max_iterations_bounds_every_round_and_load_step_together() {
         }
     }
 }
+
+#[test]
+fn a_robot_on_a_frictionless_slope_slides_without_bound_and_is_told_at_once() {
+    // The Solo-12 on its ground with gravity tilted by α (a slope of α): frictionless feet
+    // slide, pulled along the slope by m g sin α; sticking feet hold it.
+    let alpha: f64 = 0.12;
+    let tilted = ImportOptions {
+        floating_base: true,
+        gravity: nalgebra::Vector3::new(9.81 * alpha.sin(), 0.0, -9.81 * alpha.cos()),
+        ..Default::default()
+    };
+    let model = load("solo12/solo12_ground", &tilted);
+    let (_, report) = restpose::solve(&model, &Options::default()).unwrap();
+    assert_eq!(report.termination, Termination::Unbounded);
+    assert_eq!(report.iterations, 0);
+    let dirs = &report.diagnostics.free_directions;
+    assert_eq!(dirs.len(), 1, "{dirs:?}");
+    let mass: f64 = model.bodies.iter().map(|b| b.gravity_mass).sum();
+    let pull = mass * 9.81 * alpha.sin();
+    assert!(
+        dirs[0].contains("sliding along (1.000, 0.000, 0.000)")
+            && dirs[0].contains(&format!("{pull:.4} N along the ground")),
+        "{} (m g sin α = {pull:.4} N)",
+        dirs[0]
+    );
+    let stick = Options {
+        friction: restpose::model::Friction::Stick,
+        ..Default::default()
+    };
+    let (_, held) = restpose::solve(&model, &stick).unwrap();
+    assert_ne!(held.termination, Termination::Unbounded);
+}

@@ -4,7 +4,8 @@
 //! 0.42 m inside the floor, and the message pointed at loops the robot does not have. Now,
 //! with grounds and no base pose given, the mechanism starts translated against gravity so that
 //! its lowest contact point touches the ground, and settles from there; an assembly that fails
-//! on a contact names the real remedy, `--base-xyz`.
+//! on a contact names the real remedy, the base's start pose (`mech:base`; the CLI adds
+//! `--base-xyz`).
 
 use restpose::urdf::{load_file, ImportOptions};
 use restpose::Options;
@@ -80,7 +81,7 @@ fn a_base_placed_inside_the_ground_names_base_xyz() {
     match restpose::solve(&model, &Options::default()) {
         Err(e) => {
             let text = e.to_string();
-            assert!(text.contains("--base-xyz"), "{text}");
+            assert!(text.contains("mech:base"), "{text}");
             assert!(!text.contains("loop geometry"), "{text}");
         }
         Ok((_, r)) => {

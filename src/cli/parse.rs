@@ -56,24 +56,6 @@ pub(crate) fn generate_size(s: &str) -> Result<usize, String> {
     bounded(s, 1, MAX_GENERATE_SIZE)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn numbers_are_checked() {
-        assert_eq!(positive("1e-9"), Ok(1e-9));
-        for bad in ["0", "-1e-9", "nan", "inf", "-inf", "x", ""] {
-            assert!(positive(bad).is_err(), "{bad}");
-        }
-        assert_eq!(finite("-9.81"), Ok(-9.81));
-        assert!(finite("NaN").is_err() && finite("1e400").is_err());
-        assert_eq!(load_steps("1000"), Ok(1000));
-        assert!(load_steps("1001").is_err() && load_steps("-1").is_err());
-        assert!(generate_size("0").is_err());
-    }
-}
-
 /// A `--servo` value: `all=K`, `JOINT=K` or `JOINT=K@REF` (K > 0 and finite, REF finite).
 pub(crate) fn servo(s: &str) -> anyhow::Result<restpose::urdf::ServoRequest> {
     let usage = || format!("--servo {s}: expected all=K, JOINT=K or JOINT=K@REF");
@@ -94,4 +76,22 @@ pub(crate) fn servo(s: &str) -> anyhow::Result<restpose::urdf::ServoRequest> {
         stiffness,
         reference,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_are_checked() {
+        assert_eq!(positive("1e-9"), Ok(1e-9));
+        for bad in ["0", "-1e-9", "nan", "inf", "-inf", "x", ""] {
+            assert!(positive(bad).is_err(), "{bad}");
+        }
+        assert_eq!(finite("-9.81"), Ok(-9.81));
+        assert!(finite("NaN").is_err() && finite("1e400").is_err());
+        assert_eq!(load_steps("1000"), Ok(1000));
+        assert!(load_steps("1001").is_err() && load_steps("-1").is_err());
+        assert!(generate_size("0").is_err());
+    }
 }

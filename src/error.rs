@@ -173,8 +173,7 @@ pub enum Error {
     #[error(
         "{}cannot assemble the mechanism from the initial guess: constraint `{row}` is violated \
          by {residual:.3e} there and {iterations} damped Newton iterations could not close the \
-         constraints (check the loop geometry or give `mech:initial` values near an assembled \
-         pose)",
+         constraints ({remedy})",
         prefix(site)
     )]
     Assembly {
@@ -186,6 +185,9 @@ pub enum Error {
         row: String,
         /// Newton iterations spent.
         iterations: usize,
+        /// What to change: for a loop joint, its geometry or initial values; for a contact that
+        /// starts inside a ground, the base's start pose.
+        remedy: String,
     },
     /// Redundant constraint rows that the assembled pose does not satisfy.
     #[error(

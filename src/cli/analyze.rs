@@ -33,11 +33,26 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
         }
     }
     let model = &loaded.model;
-    let (state, mut report) = restpose::solve(model, &a.solver_options()).map_err(|e| match e {
+    let mut solver_options = a.solver_options();
+    let progress = super::progress::Line::start();
+    if let Some(line) = &progress {
+        solver_options.progress = line.callback();
+    }
+    let solved = restpose::solve(model, &solver_options);
+    if let Some(line) = progress {
+        line.finish();
+    }
+    let (state, mut report) = solved.map_err(|e| match e {
         restpose::Error::ConstantEnergy { .. } if a.input.inertia_from_geometry.is_none() => {
             anyhow::anyhow!(
                 "{e}; links without <inertial> can get masses from their geometry with \
                  --inertia-from-geometry DENSITY"
+            )
+        }
+        restpose::Error::Assembly { ref remedy, .. } if remedy.contains("mech:base") => {
+            anyhow::anyhow!(
+                "{e}; on the command line: --base-xyz X Y Z (and --base-rpy) for the base, \
+                 --initial JOINT=VALUE for the joints"
             )
         }
         e => e.into(),

@@ -65,6 +65,22 @@ pub(crate) struct InputArgs {
     #[arg(long, num_args = 3, value_names = ["ROLL", "PITCH", "YAW"], allow_hyphen_values = true,
           value_parser = parse::finite)]
     pub(crate) base_rpy: Option<Vec<f64>>,
+    /// Hold joints like position servos: `all=K` (every revolute, continuous and prismatic
+    /// joint that is not locked or a mimic) or `JOINT=K[@REF]`, a joint spring of stiffness K
+    /// [N m/rad or N/m] about REF (default: the reference pose, else the initial value);
+    /// later ones override earlier ones (repeatable).
+    #[arg(long, value_name = "JOINT=K[@REF]")]
+    pub(crate) servo: Vec<String>,
+    /// The servos' reference pose: a joint_states YAML (what --write-joint-states writes) or
+    /// any pose file `verify --pose` reads.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) servo_reference: Option<PathBuf>,
+    /// An SRDF file whose `<group_state name=STATE>` (--state) is the servos' reference pose.
+    #[arg(long, value_name = "FILE.srdf", requires = "state")]
+    pub(crate) srdf: Option<PathBuf>,
+    /// The named `group_state` of --srdf.
+    #[arg(long, value_name = "NAME", requires = "srdf")]
+    pub(crate) state: Option<String>,
 }
 
 impl InputArgs {
@@ -92,6 +108,23 @@ impl InputArgs {
                 .split_once('=')
                 .with_context(|| format!("--package {p}: expected NAME=DIR"))?;
             opts.packages.push((n.to_string(), PathBuf::from(d)));
+        }
+        for s in &self.servo {
+            opts.servos.push(parse::servo(s)?);
+        }
+        if let Some(path) = &self.servo_reference {
+            let values = restpose::verify::read_pose(path)?;
+            let mut named: Vec<(String, f64)> = values
+                .into_iter()
+                .filter(|(_, v)| v.len() == 1)
+                .map(|(n, v)| (n, v[0]))
+                .collect();
+            named.sort_by(|a, b| a.0.cmp(&b.0));
+            opts.servo_reference.extend(named);
+        }
+        if let (Some(path), Some(state)) = (&self.srdf, &self.state) {
+            opts.servo_reference
+                .extend(restpose::urdf::srdf_state(path, state)?);
         }
         Ok(opts)
     }

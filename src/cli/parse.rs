@@ -56,6 +56,28 @@ pub(crate) fn generate_size(s: &str) -> Result<usize, String> {
     bounded(s, 1, MAX_GENERATE_SIZE)
 }
 
+/// A `--servo` value: `all=K`, `JOINT=K` or `JOINT=K@REF` (K > 0 and finite, REF finite).
+pub(crate) fn servo(s: &str) -> anyhow::Result<restpose::urdf::ServoRequest> {
+    let usage = || format!("--servo {s}: expected all=K, JOINT=K or JOINT=K@REF");
+    let (joint, rest) = s.rsplit_once('=').ok_or_else(|| anyhow::anyhow!(usage()))?;
+    let (k, reference) = match rest.split_once('@') {
+        Some((k, r)) => (
+            k,
+            Some(finite(r).map_err(|e| anyhow::anyhow!("{}: {e}", usage()))?),
+        ),
+        None => (rest, None),
+    };
+    let stiffness = positive(k).map_err(|e| anyhow::anyhow!("--servo {s}: stiffness {e}"))?;
+    if joint.is_empty() {
+        anyhow::bail!(usage());
+    }
+    Ok(restpose::urdf::ServoRequest {
+        joint: (joint != "all").then(|| joint.to_string()),
+        stiffness,
+        reference,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

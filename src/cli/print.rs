@@ -142,6 +142,19 @@ pub(crate) fn analysis(r: &AnalysisResult) {
         );
     }
     stops_and_contacts(&r.active_limits, &r.contacts);
+    if !r.servos.is_empty() {
+        out!();
+        out!("  servo (actuator)                 reference     position      torque [N m or N]");
+        for v in &r.servos {
+            out!(
+                "  {:<32} {:>9.6} {:>12.6}   {:>12.4}",
+                v.joint,
+                v.reference,
+                v.position,
+                v.torque
+            );
+        }
+    }
     if r.slipping {
         out!("  warning: a sticking contact needs more friction than its coefficient mu: the mechanism would slide from this pose");
     }

@@ -68,6 +68,41 @@ pub struct LimitViolation {
     pub limits: [f64; 2],
 }
 
+/// A position servo (`--servo`) at the rest pose: the actuator torque (or force) that holds
+/// its joint, `τ = −k (θ − θ_ref)`.
+#[derive(Clone, Debug, Serialize)]
+pub struct ServoResult {
+    /// Joint name.
+    pub joint: String,
+    /// Stiffness `k` \[N m/rad or N/m\].
+    pub stiffness: f64,
+    /// Reference `θ_ref` \[rad or m\].
+    pub reference: f64,
+    /// Rest position `θ` \[rad or m\].
+    pub position: f64,
+    /// Actuator torque \[N m\] (force \[N\] on a prismatic joint).
+    pub torque: f64,
+}
+
+/// The servos of `model` at `state`.
+pub fn servo_results(model: &Model, state: &State) -> Vec<ServoResult> {
+    model
+        .servos
+        .iter()
+        .filter_map(|s| {
+            let j = &model.joints[s.joint.index()];
+            let position = *state.joint(model, &j.name)?.first()?;
+            Some(ServoResult {
+                joint: j.name.clone(),
+                stiffness: s.stiffness,
+                reference: s.reference,
+                position,
+                torque: s.torque(position),
+            })
+        })
+        .collect()
+}
+
 /// The whole result, as written by `restpose analyze --json`.
 #[derive(Clone, Debug, Serialize)]
 pub struct AnalysisResult {
@@ -123,6 +158,9 @@ pub struct AnalysisResult {
     pub coordinates: usize,
     /// Constraint rows (before dropping redundant ones).
     pub constraints: usize,
+    /// Position servos with their holding torques (absent without `--servo`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub servos: Vec<ServoResult>,
 }
 
 impl AnalysisResult {
@@ -208,6 +246,7 @@ impl AnalysisResult {
             bodies: report.sizes.bodies,
             coordinates: report.sizes.coordinates,
             constraints: report.sizes.constraint_rows,
+            servos: servo_results(model, state),
         }
     }
 

@@ -60,6 +60,7 @@ impl ModelBuilder {
                 joints: Vec::new(),
                 springs: Vec::new(),
                 joint_springs: Vec::new(),
+                servos: Vec::new(),
                 loads: Vec::new(),
                 efforts: Vec::new(),
                 locks: Vec::new(),

@@ -137,7 +137,53 @@ pub struct Initial {
     pub value: f64,
 }
 
+/// A position servo on a single-coordinate joint: a joint spring `τ = −k (θ − θ_ref)` (also
+/// in [`crate::Model::joint_springs`]), reported as the actuator torque (or force) that holds
+/// the joint.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Servo {
+    /// Joint.
+    pub joint: JointId,
+    /// Stiffness `k` \[N m/rad or N/m\].
+    pub stiffness: f64,
+    /// Reference `θ_ref` \[rad or m\].
+    pub reference: f64,
+}
+
+impl Servo {
+    /// The actuator torque (or force) `−k (θ − θ_ref)` at the joint value `theta`.
+    pub fn torque(&self, theta: f64) -> f64 {
+        -self.stiffness * (theta - self.reference)
+    }
+}
+
 impl ModelBuilder {
+    /// Adds a position servo on coordinate 0 of `joint` (module docs of [`Servo`]): a linear
+    /// joint spring of `stiffness` about `reference`, replacing a servo already on the joint.
+    pub fn add_servo(&mut self, joint: JointId, stiffness: f64, reference: f64) {
+        let law = ForceLaw::Linear {
+            stiffness,
+            preload: 0.0,
+        };
+        if let Some(k) = self.model.servos.iter().position(|s| s.joint == joint) {
+            self.model.servos.remove(k);
+            // Its spring is the k-th servo spring: the servo springs are kept last, in order.
+            let first = self.model.joint_springs.len() - self.model.servos.len() - 1;
+            self.model.joint_springs.remove(first + k);
+        }
+        self.model.joint_springs.push(JointSpring {
+            joint,
+            dof: 0,
+            reference,
+            law,
+        });
+        self.model.servos.push(Servo {
+            joint,
+            stiffness,
+            reference,
+        });
+    }
+
     /// Adds a point-to-point spring.
     pub fn add_spring(&mut self, spring: Spring) {
         self.model.springs.push(spring);
@@ -145,7 +191,7 @@ impl ModelBuilder {
 
     /// Adds a spring on coordinate `dof` of `joint`, `reference` \[rad or m\] at zero force.
     pub fn add_joint_spring(&mut self, joint: JointId, dof: usize, law: ForceLaw, reference: f64) {
-        self.model.joint_springs.push(JointSpring {
+        self.push_joint_spring(JointSpring {
             joint,
             dof,
             reference,
@@ -155,7 +201,9 @@ impl ModelBuilder {
 
     /// Adds a joint spring given in full.
     pub fn push_joint_spring(&mut self, spring: JointSpring) {
-        self.model.joint_springs.push(spring);
+        // Before the servos' springs, which are kept last (see `add_servo`).
+        let at = self.model.joint_springs.len() - self.model.servos.len();
+        self.model.joint_springs.insert(at, spring);
     }
 
     /// Adds a dead load.

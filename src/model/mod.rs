@@ -25,7 +25,7 @@ pub use check::{LARGEST_GRAVITY, LARGEST_LENGTH, LARGEST_MAGNITUDE};
 pub use connect::axis_frame;
 pub use contact::{ContactPoint, ContactSettings, Friction, Ground};
 pub use force::{
-    Effort, ForceLaw, Initial, JointSpring, Load, Lock, Mimic, Spring, SpringEnd, SpringMode,
+    Effort, ForceLaw, Initial, JointSpring, Load, Lock, Mimic, Servo, Spring, SpringEnd, SpringMode,
 };
 pub use hull::Hull;
 pub use joint::{Joint, JointId, JointKind};
@@ -50,6 +50,8 @@ pub struct Model {
     pub springs: Vec<Spring>,
     /// Springs on joint coordinates.
     pub joint_springs: Vec<JointSpring>,
+    /// Position servos (their springs are the last entries of `joint_springs`).
+    pub servos: Vec<Servo>,
     /// Constant dead loads.
     pub loads: Vec<Load>,
     /// Constant generalized forces on joint coordinates.

@@ -211,13 +211,18 @@ pub(crate) fn solve(
             .copied()
             .collect();
         let guard = Guard::new(model, options, inactive, &active, tol, &q);
+        // `max_iterations` bounds the iterations of all rounds together.
+        let budget = Options {
+            max_iterations: options.max_iterations.saturating_sub(iterations),
+            ..options.clone()
+        };
         let round = super::solve_round(
             model,
             crate::State { q, branches },
             locks,
             &active,
             Some(&guard),
-            options,
+            &budget,
         )?;
         iterations += round.report.iterations;
         counters.add_counts(&round.report.diagnostics);

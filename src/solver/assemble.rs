@@ -81,6 +81,44 @@ fn newton(
     Err(Failure::Stuck(MAX))
 }
 
+/// The start of a floating mechanism placed on the grounds: with grounds, contact points and
+/// no base pose given (`mech:base`, `--base-xyz`), every group of bodies that no joint holds
+/// to the world is translated against gravity (along +z without gravity), as it is (upright
+/// when the base starts at the identity), until its lowest contact point touches the grounds
+/// that face that way: `t = max_{c,g} −g_gap(c) / (n_g·û)`. It then settles from there.
+pub(crate) fn grounded_start(model: &Model, mut start: crate::State) -> crate::State {
+    if model.base_pose.is_some() || model.grounds.is_empty() || model.contact_points.is_empty() {
+        return start;
+    }
+    let up = if model.gravity.norm() > 0.0 {
+        -model.gravity.normalize()
+    } else {
+        nalgebra::Vector3::z()
+    };
+    let (root, world) = super::unbounded::groups(model);
+    let mut lift = vec![f64::NEG_INFINITY; model.bodies.len() + 1];
+    for (k, c) in model.contact_points.iter().enumerate() {
+        let r = root[c.body.0];
+        if r == world {
+            continue;
+        }
+        let x = crate::constraints::unilateral::point_world(model, k, &start.q);
+        for g in model.grounds.iter().filter(|g| g.normal.dot(&up) > 1e-9) {
+            let gap = g.normal.dot(&(x - g.origin)) - c.radius;
+            lift[r] = lift[r].max(-gap / g.normal.dot(&up));
+        }
+    }
+    for b in 0..model.bodies.len() {
+        let t = lift[root[b]];
+        if t.is_finite() {
+            for k in 0..3 {
+                start.q[7 * b + k] += t * up[k];
+            }
+        }
+    }
+    start
+}
+
 /// Assembles `q` (closes loops, applies locks and normalizes) or explains why it cannot.
 pub(crate) fn assemble(
     model: &Model,
@@ -161,11 +199,28 @@ pub(crate) fn project(
         Err(Failure::Stuck(iterations)) => {
             let worst = worst_joint_row(&mut sys, &q0);
             let row = sys.problem.cons.row_name(worst).to_string();
+            // The blocks are in row order: the row is the last block starting at or before it.
+            let unilateral = sys
+                .problem
+                .cons
+                .blocks
+                .iter()
+                .rev()
+                .find(|b| b.first <= worst)
+                .is_some_and(|b| matches!(b.kind, crate::constraints::BlockKind::Unilateral(_)));
+            let remedy = if unilateral {
+                "a contact or stop starts too far inside its bound to be pushed out together with \
+                 the joints: start the floating base above the ground (`mech:base`), or the \
+                 joints inside their limits (`mech:initial`)"
+            } else {
+                "check the loop geometry or give `mech:initial` values near an assembled pose"
+            };
             Err(Error::Assembly {
                 site: model.row_site(&row).map(Box::new),
                 residual: sys.phi()[worst].abs(),
                 row,
                 iterations,
+                remedy: remedy.into(),
             })
         }
     }

@@ -16,7 +16,13 @@
 //! corrector's remaining residual (otherwise `μ·Φ` can exceed the decrease a Newton step
 //! promises near the minimum); if the corrector fails
 //! the step is halved (paper step (f)). When no step is found, the coordinates are
-//! re-partitioned once at the current point; a sparse partition with second-pass choices for
+//! re-partitioned once at the current point. A dense partition is also compared with a fresh
+//! full pivoting after a step where the smallest-to-largest pivot ratio of `Φ_u` has fallen
+//! below [`PIVOT_DRIFT`] of its value where the partition was made, and replaced if that one
+//! differs: as the mechanism moves, the dependent coordinates chosen at the start lose their
+//! hold (an Euler parameter near a turning point), `H = −Φ_u⁻¹ Φ_v` grows, the reduced
+//! Hessian's eigenvalues spread with it and its floor swallows the physical curvatures (a
+//! UR5 swinging down from horizontal stalled at ‖∇f‖ = 10⁻² for 200 iterations). a sparse partition with second-pass choices for
 //! contact or stop rows (module `sparse::partition`) is recomputed after every step and
 //! replaced when those choices have changed. At a stationary point with a negative reduced
 //! Hessian eigenvalue (a saddle or maximum) the search leaves along its eigenvector, unless
@@ -31,7 +37,6 @@ use super::active_set::Guard;
 use super::options::{Method, Options};
 use super::partition::Partition;
 use super::report::{Diagnostics, Iterate, Termination};
-use super::sparse::kkt::Factored;
 use super::spectrum::{spectrum, Spectrum};
 use super::system::{Backend, Eval, System};
 use nalgebra::{DMatrix, DVector};
@@ -58,6 +63,20 @@ pub(crate) struct Outcome {
 /// `max(gradient_tolerance, 1e-13 · Σ|V_k|)`, `V_k` the individual energy terms. It exceeds the
 /// default 1e-8 J only for models whose energy terms add up to more than 10⁵ J.
 const GRADIENT_FLOOR: f64 = 1e-13;
+
+/// A dense partition whose smallest-to-largest pivot ratio of `Φ_u` has fallen below this
+/// fraction of its value where the partition was made is checked against a fresh one.
+const PIVOT_DRIFT: f64 = 0.85;
+
+/// Whether two partitions choose the same dependent coordinates and rows (in any order).
+fn same_split(a: &Partition, b: &Partition) -> bool {
+    let sorted = |x: &[usize]| {
+        let mut x = x.to_vec();
+        x.sort_unstable();
+        x
+    };
+    sorted(&a.dependent) == sorted(&b.dependent) && sorted(&a.rows) == sorted(&b.rows)
+}
 
 /// The inverse-Hessian approximation of BFGS / DFP in the current independent coordinates.
 struct QuasiNewton {
@@ -140,57 +159,6 @@ fn extent(q: &DVector<f64>) -> f64 {
         .sqrt()
 }
 
-/// The Newton direction from the sparse KKT system (module `sparse::kkt`): the exact
-/// reduced Newton step if it is a descent direction, else the step with the `W` block shifted
-/// by `δ I`, `δ = 10⁻⁶ max|Ŵ_ii|` and growing a hundredfold until it is (a
-/// Levenberg–Marquardt-type modification of an indefinite reduced Hessian); the steepest
-/// descent direction if no shift works.
-fn kkt_direction(
-    sys: &mut System,
-    q: &DVector<f64>,
-    part: &Partition,
-    eval: &Eval,
-) -> DVector<f64> {
-    let g = &eval.grad_v;
-    // Right side `−S (V_qᵀ − Φ_qᵀ μ)`: zero on the dependent coordinates (`Φ_uᵀ μ = V_uᵀ`) and
-    // `−∇f` on the independent ones. It has the same projection `Zᵀ b = −∇f` as `−S V_qᵀ`,
-    // but is small near the minimum where `V_q` is not (the applied forces balanced by the
-    // constraint forces), so the solve's rounding error shrinks with the gradient.
-    let mut b = DVector::zeros(q.len());
-    for (k, &c) in part.independent.iter().enumerate() {
-        b[c] = -g[k];
-    }
-    let mut delta = 0.0;
-    for attempt in 0..12 {
-        let mut factored = sys.factor_kkt(q, part, eval, attempt == 0, delta);
-        let mut dq = sys.kkt_solve(&b);
-        if dq.is_none() && matches!(factored, Factored::Ldlt { .. }) {
-            // LDLᵀ without pivoting was not accurate enough here: LU with partial pivoting.
-            factored = sys.kkt_fall_back_to_lu();
-            dq = sys.kkt_solve(&b);
-        }
-        // The step is taken if it goes downhill, even where the reduced Hessian is indefinite
-        // (LDLᵀ would count its negative eigenvalues, but a global shift large enough to
-        // remove them slows the soft parts of a stiff mechanism down to a crawl; the line
-        // search and the final stability check handle what is left).
-        if let (false, Some(dq)) = (factored == Factored::None, dq) {
-            let d = DVector::from_iterator(
-                part.independent.len(),
-                part.independent.iter().map(|&c| dq[c]),
-            );
-            if d.dot(g) < -1e-12 * d.norm() * g.norm() {
-                return d;
-            }
-        }
-        delta = if delta == 0.0 {
-            1e-6 * sys.kkt_scale().max(1e-12)
-        } else {
-            delta * 100.0
-        };
-    }
-    -g.clone()
-}
-
 /// Minimizes from `q`; with a `guard`, a step that would violate one of its inequalities is
 /// cut where the first one reaches its boundary, and the minimization stops there
 /// (`Outcome::blocked`).
@@ -220,6 +188,7 @@ pub(crate) fn minimize(
     // The step length the line search starts from: 1, or after a step the corrector could
     // not follow in full, the fraction that it could, doubled after each full success.
     let mut reach = 1.0f64;
+    let mut pivot_reference = eval.factors.pivot_ratio();
     loop {
         let f = eval.merit;
         let gnorm = eval.grad_v.amax();
@@ -236,6 +205,9 @@ pub(crate) fn minimize(
             });
             if options.record_iterates {
                 iterates.push(q.clone());
+            }
+            if let Some(report) = &options.progress.0 {
+                report(iteration, eval.energy.total, gnorm);
             }
         }
         let mut negative_curvature = None;
@@ -282,7 +254,7 @@ pub(crate) fn minimize(
                     }
                     d
                 }
-                (_, Method::Newton) => kkt_direction(sys, &q, &part, &eval),
+                (_, Method::Newton) => super::kkt_direction::kkt_direction(sys, &q, &part, &eval),
                 _ => -(&qn.binv * g),
             }
         };
@@ -433,8 +405,24 @@ pub(crate) fn minimize(
                 // second-pass choices) when the partition at `q` makes other ones. (Not on
                 // any change: where a carried row ends in the final full pivoting among
                 // nearly equal levers would flip from step to step.)
+                let drifted = match (eval.factors.pivot_ratio(), pivot_reference) {
+                    (Some(now), Some(reference)) => now < PIVOT_DRIFT * reference,
+                    _ => false,
+                };
                 if eval.factors.ill_conditioned() {
                     (part, eval, qn) = repartition(sys, &q, options.method, &mut diag)?;
+                    pivot_reference = eval.factors.pivot_ratio();
+                } else if drifted {
+                    // The dependent coordinates chosen at the start of this partition are
+                    // losing their hold: a fresh full pivoting at `q`, adopted if it differs.
+                    let fresh = sys.partition(&q);
+                    if !same_split(&fresh, &part) {
+                        diag.repartitions += 1;
+                        eval = sys.evaluate(&q, &fresh)?;
+                        part = fresh;
+                        qn = QuasiNewton::new(part.independent.len(), options.method);
+                    }
+                    pivot_reference = eval.factors.pivot_ratio();
                 } else if !part.second_pass.is_empty() {
                     let fresh = sys.partition(&q);
                     if fresh.second_pass != part.second_pass {
@@ -447,6 +435,7 @@ pub(crate) fn minimize(
             }
             None if !just_repartitioned => {
                 (part, eval, qn) = repartition(sys, &q, options.method, &mut diag)?;
+                pivot_reference = eval.factors.pivot_ratio();
                 just_repartitioned = true;
             }
             None => {

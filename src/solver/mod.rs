@@ -20,6 +20,8 @@ mod cone;
 mod distribution;
 mod eigen;
 mod guard;
+mod kkt_direction;
+mod load_steps;
 mod minimize;
 mod mode_animation;
 mod options;
@@ -34,7 +36,7 @@ pub(crate) mod system;
 mod unbounded;
 
 pub use mode_animation::mode_animation;
-pub use options::{Limits, LinearAlgebra, Method, Options};
+pub use options::{Limits, LinearAlgebra, Method, Options, Progress, ProgressFn};
 pub use report::{
     ActiveLimit, Contact, ContactState, Diagnostics, Iterate, Reaction, Report, Sizes, Stability,
     Termination, Timings, Verdict,
@@ -227,7 +229,9 @@ pub(crate) fn stability_of(
     Some(stability(sys, q, part, eval, &eig))
 }
 
-/// Finds the stable static equilibrium of `model` from its initial guess.
+/// Finds the stable static equilibrium of `model` from its initial guess (a floating
+/// mechanism with grounds and no base pose given starts with its lowest contact point on the
+/// grounds, module `assemble`).
 ///
 /// # Errors
 /// [`Error::Assembly`] if the loops cannot be closed from the initial guess,
@@ -247,7 +251,7 @@ pub(crate) fn stability_of(
 /// # let _ = state;
 /// ```
 pub fn solve(model: &Model, options: &Options) -> Result<(State, Report)> {
-    let start = initial_state(model);
+    let start = assemble::grounded_start(model, initial_state(model));
     solve_from(model, start, options)
 }
 
@@ -262,23 +266,12 @@ pub fn solve_from(model: &Model, start: State, options: &Options) -> Result<(Sta
     let q = assemble::assemble(model, start.q, &mut branches, &locks, options)?;
     let q = State { q, branches };
     let assembly = started.elapsed().as_secs_f64();
-    let (state, mut report) = match options.load_steps {
-        0 => {
-            let direct = solve_assembled(model, q.clone(), &locks, options)?;
-            if direct.1.converged() || direct.1.termination == Termination::Unbounded {
-                direct
-            } else {
-                let ramped = ramp(model, q, AUTOMATIC_LOAD_STEPS, &locks, options)?;
-                if ramped.1.converged() {
-                    ramped
-                } else {
-                    direct
-                }
-            }
-        }
-        1 => solve_assembled(model, q, &locks, options)?,
-        n => ramp(model, q, n, &locks, options)?,
-    };
+    let (state, mut report) =
+        if let Some(fall) = unbounded::fall_at_start(model, &q, &locks, options)? {
+            fall
+        } else {
+            load_steps::solve(model, q, &locks, options)?
+        };
     // Everything after the assembly that is not the final stability is iterations (load
     // stages and a direct attempt before a ramp included).
     let t = &mut report.diagnostics.timings;
@@ -290,36 +283,8 @@ pub fn solve_from(model: &Model, start: State, options: &Options) -> Result<(Sta
 /// BFGS / DFP store a dense `dof × dof` inverse-Hessian approximation: refused above this.
 const QUASI_NEWTON_DOF_LIMIT: usize = 2000;
 
-/// Load steps tried when a direct solve does not converge (`Options::load_steps = 0`).
-const AUTOMATIC_LOAD_STEPS: usize = 8;
-
-/// Load stepping: solves with gravity, loads and efforts scaled by `k / n`, `k = 1 … n`, each
-/// stage starting from the previous rest pose.
-fn ramp(
-    model: &Model,
-    mut q: State,
-    n: usize,
-    locks: &[(JointId, usize, f64)],
-    options: &Options,
-) -> Result<(State, Report)> {
-    let mut iterations = 0;
-    let mut counters = Diagnostics::default();
-    for k in 1..n {
-        let stage = model.with_load_factor(k as f64 / n as f64);
-        let (s, r) = solve_assembled(&stage, q, locks, options)?;
-        q = s;
-        iterations += r.iterations;
-        counters.add_counts(&r.diagnostics);
-    }
-    let (s, mut r) = solve_assembled(model, q, locks, options)?;
-    r.iterations += iterations;
-    r.diagnostics.add_counts(&counters);
-    r.diagnostics.load_steps = n;
-    Ok((s, r))
-}
-
 /// Minimizes from an assembled `q`: partition, minimize, stability, reactions.
-fn solve_assembled(
+pub(crate) fn solve_assembled(
     model: &Model,
     start: State,
     locks: &[(JointId, usize, f64)],

@@ -42,6 +42,24 @@ pub enum Limits {
     Ignore,
 }
 
+/// Called after every minimizer iteration with `(iteration, potential energy [J], ‖∂V/∂v‖∞
+/// [J])`, the iteration counted within its round (the CLI draws its progress line from it).
+pub type ProgressFn = dyn Fn(usize, f64, f64) + Send + Sync;
+
+/// An optional progress callback ([`ProgressFn`]).
+#[derive(Clone, Default)]
+pub struct Progress(pub Option<std::sync::Arc<ProgressFn>>);
+
+impl std::fmt::Debug for Progress {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(if self.0.is_some() {
+            "Progress(Some)"
+        } else {
+            "Progress(None)"
+        })
+    }
+}
+
 /// Options of [`crate::solve`].
 #[derive(Clone, Debug)]
 pub struct Options {
@@ -89,6 +107,8 @@ pub struct Options {
     /// Complementarity tolerance: a contact force or stop effort of the wrong sign smaller
     /// than this fraction of the largest applied force does not release it (default: 1e-9).
     pub force_tolerance: f64,
+    /// Called after every iteration (default: none).
+    pub progress: Progress,
 }
 
 impl Default for Options {
@@ -109,6 +129,7 @@ impl Default for Options {
             mu: None,
             gap_tolerance: 1e-9,
             force_tolerance: 1e-9,
+            progress: Progress::default(),
         }
     }
 }

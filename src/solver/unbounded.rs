@@ -15,10 +15,46 @@
 //! second: its rate changes by `δθ / (θ − θ_ref)` a step (`10⁻⁶` only at `θ − θ_ref` ≈ 3·10⁵
 //! rad with the default step cap). A zero-curvature point of a bounded energy (a pendulum
 //! passing the horizontal) fails it at the next step.
+//!
+//! Before iterating, [`falling`] finds what needs no iteration: a group of bodies that no
+//! joint, spring, lock or possible contact connects to the world (a floating base with no
+//! ground under it), pulled by a net constant force `F = Σ m_b g + Σ f_load ≠ 0`. Its energy
+//! falls as `−|F| s` along `s = F̂ · r` without bound, so the solve reports `unbounded` at the
+//! start, naming the bodies and the force. Likewise a group that rests only on frictionless
+//! grounds while the pull has a component `F·t > 0` along a direction `t` that no ground
+//! opposes (`n_g·t ≥ 0` for every ground `g`): it slides along `t` without bound (a robot on a
+//! frictionless slope).
 
 use crate::jet::{global_index, pair_of};
-use crate::model::Model;
+use crate::model::{JointId, Model};
+use crate::state::State;
 use nalgebra::DVector;
+
+/// The report of a mechanism that [`falling`] finds unbounded before any iteration: the
+/// assembled start with its energy, gradient and stability, `termination: unbounded` and the
+/// falling groups as free directions; `None` if nothing falls.
+///
+/// # Errors
+/// As [`super::solve_round`].
+pub(crate) fn fall_at_start(
+    model: &Model,
+    start: &State,
+    locks: &[(JointId, usize, f64)],
+    options: &super::Options,
+) -> crate::Result<Option<(State, super::Report)>> {
+    let Some(directions) = falling(model, options) else {
+        return Ok(None);
+    };
+    let options = super::Options {
+        max_iterations: 0,
+        ..options.clone()
+    };
+    let round = super::solve_round(model, start.clone(), locks, &[], None, &options)?;
+    let mut report = round.report;
+    report.termination = super::Termination::Unbounded;
+    report.diagnostics.free_directions = directions;
+    Ok(Some((round.state, report)))
+}
 
 /// Consecutive accepted steps at a constant energy rate that declare the energy unbounded.
 pub(crate) const UNBOUNDED_STEPS: usize = 6;
@@ -132,6 +168,160 @@ pub(crate) fn free_directions(model: &Model, q: &DVector<f64>, dq: &DVector<f64>
         }
     }
     out
+}
+
+/// The groups of bodies that nothing holds while a net constant force pulls them (module
+/// docs): one free direction per group, with the reason, or `None` if every group is held or
+/// balanced.
+///
+/// A group is held if a non-floating joint, a spring, or a lock, mimic or joint spring on a
+/// floating joint connects it to the world, or if it has contact points and the model has a
+/// ground or an obstacle below which they might come to rest (a ground whose normal points
+/// along the pull cannot hold it: the group falls away from it).
+pub(crate) fn falling(model: &Model, options: &super::Options) -> Option<Vec<String>> {
+    let n = model.bodies.len();
+    let (mut parent, world) = groups(model);
+    // Net constant force per group.
+    let mut force = vec![nalgebra::Vector3::zeros(); n + 1];
+    let mut members = vec![Vec::new(); n + 1];
+    for (b, body) in model.bodies.iter().enumerate() {
+        let r = find(&mut parent, b);
+        force[r] += model.gravity * body.gravity_mass;
+        members[r].push(b);
+    }
+    for l in &model.loads {
+        let r = find(&mut parent, l.body.0);
+        force[r] += l.force;
+    }
+    let scale = super::active_set::force_scale(model);
+    let mut out = Vec::new();
+    for r in 0..n {
+        if r == world || members[r].is_empty() {
+            continue;
+        }
+        let f = force[r];
+        if f.norm() <= 1e-9 * scale {
+            continue;
+        }
+        let dir = f / f.norm();
+        let touches = model
+            .contact_points
+            .iter()
+            .any(|c| find(&mut parent, c.body.0) == r);
+        let support =
+            !model.obstacles.is_empty() || model.grounds.iter().any(|g| g.normal.dot(&dir) < 0.0);
+        if touches && support {
+            // Resting on frictionless grounds only: a rigid translation along `t` with
+            // `n_g·t ≥ 0` for every ground keeps every gap open and lowers the energy by
+            // `F·t` per metre.
+            let frictionless = model.obstacles.is_empty()
+                && model
+                    .contact_points
+                    .iter()
+                    .filter(|c| find(&mut parent, c.body.0) == r)
+                    .all(|c| {
+                        c.settings.friction.unwrap_or(options.friction)
+                            == crate::model::Friction::None
+                    });
+            if let Some(t) = frictionless.then(|| slide(model, &f)).flatten() {
+                if f.dot(&t) > 1e-9 * scale {
+                    out.push(format!(
+                        "body `{}` sliding along ({:.3}, {:.3}, {:.3}) (its contacts are frictionless and no ground stops it; gravity and loads pull it with {:.4} N along the ground)",
+                        model.bodies[members[r][0]].name,
+                        shown(t.x),
+                        shown(t.y),
+                        shown(t.z),
+                        f.dot(&t)
+                    ));
+                }
+            }
+            continue;
+        }
+        let why = if model.grounds.is_empty() && model.obstacles.is_empty() {
+            "no joint or spring holds it and there is no ground"
+        } else if !touches {
+            "no joint or spring holds it and it has no contact points"
+        } else {
+            "no joint or spring holds it and no ground is below it"
+        };
+        out.push(format!(
+            "body `{}` translating along ({:.3}, {:.3}, {:.3}) ({why}; gravity and loads pull it with {:.4} N)",
+            model.bodies[members[r][0]].name,
+            shown(dir.x),
+            shown(dir.y),
+            shown(dir.z),
+            f.norm()
+        ));
+    }
+    (!out.is_empty()).then_some(out)
+}
+
+/// The unit direction `t` maximizing `f·t` subject to `n_g·t ≥ 0` for every ground (a cone
+/// in 3-D: its best direction is `f` itself, `f` projected on one ground plane, or the line
+/// where two planes meet), if one with `f·t > 0` exists.
+fn slide(model: &Model, f: &nalgebra::Vector3<f64>) -> Option<nalgebra::Vector3<f64>> {
+    let normals: Vec<_> = model.grounds.iter().map(|g| g.normal).collect();
+    let mut candidates = vec![*f];
+    for n in &normals {
+        candidates.push(f - n * n.dot(f));
+    }
+    for (i, a) in normals.iter().enumerate() {
+        for b in &normals[i + 1..] {
+            let l = a.cross(b);
+            candidates.push(l * l.dot(f).signum());
+        }
+    }
+    candidates
+        .into_iter()
+        .filter(|t| t.norm() > 1e-12 * f.norm())
+        .map(|t| t.normalize())
+        .filter(|t| normals.iter().all(|n| n.dot(t) >= -1e-12))
+        .max_by(|a, b| a.dot(f).total_cmp(&b.dot(f)))
+        .filter(|t| t.dot(f) > 0.0)
+}
+
+/// Union-find root of `i` in `p`.
+fn find(p: &mut [usize], mut i: usize) -> usize {
+    while p[i] != i {
+        p[i] = p[p[i]];
+        i = p[i];
+    }
+    i
+}
+
+/// The groups of bodies joined by joints and springs (union-find parents over the bodies,
+/// index `bodies.len()` the world), with the world's root. A floating joint joins nothing
+/// unless a lock, mimic or joint spring acts on it.
+pub(crate) fn groups(model: &Model) -> (Vec<usize>, usize) {
+    let n = model.bodies.len();
+    let mut parent: Vec<usize> = (0..=n).collect();
+    let join =
+        |p: &mut Vec<usize>, a: Option<crate::model::BodyId>, b: Option<crate::model::BodyId>| {
+            let (a, b) = (a.map_or(n, |x| x.0), b.map_or(n, |x| x.0));
+            let (ra, rb) = (find(p, a), find(p, b));
+            p[ra] = rb;
+        };
+    let held_joint = |id: usize| {
+        model.locks.iter().any(|l| l.joint.0 == id)
+            || model.joint_springs.iter().any(|s| s.joint.0 == id)
+            || model
+                .mimics
+                .iter()
+                .any(|m| m.joint.0 == id || m.reference.0 == id)
+    };
+    for (id, j) in model.joints.iter().enumerate().filter(|(_, j)| !j.merged) {
+        if j.kind != crate::model::JointKind::Floating || held_joint(id) {
+            join(&mut parent, j.bodies[0], j.bodies[1]);
+        }
+    }
+    for s in &model.springs {
+        join(&mut parent, s.ends[0].body, s.ends[1].body);
+    }
+    for b in 0..=n {
+        parent[b] = find(&mut parent, b);
+    }
+    let world = find(&mut parent, n);
+    (parent, world)
 }
 
 /// `x` rounded to the 3 decimals shown, without a sign on zero (no "-0.000").

@@ -348,6 +348,7 @@ pub(super) fn import(
     };
     extensions::read(&src, &ext, &urdf_joints, &mut b, options)?;
     super::foreign::read(&src, &drake_nodes, &gazebo_nodes, &mut b)?;
+    super::servo::add(&mut b, options)?;
     if !auto_child.is_empty() {
         // The child's joint frame that makes the joint hold at the initial guess.
         let start = State::initial(b.model.partial());

@@ -13,11 +13,13 @@ mod import;
 mod links;
 mod mimic;
 mod schema;
+mod servo;
 mod text;
 mod tree;
 mod write_back;
 mod xml;
 
+pub use servo::{srdf_state, ServoRequest};
 pub use text::{read_file as read_text, MAX_DEPTH, MAX_FILE_BYTES};
 pub use write_back::with_initial_pose;
 
@@ -48,6 +50,11 @@ pub struct ImportOptions {
     pub ground: bool,
     /// Start pose of the root link in the world when the base floats; overrides `mech:base`.
     pub base_pose: Option<nalgebra::Isometry3<f64>>,
+    /// Position servos (`--servo`), applied in order after the file's own elements.
+    pub servos: Vec<ServoRequest>,
+    /// Reference pose of the servos `(joint, value)` (`--servo-reference`, an SRDF
+    /// `group_state`): a servo without its own reference holds its joint at this value.
+    pub servo_reference: Vec<(String, f64)>,
 }
 
 impl Default for ImportOptions {
@@ -61,6 +68,8 @@ impl Default for ImportOptions {
             inertia_density: None,
             ground: false,
             base_pose: None,
+            servos: Vec::new(),
+            servo_reference: Vec::new(),
         }
     }
 }

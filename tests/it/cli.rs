@@ -525,6 +525,9 @@ fn numeric_options_are_validated() {
             "-q",
             "--load-steps",
             "1000",
+            // `--max-iterations` bounds all 1000 load steps together.
+            "--max-iterations",
+            "100000",
             "--tolerance",
             "1e-9",
         ])

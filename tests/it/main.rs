@@ -23,6 +23,7 @@ mod readme;
 mod real_robots;
 mod regressions;
 mod robots;
+mod servo;
 mod sparse;
 mod stdout_outputs;
 mod verify;

@@ -69,6 +69,19 @@ impl Factors {
         }
     }
 
+    /// The smallest pivot of `U` over the largest (dense; `None` for the sparse factors): a
+    /// cheap measure of how well the dependent coordinates are determined by the independent
+    /// rows at this configuration.
+    pub(crate) fn pivot_ratio(&self) -> Option<f64> {
+        match self {
+            Factors::Dense { lu, .. } => {
+                let d = lu.u().diagonal().abs();
+                Some(if d.is_empty() { 1.0 } else { d.min() / d.max() })
+            }
+            Factors::Sparse(_) => None,
+        }
+    }
+
     /// Whether `Φ_u` has become ill-conditioned (dense: a pivot of `U` below `1e-8` of the
     /// largest; the sparse factors do not tell, and the minimizer re-partitions when the
     /// corrector or the line search fails instead).

@@ -1,5 +1,6 @@
 //! The result JSON (field names are a contract; see the README).
 
+use super::configuration::{configuration, values, Convention};
 use crate::forces::Energy;
 use crate::model::{JointKind, Model};
 use crate::solver::{
@@ -92,6 +93,14 @@ pub struct AnalysisResult {
     /// Every link's frame in the world, in model order.
     #[serde(serialize_with = "ordered_map")]
     pub links: Vec<(String, LinkResult)>,
+    /// The pose as MuJoCo's `qpos` for this URDF (see [`super::configuration`]): depth first,
+    /// children in `<joint>` element order, floating base `x y z w x y z` first; `null` when
+    /// the model has a joint MuJoCo does not read from a URDF.
+    pub q_mujoco: Option<Vec<f64>>,
+    /// The pose as Pinocchio's `q` for this URDF: depth first, children sorted by joint name,
+    /// free flyer `x y z qx qy qz qw` first, a continuous joint as `cos θ, sin θ`; `null` when
+    /// the model has a joint Pinocchio does not read from a URDF.
+    pub q_pinocchio: Option<Vec<f64>>,
     /// Stability verdict (absent for a structure with no degree of freedom).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stability: Option<Stability>,
@@ -199,6 +208,12 @@ impl AnalysisResult {
             history: report.history.clone(),
             joints,
             links,
+            q_mujoco: configuration(model, state, Convention::Mujoco)
+                .ok()
+                .map(|q| values(&q)),
+            q_pinocchio: configuration(model, state, Convention::Pinocchio)
+                .ok()
+                .map(|q| values(&q)),
             stability: report.stability.clone(),
             reactions: report.reactions.clone(),
             redundant_constraints: report.redundant_constraints.clone(),

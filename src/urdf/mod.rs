@@ -10,12 +10,15 @@ mod edges;
 mod extensions;
 mod foreign;
 mod import;
+mod limits;
 mod links;
 mod mimic;
 mod schema;
 mod text;
 mod tree;
 mod write_back;
+#[cfg(feature = "xacro")]
+pub mod xacro;
 mod xml;
 
 pub use text::{read_file as read_text, MAX_DEPTH, MAX_FILE_BYTES};
@@ -48,6 +51,8 @@ pub struct ImportOptions {
     pub ground: bool,
     /// Start pose of the root link in the world when the base floats; overrides `mech:base`.
     pub base_pose: Option<nalgebra::Isometry3<f64>>,
+    /// `--xacro-arg NAME:=VALUE`: arguments of a xacro file (feature `xacro`).
+    pub xacro_args: Vec<(String, String)>,
 }
 
 impl Default for ImportOptions {
@@ -61,6 +66,7 @@ impl Default for ImportOptions {
             inertia_density: None,
             ground: false,
             base_pose: None,
+            xacro_args: Vec::new(),
         }
     }
 }
@@ -76,7 +82,8 @@ pub struct Loaded {
     pub ignored: Vec<String>,
 }
 
-/// Reads a URDF file.
+/// Reads a URDF file, or a xacro file (`*.xacro`, or a file declaring the xacro namespace)
+/// expanded first when the feature `xacro` is on (see [`xacro`]).
 ///
 /// # Errors
 /// [`Error::Io`] if the file cannot be read, [`Error::Input`] (with line and column) if it is
@@ -92,7 +99,37 @@ pub fn load_file(path: impl AsRef<Path>, options: &ImportOptions) -> Result<Load
             d.to_path_buf()
         }
     });
+    #[cfg(feature = "xacro")]
+    if xacro::is_xacro(path, &text) {
+        let expanded = xacro::expand(path, &options.xacro_args, &options.packages)?;
+        let file = path.display().to_string();
+        let mut loaded = import::import(&expanded, &file, dir, options)
+            .map_err(|e| xacro::locate(e, path))?;
+        // Positions in warnings are in the expansion too.
+        for w in &mut loaded.warnings {
+            if let Some(rest) = w.strip_prefix(&format!("{file}:")) {
+                *w = format!("{file} (expanded):{rest}");
+            }
+        }
+        return Ok(loaded);
+    }
     import::import(&text, &path.display().to_string(), dir, options)
+}
+
+/// The text of the URDF file at `path`: a xacro file (feature `xacro`) is expanded with the
+/// options' `xacro_args` and `packages`, as [`load_file`] does.
+///
+/// # Errors
+/// As [`load_file`], for reading and expanding.
+pub fn read_urdf_text(path: impl AsRef<Path>, options: &ImportOptions) -> Result<String> {
+    let path = path.as_ref();
+    let text = text::read_file(path)?;
+    #[cfg(feature = "xacro")]
+    if xacro::is_xacro(path, &text) {
+        return xacro::expand(path, &options.xacro_args, &options.packages);
+    }
+    let _ = options;
+    Ok(text)
 }
 
 /// Reads URDF text; `file` names it in error messages; relative mesh paths are taken from the

@@ -67,8 +67,25 @@ def pose_error(p, R, link):
     return max(dp, dR)
 
 
+def quietly(load, *args):
+    """load(*args) with the C library's stdout and stderr closed: MuJoCo warns on every
+    load that an attached model with an empty prefix (the URDF's own names) cannot be saved."""
+    sys.stdout.flush()
+    saved = [os.dup(1), os.dup(2)]
+    null = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(null, 1)
+        os.dup2(null, 2)
+        return load(*args)
+    finally:
+        os.dup2(saved[0], 1)
+        os.dup2(saved[1], 2)
+        for fd in saved + [null]:
+            os.close(fd)
+
+
 def check_mujoco(key_file, links):
-    model = mujoco.MjModel.from_xml_path(key_file)
+    model = quietly(mujoco.MjModel.from_xml_path, key_file)
     data = mujoco.MjData(model)
     mujoco.mj_resetDataKeyframe(model, data, 0)
     mujoco.mj_forward(model, data)
@@ -157,6 +174,10 @@ def main():
             continue
         result = json.load(open(res))
         floating = "--floating-base" in args
+        q_mj, q_pin = result["q_mujoco"], result["q_pinocchio"]
+        start = 7 if floating else 0
+        print(f"     {name}: largest joint value {max(abs(x) for x in q_mj[start:]):.3f}, "
+              f"MuJoCo and Pinocchio orders {'differ' if q_mj != q_pin else 'agree'}")
         try:
             m_err, m_n, nq = check_mujoco(key, result["links"])
             if len(result["q_mujoco"]) != nq:

@@ -142,10 +142,17 @@ impl State {
             .filter(|j| j.tree)
             .map(|j| j.child_link.as_str())
             .collect();
-        let root = model.links.iter().find(|l| !moved.contains(l.name.as_str()))?;
+        let root = model
+            .links
+            .iter()
+            .find(|l| !moved.contains(l.name.as_str()))?;
         let body = root.body?;
-        (self.q.len() == model.coordinate_count())
-            .then(|| (root.name.as_str(), self.body_pose(body) * root.body_from_link))
+        (self.q.len() == model.coordinate_count()).then(|| {
+            (
+                root.name.as_str(),
+                self.body_pose(body) * root.body_from_link,
+            )
+        })
     }
 
     /// Coordinates of every joint, as reported in the result: scalar coordinates for

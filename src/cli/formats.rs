@@ -16,7 +16,10 @@ pub(crate) fn write(a: &AnalyzeArgs, model: &Model, state: &State) -> anyhow::Re
             Some(p) if !print::is_stdout(Some(p)) => p.clone(),
             _ => a.file.clone(),
         };
-        if urdf.extension().is_some_and(|e| e.eq_ignore_ascii_case("xacro")) {
+        if urdf
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("xacro"))
+        {
             bail!(
                 "--write-mujoco-key {}: MuJoCo reads URDF, not xacro: add --write-urdf OUT.urdf \
                  (the expanded URDF, which the keyframe then loads)",

@@ -4,10 +4,10 @@
 //! Both tools walk the URDF joint tree depth first from the root link; they differ in the
 //! order of a link's children and in the quaternion convention:
 //!
-//! | | children of a link | floating base (first) | continuous joint | spherical |
+//! | | children of a link | floating base (first) | continuous joint | `spherical` |
 //! |---|---|---|---|---|
-//! | MuJoCo (`mj_loadXML` of the URDF) | `<joint>` element order | `x y z` + `w x y z` | `θ` | `w x y z` |
-//! | Pinocchio (`buildModelFromUrdf`) | sorted by joint name (urdfdom's `std::map`) | `x y z` + `x y z w` | `cos θ, sin θ` | `x y z w` |
+//! | MuJoCo (`mj_loadXML` of the URDF) | `<joint>` element order | `x y z` + `w x y z` | `θ` | `w x y z` (ball) |
+//! | Pinocchio (`buildModelFromUrdf`) | sorted by joint name (urdfdom's `std::map`) | `x y z` + `x y z w` | `cos θ, sin θ` | not read (urdfdom) |
 //!
 //! Revolute and prismatic joints give one entry `θ` or `d` about or along their axis, as in the
 //! URDF; fixed joints give none; a `<mimic>` follower keeps its own entry (its value, which
@@ -41,8 +41,9 @@ pub struct Entry {
 /// the model (a joint type its URDF reader does not take, a loop joint).
 ///
 /// # Errors
-/// A message naming the joint when a tree joint is of a type other than revolute,
-/// continuous, prismatic, fixed, floating or spherical.
+/// A message naming the joint when a tree joint is of a type the tool does not read from a
+/// URDF: other than revolute, continuous, prismatic, fixed, floating (and spherical for
+/// MuJoCo). Planar joints are refused too (both tools read them, with their own axes).
 pub fn configuration(
     model: &Model,
     state: &State,
@@ -90,18 +91,17 @@ pub fn configuration(
         while let Some(j) = stack.pop() {
             let joint = &model.joints[j];
             let v = &values[j].1;
-            let entries = joint_entries(joint.kind, v, convention)
-                .ok_or_else(|| {
-                    format!(
-                        "joint `{}` is of type {}, which {} does not read from a URDF",
-                        joint.name,
-                        joint.kind.name(),
-                        match convention {
-                            Convention::Mujoco => "MuJoCo",
-                            Convention::Pinocchio => "Pinocchio",
-                        }
-                    )
-                })?;
+            let entries = joint_entries(joint.kind, v, convention).ok_or_else(|| {
+                format!(
+                    "joint `{}` is of type {}, which {} does not read from a URDF",
+                    joint.name,
+                    joint.kind.name(),
+                    match convention {
+                        Convention::Mujoco => "MuJoCo",
+                        Convention::Pinocchio => "Pinocchio",
+                    }
+                )
+            })?;
             out.extend(entries.into_iter().map(|value| Entry {
                 joint: Some(joint.name.clone()),
                 value,
@@ -129,7 +129,6 @@ fn joint_entries(kind: JointKind, v: &[f64], convention: Convention) -> Option<V
         (JointKind::Continuous, Convention::Pinocchio) => vec![at(0).cos(), at(0).sin()],
         // restpose: [w, x, y, z]; [x, y, z, w, qx, qy, qz] for floating.
         (JointKind::Spherical, Convention::Mujoco) => vec![at(0), at(1), at(2), at(3)],
-        (JointKind::Spherical, Convention::Pinocchio) => vec![at(1), at(2), at(3), at(0)],
         (JointKind::Floating, Convention::Mujoco) => (0..7).map(at).collect(),
         (JointKind::Floating, Convention::Pinocchio) => {
             vec![at(0), at(1), at(2), at(4), at(5), at(6), at(3)]

@@ -43,10 +43,10 @@ pub fn joint_states_yaml(model: &Model, state: &State) -> String {
         );
         let _ = writeln!(s, "base:");
         let _ = writeln!(s, "  link: {}", quote(link));
-        let _ = writeln!(s, "  position: [{}, {}, {}]", t.x, t.y, t.z);
+        let _ = writeln!(s, "  position: [{:?}, {:?}, {:?}]", t.x, t.y, t.z);
         let _ = writeln!(
             s,
-            "  orientation_wxyz: [{}, {}, {}, {}]",
+            "  orientation_wxyz: [{:?}, {:?}, {:?}, {:?}]",
             r.w, r.i, r.j, r.k
         );
     }

@@ -26,10 +26,15 @@ pub fn mujoco_key(model: &Model, state: &State, urdf: &str) -> Result<String, St
     let root = model
         .links
         .iter()
-        .find(|l| !model.joints.iter().any(|j| j.tree && j.child_link == l.name))
+        .find(|l| {
+            !model
+                .joints
+                .iter()
+                .any(|j| j.tree && j.child_link == l.name)
+        })
         .ok_or("the model has no root link")?;
     let floating = root.body.is_some();
-    let qpos: Vec<String> = q.iter().map(|v| format!("{v}")).collect();
+    let qpos: Vec<String> = q.iter().map(|v| format!("{v:?}")).collect();
     let mut s = String::new();
     let _ = writeln!(
         s,

@@ -6,8 +6,9 @@
 //! Values are what MoveIt and Pinocchio's `loadReferenceConfigurations` read: an angle or a
 //! length per revolute, continuous or prismatic joint (Pinocchio turns a continuous joint's
 //! `θ` into its `cos θ, sin θ`); the floating base (virtual joint `root_joint`, Pinocchio's name
-//! for its free flyer) as `x y z qx qy qz qw`, the root link's pose in the world; a spherical
-//! joint as `qx qy qz qw`. Joints with several coordinates of other types are not written.
+//! for its free flyer) as `x y z qx qy qz qw`, the root link's pose in the world. A model with
+//! a joint Pinocchio does not read from a URDF (spherical, planar, restpose's extensions) is
+//! refused, naming the joint.
 
 use super::configuration::{configuration, Convention};
 use super::mujoco::attr;
@@ -36,7 +37,12 @@ pub fn srdf(model: &Model, state: &State, group: &str, state_name: &str) -> Resu
     let root = model
         .links
         .iter()
-        .find(|l| !model.joints.iter().any(|j| j.tree && j.child_link == l.name))
+        .find(|l| {
+            !model
+                .joints
+                .iter()
+                .any(|j| j.tree && j.child_link == l.name)
+        })
         .ok_or("the model has no root link")?;
     let values = state.joint_values(model);
     let mut s = String::new();
@@ -75,7 +81,7 @@ pub fn srdf(model: &Model, state: &State, group: &str, state_name: &str) -> Resu
                 .unwrap_or_default(),
             _ => v.clone(),
         };
-        let text: Vec<String> = v.iter().map(|x| format!("{x}")).collect();
+        let text: Vec<String> = v.iter().map(|x| format!("{x:?}")).collect();
         let _ = writeln!(
             s,
             "    <joint name=\"{}\" value=\"{}\"/>",

@@ -103,8 +103,8 @@ pub fn load_file(path: impl AsRef<Path>, options: &ImportOptions) -> Result<Load
     if xacro::is_xacro(path, &text) {
         let expanded = xacro::expand(path, &options.xacro_args, &options.packages)?;
         let file = path.display().to_string();
-        let mut loaded = import::import(&expanded, &file, dir, options)
-            .map_err(|e| xacro::locate(e, path))?;
+        let mut loaded =
+            import::import(&expanded, &file, dir, options).map_err(|e| xacro::locate(e, path))?;
         // Positions in warnings are in the expansion too.
         for w in &mut loaded.warnings {
             if let Some(rest) = w.strip_prefix(&format!("{file}:")) {

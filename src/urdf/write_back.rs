@@ -58,7 +58,7 @@ pub fn with_initial_pose(text: &str, file: &str, model: &Model, state: &State) -
         let r = pose.rotation;
         let _ = writeln!(
             block,
-            "  <{tag}:base xyz=\"{} {} {}\" quat_xyzw=\"{} {} {} {}\"/>",
+            "  <{tag}:base xyz=\"{:?} {:?} {:?}\" quat_xyzw=\"{:?} {:?} {:?} {:?}\"/>",
             t.x, t.y, t.z, r.i, r.j, r.k, r.w
         );
     }

@@ -18,7 +18,8 @@ use xacro_rs::XacroProcessor;
 
 /// Whether `path` names a xacro file (`*.xacro`), or `text` declares the xacro namespace.
 pub fn is_xacro(path: &Path, text: &str) -> bool {
-    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("xacro"))
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("xacro"))
         || text.contains("xmlns:xacro=")
 }
 
@@ -55,7 +56,11 @@ impl ExtensionHandler for GivenPackages {
 /// [`Error::Io`] if the file cannot be read, [`Error::Input`] naming the file when the
 /// expansion fails (unknown macro or property, a bad expression, an include or `$(find)` that
 /// cannot be resolved), with `xacro-rs`'s message and its macro and include stack.
-pub fn expand(path: &Path, args: &[(String, String)], packages: &[(String, PathBuf)]) -> Result<String> {
+pub fn expand(
+    path: &Path,
+    args: &[(String, String)],
+    packages: &[(String, PathBuf)],
+) -> Result<String> {
     if let Err(cause) = std::fs::metadata(path) {
         return Err(Error::Io {
             path: path.display().to_string(),
@@ -81,20 +86,21 @@ pub fn expand(path: &Path, args: &[(String, String)], packages: &[(String, PathB
         .with_compat_all()
         .with_ros_yaml_units()
         .build()
-        .run(path).map_err(|e| {
-        let text = e.to_string();
-        let mut message = String::from("xacro expansion failed: ");
-        message.push_str(text.trim_end());
-        if text.contains("find") || text.contains("package") {
-            message.push_str(" (give package directories with --package NAME=DIR)");
-        }
-        Error::Input {
-            file: path.display().to_string(),
-            line: 1,
-            col: 1,
-            message,
-        }
-    })
+        .run(path)
+        .map_err(|e| {
+            let text = e.to_string();
+            let mut message = String::from("xacro expansion failed: ");
+            message.push_str(text.trim_end());
+            if text.contains("find") || text.contains("package") {
+                message.push_str(" (give package directories with --package NAME=DIR)");
+            }
+            Error::Input {
+                file: path.display().to_string(),
+                line: 1,
+                col: 1,
+                message,
+            }
+        })
 }
 
 /// Renames an importer error located in the expanded text of `path`: the position is in the
@@ -102,10 +108,7 @@ pub fn expand(path: &Path, args: &[(String, String)], packages: &[(String, PathB
 pub(crate) fn locate(e: Error, path: &Path) -> Error {
     match e {
         Error::Input {
-            line,
-            col,
-            message,
-            ..
+            line, col, message, ..
         } => Error::Input {
             file: format!("{} (expanded)", path.display()),
             line,
@@ -133,7 +136,9 @@ fn literal_arg_defaults(path: &Path) -> Vec<(String, String)> {
         .children()
         .filter(|n| {
             n.tag_name().name() == "arg"
-                && n.tag_name().namespace().is_some_and(|u| u.contains("xacro"))
+                && n.tag_name()
+                    .namespace()
+                    .is_some_and(|u| u.contains("xacro"))
         })
         .filter_map(|n| Some((n.attribute("name")?, n.attribute("default")?)))
         .filter(|(_, d)| !d.contains("$(") && !d.contains("${"))

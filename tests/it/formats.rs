@@ -37,14 +37,11 @@ fn q_vectors_follow_mujoco_and_pinocchio_orders_and_quaternions() {
         ..Default::default()
     };
     let model = load_str(TWO_ARMS, "two_arms.urdf", &opts).unwrap().model;
-    let values: HashMap<String, Vec<f64>> = [
-        ("right_s0", 0.4),
-        ("right_e0", 0.25),
-        ("left_s0", -2.5),
-    ]
-    .into_iter()
-    .map(|(n, v)| (n.to_string(), vec![v]))
-    .collect();
+    let values: HashMap<String, Vec<f64>> =
+        [("right_s0", 0.4), ("right_e0", 0.25), ("left_s0", -2.5)]
+            .into_iter()
+            .map(|(n, v)| (n.to_string(), vec![v]))
+            .collect();
     let state = State::from_joint_values(&model, &values);
     let base = opts.base_pose.unwrap();
     let (t, r) = (base.translation.vector, base.rotation);
@@ -133,12 +130,30 @@ fn floating_base_round_trips_through_every_written_pose() {
         p("rest.srdf"),
     );
     args.extend([
-        "--json", &json, "--write-joint-states", &yaml, "--write-urdf", &urdf,
-        "--write-mujoco-key", &key, "--write-srdf", &srdf, "--group", "legs", "--state", "standing",
+        "--json",
+        &json,
+        "--write-joint-states",
+        &yaml,
+        "--write-urdf",
+        &urdf,
+        "--write-mujoco-key",
+        &key,
+        "--write-srdf",
+        &srdf,
+        "--group",
+        "legs",
+        "--state",
+        "standing",
     ]);
     let a = run(&args);
-    assert_eq!(a.status.code(), Some(0), "{}", String::from_utf8_lossy(&a.stderr));
-    let result: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(
+        a.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&a.stderr)
+    );
+    let result: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     let root = result["links"]["base_link"].clone();
     let pos: Vec<f64> = serde_json::from_value(root["position"].clone()).unwrap();
     let wxyz: Vec<f64> = serde_json::from_value(root["orientation_wxyz"].clone()).unwrap();
@@ -158,7 +173,11 @@ fn floating_base_round_trips_through_every_written_pose() {
     // Every joint value, from the JSON's joints, in one of the vectors.
     let joints = result["joints"].as_object().unwrap();
     for (name, j) in joints {
-        if let Some(v) = j["position"].as_array().and_then(|a| a.first()).and_then(|v| v.as_f64()) {
+        if let Some(v) = j["position"]
+            .as_array()
+            .and_then(|a| a.first())
+            .and_then(|v| v.as_f64())
+        {
             assert!(q_mj[7..].iter().any(|x| (x - v).abs() < 1e-15), "{name}");
         }
     }
@@ -173,7 +192,10 @@ fn floating_base_round_trips_through_every_written_pose() {
     assert_eq!(attribute(&s, "group_state", "group"), "legs");
     assert_eq!(attribute(&s, "group_state", "name"), "standing");
     let doc = roxmltree::Document::parse(&s).unwrap();
-    let state = doc.descendants().find(|n| n.has_tag_name("group_state")).unwrap();
+    let state = doc
+        .descendants()
+        .find(|n| n.has_tag_name("group_state"))
+        .unwrap();
     let mut seen = 0;
     for j in state.children().filter(|n| n.has_tag_name("joint")) {
         let v = numbers(j.attribute("value").unwrap());
@@ -189,12 +211,20 @@ fn floating_base_round_trips_through_every_written_pose() {
     // verify passes each written pose: the JSON, the YAML (its `base`), the URDF's mech:base
     // and mech:initial (no --pose: the file's own initial values).
     let mut yaml_text = std::fs::read_to_string(&yaml).unwrap();
-    assert!(yaml_text.contains("base:\n  link: \"base_link\""), "{yaml_text}");
+    assert!(
+        yaml_text.contains("base:\n  link: \"base_link\""),
+        "{yaml_text}"
+    );
     for pose in [&json, &yaml] {
         let mut v = vec!["verify", file.as_str(), "--pose", pose];
         v.extend(common);
         let out = run(&v);
-        assert_eq!(out.status.code(), Some(0), "{pose}: {}", String::from_utf8_lossy(&out.stderr));
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{pose}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
     }
     // Without its base section the YAML does not pass (the base would be at the origin).
     let cut = yaml_text.find("# the floating base").unwrap();
@@ -209,13 +239,19 @@ fn floating_base_round_trips_through_every_written_pose() {
     let mut v = vec!["analyze", urdf.as_str(), "--json", &again];
     v.extend(common);
     let out = run(&v);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let second: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&again).unwrap()).unwrap();
     assert_eq!(second["iterations"], 0, "{}", second["history"]);
     for (name, l) in result["links"].as_object().unwrap() {
         let a: Vec<f64> = serde_json::from_value(l["position"].clone()).unwrap();
-        let b: Vec<f64> = serde_json::from_value(second["links"][name]["position"].clone()).unwrap();
+        let b: Vec<f64> =
+            serde_json::from_value(second["links"][name]["position"].clone()).unwrap();
         assert_close(&a, &b);
     }
 }
@@ -232,14 +268,39 @@ fn bullet_and_urdfdom_limit_conventions() {
 {limit}</joint></robot>"#
         )
     };
-    let bullet = load_str(&j(r#"<limit lower="1" upper="-1" effort="1" velocity="1"/>"#), "b.urdf", &Default::default()).unwrap();
+    let bullet = load_str(
+        &j(r#"<limit lower="1" upper="-1" effort="1" velocity="1"/>"#),
+        "b.urdf",
+        &Default::default(),
+    )
+    .unwrap();
     assert_eq!(bullet.model.joints[0].limits, None);
     assert_eq!(bullet.warnings.len(), 1);
-    assert!(bullet.warnings[0].starts_with("b.urdf:3:1: joint `j`") && bullet.warnings[0].contains("unlimited"), "{:?}", bullet.warnings);
-    let bare = load_str(&j(r#"<limit effort="1" velocity="1"/>"#), "u.urdf", &Default::default()).unwrap();
+    assert!(
+        bullet.warnings[0].starts_with("b.urdf:3:1: joint `j`")
+            && bullet.warnings[0].contains("unlimited"),
+        "{:?}",
+        bullet.warnings
+    );
+    let bare = load_str(
+        &j(r#"<limit effort="1" velocity="1"/>"#),
+        "u.urdf",
+        &Default::default(),
+    )
+    .unwrap();
     assert_eq!(bare.model.joints[0].limits, Some([0.0, 0.0]));
-    assert!(bare.warnings[0].starts_with("u.urdf:3:1: joint `j`") && bare.warnings[0].contains("[0, 0]"), "{:?}", bare.warnings);
-    let fine = load_str(&j(r#"<limit lower="-1" upper="1" effort="1" velocity="1"/>"#), "f.urdf", &Default::default()).unwrap();
+    assert!(
+        bare.warnings[0].starts_with("u.urdf:3:1: joint `j`")
+            && bare.warnings[0].contains("[0, 0]"),
+        "{:?}",
+        bare.warnings
+    );
+    let fine = load_str(
+        &j(r#"<limit lower="-1" upper="1" effort="1" velocity="1"/>"#),
+        "f.urdf",
+        &Default::default(),
+    )
+    .unwrap();
     assert!(fine.warnings.is_empty());
     assert_eq!(fine.model.joints[0].limits, Some([-1.0, 1.0]));
 }
@@ -255,7 +316,8 @@ fn write_back_escapes_joint_names() {
     let values: HashMap<String, Vec<f64>> = [("a&b<\"c".to_string(), vec![0.7])].into();
     let state = State::from_joint_values(&model, &values);
     let out = restpose::urdf::with_initial_pose(text, "e.urdf", &model, &state).unwrap();
-    let again = load_str(&out, "out.urdf", &Default::default()).unwrap_or_else(|e| panic!("{e}\n{out}"));
+    let again =
+        load_str(&out, "out.urdf", &Default::default()).unwrap_or_else(|e| panic!("{e}\n{out}"));
     let s = State::initial(&again.model);
     assert!((s.joint(&again.model, "a&b<\"c").unwrap()[0] - 0.7).abs() < 1e-15);
 }

@@ -36,13 +36,22 @@ fn assert_same_robot(expanded: &restpose::Model, reference: &restpose::Model, ma
             .unwrap_or_else(|| panic!("link `{}` missing from the expansion", l.name));
         let pb = b.link_pose(reference, &l.name).unwrap();
         let dp = (pa.translation.vector - pb.translation.vector).amax();
-        let dr = (pa.rotation.to_rotation_matrix().matrix() - pb.rotation.to_rotation_matrix().matrix())
-            .amax();
-        assert!(dp < 1e-12 && dr < 1e-12, "link `{}`: {dp:e} m, {dr:e}", l.name);
+        let dr = (pa.rotation.to_rotation_matrix().matrix()
+            - pb.rotation.to_rotation_matrix().matrix())
+        .amax();
+        assert!(
+            dp < 1e-12 && dr < 1e-12,
+            "link `{}`: {dp:e} m, {dr:e}",
+            l.name
+        );
     }
     // Same joints; limits to the 12 digits a published URDF is printed with.
     let sorted = |m: &restpose::Model| {
-        let mut v: Vec<_> = m.joints.iter().map(|j| (j.name.clone(), j.kind.name(), j.limits)).collect();
+        let mut v: Vec<_> = m
+            .joints
+            .iter()
+            .map(|j| (j.name.clone(), j.kind.name(), j.limits))
+            .collect();
         v.sort_by(|x, y| x.0.cmp(&y.0));
         v
     };
@@ -60,8 +69,16 @@ fn assert_same_robot(expanded: &restpose::Model, reference: &restpose::Model, ma
         }
     }
     for body in reference.bodies.iter().filter(|_| masses) {
-        let other = expanded.bodies.iter().find(|b| b.name == body.name).unwrap();
-        assert!((other.mass - body.mass).abs() <= 1e-12 * body.mass.max(1.0), "body `{}`", body.name);
+        let other = expanded
+            .bodies
+            .iter()
+            .find(|b| b.name == body.name)
+            .unwrap();
+        assert!(
+            (other.mass - body.mass).abs() <= 1e-12 * body.mass.max(1.0),
+            "body `{}`",
+            body.name
+        );
     }
 }
 
@@ -74,23 +91,41 @@ fn a1_xacro_expands_to_unitrees_published_urdf() {
     .unwrap_or_else(|e| panic!("{e}"));
     // Unitree's published URDF: the same kinematics (its masses are of a later revision
     // than the xacro's `const.xacro`: hip 0.696 kg there, 0.595 kg in the xacro).
-    let r = load_file(dir().join("a1_description/urdf/a1.urdf"), &options(&[], &[])).unwrap();
+    let r = load_file(
+        dir().join("a1_description/urdf/a1.urdf"),
+        &options(&[], &[]),
+    )
+    .unwrap();
     assert_same_robot(&x.model, &r.model, false);
     // The xacro's own numbers, as xacrodoc expands them: everything the same.
     let r = load_file(dir().join("reference/a1.xacrodoc.urdf"), &options(&[], &[])).unwrap();
     assert_same_robot(&x.model, &r.model, true);
     // The 12 leg joints, in the published file's limits.
-    assert_eq!(x.model.joints.iter().filter(|j| j.kind.name() == "revolute").count(), 12);
+    assert_eq!(
+        x.model
+            .joints
+            .iter()
+            .filter(|j| j.kind.name() == "revolute")
+            .count(),
+        12
+    );
 }
 
 #[test]
 fn ur5e_xacro_with_arguments_expands_as_xacrodoc_does() {
     let x = load_file(
         dir().join("ur_description/urdf/ur.urdf.xacro"),
-        &options(&[("ur_type", "ur5e"), ("name", "ur5e")], &["ur_description"]),
+        &options(
+            &[("ur_type", "ur5e"), ("name", "ur5e")],
+            &["ur_description"],
+        ),
     )
     .unwrap_or_else(|e| panic!("{e}"));
-    let r = load_file(dir().join("reference/ur5e.xacrodoc.urdf"), &options(&[], &[])).unwrap();
+    let r = load_file(
+        dir().join("reference/ur5e.xacrodoc.urdf"),
+        &options(&[], &[]),
+    )
+    .unwrap();
     assert_same_robot(&x.model, &r.model, true);
     // Another argument gives another robot (the UR10e is longer).
     let ur10 = load_file(
@@ -116,8 +151,14 @@ fn franka_panda_xacro_beyond_xacro_rs_is_a_clear_error() {
     )
     .unwrap_err()
     .to_string();
-    assert!(e.contains("panda.urdf.xacro:1:1: xacro expansion failed"), "{e}");
-    assert!(e.contains("split") && e.contains("in macro: collision_capsule"), "{e}");
+    assert!(
+        e.contains("panda.urdf.xacro:1:1: xacro expansion failed"),
+        "{e}"
+    );
+    assert!(
+        e.contains("split") && e.contains("in macro: collision_capsule"),
+        "{e}"
+    );
 }
 
 /// `restpose analyze FILE.xacro --xacro-arg … --package …` solves the expanded robot; a
@@ -133,8 +174,22 @@ fn cli_reads_xacro_and_names_the_file_in_errors() {
             .unwrap()
     };
     let x = xacro.to_str().unwrap();
-    let ok = run(&["analyze", x, "--xacro-arg", "ur_type:=ur5e", "--package", &pkg, "--json", "-"]);
-    assert_eq!(ok.status.code(), Some(0), "{}", String::from_utf8_lossy(&ok.stderr));
+    let ok = run(&[
+        "analyze",
+        x,
+        "--xacro-arg",
+        "ur_type:=ur5e",
+        "--package",
+        &pkg,
+        "--json",
+        "-",
+    ]);
+    assert_eq!(
+        ok.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
     let json: serde_json::Value = serde_json::from_slice(&ok.stdout).unwrap();
     assert_eq!(json["converged"], true);
     assert_eq!(json["q_mujoco"].as_array().unwrap().len(), 6);
@@ -165,7 +220,10 @@ fn cli_reads_xacro_and_names_the_file_in_errors() {
     let b = run(&["check", bad.to_str().unwrap()]);
     assert_eq!(b.status.code(), Some(1));
     let e = String::from_utf8_lossy(&b.stderr);
-    assert!(e.contains("bad.urdf.xacro") && e.contains("undefined_property"), "{e}");
+    assert!(
+        e.contains("bad.urdf.xacro") && e.contains("undefined_property"),
+        "{e}"
+    );
     // An error in the expanded URDF: the xacro file, marked as expanded.
     std::fs::write(
         &bad,
@@ -175,5 +233,8 @@ fn cli_reads_xacro_and_names_the_file_in_errors() {
     let b = run(&["check", bad.to_str().unwrap()]);
     assert_eq!(b.status.code(), Some(1));
     let e = String::from_utf8_lossy(&b.stderr);
-    assert!(e.contains("bad.urdf.xacro (expanded):") && e.contains("nowhere"), "{e}");
+    assert!(
+        e.contains("bad.urdf.xacro (expanded):") && e.contains("nowhere"),
+        "{e}"
+    );
 }

@@ -94,12 +94,14 @@ pub struct AnalysisResult {
     #[serde(serialize_with = "ordered_map")]
     pub links: Vec<(String, LinkResult)>,
     /// The pose as MuJoCo's `qpos` for this URDF (see [`super::configuration`]): depth first,
-    /// children in `<joint>` element order, floating base `x y z w x y z` first; `null` when
-    /// the model has a joint MuJoCo does not read from a URDF.
+    /// children in `<joint>` element order, floating base `x y z w x y z` first; when the
+    /// model has a joint MuJoCo does not read from a URDF, absent.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub q_mujoco: Option<Vec<f64>>,
     /// The pose as Pinocchio's `q` for this URDF: depth first, children sorted by joint name,
-    /// free flyer `x y z qx qy qz qw` first, a continuous joint as `cos θ, sin θ`; `null` when
-    /// the model has a joint Pinocchio does not read from a URDF.
+    /// free flyer `x y z qx qy qz qw` first, a continuous joint as `cos θ, sin θ`; when the
+    /// model has a joint Pinocchio does not read from a URDF, absent.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub q_pinocchio: Option<Vec<f64>>,
     /// Stability verdict (absent for a structure with no degree of freedom).
     #[serde(skip_serializing_if = "Option::is_none")]

@@ -92,7 +92,7 @@ pub fn expand(
             let mut message = String::from("xacro expansion failed: ");
             message.push_str(text.trim_end());
             if text.contains("find") || text.contains("package") {
-                message.push_str(" (give package directories with --package NAME=DIR)");
+                message.push_str(&format!(" ({})", crate::geometry::UNKNOWN_PACKAGE_HINT));
             }
             Error::Input {
                 file: path.display().to_string(),

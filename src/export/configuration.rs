@@ -53,7 +53,10 @@ pub fn configuration(
     let tree: Vec<usize> = (0..model.joints.len())
         .filter(|&j| model.joints[j].tree)
         .collect();
-    let is_child = |link: &str| tree.iter().any(|&j| model.joints[j].child_link == link);
+    let children_of_joints: std::collections::HashSet<&str> = tree
+        .iter()
+        .map(|&j| model.joints[j].child_link.as_str())
+        .collect();
     let mut children: std::collections::HashMap<&str, Vec<usize>> = Default::default();
     for &j in &tree {
         children
@@ -67,7 +70,11 @@ pub fn configuration(
         }
     }
     let mut out = Vec::new();
-    let roots: Vec<_> = model.links.iter().filter(|l| !is_child(&l.name)).collect();
+    let roots: Vec<_> = model
+        .links
+        .iter()
+        .filter(|l| !children_of_joints.contains(l.name.as_str()))
+        .collect();
     for root in roots {
         if let Some(b) = root.body {
             let pose = state.body_pose(b) * root.body_from_link;

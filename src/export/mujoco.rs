@@ -23,17 +23,7 @@ use std::fmt::Write;
 /// A message naming the joint when the model has a joint MuJoCo does not read from a URDF.
 pub fn mujoco_key(model: &Model, state: &State, urdf: &str) -> Result<String, String> {
     let q = values(&configuration(model, state, Convention::Mujoco)?);
-    let root = model
-        .links
-        .iter()
-        .find(|l| {
-            !model
-                .joints
-                .iter()
-                .any(|j| j.tree && j.child_link == l.name)
-        })
-        .ok_or("the model has no root link")?;
-    let floating = root.body.is_some();
+    let floating = state.floating_base(model).is_some();
     let qpos: Vec<String> = q.iter().map(|v| format!("{v:?}")).collect();
     let mut s = String::new();
     let _ = writeln!(

@@ -34,16 +34,6 @@ pub fn srdf(model: &Model, state: &State, group: &str, state_name: &str) -> Resu
             _ => joints.push((name, vec![e.value])),
         }
     }
-    let root = model
-        .links
-        .iter()
-        .find(|l| {
-            !model
-                .joints
-                .iter()
-                .any(|j| j.tree && j.child_link == l.name)
-        })
-        .ok_or("the model has no root link")?;
     let values = state.joint_values(model);
     let mut s = String::new();
     let _ = writeln!(s, "<?xml version=\"1.0\"?>");
@@ -53,11 +43,11 @@ pub fn srdf(model: &Model, state: &State, group: &str, state_name: &str) -> Resu
         model.name.replace("--", "- -")
     );
     let _ = writeln!(s, "<robot name=\"{}\">", attr(&model.name));
-    if root.body.is_some() {
+    if let Some((root, _)) = state.floating_base(model) {
         let _ = writeln!(
             s,
             "  <virtual_joint name=\"{ROOT_JOINT}\" type=\"floating\" parent_frame=\"world\" child_link=\"{}\"/>",
-            attr(&root.name)
+            attr(root)
         );
     }
     let _ = writeln!(s, "  <group name=\"{}\">", attr(group));

@@ -83,7 +83,7 @@ pub struct Loaded {
 }
 
 /// Reads a URDF file, or a xacro file (`*.xacro`, or a file declaring the xacro namespace)
-/// expanded first when the feature `xacro` is on (see [`xacro`]).
+/// expanded first when the feature `xacro` is on (module `xacro`).
 ///
 /// # Errors
 /// [`Error::Io`] if the file cannot be read, [`Error::Input`] (with line and column) if it is

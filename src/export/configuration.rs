@@ -14,7 +14,7 @@
 //! the mimic constraint holds at `m θ_ref + offset`). The floating base is the pose of the
 //! root link in the world, `world_from_root = (x, y, z, quaternion)`.
 
-use crate::model::{JointKind, Model};
+use crate::model::{JointId, JointKind, Model};
 use crate::state::State;
 
 /// Whose configuration vector.
@@ -32,7 +32,7 @@ pub enum Convention {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Entry {
     /// The joint, or `None` for the floating base's seven entries.
-    pub joint: Option<String>,
+    pub joint: Option<JointId>,
     /// The value \[m, rad, or 1 for quaternion and cos/sin components\].
     pub value: f64,
 }
@@ -49,7 +49,17 @@ pub fn configuration(
     state: &State,
     convention: Convention,
 ) -> Result<Vec<Entry>, String> {
-    let values = state.joint_values(model);
+    configuration_of(model, state, &state.joint_values(model), convention)
+}
+
+/// [`configuration`] with the joint values of `state` already at hand (`values`, as
+/// [`State::joint_values`] gives them).
+pub(crate) fn configuration_of(
+    model: &Model,
+    state: &State,
+    values: &[(String, Vec<f64>)],
+    convention: Convention,
+) -> Result<Vec<Entry>, String> {
     let tree: Vec<usize> = (0..model.joints.len())
         .filter(|&j| model.joints[j].tree)
         .collect();
@@ -110,7 +120,7 @@ pub fn configuration(
                 )
             })?;
             out.extend(entries.into_iter().map(|value| Entry {
-                joint: Some(joint.name.clone()),
+                joint: Some(JointId(j)),
                 value,
             }));
             if let Some(c) = children.get(joint.child_link.as_str()) {

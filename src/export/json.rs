@@ -1,6 +1,6 @@
 //! The result JSON (field names are a contract; see the README).
 
-use super::configuration::{configuration, values, Convention};
+use super::configuration::{configuration_of, values as values_only, Convention};
 use crate::forces::Energy;
 use crate::model::{JointKind, Model};
 use crate::solver::{
@@ -139,8 +139,14 @@ pub struct AnalysisResult {
 impl AnalysisResult {
     /// Builds the result of a solve.
     pub fn new(model: &Model, state: &State, report: &Report) -> Self {
-        let joints: Vec<(String, JointResult)> = state
-            .joint_values(model)
+        let values = state.joint_values(model);
+        let q = |c| {
+            configuration_of(model, state, &values, c)
+                .ok()
+                .map(|q| values_only(&q))
+        };
+        let (q_mujoco, q_pinocchio) = (q(Convention::Mujoco), q(Convention::Pinocchio));
+        let joints: Vec<(String, JointResult)> = values
             .into_iter()
             .zip(&model.joints)
             .map(|((name, position), j)| {
@@ -210,12 +216,8 @@ impl AnalysisResult {
             history: report.history.clone(),
             joints,
             links,
-            q_mujoco: configuration(model, state, Convention::Mujoco)
-                .ok()
-                .map(|q| values(&q)),
-            q_pinocchio: configuration(model, state, Convention::Pinocchio)
-                .ok()
-                .map(|q| values(&q)),
+            q_mujoco,
+            q_pinocchio,
             stability: report.stability.clone(),
             reactions: report.reactions.clone(),
             redundant_constraints: report.redundant_constraints.clone(),

@@ -27,12 +27,16 @@ pub fn srdf(model: &Model, state: &State, group: &str, state_name: &str) -> Resu
     // Pinocchio's q, grouped back by joint (its entries of one joint are consecutive).
     let q = configuration(model, state, Convention::Pinocchio)?;
     let mut joints: Vec<(String, Vec<f64>)> = Vec::new();
+    let mut last = None;
     for e in &q {
-        let name = e.joint.clone().unwrap_or_else(|| ROOT_JOINT.to_string());
         match joints.last_mut() {
-            Some((n, v)) if *n == name => v.push(e.value),
-            _ => joints.push((name, vec![e.value])),
+            Some((_, v)) if last == Some(e.joint) => v.push(e.value),
+            _ => {
+                let name = e.joint.map_or(ROOT_JOINT, |j| model.joint(j).name.as_str());
+                joints.push((name.to_string(), vec![e.value]));
+            }
         }
+        last = Some(e.joint);
     }
     let values = state.joint_values(model);
     let mut s = String::new();

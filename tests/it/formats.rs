@@ -67,7 +67,7 @@ fn q_vectors_follow_mujoco_and_pinocchio_orders_and_quaternions() {
     let names: Vec<Option<String>> = configuration(&model, &state, Convention::Mujoco)
         .unwrap()
         .into_iter()
-        .map(|e| e.joint)
+        .map(|e| e.joint.map(|j| model.joint(j).name.clone()))
         .collect();
     assert_eq!(names[..7], vec![None; 7][..]);
     assert_eq!(

@@ -25,8 +25,15 @@ if [[ ! -f "$VENV/.complete" ]]; then
     rm -rf "$VENV"
     python3 -m venv "$VENV" || exit 1
     if ! "$VENV/bin/pip" install --quiet --disable-pip-version-check "${PACKAGES[@]}"; then
-        echo "peers: cannot install ${PACKAGES[*]} from PyPI (unreachable?)" >&2
         rm -rf "$VENV"
+        # A skip only when the index cannot be reached; any other install failure fails.
+        if python3 -c 'import os, urllib.request
+index = os.environ.get("PIP_INDEX_URL", "https://pypi.org/simple").rstrip("/")
+urllib.request.urlopen(index + "/pip/", timeout=20)' 2>/dev/null; then
+            echo "peers: installing ${PACKAGES[*]} failed although the package index is reachable" >&2
+            exit 1
+        fi
+        echo "peers: cannot install ${PACKAGES[*]}: the package index is unreachable" >&2
         exit 2
     fi
     touch "$VENV/.complete"

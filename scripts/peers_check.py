@@ -9,7 +9,9 @@ xacro file vendored in robots/xacro):
   3. Pinocchio builds the model from the same URDF (free flyer when the base floats), runs the
      forward kinematics at `q_pinocchio`: every body frame must be where restpose put its link;
   4. `pin.loadReferenceConfigurations` reads the SRDF: the named state must equal
-     `q_pinocchio`.
+     `q_pinocchio`;
+  5. restpose's own round trip: `verify --pose` passes the result JSON and the joint-states
+     YAML, and `analyze` of the written URDF takes 0 iterations.
 Poses are compared as the largest of the position error [m] and the rotation-matrix error
 (max entry); the tolerance is 1e-9. Prints one line per robot and tool with the largest
 error; exits 1 on any failure.
@@ -165,8 +167,9 @@ def main():
             args = []
         else:
             stripped(src, urdf, springs)
+        yaml = os.path.join(work, tag + ".yaml")
         cmd = [RESTPOSE, "analyze", urdf, *args, "--json", res, "--write-mujoco-key", key,
-               "--write-srdf", srdf, "--write-urdf", written, "-q"]
+               "--write-srdf", srdf, "--write-urdf", written, "--write-joint-states", yaml, "-q"]
         out = subprocess.run(cmd, capture_output=True, text=True)
         if out.returncode != 0:
             print(f"FAIL {name}: restpose analyze exited {out.returncode}: {out.stderr.strip()}")
@@ -178,6 +181,23 @@ def main():
         start = 7 if floating else 0
         print(f"     {name}: largest joint value {max(abs(x) for x in q_mj[start:]):.3f}, "
               f"MuJoCo and Pinocchio orders {'differ' if q_mj != q_pin else 'agree'}")
+        # restpose's own round trip: verify passes the JSON and the YAML, and analyze of the
+        # written URDF starts at rest (the base pose included).
+        flags = [a for a in args if a != "--base-xyz" and not re.fullmatch(r"-?[0-9.]+", a)]
+        trips, trip_ok = [], True
+        for pose in (res, yaml):
+            v = subprocess.run([RESTPOSE, "verify", urdf, *flags, "--pose", pose, "-q"],
+                               capture_output=True, text=True)
+            trips.append(f"verify {os.path.splitext(pose)[1][1:]} exit {v.returncode}")
+            trip_ok &= v.returncode == 0
+        again = os.path.join(work, tag + "_again.json")
+        a = subprocess.run([RESTPOSE, "analyze", written, *flags, "--json", again, "-q"],
+                           capture_output=True, text=True)
+        iterations = json.load(open(again))["iterations"] if a.returncode == 0 else None
+        trips.append(f"analyze of the written URDF: {iterations} iterations")
+        trip_ok &= iterations == 0
+        failed += not trip_ok
+        print(f"{'ok  ' if trip_ok else 'FAIL'} {name}: {', '.join(trips)}")
         try:
             m_err, m_n, nq = check_mujoco(key, result["links"])
             if len(result["q_mujoco"]) != nq:

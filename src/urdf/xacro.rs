@@ -7,8 +7,9 @@
 //! `package.xml` named `NAME` above the file). The same directories resolve the expanded
 //! URDF's `package://NAME/…` meshes.
 //!
-//! Errors of the expansion name the xacro file (and the macro and include stack that
-//! `xacro-rs` reports); an error in the expanded URDF names the xacro file with the line and
+//! Errors of the expansion name the xacro file with `xacro-rs`'s message and macro stack, at
+//! the line and column of the failing expression or argument where it is found in the
+//! sources (`xacro-rs` gives no position); an error in the expanded URDF names the xacro file with the line and
 //! column in the expanded text, and says so.
 
 use crate::error::{Error, Result};
@@ -94,13 +95,66 @@ pub fn expand(
             if text.contains("find") || text.contains("package") {
                 message.push_str(&format!(" ({})", crate::geometry::UNKNOWN_PACKAGE_HINT));
             }
+            let (file, line, col) = source_position(&text, path, packages)
+                .unwrap_or_else(|| (path.to_path_buf(), 1, 1));
             Error::Input {
-                file: path.display().to_string(),
-                line: 1,
-                col: 1,
+                file: file.display().to_string(),
+                line,
+                col,
                 message,
             }
         })
+}
+
+/// Where in the xacro sources an expansion error is: the first `${EXPRESSION` of an
+/// "Evaluation error in 'EXPRESSION'", or `$(arg NAME)` of an "Undefined argument: 'NAME'",
+/// in the top file, else in the `.xacro` files below its folder and the package folders
+/// (`xacro-rs` names only the top file). `None` when the text is not found.
+fn source_position(
+    message: &str,
+    path: &Path,
+    packages: &[(String, PathBuf)],
+) -> Option<(PathBuf, u32, u32)> {
+    let needle = if let Some(rest) = message.split("Evaluation error in '").nth(1) {
+        format!("${{{}", rest.split("': ").next()?)
+    } else if let Some(rest) = message.split("Undefined argument: '").nth(1) {
+        format!("$(arg {})", rest.split('\'').next()?)
+    } else {
+        return None;
+    };
+    let mut files = vec![path.to_path_buf()];
+    let mut dirs: Vec<PathBuf> = path.parent().map(Path::to_path_buf).into_iter().collect();
+    dirs.extend(packages.iter().map(|(_, d)| d.clone()));
+    // A bounded walk: at most 2,000 entries.
+    let mut seen = 0;
+    while let Some(dir) = dirs.pop() {
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            seen += 1;
+            if seen > 2_000 {
+                break;
+            }
+            let p = e.path();
+            if p.is_dir() {
+                dirs.push(p);
+            } else if p.extension().is_some_and(|x| x == "xacro") && p != path {
+                files.push(p);
+            }
+        }
+    }
+    files.into_iter().find_map(|f| {
+        let text = std::fs::read_to_string(&f).ok()?;
+        let at = text.find(&needle)?;
+        let before = &text[..at];
+        let line = before.matches('\n').count() + 1;
+        let col = before[before.rfind('\n').map_or(0, |p| p + 1)..]
+            .chars()
+            .count()
+            + 1;
+        Some((f, line as u32, col as u32))
+    })
 }
 
 /// Renames an importer error located in the expanded text of `path`: the position is in the

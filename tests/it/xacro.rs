@@ -152,12 +152,21 @@ fn franka_panda_xacro_beyond_xacro_rs_is_a_clear_error() {
     .unwrap_err()
     .to_string();
     assert!(
-        e.contains("panda.urdf.xacro:1:1: xacro expansion failed"),
+        e.contains("xacro expansion failed") && e.contains("in macro: collision_capsule"),
         "{e}"
     );
+    // Located in the included file that holds the expression, at the expression.
+    let utils = dir().join("franka_description/robots/common/utils.xacro");
+    let at = e
+        .strip_prefix(&format!("{}:", utils.display()))
+        .unwrap_or_else(|| panic!("not located in utils.xacro: {e}"));
+    let mut pos = at.split(':').map(|n| n.parse::<usize>().unwrap_or(0));
+    let (line, col) = (pos.next().unwrap(), pos.next().unwrap());
+    let text = std::fs::read_to_string(&utils).unwrap();
+    let source_line = text.lines().nth(line - 1).unwrap();
     assert!(
-        e.contains("split") && e.contains("in macro: collision_capsule"),
-        "{e}"
+        source_line[col - 1..].starts_with("${xyz.split("),
+        "{source_line}"
     );
 }
 
@@ -220,8 +229,10 @@ fn cli_reads_xacro_and_names_the_file_in_errors() {
     let b = run(&["check", bad.to_str().unwrap()]);
     assert_eq!(b.status.code(), Some(1));
     let e = String::from_utf8_lossy(&b.stderr);
+    // At the expression: line 1, column 73 of the one-line file.
     assert!(
-        e.contains("bad.urdf.xacro") && e.contains("undefined_property"),
+        e.contains("bad.urdf.xacro:1:73: xacro expansion failed")
+            && e.contains("undefined_property"),
         "{e}"
     );
     // An error in the expanded URDF: the xacro file, marked as expanded.

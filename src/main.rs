@@ -19,7 +19,12 @@ fn main() -> ExitCode {
     match out {
         Ok(code) => ExitCode::from(code),
         Err(e) => {
-            eprintln!("error: {e:#}");
+            // The library's hint for a package directory, as the option that gives it.
+            let hint = restpose::geometry::UNKNOWN_PACKAGE_HINT;
+            eprintln!(
+                "error: {}",
+                format!("{e:#}").replace(hint, "use --package NAME=DIR")
+            );
             ExitCode::from(cli::exit::INPUT)
         }
     }

@@ -132,6 +132,29 @@ impl State {
         State::from_joint_values(model, &initial_values(model))
     }
 
+    /// The floating base: the root link (the first link that no tree joint moves) and its
+    /// pose in the world, when that link is on a body (the base floats); `None` for a base
+    /// welded to the world.
+    pub fn floating_base<'m>(&self, model: &'m Model) -> Option<(&'m str, Isometry3<f64>)> {
+        let moved: std::collections::HashSet<&str> = model
+            .joints
+            .iter()
+            .filter(|j| j.tree)
+            .map(|j| j.child_link.as_str())
+            .collect();
+        let root = model
+            .links
+            .iter()
+            .find(|l| !moved.contains(l.name.as_str()))?;
+        let body = root.body?;
+        (self.q.len() == model.coordinate_count()).then(|| {
+            (
+                root.name.as_str(),
+                self.body_pose(body) * root.body_from_link,
+            )
+        })
+    }
+
     /// Coordinates of every joint, as reported in the result: scalar coordinates for
     /// revolute-like joints, the relative rotation `[w, x, y, z]` of a spherical joint,
     /// `[x, y, z, w, qx, qy, qz]` of a floating joint, `[]` otherwise.

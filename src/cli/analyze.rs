@@ -69,7 +69,7 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
     }
     if result.converged {
         if let Some(path) = &a.write_urdf {
-            let text = restpose::urdf::read_text(&a.file)?;
+            let text = restpose::urdf::read_urdf_text(&a.file, &opts)?;
             let out = restpose::urdf::with_initial_pose(
                 &text,
                 &a.file.display().to_string(),
@@ -82,9 +82,15 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
             let out = restpose::export::joint_states::joint_states_yaml(model, &state);
             print::write_output(path, &out)?;
         }
-    } else if a.write_urdf.is_some() || a.write_joint_states.is_some() {
+        super::formats::write(a, model, &state)?;
+    } else if a.write_urdf.is_some()
+        || a.write_joint_states.is_some()
+        || a.formats.write_mujoco_key.is_some()
+        || a.formats.write_srdf.is_some()
+    {
         eprintln!(
-            "note: --write-urdf / --write-joint-states are written only for a converged rest pose"
+            "note: --write-urdf / --write-joint-states / --write-mujoco-key / --write-srdf are \
+             written only for a converged rest pose"
         );
     }
     if !a.quiet && a.stdout_outputs().is_empty() {

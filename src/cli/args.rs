@@ -75,12 +75,16 @@ pub(crate) struct InputArgs {
     /// any pose file `verify --pose` reads.
     #[arg(long, value_name = "FILE")]
     pub(crate) servo_reference: Option<PathBuf>,
-    /// An SRDF file whose `<group_state name=STATE>` (--state) is the servos' reference pose.
-    #[arg(long, value_name = "FILE.srdf", requires = "state")]
+    /// An SRDF file whose `<group_state name=STATE>` (--srdf-state) is the servos' reference
+    /// pose.
+    #[arg(long, value_name = "FILE.srdf", requires = "srdf_state")]
     pub(crate) srdf: Option<PathBuf>,
     /// The named `group_state` of --srdf.
     #[arg(long, value_name = "NAME", requires = "srdf")]
-    pub(crate) state: Option<String>,
+    pub(crate) srdf_state: Option<String>,
+    /// Argument of a xacro file (`FILE.xacro`, expanded in-process; repeatable).
+    #[arg(long, value_name = "NAME:=VALUE")]
+    pub(crate) xacro_arg: Vec<String>,
 }
 
 impl InputArgs {
@@ -122,9 +126,14 @@ impl InputArgs {
             named.sort_by(|a, b| a.0.cmp(&b.0));
             opts.servo_reference.extend(named);
         }
-        if let (Some(path), Some(state)) = (&self.srdf, &self.state) {
+        if let (Some(path), Some(state)) = (&self.srdf, &self.srdf_state) {
             opts.servo_reference
                 .extend(restpose::urdf::srdf_state(path, state)?);
+        for a in &self.xacro_arg {
+            let (n, v) = a
+                .split_once(":=")
+                .with_context(|| format!("--xacro-arg {a}: expected NAME:=VALUE"))?;
+            opts.xacro_args.push((n.trim().to_string(), v.to_string()));
         }
         Ok(opts)
     }
@@ -243,6 +252,8 @@ pub(crate) struct AnalyzeArgs {
     /// output, which then carries only this file).
     #[arg(long, value_name = "OUT.yaml")]
     pub(crate) write_joint_states: Option<PathBuf>,
+    #[command(flatten)]
+    pub(crate) formats: FormatArgs,
     /// Maximum minimizer iterations.
     #[arg(long, default_value_t = Options::default().max_iterations)]
     pub(crate) max_iterations: usize,
@@ -294,6 +305,8 @@ impl AnalyzeArgs {
             ("--json", &self.json),
             ("--write-urdf", &self.write_urdf),
             ("--write-joint-states", &self.write_joint_states),
+            ("--write-mujoco-key", &self.formats.write_mujoco_key),
+            ("--write-srdf", &self.formats.write_srdf),
         ]
         .into_iter()
         .filter(|(_, p)| super::print::is_stdout(p.as_ref()))
@@ -336,6 +349,24 @@ impl AnalyzeArgs {
             ..Default::default()
         }
     }
+}
+
+/// The rest pose in other tools' files (`analyze`; written only when converged).
+#[derive(clap::Args, Clone)]
+pub(crate) struct FormatArgs {
+    /// Write the rest pose as a MuJoCo keyframe: an MJCF file that loads the URDF (the
+    /// `--write-urdf` file when given) with `<key name="rest" qpos>` (`-`: standard output).
+    #[arg(long, value_name = "OUT.xml")]
+    pub(crate) write_mujoco_key: Option<PathBuf>,
+    /// Write the rest pose as a MoveIt SRDF `<group_state>` (`-`: standard output).
+    #[arg(long, value_name = "OUT.srdf")]
+    pub(crate) write_srdf: Option<PathBuf>,
+    /// The SRDF group of `--write-srdf` (every moving joint).
+    #[arg(long, value_name = "NAME", default_value = "all")]
+    pub(crate) group: String,
+    /// The SRDF named state of `--write-srdf`.
+    #[arg(long, value_name = "NAME", default_value = "rest")]
+    pub(crate) state: String,
 }
 
 /// A joint coordinate given as `JOINT=VALUE` or `JOINT[DOF]=VALUE` to option `--{what}`.

@@ -6,6 +6,7 @@ pub(crate) mod analyze;
 pub(crate) mod args;
 pub(crate) mod check;
 pub(crate) mod exit;
+pub(crate) mod formats;
 pub(crate) mod generate;
 pub(crate) mod parse;
 pub(crate) mod print;

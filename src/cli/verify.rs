@@ -39,7 +39,8 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
         bail!("give the pose with --pose FILE or --joint NAME=VALUE");
     }
     // A floating base: its pose comes from the result JSON's `links` (the root link's
-    // `position` and `orientation_wxyz`), else from `mech:base` / `--base-xyz`.
+    // `position` and `orientation_wxyz`) or the YAML's `base`, else from `mech:base` /
+    // `--base-xyz`.
     let based;
     let model = match a.pose.as_deref().and_then(|p| base_pose(model, p)) {
         Some(pose) => {
@@ -112,7 +113,8 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
 }
 
 /// The pose of the floating root link in a result JSON `path` (`links.ROOT.position` and
-/// `orientation_wxyz`), when the model's base floats (a body that no tree joint moves).
+/// `orientation_wxyz`) or a joint-states YAML (`base.position` and `orientation_wxyz`, with
+/// `base.link` the root link), when the model's base floats (a body that no tree joint moves).
 fn base_pose(model: &restpose::Model, path: &std::path::Path) -> Option<nalgebra::Isometry3<f64>> {
     // The bodies some tree joint moves, in one pass (a scan of the joints per body was
     // `O(N²)` name comparisons: 10 % of `verify` at 10,000 links).
@@ -129,8 +131,14 @@ fn base_pose(model: &restpose::Model, path: &std::path::Path) -> Option<nalgebra
         .find(|(_, &m)| !m)
         .map(|(b, _)| b)?;
     let text = std::fs::read_to_string(path).ok()?;
-    let json: serde_json::Value = serde_json::from_str(&text).ok()?;
-    let link = json.get("links")?.get(&root.name)?;
+    // JSON, or YAML (a joint-states file with restpose's `base` section).
+    let json: serde_json::Value = serde_json::from_str(&text)
+        .ok()
+        .or_else(|| serde_yaml_ng::from_str(&text).ok())?;
+    let link = match json.get("base") {
+        Some(b) if b.get("link").and_then(|l| l.as_str()) == Some(root.name.as_str()) => b,
+        _ => json.get("links")?.get(&root.name)?,
+    };
     let v = |key: &str, n: usize| -> Option<Vec<f64>> {
         let a = link.get(key)?.as_array()?;
         let v: Option<Vec<f64>> = a.iter().map(|x| x.as_f64()).collect();

@@ -7,6 +7,9 @@
 //! the result JSON's `joints.*.position` (a spherical joint's quaternion `[w, x, y, z]`, a
 //! floating joint's `[x, y, z, w, qx, qy, qz]`). `restpose verify --pose` reads both back.
 //! Joints without coordinates (fixed, distance, point-on-line) are not listed.
+//! A floating base adds a `base` mapping: the root link's name, `position` \[m\] and
+//! `orientation_wxyz` in the world, as in the result JSON's `links`, which `verify
+//! --floating-base --pose` reads back.
 
 use crate::model::Model;
 use crate::state::State;
@@ -31,6 +34,22 @@ pub fn joint_states_yaml(model: &Model, state: &State) -> String {
     let _ = writeln!(s, "# rest pose of `{}` written by restpose", model.name);
     let _ = writeln!(s, "name: [{}]", names.join(", "));
     let _ = writeln!(s, "position: [{}]", positions.join(", "));
+    if let Some((link, pose)) = state.floating_base(model) {
+        let t = pose.translation.vector;
+        let r = pose.rotation;
+        let _ = writeln!(
+            s,
+            "# the floating base: its root link's pose in the world (position [m], unit quaternion w x y z)"
+        );
+        let _ = writeln!(s, "base:");
+        let _ = writeln!(s, "  link: {}", quote(link));
+        let _ = writeln!(s, "  position: [{:?}, {:?}, {:?}]", t.x, t.y, t.z);
+        let _ = writeln!(
+            s,
+            "  orientation_wxyz: [{:?}, {:?}, {:?}, {:?}]",
+            r.w, r.i, r.j, r.k
+        );
+    }
     if !multi.is_empty() {
         let _ = writeln!(
             s,

@@ -1,5 +1,6 @@
 //! The result JSON (field names are a contract, documented in docs/json.md).
 
+use super::configuration::{configuration_of, values as values_only, Convention};
 use crate::forces::Energy;
 use crate::model::{JointKind, Model};
 use crate::solver::{
@@ -127,6 +128,16 @@ pub struct AnalysisResult {
     /// Every link's frame in the world, in model order.
     #[serde(serialize_with = "ordered_map")]
     pub links: Vec<(String, LinkResult)>,
+    /// The pose as MuJoCo's `qpos` for this URDF (see [`super::configuration`]): depth first,
+    /// children in `<joint>` element order, floating base `x y z w x y z` first; when the
+    /// model has a joint MuJoCo does not read from a URDF, absent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub q_mujoco: Option<Vec<f64>>,
+    /// The pose as Pinocchio's `q` for this URDF: depth first, children sorted by joint name,
+    /// free flyer `x y z qx qy qz qw` first, a continuous joint as `cos θ, sin θ`; when the
+    /// model has a joint Pinocchio does not read from a URDF, absent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub q_pinocchio: Option<Vec<f64>>,
     /// Stability verdict (absent for a structure with no degree of freedom).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stability: Option<Stability>,
@@ -166,8 +177,14 @@ pub struct AnalysisResult {
 impl AnalysisResult {
     /// Builds the result of a solve.
     pub fn new(model: &Model, state: &State, report: &Report) -> Self {
-        let joints: Vec<(String, JointResult)> = state
-            .joint_values(model)
+        let values = state.joint_values(model);
+        let q = |c| {
+            configuration_of(model, state, &values, c)
+                .ok()
+                .map(|q| values_only(&q))
+        };
+        let (q_mujoco, q_pinocchio) = (q(Convention::Mujoco), q(Convention::Pinocchio));
+        let joints: Vec<(String, JointResult)> = values
             .into_iter()
             .zip(&model.joints)
             .map(|((name, position), j)| {
@@ -237,6 +254,8 @@ impl AnalysisResult {
             history: report.history.clone(),
             joints,
             links,
+            q_mujoco,
+            q_pinocchio,
             stability: report.stability.clone(),
             reactions: report.reactions.clone(),
             redundant_constraints: report.redundant_constraints.clone(),

@@ -1,8 +1,12 @@
-//! Result writers: the result JSON ([`json`]), ROS joint states ([`joint_states`]), and
-//! atomic file output. The URDF write-back is [`crate::urdf::with_initial_pose`].
+//! Result writers: the result JSON ([`json`]), ROS joint states ([`joint_states`]), the pose
+//! in other tools' terms ([`configuration`]: MuJoCo's `qpos`, Pinocchio's `q`; [`mujoco`]: a
+//! MuJoCo keyframe; [`srdf`]: a MoveIt named state), and atomic file output. The URDF write-back is [`crate::urdf::with_initial_pose`].
 
+pub mod configuration;
 pub mod joint_states;
 pub mod json;
+pub mod mujoco;
+pub mod srdf;
 pub mod summary;
 
 use crate::error::{Error, Result};

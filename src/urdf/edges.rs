@@ -6,6 +6,7 @@
 //! link frame is `J` at zero displacement). An endpoint may also be a `mech:frame` (folded into
 //! the origin) or the undeclared `world`.
 
+use super::limits::{limits, urdf_limits};
 use super::xml::{child, Source};
 use crate::error::Result;
 use crate::model::JointKind;
@@ -92,30 +93,6 @@ pub(super) fn resolve(
             src.describe(node)
         ),
     ))
-}
-
-/// Position limits from `<limit lower upper>` (a missing bound is 0, as in urdfdom);
-/// `lower > upper` is an error.
-fn limits(src: &Source, node: Node) -> Result<Option<[f64; 2]>> {
-    let Some(l) = child(node, "limit") else {
-        return Ok(None);
-    };
-    match (src.f64_opt(l, "lower")?, src.f64_opt(l, "upper")?) {
-        (None, None) => Ok(None),
-        (lo, hi) => {
-            let (lo, hi) = (lo.unwrap_or(0.0), hi.unwrap_or(0.0));
-            if lo > hi {
-                return Err(src.error(
-                    l,
-                    format!(
-                        "{}: <limit> has lower {lo} > upper {hi}",
-                        src.describe(node)
-                    ),
-                ));
-            }
-            Ok(Some([lo, hi]))
-        }
-    }
 }
 
 /// The axis of a URDF joint. Fixed, floating and spherical joints have none: urdfdom does not
@@ -209,7 +186,7 @@ pub(super) fn urdf_joint<'a>(
     let name = src.req(node, "name")?.to_string();
     let kind = urdf_kind(src, node, src.req(node, "type")?, warnings)?;
     let [(parent, pf, parent_link), (child_i, cf, child_link)] = ends(src, node, frames, &name)?;
-    let mut lim = limits(src, node)?;
+    let mut lim = urdf_limits(src, node, kind, warnings)?;
     if kind == JointKind::Continuous && lim.take().is_some_and(|[lo, hi]| lo != 0.0 || hi != 0.0) {
         warnings.push(src.warning(
             node,

@@ -10,6 +10,7 @@ mod edges;
 mod extensions;
 mod foreign;
 mod import;
+mod limits;
 mod links;
 mod mimic;
 mod schema;
@@ -17,6 +18,8 @@ mod servo;
 mod text;
 mod tree;
 mod write_back;
+#[cfg(feature = "xacro")]
+pub mod xacro;
 mod xml;
 
 pub use servo::{srdf_state, ServoRequest};
@@ -55,6 +58,8 @@ pub struct ImportOptions {
     /// Reference pose of the servos `(joint, value)` (`--servo-reference`, an SRDF
     /// `group_state`): a servo without its own reference holds its joint at this value.
     pub servo_reference: Vec<(String, f64)>,
+    /// `--xacro-arg NAME:=VALUE`: arguments of a xacro file (feature `xacro`).
+    pub xacro_args: Vec<(String, String)>,
 }
 
 impl Default for ImportOptions {
@@ -70,6 +75,7 @@ impl Default for ImportOptions {
             base_pose: None,
             servos: Vec::new(),
             servo_reference: Vec::new(),
+            xacro_args: Vec::new(),
         }
     }
 }
@@ -85,7 +91,8 @@ pub struct Loaded {
     pub ignored: Vec<String>,
 }
 
-/// Reads a URDF file.
+/// Reads a URDF file, or a xacro file (`*.xacro`, or a file declaring the xacro namespace)
+/// expanded first when the feature `xacro` is on (module `xacro`).
 ///
 /// # Errors
 /// [`Error::Io`] if the file cannot be read, [`Error::Input`] (with line and column) if it is
@@ -101,7 +108,37 @@ pub fn load_file(path: impl AsRef<Path>, options: &ImportOptions) -> Result<Load
             d.to_path_buf()
         }
     });
+    #[cfg(feature = "xacro")]
+    if xacro::is_xacro(path, &text) {
+        let expanded = xacro::expand(path, &options.xacro_args, &options.packages)?;
+        let file = path.display().to_string();
+        let mut loaded =
+            import::import(&expanded, &file, dir, options).map_err(|e| xacro::locate(e, path))?;
+        // Positions in warnings are in the expansion too.
+        for w in &mut loaded.warnings {
+            if let Some(rest) = w.strip_prefix(&format!("{file}:")) {
+                *w = format!("{file} (expanded):{rest}");
+            }
+        }
+        return Ok(loaded);
+    }
     import::import(&text, &path.display().to_string(), dir, options)
+}
+
+/// The text of the URDF file at `path`: a xacro file (feature `xacro`) is expanded with the
+/// options' `xacro_args` and `packages`, as [`load_file`] does.
+///
+/// # Errors
+/// As [`load_file`], for reading and expanding.
+pub fn read_urdf_text(path: impl AsRef<Path>, options: &ImportOptions) -> Result<String> {
+    let path = path.as_ref();
+    let text = text::read_file(path)?;
+    #[cfg(feature = "xacro")]
+    if xacro::is_xacro(path, &text) {
+        return xacro::expand(path, &options.xacro_args, &options.packages);
+    }
+    let _ = options;
+    Ok(text)
 }
 
 /// Reads URDF text; `file` names it in error messages; relative mesh paths are taken from the

@@ -18,8 +18,8 @@ pub const MAX_FILE_BYTES: u64 = 256 << 20;
 pub const MAX_DEPTH: usize = 1_000;
 
 /// The xacro hint.
-const XACRO: &str =
-    "xacro macros are not expanded URDF: run `xacro FILE.urdf.xacro > FILE.urdf` first";
+const XACRO: &str = "xacro macros are not expanded URDF: name the file `*.xacro` to have \
+     restpose expand it (feature `xacro`), or run `xacro FILE.urdf.xacro > FILE.urdf` first";
 
 /// Encoding names (lower case) read as Latin-1, where every byte is the code point of that
 /// value. `windows-1252` differs only in 0x80–0x9F, which URDF files do not use for markup.

@@ -6,6 +6,9 @@
 //! elements survive. Scalar coordinates are written one per element (`dof` when not 0);
 //! spherical and floating joints get their whole coordinate vector in one `value` list
 //! (quaternion `w x y z`; `x y z w qx qy qz`), a restpose extension of the format.
+//! A floating base's pose (its root link in the world) replaces any `mech:base` as
+//! `<mech:base xyz quat_xyzw/>`, so that `--floating-base` starts there. Names are escaped
+//! (`&`, `<`, `>`, `"`) in attribute values.
 
 use super::xml::MECH_NS;
 use crate::error::Result;
@@ -25,13 +28,15 @@ pub fn with_initial_pose(text: &str, file: &str, model: &Model, state: &State) -
     let robot = doc.root_element();
     let prefix = robot.lookup_prefix(MECH_NS).map(str::to_string);
     let tag = prefix.clone().map_or("mech".to_string(), |p| p);
+    let base = state.floating_base(model);
     // Byte ranges to delete: existing initial values with the whitespace before them.
     let mut cut: Vec<(usize, usize)> = robot
         .children()
         .filter(|c| {
             c.is_element()
                 && c.tag_name().namespace() == Some(MECH_NS)
-                && c.tag_name().name() == "initial"
+                && (c.tag_name().name() == "initial"
+                    || (c.tag_name().name() == "base" && base.is_some()))
         })
         .map(|c| {
             let r = c.range();
@@ -48,7 +53,17 @@ pub fn with_initial_pose(text: &str, file: &str, model: &Model, state: &State) -
     let end = robot.range().end;
     let close = text[..end].rfind("</").unwrap_or(end);
     let mut block = String::new();
+    if let Some((_, pose)) = base {
+        let t = pose.translation.vector;
+        let r = pose.rotation;
+        let _ = writeln!(
+            block,
+            "  <{tag}:base xyz=\"{:?} {:?} {:?}\" quat_xyzw=\"{:?} {:?} {:?} {:?}\"/>",
+            t.x, t.y, t.z, r.i, r.j, r.k, r.w
+        );
+    }
     for ((name, values), joint) in state.joint_values(model).into_iter().zip(&model.joints) {
+        let name = escape(&name);
         if joint.merged
             || values.is_empty()
             || matches!(joint.kind, JointKind::Fixed | JointKind::Distance { .. })
@@ -94,4 +109,12 @@ pub fn with_initial_pose(text: &str, file: &str, model: &Model, state: &State) -
         }
     }
     Ok(out)
+}
+
+/// `s` escaped for an attribute value in double quotes.
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
 }

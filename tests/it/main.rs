@@ -10,6 +10,7 @@ mod common;
 mod contact;
 mod degenerate;
 mod engineering;
+mod formats;
 mod golden;
 mod importer;
 mod importer_fuzz;
@@ -30,3 +31,5 @@ mod verify;
 #[cfg(feature = "viewer")]
 mod viewer;
 mod write_back;
+#[cfg(feature = "xacro")]
+mod xacro;

@@ -1,0 +1,201 @@
+//! xacro input: a `.xacro` file is expanded to URDF text in-process by the `xacro-rs` crate
+//! (macros, properties, conditionals, `$(arg)`, `$(find)`, `load_yaml`), then imported like
+//! any URDF.
+//!
+//! `$(find NAME)` resolves, in order, to the directory given as `packages` (`--package
+//! NAME=DIR`), then the way ROS would (`RUST_XACRO_PACKAGE_MAP`, `ROS_PACKAGE_PATH`, a
+//! `package.xml` named `NAME` above the file). The same directories resolve the expanded
+//! URDF's `package://NAME/…` meshes.
+//!
+//! Errors of the expansion name the xacro file with `xacro-rs`'s message and macro stack, at
+//! the line and column of the failing expression or argument where it is found in the
+//! sources (`xacro-rs` gives no position); an error in the expanded URDF names the xacro file with the line and
+//! column in the expanded text, and says so.
+
+use crate::error::{Error, Result};
+use std::path::{Path, PathBuf};
+use xacro_rs::extensions::{ExtensionHandler, FindExtension, OptEnvExtension};
+use xacro_rs::XacroProcessor;
+
+/// Whether `path` names a xacro file (`*.xacro`), or `text` declares the xacro namespace.
+pub fn is_xacro(path: &Path, text: &str) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("xacro"))
+        || text.contains("xmlns:xacro=")
+}
+
+/// `$(find NAME)` through the user's `NAME=DIR` list; other names go to the next handler.
+struct GivenPackages(Vec<(String, PathBuf)>);
+
+impl ExtensionHandler for GivenPackages {
+    fn resolve(
+        &self,
+        command: &str,
+        args_raw: &str,
+    ) -> std::result::Result<Option<String>, Box<dyn std::error::Error>> {
+        if command != "find" {
+            return Ok(None);
+        }
+        let name = args_raw.trim();
+        Ok(self
+            .0
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, d)| std::path::absolute(d).unwrap_or_else(|_| d.clone()))
+            .map(|d| d.display().to_string()))
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+}
+
+/// The URDF text that the xacro file at `path` expands to with the arguments `args`
+/// (`NAME:=VALUE` pairs) and the package directories `packages`.
+///
+/// # Errors
+/// [`Error::Io`] if the file cannot be read, [`Error::Input`] naming the file when the
+/// expansion fails (unknown macro or property, a bad expression, an include or `$(find)` that
+/// cannot be resolved), with `xacro-rs`'s message and its macro and include stack.
+pub fn expand(
+    path: &Path,
+    args: &[(String, String)],
+    packages: &[(String, PathBuf)],
+) -> Result<String> {
+    if let Err(cause) = std::fs::metadata(path) {
+        return Err(Error::Io {
+            path: path.display().to_string(),
+            cause,
+        });
+    }
+    // Literal defaults of the top file's `<xacro:arg>`s, for the arguments that the user
+    // did not give: `xacro-rs` evaluates `<robot name="$(arg name)">` before it reads the
+    // `<xacro:arg name="name" default="ur"/>` below it, which python xacro accepts.
+    let mut args = args.to_vec();
+    for (name, default) in literal_arg_defaults(path) {
+        if !args.iter().any(|(n, _)| *n == name) {
+            args.push((name, default));
+        }
+    }
+    // As python xacro: tolerant of duplicate macro parameters and unusual namespace URIs,
+    // ROS units (`!degrees`) in YAML.
+    XacroProcessor::builder()
+        .with_args(args.into_iter().collect())
+        .with_extension(Box::new(GivenPackages(packages.to_vec())))
+        .with_extension(Box::new(FindExtension::new()))
+        .with_extension(Box::new(OptEnvExtension::new()))
+        .with_compat_all()
+        .with_ros_yaml_units()
+        .build()
+        .run(path)
+        .map_err(|e| {
+            let text = e.to_string();
+            let mut message = String::from("xacro expansion failed: ");
+            message.push_str(text.trim_end());
+            if text.contains("find") || text.contains("package") {
+                message.push_str(&format!(" ({})", crate::geometry::UNKNOWN_PACKAGE_HINT));
+            }
+            let (file, line, col) = source_position(&text, path, packages)
+                .unwrap_or_else(|| (path.to_path_buf(), 1, 1));
+            Error::Input {
+                file: file.display().to_string(),
+                line,
+                col,
+                message,
+            }
+        })
+}
+
+/// Where in the xacro sources an expansion error is: the first `${EXPRESSION` of an
+/// "Evaluation error in 'EXPRESSION'", or `$(arg NAME)` of an "Undefined argument: 'NAME'",
+/// in the top file, else in the `.xacro` files below its folder and the package folders
+/// (`xacro-rs` names only the top file). `None` when the text is not found.
+fn source_position(
+    message: &str,
+    path: &Path,
+    packages: &[(String, PathBuf)],
+) -> Option<(PathBuf, u32, u32)> {
+    let needle = if let Some(rest) = message.split("Evaluation error in '").nth(1) {
+        format!("${{{}", rest.split("': ").next()?)
+    } else if let Some(rest) = message.split("Undefined argument: '").nth(1) {
+        format!("$(arg {})", rest.split('\'').next()?)
+    } else {
+        return None;
+    };
+    let mut files = vec![path.to_path_buf()];
+    let mut dirs: Vec<PathBuf> = path.parent().map(Path::to_path_buf).into_iter().collect();
+    dirs.extend(packages.iter().map(|(_, d)| d.clone()));
+    // A bounded walk: at most 2,000 entries.
+    let mut seen = 0;
+    while let Some(dir) = dirs.pop() {
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            seen += 1;
+            if seen > 2_000 {
+                break;
+            }
+            let p = e.path();
+            if p.is_dir() {
+                dirs.push(p);
+            } else if p.extension().is_some_and(|x| x == "xacro") && p != path {
+                files.push(p);
+            }
+        }
+    }
+    files.into_iter().find_map(|f| {
+        let text = std::fs::read_to_string(&f).ok()?;
+        let at = text.find(&needle)?;
+        let before = &text[..at];
+        let line = before.matches('\n').count() + 1;
+        let col = before[before.rfind('\n').map_or(0, |p| p + 1)..]
+            .chars()
+            .count()
+            + 1;
+        Some((f, line as u32, col as u32))
+    })
+}
+
+/// Renames an importer error located in the expanded text of `path`: the position is in the
+/// expansion, which the message says.
+pub(crate) fn locate(e: Error, path: &Path) -> Error {
+    match e {
+        Error::Input {
+            line, col, message, ..
+        } => Error::Input {
+            file: format!("{} (expanded)", path.display()),
+            line,
+            col,
+            message: format!(
+                "{message} (line and column of the URDF the xacro file expands to; see it with \
+                 `xacro-rs {} > expanded.urdf`)",
+                path.display()
+            ),
+        },
+        e => e,
+    }
+}
+
+/// `(name, default)` of each `<xacro:arg>` child of the root of the file at `path` whose
+/// default is literal (no `$(…)` or `${…}`).
+fn literal_arg_defaults(path: &Path) -> Vec<(String, String)> {
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return Vec::new();
+    };
+    let Ok(doc) = roxmltree::Document::parse(&text) else {
+        return Vec::new();
+    };
+    doc.root_element()
+        .children()
+        .filter(|n| {
+            n.tag_name().name() == "arg"
+                && n.tag_name()
+                    .namespace()
+                    .is_some_and(|u| u.contains("xacro"))
+        })
+        .filter_map(|n| Some((n.attribute("name")?, n.attribute("default")?)))
+        .filter(|(_, d)| !d.contains("$(") && !d.contains("${"))
+        .map(|(n, d)| (n.to_string(), d.to_string()))
+        .collect()
+}

@@ -14,22 +14,16 @@
 //!   equilibrium analysis of large-scale mechanical systems, *Int. J. Numer. Meth. Eng.* 21
 //!   (1985) 451–464 (`shared/paper/`).
 
-mod active_set;
 mod assemble;
-mod cone;
-mod distribution;
-mod eigen;
-mod guard;
+mod inequality;
 mod minimize;
 mod mode_animation;
 mod options;
 pub(crate) mod partition;
 mod reactions;
 mod report;
-mod rolling;
 pub(crate) mod sparse;
-mod spectrum;
-mod stability_inertia;
+mod stability;
 pub(crate) mod system;
 mod unbounded;
 
@@ -46,7 +40,9 @@ use crate::error::{Error, Result};
 use crate::kinematics::Branches;
 use crate::model::{JointId, Model};
 use crate::state::{JointValues, State};
+use inequality::{active_set, distribution};
 use nalgebra::DVector;
+use stability::{inertia, spectrum};
 use system::System;
 
 /// Initial guess: forward kinematics with every joint at its `mech:initial` / `--initial`
@@ -171,7 +167,7 @@ pub(crate) fn stability_at(model: &Model, state: &State, eigenvalues: bool) -> O
     stability_on(model, state, &[], eigenvalues)
 }
 
-pub(crate) use cone::stability_touching;
+pub(crate) use stability::cone::stability_touching;
 
 /// [`stability_at`] on the tangent space of the equality rows and the inequalities `active`
 /// (the stops and contacts that carry a force); `eigenvalues` as in [`stability_of`].
@@ -199,7 +195,7 @@ pub(crate) fn stability_on(
 ///
 /// Where the eigenvalues would come from Lanczos (sparse path, more than
 /// `spectrum::EXACT_UP_TO` degrees of freedom) and `eigenvalues` is false, the verdict comes
-/// from the inertia of the shifted KKT matrix alone (module `stability_inertia`), without
+/// from the inertia of the shifted KKT matrix alone (module `stability::inertia`), without
 /// eigenvalues or mode shapes; Lanczos only if that inertia cannot be trusted.
 pub(crate) fn stability_of(
     sys: &mut System,
@@ -214,7 +210,7 @@ pub(crate) fn stability_of(
     let lanczos =
         sys.backend == system::Backend::Sparse && part.independent.len() > spectrum::EXACT_UP_TO;
     if lanczos && !eigenvalues {
-        if let Some((verdict, tolerance)) = stability_inertia::inertia_verdict(sys, q, part, eval) {
+        if let Some((verdict, tolerance)) = inertia::inertia_verdict(sys, q, part, eval) {
             return Some(Stability {
                 verdict,
                 tolerance,

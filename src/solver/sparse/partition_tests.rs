@@ -50,10 +50,10 @@ fn a_contact_below_a_steep_link_is_not_pivoted_on_its_angle() {
     let q0 = crate::solver::initial_state(&model).q;
     let q = crate::solver::assemble_only(&model, q0, &mut Default::default(), &[]).unwrap();
     let options = crate::solver::Options::default();
-    let active: Vec<_> = crate::solver::active_set::inequalities(&model, &options)
+    let active: Vec<_> = crate::solver::inequality::active_set::inequalities(&model, &options)
         .into_iter()
         .filter(|u| gap(&model, u, &q, &Default::default()).is_some_and(|g| g.abs() < 1e-9))
-        .map(|u| crate::solver::active_set::activate(&model, &options, u, &q))
+        .map(|u| crate::solver::inequality::active_set::activate(&model, &options, u, &q))
         .collect();
     // Links 19 (the lowest hanging one) to 59 touch.
     assert_eq!(active.len(), 41);

@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::constraints::Constraints;
-use crate::solver::eigen::symmetric_eigen;
+use crate::solver::stability::eigen::symmetric_eigen;
 use crate::solver::system::Backend;
 use crate::urdf::{load_str, ImportOptions};
 

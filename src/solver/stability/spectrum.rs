@@ -18,9 +18,9 @@
 //! - Y. Saad, *Numerical Methods for Large Eigenvalue Problems*, 2nd ed., SIAM (2011), §6.6.
 
 use super::eigen::symmetric_eigen;
-use super::partition::Partition;
-use super::sparse::kkt::Factored;
-use super::system::{Backend, Eval, System};
+use crate::solver::partition::Partition;
+use crate::solver::sparse::kkt::Factored;
+use crate::solver::system::{Backend, Eval, System};
 use nalgebra::{DMatrix, DVector};
 
 /// Up to this many degrees of freedom the reduced Hessian is formed and decomposed exactly.

@@ -32,10 +32,10 @@
 //!   (active-set methods), §15.4 (handling inequalities in reduced-gradient methods).
 
 pub(crate) use super::guard::Guard;
-use super::options::{Limits, Options};
 use crate::constraints::unilateral::{self, Active, Unilateral};
 use crate::kinematics::Branches;
 use crate::model::{Friction, Model};
+use crate::solver::options::{Limits, Options};
 use nalgebra::{DVector, Vector3};
 
 /// `g` divided by the characteristic length for a gap in m.
@@ -178,7 +178,7 @@ pub(crate) fn solve(
     start: crate::State,
     locks: &[(crate::model::JointId, usize, f64)],
     options: &Options,
-) -> crate::Result<(crate::State, super::Report)> {
+) -> crate::Result<(crate::State, crate::solver::Report)> {
     let all = inequalities(model, options);
     let tol = options.gap_tolerance;
     let threshold = options.force_tolerance * force_scale(model);
@@ -201,17 +201,24 @@ pub(crate) fn solve(
     let mut touched = Vec::new();
     super::rolling::record_touches(model, &active, &state.q, &mut touched);
     let mut iterations = 0;
-    let mut counters = super::Diagnostics::default();
+    let mut counters = crate::solver::Diagnostics::default();
     loop {
         let mut branches = state.branches.clone();
-        let q = super::assemble::project(model, state.q, &mut branches, locks, &active, options)?;
+        let q = crate::solver::assemble::project(
+            model,
+            state.q,
+            &mut branches,
+            locks,
+            &active,
+            options,
+        )?;
         let inactive: Vec<Unilateral> = all
             .iter()
             .filter(|u| !active.iter().any(|a| a.row == **u))
             .copied()
             .collect();
         let guard = Guard::new(model, options, inactive, &active, tol, &q);
-        let round = super::solve_round(
+        let round = crate::solver::solve_round(
             model,
             crate::State { q, branches },
             locks,
@@ -239,7 +246,7 @@ pub(crate) fn solve(
             if rolls <= super::rolling::MAX_ROLLS {
                 continue;
             }
-            report.termination = super::Termination::Unbounded;
+            report.termination = crate::solver::Termination::Unbounded;
             rolled_too_far = true;
         }
         if report.converged() && !cycling && !rolled_too_far {
@@ -254,15 +261,15 @@ pub(crate) fn solve(
                 if rolls <= super::rolling::MAX_ROLLS {
                     continue;
                 }
-                report.termination = super::Termination::Unbounded;
+                report.termination = crate::solver::Termination::Unbounded;
             }
         }
         if cycling {
-            report.termination = super::Termination::ActiveSetCycling;
+            report.termination = crate::solver::Termination::ActiveSetCycling;
         }
         // A round stopped at an inequality or a roll limit has no verdict of its own.
         if (cycling || rolled_too_far) && round.blocked.is_some() {
-            report.stability = super::stability_on(model, &state, &active, true);
+            report.stability = crate::solver::stability_on(model, &state, &active, true);
         }
         report.iterations = iterations;
         let own = report.diagnostics.clone();
@@ -280,7 +287,9 @@ pub(crate) fn solve(
         // critical cone instead (module `cone`).
         let (strong, weak) = split(model, &round.multipliers, threshold);
         if report.converged() && !weak.is_empty() {
-            report.stability = super::cone::stability_touching(model, &state, &strong, &weak, true);
+            report.stability = crate::solver::stability::cone::stability_touching(
+                model, &state, &strong, &weak, true,
+            );
         }
         return Ok((state, report));
     }
@@ -292,9 +301,9 @@ fn describe(
     options: &Options,
     state: &crate::State,
     multipliers: &[(Active, Vec<f64>)],
-    report: &mut super::Report,
+    report: &mut crate::solver::Report,
 ) {
-    use super::report::{ActiveLimit, Contact, ContactState};
+    use crate::solver::report::{ActiveLimit, Contact, ContactState};
     for (a, m) in multipliers {
         match a.row {
             Unilateral::Limit {

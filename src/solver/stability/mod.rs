@@ -8,8 +8,10 @@
 //!   (sparse, many degrees of freedom); also used by the minimizer to leave saddles.
 //! - `inertia`: the verdict from the inertia of the shifted KKT matrix, without eigenvalues.
 //! - `cone`: the verdict on the critical cone, where stops and contacts touch without force.
+//! - `verdict`: the verdict and mode shapes from the eigenpairs, and the entry points.
 
 pub(crate) mod cone;
 pub(crate) mod eigen;
 pub(crate) mod inertia;
 pub(crate) mod spectrum;
+pub(crate) mod verdict;

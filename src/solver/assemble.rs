@@ -6,7 +6,7 @@
 //! assembly branch); if that fails, the assembly is retried without them.
 
 use super::options::Options;
-use super::system::System;
+use super::system::{Backend, System};
 use crate::constraints::unilateral::Active;
 use crate::constraints::Constraints;
 use crate::error::{Error, Result};
@@ -99,11 +99,11 @@ pub(crate) fn assemble(
     }
     if held.len() > locks.len() {
         let cons = Constraints::new(model, &held).on_branches(branches.clone());
-        let mut sys = System::with_options(model, cons, options);
+        let mut sys = System::new(model, cons, Backend::of(model, options));
         if let Ok(qa) = newton(&mut sys, q.clone(), tol) {
             let cons =
                 Constraints::new(model, locks).on_branches(sys.problem.cons.branches.clone());
-            let mut fin = System::with_options(model, cons, options);
+            let mut fin = System::new(model, cons, Backend::of(model, options));
             fin.residual(&qa);
             if fin.dimensionless_residual() <= tol.max(1e-8) {
                 *branches = fin.problem.cons.branches;
@@ -127,7 +127,7 @@ pub(crate) fn project(
     let cons = Constraints::new(model, locks)
         .with_active(model, active)
         .on_branches(branches.clone());
-    let mut sys = System::with_options(model, cons, options);
+    let mut sys = System::new(model, cons, Backend::of(model, options));
     let q0 = q.clone();
     match newton(&mut sys, q, tol) {
         Ok(qa) => {

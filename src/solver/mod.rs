@@ -38,8 +38,7 @@ pub use report::{
     ActiveLimit, Contact, ContactState, Diagnostics, Iterate, Reaction, Report, Sizes, Stability,
     Termination, Timings, Verdict,
 };
-pub(crate) use stability::cone::stability_touching;
-pub(crate) use stability::verdict::{stability_at, stability_of, stability_on};
+pub(crate) use stability::verdict::{stability_of, stability_on, stability_verdict};
 
 use crate::constraints::unilateral::Active;
 use crate::constraints::Constraints;
@@ -50,7 +49,7 @@ use crate::state::{JointValues, State};
 use inequality::{active_set, distribution};
 use nalgebra::DVector;
 use stability::{spectrum, verdict};
-use system::System;
+use system::{Backend, System};
 
 /// Initial guess: forward kinematics with every joint at its `mech:initial` / `--initial`
 /// value (0 otherwise). Loop joints are not yet closed.
@@ -221,7 +220,7 @@ pub(crate) fn solve_round(
     let cons = Constraints::new(model, locks)
         .with_active(model, active)
         .on_branches(start.branches.clone());
-    let mut sys = System::with_options(model, cons, options);
+    let mut sys = System::new(model, cons, Backend::of(model, options));
     let part = sys.partition(&q);
     let dof0 = part.independent.len();
     if options.method != Method::Newton && dof0 > QUASI_NEWTON_DOF_LIMIT {

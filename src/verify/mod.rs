@@ -424,11 +424,15 @@ fn verify_on(
     // and the critical cone of those that touch without one (`solver::cone`).
     let stability = match (passed, sparse) {
         (false, _) => None,
-        (true, _) if !strong.is_empty() || !weak.is_empty() => {
-            crate::solver::stability_touching(model, state, &strong, &weak, eigenvalues)
+        (true, true) if strong.is_empty() && weak.is_empty() => stability,
+        (true, _) => {
+            let backend = if sparse {
+                Backend::Sparse
+            } else {
+                Backend::Dense
+            };
+            crate::solver::stability_verdict(model, state, &strong, &weak, backend, eigenvalues)
         }
-        (true, true) => stability,
-        (true, false) => crate::solver::stability_at(model, state, eigenvalues),
     };
     Ok(Verification {
         passed,

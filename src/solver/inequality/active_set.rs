@@ -36,6 +36,7 @@ use crate::constraints::unilateral::{self, Active, Unilateral};
 use crate::kinematics::Branches;
 use crate::model::{Friction, Model};
 use crate::solver::options::{Limits, Options};
+use crate::solver::system::Backend;
 use nalgebra::{DVector, Vector3};
 
 /// `g` divided by the characteristic length for a gap in m.
@@ -269,7 +270,13 @@ pub(crate) fn solve(
         }
         // A round stopped at an inequality or a roll limit has no verdict of its own.
         if (cycling || rolled_too_far) && round.blocked.is_some() {
-            report.stability = crate::solver::stability_on(model, &state, &active, true);
+            report.stability = crate::solver::stability_on(
+                model,
+                &state,
+                &active,
+                Backend::of(model, options),
+                true,
+            );
         }
         report.iterations = iterations;
         let own = report.diagnostics.clone();
@@ -287,8 +294,13 @@ pub(crate) fn solve(
         // critical cone instead (module `cone`).
         let (strong, weak) = split(model, &round.multipliers, threshold);
         if report.converged() && !weak.is_empty() {
-            report.stability = crate::solver::stability::cone::stability_touching(
-                model, &state, &strong, &weak, true,
+            report.stability = crate::solver::stability_verdict(
+                model,
+                &state,
+                &strong,
+                &weak,
+                Backend::of(model, options),
+                true,
             );
         }
         return Ok((state, report));

@@ -223,6 +223,7 @@ mod tests {
     use super::*;
     use crate::constraints::Constraints;
     use crate::solver::inequality::active_set::{activate, inequalities};
+    use crate::solver::system::Backend;
     use crate::urdf::{load_str, ImportOptions};
 
     /// A link on a hinge 0.04 m above the ground, from the horizontal, turned toward the
@@ -266,7 +267,7 @@ mod tests {
         let cons = Constraints::new(&model, &[])
             .with_active(&model, &active)
             .on_branches(branches);
-        let mut sys = System::with_options(&model, cons, &options);
+        let mut sys = System::new(&model, cons, Backend::of(&model, &options));
         let part = sys.partition(&q);
         let eval = sys.evaluate(&q, &part).unwrap();
         // The direction of the independent coordinates that closes the lowest gap fastest

@@ -3,10 +3,10 @@
 //! `t = 10⁻¹⁰ max(λ_max, 1)` (`Spectrum::tolerance`), and the mode shapes of the lowest
 //! eigenvalues as joint-coordinate changes.
 //!
-//! The entry points, from the most general: [`stability_touching`](super::cone::stability_touching)
-//! (stops and contacts that carry a force and those that touch without one), [`stability_on`]
-//! (every given row held), [`stability_at`] (the model's equality rows only), and
-//! [`stability_of`] (a system already partitioned and evaluated, as `verify` has made it).
+//! The entry point is [`stability_verdict`] (stops and contacts that carry a force and those
+//! that touch without one, or none); [`stability_on`] holds every given row, and
+//! [`stability_of`] judges a system already partitioned and evaluated (as `verify` has made
+//! it, or the minimizer).
 
 use super::inertia;
 use super::spectrum::{self, Spectrum};
@@ -14,7 +14,7 @@ use crate::constraints::unilateral::Active;
 use crate::constraints::Constraints;
 use crate::model::Model;
 use crate::solver::partition::Partition;
-use crate::solver::system::{self, System};
+use crate::solver::system::{Backend, System};
 use crate::solver::{lock_values, Stability, Verdict};
 use crate::state::State;
 
@@ -24,7 +24,7 @@ pub(crate) fn from_spectrum(
     sys: &System,
     q: &nalgebra::DVector<f64>,
     part: &Partition,
-    eval: &system::Eval,
+    eval: &crate::solver::system::Eval,
     spectrum: &Spectrum,
 ) -> Stability {
     let (vals, vecs) = (&spectrum.values, &spectrum.vectors);
@@ -93,26 +93,37 @@ pub(crate) fn from_spectrum(
     }
 }
 
-/// Stability verdict at a state that is feasible and balanced (`None` with no degree of
-/// freedom or where the energy is undefined).
-/// `eigenvalues` as in [`stability_of`].
-pub(crate) fn stability_at(model: &Model, state: &State, eigenvalues: bool) -> Option<Stability> {
-    stability_on(model, state, &[], eigenvalues)
+/// The stability verdict at a state that is feasible and balanced, where the stops and
+/// contacts `strong` carry a force and `weak` touch without one (both empty: the model's
+/// equality rows alone), with the linear algebra `backend`: the entry point. On the tangent
+/// space of the rows held ([`stability_on`]), or on the critical cone where some touch
+/// without a force ([`stability_touching`](super::cone::stability_touching)). `None` with no
+/// degree of freedom or where the energy is undefined; `eigenvalues` as in [`stability_of`].
+pub(crate) fn stability_verdict(
+    model: &Model,
+    state: &State,
+    strong: &[Active],
+    weak: &[Active],
+    backend: Backend,
+    eigenvalues: bool,
+) -> Option<Stability> {
+    super::cone::stability_touching(model, state, strong, weak, backend, eigenvalues)
 }
 
-/// [`stability_at`] on the tangent space of the equality rows and the inequalities `active`
-/// (the stops and contacts that carry a force); `eigenvalues` as in [`stability_of`].
+/// The verdict on the tangent space of the equality rows and the inequalities `active` (every
+/// one held as a row); `eigenvalues` as in [`stability_of`].
 pub(crate) fn stability_on(
     model: &Model,
     state: &State,
     active: &[Active],
+    backend: Backend,
     eigenvalues: bool,
 ) -> Option<Stability> {
     let q = &state.q;
     let sys_cons = Constraints::new(model, &lock_values(model))
         .with_active(model, active)
         .on_branches(state.branches.clone());
-    let mut sys = System::new(model, sys_cons);
+    let mut sys = System::new(model, sys_cons, backend);
     let part = sys.partition(q);
     if part.independent.is_empty() {
         return None;
@@ -121,7 +132,7 @@ pub(crate) fn stability_on(
     stability_of(&mut sys, q, &part, &eval, eigenvalues)
 }
 
-/// [`stability_at`] with the system of the model's rows already partitioned and evaluated at
+/// The verdict with the system of the model's rows already partitioned and evaluated at
 /// `q` (what `verify` has made for its balance check); `None` with no degree of freedom.
 ///
 /// Where the eigenvalues would come from Lanczos (sparse path, more than
@@ -132,14 +143,13 @@ pub(crate) fn stability_of(
     sys: &mut System,
     q: &nalgebra::DVector<f64>,
     part: &Partition,
-    eval: &system::Eval,
+    eval: &crate::solver::system::Eval,
     eigenvalues: bool,
 ) -> Option<Stability> {
     if part.independent.is_empty() {
         return None;
     }
-    let lanczos =
-        sys.backend == system::Backend::Sparse && part.independent.len() > spectrum::EXACT_UP_TO;
+    let lanczos = !spectrum::exact(sys.backend, part.independent.len());
     if lanczos && !eigenvalues {
         if let Some((verdict, tolerance)) = inertia::inertia_verdict(sys, q, part, eval) {
             return Some(Stability {

@@ -138,7 +138,9 @@ pub(crate) struct VerifyArgs {
     /// largest generalized force on any coordinate.
     #[arg(long, default_value_t = Tolerances::default().force, value_parser = parse::positive)]
     pub(crate) force_tolerance: f64,
-    /// Largest constraint violation for the pose to pass [m or rad].
+    /// Largest raw constraint violation ‖Φ‖∞ for the pose to pass [m or rad] (a check of the
+    /// given pose in its own units; `analyze --constraint-tolerance` is the solver's
+    /// dimensionless target instead).
     #[arg(long, default_value_t = Tolerances::default().constraint, value_parser = parse::positive)]
     pub(crate) constraint_tolerance: f64,
     /// Write the verification as JSON to this file (`-`: standard output, which then carries
@@ -216,7 +218,9 @@ pub(crate) struct AnalyzeArgs {
     /// Tolerance on the scaled reduced gradient [J].
     #[arg(long, default_value_t = Options::default().gradient_tolerance, value_parser = parse::positive)]
     pub(crate) tolerance: f64,
-    /// Tolerance on the constraint residual ‖Φ‖∞.
+    /// Tolerance on the dimensionless constraint residual ‖DΦ‖∞: each row in m^k divided by
+    /// L^k, L the characteristic length (rotations as they are), so that it means the same in
+    /// any length unit. The reported `constraint_residual` is the raw ‖Φ‖∞ [m or rad].
     #[arg(long, default_value_t = Options::default().constraint_tolerance, value_parser = parse::positive)]
     pub(crate) constraint_tolerance: f64,
     /// Minimizer.

@@ -50,9 +50,9 @@ pub struct Options {
     /// Convergence tolerance on the reduced gradient `‖∂V/∂v‖∞` in scaled coordinates \[J\]
     /// (default: 1e-8).
     pub gradient_tolerance: f64,
-    /// Newton corrector tolerance on the dimensionless residual `‖D Φ‖∞`: rows in m divided by
-    /// the characteristic length `L`, rows in m² by `L²`, dimensionless rows as they are, so
-    /// that the tolerance means the same in any length unit (default: 1e-10).
+    /// Tolerance on the dimensionless constraint residual `‖D Φ‖∞` (rows in m^k divided by
+    /// `L^k`, `L` the characteristic length; the one meaning, module `system::residual`) of the
+    /// assembly, the corrector and the stops' and contacts' gaps (default: 1e-10).
     pub constraint_tolerance: f64,
     /// Maximum minimizer iterations (default: 200).
     pub max_iterations: usize,
@@ -96,7 +96,7 @@ impl Default for Options {
         Options {
             method: Method::Newton,
             gradient_tolerance: 1e-8,
-            constraint_tolerance: 1e-10,
+            constraint_tolerance: super::system::residual::TOLERANCE,
             max_iterations: 200,
             max_corrector_iterations: 25,
             max_step: 0.3,

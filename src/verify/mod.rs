@@ -71,7 +71,8 @@ pub struct Tolerances {
     /// Largest joint effort (or unassigned generalized force) a balanced pose may need
     /// \[N m or N\] (default: 1e-6).
     pub force: f64,
-    /// Largest constraint violation \[m or rad\] (default: 1e-8).
+    /// Largest raw constraint violation `‖Φ‖∞` \[m or rad\] (default: 1e-8; the solver's own
+    /// tolerance is on the dimensionless `‖D Φ‖∞`, module `solver::system::residual`).
     pub constraint: f64,
     /// Effort tolerance relative to the largest generalized force `‖S ∇V‖∞`, added to `force`
     /// (default: 1e-9).

@@ -39,7 +39,8 @@ use crate::solver::options::{Limits, Options};
 use crate::solver::system::Backend;
 use nalgebra::{DVector, Vector3};
 
-/// `g` divided by the characteristic length for a gap in m.
+/// `g` divided by the characteristic length for a gap in m: its row's `D g`, as in the
+/// constraint residual (module `system::residual`).
 pub(crate) fn dimensionless(model: &Model, u: &Unilateral, g: f64) -> f64 {
     if unilateral::length_power(model, u) == 1 {
         g / model.length_scale

@@ -35,8 +35,7 @@ impl<'a> System<'a> {
         &self.work.phi
     }
 
-    /// `‖D Φ‖∞` at the point of the last evaluation: the residual with each row in m^k divided
-    /// by `L^k`, so that one tolerance means the same in any length unit.
+    /// `‖D Φ‖∞` at the point of the last evaluation (module `residual`).
     pub(crate) fn dimensionless_residual(&self) -> f64 {
         self.problem.scaling.residual(&self.work.phi)
     }

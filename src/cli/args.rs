@@ -6,6 +6,7 @@ use super::parse;
 use anyhow::{bail, Context};
 use clap::{Parser, Subcommand, ValueEnum};
 use restpose::model::Friction;
+use restpose::solver::ContactPolicy;
 use restpose::urdf::ImportOptions;
 use restpose::verify::Tolerances;
 use restpose::{Limits, LinearAlgebra, Method, Options};
@@ -149,18 +150,8 @@ pub(crate) struct VerifyArgs {
     pub(crate) json: Option<PathBuf>,
     #[command(flatten)]
     pub(crate) input: InputArgs,
-    /// URDF joint limits: enforce (the pose may rest on a stop, which carries an effort, and
-    /// may not go beyond one) or ignore.
-    #[arg(long, value_enum, default_value_t = Options::default().limits)]
-    pub(crate) limits: Limits,
-    /// Contacts without a friction setting in <mech:contact>: none (frictionless) or stick
-    /// (they may carry a tangential force).
-    #[arg(long, value_enum, default_value_t = Options::default().friction)]
-    pub(crate) friction: Friction,
-    /// Friction coefficient of sticking contacts without `mu` in <mech:contact>: a contact
-    /// needing more fails the pose.
-    #[arg(long, value_name = "MU", value_parser = parse::positive)]
-    pub(crate) mu: Option<f64>,
+    #[command(flatten)]
+    pub(crate) contact: ContactArgs,
     /// Verification path: dense (orthonormal null-space basis, O(n³)), sparse (the solver's
     /// sparse partition, O(N)), or auto: sparse above 40 bodies.
     #[arg(long, value_enum, default_value_t = Options::default().linear_algebra)]
@@ -238,18 +229,8 @@ pub(crate) struct AnalyzeArgs {
     /// Stop at an unstable stationary point instead of leaving it.
     #[arg(long)]
     pub(crate) allow_unstable: bool,
-    /// URDF joint limits: enforce (joints can rest on their stops) or ignore (only report a
-    /// rest pose outside them).
-    #[arg(long, value_enum, default_value_t = Options::default().limits)]
-    pub(crate) limits: Limits,
-    /// Contacts without a friction setting in <mech:contact>: none (frictionless) or stick
-    /// (held where they first touch; the needed friction coefficient is reported).
-    #[arg(long, value_enum, default_value_t = Options::default().friction)]
-    pub(crate) friction: Friction,
-    /// Friction coefficient of sticking contacts without `mu` in <mech:contact>: a contact
-    /// needing more is reported as slipping.
-    #[arg(long, value_name = "MU", value_parser = parse::positive)]
-    pub(crate) mu: Option<f64>,
+    #[command(flatten)]
+    pub(crate) contact: ContactArgs,
     /// Print only errors.
     #[arg(long, short)]
     pub(crate) quiet: bool,
@@ -301,10 +282,38 @@ impl AnalyzeArgs {
             max_iterations: self.max_iterations,
             allow_unstable: self.allow_unstable,
             load_steps: self.load_steps,
+            ..Default::default()
+        }
+        .with_contact(self.contact.policy())
+    }
+}
+
+/// The stops' and contacts' options, shared by `analyze` and `verify` (one definition, one
+/// help text): the [`ContactPolicy`].
+#[derive(clap::Args, Clone, Debug)]
+pub(crate) struct ContactArgs {
+    /// URDF joint limits: enforce (a joint can rest on its stop, which carries an effort, and
+    /// may not go beyond it) or ignore (a pose outside them is only reported).
+    #[arg(long, value_enum, default_value_t = ContactPolicy::default().limits)]
+    pub(crate) limits: Limits,
+    /// Contacts without a friction setting in <mech:contact>: none (frictionless) or stick
+    /// (held where they first touch, carrying a tangential force; the needed friction
+    /// coefficient is reported).
+    #[arg(long, value_enum, default_value_t = ContactPolicy::default().friction)]
+    pub(crate) friction: Friction,
+    /// Friction coefficient of sticking contacts without `mu` in <mech:contact>: a contact
+    /// needing more is reported as slipping (`verify`: the pose fails).
+    #[arg(long, value_name = "MU", value_parser = parse::positive)]
+    pub(crate) mu: Option<f64>,
+}
+
+impl ContactArgs {
+    /// The policy these options give.
+    pub(crate) fn policy(&self) -> ContactPolicy {
+        ContactPolicy {
             limits: self.limits,
             friction: self.friction,
             mu: self.mu,
-            ..Default::default()
         }
     }
 }

@@ -33,7 +33,7 @@ pub(crate) mod system;
 mod unbounded;
 
 pub use mode_animation::mode_animation;
-pub use options::{Limits, LinearAlgebra, Method, Options};
+pub use options::{ContactPolicy, Limits, LinearAlgebra, Method, Options};
 pub use report::{
     ActiveLimit, Contact, ContactState, Diagnostics, Iterate, Reaction, Report, Sizes, Stability,
     Termination, Timings, Verdict,

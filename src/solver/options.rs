@@ -30,7 +30,7 @@ pub enum LinearAlgebra {
     Sparse,
 }
 
-/// Whether URDF joint limits hold the joints.
+/// Whether URDF joint limits hold the joints (part of a [`ContactPolicy`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
@@ -40,6 +40,46 @@ pub enum Limits {
     Enforce,
     /// Limits are read and a rest pose outside them is reported, not prevented.
     Ignore,
+}
+
+/// What the stops and contacts do, for `solve` and `verify` alike: whether URDF joint limits
+/// hold, and the friction and coefficient of contacts whose `mech:contact` does not say. The
+/// one rule resolving a contact's friction ([`ContactPolicy::friction_of`]) and coefficient
+/// ([`ContactPolicy::mu_of`]): its own setting, else the policy's.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct ContactPolicy {
+    /// Joint limits as inequality constraints, or only reported (default: enforce); with
+    /// `friction` and `mu`, the [`ContactPolicy`] of [`Options::contact`].
+    pub limits: Limits,
+    /// Tangential behaviour of contacts whose `mech:contact` does not say (default: none,
+    /// frictionless).
+    pub friction: crate::model::Friction,
+    /// Friction coefficient of contacts whose `mech:contact` does not say (default: none: the
+    /// needed coefficient is reported, never judged).
+    pub mu: Option<f64>,
+}
+
+impl ContactPolicy {
+    /// Whether URDF joint limits are inequality constraints.
+    pub fn enforces_limits(&self) -> bool {
+        self.limits == Limits::Enforce
+    }
+
+    /// The friction of a contact with the settings `c`: its own, else the policy's.
+    pub fn friction_of(&self, c: &crate::model::ContactSettings) -> crate::model::Friction {
+        c.friction.unwrap_or(self.friction)
+    }
+
+    /// Whether a contact with the settings `c` sticks.
+    pub fn sticks(&self, c: &crate::model::ContactSettings) -> bool {
+        self.friction_of(c) == crate::model::Friction::Stick
+    }
+
+    /// The friction coefficient of a contact with the settings `c`: its own, else the
+    /// policy's (`None`: the needed coefficient is reported, never judged).
+    pub fn mu_of(&self, c: &crate::model::ContactSettings) -> Option<f64> {
+        c.mu.or(self.mu)
+    }
 }
 
 /// Options of [`crate::solve`].
@@ -91,6 +131,28 @@ pub struct Options {
     pub force_tolerance: f64,
 }
 
+impl Options {
+    /// The stops' and contacts' policy of these options (`limits`, `friction`, `mu`).
+    pub fn contact(&self) -> ContactPolicy {
+        ContactPolicy {
+            limits: self.limits,
+            friction: self.friction,
+            mu: self.mu,
+        }
+    }
+
+    /// These options with the stops' and contacts' policy `policy`.
+    #[must_use]
+    pub fn with_contact(self, policy: ContactPolicy) -> Self {
+        Options {
+            limits: policy.limits,
+            friction: policy.friction,
+            mu: policy.mu,
+            ..self
+        }
+    }
+}
+
 impl Default for Options {
     fn default() -> Self {
         Options {
@@ -104,9 +166,9 @@ impl Default for Options {
             allow_unstable: false,
             record_iterates: false,
             linear_algebra: LinearAlgebra::Auto,
-            limits: Limits::Enforce,
-            friction: crate::model::Friction::None,
-            mu: None,
+            limits: ContactPolicy::default().limits,
+            friction: ContactPolicy::default().friction,
+            mu: ContactPolicy::default().mu,
             gap_tolerance: 1e-9,
             force_tolerance: 1e-9,
         }

@@ -34,8 +34,8 @@
 pub(crate) use super::guard::Guard;
 use crate::constraints::unilateral::{self, Active, Unilateral};
 use crate::kinematics::Branches;
-use crate::model::{Friction, Model};
-use crate::solver::options::{Limits, Options};
+use crate::model::Model;
+use crate::solver::options::Options;
 use crate::solver::system::Backend;
 use nalgebra::{DVector, Vector3};
 
@@ -51,7 +51,7 @@ pub(crate) fn dimensionless(model: &Model, u: &Unilateral, g: f64) -> f64 {
 
 /// Every inequality of the model under `options`.
 pub(crate) fn inequalities(model: &Model, options: &Options) -> Vec<Unilateral> {
-    unilateral::inequalities(model, options.limits == Limits::Enforce)
+    unilateral::inequalities(model, options.contact().enforces_limits())
 }
 
 /// `u` made active at `q`: a sticking contact is anchored at the point's projection on the
@@ -65,8 +65,7 @@ pub(crate) fn activate(
     let anchor = match u {
         Unilateral::Contact { point, ground } => {
             let c = &model.contact_points[point];
-            let friction = c.settings.friction.unwrap_or(options.friction);
-            (friction == Friction::Stick).then(|| {
+            options.contact().sticks(&c.settings).then(|| {
                 let x = unilateral::point_world(model, point, q);
                 let (_, normal) = unilateral::surface(model, ground, &x);
                 let g = unilateral::gap(model, &u, q, &Branches::default()).unwrap_or(0.0);
@@ -350,7 +349,7 @@ fn describe(
                 } else {
                     f64::INFINITY
                 };
-                let mu = c.settings.mu.or(options.mu);
+                let mu = options.contact().mu_of(&c.settings);
                 let contact_state = match (a.anchor, mu) {
                     (None, _) => ContactState::Touching,
                     (Some(_), Some(mu)) if required > mu => ContactState::Slipping,

@@ -12,7 +12,7 @@
 use super::active_set::dimensionless;
 use crate::constraints::unilateral::{self, Active, Unilateral};
 use crate::kinematics::Branches;
-use crate::model::{Friction, Model};
+use crate::model::Model;
 use crate::solver::options::Options;
 use crate::solver::partition::Partition;
 use crate::solver::system::{Eval, System};
@@ -45,13 +45,9 @@ impl<'m> Guard<'m> {
         q: &DVector<f64>,
     ) -> Self {
         let sticking = inactive.iter().any(|u| match *u {
-            Unilateral::Contact { point, .. } => {
-                model.contact_points[point]
-                    .settings
-                    .friction
-                    .unwrap_or(options.friction)
-                    == Friction::Stick
-            }
+            Unilateral::Contact { point, .. } => options
+                .contact()
+                .sticks(&model.contact_points[point].settings),
             Unilateral::Limit { .. } => false,
         });
         let rolls = super::rolling::limits(model, active);
@@ -223,6 +219,7 @@ mod tests {
     use super::*;
     use crate::constraints::Constraints;
     use crate::solver::inequality::active_set::{activate, inequalities};
+    use crate::model::Friction;
     use crate::solver::system::Backend;
     use crate::urdf::{load_str, ImportOptions};
 

@@ -7,7 +7,6 @@
 
 mod body;
 mod builder;
-mod check;
 mod connect;
 mod contact;
 mod curvature;
@@ -15,13 +14,13 @@ mod force;
 mod hull;
 mod joint;
 mod mass;
+mod numeric;
 mod obstacle;
 mod site;
 mod validate;
 
 pub use body::{Body, BodyId, Link};
 pub use builder::ModelBuilder;
-pub use check::{LARGEST_GRAVITY, LARGEST_LENGTH, LARGEST_MAGNITUDE};
 pub use connect::axis_frame;
 pub use contact::{ContactPoint, ContactSettings, Friction, Ground};
 pub use force::{
@@ -30,6 +29,7 @@ pub use force::{
 pub use hull::Hull;
 pub use joint::{Joint, JointId, JointKind};
 pub use mass::Inertial;
+pub use numeric::{LARGEST_GRAVITY, LARGEST_LENGTH, LARGEST_MAGNITUDE};
 pub use obstacle::Obstacle;
 
 use nalgebra::Vector3;

@@ -17,7 +17,7 @@
 //! ## References
 //! - P. E. Nikravesh, O. K. Srinivasan, Generalized co-ordinate partitioning in static
 //!   equilibrium analysis of large-scale mechanical systems, *Int. J. Numer. Meth. Eng.* 21
-//!   (1985) 451–464 (`shared/paper/`).
+//!   (1985) 451–464.
 
 mod assemble;
 mod inequality;

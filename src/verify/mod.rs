@@ -1,9 +1,10 @@
 //! Is a given pose a rest pose? Independent checks of a configuration.
 //!
-//! Nothing here uses the solver's partition. With `S` the coordinate scaling of the solver
-//! (positions by the characteristic length) and `N` an orthonormal basis of the null space of
-//! `Φ_q S` (feasible motions), a pose is balanced when the projected gradient `Nᵀ S ∇V`
-//! vanishes.
+//! With `S` the coordinate scaling of the solver (positions by the characteristic length) and
+//! `N` an orthonormal basis of the null space of `Φ_q S` (feasible motions), a pose is
+//! balanced when the projected gradient `Nᵀ S ∇V` vanishes. The dense path (module `dense`)
+//! uses no partition of the solver; the sparse path (module `reduced`, below) uses the
+//! solver's sparse partition, at the pose given, for its null space.
 //!
 //! The per-joint imbalance is the effort `τ` each joint coordinate would need to hold the pose
 //! (Adams' "imbalance"): with `B` the gradients `∇θ_k` of the tree joints' scalar coordinates,
@@ -26,18 +27,18 @@
 //! 10,000-link chain carries 10⁸ N m at its base), so an absolute tolerance alone would reject
 //! exact answers of large models.
 
-mod check;
 mod closure;
 mod dense;
+mod initial_guess;
 mod pose;
 mod rank;
 mod reduced;
 mod unilateral;
 mod unilateral_sparse;
 
-pub use check::{check, ModelCheck};
 use closure::closures;
 pub use closure::Closure;
+pub use initial_guess::{check, ModelCheck};
 pub use pose::{parse_pose, pose_state, read_pose};
 pub use unilateral::{UnilateralCheck, Unilaterals};
 

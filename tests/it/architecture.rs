@@ -8,7 +8,7 @@
 //! ```
 //!
 //! A reference is any `crate::module` path in code (comments and doc links are skipped). A
-//! second test holds every file of `src/` to at most 500 lines (issue 11).
+//! second test holds every file of `src/` to at most 500 lines.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -127,7 +127,7 @@ fn modules_use_only_lower_layers() {
     );
 }
 
-/// Longest file allowed under `src/` [lines]: one concept per file (STYLE.md, issue 11).
+/// Longest file allowed under `src/` [lines]: one concept per file (`docs/architecture.md`).
 const MAX_FILE_LINES: usize = 500;
 
 #[test]

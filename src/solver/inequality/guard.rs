@@ -218,8 +218,8 @@ impl<'m> Guard<'m> {
 mod tests {
     use super::*;
     use crate::constraints::Constraints;
-    use crate::solver::inequality::active_set::{activate, inequalities};
     use crate::model::Friction;
+    use crate::solver::inequality::active_set::{activate, inequalities};
     use crate::solver::system::Backend;
     use crate::urdf::{load_str, ImportOptions};
 

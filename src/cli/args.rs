@@ -3,13 +3,13 @@
 //! `clap::ValueEnum` themselves (feature `cli`).
 
 use super::parse;
+use super::values::{Family, Friction, Limits, LinearAlgebra, Method};
 use anyhow::{bail, Context};
 use clap::{Parser, Subcommand, ValueEnum};
-use restpose::model::Friction;
 use restpose::solver::ContactPolicy;
 use restpose::urdf::ImportOptions;
 use restpose::verify::Tolerances;
-use restpose::{Limits, LinearAlgebra, Method, Options};
+use restpose::Options;
 use std::path::PathBuf;
 
 #[derive(Parser)]
@@ -154,7 +154,7 @@ pub(crate) struct VerifyArgs {
     pub(crate) contact: ContactArgs,
     /// Verification path: dense (orthonormal null-space basis, O(n³)), sparse (the solver's
     /// sparse partition, O(N)), or auto: sparse above 40 bodies.
-    #[arg(long, value_enum, default_value_t = Options::default().linear_algebra)]
+    #[arg(long, value_enum, default_value_t = LinearAlgebra::from(Options::default().linear_algebra))]
     pub(crate) linear_algebra: LinearAlgebra,
     /// Report the lowest eigenvalues and mode shapes of the stability verdict at any size.
     /// Without it, above 200 degrees of freedom on the sparse path the verdict comes from the
@@ -170,7 +170,7 @@ pub(crate) struct VerifyArgs {
 pub(crate) struct GenerateArgs {
     /// Family.
     #[arg(value_enum)]
-    pub(crate) family: restpose::generate::Family,
+    pub(crate) family: Family,
     /// Number of links (chains, rope) or loops (ladder), 1 to 1,000,000.
     #[arg(long, default_value_t = 20, value_parser = parse::generate_size)]
     pub(crate) size: usize,
@@ -215,11 +215,11 @@ pub(crate) struct AnalyzeArgs {
     #[arg(long, default_value_t = Options::default().constraint_tolerance, value_parser = parse::positive)]
     pub(crate) constraint_tolerance: f64,
     /// Minimizer.
-    #[arg(long, value_enum, default_value_t = Options::default().method)]
+    #[arg(long, value_enum, default_value_t = Method::from(Options::default().method))]
     pub(crate) method: Method,
     /// Linear algebra: dense matrices (small models), sparse (partition body by body, faer
     /// sparse LU, Newton steps from the sparse KKT system), or auto: sparse above 40 bodies.
-    #[arg(long, value_enum, default_value_t = Options::default().linear_algebra)]
+    #[arg(long, value_enum, default_value_t = LinearAlgebra::from(Options::default().linear_algebra))]
     pub(crate) linear_algebra: LinearAlgebra,
     /// Ramp gravity, loads and efforts in N steps (0: automatic, 8 steps only if the direct
     /// solve fails; 1: never; at most 1000).
@@ -275,8 +275,8 @@ impl AnalyzeArgs {
     pub(crate) fn solver_options(&self) -> Options {
         Options {
             record_iterates: self.rrd.is_some(),
-            method: self.method,
-            linear_algebra: self.linear_algebra,
+            method: self.method.into(),
+            linear_algebra: self.linear_algebra.into(),
             gradient_tolerance: self.tolerance,
             constraint_tolerance: self.constraint_tolerance,
             max_iterations: self.max_iterations,
@@ -294,12 +294,12 @@ impl AnalyzeArgs {
 pub(crate) struct ContactArgs {
     /// URDF joint limits: enforce (a joint can rest on its stop, which carries an effort, and
     /// may not go beyond it) or ignore (a pose outside them is only reported).
-    #[arg(long, value_enum, default_value_t = ContactPolicy::default().limits)]
+    #[arg(long, value_enum, default_value_t = Limits::from(ContactPolicy::default().limits))]
     pub(crate) limits: Limits,
     /// Contacts without a friction setting in <mech:contact>: none (frictionless) or stick
     /// (held where they first touch, carrying a tangential force; the needed friction
     /// coefficient is reported).
-    #[arg(long, value_enum, default_value_t = ContactPolicy::default().friction)]
+    #[arg(long, value_enum, default_value_t = Friction::from(ContactPolicy::default().friction))]
     pub(crate) friction: Friction,
     /// Friction coefficient of sticking contacts without `mu` in <mech:contact>: a contact
     /// needing more is reported as slipping (`verify`: the pose fails).
@@ -311,8 +311,8 @@ impl ContactArgs {
     /// The policy these options give.
     pub(crate) fn policy(&self) -> ContactPolicy {
         ContactPolicy {
-            limits: self.limits,
-            friction: self.friction,
+            limits: self.limits.into(),
+            friction: self.friction.into(),
             mu: self.mu,
         }
     }

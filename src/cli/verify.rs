@@ -73,7 +73,7 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
         &state,
         &tol,
         &uni,
-        a.linear_algebra,
+        a.linear_algebra.into(),
         eigenvalues,
     )?;
     if let Some(path) = &a.json {

@@ -2,7 +2,6 @@
 
 /// Minimization method in the independent coordinates.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum Method {
     /// Newton's method with the exact reduced Hessian (modified to be positive definite away
@@ -17,7 +16,6 @@ pub enum Method {
 
 /// Linear algebra of the solver.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum LinearAlgebra {
     /// Dense up to 40 bodies (280 coordinates), sparse above (default).
@@ -32,7 +30,6 @@ pub enum LinearAlgebra {
 
 /// Whether URDF joint limits hold the joints (part of a [`ContactPolicy`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum Limits {
     /// `lower ≤ θ ≤ upper` are inequality constraints: a joint can rest on its stop (default).

@@ -11,7 +11,6 @@ mod connect;
 mod contact;
 mod curvature;
 mod force;
-mod hull;
 mod joint;
 mod mass;
 mod numeric;
@@ -19,6 +18,7 @@ mod obstacle;
 mod site;
 mod validate;
 
+pub use crate::geometry::Hull;
 pub use body::{Body, BodyId, Link};
 pub use builder::ModelBuilder;
 pub use connect::axis_frame;
@@ -26,7 +26,6 @@ pub use contact::{ContactPoint, ContactSettings, Friction, Ground};
 pub use force::{
     Effort, ForceLaw, Initial, JointSpring, Load, Lock, Mimic, Spring, SpringEnd, SpringMode,
 };
-pub use hull::Hull;
 pub use joint::{Joint, JointId, JointKind};
 pub use mass::Inertial;
 pub use numeric::{LARGEST_GRAVITY, LARGEST_LENGTH, LARGEST_MAGNITUDE};

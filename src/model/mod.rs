@@ -12,6 +12,7 @@ mod contact;
 mod curvature;
 mod force;
 mod joint;
+mod joint_kind;
 mod mass;
 mod numeric;
 mod obstacle;
@@ -27,6 +28,7 @@ pub use force::{
     Effort, ForceLaw, Initial, JointSpring, Load, Lock, Mimic, Spring, SpringEnd, SpringMode,
 };
 pub use joint::{Joint, JointId, JointKind};
+pub(crate) use joint_kind::MAX_SCALAR_COORDINATES;
 pub use mass::Inertial;
 pub use numeric::{LARGEST_GRAVITY, LARGEST_LENGTH, LARGEST_MAGNITUDE};
 pub use obstacle::Obstacle;

@@ -259,6 +259,19 @@ fn solver_folders_are_signposts() {
             ));
         }
     }
+    // The geometry folder is a signpost too.
+    let geometry = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/geometry/mod.rs");
+    match std::fs::read_to_string(&geometry) {
+        Ok(text) => {
+            for (line, code) in code_lines(&text) {
+                problems.push(format!(
+                    "{}:{line}: code in a signpost: {code}",
+                    geometry.display()
+                ));
+            }
+        }
+        Err(_) => problems.push(format!("{}: missing", geometry.display())),
+    }
     // No other folder hides in the solver without being listed here.
     for entry in std::fs::read_dir(&solver).expect("src/solver is readable") {
         let path = entry.expect("directory entry").path();

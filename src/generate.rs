@@ -18,7 +18,6 @@ use std::fmt::Write;
 
 /// A generated mechanism family.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Family {
     /// N-link spatial pendulum chain with joint springs (alternating joint axes).
     Chain,

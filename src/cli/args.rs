@@ -3,12 +3,13 @@
 //! `clap::ValueEnum` themselves (feature `cli`).
 
 use super::parse;
+use super::values::{Family, Friction, Limits, LinearAlgebra, Method};
 use anyhow::{bail, Context};
 use clap::{Parser, Subcommand, ValueEnum};
-use restpose::model::Friction;
+use restpose::solver::ContactPolicy;
 use restpose::urdf::ImportOptions;
 use restpose::verify::Tolerances;
-use restpose::{Limits, LinearAlgebra, Method, Options};
+use restpose::Options;
 use std::path::PathBuf;
 
 #[derive(Parser)]
@@ -180,7 +181,9 @@ pub(crate) struct VerifyArgs {
     /// largest generalized force on any coordinate.
     #[arg(long, default_value_t = Tolerances::default().force, value_parser = parse::positive)]
     pub(crate) force_tolerance: f64,
-    /// Largest constraint violation for the pose to pass [m or rad].
+    /// Largest raw constraint violation ‖Φ‖∞ for the pose to pass [m or rad] (a check of the
+    /// given pose in its own units; `analyze --constraint-tolerance` is the solver's
+    /// dimensionless target instead).
     #[arg(long, default_value_t = Tolerances::default().constraint, value_parser = parse::positive)]
     pub(crate) constraint_tolerance: f64,
     /// Write the verification as JSON to this file (`-`: standard output, which then carries
@@ -189,21 +192,11 @@ pub(crate) struct VerifyArgs {
     pub(crate) json: Option<PathBuf>,
     #[command(flatten)]
     pub(crate) input: InputArgs,
-    /// URDF joint limits: enforce (the pose may rest on a stop, which carries an effort, and
-    /// may not go beyond one) or ignore.
-    #[arg(long, value_enum, default_value_t = Options::default().limits)]
-    pub(crate) limits: Limits,
-    /// Contacts without a friction setting in <mech:contact>: none (frictionless) or stick
-    /// (they may carry a tangential force).
-    #[arg(long, value_enum, default_value_t = Options::default().friction)]
-    pub(crate) friction: Friction,
-    /// Friction coefficient of sticking contacts without `mu` in <mech:contact>: a contact
-    /// needing more fails the pose.
-    #[arg(long, value_name = "MU", value_parser = parse::positive)]
-    pub(crate) mu: Option<f64>,
+    #[command(flatten)]
+    pub(crate) contact: ContactArgs,
     /// Verification path: dense (orthonormal null-space basis, O(n³)), sparse (the solver's
     /// sparse partition, O(N)), or auto: sparse above 40 bodies.
-    #[arg(long, value_enum, default_value_t = Options::default().linear_algebra)]
+    #[arg(long, value_enum, default_value_t = LinearAlgebra::from(Options::default().linear_algebra))]
     pub(crate) linear_algebra: LinearAlgebra,
     /// Report the lowest eigenvalues and mode shapes of the stability verdict at any size.
     /// Without it, above 200 degrees of freedom on the sparse path the verdict comes from the
@@ -219,7 +212,7 @@ pub(crate) struct VerifyArgs {
 pub(crate) struct GenerateArgs {
     /// Family.
     #[arg(value_enum)]
-    pub(crate) family: restpose::generate::Family,
+    pub(crate) family: Family,
     /// Number of links (chains, rope) or loops (ladder), 1 to 1,000,000.
     #[arg(long, default_value_t = 20, value_parser = parse::generate_size)]
     pub(crate) size: usize,
@@ -260,15 +253,17 @@ pub(crate) struct AnalyzeArgs {
     /// Tolerance on the scaled reduced gradient [J].
     #[arg(long, default_value_t = Options::default().gradient_tolerance, value_parser = parse::positive)]
     pub(crate) tolerance: f64,
-    /// Tolerance on the constraint residual ‖Φ‖∞.
+    /// Tolerance on the dimensionless constraint residual ‖DΦ‖∞: each row in m^k divided by
+    /// L^k, L the characteristic length (rotations as they are), so that it means the same in
+    /// any length unit. The reported `constraint_residual` is the raw ‖Φ‖∞ [m or rad].
     #[arg(long, default_value_t = Options::default().constraint_tolerance, value_parser = parse::positive)]
     pub(crate) constraint_tolerance: f64,
     /// Minimizer.
-    #[arg(long, value_enum, default_value_t = Options::default().method)]
+    #[arg(long, value_enum, default_value_t = Method::from(Options::default().method))]
     pub(crate) method: Method,
     /// Linear algebra: dense matrices (small models), sparse (partition body by body, faer
     /// sparse LU, Newton steps from the sparse KKT system), or auto: sparse above 40 bodies.
-    #[arg(long, value_enum, default_value_t = Options::default().linear_algebra)]
+    #[arg(long, value_enum, default_value_t = LinearAlgebra::from(Options::default().linear_algebra))]
     pub(crate) linear_algebra: LinearAlgebra,
     /// Ramp gravity, loads and efforts in N steps (0: automatic, 8 steps only if the direct
     /// solve fails; 1: never; at most 1000).
@@ -278,18 +273,8 @@ pub(crate) struct AnalyzeArgs {
     /// Stop at an unstable stationary point instead of leaving it.
     #[arg(long)]
     pub(crate) allow_unstable: bool,
-    /// URDF joint limits: enforce (joints can rest on their stops) or ignore (only report a
-    /// rest pose outside them).
-    #[arg(long, value_enum, default_value_t = Options::default().limits)]
-    pub(crate) limits: Limits,
-    /// Contacts without a friction setting in <mech:contact>: none (frictionless) or stick
-    /// (held where they first touch; the needed friction coefficient is reported).
-    #[arg(long, value_enum, default_value_t = Options::default().friction)]
-    pub(crate) friction: Friction,
-    /// Friction coefficient of sticking contacts without `mu` in <mech:contact>: a contact
-    /// needing more is reported as slipping.
-    #[arg(long, value_name = "MU", value_parser = parse::positive)]
-    pub(crate) mu: Option<f64>,
+    #[command(flatten)]
+    pub(crate) contact: ContactArgs,
     /// Print only errors.
     #[arg(long, short)]
     pub(crate) quiet: bool,
@@ -336,17 +321,45 @@ impl AnalyzeArgs {
     pub(crate) fn solver_options(&self) -> Options {
         Options {
             record_iterates: self.rrd.is_some(),
-            method: self.method,
-            linear_algebra: self.linear_algebra,
+            method: self.method.into(),
+            linear_algebra: self.linear_algebra.into(),
             gradient_tolerance: self.tolerance,
             constraint_tolerance: self.constraint_tolerance,
             max_iterations: self.max_iterations,
             allow_unstable: self.allow_unstable,
             load_steps: self.load_steps,
-            limits: self.limits,
-            friction: self.friction,
-            mu: self.mu,
             ..Default::default()
+        }
+        .with_contact(self.contact.policy())
+    }
+}
+
+/// The stops' and contacts' options, shared by `analyze` and `verify` (one definition, one
+/// help text): the [`ContactPolicy`].
+#[derive(clap::Args, Clone, Debug)]
+pub(crate) struct ContactArgs {
+    /// URDF joint limits: enforce (a joint can rest on its stop, which carries an effort, and
+    /// may not go beyond it) or ignore (a pose outside them is only reported).
+    #[arg(long, value_enum, default_value_t = Limits::from(ContactPolicy::default().limits))]
+    pub(crate) limits: Limits,
+    /// Contacts without a friction setting in <mech:contact>: none (frictionless) or stick
+    /// (held where they first touch, carrying a tangential force; the needed friction
+    /// coefficient is reported).
+    #[arg(long, value_enum, default_value_t = Friction::from(ContactPolicy::default().friction))]
+    pub(crate) friction: Friction,
+    /// Friction coefficient of sticking contacts without `mu` in <mech:contact>: a contact
+    /// needing more is reported as slipping (`verify`: the pose fails).
+    #[arg(long, value_name = "MU", value_parser = parse::positive)]
+    pub(crate) mu: Option<f64>,
+}
+
+impl ContactArgs {
+    /// The policy these options give.
+    pub(crate) fn policy(&self) -> ContactPolicy {
+        ContactPolicy {
+            limits: self.limits.into(),
+            friction: self.friction.into(),
+            mu: self.mu,
         }
     }
 }

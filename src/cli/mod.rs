@@ -11,5 +11,6 @@ pub(crate) mod generate;
 pub(crate) mod parse;
 pub(crate) mod print;
 pub(crate) mod progress;
+pub(crate) mod values;
 pub(crate) mod verify;
 pub(crate) mod view;

@@ -63,11 +63,7 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
         constraint: a.constraint_tolerance,
         ..Default::default()
     };
-    let uni = restpose::verify::Unilaterals {
-        limits: a.limits,
-        friction: a.friction,
-        mu: a.mu,
-    };
+    let uni = a.contact.policy();
     let eigenvalues = if a.eigenvalues {
         restpose::verify::Eigenvalues::Always
     } else {
@@ -78,7 +74,7 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
         &state,
         &tol,
         &uni,
-        a.linear_algebra,
+        a.linear_algebra.into(),
         eigenvalues,
     )?;
     if let Some(path) = &a.json {

@@ -9,8 +9,8 @@
 //! unwrapped angle.
 
 use super::coordinate::coordinate;
-use super::kind::MAX_SCALAR_COORDINATES;
 use crate::jet::pair_of;
+use crate::model::MAX_SCALAR_COORDINATES;
 use crate::model::{JointId, Model};
 use nalgebra::DVector;
 

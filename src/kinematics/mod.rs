@@ -1,6 +1,6 @@
 //! Joint kinematics shared by the constraint equations and the forces: joint frames, joint
-//! coordinates read on a continuous branch, and the [`crate::model::JointKind`] queries (how many
-//! values each joint kind takes, which of them are angles).
+//! coordinates read on a continuous branch (the [`crate::model::JointKind`] queries, how many
+//! values each joint kind takes and which of them are angles, are in `model/joint_kind.rs`).
 //!
 //! Layering: `math → model → kinematics → {constraints, forces} → state → solver`. Constraints
 //! and forces both read joint coordinates from here and never from each other.
@@ -11,7 +11,6 @@
 mod branches;
 mod coordinate;
 mod frames;
-mod kind;
 mod motion;
 
 pub use branches::Branches;

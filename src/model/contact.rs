@@ -37,7 +37,6 @@ impl Default for Ground {
 
 /// Tangential behaviour of a contact.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "snake_case")]
 pub enum Friction {
     /// Frictionless: the contact pushes along the normal only (the energy minimum).

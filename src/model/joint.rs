@@ -63,26 +63,6 @@ pub enum JointKind {
     PointOnLine,
 }
 
-impl JointKind {
-    /// The type name used in URDF and in the result JSON.
-    pub fn name(&self) -> &'static str {
-        match self {
-            JointKind::Revolute => "revolute",
-            JointKind::Continuous => "continuous",
-            JointKind::Prismatic => "prismatic",
-            JointKind::Fixed => "fixed",
-            JointKind::Floating => "floating",
-            JointKind::Planar => "planar",
-            JointKind::Spherical => "spherical",
-            JointKind::Universal => "universal",
-            JointKind::Cylindrical => "cylindrical",
-            JointKind::Screw { .. } => "screw",
-            JointKind::Distance { .. } => "distance",
-            JointKind::PointOnLine => "point_on_line",
-        }
-    }
-}
-
 /// A joint between a parent and a child body.
 #[derive(Clone, Debug)]
 pub struct Joint {

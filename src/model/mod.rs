@@ -7,29 +7,30 @@
 
 mod body;
 mod builder;
-mod check;
 mod connect;
 mod contact;
 mod curvature;
 mod force;
-mod hull;
 mod joint;
+mod joint_kind;
 mod mass;
+mod numeric;
 mod obstacle;
 mod site;
 mod validate;
 
+pub use crate::geometry::Hull;
 pub use body::{Body, BodyId, Link};
 pub use builder::ModelBuilder;
-pub use check::{LARGEST_GRAVITY, LARGEST_LENGTH, LARGEST_MAGNITUDE};
 pub use connect::axis_frame;
 pub use contact::{ContactPoint, ContactSettings, Friction, Ground};
 pub use force::{
     Effort, ForceLaw, Initial, JointSpring, Load, Lock, Mimic, Servo, Spring, SpringEnd, SpringMode,
 };
-pub use hull::Hull;
 pub use joint::{Joint, JointId, JointKind};
+pub(crate) use joint_kind::MAX_SCALAR_COORDINATES;
 pub use mass::Inertial;
+pub use numeric::{LARGEST_GRAVITY, LARGEST_LENGTH, LARGEST_MAGNITUDE};
 pub use obstacle::Obstacle;
 
 use nalgebra::Vector3;

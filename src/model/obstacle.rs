@@ -13,12 +13,12 @@
 //! exactly on an edge or a vertex has a gap that is `C¹` there, not `C²`.
 //!
 //! Shapes: boxes, spheres, capsules and cylinders (closed forms in the shape's frame below) and
-//! meshes, by their convex hull (parry3d; closest points in `model::hull`). The closed forms are
+//! meshes, by their convex hull (parry3d; closest points in `geometry::hull`). The closed forms are
 //! kept rather than parry's point projection: on the surface (where a resting contact is) they
 //! give the face's exact normal, where a projection has only `x − c = 0`; the unit tests check
 //! them against parry's projections.
 
-use super::hull::Hull;
+use crate::geometry::Hull;
 use crate::geometry::ShapeKind;
 use nalgebra::{Isometry3, Point3, Vector3};
 

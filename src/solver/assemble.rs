@@ -6,7 +6,8 @@
 //! assembly branch); if that fails, the assembly is retried without them.
 
 use super::options::Options;
-use super::system::System;
+use super::system::residual::REDUNDANT_FLOOR;
+use super::system::{Backend, System};
 use crate::constraints::unilateral::Active;
 use crate::constraints::Constraints;
 use crate::error::{Error, Result};
@@ -35,12 +36,8 @@ fn newton(
             return Ok(q);
         }
         let part = sys.partition(&q);
-        let rows_residual = |sys: &System, phi: &DVector<f64>| {
-            part.rows
-                .iter()
-                .map(|&i| (phi[i] * sys.problem.scaling.rows[i]).abs())
-                .fold(0.0, f64::max)
-        };
+        let rows_residual =
+            |sys: &System, phi: &DVector<f64>| sys.problem.scaling.residual_over(phi, &part.rows);
         let res = rows_residual(sys, &phi);
         if res <= tol {
             let worst = part
@@ -48,9 +45,10 @@ fn newton(
                 .iter()
                 .copied()
                 .max_by(|&a, &b| {
-                    (phi[a] * sys.problem.scaling.rows[a])
-                        .abs()
-                        .total_cmp(&(phi[b] * sys.problem.scaling.rows[b]).abs())
+                    let scaling = &sys.problem.scaling;
+                    scaling
+                        .row_residual(&phi, a)
+                        .total_cmp(&scaling.row_residual(&phi, b))
                 })
                 .unwrap_or_else(|| phi.iamax());
             return Err(Failure::Inconsistent(worst));
@@ -137,13 +135,13 @@ pub(crate) fn assemble(
     }
     if held.len() > locks.len() {
         let cons = Constraints::new(model, &held).on_branches(branches.clone());
-        let mut sys = System::with_options(model, cons, options);
+        let mut sys = System::new(model, cons, Backend::of(model, options));
         if let Ok(qa) = newton(&mut sys, q.clone(), tol) {
             let cons =
                 Constraints::new(model, locks).on_branches(sys.problem.cons.branches.clone());
-            let mut fin = System::with_options(model, cons, options);
+            let mut fin = System::new(model, cons, Backend::of(model, options));
             fin.residual(&qa);
-            if fin.dimensionless_residual() <= tol.max(1e-8) {
+            if fin.dimensionless_residual() <= tol.max(REDUNDANT_FLOOR) {
                 *branches = fin.problem.cons.branches;
                 return Ok(qa);
             }
@@ -165,7 +163,7 @@ pub(crate) fn project(
     let cons = Constraints::new(model, locks)
         .with_active(model, active)
         .on_branches(branches.clone());
-    let mut sys = System::with_options(model, cons, options);
+    let mut sys = System::new(model, cons, Backend::of(model, options));
     let q0 = q.clone();
     match newton(&mut sys, q, tol) {
         Ok(qa) => {

@@ -33,11 +33,12 @@
 //! - R. Fletcher, M. J. D. Powell, A rapidly convergent descent method for minimization,
 //!   *Computer Journal* 6 (1963) 163–168.
 
-use super::active_set::Guard;
+use super::inequality::active_set::Guard;
 use super::options::{Method, Options};
 use super::partition::Partition;
 use super::report::{Diagnostics, Iterate, Termination};
-use super::spectrum::{spectrum, Spectrum};
+use super::sparse::kkt::Factored;
+use super::stability::spectrum::{spectrum, Spectrum};
 use super::system::{Backend, Eval, System};
 use nalgebra::{DMatrix, DVector};
 

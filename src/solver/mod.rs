@@ -6,20 +6,21 @@
 //!    (module `assemble`).
 //! 2. Partition `q = [u; v]` by full pivoting of `Φ_q` (module `partition`).
 //! 3. Minimize `f(v) = V(u(v), v)` (module `minimize`), with the corrector keeping `Φ = 0`.
-//! 4. Stability from the eigenvalues of the reduced Hessian; reactions from the multipliers
-//!    `μ` (`V_qᵀ = Φ_qᵀ μ`).
+//! 4. Stability from the eigenvalues of the reduced Hessian (folder `stability`); reactions
+//!    from the multipliers `μ` (`V_qᵀ = Φ_qᵀ μ`, module `reactions`).
+//!
+//! Stops and contacts (`g(q) ≥ 0`) wrap steps 2–4 in an active-set iteration (folder
+//! `inequality`). The evaluation of the partitioned problem (corrector, reduced gradient and
+//! Hessian, dense or sparse backend) is folder `system`; the large-scale linear algebra is
+//! folder `sparse`.
 //!
 //! ## References
 //! - P. E. Nikravesh, O. K. Srinivasan, Generalized co-ordinate partitioning in static
 //!   equilibrium analysis of large-scale mechanical systems, *Int. J. Numer. Meth. Eng.* 21
-//!   (1985) 451–464 (`shared/paper/`).
+//!   (1985) 451–464.
 
-mod active_set;
 mod assemble;
-mod cone;
-mod distribution;
-mod eigen;
-mod guard;
+mod inequality;
 mod kkt_direction;
 mod load_steps;
 mod minimize;
@@ -28,19 +29,18 @@ mod options;
 pub(crate) mod partition;
 mod reactions;
 mod report;
-mod rolling;
 pub(crate) mod sparse;
-mod spectrum;
-mod stability_inertia;
+mod stability;
 pub(crate) mod system;
 mod unbounded;
 
 pub use mode_animation::mode_animation;
-pub use options::{Limits, LinearAlgebra, Method, Options, Progress, ProgressFn};
+pub use options::{ContactPolicy, Limits, LinearAlgebra, Method, Options, Progress, ProgressFn};
 pub use report::{
     ActiveLimit, Contact, ContactState, Diagnostics, Iterate, Reaction, Report, Sizes, Stability,
     Termination, Timings, Verdict,
 };
+pub(crate) use stability::verdict::{stability_of, stability_on, stability_verdict};
 
 use crate::constraints::unilateral::Active;
 use crate::constraints::Constraints;
@@ -48,8 +48,10 @@ use crate::error::{Error, Result};
 use crate::kinematics::Branches;
 use crate::model::{JointId, Model};
 use crate::state::{JointValues, State};
+use inequality::{active_set, distribution};
 use nalgebra::DVector;
-use system::System;
+use stability::{spectrum, verdict};
+use system::{Backend, System};
 
 /// Initial guess: forward kinematics with every joint at its `mech:initial` / `--initial`
 /// value (0 otherwise). Loop joints are not yet closed.
@@ -89,144 +91,6 @@ pub(crate) fn assemble_only(
     locks: &[(JointId, usize, f64)],
 ) -> Result<nalgebra::DVector<f64>> {
     assemble::project(model, q, branches, locks, &[], &Options::default())
-}
-
-/// The stability verdict from the reduced-Hessian eigenvalues (ascending, at least one) and
-/// eigenvectors, with the mode shapes of the smallest as joint-coordinate changes.
-fn stability(
-    sys: &System,
-    q: &nalgebra::DVector<f64>,
-    part: &partition::Partition,
-    eval: &system::Eval,
-    spectrum: &spectrum::Spectrum,
-) -> Stability {
-    let (vals, vecs) = (&spectrum.values, &spectrum.vectors);
-    let tol = spectrum.tolerance();
-    let negative_by_inertia = spectrum.negative_by_inertia.unwrap_or(0) > 0;
-    let verdict = if vals[0] < -tol || negative_by_inertia {
-        Verdict::Unstable
-    } else if vals[0] <= tol {
-        Verdict::Neutral
-    } else {
-        Verdict::Stable
-    };
-    let shown = vals.len().min(6);
-    // The gradients of every joint coordinate, once for all modes: (joint, per coordinate the
-    // (global index, derivative) pairs).
-    type Gradient = Vec<(usize, f64)>;
-    let gradients: Vec<(&str, Vec<Gradient>)> = if shown == 0 {
-        Vec::new()
-    } else {
-        sys.problem
-            .model
-            .joints
-            .iter()
-            .filter(|j| !j.merged)
-            .map(|j| {
-                let pair = crate::jet::pair_of(&j.bodies, q, false);
-                let g = (0..j.kind.scalar_coordinates())
-                    .filter_map(|dof| crate::kinematics::coordinate(j, &pair, dof, 0.0))
-                    .map(|s| {
-                        (0..crate::jet::NL)
-                            .filter_map(|i| {
-                                crate::jet::global_index(&j.bodies, i).map(|g| (g, s.g[i]))
-                            })
-                            .collect()
-                    })
-                    .collect();
-                (j.name.as_str(), g)
-            })
-            .collect()
-    };
-    let modes = (0..shown)
-        .map(|k| {
-            let dq = sys.tangent_step(part, eval, &vecs.column(k).into_owned());
-            let mut mode = std::collections::BTreeMap::new();
-            for (name, coords) in &gradients {
-                let d: Vec<f64> = coords
-                    .iter()
-                    .map(|c| c.iter().map(|&(g, x)| x * dq[g]).sum())
-                    .collect();
-                if !d.is_empty() {
-                    mode.insert(name.to_string(), d);
-                }
-            }
-            let big = mode.values().flatten().fold(0.0f64, |a, &b| a.max(b.abs()));
-            if big > 0.0 {
-                mode.values_mut().flatten().for_each(|x| *x /= big);
-            }
-            mode
-        })
-        .collect();
-    Stability {
-        verdict,
-        tolerance: tol,
-        eigenvalues: vals.iter().take(shown).copied().collect(),
-        modes,
-    }
-}
-
-/// Stability verdict at a state that is feasible and balanced (`None` with no degree of
-/// freedom or where the energy is undefined).
-/// `eigenvalues` as in [`stability_of`].
-pub(crate) fn stability_at(model: &Model, state: &State, eigenvalues: bool) -> Option<Stability> {
-    stability_on(model, state, &[], eigenvalues)
-}
-
-pub(crate) use cone::stability_touching;
-
-/// [`stability_at`] on the tangent space of the equality rows and the inequalities `active`
-/// (the stops and contacts that carry a force); `eigenvalues` as in [`stability_of`].
-pub(crate) fn stability_on(
-    model: &Model,
-    state: &State,
-    active: &[Active],
-    eigenvalues: bool,
-) -> Option<Stability> {
-    let q = &state.q;
-    let sys_cons = Constraints::new(model, &lock_values(model))
-        .with_active(model, active)
-        .on_branches(state.branches.clone());
-    let mut sys = System::new(model, sys_cons);
-    let part = sys.partition(q);
-    if part.independent.is_empty() {
-        return None;
-    }
-    let eval = sys.evaluate(q, &part)?;
-    stability_of(&mut sys, q, &part, &eval, eigenvalues)
-}
-
-/// [`stability_at`] with the system of the model's rows already partitioned and evaluated at
-/// `q` (what `verify` has made for its balance check); `None` with no degree of freedom.
-///
-/// Where the eigenvalues would come from Lanczos (sparse path, more than
-/// `spectrum::EXACT_UP_TO` degrees of freedom) and `eigenvalues` is false, the verdict comes
-/// from the inertia of the shifted KKT matrix alone (module `stability_inertia`), without
-/// eigenvalues or mode shapes; Lanczos only if that inertia cannot be trusted.
-pub(crate) fn stability_of(
-    sys: &mut System,
-    q: &nalgebra::DVector<f64>,
-    part: &partition::Partition,
-    eval: &system::Eval,
-    eigenvalues: bool,
-) -> Option<Stability> {
-    if part.independent.is_empty() {
-        return None;
-    }
-    let lanczos =
-        sys.backend == system::Backend::Sparse && part.independent.len() > spectrum::EXACT_UP_TO;
-    if lanczos && !eigenvalues {
-        if let Some((verdict, tolerance)) = stability_inertia::inertia_verdict(sys, q, part, eval) {
-            return Some(Stability {
-                verdict,
-                tolerance,
-                eigenvalues: Vec::new(),
-                modes: Vec::new(),
-            });
-        }
-    }
-    let eig = spectrum::spectrum(sys, q, part, eval);
-    Some(stability(sys, q, part, eval, &eig))
 }
 
 /// Finds the stable static equilibrium of `model` from its initial guess (a floating
@@ -321,7 +185,7 @@ pub(crate) fn solve_round(
     let cons = Constraints::new(model, locks)
         .with_active(model, active)
         .on_branches(start.branches.clone());
-    let mut sys = System::with_options(model, cons, options);
+    let mut sys = System::new(model, cons, Backend::of(model, options));
     let part = sys.partition(&q);
     let dof0 = part.independent.len();
     if options.method != Method::Newton && dof0 > QUASI_NEWTON_DOF_LIMIT {
@@ -381,7 +245,7 @@ pub(crate) fn solve_round(
             .clone()
             .unwrap_or_else(|| spectrum::spectrum(&mut sys, &out.q, &out.part, &out.eval));
         diagnostics.eigenvalues_by = if eig.exact { "exact" } else { "lanczos" }.into();
-        stability(&sys, &out.q, &out.part, &out.eval, &eig)
+        verdict::from_spectrum(&sys, &out.q, &out.part, &out.eval, &eig)
     });
     let mut mu = DVector::zeros(sys.problem.cons.len());
     for (k, &row) in out.part.rows.iter().enumerate() {

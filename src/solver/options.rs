@@ -2,7 +2,6 @@
 
 /// Minimization method in the independent coordinates.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum Method {
     /// Newton's method with the exact reduced Hessian (modified to be positive definite away
@@ -17,7 +16,6 @@ pub enum Method {
 
 /// Linear algebra of the solver.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum LinearAlgebra {
     /// Dense up to 40 bodies (280 coordinates), sparse above (default).
@@ -30,9 +28,8 @@ pub enum LinearAlgebra {
     Sparse,
 }
 
-/// Whether URDF joint limits hold the joints.
+/// Whether URDF joint limits hold the joints (part of a [`ContactPolicy`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum Limits {
     /// `lower ≤ θ ≤ upper` are inequality constraints: a joint can rest on its stop (default).
@@ -60,6 +57,46 @@ impl std::fmt::Debug for Progress {
     }
 }
 
+/// What the stops and contacts do, for `solve` and `verify` alike: whether URDF joint limits
+/// hold, and the friction and coefficient of contacts whose `mech:contact` does not say. The
+/// one rule resolving a contact's friction ([`ContactPolicy::friction_of`]) and coefficient
+/// ([`ContactPolicy::mu_of`]): its own setting, else the policy's.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct ContactPolicy {
+    /// Joint limits as inequality constraints, or only reported (default: enforce); with
+    /// `friction` and `mu`, the [`ContactPolicy`] of [`Options::contact`].
+    pub limits: Limits,
+    /// Tangential behaviour of contacts whose `mech:contact` does not say (default: none,
+    /// frictionless).
+    pub friction: crate::model::Friction,
+    /// Friction coefficient of contacts whose `mech:contact` does not say (default: none: the
+    /// needed coefficient is reported, never judged).
+    pub mu: Option<f64>,
+}
+
+impl ContactPolicy {
+    /// Whether URDF joint limits are inequality constraints.
+    pub fn enforces_limits(&self) -> bool {
+        self.limits == Limits::Enforce
+    }
+
+    /// The friction of a contact with the settings `c`: its own, else the policy's.
+    pub fn friction_of(&self, c: &crate::model::ContactSettings) -> crate::model::Friction {
+        c.friction.unwrap_or(self.friction)
+    }
+
+    /// Whether a contact with the settings `c` sticks.
+    pub fn sticks(&self, c: &crate::model::ContactSettings) -> bool {
+        self.friction_of(c) == crate::model::Friction::Stick
+    }
+
+    /// The friction coefficient of a contact with the settings `c`: its own, else the
+    /// policy's (`None`: the needed coefficient is reported, never judged).
+    pub fn mu_of(&self, c: &crate::model::ContactSettings) -> Option<f64> {
+        c.mu.or(self.mu)
+    }
+}
+
 /// Options of [`crate::solve`].
 #[derive(Clone, Debug)]
 pub struct Options {
@@ -68,9 +105,9 @@ pub struct Options {
     /// Convergence tolerance on the reduced gradient `‖∂V/∂v‖∞` in scaled coordinates \[J\]
     /// (default: 1e-8).
     pub gradient_tolerance: f64,
-    /// Newton corrector tolerance on the dimensionless residual `‖D Φ‖∞`: rows in m divided by
-    /// the characteristic length `L`, rows in m² by `L²`, dimensionless rows as they are, so
-    /// that the tolerance means the same in any length unit (default: 1e-10).
+    /// Tolerance on the dimensionless constraint residual `‖D Φ‖∞` (rows in m^k divided by
+    /// `L^k`, `L` the characteristic length; the one meaning, module `system::residual`) of the
+    /// assembly, the corrector and the stops' and contacts' gaps (default: 1e-10).
     pub constraint_tolerance: f64,
     /// Maximum minimizer iterations (default: 200).
     pub max_iterations: usize,
@@ -111,12 +148,34 @@ pub struct Options {
     pub progress: Progress,
 }
 
+impl Options {
+    /// The stops' and contacts' policy of these options (`limits`, `friction`, `mu`).
+    pub fn contact(&self) -> ContactPolicy {
+        ContactPolicy {
+            limits: self.limits,
+            friction: self.friction,
+            mu: self.mu,
+        }
+    }
+
+    /// These options with the stops' and contacts' policy `policy`.
+    #[must_use]
+    pub fn with_contact(self, policy: ContactPolicy) -> Self {
+        Options {
+            limits: policy.limits,
+            friction: policy.friction,
+            mu: policy.mu,
+            ..self
+        }
+    }
+}
+
 impl Default for Options {
     fn default() -> Self {
         Options {
             method: Method::Newton,
             gradient_tolerance: 1e-8,
-            constraint_tolerance: 1e-10,
+            constraint_tolerance: super::system::residual::TOLERANCE,
             max_iterations: 200,
             max_corrector_iterations: 25,
             max_step: 0.3,
@@ -124,9 +183,9 @@ impl Default for Options {
             allow_unstable: false,
             record_iterates: false,
             linear_algebra: LinearAlgebra::Auto,
-            limits: Limits::Enforce,
-            friction: crate::model::Friction::None,
-            mu: None,
+            limits: ContactPolicy::default().limits,
+            friction: ContactPolicy::default().friction,
+            mu: ContactPolicy::default().mu,
             gap_tolerance: 1e-9,
             force_tolerance: 1e-9,
             progress: Progress::default(),

@@ -113,7 +113,8 @@ pub struct Diagnostics {
     pub gradient_tolerance: f64,
     /// Load steps used (1: the full load at once).
     pub load_steps: usize,
-    /// Final `‖Φ‖∞`.
+    /// Final raw `‖Φ‖∞` \[m or rad\] (the tolerance applies to the dimensionless `‖D Φ‖∞`,
+    /// module `system::residual`).
     pub constraint_residual: f64,
     /// Linear algebra used: `"dense"` or `"sparse"` (see [`crate::solver::LinearAlgebra`]).
     pub linear_algebra: String,

@@ -19,7 +19,7 @@ pub(super) const DRAKE_NS: &str = "http://drake.mit.edu";
 
 /// Where an edge comes from, which decides its preference for the spanning tree.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Source_ {
+pub(super) enum Declaration {
     /// URDF `<joint>`: a tree edge; fixed ones weld links into one body.
     Urdf,
     /// `<drake:joint>`: a tree edge of another type.
@@ -43,7 +43,7 @@ pub(super) struct Edge<'a> {
     pub(super) axis: Vector3<f64>,
     pub(super) axis2: Vector3<f64>,
     pub(super) limits: Option<[f64; 2]>,
-    pub(super) source: Source_,
+    pub(super) source: Declaration,
     /// `<child_origin auto="initial"/>`: computed so the joint holds at the initial guess.
     pub(super) auto_child_origin: bool,
 }
@@ -208,7 +208,7 @@ pub(super) fn urdf_joint<'a>(
         axis: urdf_axis(src, node, kind, warnings)?,
         axis2: Vector3::y(),
         limits: lim,
-        source: Source_::Urdf,
+        source: Declaration::Urdf,
         auto_child_origin: false,
         name,
     })
@@ -258,7 +258,7 @@ pub(super) fn drake_joint<'a>(
         axis: src.axis(child(node, "axis"), node, default_axis)?,
         axis2: Vector3::y(),
         limits: limits(src, node)?,
-        source: Source_::Drake,
+        source: Declaration::Drake,
         auto_child_origin: false,
         name,
     })
@@ -336,7 +336,7 @@ pub(super) fn mech_loop_joint<'a>(
         axis,
         axis2,
         limits: limits(src, node)?,
-        source: Source_::Loop,
+        source: Declaration::Loop,
         auto_child_origin,
         name,
     })
@@ -372,7 +372,7 @@ pub(super) fn foreign_loop_joint<'a>(
         axis: src.axis(child(node, "axis"), node, Vector3::x())?,
         axis2: Vector3::y(),
         limits: limits(src, node)?,
-        source: Source_::Loop,
+        source: Declaration::Loop,
         auto_child_origin: false,
         name,
     })
@@ -431,7 +431,7 @@ pub(super) fn drake_ball_constraint<'a>(
         axis: Vector3::x(),
         axis2: Vector3::y(),
         limits: None,
-        source: Source_::Loop,
+        source: Declaration::Loop,
         auto_child_origin: false,
         name,
     })

@@ -12,7 +12,7 @@
 //! The root link is welded to the world (its frame is the world frame) unless a floating base
 //! is asked for.
 
-use super::edges::{self, Edge, FrameMap, Frames, Source_, DRAKE_NS};
+use super::edges::{self, Declaration, Edge, FrameMap, Frames, DRAKE_NS};
 use super::extensions;
 use super::links::read_link;
 use super::xml::{is_mech, Source};
@@ -219,7 +219,7 @@ pub(super) fn import(
                 ),
             ));
         }
-        if e.source != Source_::Loop {
+        if e.source != Declaration::Loop {
             let Some(c) = e.child else {
                 return Err(src.error(
                     e.node,
@@ -308,7 +308,7 @@ pub(super) fn import(
         let (pb, pf) = place(e.parent);
         let (cb, cf) = place(e.child);
         let tree_edge = tree.in_tree[k];
-        let merged = tree_edge && e.source == Source_::Urdf && e.kind == JointKind::Fixed;
+        let merged = tree_edge && e.source == Declaration::Urdf && e.kind == JointKind::Fixed;
         if !merged && pb == cb {
             return Err(src.error(
                 e.node,
@@ -334,7 +334,7 @@ pub(super) fn import(
         if e.auto_child_origin {
             auto_child.push(id);
         }
-        if e.source == Source_::Urdf {
+        if e.source == Declaration::Urdf {
             urdf_joints.push((id, e.node));
         }
     }

@@ -1,4 +1,4 @@
-//! The input boundary: URDF text (with the `mech:` extensions of `URDF_EXTENSIONS.md`) to a
+//! The input boundary: URDF text (with the `mech:` extensions of `docs/urdf-extensions.md`) to a
 //! validated [`Model`]. Nothing else in the crate sees XML.
 //!
 //! The file is read with `roxmltree`, which keeps the position of every element, so that each

@@ -7,7 +7,7 @@
 //! URDF `fixed` tree joints form one body (group) whose frame is that of its topmost link:
 //! `body_from_child = body_from_parent · origin`.
 
-use super::edges::{Edge, Source_};
+use super::edges::{Declaration, Edge};
 use crate::model::JointKind;
 use nalgebra::Isometry3;
 use std::cmp::Reverse;
@@ -33,7 +33,7 @@ pub(super) fn spanning_tree(edges: &[Edge], links: usize, root: usize) -> Tree {
     let mut preferred: Vec<Vec<usize>> = vec![Vec::new(); links + 1];
     let mut loops: Vec<Vec<usize>> = vec![Vec::new(); links + 1];
     for (k, e) in edges.iter().enumerate() {
-        if e.source == Source_::Loop {
+        if e.source == Declaration::Loop {
             loops[slot(e.parent)].push(k);
         } else {
             preferred[slot(e.parent)].push(k);
@@ -103,7 +103,7 @@ pub(super) fn group_links(edges: &[Edge], tree: &Tree, links: usize, root: usize
     for &k in &tree.order {
         let e = &edges[k];
         let Some(c) = e.child else { continue };
-        if e.source == Source_::Urdf && e.kind == JointKind::Fixed {
+        if e.source == Declaration::Urdf && e.kind == JointKind::Fixed {
             match e.parent {
                 Some(p) => {
                     g.group[c] = g.group[p];

@@ -1,9 +1,10 @@
 //! Is a given pose a rest pose? Independent checks of a configuration.
 //!
-//! Nothing here uses the solver's partition. With `S` the coordinate scaling of the solver
-//! (positions by the characteristic length) and `N` an orthonormal basis of the null space of
-//! `Φ_q S` (feasible motions), a pose is balanced when the projected gradient `Nᵀ S ∇V`
-//! vanishes.
+//! With `S` the coordinate scaling of the solver (positions by the characteristic length) and
+//! `N` an orthonormal basis of the null space of `Φ_q S` (feasible motions), a pose is
+//! balanced when the projected gradient `Nᵀ S ∇V` vanishes. The dense path (module `dense`)
+//! uses no partition of the solver; the sparse path (module `reduced`, below) uses the
+//! solver's sparse partition, at the pose given, for its null space.
 //!
 //! The per-joint imbalance is the effort `τ` each joint coordinate would need to hold the pose
 //! (Adams' "imbalance"): with `B` the gradients `∇θ_k` of the tree joints' scalar coordinates,
@@ -26,18 +27,18 @@
 //! 10,000-link chain carries 10⁸ N m at its base), so an absolute tolerance alone would reject
 //! exact answers of large models.
 
-mod check;
 mod closure;
 mod dense;
+mod initial_guess;
 mod pose;
 mod rank;
 mod reduced;
 mod unilateral;
 mod unilateral_sparse;
 
-pub use check::{check, ModelCheck};
 use closure::closures;
 pub use closure::Closure;
+pub use initial_guess::{check, ModelCheck};
 pub use pose::{parse_pose, pose_state, read_pose};
 pub use unilateral::{UnilateralCheck, Unilaterals};
 
@@ -71,7 +72,8 @@ pub struct Tolerances {
     /// Largest joint effort (or unassigned generalized force) a balanced pose may need
     /// \[N m or N\] (default: 1e-6).
     pub force: f64,
-    /// Largest constraint violation \[m or rad\] (default: 1e-8).
+    /// Largest raw constraint violation `‖Φ‖∞` \[m or rad\] (default: 1e-8; the solver's own
+    /// tolerance is on the dimensionless `‖D Φ‖∞`, module `solver::system::residual`).
     pub constraint: f64,
     /// Effort tolerance relative to the largest generalized force `‖S ∇V‖∞`, added to `force`
     /// (default: 1e-9).
@@ -424,11 +426,15 @@ fn verify_on(
     // and the critical cone of those that touch without one (`solver::cone`).
     let stability = match (passed, sparse) {
         (false, _) => None,
-        (true, _) if !strong.is_empty() || !weak.is_empty() => {
-            crate::solver::stability_touching(model, state, &strong, &weak, eigenvalues)
+        (true, true) if strong.is_empty() && weak.is_empty() => stability,
+        (true, _) => {
+            let backend = if sparse {
+                Backend::Sparse
+            } else {
+                Backend::Dense
+            };
+            crate::solver::stability_verdict(model, state, &strong, &weak, backend, eigenvalues)
         }
-        (true, true) => stability,
-        (true, false) => crate::solver::stability_at(model, state, eigenvalues),
     };
     Ok(Verification {
         passed,

@@ -341,7 +341,7 @@ mod tests {
         let q0 = crate::solver::initial_state(&model).q;
         let q = crate::solver::assemble_only(&model, q0, &mut branches, &locks).unwrap();
         let cons = Constraints::new(&model, &locks).on_branches(branches);
-        let mut sys = System::with_backend(&model, cons, Backend::Sparse);
+        let mut sys = System::new(&model, cons, Backend::Sparse);
         let mut phi = nalgebra::DVector::zeros(sys.problem.cons.len());
         let mut jac = crate::constraints::Triplets::default();
         sys.problem

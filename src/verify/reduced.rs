@@ -80,7 +80,7 @@ pub(super) fn reduced<'a>(
         .iter()
         .zip(&scale)
         .fold(0.0f64, |a, (x, s)| a.max((x * s).abs()));
-    let mut sys = System::with_backend(
+    let mut sys = System::new(
         model,
         Constraints::new(model, locks).on_branches(state.branches.clone()),
         Backend::Sparse,

@@ -39,34 +39,14 @@
 
 use crate::constraints::unilateral::{self, Active, Anchor, Unilateral};
 use crate::jet::{pair_of, scatter};
-use crate::model::{Friction, Model};
-use crate::solver::{ActiveLimit, Contact, ContactState, Limits};
+use crate::model::Model;
+use crate::solver::{ActiveLimit, Contact, ContactPolicy, ContactState};
 use crate::state::State;
 use nalgebra::{DMatrix, DVector, Vector3};
 
-/// How `verify` treats stops and contacts (the same choices as `analyze`'s options).
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-pub struct Unilaterals {
-    /// URDF joint limits: enforced (a pose may rest on a stop, and may not go beyond one) or
-    /// ignored.
-    pub limits: Limits,
-    /// Contacts without a friction setting in `mech:contact`: frictionless, or able to carry a
-    /// tangential force (sticking).
-    pub friction: Friction,
-    /// Friction coefficient of sticking contacts without `mu` in `mech:contact`.
-    pub mu: Option<f64>,
-}
-
-impl Default for Unilaterals {
-    /// Limits enforced, frictionless, no coefficient (as `analyze`).
-    fn default() -> Self {
-        Unilaterals {
-            limits: Limits::Enforce,
-            friction: Friction::None,
-            mu: None,
-        }
-    }
-}
+/// How `verify` treats stops and contacts: the solver's [`ContactPolicy`] (the same choices
+/// as `analyze`'s options; a sticking contact needing more than its `mu` fails the pose).
+pub type Unilaterals = ContactPolicy;
 
 /// What the stops and contacts do at the pose.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
@@ -140,7 +120,7 @@ pub(super) fn touching(
     out: &mut UnilateralCheck,
 ) -> Vec<Touching> {
     let mut list = Vec::new();
-    for u in unilateral::inequalities(model, opts.limits == Limits::Enforce) {
+    for u in unilateral::inequalities(model, opts.enforces_limits()) {
         let Some(g) = unilateral::gap(model, &u, &state.q, &state.branches) else {
             continue;
         };
@@ -162,7 +142,7 @@ pub(super) fn touching(
         let (anchor, mu) = match u {
             Unilateral::Contact { point, ground } => {
                 let c = &model.contact_points[point];
-                let stick = c.settings.friction.unwrap_or(opts.friction) == Friction::Stick;
+                let stick = opts.sticks(&c.settings);
                 let anchor = stick.then(|| {
                     let x = unilateral::point_world(model, point, &state.q);
                     let (_, normal) = unilateral::surface(model, ground, &x);
@@ -179,7 +159,7 @@ pub(super) fn touching(
                         body: c.point - a.transpose() * normal * c.radius,
                     }
                 });
-                (anchor, c.settings.mu.or(opts.mu).filter(|_| stick))
+                (anchor, opts.mu_of(&c.settings).filter(|_| stick))
             }
             Unilateral::Limit { .. } => (None, None),
         };

@@ -157,7 +157,7 @@ fn multipliers(
         .filter(|b| matches!(b.kind, BlockKind::Unilateral(_)))
         .map(|b| b.first)
         .collect();
-    let mut sys = System::with_backend(model, cons, Backend::Sparse);
+    let mut sys = System::new(model, cons, Backend::Sparse);
     let first = firsts.first().copied().unwrap_or(sys.problem.cons.len());
     for r in first..sys.problem.cons.len() {
         sys.problem.scaling.rows[r] *= PREFERENCE;

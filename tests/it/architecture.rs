@@ -8,7 +8,7 @@
 //! ```
 //!
 //! A reference is any `crate::module` path in code (comments and doc links are skipped). A
-//! second test holds every file of `src/` to at most 500 lines (issue 11).
+//! second test holds every file of `src/` to at most 500 lines.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -127,7 +127,7 @@ fn modules_use_only_lower_layers() {
     );
 }
 
-/// Longest file allowed under `src/` [lines]: one concept per file (STYLE.md, issue 11).
+/// Longest file allowed under `src/` [lines]: one concept per file (`docs/architecture.md`).
 const MAX_FILE_LINES: usize = 500;
 
 #[test]
@@ -192,4 +192,99 @@ fn library_strings_name_no_command_line_option() {
         "library strings that name a CLI option:\n{}",
         found.join("\n")
     );
+}
+
+/// The folders of the solver wing (issue 20): each is a signpost, its `mod.rs` a `//!` module
+/// doc naming what is inside, then only `mod` lines and re-exports (`use`), the code in the
+/// files it lists.
+const SOLVER_FOLDERS: &[&str] = &["inequality", "sparse", "stability", "system"];
+
+/// The lines of `text` that are neither module docs, attributes, `mod` declarations nor `use`
+/// re-exports (a grouped `use` spanning lines counted as one).
+fn code_lines(text: &str) -> Vec<(usize, String)> {
+    let mut found = Vec::new();
+    let mut in_use = false;
+    for (n, line) in text.lines().enumerate() {
+        let code = line.trim();
+        let item = code
+            .trim_start_matches("pub(crate) ")
+            .trim_start_matches("pub(super) ")
+            .trim_start_matches("pub ");
+        if in_use {
+            in_use = !code.ends_with(';');
+            continue;
+        }
+        if code.is_empty() || code.starts_with("//") || code.starts_with("#[") {
+            continue;
+        }
+        if item.starts_with("mod ") && item.ends_with(';') {
+            continue;
+        }
+        if item.starts_with("use ") {
+            in_use = !code.ends_with(';');
+            continue;
+        }
+        found.push((n + 1, code.to_owned()));
+    }
+    found
+}
+
+#[test]
+fn solver_folders_are_signposts() {
+    let solver = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/solver");
+    let mut problems = Vec::new();
+    for folder in SOLVER_FOLDERS {
+        let file = solver.join(folder).join("mod.rs");
+        let Ok(text) = std::fs::read_to_string(&file) else {
+            problems.push(format!("{}: missing", file.display()));
+            continue;
+        };
+        if !text.starts_with("//!") {
+            problems.push(format!(
+                "{}: does not start with a `//!` doc",
+                file.display()
+            ));
+        }
+        let mods = text
+            .lines()
+            .filter(|l| l.trim_start_matches("pub(crate) ").starts_with("mod "))
+            .count();
+        if mods == 0 {
+            problems.push(format!("{}: declares no module", file.display()));
+        }
+        for (line, code) in code_lines(&text) {
+            problems.push(format!(
+                "{}:{line}: code in a signpost: {code}",
+                file.display()
+            ));
+        }
+    }
+    // The geometry folder is a signpost too.
+    let geometry = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/geometry/mod.rs");
+    match std::fs::read_to_string(&geometry) {
+        Ok(text) => {
+            for (line, code) in code_lines(&text) {
+                problems.push(format!(
+                    "{}:{line}: code in a signpost: {code}",
+                    geometry.display()
+                ));
+            }
+        }
+        Err(_) => problems.push(format!("{}: missing", geometry.display())),
+    }
+    // No other folder hides in the solver without being listed here.
+    for entry in std::fs::read_dir(&solver).expect("src/solver is readable") {
+        let path = entry.expect("directory entry").path();
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        if path.is_dir() && !SOLVER_FOLDERS.contains(&name) {
+            problems.push(format!("{}: folder not in SOLVER_FOLDERS", path.display()));
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+#[test]
+fn signpost_check_finds_code() {
+    let text = "//! doc\nmod a;\npub(crate) use a::{\n    B,\n};\nfn f() {}\n";
+    assert_eq!(code_lines(text), vec![(6, "fn f() {}".to_owned())]);
 }

@@ -23,7 +23,7 @@
 //! `E_v` their selector) gives `Zᵀ (Ŵ − σ E_v) Z = Ĥ − σ I`, since `Z`'s independent block is
 //! the identity: by Sylvester's law of inertia (Haynsworth's inertia additivity over the
 //! constraint block) the LDLᵀ then has `rows + #{λ(Ĥ) < σ}` negative pivots, an exact count
-//! of the reduced Hessian's eigenvalues below `σ` (module `solver::stability_inertia`).
+//! of the reduced Hessian's eigenvalues below `σ` (module `solver::stability::inertia`).
 
 use super::hessian::BlockHessian;
 use super::pattern::{Ix, Pattern, NONE};

@@ -10,7 +10,7 @@
 //!   once per partition, numeric factorization per evaluation;
 //! - the Newton step (module `kkt`): the sparse KKT system instead of the dense reduced Hessian
 //!   `Zᵀ W Z`, which is dense for a chain;
-//! - the stability verdict (`solver::spectrum`): Lanczos on `(Zᵀ W Z)⁻¹` through the KKT
+//! - the stability verdict (`solver::stability::spectrum`): Lanczos on `(Zᵀ W Z)⁻¹` through the KKT
 //!   factors when the degrees of freedom are many.
 
 pub(crate) mod factor;

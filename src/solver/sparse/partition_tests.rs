@@ -50,16 +50,16 @@ fn a_contact_below_a_steep_link_is_not_pivoted_on_its_angle() {
     let q0 = crate::solver::initial_state(&model).q;
     let q = crate::solver::assemble_only(&model, q0, &mut Default::default(), &[]).unwrap();
     let options = crate::solver::Options::default();
-    let active: Vec<_> = crate::solver::active_set::inequalities(&model, &options)
+    let active: Vec<_> = crate::solver::inequality::active_set::inequalities(&model, &options)
         .into_iter()
         .filter(|u| gap(&model, u, &q, &Default::default()).is_some_and(|g| g.abs() < 1e-9))
-        .map(|u| crate::solver::active_set::activate(&model, &options, u, &q))
+        .map(|u| crate::solver::inequality::active_set::activate(&model, &options, u, &q))
         .collect();
     // Links 19 (the lowest hanging one) to 59 touch.
     assert_eq!(active.len(), 41);
     let cons = || Constraints::new(&model, &[]).with_active(&model, &active);
-    let mut sparse = System::with_backend(&model, cons(), Backend::Sparse);
-    let mut dense = System::with_backend(&model, cons(), Backend::Dense);
+    let mut sparse = System::new(&model, cons(), Backend::Sparse);
+    let mut dense = System::new(&model, cons(), Backend::Dense);
     let ps = sparse.partition(&q);
     let pd = dense.partition(&q);
     assert!(!ps.second_pass.is_empty() && pd.second_pass.is_empty());
@@ -106,8 +106,8 @@ fn same_rank_as_full_pivoting_and_well_conditioned() {
         let q0 = crate::solver::initial_state(&model).q;
         let q = crate::solver::assemble_only(&model, q0, &mut Default::default(), &[]).unwrap();
         let cons = || Constraints::new(&model, &[]);
-        let mut dense = System::with_backend(&model, cons(), Backend::Dense);
-        let mut sparse = System::with_backend(&model, cons(), Backend::Sparse);
+        let mut dense = System::new(&model, cons(), Backend::Dense);
+        let mut sparse = System::new(&model, cons(), Backend::Sparse);
         let pd = dense.partition(&q);
         let ps = sparse.partition(&q);
         assert_eq!(ps.independent.len(), pd.independent.len(), "{}", model.name);

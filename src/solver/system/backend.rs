@@ -1,4 +1,6 @@
-//! Dense or sparse linear algebra, chosen once per system.
+//! Dense or sparse linear algebra, chosen once per system: [`Backend::choose`] is the one
+//! place that decides (a solve by its options, [`Backend::of`]; `verify` by its own
+//! `linear_algebra`), and a [`System`](super::System) is built with the backend chosen.
 //!
 //! Both backends partition `Φ_q = [Φ_u Φ_v]` and factor `Φ_u`; the dense one by full pivoting
 //! of the dense Jacobian and nalgebra's LU, the sparse one body by body (module `sparse`) and
@@ -38,6 +40,11 @@ impl Backend {
             LinearAlgebra::Auto | LinearAlgebra::Dense => Backend::Dense,
             LinearAlgebra::Sparse => Backend::Sparse,
         }
+    }
+
+    /// The backend of a solve with `options` (its `linear_algebra`; automatic: by size).
+    pub(crate) fn of(model: &Model, options: &crate::solver::Options) -> Self {
+        Self::choose(model, options.linear_algebra)
     }
 
     /// `"dense"` or `"sparse"` (as the report's diagnostics name it).

@@ -16,26 +16,9 @@ pub(crate) struct System<'a> {
 }
 
 impl<'a> System<'a> {
-    /// The system with the automatic choice of linear algebra (by size).
-    pub(crate) fn new(model: &'a Model, cons: Constraints) -> Self {
-        Self::with_backend(
-            model,
-            cons,
-            Backend::choose(model, crate::solver::LinearAlgebra::Auto),
-        )
-    }
-
-    /// The system with the linear algebra of `options` (automatic: by size).
-    pub(crate) fn with_options(
-        model: &'a Model,
-        cons: Constraints,
-        options: &crate::solver::Options,
-    ) -> Self {
-        Self::with_backend(model, cons, Backend::choose(model, options.linear_algebra))
-    }
-
-    /// The system with the given linear algebra.
-    pub(crate) fn with_backend(model: &'a Model, cons: Constraints, backend: Backend) -> Self {
+    /// The system of the rows `cons` of `model` with the linear algebra `backend` (chosen once,
+    /// by [`Backend::choose`]).
+    pub(crate) fn new(model: &'a Model, cons: Constraints, backend: Backend) -> Self {
         System {
             work: Workspace::new(cons.len()),
             problem: Problem::new(model, cons),
@@ -52,8 +35,7 @@ impl<'a> System<'a> {
         &self.work.phi
     }
 
-    /// `‖D Φ‖∞` at the point of the last evaluation: the residual with each row in m^k divided
-    /// by `L^k`, so that one tolerance means the same in any length unit.
+    /// `‖D Φ‖∞` at the point of the last evaluation (module `residual`).
     pub(crate) fn dimensionless_residual(&self) -> f64 {
         self.problem.scaling.residual(&self.work.phi)
     }

@@ -2,8 +2,10 @@
 //! rows, optionally starting with chord steps on the factors of a nearby point. It gives up
 //! at the second Newton step that does not decrease the residual (outside Newton's region of
 //! convergence, or no solution for this `v`: the line search then halves the step) rather
-//! than after `max_iterations` refactorizations.
+//! than after `max_iterations` refactorizations. The residual is `‖D Φ‖∞` (module
+//! `residual`): over the independent rows while iterating, over every row at the end.
 
+use super::residual::REDUNDANT_FLOOR;
 use super::{Factors, System};
 use crate::solver::partition::Partition;
 use nalgebra::DVector;
@@ -58,11 +60,10 @@ impl System<'_> {
         let (mut newton, mut stalls) = (false, 0);
         for it in 0..=max_iterations {
             self.residual(q);
-            let res = part
-                .rows
-                .iter()
-                .map(|&i| self.work.phi[i].abs() * self.problem.scaling.rows[i])
-                .fold(0.0, f64::max);
+            let res = self
+                .problem
+                .scaling
+                .residual_over(&self.work.phi, &part.rows);
             if !res.is_finite() {
                 return Err(CorrectorFailure);
             }
@@ -72,7 +73,7 @@ impl System<'_> {
             let target = if chord.is_some() { 1e-3 * tol } else { tol };
             if res <= target || (res <= tol && it == max_iterations) {
                 let all = self.dimensionless_residual();
-                return if all <= tol.max(1e-8) {
+                return if all <= tol.max(REDUNDANT_FLOOR) {
                     Ok(it)
                 } else {
                     Err(CorrectorFailure)

@@ -23,6 +23,7 @@ mod factors;
 mod kkt;
 mod problem;
 mod reduced;
+pub(crate) mod residual;
 #[cfg(test)]
 mod tests;
 mod workspace;

@@ -3,12 +3,11 @@
 //!
 //! Coordinates are scaled by `S` (the characteristic length `L` for positions, 1 for Euler
 //! parameters) and constraint rows by `D` (`L^−k` for a row in m^k), so that the dimensionless
-//! Jacobian `D Φ_q S` and residual `‖D Φ‖∞` mean the same in any length unit. The solver and
-//! `verify` use this one scaling.
+//! Jacobian `D Φ_q S` and residual `‖D Φ‖∞` (module `residual`) mean the same in any length
+//! unit. The solver and `verify` use this one scaling.
 
 use crate::constraints::Constraints;
 use crate::model::Model;
-use nalgebra::DVector;
 
 /// The model and its constraint rows with their scaling (read-only during a solve, except
 /// that the joint-angle branches follow the iterates).
@@ -48,14 +47,6 @@ impl Scaling {
                 .map(|i| l.powi(-cons.length_power(i)))
                 .collect(),
         }
-    }
-
-    /// `‖D Φ‖∞`: the residual with each row in m^k divided by `L^k`.
-    pub(crate) fn residual(&self, phi: &DVector<f64>) -> f64 {
-        phi.iter()
-            .zip(&self.rows)
-            .map(|(p, s)| (p * s).abs())
-            .fold(0.0, f64::max)
     }
 }
 

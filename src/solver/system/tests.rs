@@ -94,7 +94,11 @@ fn constraint_jacobian_and_weighted_hessian_match_finite_differences() {
     for model in models() {
         let n = model.coordinate_count();
         let sys_cons = Constraints::new(&model, &[(crate::model::JointId(0), 0, 0.3)]);
-        let mut sys = System::new(&model, sys_cons);
+        let mut sys = System::new(
+            &model,
+            sys_cons,
+            Backend::choose(&model, crate::solver::LinearAlgebra::Auto),
+        );
         let m = sys.problem.cons.len();
         let q = random_q(n, 11);
         let j = sys.jacobian(&q);
@@ -153,12 +157,11 @@ fn kkt_step_is_the_reduced_newton_step() {
     for model in all {
         let q0 = crate::solver::initial_state(&model).q;
         let q = crate::solver::assemble_only(&model, q0, &mut Default::default(), &[]).unwrap();
-        let mut dense = System::with_backend(&model, Constraints::new(&model, &[]), Backend::Dense);
+        let mut dense = System::new(&model, Constraints::new(&model, &[]), Backend::Dense);
         let part = dense.partition(&q);
         let ed = dense.evaluate(&q, &part).unwrap();
         let hd = dense.reduced_hessian(&q, &part, &ed);
-        let mut sparse =
-            System::with_backend(&model, Constraints::new(&model, &[]), Backend::Sparse);
+        let mut sparse = System::new(&model, Constraints::new(&model, &[]), Backend::Sparse);
         let es = sparse.evaluate(&q, &part).unwrap();
         let hs = sparse.reduced_hessian(&q, &part, &es);
         let scale = hd.amax().max(1.0);
@@ -222,7 +225,11 @@ fn reduced_gradient_and_hessian_match_differences_through_the_corrector() {
     for model in models() {
         let q0 = crate::solver::initial_state(&model).q;
         let q = crate::solver::assemble_only(&model, q0, &mut Default::default(), &[]).unwrap();
-        let mut sys = System::new(&model, Constraints::new(&model, &[]));
+        let mut sys = System::new(
+            &model,
+            Constraints::new(&model, &[]),
+            Backend::choose(&model, crate::solver::LinearAlgebra::Auto),
+        );
         let part = sys.partition(&q);
         let e = sys.evaluate(&q, &part).unwrap();
         let hr = sys.reduced_hessian(&q, &part, &e);

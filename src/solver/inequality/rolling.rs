@@ -11,9 +11,9 @@
 //! more than `gap_tolerance · L`. At the answer the friction force acts at the touching point
 //! with no slip there, as MuJoCo's condim-3 contact, and the pose is the rolling model's.
 
-use super::options::Options;
 use crate::constraints::unilateral::{self, Active, Unilateral};
 use crate::model::Model;
+use crate::solver::options::Options;
 use nalgebra::{DVector, Vector3};
 
 /// Re-anchorings of rolling sticking contacts before the search gives up.

@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::constraints::Constraints;
-use crate::solver::eigen::symmetric_eigen;
+use crate::solver::stability::eigen::symmetric_eigen;
 use crate::solver::system::Backend;
 use crate::urdf::{load_str, ImportOptions};
 
@@ -59,7 +59,7 @@ fn counts_and_verdicts_match_the_dense_eigendecomposition() {
     for (n, flip, amplitude) in [(30, false, 0.3), (30, true, 0.3), (60, true, 1.0)] {
         let model = chain(n, flip);
         let q = bent(&model, n, amplitude);
-        let mut sys = System::with_backend(&model, Constraints::new(&model, &[]), Backend::Sparse);
+        let mut sys = System::new(&model, Constraints::new(&model, &[]), Backend::Sparse);
         let part = sys.partition(&q);
         let eval = sys.evaluate(&q, &part).unwrap();
         let (exact, _) = symmetric_eigen(&sys.reduced_hessian(&q, &part, &eval));
@@ -115,7 +115,7 @@ fn neutral_without_gravity_or_springs() {
         .unwrap()
         .model;
     let q = bent(&model, n, 0.3);
-    let mut sys = System::with_backend(&model, Constraints::new(&model, &[]), Backend::Sparse);
+    let mut sys = System::new(&model, Constraints::new(&model, &[]), Backend::Sparse);
     let part = sys.partition(&q);
     let eval = sys.evaluate(&q, &part).unwrap();
     let (exact, _) = symmetric_eigen(&sys.reduced_hessian(&q, &part, &eval));
@@ -133,7 +133,7 @@ fn verdicts_match_lanczos_on_large_chains() {
     for flip in [false, true] {
         let model = chain(n, flip);
         let q = bent(&model, n, 0.3);
-        let mut sys = System::with_backend(&model, Constraints::new(&model, &[]), Backend::Sparse);
+        let mut sys = System::new(&model, Constraints::new(&model, &[]), Backend::Sparse);
         let part = sys.partition(&q);
         let eval = sys.evaluate(&q, &part).unwrap();
         let (verdict, tol) = inertia_verdict(&mut sys, &q, &part, &eval).unwrap();

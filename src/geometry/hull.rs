@@ -1,6 +1,6 @@
 //! Convex hulls of meshes as obstacles: the closest point of the hull's surface to a point and
 //! the outward normal there, from the hull's triangles (computed by parry3d, module
-//! `geometry`).
+//! `mesh`).
 //!
 //! The hull is `{y : n_i·y ≤ d_i}` over its face planes. For `p` with
 //! `s = max_i (n_i·p − d_i) ≤ 0` (inside or on the surface) the signed distance is `s`, the

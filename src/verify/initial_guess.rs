@@ -58,7 +58,7 @@ pub fn check(model: &Model) -> ModelCheck {
 /// What the assembly reports, [`Error::ForceTableOutOfRange`] (or another undefined term) if
 /// the energy cannot be evaluated at the assembled guess.
 fn sparse_dof(model: &Model, start: State, cons: Constraints) -> Result<usize> {
-    let mut sys = System::with_backend(
+    let mut sys = System::new(
         model,
         cons.on_branches(start.branches.clone()),
         Backend::Sparse,
@@ -69,7 +69,7 @@ fn sparse_dof(model: &Model, start: State, cons: Constraints) -> Result<usize> {
     } else {
         let state = assemble(model, &start)?;
         let cons = sys.problem.cons.on_branches(state.branches.clone());
-        sys = System::with_backend(model, cons, Backend::Sparse);
+        sys = System::new(model, cons, Backend::Sparse);
         state
     };
     if super::potential_energy(model, &state).is_none() {

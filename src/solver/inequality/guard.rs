@@ -10,12 +10,12 @@
 //!   equation", *BIT* 11 (1971) 168–174 (the Illinois method).
 
 use super::active_set::dimensionless;
-use super::options::Options;
-use super::partition::Partition;
-use super::system::{Eval, System};
 use crate::constraints::unilateral::{self, Active, Unilateral};
 use crate::kinematics::Branches;
-use crate::model::{Friction, Model};
+use crate::model::Model;
+use crate::solver::options::Options;
+use crate::solver::partition::Partition;
+use crate::solver::system::{Eval, System};
 use nalgebra::{DVector, Vector3};
 
 /// The inactive inequalities that a step must not violate.
@@ -45,13 +45,9 @@ impl<'m> Guard<'m> {
         q: &DVector<f64>,
     ) -> Self {
         let sticking = inactive.iter().any(|u| match *u {
-            Unilateral::Contact { point, .. } => {
-                model.contact_points[point]
-                    .settings
-                    .friction
-                    .unwrap_or(options.friction)
-                    == Friction::Stick
-            }
+            Unilateral::Contact { point, .. } => options
+                .contact()
+                .sticks(&model.contact_points[point].settings),
             Unilateral::Limit { .. } => false,
         });
         let rolls = super::rolling::limits(model, active);
@@ -222,7 +218,9 @@ impl<'m> Guard<'m> {
 mod tests {
     use super::*;
     use crate::constraints::Constraints;
-    use crate::solver::active_set::{activate, inequalities};
+    use crate::model::Friction;
+    use crate::solver::inequality::active_set::{activate, inequalities};
+    use crate::solver::system::Backend;
     use crate::urdf::{load_str, ImportOptions};
 
     /// A link on a hinge 0.04 m above the ground, from the horizontal, turned toward the
@@ -245,7 +243,7 @@ mod tests {
         let tol = options.gap_tolerance;
         let start = crate::State::initial(&model);
         let mut branches = start.branches.clone();
-        let q = super::super::assemble::assemble(&model, start.q, &mut branches, &[], &options)
+        let q = crate::solver::assemble::assemble(&model, start.q, &mut branches, &[], &options)
             .unwrap();
         let all = inequalities(&model, &options);
         let touches = |u: &Unilateral| {
@@ -259,14 +257,14 @@ mod tests {
             .collect();
         let inactive: Vec<Unilateral> = all.iter().filter(|u| !touches(u)).copied().collect();
         assert!(active.is_empty() && inactive.len() == 1);
-        let q = super::super::assemble::project(&model, q, &mut branches, &[], &active, &options)
+        let q = crate::solver::assemble::project(&model, q, &mut branches, &[], &active, &options)
             .unwrap();
         let mut guard = Guard::new(&model, &options, inactive, &active, tol, &q);
         assert!(guard.falsi);
         let cons = Constraints::new(&model, &[])
             .with_active(&model, &active)
             .on_branches(branches);
-        let mut sys = System::with_options(&model, cons, &options);
+        let mut sys = System::new(&model, cons, Backend::of(&model, &options));
         let part = sys.partition(&q);
         let eval = sys.evaluate(&q, &part).unwrap();
         // The direction of the independent coordinates that closes the lowest gap fastest

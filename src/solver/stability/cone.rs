@@ -33,12 +33,12 @@
 //!   (second-order conditions, the critical cone).
 
 use super::eigen::symmetric_eigen;
-use super::report::{Stability, Verdict};
 use super::spectrum::EXACT_UP_TO;
-use super::system::System;
 use crate::constraints::unilateral::{self, Active};
 use crate::constraints::Constraints;
 use crate::model::Model;
+use crate::solver::report::{Stability, Verdict};
+use crate::solver::system::{Backend, System};
 use crate::State;
 use nalgebra::{DMatrix, DVector};
 
@@ -121,24 +121,25 @@ pub(crate) fn stability_touching(
     state: &State,
     strong: &[Active],
     weak: &[Active],
+    backend: Backend,
     eigenvalues: bool,
 ) -> Option<Stability> {
     if weak.is_empty() {
-        return super::stability_on(model, state, strong, eigenvalues);
+        return crate::solver::stability_on(model, state, strong, backend, eigenvalues);
     }
     let all: Vec<Active> = strong.iter().chain(weak).copied().collect();
     let q = &state.q;
-    let cons = Constraints::new(model, &super::lock_values(model))
+    let cons = Constraints::new(model, &crate::solver::lock_values(model))
         .with_active(model, strong)
         .on_branches(state.branches.clone());
-    let mut sys = System::new(model, cons);
+    let mut sys = System::new(model, cons, backend);
     let part = sys.partition(q);
     let dof = part.independent.len();
     if dof == 0 {
-        return super::stability_on(model, state, &all, eigenvalues);
+        return crate::solver::stability_on(model, state, &all, backend, eigenvalues);
     }
     if dof > EXACT_UP_TO || weak.len() > MAX_WEAK {
-        return super::stability_on(model, state, strong, eigenvalues);
+        return crate::solver::stability_on(model, state, strong, backend, eigenvalues);
     }
     let eval = sys.evaluate(q, &part)?;
     let h = sys.reduced_hessian(q, &part, &eval);
@@ -174,8 +175,8 @@ pub(crate) fn stability_touching(
     } else {
         Verdict::Stable
     };
-    let shown = super::stability_on(model, state, &all, eigenvalues)
-        .or_else(|| super::stability_on(model, state, strong, eigenvalues));
+    let shown = crate::solver::stability_on(model, state, &all, backend, eigenvalues)
+        .or_else(|| crate::solver::stability_on(model, state, strong, backend, eigenvalues));
     shown.map(|mut s| {
         s.verdict = verdict;
         s.tolerance = tol;

@@ -13,7 +13,7 @@
 //!
 //! (Sylvester's law of inertia with Haynsworth's additivity over the constraint block): the
 //! number of negative pivots of its LDLᵀ minus `m` is exactly the number of eigenvalues of `Ĥ`
-//! below `σ`. The verdict of [`super::Stability`] with tolerance `t = 10⁻¹⁰ max(λ_max, 1)`
+//! below `σ`. The verdict of [`Stability`](crate::solver::Stability) with tolerance `t = 10⁻¹⁰ max(λ_max, 1)`
 //! (`λ_max` by power iteration, as on the Lanczos path) then needs one or two factorizations:
 //!
 //! - `#{λ < t} = 0`: **stable** (every eigenvalue above the tolerance);
@@ -35,11 +35,11 @@
 //! - N. I. M. Gould, "On practical conditions for the existence and uniqueness of solutions
 //!   to the general equality quadratic programming problem", *Math. Program.* 32 (1985).
 
-use super::partition::Partition;
-use super::report::Verdict;
-use super::sparse::kkt::Factored;
 use super::spectrum::largest_eigenvalue;
-use super::system::{Eval, System};
+use crate::solver::partition::Partition;
+use crate::solver::report::Verdict;
+use crate::solver::sparse::kkt::Factored;
+use crate::solver::system::{Eval, System};
 use nalgebra::DVector;
 
 /// The verdict and its tolerance from the KKT inertia at a feasible `q` of the sparse path;

@@ -18,9 +18,9 @@
 //! - Y. Saad, *Numerical Methods for Large Eigenvalue Problems*, 2nd ed., SIAM (2011), §6.6.
 
 use super::eigen::symmetric_eigen;
-use super::partition::Partition;
-use super::sparse::kkt::Factored;
-use super::system::{Backend, Eval, System};
+use crate::solver::partition::Partition;
+use crate::solver::sparse::kkt::Factored;
+use crate::solver::system::{Backend, Eval, System};
 use nalgebra::{DMatrix, DVector};
 
 /// Up to this many degrees of freedom the reduced Hessian is formed and decomposed exactly.
@@ -65,6 +65,12 @@ impl Spectrum {
 }
 
 /// The spectrum at a feasible `q` (dof > 0).
+/// Whether the spectrum of `dof` degrees of freedom with `backend` is exact (the reduced
+/// Hessian formed and decomposed) rather than found by Lanczos.
+pub(crate) fn exact(backend: Backend, dof: usize) -> bool {
+    backend == Backend::Dense || dof <= EXACT_UP_TO
+}
+
 pub(crate) fn spectrum(
     sys: &mut System,
     q: &DVector<f64>,
@@ -72,7 +78,7 @@ pub(crate) fn spectrum(
     eval: &Eval,
 ) -> Spectrum {
     let dof = part.independent.len();
-    if sys.backend == Backend::Dense || dof <= EXACT_UP_TO {
+    if exact(sys.backend, dof) {
         let (values, vectors) = symmetric_eigen(&sys.reduced_hessian(q, part, eval));
         let largest = values.amax();
         return Spectrum {
@@ -293,8 +299,7 @@ mod tests {
                 values.insert(format!("joint{i}"), vec![0.3 * ((i as f64) * 0.7).sin()]);
             }
             let q = crate::state::State::from_joint_values(&model, &values).q;
-            let mut sys =
-                System::with_backend(&model, Constraints::new(&model, &[]), Backend::Sparse);
+            let mut sys = System::new(&model, Constraints::new(&model, &[]), Backend::Sparse);
             let part = sys.partition(&q);
             let eval = sys.evaluate(&q, &part).unwrap();
             let exact = symmetric_eigen(&sys.reduced_hessian(&q, &part, &eval)).0;

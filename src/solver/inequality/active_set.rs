@@ -32,13 +32,15 @@
 //!   (active-set methods), §15.4 (handling inequalities in reduced-gradient methods).
 
 pub(crate) use super::guard::Guard;
-use super::options::{Limits, Options};
 use crate::constraints::unilateral::{self, Active, Unilateral};
 use crate::kinematics::Branches;
-use crate::model::{Friction, Model};
+use crate::model::Model;
+use crate::solver::options::Options;
+use crate::solver::system::Backend;
 use nalgebra::{DVector, Vector3};
 
-/// `g` divided by the characteristic length for a gap in m.
+/// `g` divided by the characteristic length for a gap in m: its row's `D g`, as in the
+/// constraint residual (module `system::residual`).
 pub(crate) fn dimensionless(model: &Model, u: &Unilateral, g: f64) -> f64 {
     if unilateral::length_power(model, u) == 1 {
         g / model.length_scale
@@ -49,7 +51,7 @@ pub(crate) fn dimensionless(model: &Model, u: &Unilateral, g: f64) -> f64 {
 
 /// Every inequality of the model under `options`.
 pub(crate) fn inequalities(model: &Model, options: &Options) -> Vec<Unilateral> {
-    unilateral::inequalities(model, options.limits == Limits::Enforce)
+    unilateral::inequalities(model, options.contact().enforces_limits())
 }
 
 /// `u` made active at `q`: a sticking contact is anchored at the point's projection on the
@@ -63,8 +65,7 @@ pub(crate) fn activate(
     let anchor = match u {
         Unilateral::Contact { point, ground } => {
             let c = &model.contact_points[point];
-            let friction = c.settings.friction.unwrap_or(options.friction);
-            (friction == Friction::Stick).then(|| {
+            options.contact().sticks(&c.settings).then(|| {
                 let x = unilateral::point_world(model, point, q);
                 let (_, normal) = unilateral::surface(model, ground, &x);
                 let g = unilateral::gap(model, &u, q, &Branches::default()).unwrap_or(0.0);
@@ -178,7 +179,7 @@ pub(crate) fn solve(
     start: crate::State,
     locks: &[(crate::model::JointId, usize, f64)],
     options: &Options,
-) -> crate::Result<(crate::State, super::Report)> {
+) -> crate::Result<(crate::State, crate::solver::Report)> {
     let all = inequalities(model, options);
     let tol = options.gap_tolerance;
     let threshold = options.force_tolerance * force_scale(model);
@@ -201,10 +202,17 @@ pub(crate) fn solve(
     let mut touched = Vec::new();
     super::rolling::record_touches(model, &active, &state.q, &mut touched);
     let mut iterations = 0;
-    let mut counters = super::Diagnostics::default();
+    let mut counters = crate::solver::Diagnostics::default();
     loop {
         let mut branches = state.branches.clone();
-        let q = super::assemble::project(model, state.q, &mut branches, locks, &active, options)?;
+        let q = crate::solver::assemble::project(
+            model,
+            state.q,
+            &mut branches,
+            locks,
+            &active,
+            options,
+        )?;
         let inactive: Vec<Unilateral> = all
             .iter()
             .filter(|u| !active.iter().any(|a| a.row == **u))
@@ -216,7 +224,7 @@ pub(crate) fn solve(
             max_iterations: options.max_iterations.saturating_sub(iterations),
             ..options.clone()
         };
-        let round = super::solve_round(
+        let round = crate::solver::solve_round(
             model,
             crate::State { q, branches },
             locks,
@@ -244,7 +252,7 @@ pub(crate) fn solve(
             if rolls <= super::rolling::MAX_ROLLS {
                 continue;
             }
-            report.termination = super::Termination::Unbounded;
+            report.termination = crate::solver::Termination::Unbounded;
             rolled_too_far = true;
         }
         if report.converged() && !cycling && !rolled_too_far {
@@ -259,15 +267,21 @@ pub(crate) fn solve(
                 if rolls <= super::rolling::MAX_ROLLS {
                     continue;
                 }
-                report.termination = super::Termination::Unbounded;
+                report.termination = crate::solver::Termination::Unbounded;
             }
         }
         if cycling {
-            report.termination = super::Termination::ActiveSetCycling;
+            report.termination = crate::solver::Termination::ActiveSetCycling;
         }
         // A round stopped at an inequality or a roll limit has no verdict of its own.
         if (cycling || rolled_too_far) && round.blocked.is_some() {
-            report.stability = super::stability_on(model, &state, &active, true);
+            report.stability = crate::solver::stability_on(
+                model,
+                &state,
+                &active,
+                Backend::of(model, options),
+                true,
+            );
         }
         report.iterations = iterations;
         let own = report.diagnostics.clone();
@@ -285,7 +299,14 @@ pub(crate) fn solve(
         // critical cone instead (module `cone`).
         let (strong, weak) = split(model, &round.multipliers, threshold);
         if report.converged() && !weak.is_empty() {
-            report.stability = super::cone::stability_touching(model, &state, &strong, &weak, true);
+            report.stability = crate::solver::stability_verdict(
+                model,
+                &state,
+                &strong,
+                &weak,
+                Backend::of(model, options),
+                true,
+            );
         }
         return Ok((state, report));
     }
@@ -297,9 +318,9 @@ fn describe(
     options: &Options,
     state: &crate::State,
     multipliers: &[(Active, Vec<f64>)],
-    report: &mut super::Report,
+    report: &mut crate::solver::Report,
 ) {
-    use super::report::{ActiveLimit, Contact, ContactState};
+    use crate::solver::report::{ActiveLimit, Contact, ContactState};
     for (a, m) in multipliers {
         match a.row {
             Unilateral::Limit {
@@ -333,7 +354,7 @@ fn describe(
                 } else {
                     f64::INFINITY
                 };
-                let mu = c.settings.mu.or(options.mu);
+                let mu = options.contact().mu_of(&c.settings);
                 let contact_state = match (a.anchor, mu) {
                     (None, _) => ContactState::Touching,
                     (Some(_), Some(mu)) if required > mu => ContactState::Slipping,

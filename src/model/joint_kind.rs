@@ -1,12 +1,31 @@
-//! Queries on joint kinds: the one place that says how many values each kind takes and which
-//! of its coordinates are angles.
+//! `impl JointKind` in one place: its type name (URDF and the result JSON), how many values
+//! each kind takes and which of its coordinates are angles. (The string→kind tables of the
+//! importer are in `urdf/edges.rs`: `<joint type>` and `mech:loop_joint type`.)
 
-use crate::model::JointKind;
+use super::JointKind;
 
 /// Largest number of scalar coordinates of any joint kind (planar: `x, y, θ`).
 pub(crate) const MAX_SCALAR_COORDINATES: usize = 3;
 
 impl JointKind {
+    /// The type name used in URDF and in the result JSON.
+    pub fn name(&self) -> &'static str {
+        match self {
+            JointKind::Revolute => "revolute",
+            JointKind::Continuous => "continuous",
+            JointKind::Prismatic => "prismatic",
+            JointKind::Fixed => "fixed",
+            JointKind::Floating => "floating",
+            JointKind::Planar => "planar",
+            JointKind::Spherical => "spherical",
+            JointKind::Universal => "universal",
+            JointKind::Cylindrical => "cylindrical",
+            JointKind::Screw { .. } => "screw",
+            JointKind::Distance { .. } => "distance",
+            JointKind::PointOnLine => "point_on_line",
+        }
+    }
+
     /// Number of scalar joint coordinates that springs, efforts, locks and initial values can
     /// address (`dof` index): 1 for revolute, continuous, prismatic and screw; 2 for universal
     /// and cylindrical; 3 for planar; 0 otherwise.

@@ -1,0 +1,96 @@
+//! The library's option enums as command-line values: clap's `ValueEnum` is derived here, in
+//! the binary, so that the library does not depend on clap. Each mirror converts both ways
+//! by an exhaustive match (a variant added to the library fails to compile here until it is
+//! added), and its variants' docs are the help's "Possible values".
+
+use restpose::generate::Family as LibFamily;
+use restpose::model::Friction as LibFriction;
+use restpose::{Limits as LibLimits, LinearAlgebra as LibLinearAlgebra, Method as LibMethod};
+
+/// A `ValueEnum` mirror of the library enum `$lib` with the same variants.
+macro_rules! mirror {
+    ($(#[$meta:meta])* $name:ident = $lib:ident { $($(#[$vmeta:meta])* $variant:ident,)* }) => {
+        $(#[$meta])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+        pub(crate) enum $name {
+            $($(#[$vmeta])* $variant,)*
+        }
+
+        impl From<$name> for $lib {
+            fn from(x: $name) -> Self {
+                match x {
+                    $($name::$variant => $lib::$variant,)*
+                }
+            }
+        }
+
+        impl From<$lib> for $name {
+            fn from(x: $lib) -> Self {
+                match x {
+                    $($lib::$variant => $name::$variant,)*
+                }
+            }
+        }
+    };
+}
+
+mirror! {
+    /// Minimization method in the independent coordinates (`restpose::Method`).
+    Method = LibMethod {
+        /// Newton's method with the exact reduced Hessian (modified to be positive definite away
+        /// from the minimum) and a backtracking line search.
+        Newton,
+        /// BFGS quasi-Newton (inverse-Hessian update) with a backtracking line search.
+        Bfgs,
+        /// Davidon–Fletcher–Powell quasi-Newton, the paper's minimizer.
+        Dfp,
+    }
+}
+
+mirror! {
+    /// Linear algebra of the solver (`restpose::LinearAlgebra`).
+    LinearAlgebra = LibLinearAlgebra {
+        /// Dense up to 40 bodies (280 coordinates), sparse above (default).
+        Auto,
+        /// Dense matrices: full-pivoting partition, dense LU, exact reduced Hessian. `O(N³)`.
+        Dense,
+        /// Sparse partition, sparse LU (faer), Newton steps from the sparse KKT system. `O(N)` per
+        /// iteration for chains, trees and ladders.
+        Sparse,
+    }
+}
+
+mirror! {
+    /// Whether URDF joint limits hold the joints (`restpose::Limits`).
+    Limits = LibLimits {
+        /// `lower ≤ θ ≤ upper` are inequality constraints: a joint can rest on its stop (default).
+        Enforce,
+        /// Limits are read and a rest pose outside them is reported, not prevented.
+        Ignore,
+    }
+}
+
+mirror! {
+    /// Tangential behaviour of a contact (`restpose::model::Friction`).
+    Friction = LibFriction {
+        /// Frictionless: the contact pushes along the normal only (the energy minimum).
+        None,
+        /// A point that touches is held where it first touched (tangential rows added); the
+        /// report gives the friction coefficient each contact needs.
+        Stick,
+    }
+}
+
+mirror! {
+    /// A generated mechanism family (`restpose::generate::Family`).
+    Family = LibFamily {
+        /// N-link spatial pendulum chain with joint springs (alternating joint axes).
+        Chain,
+        /// N-link planar chain (all axes parallel) with joint springs.
+        PlanarChain,
+        /// Ladder of N closed four-bar loops.
+        Ladder,
+        /// N-link planar rope hanging from the world onto the ground (sphere contacts).
+        Rope,
+    }
+}

@@ -1,0 +1,12 @@
+//! Inequalities: joint stops and contacts `g(q) ≥ 0`, by an active-set iteration around the
+//! equality-constrained solve (the active `g_k` join `Φ` as rows `g_k(q) = 0`).
+//!
+//! - `active_set`: the iteration (which inequality joins, which leaves, when it stops).
+//! - `guard`: where a step first reaches an inactive inequality's boundary.
+//! - `rolling`: sticking spheres re-anchored where they touch after rolling.
+//! - `distribution`: the least-norm force distribution of a statically indeterminate support.
+
+pub(crate) mod active_set;
+pub(crate) mod distribution;
+pub(crate) mod guard;
+pub(crate) mod rolling;

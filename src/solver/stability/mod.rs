@@ -1,0 +1,17 @@
+//! Stability of a rest pose: the verdict from the lowest eigenvalues of the reduced Hessian
+//! `Ĥ = Zᵀ W Z` (`Z` a basis of the tangent space of the active rows, `W` the Lagrangian
+//! Hessian): stable when `λ_min > t`, unstable when `λ_min < −t`, neutral otherwise
+//! (`t = 10⁻¹⁰ max(λ_max, 1)`).
+//!
+//! - `eigen`: guarded symmetric eigendecomposition `A = V Λ Vᵀ` (dense).
+//! - `spectrum`: the low end of the spectrum of `Ĥ`, exact (dense) or by Lanczos on `Ĥ⁻¹`
+//!   (sparse, many degrees of freedom); also used by the minimizer to leave saddles.
+//! - `inertia`: the verdict from the inertia of the shifted KKT matrix, without eigenvalues.
+//! - `cone`: the verdict on the critical cone, where stops and contacts touch without force.
+//! - `verdict`: the verdict and mode shapes from the eigenpairs, and the entry points.
+
+pub(crate) mod cone;
+pub(crate) mod eigen;
+pub(crate) mod inertia;
+pub(crate) mod spectrum;
+pub(crate) mod verdict;

@@ -1,0 +1,165 @@
+//! The verdict at a rest pose from the eigenvalues of the reduced Hessian `Ĥ = Zᵀ W Z`:
+//! stable when `λ_min > t`, unstable when `λ_min < −t`, neutral otherwise, with
+//! `t = 10⁻¹⁰ max(λ_max, 1)` (`Spectrum::tolerance`), and the mode shapes of the lowest
+//! eigenvalues as joint-coordinate changes.
+//!
+//! The entry point is [`stability_verdict`] (stops and contacts that carry a force and those
+//! that touch without one, or none); [`stability_on`] holds every given row, and
+//! [`stability_of`] judges a system already partitioned and evaluated (as `verify` has made
+//! it, or the minimizer).
+
+use super::inertia;
+use super::spectrum::{self, Spectrum};
+use crate::constraints::unilateral::Active;
+use crate::constraints::Constraints;
+use crate::model::Model;
+use crate::solver::partition::Partition;
+use crate::solver::system::{Backend, System};
+use crate::solver::{lock_values, Stability, Verdict};
+use crate::state::State;
+
+/// The stability verdict from the reduced-Hessian eigenvalues (ascending, at least one) and
+/// eigenvectors, with the mode shapes of the smallest as joint-coordinate changes.
+pub(crate) fn from_spectrum(
+    sys: &System,
+    q: &nalgebra::DVector<f64>,
+    part: &Partition,
+    eval: &crate::solver::system::Eval,
+    spectrum: &Spectrum,
+) -> Stability {
+    let (vals, vecs) = (&spectrum.values, &spectrum.vectors);
+    let tol = spectrum.tolerance();
+    let negative_by_inertia = spectrum.negative_by_inertia.unwrap_or(0) > 0;
+    let verdict = if vals[0] < -tol || negative_by_inertia {
+        Verdict::Unstable
+    } else if vals[0] <= tol {
+        Verdict::Neutral
+    } else {
+        Verdict::Stable
+    };
+    let shown = vals.len().min(6);
+    // The gradients of every joint coordinate, once for all modes: (joint, per coordinate the
+    // (global index, derivative) pairs).
+    type Gradient = Vec<(usize, f64)>;
+    let gradients: Vec<(&str, Vec<Gradient>)> = if shown == 0 {
+        Vec::new()
+    } else {
+        sys.problem
+            .model
+            .joints
+            .iter()
+            .filter(|j| !j.merged)
+            .map(|j| {
+                let pair = crate::jet::pair_of(&j.bodies, q, false);
+                let g = (0..j.kind.scalar_coordinates())
+                    .filter_map(|dof| crate::kinematics::coordinate(j, &pair, dof, 0.0))
+                    .map(|s| {
+                        (0..crate::jet::NL)
+                            .filter_map(|i| {
+                                crate::jet::global_index(&j.bodies, i).map(|g| (g, s.g[i]))
+                            })
+                            .collect()
+                    })
+                    .collect();
+                (j.name.as_str(), g)
+            })
+            .collect()
+    };
+    let modes = (0..shown)
+        .map(|k| {
+            let dq = sys.tangent_step(part, eval, &vecs.column(k).into_owned());
+            let mut mode = std::collections::BTreeMap::new();
+            for (name, coords) in &gradients {
+                let d: Vec<f64> = coords
+                    .iter()
+                    .map(|c| c.iter().map(|&(g, x)| x * dq[g]).sum())
+                    .collect();
+                if !d.is_empty() {
+                    mode.insert(name.to_string(), d);
+                }
+            }
+            let big = mode.values().flatten().fold(0.0f64, |a, &b| a.max(b.abs()));
+            if big > 0.0 {
+                mode.values_mut().flatten().for_each(|x| *x /= big);
+            }
+            mode
+        })
+        .collect();
+    Stability {
+        verdict,
+        tolerance: tol,
+        eigenvalues: vals.iter().take(shown).copied().collect(),
+        modes,
+    }
+}
+
+/// The stability verdict at a state that is feasible and balanced, where the stops and
+/// contacts `strong` carry a force and `weak` touch without one (both empty: the model's
+/// equality rows alone), with the linear algebra `backend`: the entry point. On the tangent
+/// space of the rows held ([`stability_on`]), or on the critical cone where some touch
+/// without a force ([`stability_touching`](super::cone::stability_touching)). `None` with no
+/// degree of freedom or where the energy is undefined; `eigenvalues` as in [`stability_of`].
+pub(crate) fn stability_verdict(
+    model: &Model,
+    state: &State,
+    strong: &[Active],
+    weak: &[Active],
+    backend: Backend,
+    eigenvalues: bool,
+) -> Option<Stability> {
+    super::cone::stability_touching(model, state, strong, weak, backend, eigenvalues)
+}
+
+/// The verdict on the tangent space of the equality rows and the inequalities `active` (every
+/// one held as a row); `eigenvalues` as in [`stability_of`].
+pub(crate) fn stability_on(
+    model: &Model,
+    state: &State,
+    active: &[Active],
+    backend: Backend,
+    eigenvalues: bool,
+) -> Option<Stability> {
+    let q = &state.q;
+    let sys_cons = Constraints::new(model, &lock_values(model))
+        .with_active(model, active)
+        .on_branches(state.branches.clone());
+    let mut sys = System::new(model, sys_cons, backend);
+    let part = sys.partition(q);
+    if part.independent.is_empty() {
+        return None;
+    }
+    let eval = sys.evaluate(q, &part)?;
+    stability_of(&mut sys, q, &part, &eval, eigenvalues)
+}
+
+/// The verdict with the system of the model's rows already partitioned and evaluated at
+/// `q` (what `verify` has made for its balance check); `None` with no degree of freedom.
+///
+/// Where the eigenvalues would come from Lanczos (sparse path, more than
+/// `spectrum::EXACT_UP_TO` degrees of freedom) and `eigenvalues` is false, the verdict comes
+/// from the inertia of the shifted KKT matrix alone (module `stability::inertia`), without
+/// eigenvalues or mode shapes; Lanczos only if that inertia cannot be trusted.
+pub(crate) fn stability_of(
+    sys: &mut System,
+    q: &nalgebra::DVector<f64>,
+    part: &Partition,
+    eval: &crate::solver::system::Eval,
+    eigenvalues: bool,
+) -> Option<Stability> {
+    if part.independent.is_empty() {
+        return None;
+    }
+    let lanczos = !spectrum::exact(sys.backend, part.independent.len());
+    if lanczos && !eigenvalues {
+        if let Some((verdict, tolerance)) = inertia::inertia_verdict(sys, q, part, eval) {
+            return Some(Stability {
+                verdict,
+                tolerance,
+                eigenvalues: Vec::new(),
+                modes: Vec::new(),
+            });
+        }
+    }
+    let eig = spectrum::spectrum(sys, q, part, eval);
+    Some(from_spectrum(sys, q, part, eval, &eig))
+}

@@ -202,6 +202,8 @@ pub(crate) fn solve(
     super::rolling::record_touches(model, &active, &state.q, &mut touched);
     let mut iterations = 0;
     let mut counters = super::Diagnostics::default();
+    let (mut history, mut iterates) = (Vec::new(), Vec::new());
+    let mut rounds = 0;
     loop {
         let mut branches = state.branches.clone();
         let q = super::assemble::project(model, state.q, &mut branches, locks, &active, options)?;
@@ -223,6 +225,14 @@ pub(crate) fn solve(
         counters.add_counts(&round.report.diagnostics);
         state = round.state;
         let mut report = round.report;
+        rounds += 1;
+        report.history.iter_mut().for_each(|h| h.round = rounds);
+        super::report::append_history(
+            &mut history,
+            &mut iterates,
+            std::mem::take(&mut report.history),
+            std::mem::take(&mut report.iterates),
+        );
         let cycling = changes - initial >= options.max_iterations;
         let mut rolled_too_far = false;
         if let (Some(hit), false) = (&round.blocked, cycling) {
@@ -265,6 +275,7 @@ pub(crate) fn solve(
             report.stability = super::stability_on(model, &state, &active, true);
         }
         report.iterations = iterations;
+        (report.history, report.iterates) = (history, iterates);
         let own = report.diagnostics.clone();
         report.diagnostics = counters;
         report.diagnostics.gradient_norm = own.gradient_norm;
@@ -281,6 +292,11 @@ pub(crate) fn solve(
         let (strong, weak) = split(model, &round.multipliers, threshold);
         if report.converged() && !weak.is_empty() {
             report.stability = super::cone::stability_touching(model, &state, &strong, &weak, true);
+        }
+        // Stops and contacts carrying a force that leave no feasible motion: a strict
+        // minimum (`stability_on`).
+        if report.converged() && report.stability.is_none() && !strong.is_empty() {
+            report.stability = super::stability_on(model, &state, &strong, true);
         }
         return Ok((state, report));
     }

@@ -233,6 +233,7 @@ pub(crate) fn minimize(
                 iteration,
                 potential_energy: eval.energy.total,
                 gradient_norm: gnorm,
+                ..Iterate::default()
             });
             if options.record_iterates {
                 iterates.push(q.clone());
@@ -461,6 +462,7 @@ pub(crate) fn minimize(
             iteration,
             potential_energy: eval.energy.total,
             gradient_norm: eval.grad_v.amax(),
+            ..Iterate::default()
         });
         if options.record_iterates {
             iterates.push(q.clone());

@@ -20,6 +20,7 @@ mod cone;
 mod distribution;
 mod eigen;
 mod guard;
+mod joint_space;
 mod minimize;
 mod mode_animation;
 mod options;
@@ -36,8 +37,8 @@ mod unbounded;
 pub use mode_animation::mode_animation;
 pub use options::{Limits, LinearAlgebra, Method, Options};
 pub use report::{
-    ActiveLimit, Contact, ContactState, Diagnostics, Iterate, Reaction, Report, Sizes, Stability,
-    Termination, Timings, Verdict,
+    ActiveLimit, Contact, ContactState, Diagnostics, Iterate, Mode, Reaction, Report, Sizes,
+    Stability, Termination, Timings, Verdict,
 };
 
 use crate::constraints::unilateral::Active;
@@ -109,6 +110,18 @@ fn stability(
         Verdict::Stable
     };
     let shown = vals.len().min(6);
+    // In joint coordinates where the whole spectrum is known (module `joint_space`).
+    if spectrum.exact && shown > 0 {
+        let h = vecs * nalgebra::DMatrix::from_diagonal(vals) * vecs.transpose();
+        if let Some((values, modes)) = joint_space::joint_spectrum(sys, q, part, eval, &h, shown) {
+            return Stability {
+                verdict,
+                tolerance: tol,
+                eigenvalues: values.into_iter().take(shown).collect(),
+                modes: modes.into_iter().map(Mode).collect(),
+            };
+        }
+    }
     // The gradients of every joint coordinate, once for all modes: (joint, per coordinate the
     // (global index, derivative) pairs).
     type Gradient = Vec<(usize, f64)>;
@@ -139,21 +152,26 @@ fn stability(
     let modes = (0..shown)
         .map(|k| {
             let dq = sys.tangent_step(part, eval, &vecs.column(k).into_owned());
-            let mut mode = std::collections::BTreeMap::new();
+            let mut mode = Vec::new();
             for (name, coords) in &gradients {
                 let d: Vec<f64> = coords
                     .iter()
                     .map(|c| c.iter().map(|&(g, x)| x * dq[g]).sum())
                     .collect();
                 if !d.is_empty() {
-                    mode.insert(name.to_string(), d);
+                    mode.push((name.to_string(), d));
                 }
             }
-            let big = mode.values().flatten().fold(0.0f64, |a, &b| a.max(b.abs()));
+            let big = mode
+                .iter()
+                .flat_map(|m| &m.1)
+                .fold(0.0f64, |a, &b| a.max(b.abs()));
             if big > 0.0 {
-                mode.values_mut().flatten().for_each(|x| *x /= big);
+                mode.iter_mut()
+                    .flat_map(|m| &mut m.1)
+                    .for_each(|x| *x /= big);
             }
-            mode
+            Mode(mode)
         })
         .collect();
     Stability {
@@ -188,7 +206,19 @@ pub(crate) fn stability_on(
     let mut sys = System::new(model, sys_cons);
     let part = sys.partition(q);
     if part.independent.is_empty() {
-        return None;
+        // Stops or contacts carrying a force leave no feasible motion: every motion the model
+        // allows raises the energy at first order (a strict minimum), if the model has any.
+        let free = !active.is_empty() && {
+            let cons =
+                Constraints::new(model, &lock_values(model)).on_branches(state.branches.clone());
+            !System::new(model, cons).partition(q).independent.is_empty()
+        };
+        return free.then(|| Stability {
+            verdict: Verdict::Stable,
+            tolerance: 0.0,
+            eigenvalues: Vec::new(),
+            modes: Vec::new(),
+        });
     }
     let eval = sys.evaluate(q, &part)?;
     stability_of(&mut sys, q, &part, &eval, eigenvalues)
@@ -268,8 +298,22 @@ pub fn solve_from(model: &Model, start: State, options: &Options) -> Result<(Sta
             if direct.1.converged() || direct.1.termination == Termination::Unbounded {
                 direct
             } else {
-                let ramped = ramp(model, q, AUTOMATIC_LOAD_STEPS, &locks, options)?;
+                let mut ramped = ramp(model, q, AUTOMATIC_LOAD_STEPS, &locks, options)?;
                 if ramped.1.converged() {
+                    // The history shows the abandoned direct attempt first (load step 0).
+                    let (mut history, mut iterates) = (direct.1.history, direct.1.iterates);
+                    for h in &mut history {
+                        h.load_step = 0;
+                    }
+                    let r = &mut ramped.1;
+                    r.iterations += direct.1.iterations;
+                    report::append_history(
+                        &mut history,
+                        &mut iterates,
+                        std::mem::take(&mut r.history),
+                        std::mem::take(&mut r.iterates),
+                    );
+                    (r.history, r.iterates) = (history, iterates);
                     ramped
                 } else {
                     direct
@@ -304,17 +348,28 @@ fn ramp(
 ) -> Result<(State, Report)> {
     let mut iterations = 0;
     let mut counters = Diagnostics::default();
+    let (mut history, mut iterates) = (Vec::new(), Vec::new());
     for k in 1..n {
         let stage = model.with_load_factor(k as f64 / n as f64);
-        let (s, r) = solve_assembled(&stage, q, locks, options)?;
+        let (s, mut r) = solve_assembled(&stage, q, locks, options)?;
         q = s;
         iterations += r.iterations;
         counters.add_counts(&r.diagnostics);
+        r.history.iter_mut().for_each(|h| h.load_step = k);
+        report::append_history(&mut history, &mut iterates, r.history, r.iterates);
     }
     let (s, mut r) = solve_assembled(model, q, locks, options)?;
     r.iterations += iterations;
     r.diagnostics.add_counts(&counters);
     r.diagnostics.load_steps = n;
+    r.history.iter_mut().for_each(|h| h.load_step = n);
+    report::append_history(
+        &mut history,
+        &mut iterates,
+        std::mem::take(&mut r.history),
+        std::mem::take(&mut r.iterates),
+    );
+    (r.history, r.iterates) = (history, iterates);
     Ok((s, r))
 }
 
@@ -430,12 +485,17 @@ pub(crate) fn solve_round(
     let multipliers = active_set::active_multipliers(&sys.problem.cons, &mu);
     let blocked = out.blocked;
     diagnostics.timings.stability = stability_started.elapsed().as_secs_f64();
+    let mut history = out.history;
+    for h in &mut history {
+        h.load_step = 1;
+        h.round = 1;
+    }
     let report = Report {
         termination: out.termination,
-        iterations: out.history.last().map_or(0, |h| h.iteration),
+        iterations: history.last().map_or(0, |h| h.iteration),
         energy: out.eval.energy,
         dof,
-        history: out.history,
+        history,
         independent_coordinates: out
             .part
             .independent

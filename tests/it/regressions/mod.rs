@@ -3,3 +3,4 @@
 mod issue_12_assembly_names_the_joint;
 mod issue_12_sparse_verify_angle_branch;
 mod issue_13_floating_base_start;
+mod issue_21_verify_forces_and_stability;

@@ -9,5 +9,6 @@ pub(crate) mod exit;
 pub(crate) mod generate;
 pub(crate) mod parse;
 pub(crate) mod print;
+pub(crate) mod report;
 pub(crate) mod verify;
 pub(crate) mod view;

@@ -4,6 +4,7 @@
 use super::args::{coord, VerifyArgs};
 use super::exit;
 use super::print;
+use super::report;
 use anyhow::{bail, Context};
 use restpose::urdf::load_file;
 
@@ -139,15 +140,15 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
     }
     if !print::is_stdout(a.json.as_ref()) {
         if a.quiet {
-            print::verdict(&model.name, &v);
+            report::verdict(&model.name, &v);
         } else {
-            print::verification(&model.name, &v, &tol);
+            report::verification(&model.name, &v, &tol);
         }
     }
     if v.passed {
         return Ok(0);
     }
-    for line in print::failures(&v.unilateral.failures) {
+    for line in report::failures(&v.unilateral.failures) {
         eprintln!("{}: not a rest pose: {line}", a.file.display());
     }
     Ok(exit::NOT_BALANCED)

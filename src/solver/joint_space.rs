@@ -19,7 +19,8 @@
 //! origin's relative displacement (m); for a joint whose coordinates do not span its motion
 //! (a distance or point-on-line tree joint) those six as well; for a floating base (a body no
 //! tree joint moves) its origin's displacement and rotation `[x, y, z, rx, ry, rz]`, named by
-//! its link. Where loops make joint coordinates dependent, the independent ones are chosen
+//! its link; a loop joint's scalar coordinates are listed in the modes too (never chosen as
+//! independent). Where loops make joint coordinates dependent, the independent ones are chosen
 //! by pivoted Gram–Schmidt on the rows of an orthonormal basis of `T`'s range (largest row
 //! first, file order breaking ties): a choice that depends on the pose only. Mode shapes are
 //! the eigenvectors mapped back to every joint coordinate, `δθ = T T_I⁻¹ y`, scaled so the
@@ -35,8 +36,9 @@ use nalgebra::{DMatrix, DVector, Matrix3, Matrix3x4, Vector4};
 type Row = Vec<(usize, f64)>;
 
 /// The joint coordinates of `model` at `q`, grouped by joint (or floating base link), in
-/// file order.
-fn chart(model: &Model, q: &DVector<f64>) -> Vec<(String, Vec<Row>)> {
+/// file order, with whether they may be chosen as independent (a loop joint's scalar
+/// coordinates are listed in the modes only).
+fn chart(model: &Model, q: &DVector<f64>) -> Vec<(String, Vec<Row>, bool)> {
     let mut out = Vec::new();
     let mut moved = vec![false; model.bodies.len()];
     // 2 E(p): world angular velocity per ṗ of body b.
@@ -67,9 +69,11 @@ fn chart(model: &Model, q: &DVector<f64>) -> Vec<(String, Vec<Row>)> {
                 .collect(),
         }
     };
-    for j in model.joints.iter().filter(|j| j.tree && !j.merged) {
-        if let Some(c) = j.bodies[1] {
-            moved[c.0] = true;
+    for j in model.joints.iter().filter(|j| !j.merged) {
+        if j.tree {
+            if let Some(c) = j.bodies[1] {
+                moved[c.0] = true;
+            }
         }
         let pair = pair_of(&j.bodies, q, false);
         let mut rows: Vec<Row> = (0..j.kind.scalar_coordinates())
@@ -84,8 +88,8 @@ fn chart(model: &Model, q: &DVector<f64>) -> Vec<(String, Vec<Row>)> {
             j.kind,
             JointKind::Floating | JointKind::Distance { .. } | JointKind::PointOnLine
         );
-        let (Some(c), p) = (j.bodies[1], j.bodies[0]) else {
-            out.push((j.name.clone(), rows));
+        let (Some(c), p, true) = (j.bodies[1], j.bodies[0], j.tree) else {
+            out.push((j.name.clone(), rows, j.tree));
             continue;
         };
         if six {
@@ -94,13 +98,13 @@ fn chart(model: &Model, q: &DVector<f64>) -> Vec<(String, Vec<Row>)> {
         if six || j.kind == JointKind::Spherical {
             rows.extend(relative(omega(c.0), p.map(|p| omega(p.0))));
         }
-        out.push((j.name.clone(), rows));
+        out.push((j.name.clone(), rows, true));
     }
     for (b, body) in model.bodies.iter().enumerate() {
         if !moved[b] {
             let mut rows = translation(b);
             rows.extend(omega(b));
-            out.push((body.name.clone(), rows));
+            out.push((body.name.clone(), rows, true));
         }
     }
     out
@@ -121,7 +125,11 @@ pub(crate) fn joint_spectrum(
     let dof = part.independent.len();
     let z = sys.null_basis(part, eval);
     let chart = chart(sys.problem.model, q);
-    let rows: Vec<&Row> = chart.iter().flat_map(|(_, r)| r).collect();
+    let rows: Vec<&Row> = chart.iter().flat_map(|(_, r, _)| r).collect();
+    let selectable: Vec<bool> = chart
+        .iter()
+        .flat_map(|(_, r, s)| r.iter().map(move |_| *s))
+        .collect();
     let t = DMatrix::from_fn(rows.len(), dof, |r, c| {
         rows[r].iter().map(|&(g, x)| x * z[(g, c)]).sum()
     });
@@ -144,7 +152,7 @@ pub(crate) fn joint_spectrum(
     let mut chosen = Vec::with_capacity(dof);
     for _ in 0..dof {
         let (best, norm) = (0..rows.len())
-            .filter(|r| !chosen.contains(r))
+            .filter(|&r| selectable[r] && !chosen.contains(&r))
             .map(|r| (r, basis.row(r).norm()))
             .fold((usize::MAX, 0.0), |a, b| {
                 if b.1 > a.1 * (1.0 + 1e-9) {
@@ -178,8 +186,8 @@ pub(crate) fn joint_spectrum(
             let mut at = 0;
             chart
                 .iter()
-                .filter(|(_, r)| !r.is_empty())
-                .map(|(name, r)| {
+                .filter(|(_, r, _)| !r.is_empty())
+                .map(|(name, r, _)| {
                     // Rounding noise (below 1e-12 of the largest change) shown as 0.
                     let v: Vec<f64> = (at..at + r.len())
                         .map(|i| d[i] * scale)

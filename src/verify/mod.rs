@@ -153,8 +153,8 @@ pub fn potential_energy(model: &Model, state: &State) -> Option<f64> {
 /// at their given values, or at the initial value when they have none).
 ///
 /// # Errors
-/// [`Error::ForceTableOutOfRange`] if the energy cannot be evaluated,
-/// [`Error::SingularPartition`] if the constraint Jacobian is singular there.
+/// [`Error::ForceTableOutOfRange`](crate::Error::ForceTableOutOfRange) if the energy cannot be evaluated,
+/// [`Error::SingularPartition`](crate::Error::SingularPartition) if the constraint Jacobian is singular there.
 pub fn balance(model: &Model, state: &State) -> Result<Balance> {
     if sparse_path(model) {
         let r = {
@@ -181,8 +181,8 @@ pub fn balance(model: &Model, state: &State) -> Result<Balance> {
 /// Verifies that `state` is a rest pose: it assembles, and no joint needs an effort to hold it.
 ///
 /// # Errors
-/// [`Error::ForceTableOutOfRange`] if the energy cannot be evaluated,
-/// [`Error::SingularPartition`] if the constraint Jacobian is singular there.
+/// [`Error::ForceTableOutOfRange`](crate::Error::ForceTableOutOfRange) if the energy cannot be evaluated,
+/// [`Error::SingularPartition`](crate::Error::SingularPartition) if the constraint Jacobian is singular there.
 ///
 /// # Example
 /// ```
@@ -279,7 +279,7 @@ pub fn verify_reporting(
 /// coordinates of a fresh partition at each step (as the solver's assembly does).
 ///
 /// # Errors
-/// [`Error::Assembly`] if the constraints cannot be satisfied from there.
+/// [`Error::Assembly`](crate::Error::Assembly) if the constraints cannot be satisfied from there.
 pub fn assemble(model: &Model, state: &State) -> Result<State> {
     let locks = crate::solver::lock_values(model);
     let mut branches = state.branches.clone();

@@ -251,3 +251,32 @@ fn a_pendulum_on_its_stop_has_a_verdict() {
         );
     }
 }
+
+/// Issue 21, item 8: `verify -q` prints the verdict line (and nothing else on standard
+/// output), the JSON names the robot and lists why the pose fails, standard error shows the
+/// failures.
+#[test]
+fn verify_quiet_prints_the_verdict_and_the_json_names_the_failures() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("v.json");
+    let file = format!("{}/robots/pendulum.urdf", env!("CARGO_MANIFEST_DIR"));
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_restpose"))
+        .args(["verify", &file, "--joint", "pivot=-1.3", "-q", "--json"])
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(4));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout),
+        "robot `pendulum`: pose FAILS\n"
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("`pivot` (dof 0) needs an effort of"), "{err}");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["robot"], "pendulum");
+    let failures = v["failures"].as_array().unwrap();
+    assert_eq!(failures.len(), 1, "{failures:?}");
+    assert!(failures[0].as_str().unwrap().contains("needs an effort"));
+    assert_eq!(v["imbalance"][0]["locked"], false);
+}

@@ -130,6 +130,7 @@ impl InputArgs {
         if let (Some(path), Some(state)) = (&self.srdf, &self.srdf_state) {
             opts.servo_reference
                 .extend(restpose::urdf::srdf_state(path, state)?);
+        }
         for a in &self.xacro_arg {
             let (n, v) = a
                 .split_once(":=")
@@ -177,6 +178,11 @@ pub(crate) struct VerifyArgs {
     /// Joint value (repeatable; overrides the pose file): JOINT=VALUE or JOINT[DOF]=VALUE.
     #[arg(long, value_name = "JOINT=VALUE")]
     pub(crate) joint: Vec<String>,
+    /// Hold a joint coordinate at its value in the pose, as `analyze --lock` held it: JOINT,
+    /// JOINT[DOF] or JOINT=VALUE (repeatable). Its effort is reported as a holding effort and
+    /// does not fail the pose.
+    #[arg(long, value_name = "JOINT")]
+    pub(crate) lock: Vec<String>,
     /// Largest effort a joint may need for the pose to pass [N m or N], plus 1e-9 of the
     /// largest generalized force on any coordinate.
     #[arg(long, default_value_t = Tolerances::default().force, value_parser = parse::positive)]

@@ -11,6 +11,7 @@ pub(crate) mod generate;
 pub(crate) mod parse;
 pub(crate) mod print;
 pub(crate) mod progress;
+pub(crate) mod report;
 pub(crate) mod values;
 pub(crate) mod verify;
 pub(crate) mod view;

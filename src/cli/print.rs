@@ -1,9 +1,9 @@
-//! Human-readable output: the analysis summary, the model as `check` understood it, and the
-//! verification report. Everything here formats values it is given; nothing computes.
+//! Human-readable output: the analysis summary and the model as `check` understood it (the
+//! verification report is module `report`). Everything here formats values it is given;
+//! nothing computes.
 
 use restpose::export::json::AnalysisResult;
 use restpose::export::summary::ModelSummary;
-use restpose::verify::{Tolerances, Verification};
 
 /// Writes a line to standard output; a closed pipe (`restpose analyze … | head`) is not an
 /// error and must not panic.
@@ -63,14 +63,36 @@ pub(crate) fn write_output(path: &std::path::Path, text: &str) -> anyhow::Result
 /// The summary of a solve (`analyze`).
 pub(crate) fn analysis(r: &AnalysisResult) {
     out!("robot `{}`", r.robot);
-    out!(
-        "  bodies {}, coordinates {}, constraint rows {} ({} redundant), degrees of freedom {}",
-        r.bodies,
-        r.coordinates,
-        r.constraints,
-        r.redundant_constraints.len(),
-        r.dof
-    );
+    // The rows of the stops and contacts the rest pose rests on are counted (1 each, 3 for a
+    // contact held tangentially): `check` counts the model's rows without them.
+    let resting = r.active_limits.len()
+        + r.contacts
+            .iter()
+            .map(|c| match c.state {
+                restpose::solver::ContactState::Touching => 1,
+                _ => 3,
+            })
+            .sum::<usize>();
+    if resting == 0 {
+        out!(
+            "  bodies {}, coordinates {}, constraint rows {} ({} redundant), degrees of freedom {}",
+            r.bodies,
+            r.coordinates,
+            r.constraints,
+            r.redundant_constraints.len(),
+            r.dof
+        );
+    } else {
+        out!(
+            "  bodies {}, coordinates {}, constraint rows {} ({} of stops and contacts at rest, {} redundant), degrees of freedom {} (with them held)",
+            r.bodies,
+            r.coordinates,
+            r.constraints,
+            resting,
+            r.redundant_constraints.len(),
+            r.dof
+        );
+    }
     if !r.redundant_constraints.is_empty() {
         out!(
             "  redundant constraints: {}",
@@ -82,10 +104,23 @@ pub(crate) fn analysis(r: &AnalysisResult) {
         r.independent_coordinates.join(", ")
     );
     out!();
-    out!("  iteration   potential energy [J]   ‖∂V/∂v‖∞ [J]");
+    // Load steps and active-set rounds get their own columns when there is more than one.
+    let staged = r.history.iter().any(|h| h.load_step != 1 || h.round != 1);
+    if staged {
+        out!("  load step   round   iteration   potential energy [J]   ‖∂V/∂v‖∞ [J]");
+    } else {
+        out!("  iteration   potential energy [J]   ‖∂V/∂v‖∞ [J]");
+    }
     for h in &r.history {
+        let stage = if !staged {
+            String::new()
+        } else if h.load_step == 0 {
+            format!("{:>9}   {:>5}   ", "direct", h.round)
+        } else {
+            format!("{:>9}   {:>5}   ", h.load_step, h.round)
+        };
         out!(
-            "  {:>9}   {:>20.9}   {:>12.3e}",
+            "  {stage}{:>9}   {:>20.9}   {:>12.3e}",
             h.iteration,
             h.potential_energy,
             h.gradient_norm
@@ -100,16 +135,26 @@ pub(crate) fn analysis(r: &AnalysisResult) {
     );
     if let Some(s) = &r.stability {
         let eig: Vec<String> = s.eigenvalues.iter().map(|e| format!("{e:.4e}")).collect();
-        out!(
-            "  stability: {} (smallest reduced-Hessian eigenvalues {})",
-            s.verdict,
-            eig.join(", ")
-        );
+        if eig.is_empty() {
+            out!("  stability: {}", s.verdict);
+        } else {
+            out!(
+                "  stability: {} (smallest eigenvalues of d²V/dθ² [N m/rad, N/m]: {})",
+                s.verdict,
+                eig.join(", ")
+            );
+        }
     }
     if let Some(mode) = r.stability.as_ref().and_then(|s| s.modes.first()) {
-        let mut parts: Vec<(&String, f64)> = mode
+        let mut parts: Vec<(String, f64)> = mode
             .iter()
-            .flat_map(|(n, v)| v.iter().map(move |x| (n, *x)))
+            .flat_map(|(n, v)| {
+                let many = v.len() > 1;
+                v.iter()
+                    .enumerate()
+                    .map(move |(k, x)| (if many { format!("{n}[{k}]") } else { n.clone() }, *x))
+            })
+            .filter(|p| p.1 != 0.0)
             .collect();
         parts.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
         let shown: Vec<String> = parts
@@ -141,7 +186,13 @@ pub(crate) fn analysis(r: &AnalysisResult) {
             v.joint, v.position, v.limits[0], v.limits[1]
         );
     }
-    stops_and_contacts(&r.active_limits, &r.contacts);
+    let position = |name: &str| {
+        r.joints
+            .iter()
+            .find(|(n, _)| n == name)
+            .and_then(|(_, j)| j.position.first().copied())
+    };
+    stops_and_contacts(&r.active_limits, &r.contacts, &position);
     if !r.servos.is_empty() {
         out!();
         out!("  servo (actuator)                 reference     position      torque [N m or N]");
@@ -181,16 +232,32 @@ pub(crate) fn analysis(r: &AnalysisResult) {
 /// The units of a joint's coordinates after its values: ` rad` when they share one, ` [rad, m]`
 /// when they differ, nothing for a joint without coordinates.
 /// The joints resting on a stop and the contacts, with their forces (analyze and verify).
-fn stops_and_contacts(
+/// The stops and contacts a pose rests on. A stop carrying no effort (below 5e-5, shown as
+/// 0.0000) is only named on one line; `position` (the joint's coordinate, where known) marks a
+/// joint beyond its stop.
+pub(crate) fn stops_and_contacts(
     limits: &[restpose::solver::ActiveLimit],
     contacts: &[restpose::solver::Contact],
+    position: &dyn Fn(&str) -> Option<f64>,
 ) {
-    if !limits.is_empty() {
+    let (carrying, idle): (Vec<_>, Vec<_>) = limits.iter().partition(|l| l.effort.abs() >= 5e-5);
+    if !carrying.is_empty() {
         out!();
         out!("  joint resting on a stop          bound     position       effort [N m or N]");
-        for l in limits {
+        for l in carrying {
+            let beyond = position(&l.joint)
+                .map(|p| {
+                    if l.bound == "lower" {
+                        l.value - p
+                    } else {
+                        p - l.value
+                    }
+                })
+                .filter(|d| *d > 1e-6)
+                .map(|d| format!("   beyond the stop by {d:.3e}"))
+                .unwrap_or_default();
             out!(
-                "  {:<32} {:<9} {:>12.6}   {:>12.4}",
+                "  {:<32} {:<9} {:>12.6}   {:>12.4}{beyond}",
                 l.joint,
                 l.bound,
                 l.value,
@@ -198,10 +265,34 @@ fn stops_and_contacts(
             );
         }
     }
+    if !idle.is_empty() {
+        let names: Vec<&str> = idle.iter().take(6).map(|l| l.joint.as_str()).collect();
+        out!(
+            "  touching a stop without effort: {} joint{} ({}{})",
+            idle.len(),
+            if idle.len() == 1 { "" } else { "s" },
+            names.join(", "),
+            if idle.len() > names.len() {
+                ", …"
+            } else {
+                ""
+            }
+        );
+    }
     if !contacts.is_empty() {
         out!();
         out!("  contact (link @ ground)          point [m]                              normal force [N]  needs μ   state");
-        for c in contacts {
+        // Beyond 40 contacts, the 20 deepest in the ground or carrying the most.
+        let mut shown: Vec<&restpose::solver::Contact> = contacts.iter().collect();
+        if shown.len() > 40 {
+            shown.sort_by(|a, b| {
+                a.gap
+                    .total_cmp(&b.gap)
+                    .then(b.normal_force.total_cmp(&a.normal_force))
+            });
+            shown.truncate(20);
+        }
+        for c in &shown {
             let p = c.point_world;
             out!(
                 "  {:<32} [{:>10.5}, {:>10.5}, {:>10.5}]   {:>14.4}  {:>8.4}   {}",
@@ -215,6 +306,12 @@ fn stops_and_contacts(
                     .ok()
                     .and_then(|v| v.as_str().map(str::to_owned))
                     .unwrap_or_default()
+            );
+        }
+        if shown.len() < contacts.len() {
+            out!(
+                "  … {} more contacts (the JSON lists every one)",
+                contacts.len() - shown.len()
             );
         }
         let total: f64 = contacts.iter().map(|c| c.normal_force).sum();
@@ -304,55 +401,5 @@ pub(crate) fn model_listing(s: &ModelSummary, w: &mut Vec<u8>) {
     }
     for f in &s.forces {
         out!("  {f}");
-    }
-}
-
-/// The verification of a pose (`verify`).
-pub(crate) fn verification(robot: &str, v: &Verification, tol: &Tolerances) {
-    out!(
-        "robot `{}`: pose {}",
-        robot,
-        if v.passed { "PASSES" } else { "FAILS" }
-    );
-    out!(
-        "  constraint residual {:.3e} (tolerance {:.1e}), potential energy {:.9} J",
-        v.constraint_residual,
-        tol.constraint,
-        v.potential_energy
-    );
-    for c in &v.closure {
-        out!(
-            "  {} `{}`: position error {:.3e} m, rotation error {:.3e} rad",
-            if c.loop_joint { "loop joint" } else { "joint" },
-            c.joint,
-            c.position_error,
-            c.rotation_error
-        );
-    }
-    out!("  joint                          dof   effort to hold [N m or N]");
-    for i in &v.imbalance {
-        let flag = if i.effort.abs() > v.effort_tolerance {
-            "  <- out of balance"
-        } else {
-            ""
-        };
-        out!("  {:<30} {:>3}   {:>14.6e}{flag}", i.joint, i.dof, i.effort);
-    }
-    if v.unassigned > v.effort_tolerance {
-        out!(
-            "  unassigned generalized force {:.3e} (spherical or floating joints)",
-            v.unassigned
-        );
-    }
-    stops_and_contacts(&v.unilateral.active_limits, &v.unilateral.contacts);
-    if v.unilateral.contacts.len() + v.unilateral.active_limits.len() > 0 {
-        out!(
-            "  penetration {:.3e}, complementarity max |g λ| {:.3e} J",
-            v.unilateral.penetration,
-            v.unilateral.complementarity
-        );
-    }
-    if let Some(s) = &v.stability {
-        out!("  stability: {}", s.verdict);
     }
 }

@@ -3,6 +3,7 @@
 //! bounds all stages together: with automatic stepping (`load_steps = 0`) the direct attempt
 //! gets half of it, and a ramp after a failed direct attempt what the attempt left.
 
+use super::report::append_history;
 use super::{solve_assembled, Diagnostics, Options, Report, Termination};
 use crate::error::Result;
 use crate::model::{JointId, Model};
@@ -35,8 +36,21 @@ pub(crate) fn solve(
             };
             let mut ramped = ramp(model, q, AUTOMATIC_LOAD_STEPS, locks, &budget)?;
             if ramped.1.converged() {
-                ramped.1.iterations += direct.1.iterations;
-                ramped.1.diagnostics.add_counts(&direct.1.diagnostics);
+                // The history shows the abandoned direct attempt first (load step 0).
+                let (mut history, mut iterates) = (direct.1.history, direct.1.iterates);
+                for h in &mut history {
+                    h.load_step = 0;
+                }
+                let r = &mut ramped.1;
+                r.iterations += direct.1.iterations;
+                r.diagnostics.add_counts(&direct.1.diagnostics);
+                append_history(
+                    &mut history,
+                    &mut iterates,
+                    std::mem::take(&mut r.history),
+                    std::mem::take(&mut r.iterates),
+                );
+                (r.history, r.iterates) = (history, iterates);
                 Ok(ramped)
             } else {
                 Ok(direct)
@@ -61,6 +75,7 @@ fn ramp(
 ) -> Result<(State, Report)> {
     let mut iterations = 0;
     let mut counters = Diagnostics::default();
+    let (mut history, mut iterates) = (Vec::new(), Vec::new());
     for k in 1..n {
         let stage = model.with_load_factor(k as f64 / n as f64);
         let budget = Options {
@@ -69,15 +84,24 @@ fn ramp(
         };
         let (s, mut r) = solve_assembled(&stage, q, locks, &budget)?;
         q = s;
+        r.history.iter_mut().for_each(|h| h.load_step = k);
         if !r.converged() {
             // A stage that did not come to rest ends the ramp (out of iterations, or no rest).
             r.iterations += iterations;
             r.diagnostics.add_counts(&counters);
             r.diagnostics.load_steps = n;
+            append_history(
+                &mut history,
+                &mut iterates,
+                std::mem::take(&mut r.history),
+                std::mem::take(&mut r.iterates),
+            );
+            (r.history, r.iterates) = (history, iterates);
             return Ok((q, r));
         }
         iterations += r.iterations;
         counters.add_counts(&r.diagnostics);
+        append_history(&mut history, &mut iterates, r.history, r.iterates);
     }
     let budget = Options {
         max_iterations: options.max_iterations.saturating_sub(iterations),
@@ -87,5 +111,13 @@ fn ramp(
     r.iterations += iterations;
     r.diagnostics.add_counts(&counters);
     r.diagnostics.load_steps = n;
+    r.history.iter_mut().for_each(|h| h.load_step = n);
+    append_history(
+        &mut history,
+        &mut iterates,
+        std::mem::take(&mut r.history),
+        std::mem::take(&mut r.iterates),
+    );
+    (r.history, r.iterates) = (history, iterates);
     Ok((s, r))
 }

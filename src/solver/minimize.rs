@@ -37,7 +37,6 @@ use super::inequality::active_set::Guard;
 use super::options::{Method, Options};
 use super::partition::Partition;
 use super::report::{Diagnostics, Iterate, Termination};
-use super::sparse::kkt::Factored;
 use super::stability::spectrum::{spectrum, Spectrum};
 use super::system::{Backend, Eval, System};
 use nalgebra::{DMatrix, DVector};
@@ -203,6 +202,7 @@ pub(crate) fn minimize(
                 iteration,
                 potential_energy: eval.energy.total,
                 gradient_norm: gnorm,
+                ..Iterate::default()
             });
             if options.record_iterates {
                 iterates.push(q.clone());
@@ -451,6 +451,7 @@ pub(crate) fn minimize(
             iteration,
             potential_energy: eval.energy.total,
             gradient_norm: eval.grad_v.amax(),
+            ..Iterate::default()
         });
         if options.record_iterates {
             iterates.push(q.clone());

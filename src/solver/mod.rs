@@ -37,8 +37,8 @@ mod unbounded;
 pub use mode_animation::mode_animation;
 pub use options::{ContactPolicy, Limits, LinearAlgebra, Method, Options, Progress, ProgressFn};
 pub use report::{
-    ActiveLimit, Contact, ContactState, Diagnostics, Iterate, Reaction, Report, Sizes, Stability,
-    Termination, Timings, Verdict,
+    ActiveLimit, Contact, ContactState, Diagnostics, Iterate, Mode, Reaction, Report, Sizes,
+    Stability, Termination, Timings, Verdict,
 };
 pub(crate) use stability::verdict::{stability_of, stability_on, stability_verdict};
 
@@ -259,12 +259,17 @@ pub(crate) fn solve_round(
     let multipliers = active_set::active_multipliers(&sys.problem.cons, &mu);
     let blocked = out.blocked;
     diagnostics.timings.stability = stability_started.elapsed().as_secs_f64();
+    let mut history = out.history;
+    for h in &mut history {
+        h.load_step = 1;
+        h.round = 1;
+    }
     let report = Report {
         termination: out.termination,
-        iterations: out.history.last().map_or(0, |h| h.iteration),
+        iterations: history.last().map_or(0, |h| h.iteration),
         energy: out.eval.energy,
         dof,
-        history: out.history,
+        history,
         independent_coordinates: out
             .part
             .independent

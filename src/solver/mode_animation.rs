@@ -11,7 +11,6 @@
 
 use crate::model::Model;
 use crate::state::{JointValues, State};
-use std::collections::BTreeMap;
 
 /// The poses of one period of the mode `mode` about `rest`, with amplitude `amplitude` (in
 /// the mode's units: the largest joint change of a mode is 1, so 0.15 moves the most moving
@@ -20,7 +19,7 @@ use std::collections::BTreeMap;
 pub fn mode_animation(
     model: &Model,
     rest: &State,
-    mode: &BTreeMap<String, Vec<f64>>,
+    mode: &super::Mode,
     frames: usize,
     amplitude: f64,
 ) -> Vec<State> {

@@ -33,14 +33,38 @@ impl Termination {
 }
 
 /// One accepted iterate.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct Iterate {
-    /// Iteration number (0 = the assembled initial guess).
+    /// Iteration number, counted over the whole solve (0 = the assembled initial guess; each
+    /// load step and active-set round starts with a row for its start, numbered as the last
+    /// row before it).
     pub iteration: usize,
-    /// Potential energy \[J\].
+    /// Potential energy \[J\] (of the load step's loads).
     pub potential_energy: f64,
     /// `‖∂V/∂v‖∞` in scaled coordinates \[J\].
     pub gradient_norm: f64,
+    /// Load step: `k` of `diagnostics.load_steps` (1 without a ramp); 0 for the direct attempt
+    /// at the full load that the automatic ramp replaced.
+    pub load_step: usize,
+    /// Active-set round: 1 for the first set of active stops and contacts, one more at each
+    /// change of the set (1 without stops and contacts).
+    pub round: usize,
+}
+
+/// Appends the history `rows` (and their configurations) of a later load step or round to
+/// `history`, renumbering its iterations after the last row of `history`.
+pub(crate) fn append_history(
+    history: &mut Vec<Iterate>,
+    iterates: &mut Vec<crate::State>,
+    rows: Vec<Iterate>,
+    states: Vec<crate::State>,
+) {
+    let offset = history.last().map_or(0, |h| h.iteration);
+    history.extend(rows.into_iter().map(|mut h| {
+        h.iteration += offset;
+        h
+    }));
+    iterates.extend(states);
 }
 
 /// The stability verdict, from the smallest eigenvalue `λ₁` of the reduced Hessian and the
@@ -80,13 +104,69 @@ pub struct Stability {
     pub verdict: Verdict,
     /// Eigenvalue tolerance used: `1e-10 · max(1, max |λ|)` \[J\].
     pub tolerance: f64,
-    /// Smallest eigenvalues of the scaled reduced Hessian, ascending (at most 6) \[J\]. Empty
-    /// from `verify` above 200 degrees of freedom on the sparse path unless asked for
-    /// (`verify::Eigenvalues::Always`): its verdict then comes from the KKT inertia alone.
+    /// Smallest eigenvalues of the reduced Hessian in joint coordinates, ascending (at most 6):
+    /// `d²V/dθ²` along the feasible motions \[N m/rad for rotations, N/m for slides\], the same
+    /// from any start (module `solver::joint_space`; independent joint coordinates where loops
+    /// make some dependent). Above 200 degrees of freedom on the sparse path (Lanczos) they are
+    /// those of the scaled reduced Hessian \[J\] instead, and `verify` leaves them empty unless
+    /// asked for (`verify::Eigenvalues::Always`): its verdict then comes from the KKT inertia
+    /// alone. Empty when stops or contacts leave no feasible motion (verdict `stable`). The
+    /// verdict and `tolerance` are those of the scaled reduced Hessian, which has the same
+    /// signs (Sylvester's law of inertia).
     pub eigenvalues: Vec<f64>,
     /// Mode shape of each listed eigenvalue: the change of every joint coordinate along the
-    /// eigenvector, scaled so that the largest is ±1 (a rotation in rad, a slide in m).
-    pub modes: Vec<std::collections::BTreeMap<String, Vec<f64>>>,
+    /// eigenvector, scaled so that the largest is ±1 (a rotation in rad, a slide in m), by joint
+    /// in the model's file order (a floating base by its link: `[x, y, z, rx, ry, rz]`).
+    pub modes: Vec<Mode>,
+}
+
+/// A mode shape: per joint (or floating base link), in file order, the change of its
+/// coordinates. Serialized as a JSON object in that order.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mode(pub Vec<(String, Vec<f64>)>);
+
+impl Mode {
+    /// The entries in file order.
+    pub fn iter(&self) -> impl Iterator<Item = (&String, &Vec<f64>)> {
+        self.0.iter().map(|(n, v)| (n, v))
+    }
+
+    /// The coordinate changes of joint `name`.
+    pub fn get(&self, name: &str) -> Option<&Vec<f64>> {
+        self.0.iter().find(|(n, _)| n == name).map(|(_, v)| v)
+    }
+}
+
+impl<'a> IntoIterator for &'a Mode {
+    type Item = (&'a String, &'a Vec<f64>);
+    type IntoIter = std::iter::Map<
+        std::slice::Iter<'a, (String, Vec<f64>)>,
+        fn(&'a (String, Vec<f64>)) -> (&'a String, &'a Vec<f64>),
+    >;
+    fn into_iter(self) -> Self::IntoIter {
+        self.0.iter().map(|(n, v)| (n, v))
+    }
+}
+
+impl std::ops::Index<&str> for Mode {
+    type Output = Vec<f64>;
+    /// # Panics
+    /// If the mode has no joint `name`.
+    fn index(&self, name: &str) -> &Vec<f64> {
+        self.get(name)
+            .unwrap_or_else(|| panic!("the mode has no joint `{name}`"))
+    }
+}
+
+impl serde::Serialize for Mode {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut m = s.serialize_map(Some(self.0.len()))?;
+        for (n, v) in &self.0 {
+            m.serialize_entry(n, v)?;
+        }
+        m.end()
+    }
 }
 
 /// Counters of what the solver had to do.
@@ -240,7 +320,8 @@ pub struct Report {
     pub energy: Energy,
     /// Degrees of freedom `n − rank(Φ_q)`.
     pub dof: usize,
-    /// Iteration history (iteration 0 = start).
+    /// Iteration history (iteration 0 = start): every load step and active-set round, in
+    /// order (see [`Iterate`]).
     pub history: Vec<Iterate>,
     /// Names of the independent coordinates of the final partition.
     pub independent_coordinates: Vec<String>,
@@ -254,8 +335,8 @@ pub struct Report {
     pub diagnostics: Diagnostics,
     /// Sizes of the problem.
     pub sizes: Sizes,
-    /// The configuration at each entry of `history` (only with `Options::record_iterates`;
-    /// with load stepping, the last stage's).
+    /// The configuration at each entry of `history` (only with `Options::record_iterates`):
+    /// every load step and active-set round.
     pub iterates: Vec<crate::State>,
     /// Contact points resting on the grounds.
     pub contacts: Vec<Contact>,

@@ -118,6 +118,7 @@ pub fn srdf_state(path: impl AsRef<Path>, state: &str) -> Result<Vec<(String, f6
         line: e.pos().row,
         col: e.pos().col,
         message: format!("malformed SRDF: {e}"),
+        element: String::new(),
     })?;
     let states: Vec<_> = doc
         .descendants()
@@ -145,6 +146,7 @@ pub fn srdf_state(path: impl AsRef<Path>, state: &str) -> Result<Vec<(String, f6
             line: at.row,
             col: at.col,
             message,
+            element: "joint".to_string(),
         };
         let name = j
             .attribute("name")

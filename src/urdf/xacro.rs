@@ -102,6 +102,7 @@ pub fn expand(
                 line,
                 col,
                 message,
+                element: String::new(),
             }
         })
 }
@@ -162,11 +163,16 @@ fn source_position(
 pub(crate) fn locate(e: Error, path: &Path) -> Error {
     match e {
         Error::Input {
-            line, col, message, ..
+            line,
+            col,
+            message,
+            element,
+            ..
         } => Error::Input {
             file: format!("{} (expanded)", path.display()),
             line,
             col,
+            element,
             message: format!(
                 "{message} (line and column of the URDF the xacro file expands to; see it with \
                  `xacro-rs {} > expanded.urdf`)",

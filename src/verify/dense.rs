@@ -1,15 +1,11 @@
 //! The dense verification path (models up to 40 bodies' coordinates): an orthonormal basis
 //! `N` of the null space of `D Φ_q S` from a full-pivoting partition and a QR factorization,
-//! the projected gradient `Nᵀ S ∇V`, and the minimum-norm efforts `τ` of
-//! `Nᵀ S B τ = Nᵀ S ∇V` (by SVD), as described in the parent module.
+//! and the projected gradient `Nᵀ S ∇V`, as described in the parent module (the efforts and
+//! forces are module `held`'s, on both paths).
 
-use super::unilateral::UnilateralCheck;
-use super::{closures, Closure, Tolerances, Unilaterals};
-use crate::constraints::unilateral::Active;
 use crate::constraints::Constraints;
 use crate::error::{Error, Result};
 use crate::forces::potential;
-use crate::jet::scatter;
 use crate::model::Model;
 use crate::solver::system::Scaling;
 use crate::state::State;
@@ -19,7 +15,6 @@ use nalgebra::{DMatrix, DVector};
 pub(super) struct Projection {
     pub(super) phi: DVector<f64>,
     pub(super) grad_s: DVector<f64>,
-    pub(super) scale: Vec<f64>,
     pub(super) null: DMatrix<f64>,
     pub(super) energy: f64,
     pub(super) cons: Constraints,
@@ -84,92 +79,8 @@ pub(super) fn project(model: &Model, state: &State) -> Result<Projection> {
     Ok(Projection {
         phi,
         grad_s: g,
-        scale,
         null,
         energy: e.total,
         cons,
-    })
-}
-
-/// What the dense checks find at a pose.
-pub(super) struct DenseChecks {
-    /// `Φ` at the pose.
-    pub(super) phi: DVector<f64>,
-    /// Potential energy \[J\].
-    pub(super) energy: f64,
-    /// `‖Nᵀ S ∇V‖∞` before the stops and contacts carry their share \[J\].
-    pub(super) projected_gradient: f64,
-    /// `‖S ∇V‖∞`, the scale of the forces \[J\].
-    pub(super) force_scale: f64,
-    /// Closure errors per joint.
-    pub(super) closure: Vec<Closure>,
-    /// Minimum-norm efforts of the scalar tree coordinates.
-    pub(super) efforts: DVector<f64>,
-    /// What no coordinate's effort can take.
-    pub(super) unassigned: f64,
-    /// The stops and contacts at the pose (module `unilateral`).
-    pub(super) unilateral: UnilateralCheck,
-    /// The stops and contacts that carry a force (the stability's tangent space).
-    pub(super) strong: Vec<Active>,
-    /// The touching stops and contacts that carry no force.
-    pub(super) weak: Vec<Active>,
-}
-
-/// The dense checks: closure, the share of the load the stops and contacts carry (module
-/// `unilateral`), then the minimum-norm efforts `τ` of `Nᵀ S B τ = Nᵀ S (∇V − carried)`.
-pub(super) fn dense_checks(
-    model: &Model,
-    state: &State,
-    tol: &Tolerances,
-    uni: &Unilaterals,
-    coords: &[(crate::model::JointId, usize, crate::jet::Scalar)],
-) -> Result<DenseChecks> {
-    let mut p = project(model, state)?;
-    let n = state.q.len();
-    let closure = closures(model, &p.cons, &p.phi, tol.constraint);
-    let projected_gradient = (p.null.transpose() * &p.grad_s).amax();
-    let force_scale = p.grad_s.amax();
-    // The stops and contacts take their share of the load first.
-    let tau = tol.force + tol.relative * force_scale;
-    let (unilateral, carried, strong, weak) =
-        super::unilateral::check(model, state, uni, &p, tol.constraint, tau);
-    p.grad_s -= carried;
-    // The (scaled) gradients of the scalar coordinates.
-    let b_cols: Vec<DVector<f64>> = coords
-        .iter()
-        .map(|(id, _, s)| {
-            let mut g = DVector::zeros(n);
-            scatter(&model.joint(*id).bodies, s, 1.0, &mut g, None);
-            for c in 0..n {
-                g[c] *= p.scale[c];
-            }
-            g
-        })
-        .collect();
-    let rhs = p.null.transpose() * &p.grad_s;
-    let (efforts, unassigned) = if b_cols.is_empty() || p.null.ncols() == 0 {
-        (DVector::zeros(b_cols.len()), rhs.amax())
-    } else {
-        let b = DMatrix::from_columns(&b_cols);
-        let m = p.null.transpose() * b;
-        let svd = m.clone().svd(true, true);
-        let eps = 1e-10 * svd.singular_values.max();
-        let tau = svd
-            .solve(&rhs, eps)
-            .unwrap_or_else(|_| DVector::zeros(b_cols.len()));
-        let rest = (&rhs - m * &tau).amax();
-        (tau, rest)
-    };
-    Ok(DenseChecks {
-        phi: p.phi,
-        energy: p.energy,
-        projected_gradient,
-        force_scale,
-        closure,
-        efforts,
-        unassigned,
-        unilateral,
-        strong,
-        weak,
     })
 }

@@ -7,18 +7,20 @@
 //! solver's sparse partition, at the pose given, for its null space.
 //!
 //! The per-joint imbalance is the effort `τ` each joint coordinate would need to hold the pose
-//! (Adams' "imbalance"): with `B` the gradients `∇θ_k` of the tree joints' scalar coordinates,
-//! `τ` is the minimum-norm solution of `Nᵀ S B τ = Nᵀ S ∇V`, i.e. the actuator efforts that,
-//! together with the joint reactions, balance the loads. For a tree it is `∂V/∂θ_k` exactly;
-//! with loops the split among the joints of a loop is the minimum-norm one. What no scalar
-//! joint coordinate can carry (a spherical or floating joint) is reported as `unassigned`.
+//! (Adams' "imbalance"), found with the stop and contact forces `λ` and the joint reactions `a`
+//! from `∇V = Φ_qᵀ a + G λ + B τ` (`B` the gradients `∇θ_k` of the tree joints' scalar
+//! coordinates, `G` those of the touching stops and contacts; module `held`). Efforts act on
+//! joint coordinates only: a floating base and the coordinates a loop determines are balanced
+//! by the reactions and the contact forces exactly, and what they cannot balance is reported
+//! as `unassigned`. Where the forces are not unique (loops, several feet), the efforts of least
+//! norm are reported, then the stop and contact forces of least norm (as `analyze`
+//! distributes them); a coordinate held by a lock (`verify --lock`) reports its holding effort
+//! without failing the pose. For a tree without contacts `τ_k = ∂V/∂θ_k`. Dense and sparse
+//! linear algebra give the same efforts and forces.
 //!
 //! Models above 40 bodies' coordinates (the solver's automatic switch to sparse linear
-//! algebra) are verified in `O(N)` by the solver's sparse partition instead (module `reduced`);
-//! smaller ones by the dense basis `N` (module `dense`). The stops and contacts a pose touches
-//! carry their share of the load first on both paths: by a least-squares balance on `N`
-//! (module `unilateral`) or by the multipliers of the sparse partition with the touching rows
-//! appended (module `unilateral_sparse`); the efforts then balance what they leave.
+//! algebra) are verified in `O(N)` by the solver's sparse partition (module `reduced`); smaller
+//! ones by the dense basis `N` (module `dense`).
 //!
 //! ## Tolerances
 //! A pose passes when `‖Φ‖∞ ≤ constraint` and every effort (and the unassigned force) is at
@@ -29,12 +31,13 @@
 
 mod closure;
 mod dense;
+mod held;
 mod initial_guess;
 mod pose;
 mod rank;
 mod reduced;
+mod run;
 mod unilateral;
-mod unilateral_sparse;
 
 use closure::closures;
 pub use closure::Closure;
@@ -42,9 +45,8 @@ pub use initial_guess::{check, ModelCheck};
 pub use pose::{parse_pose, pose_state, read_pose};
 pub use unilateral::{UnilateralCheck, Unilaterals};
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::forces::potential;
-use crate::jet::pair_of;
 use crate::model::Model;
 use crate::solver::system::Backend;
 use crate::solver::Stability;
@@ -99,11 +101,16 @@ pub struct Imbalance {
     pub dof: usize,
     /// Effort on the child along the coordinate \[N m or N\].
     pub effort: f64,
+    /// Whether a lock of the model (`verify --lock`, `mech:lock`) holds the coordinate: its
+    /// effort is then the lock's holding effort, not an imbalance (it does not fail the pose).
+    pub locked: bool,
 }
 
 /// Result of [`verify`].
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Verification {
+    /// The robot's name.
+    pub robot: String,
     /// Constraint residual and tolerance met, and no joint needs more than the force tolerance.
     pub passed: bool,
     /// `‖Φ‖∞`.
@@ -148,13 +155,13 @@ pub fn potential_energy(model: &Model, state: &State) -> Option<f64> {
 /// at their given values, or at the initial value when they have none).
 ///
 /// # Errors
-/// [`Error::ForceTableOutOfRange`] if the energy cannot be evaluated,
-/// [`Error::SingularPartition`] if the constraint Jacobian is singular there.
+/// [`Error::ForceTableOutOfRange`](crate::Error::ForceTableOutOfRange) if the energy cannot be evaluated,
+/// [`Error::SingularPartition`](crate::Error::SingularPartition) if the constraint Jacobian is singular there.
 pub fn balance(model: &Model, state: &State) -> Result<Balance> {
     if sparse_path(model) {
         let r = {
             let locks = crate::solver::lock_values(model);
-            reduced::reduced(model, state, &locks, locks.len())?
+            reduced::reduced(model, state, &locks)?
         };
         return Ok(Balance {
             constraint_residual: r.phi.amax(),
@@ -176,8 +183,8 @@ pub fn balance(model: &Model, state: &State) -> Result<Balance> {
 /// Verifies that `state` is a rest pose: it assembles, and no joint needs an effort to hold it.
 ///
 /// # Errors
-/// [`Error::ForceTableOutOfRange`] if the energy cannot be evaluated,
-/// [`Error::SingularPartition`] if the constraint Jacobian is singular there.
+/// [`Error::ForceTableOutOfRange`](crate::Error::ForceTableOutOfRange) if the energy cannot be evaluated,
+/// [`Error::SingularPartition`](crate::Error::SingularPartition) if the constraint Jacobian is singular there.
 ///
 /// # Example
 /// ```
@@ -205,7 +212,7 @@ pub fn verify_with_options(
     tol: &Tolerances,
     uni: &Unilaterals,
 ) -> Result<Verification> {
-    verify_on(model, state, tol, uni, sparse_path(model), false)
+    run::verify_on(model, state, tol, uni, sparse_path(model), false)
 }
 
 /// [`verify_with_options`] on the path `linear_algebra` says: `Auto` as
@@ -260,7 +267,7 @@ pub fn verify_reporting(
         crate::solver::LinearAlgebra::Dense => false,
         crate::solver::LinearAlgebra::Sparse => true,
     };
-    verify_on(
+    run::verify_on(
         model,
         state,
         tol,
@@ -270,209 +277,11 @@ pub fn verify_reporting(
     )
 }
 
-/// The scalar coordinates of the tree joints: `(joint, dof, value)` and their gradients.
-fn tree_coordinates(
-    model: &Model,
-    state: &State,
-) -> Vec<(crate::model::JointId, usize, crate::jet::Scalar)> {
-    let mut coords = Vec::new();
-    for (i, j) in model.joints.iter().enumerate() {
-        if !j.tree || j.merged {
-            continue;
-        }
-        let pair = pair_of(&j.bodies, &state.q, false);
-        for dof in 0..j.kind.scalar_coordinates() {
-            if let Some(s) = crate::kinematics::coordinate(
-                j,
-                &pair,
-                dof,
-                state.branches.get(crate::model::JointId(i), dof),
-            ) {
-                coords.push((crate::model::JointId(i), dof, s));
-            }
-        }
-    }
-    coords
-}
-
-/// [`verify`] on the dense (`sparse = false`) or the sparse path.
-///
-/// On the sparse path the stability verdict reuses the partition and evaluation of the
-/// balance check, and is computed on a second thread while the efforts are (kept only when
-/// the pose passes); both only read the model and the state. `eigenvalues`: the lowest
-/// eigenvalues also where only Lanczos finds them ([`Eigenvalues::Always`]).
-fn verify_on(
-    model: &Model,
-    state: &State,
-    tol: &Tolerances,
-    uni: &Unilaterals,
-    sparse: bool,
-    eigenvalues: bool,
-) -> Result<Verification> {
-    let (
-        coords,
-        phi,
-        energy,
-        projected_gradient,
-        force_scale,
-        closure,
-        efforts,
-        unassigned,
-        stability,
-        contact,
-        (strong, weak),
-    ) = if sparse {
-        let locks = crate::solver::lock_values(model);
-        let r = reduced::reduced(model, state, &locks, locks.len())?;
-        let closure = closures(model, &r.sys.problem.cons, &r.phi, tol.constraint);
-        let reduced::Reduced {
-            phi,
-            energy,
-            reduced_gradient,
-            force_scale,
-            redundant,
-            mut sys,
-            part,
-            eval,
-            ..
-        } = r;
-        let assembled = phi.amax() <= tol.constraint;
-        // The stops and contacts take their share of the load first (module
-        // `unilateral_sparse`).
-        let tau = tol.force + tol.relative * force_scale;
-        let contact = unilateral_sparse::check(model, state, uni, &locks, tol.constraint, tau)?;
-        let carried = contact.touching.then_some(&contact.carried);
-        // Without a stop or contact carrying a force, the verdict on this partition.
-        let free = contact.strong.is_empty() && contact.weak.is_empty();
-        let (coords, efforts, unassigned, stability) = std::thread::scope(|s| {
-            let verdict = (assembled && free).then(|| {
-                s.spawn(|| {
-                    crate::solver::stability_of(&mut sys, &state.q, &part, &eval, eigenvalues)
-                })
-            });
-            // The joint coordinates here, off the verdict's path.
-            let coords = tree_coordinates(model, state);
-            let values: Vec<_> = coords.iter().map(|c| (c.0, c.1, c.2.v)).collect();
-            let (efforts, unassigned) =
-                reduced::efforts(model, state, &locks, &values, redundant.len(), carried)?;
-            let passed = passes(phi.amax(), &efforts, unassigned, force_scale, tol);
-            // A panic there is re-raised here, as if the verdict had been computed on
-            // this thread.
-            let stability = match verdict {
-                Some(h) if passed => h
-                    .join()
-                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
-                _ => None,
-            };
-            Ok::<_, Error>((coords, efforts, unassigned, stability))
-        })?;
-        (
-            coords,
-            phi,
-            energy,
-            reduced_gradient,
-            force_scale,
-            closure,
-            DVector::from_vec(efforts),
-            unassigned,
-            stability,
-            contact.check,
-            (contact.strong, contact.weak),
-        )
-    } else {
-        let coords = tree_coordinates(model, state);
-        let d = dense::dense_checks(model, state, tol, uni, &coords)?;
-        // The stability is judged below, once the stops and contacts have settled.
-        (
-            coords,
-            d.phi,
-            d.energy,
-            d.projected_gradient,
-            d.force_scale,
-            d.closure,
-            d.efforts,
-            d.unassigned,
-            None,
-            d.unilateral,
-            (d.strong, d.weak),
-        )
-    };
-    let imbalance: Vec<Imbalance> = coords
-        .iter()
-        .zip(efforts.iter())
-        .map(|((id, dof, _), &effort)| Imbalance {
-            joint: model.joint(*id).name.clone(),
-            dof: *dof,
-            effort,
-        })
-        .collect();
-    let max_imbalance = imbalance
-        .iter()
-        .max_by(|a, b| a.effort.abs().total_cmp(&b.effort.abs()))
-        .cloned();
-    let constraint_residual = phi.amax();
-    let effort_tolerance = tol.force + tol.relative * force_scale;
-    let balanced = passes(
-        constraint_residual,
-        efforts.as_slice(),
-        unassigned,
-        force_scale,
-        tol,
-    );
-    let mut contact = contact;
-    let passed = contact.settle(tol.constraint, balanced) && balanced;
-    // The sparse path judged the stability beside the efforts where no stop or contact
-    // touches; otherwise it is judged here, on the tangent space of those that carry a force
-    // and the critical cone of those that touch without one (`solver::cone`).
-    let stability = match (passed, sparse) {
-        (false, _) => None,
-        (true, true) if strong.is_empty() && weak.is_empty() => stability,
-        (true, _) => {
-            let backend = if sparse {
-                Backend::Sparse
-            } else {
-                Backend::Dense
-            };
-            crate::solver::stability_verdict(model, state, &strong, &weak, backend, eigenvalues)
-        }
-    };
-    Ok(Verification {
-        passed,
-        constraint_residual,
-        closure,
-        imbalance,
-        max_imbalance,
-        unassigned,
-        projected_gradient,
-        potential_energy: energy,
-        stability,
-        tolerances: *tol,
-        force_scale,
-        effort_tolerance,
-        unilateral: contact,
-    })
-}
-
-/// Whether a pose passes: `‖Φ‖∞` within the constraint tolerance, every effort and the
-/// unassigned force within `force + relative · force_scale`.
-fn passes(
-    residual: f64,
-    efforts: &[f64],
-    unassigned: f64,
-    force_scale: f64,
-    tol: &Tolerances,
-) -> bool {
-    let effort_tolerance = tol.force + tol.relative * force_scale;
-    residual <= tol.constraint
-        && efforts.iter().all(|e| e.abs() <= effort_tolerance)
-        && unassigned <= effort_tolerance
-}
-
 /// Brings `state` onto `Φ = 0` by a damped Newton iteration that changes the dependent
 /// coordinates of a fresh partition at each step (as the solver's assembly does).
 ///
 /// # Errors
-/// [`Error::Assembly`] if the constraints cannot be satisfied from there.
+/// [`Error::Assembly`](crate::Error::Assembly) if the constraints cannot be satisfied from there.
 pub fn assemble(model: &Model, state: &State) -> Result<State> {
     let locks = crate::solver::lock_values(model);
     let mut branches = state.branches.clone();

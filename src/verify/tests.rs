@@ -3,7 +3,7 @@ use super::*;
 use crate::urdf::{load_str, ImportOptions};
 
 fn verify_on(m: &Model, s: &State, tol: &Tolerances, sparse: bool) -> Result<Verification> {
-    super::verify_on(m, s, tol, &Unilaterals::default(), sparse, false)
+    super::run::verify_on(m, s, tol, &Unilaterals::default(), sparse, false)
 }
 
 fn load(text: &str) -> Model {

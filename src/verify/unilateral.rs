@@ -11,38 +11,22 @@
 //!   at the touching point, `t_1, t_2` a basis of the ground plane);
 //! - `g_k > ε`: no force.
 //!
-//! With `N` the orthonormal basis of the feasible motions of the equality rows (module docs of
-//! `verify`), `S` the coordinate scaling and `G` the gradients of the touching rows, the forces
-//! solve the least-squares balance
-//!
-//! `min ‖Nᵀ S (∇V − G λ)‖₂` subject to `λ_k ≥ 0` on the normal rows,
-//!
-//! (columns of `Nᵀ S G` normalized to unit length). The unconstrained minimum-norm solution is
-//! taken when its normal forces are all ≥ `−τ` (`τ` the effort tolerance): it is the minimum-
-//! norm force distribution of a statically indeterminate support (a box flat on four vertices
-//! gets `m g / 4` on each). Otherwise the forces come from a non-negative least-squares solve
-//! (Lawson–Hanson), and the rows whose unconstrained force was negative are named: the pose
-//! would need them to pull. What the forces leave, `Nᵀ S (∇V − G λ)`, goes to the joint
-//! imbalance check as before, so a pose the stops and contacts cannot hold fails there.
-//!
-//! That balance is the dense path's; the sparse path computes the forces from the solver's
-//! sparse partition instead (module `unilateral_sparse`) and shares the rest of this module
-//! (which rows touch, the report, the friction check).
+//! The forces `λ` come from module `held`, with the joint efforts and reactions (the same on
+//! the dense and the sparse path); this module finds the touching rows and reports them. A
+//! normal force below `−τ` (`τ` the effort tolerance) would pull: the row is named, carries
+//! nothing, and what it would have carried is left to the joint efforts, so a pose the stops
+//! and contacts cannot hold fails there.
 //!
 //! Complementarity `g_k λ_k = 0` holds to `|g_k λ_k| ≤ ε λ_k` by construction (only touching
 //! rows carry force); its largest value is reported. A sticking contact with a friction
 //! coefficient `μ` (its link's `mech:contact mu`, else `--mu`) fails when `|f_t| > μ f_n`.
-//!
-//! ## References
-//! - C. L. Lawson, R. J. Hanson, *Solving Least Squares Problems*, SIAM (1995), ch. 23
-//!   (algorithm NNLS).
 
 use crate::constraints::unilateral::{self, Active, Anchor, Unilateral};
-use crate::jet::{pair_of, scatter};
+use crate::jet::pair_of;
 use crate::model::Model;
 use crate::solver::{ActiveLimit, Contact, ContactPolicy, ContactState};
 use crate::state::State;
-use nalgebra::{DMatrix, DVector, Vector3};
+use nalgebra::Vector3;
 
 /// How `verify` treats stops and contacts: the solver's [`ContactPolicy`] (the same choices
 /// as `analyze`'s options; a sticking contact needing more than its `mu` fails the pose).
@@ -59,7 +43,9 @@ pub struct UnilateralCheck {
     pub penetration: f64,
     /// The largest `|g_k λ_k|` of the touching inequalities \[J\].
     pub complementarity: f64,
-    /// Why the stops and contacts refuse the pose (empty when they do not).
+    /// Why the pose fails (empty when it passes): points inside a ground or joints beyond a
+    /// stop, stops or contacts that would have to pull, slipping contacts, the constraint
+    /// residual, each joint effort beyond the tolerance (largest first), the unassigned force.
     pub failures: Vec<String>,
 }
 
@@ -92,22 +78,8 @@ pub(super) struct Touching {
 
 impl Touching {
     /// `∇` of row `k` into `g` times `c` (unscaled coordinates).
-    pub(super) fn add_gradient(&self, k: usize, c: f64, g: &mut DVector<f64>) {
-        scatter(&self.bodies, &self.rows[k], c, g, None);
-    }
-
-    /// The scaled gradients `S ∇g` of its rows.
-    fn columns(&self, n: usize, scale: &[f64]) -> Vec<DVector<f64>> {
-        (0..self.rows.len())
-            .map(|k| {
-                let mut g = DVector::zeros(n);
-                self.add_gradient(k, 1.0, &mut g);
-                for (c, &f) in scale.iter().enumerate() {
-                    g[c] *= f;
-                }
-                g
-            })
-            .collect()
+    pub(super) fn add_gradient(&self, k: usize, c: f64, g: &mut nalgebra::DVector<f64>) {
+        crate::jet::scatter(&self.bodies, &self.rows[k], c, g, None);
     }
 }
 
@@ -180,170 +152,38 @@ pub(super) fn touching(
     list
 }
 
-/// Minimizes `‖M x − b‖₂` subject to `x_i ≥ 0` for `signed[i]` (Lawson–Hanson, with the
-/// unsigned variables always free). `M`'s columns are assumed normalized.
-fn nnls(m: &DMatrix<f64>, b: &DVector<f64>, signed: &[bool]) -> DVector<f64> {
-    let k = m.ncols();
-    let solve_on = |passive: &[bool]| -> DVector<f64> {
-        let idx: Vec<usize> = (0..k).filter(|&i| passive[i]).collect();
-        let mut z = DVector::zeros(k);
-        if idx.is_empty() {
-            return z;
-        }
-        let sub = DMatrix::from_fn(m.nrows(), idx.len(), |r, c| m[(r, idx[c])]);
-        let svd = sub.svd(true, true);
-        let eps = 1e-12 * svd.singular_values.max().max(1e-300);
-        if let Ok(s) = svd.solve(b, eps) {
-            for (c, &i) in idx.iter().enumerate() {
-                z[i] = s[c];
-            }
-        }
-        z
-    };
-    let mut passive: Vec<bool> = signed.iter().map(|s| !s).collect();
-    let mut x = solve_on(&passive);
-    let tol = 1e-12 * b.amax().max(1e-300) * (k as f64);
-    for _ in 0..(3 * k + 10) {
-        let w = m.transpose() * (b - m * &x);
-        let Some(j) = (0..k)
-            .filter(|&i| !passive[i] && w[i] > tol)
-            .max_by(|&a, &c| w[a].total_cmp(&w[c]))
-        else {
-            break;
-        };
-        passive[j] = true;
-        for _ in 0..(3 * k + 10) {
-            let z = solve_on(&passive);
-            let blocking: Vec<usize> = (0..k)
-                .filter(|&i| passive[i] && signed[i] && z[i] <= 0.0)
-                .collect();
-            if blocking.is_empty() {
-                x = z;
-                break;
-            }
-            let alpha = blocking
-                .iter()
-                .map(|&i| x[i] / (x[i] - z[i]).max(1e-300))
-                .fold(1.0f64, f64::min);
-            x += (&z - &x) * alpha;
-            for i in 0..k {
-                if passive[i] && signed[i] && x[i] <= 1e-15 * x.amax().max(1e-300) {
-                    passive[i] = false;
-                    x[i] = 0.0;
-                }
-            }
-        }
-    }
-    x
-}
-
-/// Checks the stops and contacts at `state`: `p` holds the basis `N`, the scaled gradient
-/// `S ∇V` and the scaling `S`; `eps` the constraint tolerance, `tau` the effort
-/// tolerance. Returns the report and the scaled generalized force the touching rows carry
-/// (`S G λ`), to be taken off `S ∇V` before the joint imbalance is computed, and the rows that
-/// carry a force (the strongly active ones) and those that touch without one (weakly active).
-pub(super) fn check(
+/// Reports the touching inequalities `list` with their `forces` (module `held`) into `out`:
+/// the contacts and stops, the complementarity, the rows that would have to pull (`pulling`:
+/// index and force) and the friction each sticking contact needs. Returns the inequalities
+/// that carry a force (`λ > tau`: the stability's tangent space) and those that touch without
+/// one (its critical cone).
+pub(super) fn report(
     model: &Model,
     state: &State,
-    opts: &Unilaterals,
-    p: &super::dense::Projection,
-    eps: f64,
+    list: &[Touching],
+    forces: &[Vec<f64>],
+    pulling_rows: &[(usize, f64)],
     tau: f64,
-) -> (UnilateralCheck, DVector<f64>, Vec<Active>, Vec<Active>) {
-    let (null, grad_s, scale) = (&p.null, &p.grad_s, &p.scale[..]);
-    let mut out = UnilateralCheck::default();
-    let list = touching(model, state, opts, eps, &mut out);
-    let n = state.q.len();
-    let columns: Vec<Vec<DVector<f64>>> = list.iter().map(|t| t.columns(n, scale)).collect();
-    let mut carried = DVector::zeros(n);
-    if list.is_empty() {
-        return (out, carried, Vec::new(), Vec::new());
-    }
-    // Columns of the balance, normalized; `signed` marks the normal rows.
-    let mut cols = Vec::new();
-    let mut signed = Vec::new();
-    let mut norms = Vec::new();
-    for t in &columns {
-        for (r, c) in t.iter().enumerate() {
-            let projected = null.transpose() * c;
-            let len = projected.norm();
-            norms.push(len);
-            cols.push(if len > 0.0 {
-                projected / len
-            } else {
-                projected
-            });
-            signed.push(r == 0);
-        }
-    }
-    let rhs = null.transpose() * grad_s;
-    let m = if null.ncols() > 0 {
-        DMatrix::from_columns(&cols)
-    } else {
-        DMatrix::zeros(0, cols.len())
-    };
-    // Unconstrained minimum-norm solution first.
-    let free = if m.nrows() > 0 {
-        let svd = m.clone().svd(true, true);
-        let e = 1e-10 * svd.singular_values.max().max(1e-300);
-        svd.solve(&rhs, e)
-            .unwrap_or_else(|_| DVector::zeros(cols.len()))
-    } else {
-        DVector::zeros(cols.len())
-    };
-    let unscale = |x: &DVector<f64>| -> DVector<f64> {
-        DVector::from_fn(
-            x.len(),
-            |i, _| {
-                if norms[i] > 0.0 {
-                    x[i] / norms[i]
-                } else {
-                    0.0
-                }
-            },
-        )
-    };
-    let free_forces = unscale(&free);
-    let negative: Vec<usize> = (0..cols.len())
-        .filter(|&i| signed[i] && free_forces[i] < -tau)
-        .collect();
-    let forces = if negative.is_empty() || m.nrows() == 0 {
-        free_forces.clone()
-    } else {
-        unscale(&nnls(&m, &rhs, &signed))
-    };
-    // The generalized force the rows carry, in scaled coordinates.
-    let mut k = 0;
+    out: &mut UnilateralCheck,
+) -> (Vec<Active>, Vec<Active>) {
     let (mut strong, mut weak) = (Vec::new(), Vec::new());
-    for (t, cols) in list.iter().zip(&columns) {
-        let lambda: Vec<f64> = (0..cols.len()).map(|r| forces[k + r]).collect();
-        for (r, c) in cols.iter().enumerate() {
-            carried.axpy(lambda[r], c, 1.0);
-        }
+    for (t, lambda) in list.iter().zip(forces) {
         if lambda[0] > tau {
             strong.push(t.active);
         } else {
             weak.push(t.active);
         }
         out.complementarity = out.complementarity.max((t.gap * lambda[0]).abs());
-        describe(model, state, t, &lambda, tau, &mut out);
-        k += cols.len();
+        describe(model, state, t, lambda, tau, out);
     }
-    // Name the rows that would have to pull, for the failure message (only meaningful when
-    // the non-negative forces then leave an imbalance: the caller decides).
-    let mut k = 0;
-    for t in &list {
-        if negative.contains(&k) {
-            out.failures
-                .push(pulling(model, &t.active.row, free_forces[k]));
-        }
-        k += t.rows.len();
+    for &(i, f) in pulling_rows {
+        out.failures.push(pulling(model, &list[i].active.row, f));
     }
-    (out, carried, strong, weak)
+    (strong, weak)
 }
 
 /// The failure of a stop or contact `u` that would have to pull with `force` to hold the pose.
-pub(super) fn pulling(model: &Model, u: &Unilateral, force: f64) -> String {
+fn pulling(model: &Model, u: &Unilateral, force: f64) -> String {
     format!(
         "`{}` would have to pull ({:.3e} {}) to hold the pose",
         unilateral::name(model, u),
@@ -358,7 +198,7 @@ pub(super) fn pulling(model: &Model, u: &Unilateral, force: f64) -> String {
 
 /// Adds the contact or stop `t` with its forces `lambda` to `out`, and a failure for a sticking
 /// contact needing more than its friction coefficient.
-pub(super) fn describe(
+fn describe(
     model: &Model,
     state: &State,
     t: &Touching,
@@ -423,30 +263,5 @@ pub(super) fn describe(
                 state: state_,
             });
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// NNLS against a case solved by hand: `b = (1, −1)` with `M = I` and `x ≥ 0` gives
-    /// `x = (1, 0)`; the free variable takes its unconstrained value.
-    #[test]
-    fn nnls_clamps_only_the_signed_variables() {
-        let m = DMatrix::identity(2, 2);
-        let b = DVector::from_vec(vec![1.0, -1.0]);
-        let x = nnls(&m, &b, &[true, true]);
-        assert!((x[0] - 1.0).abs() < 1e-14 && x[1] == 0.0, "{x}");
-        let x = nnls(&m, &b, &[true, false]);
-        assert!(
-            (x[0] - 1.0).abs() < 1e-14 && (x[1] + 1.0).abs() < 1e-14,
-            "{x}"
-        );
-        // Two columns pulling the same way: the non-negative fit uses the one that helps.
-        let m = DMatrix::from_row_slice(2, 2, &[1.0, 0.6, 0.0, 0.8]);
-        let b = DVector::from_vec(vec![1.0, -2.0]);
-        let x = nnls(&m, &b, &[true, true]);
-        assert!((x[0] - 1.0).abs() < 1e-12 && x[1] == 0.0, "{x}");
     }
 }

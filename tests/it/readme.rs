@@ -80,9 +80,14 @@ fn blocks(text: &str) -> Vec<Block> {
 }
 
 /// The `$ restpose` blocks: (line number of the command, arguments, expected output lines).
+/// The `$ restpose …` blocks that are run: a fence whose first line is one `restpose`
+/// command on the repository's files, followed by its output. A ```` ```console ```` block is a
+/// transcript (several commands, pipes, or files outside the repository, such as
+/// example-robot-data's) and is shown, not run; so is a block with a second `$ ` line.
 fn examples(text: &str) -> Vec<(usize, Vec<String>, Vec<String>)> {
     blocks(text)
         .into_iter()
+        .filter(|b| b.info != "console" && b.lines.iter().skip(1).all(|l| !l.starts_with("$ ")))
         .filter_map(|b| {
             let (first, rest) = b.lines.split_first()?;
             let command = first.strip_prefix("$ restpose ")?;

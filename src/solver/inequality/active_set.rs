@@ -203,6 +203,8 @@ pub(crate) fn solve(
     super::rolling::record_touches(model, &active, &state.q, &mut touched);
     let mut iterations = 0;
     let mut counters = crate::solver::Diagnostics::default();
+    let (mut history, mut iterates) = (Vec::new(), Vec::new());
+    let mut rounds = 0;
     loop {
         let mut branches = state.branches.clone();
         let q = crate::solver::assemble::project(
@@ -236,6 +238,14 @@ pub(crate) fn solve(
         counters.add_counts(&round.report.diagnostics);
         state = round.state;
         let mut report = round.report;
+        rounds += 1;
+        report.history.iter_mut().for_each(|h| h.round = rounds);
+        crate::solver::report::append_history(
+            &mut history,
+            &mut iterates,
+            std::mem::take(&mut report.history),
+            std::mem::take(&mut report.iterates),
+        );
         let cycling = changes - initial >= options.max_iterations;
         let mut rolled_too_far = false;
         if let (Some(hit), false) = (&round.blocked, cycling) {
@@ -284,6 +294,7 @@ pub(crate) fn solve(
             );
         }
         report.iterations = iterations;
+        (report.history, report.iterates) = (history, iterates);
         let own = report.diagnostics.clone();
         report.diagnostics = counters;
         report.diagnostics.gradient_norm = own.gradient_norm;
@@ -304,6 +315,17 @@ pub(crate) fn solve(
                 &state,
                 &strong,
                 &weak,
+                Backend::of(model, options),
+                true,
+            );
+        }
+        // Stops and contacts carrying a force that leave no feasible motion: a strict
+        // minimum (`stability_on`).
+        if report.converged() && report.stability.is_none() && !strong.is_empty() {
+            report.stability = crate::solver::stability_on(
+                model,
+                &state,
+                &strong,
                 Backend::of(model, options),
                 true,
             );

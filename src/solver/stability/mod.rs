@@ -9,9 +9,12 @@
 //! - `inertia`: the verdict from the inertia of the shifted KKT matrix, without eigenvalues.
 //! - `cone`: the verdict on the critical cone, where stops and contacts touch without force.
 //! - `verdict`: the verdict and mode shapes from the eigenpairs, and the entry points.
+//! - `joint_space`: the reported eigenvalues and modes in joint coordinates,
+//!   `H_θ = T⁻ᵀ Ĥ T⁻¹` (physical units, independent of the partition).
 
 pub(crate) mod cone;
 pub(crate) mod eigen;
 pub(crate) mod inertia;
+pub(crate) mod joint_space;
 pub(crate) mod spectrum;
 pub(crate) mod verdict;

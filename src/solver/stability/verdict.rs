@@ -1,7 +1,10 @@
 //! The verdict at a rest pose from the eigenvalues of the reduced Hessian `Ĥ = Zᵀ W Z`:
 //! stable when `λ_min > t`, unstable when `λ_min < −t`, neutral otherwise, with
 //! `t = 10⁻¹⁰ max(λ_max, 1)` (`Spectrum::tolerance`), and the mode shapes of the lowest
-//! eigenvalues as joint-coordinate changes.
+//! eigenvalues as joint-coordinate changes. Where the whole spectrum is known the eigenvalues
+//! and modes are reported in joint coordinates (module `joint_space`): physical units,
+//! independent of the start; `stable` where stops or contacts carrying a force leave no
+//! feasible motion.
 //!
 //! The entry point is [`stability_verdict`] (stops and contacts that carry a force and those
 //! that touch without one, or none); [`stability_on`] holds every given row, and
@@ -9,13 +12,14 @@
 //! it, or the minimizer).
 
 use super::inertia;
+use super::joint_space;
 use super::spectrum::{self, Spectrum};
 use crate::constraints::unilateral::Active;
 use crate::constraints::Constraints;
 use crate::model::Model;
 use crate::solver::partition::Partition;
 use crate::solver::system::{Backend, System};
-use crate::solver::{lock_values, Stability, Verdict};
+use crate::solver::{lock_values, Mode, Stability, Verdict};
 use crate::state::State;
 
 /// The stability verdict from the reduced-Hessian eigenvalues (ascending, at least one) and
@@ -38,6 +42,18 @@ pub(crate) fn from_spectrum(
         Verdict::Stable
     };
     let shown = vals.len().min(6);
+    // In joint coordinates where the whole spectrum is known (module `joint_space`).
+    if spectrum.exact && shown > 0 {
+        let h = vecs * nalgebra::DMatrix::from_diagonal(vals) * vecs.transpose();
+        if let Some((values, modes)) = joint_space::joint_spectrum(sys, q, part, eval, &h, shown) {
+            return Stability {
+                verdict,
+                tolerance: tol,
+                eigenvalues: values.into_iter().take(shown).collect(),
+                modes: modes.into_iter().map(Mode).collect(),
+            };
+        }
+    }
     // The gradients of every joint coordinate, once for all modes: (joint, per coordinate the
     // (global index, derivative) pairs).
     type Gradient = Vec<(usize, f64)>;
@@ -68,21 +84,26 @@ pub(crate) fn from_spectrum(
     let modes = (0..shown)
         .map(|k| {
             let dq = sys.tangent_step(part, eval, &vecs.column(k).into_owned());
-            let mut mode = std::collections::BTreeMap::new();
+            let mut mode = Vec::new();
             for (name, coords) in &gradients {
                 let d: Vec<f64> = coords
                     .iter()
                     .map(|c| c.iter().map(|&(g, x)| x * dq[g]).sum())
                     .collect();
                 if !d.is_empty() {
-                    mode.insert(name.to_string(), d);
+                    mode.push((name.to_string(), d));
                 }
             }
-            let big = mode.values().flatten().fold(0.0f64, |a, &b| a.max(b.abs()));
+            let big = mode
+                .iter()
+                .flat_map(|m| &m.1)
+                .fold(0.0f64, |a, &b| a.max(b.abs()));
             if big > 0.0 {
-                mode.values_mut().flatten().for_each(|x| *x /= big);
+                mode.iter_mut()
+                    .flat_map(|m| &mut m.1)
+                    .for_each(|x| *x /= big);
             }
-            mode
+            Mode(mode)
         })
         .collect();
     Stability {
@@ -126,7 +147,22 @@ pub(crate) fn stability_on(
     let mut sys = System::new(model, sys_cons, backend);
     let part = sys.partition(q);
     if part.independent.is_empty() {
-        return None;
+        // Stops or contacts carrying a force leave no feasible motion: every motion the model
+        // allows raises the energy at first order (a strict minimum), if the model has any.
+        let free = !active.is_empty() && {
+            let cons =
+                Constraints::new(model, &lock_values(model)).on_branches(state.branches.clone());
+            !System::new(model, cons, backend)
+                .partition(q)
+                .independent
+                .is_empty()
+        };
+        return free.then(|| Stability {
+            verdict: Verdict::Stable,
+            tolerance: 0.0,
+            eigenvalues: Vec::new(),
+            modes: Vec::new(),
+        });
     }
     let eval = sys.evaluate(q, &part)?;
     stability_of(&mut sys, q, &part, &eval, eigenvalues)

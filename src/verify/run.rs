@@ -1,0 +1,249 @@
+//! [`super::verify`] on the dense or the sparse path: the balance of the model's rows, the
+//! forces that hold the pose (module `held`), the report of the stops and contacts (module
+//! `unilateral`) and the stability verdict.
+
+use super::{
+    closures, held, reduced, unilateral, Imbalance, Tolerances, Unilaterals, Verification,
+};
+use crate::error::Error;
+use crate::error::Result;
+use crate::jet::pair_of;
+use crate::model::{JointId, Model};
+use crate::solver::system::Backend;
+use crate::state::State;
+
+/// The scalar coordinates of the tree joints: `(joint, dof, value)` and their gradients.
+pub(super) fn tree_coordinates(
+    model: &Model,
+    state: &State,
+) -> Vec<(JointId, usize, crate::jet::Scalar)> {
+    let mut coords = Vec::new();
+    for (i, j) in model.joints.iter().enumerate() {
+        if !j.tree || j.merged {
+            continue;
+        }
+        let pair = pair_of(&j.bodies, &state.q, false);
+        for dof in 0..j.kind.scalar_coordinates() {
+            if let Some(s) =
+                crate::kinematics::coordinate(j, &pair, dof, state.branches.get(JointId(i), dof))
+            {
+                coords.push((JointId(i), dof, s));
+            }
+        }
+    }
+    coords
+}
+
+/// [`super::verify`] on the dense (`sparse = false`) or the sparse path.
+///
+/// On the sparse path the stability verdict reuses the partition and evaluation of the
+/// balance check, and is computed on a second thread while the forces are (kept only when
+/// the pose passes); both only read the model and the state. `eigenvalues`: the lowest
+/// eigenvalues also where only Lanczos finds them ([`super::Eigenvalues::Always`]).
+pub(super) fn verify_on(
+    model: &Model,
+    state: &State,
+    tol: &Tolerances,
+    uni: &Unilaterals,
+    sparse: bool,
+    eigenvalues: bool,
+) -> Result<Verification> {
+    // The forces on both paths from the sparse partition (module `held`): one computation,
+    // so the dense and the sparse path report the same numbers (a pose balanced to the
+    // solver's gradient tolerance leaves the forces determined to about that, and partitions
+    // differ in where they put the rest).
+    let backend = Backend::Sparse;
+    let mut contact = unilateral::UnilateralCheck::default();
+    let list = unilateral::touching(model, state, uni, tol.constraint, &mut contact);
+    let coords = tree_coordinates(model, state);
+    let values: Vec<_> = coords.iter().map(|c| (c.0, c.1, c.2.v)).collect();
+    let (phi, energy, projected_gradient, force_scale, closure, held, stability) = if sparse {
+        let locks = crate::solver::lock_values(model);
+        let r = reduced::reduced(model, state, &locks)?;
+        let closure = closures(model, &r.sys.problem.cons, &r.phi, tol.constraint);
+        let reduced::Reduced {
+            phi,
+            energy,
+            reduced_gradient,
+            force_scale,
+            mut sys,
+            part,
+            eval,
+            ..
+        } = r;
+        let assembled = phi.amax() <= tol.constraint;
+        let tau = tol.force + tol.relative * force_scale;
+        // Without a stop or contact touching, the verdict on this partition.
+        let (held, stability) = std::thread::scope(|s| {
+            let verdict = (assembled && list.is_empty()).then(|| {
+                s.spawn(|| {
+                    crate::solver::stability_of(&mut sys, &state.q, &part, &eval, eigenvalues)
+                })
+            });
+            let held = held::held(model, state, &list, &values, backend, tau)?;
+            let passed = passes(phi.amax(), &held, force_scale, tol);
+            // A panic there is re-raised here, as if the verdict had been computed on
+            // this thread.
+            let stability = match verdict {
+                Some(h) if passed => h
+                    .join()
+                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
+                _ => None,
+            };
+            Ok::<_, Error>((held, stability))
+        })?;
+        (
+            phi,
+            energy,
+            reduced_gradient,
+            force_scale,
+            closure,
+            held,
+            stability,
+        )
+    } else {
+        let p = super::dense::project(model, state)?;
+        let closure = closures(model, &p.cons, &p.phi, tol.constraint);
+        let projected_gradient = (p.null.transpose() * &p.grad_s).amax();
+        let force_scale = p.grad_s.amax();
+        let tau = tol.force + tol.relative * force_scale;
+        let held = held::held(model, state, &list, &values, backend, tau)?;
+        (
+            p.phi,
+            p.energy,
+            projected_gradient,
+            force_scale,
+            closure,
+            held,
+            None,
+        )
+    };
+    let effort_tolerance = tol.force + tol.relative * force_scale;
+    let (strong, weak) = unilateral::report(
+        model,
+        state,
+        &list,
+        &held.forces,
+        &held.pulling,
+        effort_tolerance,
+        &mut contact,
+    );
+    let imbalance: Vec<Imbalance> = coords
+        .iter()
+        .zip(held.efforts.iter().zip(&held.locked))
+        .map(|((id, dof, _), (&effort, &locked))| Imbalance {
+            joint: model.joint(*id).name.clone(),
+            dof: *dof,
+            effort,
+            locked,
+        })
+        .collect();
+    let max_imbalance = imbalance
+        .iter()
+        .filter(|i| !i.locked)
+        .max_by(|a, b| a.effort.abs().total_cmp(&b.effort.abs()))
+        .cloned();
+    let constraint_residual = phi.amax();
+    let balanced = passes(constraint_residual, &held, force_scale, tol);
+    let passed = contact.settle(tol.constraint, balanced) && balanced;
+    if !balanced {
+        imbalance_failures(
+            model,
+            constraint_residual,
+            &imbalance,
+            held.unassigned,
+            effort_tolerance,
+            tol,
+            &mut contact.failures,
+        );
+    }
+    // The sparse path judged the stability beside the forces where no stop or contact
+    // touches; otherwise it is judged here, on the tangent space of those that carry a force
+    // and the critical cone of those that touch without one (`solver::cone`).
+    let backend = if sparse {
+        crate::solver::system::Backend::Sparse
+    } else {
+        crate::solver::system::Backend::Dense
+    };
+    let stability = match (passed, sparse) {
+        (false, _) => None,
+        (true, true) if strong.is_empty() && weak.is_empty() => stability,
+        (true, _) => {
+            crate::solver::stability_verdict(model, state, &strong, &weak, backend, eigenvalues)
+        }
+    };
+    Ok(Verification {
+        robot: model.name.clone(),
+        passed,
+        constraint_residual,
+        closure,
+        imbalance,
+        max_imbalance,
+        unassigned: held.unassigned,
+        projected_gradient,
+        potential_energy: energy,
+        stability,
+        tolerances: *tol,
+        force_scale,
+        effort_tolerance,
+        unilateral: contact,
+    })
+}
+
+/// The failures of the balance, appended to `failures`: the constraint residual, each effort
+/// beyond the tolerance (largest first), the unassigned force.
+fn imbalance_failures(
+    model: &Model,
+    residual: f64,
+    imbalance: &[Imbalance],
+    unassigned: f64,
+    effort_tolerance: f64,
+    tol: &Tolerances,
+    failures: &mut Vec<String>,
+) {
+    if residual > tol.constraint {
+        failures.push(format!(
+            "constraint residual {residual:.3e} beyond the tolerance {:.1e}",
+            tol.constraint
+        ));
+    }
+    let mut out: Vec<&Imbalance> = imbalance
+        .iter()
+        .filter(|i| !i.locked && i.effort.abs() > effort_tolerance)
+        .collect();
+    // Largest first as printed (4 digits), file order among equals: the dense and the sparse
+    // path list them alike.
+    let shown = |e: f64| format!("{:.3e}", e.abs()).parse::<f64>().unwrap_or(e.abs());
+    out.sort_by(|a, b| shown(b.effort).total_cmp(&shown(a.effort)));
+    for i in out {
+        let angle = model
+            .joint_id(&i.joint)
+            .is_none_or(|id| model.joint(id).kind.is_angle(i.dof));
+        failures.push(format!(
+            "`{}` (dof {}) needs an effort of {:.3e} {} to hold the pose",
+            i.joint,
+            i.dof,
+            i.effort,
+            if angle { "N m" } else { "N" }
+        ));
+    }
+    if unassigned > effort_tolerance {
+        failures.push(format!(
+            "unassigned generalized force {unassigned:.3e} J: no joint coordinate can carry it \
+             (a floating base or a spherical joint out of balance)"
+        ));
+    }
+}
+
+/// Whether a pose passes: `‖Φ‖∞` within the constraint tolerance, every effort of a coordinate
+/// no lock holds and the unassigned force within `force + relative · force_scale`.
+fn passes(residual: f64, held: &held::Held, force_scale: f64, tol: &Tolerances) -> bool {
+    let effort_tolerance = tol.force + tol.relative * force_scale;
+    residual <= tol.constraint
+        && held
+            .efforts
+            .iter()
+            .zip(&held.locked)
+            .all(|(e, &l)| l || e.abs() <= effort_tolerance)
+        && held.unassigned <= effort_tolerance
+}

@@ -19,7 +19,7 @@ fn main() -> ExitCode {
     match out {
         Ok(code) => ExitCode::from(code),
         Err(e) => {
-            eprintln!("error: {e:#}");
+            cli::print::note!("error: {e:#}");
             ExitCode::from(cli::exit::INPUT)
         }
     }

@@ -18,7 +18,8 @@ mod active_set;
 mod assemble;
 mod cone;
 mod distribution;
-mod eigen;
+pub(crate) mod eigen;
+pub(crate) mod finite;
 mod guard;
 mod minimize;
 mod mode_animation;
@@ -372,6 +373,7 @@ pub(crate) fn solve_round(
     }
     if dof0 > 0 && !crate::forces::has_energy(model) {
         return Err(Error::ConstantEnergy {
+            file: model.source_file(),
             robot: model.name.clone(),
             dof: dof0,
         });
@@ -389,9 +391,13 @@ pub(crate) fn solve_round(
     };
     let iteration = out.history.last().map_or(0, |h| h.iteration);
     if !out.eval.energy.total.is_finite() {
-        return Err(Error::NonFinite {
-            what: "potential energy".into(),
-            iteration,
+        return Err(Error::NonFiniteEnergy {
+            at: format!("iteration {iteration} of the solve"),
+            term: crate::forces::finite::non_finite_term(
+                model,
+                &sys.problem.cons.branches,
+                &out.q,
+            ),
         });
     }
     if let Some(i) = out.q.iter().position(|x| !x.is_finite()) {

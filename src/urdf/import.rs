@@ -285,6 +285,7 @@ pub(super) fn import(
         }
     };
     for (i, l) in link_in.into_iter().enumerate() {
+        model.set_link_source(i, src.location(link_nodes[i]));
         model.add_link(
             l.name,
             body_of(i),
@@ -373,8 +374,12 @@ pub(super) fn import(
 
 /// Places a [`crate::Error::InvalidNumber`] of the built model at its element in the file: the
 /// element named by it (a `name`, `joint` or `link` attribute), at its child element named
-/// like the attribute when it has one (`<mass>`, `<inertia>`), else at `<robot>`.
+/// like the attribute when it has one (`<mass>`, `<inertia>`), else at `<robot>`. An
+/// [`crate::Error::Model`] is placed by [`locate_model`].
 fn locate_invalid(src: &Source, robot: Node, e: crate::Error) -> crate::Error {
+    if let crate::Error::Model(message) = &e {
+        return locate_model(src, robot, message);
+    }
     let crate::Error::InvalidNumber {
         name, attribute, ..
     } = &e
@@ -400,4 +405,39 @@ fn locate_invalid(src: &Source, robot: Node, e: crate::Error) -> crate::Error {
         .or(element)
         .unwrap_or(robot);
     src.error(node, e.to_string())
+}
+
+/// Places a builder's message about an element (`link `arm` is selected for contact but has
+/// no <collision> geometry`, `spring `s` …`) at that element: the first ``KIND `NAME` `` of
+/// the message names it; a link's contact problem is placed at its `<mech:contact>`.
+fn locate_model(src: &Source, robot: Node, message: &str) -> crate::Error {
+    let mut parts = message.splitn(3, '`');
+    let (head, name) = (parts.next().unwrap_or(""), parts.next().unwrap_or(""));
+    let kind = head.split_whitespace().last().unwrap_or("");
+    let tags: &[&str] = match kind {
+        "link" if message.contains("contact") => &["contact", "link"],
+        "link" => &["link", "obstacle"],
+        "spring" => &["spring", "linear_spring_damper"],
+        "joint" | "on" => &["joint", "loop_joint", "joint_spring", "joint_effort"],
+        "load" => &["force"],
+        "ground" => &["ground"],
+        _ => &[],
+    };
+    let named = |n: &Node| {
+        n.is_element()
+            && !name.is_empty()
+            && ["name", "joint", "link"]
+                .iter()
+                .any(|a| n.attribute(*a) == Some(name))
+    };
+    let node = tags
+        .iter()
+        .find_map(|t| {
+            robot
+                .descendants()
+                .find(|n| named(n) && n.tag_name().name() == *t)
+        })
+        .or_else(|| robot.descendants().find(|n| named(n)))
+        .unwrap_or(robot);
+    src.error(node, message.to_string())
 }

@@ -152,11 +152,12 @@ pub(super) fn dense_checks(
     } else {
         let b = DMatrix::from_columns(&b_cols);
         let m = p.null.transpose() * b;
-        let svd = m.clone().svd(true, true);
-        let eps = 1e-10 * svd.singular_values.max();
-        let tau = svd
-            .solve(&rhs, eps)
-            .unwrap_or_else(|_| DVector::zeros(b_cols.len()));
+        let tau = crate::solver::eigen::svd(m.clone(), true, true)
+            .and_then(|svd| {
+                let eps = 1e-10 * svd.singular_values.max();
+                svd.solve(&rhs, eps).ok()
+            })
+            .unwrap_or_else(|| DVector::zeros(b_cols.len()));
         let rest = (&rhs - m * &tau).amax();
         (tau, rest)
     };

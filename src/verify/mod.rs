@@ -38,7 +38,7 @@ mod unilateral_sparse;
 pub use check::{check, ModelCheck};
 use closure::closures;
 pub use closure::Closure;
-pub use pose::{parse_pose, pose_state, read_pose};
+pub use pose::{parse_pose, pose_state, pose_state_with_bodies, read_pose};
 pub use unilateral::{UnilateralCheck, Unilaterals};
 
 use crate::error::{Error, Result};
@@ -149,6 +149,7 @@ pub fn potential_energy(model: &Model, state: &State) -> Option<f64> {
 /// [`Error::ForceTableOutOfRange`] if the energy cannot be evaluated,
 /// [`Error::SingularPartition`] if the constraint Jacobian is singular there.
 pub fn balance(model: &Model, state: &State) -> Result<Balance> {
+    crate::solver::finite::guard(model, state, "the given pose")?;
     if sparse_path(model) {
         let r = {
             let locks = crate::solver::lock_values(model);
@@ -203,7 +204,14 @@ pub fn verify_with_options(
     tol: &Tolerances,
     uni: &Unilaterals,
 ) -> Result<Verification> {
-    verify_on(model, state, tol, uni, sparse_path(model), false)
+    verify_on(
+        model,
+        state,
+        tol,
+        uni,
+        sparse_path(model),
+        Eigenvalues::WhenCheap,
+    )
 }
 
 /// [`verify_with_options`] on the path `linear_algebra` says: `Auto` as
@@ -240,6 +248,9 @@ pub enum Eigenvalues {
     /// Always the lowest eigenvalues and mode shapes (above 200 degrees of freedom on the
     /// sparse path, the low end found by Lanczos, as `analyze` reports them).
     Always,
+    /// No stability verdict (`stability` is `None`): the balance checks only, as `analyze`
+    /// runs them on its own answer.
+    Skip,
 }
 
 /// [`verify_using`] with the eigenvalues `eigenvalues` asks for.
@@ -258,14 +269,7 @@ pub fn verify_reporting(
         crate::solver::LinearAlgebra::Dense => false,
         crate::solver::LinearAlgebra::Sparse => true,
     };
-    verify_on(
-        model,
-        state,
-        tol,
-        uni,
-        sparse,
-        eigenvalues == Eigenvalues::Always,
-    )
+    verify_on(model, state, tol, uni, sparse, eigenvalues)
 }
 
 /// The scalar coordinates of the tree joints: `(joint, dof, value)` and their gradients.
@@ -305,8 +309,11 @@ fn verify_on(
     tol: &Tolerances,
     uni: &Unilaterals,
     sparse: bool,
-    eigenvalues: bool,
+    eigenvalues: Eigenvalues,
 ) -> Result<Verification> {
+    let skip = eigenvalues == Eigenvalues::Skip;
+    let eigenvalues = eigenvalues == Eigenvalues::Always;
+    crate::solver::finite::guard(model, state, "the given pose")?;
     let (
         coords,
         phi,
@@ -343,7 +350,7 @@ fn verify_on(
         // Without a stop or contact carrying a force, the verdict on this partition.
         let free = contact.strong.is_empty() && contact.weak.is_empty();
         let (coords, efforts, unassigned, stability) = std::thread::scope(|s| {
-            let verdict = (assembled && free).then(|| {
+            let verdict = (assembled && free && !skip).then(|| {
                 s.spawn(|| {
                     crate::solver::stability_of(&mut sys, &state.q, &part, &eval, eigenvalues)
                 })
@@ -424,6 +431,7 @@ fn verify_on(
     // and the critical cone of those that touch without one (`solver::cone`).
     let stability = match (passed, sparse) {
         (false, _) => None,
+        _ if skip => None,
         (true, _) if !strong.is_empty() || !weak.is_empty() => {
             crate::solver::stability_touching(model, state, &strong, &weak, eigenvalues)
         }

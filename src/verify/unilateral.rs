@@ -211,7 +211,9 @@ fn nnls(m: &DMatrix<f64>, b: &DVector<f64>, signed: &[bool]) -> DVector<f64> {
             return z;
         }
         let sub = DMatrix::from_fn(m.nrows(), idx.len(), |r, c| m[(r, idx[c])]);
-        let svd = sub.svd(true, true);
+        let Some(svd) = crate::solver::eigen::svd(sub, true, true) else {
+            return z;
+        };
         let eps = 1e-12 * svd.singular_values.max().max(1e-300);
         if let Ok(s) = svd.solve(b, eps) {
             for (c, &i) in idx.iter().enumerate() {
@@ -304,10 +306,12 @@ pub(super) fn check(
     };
     // Unconstrained minimum-norm solution first.
     let free = if m.nrows() > 0 {
-        let svd = m.clone().svd(true, true);
-        let e = 1e-10 * svd.singular_values.max().max(1e-300);
-        svd.solve(&rhs, e)
-            .unwrap_or_else(|_| DVector::zeros(cols.len()))
+        crate::solver::eigen::svd(m.clone(), true, true)
+            .and_then(|svd| {
+                let e = 1e-10 * svd.singular_values.max().max(1e-300);
+                svd.solve(&rhs, e).ok()
+            })
+            .unwrap_or_else(|| DVector::zeros(cols.len()))
     } else {
         DVector::zeros(cols.len())
     };

@@ -226,9 +226,11 @@ fn multipliers(
         let w = DMatrix::from_diagonal(&DVector::from_vec(weight));
         let kw = dirs.transpose() * &w;
         let normal = &kw * &dirs;
-        let svd = normal.svd(true, true);
-        let e = 1e-12 * svd.singular_values.max().max(1e-300);
-        if let Ok(t) = svd.solve(&(&kw * &lambda), e) {
+        let solved = crate::solver::eigen::svd(normal, true, true).and_then(|svd| {
+            let e = 1e-12 * svd.singular_values.max().max(1e-300);
+            svd.solve(&(&kw * &lambda), e).ok()
+        });
+        if let Some(t) = solved {
             lambda -= &dirs * t;
         }
     }

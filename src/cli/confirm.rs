@@ -17,8 +17,17 @@ pub(crate) fn rejection(a: &AnalyzeArgs, model: &Model, state: &State) -> Option
         .into_iter()
         .filter(|(_, v)| !v.is_empty())
         .collect();
+    // And the floating bases, whose poses `verify` reads from the JSON's `links` too.
+    let mut moved = vec![false; model.bodies.len()];
+    for j in model.joints.iter().filter(|j| j.tree && !j.merged) {
+        if let Some(c) = j.bodies[1] {
+            moved[c.index()] = true;
+        }
+    }
+    let roots = model.body_ids().filter(|b| !moved[b.index()]);
     let bodies: Vec<_> = State::bodies_without_values(model)
         .into_iter()
+        .chain(roots)
         .map(|b| (b, state.body_pose(b)))
         .collect();
     let read_back = match restpose::verify::pose_state_with_bodies(model, &values, &bodies) {

@@ -37,7 +37,14 @@ NULLABLE = {
     "effort_limit", "base", "reason", "suggestion", "limit", "at", "fraction",
 }
 
-NONFINITE_TEXT = re.compile(r"(?<![A-Za-z_])(NaN|nan|-?inf)(?![A-Za-z_])")
+# How Rust prints a non-finite f64 (`NaN`, `inf`, `-inf`), outside quoted input.
+NONFINITE_TEXT = re.compile(r"(?<![A-Za-z_.])(NaN|-?inf)(?![A-Za-z_])")
+QUOTED = re.compile(r'"[^"\n]*"|`[^`\n]*`')
+
+
+def non_finite(text):
+    """Non-finite numbers printed by restpose (not the input quoted back)."""
+    return NONFINITE_TEXT.findall(QUOTED.sub("", text))
 
 
 def limit_memory(bytes_):
@@ -151,9 +158,8 @@ class Campaign:
         if rc == 101 or rc < 0:
             self.fault("panics", name, text, cmd, f"exit {rc}\n{err[-4000:]}")
             return
-        found = NONFINITE_TEXT.findall(out + err)
-        # A NaN the user wrote and the error quotes back is not an output of the solver.
-        if found and not (rc == 1 and err.startswith("error:") and "not a finite number" in err):
+        found = non_finite(out + err)
+        if found:
             self.fault("non_finite", name, text, cmd, f"text {found[:5]}\n{out[-2000:]}\n{err[-2000:]}")
             return
         if json_path and os.path.exists(json_path):

@@ -285,7 +285,6 @@ pub(super) fn import(
         }
     };
     for (i, l) in link_in.into_iter().enumerate() {
-        model.set_link_source(i, src.location(link_nodes[i]));
         model.add_link(
             l.name,
             body_of(i),
@@ -294,6 +293,7 @@ pub(super) fn import(
             l.visuals,
             l.collisions,
         );
+        model.set_link_source(i, src.location(link_nodes[i]));
     }
 
     // Joints, in document order by kind of element.

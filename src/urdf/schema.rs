@@ -217,9 +217,13 @@ fn check_node(
         }
         let name = c.tag_name().name();
         if seen.contains(&name) && !REPEATABLE.contains(&name) {
+            let named = node
+                .attribute("name")
+                .map(|n| format!(" `{n}`"))
+                .unwrap_or_default();
             return Err(src.error(
                 c,
-                format!("{what} has a second <{name}>: it takes one"),
+                format!("{what}{named} has a second <{name}>: it takes one"),
             ));
         }
         seen.push(name);

@@ -3,3 +3,8 @@
 mod issue_12_assembly_names_the_joint;
 mod issue_12_sparse_verify_angle_branch;
 mod issue_13_floating_base_start;
+mod issue_25_closed_pipe;
+mod issue_25_fuzz_smoke;
+mod issue_25_located_errors;
+mod issue_25_unbounded_numbers;
+mod issue_25_verify_agrees_with_analyze;

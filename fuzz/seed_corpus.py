@@ -1,4 +1,4 @@
-"""Regenerates fuzz/corpus/seed: the robots of robots/ and the URDF fixtures written as raw
+"""Regenerates fuzz/seeds: the robots of robots/ and the URDF fixtures written as raw
 strings in tests/it/*.rs (those without format placeholders), each at most 32 KiB."""
 
 import glob
@@ -7,7 +7,7 @@ import os
 import re
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-OUT = os.path.join(ROOT, "fuzz", "corpus", "seed")
+OUT = os.path.join(ROOT, "fuzz", "seeds")
 
 
 def main():

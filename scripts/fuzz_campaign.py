@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Black-box fuzz campaign on the restpose binary (docs/fuzzing.md).
 
-Structure-aware mutants of the committed corpus (fuzz/corpus/seed: robots/ and the tests'
+Structure-aware mutants of the committed corpus (fuzz/seeds: robots/ and the tests'
 fixtures) go through `check`, `analyze` and `verify` (on analyze's own JSON) with random
 options, each run under a time limit and a memory limit. Counted as faults:
   - panic: exit code 101, or death by a signal (other than the time limit's);
@@ -253,5 +253,5 @@ if __name__ == "__main__":
     ap.add_argument("--memory", type=int, default=4096, help="per run [MiB]")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--out", default="/tmp/restpose-campaign")
-    ap.add_argument("--corpus", nargs="*", default=[os.path.join(ROOT, "fuzz/corpus/seed")])
+    ap.add_argument("--corpus", nargs="*", default=[os.path.join(ROOT, "fuzz/seeds")])
     Campaign(ap.parse_args()).main()

@@ -96,8 +96,7 @@ fn attributes(text: &str) -> Vec<(usize, usize, usize, usize)> {
     while let Some(k) = text[i..].find("=\"") {
         let eq = i + k;
         let mut s = eq;
-        while s > 0 && (b[s - 1].is_ascii_alphanumeric() || b[s - 1] == b'_' || b[s - 1] == b':')
-        {
+        while s > 0 && (b[s - 1].is_ascii_alphanumeric() || b[s - 1] == b'_' || b[s - 1] == b':') {
             s -= 1;
         }
         let v0 = eq + 2;
@@ -313,8 +312,11 @@ impl Choices {
     }
 
     fn linear_algebra(&self) -> LinearAlgebra {
-        [LinearAlgebra::Auto, LinearAlgebra::Dense, LinearAlgebra::Sparse]
-            [self.linear_algebra as usize % 3]
+        [
+            LinearAlgebra::Auto,
+            LinearAlgebra::Dense,
+            LinearAlgebra::Sparse,
+        ][self.linear_algebra as usize % 3]
     }
 }
 
@@ -413,7 +415,7 @@ pub fn exercise(text: &str, choices: &Choices) -> Reached {
     }
 }
 
-/// The seed corpus committed in `fuzz/corpus/seed` (robots and the tests' fixtures).
+/// The seed corpus committed in `fuzz/seeds` (robots and the tests' fixtures).
 pub fn seeds(corpus: &std::path::Path) -> Vec<(String, String)> {
     let mut out: Vec<(String, String)> = std::fs::read_dir(corpus)
         .map(|d| {

@@ -75,7 +75,7 @@ pub(crate) fn bad_size(shape: &crate::geometry::ShapeKind) -> Option<(&'static s
         ShapeKind::Mesh { scale, .. } => {
             return scale
                 .iter()
-                .find(|v| !(v.abs() <= LARGEST_LENGTH))
+                .find(|v| !(v.is_finite() && v.abs() <= LARGEST_LENGTH))
                 .map(|&v| ("scale", v))
         }
     };

@@ -22,7 +22,7 @@ pub(crate) fn svd(
     compute_v: bool,
 ) -> Option<nalgebra::SVD<f64, nalgebra::Dyn, nalgebra::Dyn>> {
     // Entries beyond 1e150 square to overflow inside the bidiagonalization.
-    if m.iter().any(|x| !(x.abs() <= 1e150)) {
+    if m.iter().any(|x| !(x.is_finite() && x.abs() <= 1e150)) {
         return None;
     }
     let s = nalgebra::SVD::try_new(m, compute_u, compute_v, f64::EPSILON, 10_000)?;

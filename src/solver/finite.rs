@@ -24,11 +24,7 @@ pub(crate) fn guard(model: &Model, state: &State, at: &str) -> Result<()> {
     let mut phi = DVector::zeros(cons.len());
     let mut jac = Triplets::default();
     cons.evaluate(model, q, &mut phi, Some(&mut jac));
-    let bad_entry = jac
-        .entries
-        .iter()
-        .find(|e| !e.2.is_finite())
-        .map(|e| e.0);
+    let bad_entry = jac.entries.iter().find(|e| !e.2.is_finite()).map(|e| e.0);
     if let Some(r) = phi.iter().position(|x| !x.is_finite()).or(bad_entry) {
         let row = cons.row_name(r).to_string();
         return Err(Error::NonFiniteConstraint {

@@ -393,11 +393,7 @@ pub(crate) fn solve_round(
     if !out.eval.energy.total.is_finite() {
         return Err(Error::NonFiniteEnergy {
             at: format!("iteration {iteration} of the solve"),
-            term: crate::forces::finite::non_finite_term(
-                model,
-                &sys.problem.cons.branches,
-                &out.q,
-            ),
+            term: crate::forces::finite::non_finite_term(model, &sys.problem.cons.branches, &out.q),
         });
     }
     if let Some(i) = out.q.iter().position(|x| !x.is_finite()) {

@@ -308,7 +308,10 @@ fn loop_kind(src: &Source, node: Node) -> Result<JointKind> {
                 Some(l) => {
                     return Err(src.error(
                         node,
-                        format!("{}: a distance joint's `length` {l} is negative", src.describe(node)),
+                        format!(
+                            "{}: a distance joint's `length` {l} is negative",
+                            src.describe(node)
+                        ),
                     ))
                 }
                 None => {

@@ -157,7 +157,12 @@ pub(super) fn read(
             }
             let multiplier = src.f64_or(m, "multiplier", 1.0)?;
             let offset = src.f64_or(m, "offset", 0.0)?;
-            src.within(m, "multiplier", &[multiplier], crate::model::LARGEST_MAGNITUDE)?;
+            src.within(
+                m,
+                "multiplier",
+                &[multiplier],
+                crate::model::LARGEST_MAGNITUDE,
+            )?;
             src.within(m, "offset", &[offset], crate::model::LARGEST_LENGTH)?;
             b.model.add_mimic(Mimic {
                 joint: id,

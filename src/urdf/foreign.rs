@@ -6,7 +6,9 @@ use super::edges::drake_part;
 use super::import::Builder;
 use super::xml::{child, parse_f64, Source};
 use crate::error::Result;
-use crate::model::{ForceLaw, LARGEST_LENGTH, LARGEST_MAGNITUDE, JointSpring, Spring, SpringEnd, SpringMode};
+use crate::model::{
+    ForceLaw, JointSpring, Spring, SpringEnd, SpringMode, LARGEST_LENGTH, LARGEST_MAGNITUDE,
+};
 use roxmltree::Node;
 
 pub(super) fn read(src: &Source, drake: &[Node], gazebo: &[Node], b: &mut Builder) -> Result<()> {

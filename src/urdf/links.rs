@@ -61,10 +61,7 @@ fn read_geometry(
                 .vec3_opt(s, "size")?
                 .ok_or_else(|| src.error(s, format!("link `{link}`: <box> needs `size`")))?;
             if let Some(v) = size.iter().find(|v| **v < 0.0) {
-                return Err(src.error(
-                    s,
-                    format!("link `{link}`: <box> has a negative size {v}"),
-                ));
+                return Err(src.error(s, format!("link `{link}`: <box> has a negative size {v}")));
             }
             src.within(s, "size", size.as_slice(), LARGEST_LENGTH)?;
             ShapeKind::Box { size }

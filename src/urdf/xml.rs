@@ -182,7 +182,7 @@ impl<'a> Source<'a> {
     /// An error unless every value is within `±bound` (the importer's number ranges of
     /// [`crate::model::LARGEST_LENGTH`] and [`crate::model::LARGEST_MAGNITUDE`]).
     pub(crate) fn within(&self, node: Node, attr: &str, values: &[f64], bound: f64) -> Result<()> {
-        match values.iter().find(|v| !(v.abs() <= bound)) {
+        match values.iter().find(|v| !(v.is_finite() && v.abs() <= bound)) {
             None => Ok(()),
             Some(v) => Err(self.error(
                 node,
@@ -235,7 +235,8 @@ impl<'a> Source<'a> {
         let rot = if let Some(q) = self.array_opt::<4>(node, "quat_xyzw")? {
             // Scaled by its largest component first, so that the norm cannot overflow.
             let big = q.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-            let quat = nalgebra::Quaternion::new(q[3], q[0], q[1], q[2]) / big.max(f64::MIN_POSITIVE);
+            let quat =
+                nalgebra::Quaternion::new(q[3], q[0], q[1], q[2]) / big.max(f64::MIN_POSITIVE);
             if big == 0.0 {
                 return Err(self.error(
                     node,

@@ -1,7 +1,8 @@
-//! Issue 25, item 9: with its standard error closed (`restpose verify F --pose P 2>&1
-//! >/dev/null | head -c 0`), restpose panicked in `eprintln!` ("failed printing to stderr")
-//! and exited 101 whenever it printed a warning (7 runs in 8). Every line to standard error
-//! now ignores a closed pipe, as standard output already did: the command's own exit code.
+//! Issue 25, item 9: with its standard error closed
+//! (`restpose verify F --pose P 2>&1 >/dev/null | head -c 0`), restpose panicked in
+//! `eprintln!` ("failed printing to stderr") and exited 101 whenever it printed a warning
+//! (7 runs in 8). Every line to standard error now ignores a closed pipe, as standard output
+//! already did: the command's own exit code.
 
 use std::process::{Command, Stdio};
 

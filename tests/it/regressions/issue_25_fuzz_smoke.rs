@@ -18,7 +18,7 @@ use fuzz_lib::{apply, exercise, seeds, Choices, Dictionary, Mutation, Reached};
 use proptest::prelude::*;
 
 fn corpus() -> Vec<(String, String)> {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus/seed");
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds");
     seeds(&dir)
 }
 
@@ -44,13 +44,20 @@ fn the_corpus_is_seeded_and_the_dictionary_read() {
     let d = Dictionary::load();
     assert!(d.tags.iter().any(|t| t == "mech:spring"));
     assert!(d.numbers.iter().any(|n| n == "1e308"));
-    assert!(d.snippets.iter().all(|s| s.starts_with('<') && s.ends_with('>')));
+    assert!(d
+        .snippets
+        .iter()
+        .all(|s| s.starts_with('<') && s.ends_with('>')));
     // Every seed goes through the harness unmutated, and most reach verify.
     let verified = c
         .iter()
         .filter(|(_, t)| exercise(t, &Choices::default()) == Reached::Verified)
         .count();
-    assert!(verified * 2 >= c.len(), "{verified} of {} seeds verified", c.len());
+    assert!(
+        verified * 2 >= c.len(),
+        "{verified} of {} seeds verified",
+        c.len()
+    );
 }
 
 /// The issue's own mutants, through the harness.

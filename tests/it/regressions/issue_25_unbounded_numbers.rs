@@ -31,7 +31,9 @@ const BALL_ON_BOX: &str = r#"<robot name="ball_on_box" xmlns:mech="urn:urdf-mech
 
 /// Line and column (from 1) where `needle` starts in `text`.
 fn line_col(text: &str, needle: &str) -> (usize, usize) {
-    let at = text.find(needle).unwrap_or_else(|| panic!("{needle} not in the text"));
+    let at = text
+        .find(needle)
+        .unwrap_or_else(|| panic!("{needle} not in the text"));
     let line = text[..at].matches('\n').count() + 1;
     let col = at - text[..at].rfind('\n').map_or(0, |i| i + 1) + 1;
     (line, col)
@@ -64,14 +66,21 @@ fn refused_at(text: &str, element: &str, what: &str) {
 
 #[test]
 fn a_negative_box_size_is_refused_where_it_is_written() {
-    let text = edit(BALL_ON_BOX, r#"<box size="1 1 1"/>"#, r#"<box size="1 -1 1"/>"#);
+    let text = edit(
+        BALL_ON_BOX,
+        r#"<box size="1 1 1"/>"#,
+        r#"<box size="1 -1 1"/>"#,
+    );
     refused_at(&text, r#"<box size="1 -1 1"/>"#, "negative size -1");
 }
 
 #[test]
 fn spring_ends_beyond_the_length_bound_are_refused_where_they_are_written() {
     for (file, end) in [
-        ("four_bar_spatial.urdf", r#"<end link="coupler" xyz="0.21 0 0"/>"#),
+        (
+            "four_bar_spatial.urdf",
+            r#"<end link="coupler" xyz="0.21 0 0"/>"#,
+        ),
         ("slider_crank.urdf", r#"<end link="slider" xyz="0 0 0"/>"#),
     ] {
         for huge in ["1e308", "-1e308", "1e10"] {
@@ -97,17 +106,29 @@ fn every_length_statics_uses_is_bounded() {
         ),
         // An obstacle's collision origin.
         (
-            edit(BALL_ON_BOX, r#"<origin xyz="0.5 0 -0.8"/>"#, r#"<origin xyz="0.5 0 1e300"/>"#),
+            edit(
+                BALL_ON_BOX,
+                r#"<origin xyz="0.5 0 -0.8"/>"#,
+                r#"<origin xyz="0.5 0 1e300"/>"#,
+            ),
             r#"<origin xyz="0.5 0 1e300"/>"#,
         ),
         // An obstacle's size.
         (
-            edit(BALL_ON_BOX, r#"<box size="1 1 1"/>"#, r#"<box size="1 1e12 1"/>"#),
+            edit(
+                BALL_ON_BOX,
+                r#"<box size="1 1 1"/>"#,
+                r#"<box size="1 1e12 1"/>"#,
+            ),
             r#"<box size="1 1e12 1"/>"#,
         ),
         // A contact sphere's radius.
         (
-            edit(BALL_ON_BOX, r#"<sphere radius="0.1"/>"#, r#"<sphere radius="1e308"/>"#),
+            edit(
+                BALL_ON_BOX,
+                r#"<sphere radius="0.1"/>"#,
+                r#"<sphere radius="1e308"/>"#,
+            ),
             r#"<sphere radius="1e308"/>"#,
         ),
     ];
@@ -133,7 +154,11 @@ fn drake_points_pitch_and_distance_are_bounded() {
     assert!(load_str(drake, "t.urdf", &ImportOptions::default()).is_ok());
     let p = r#"<drake:linear_spring_damper_p_BQ value="1e308 -2 0"/>"#;
     refused_at(
-        &edit(drake, r#"<drake:linear_spring_damper_p_BQ value="-1 -2 0"/>"#, p),
+        &edit(
+            drake,
+            r#"<drake:linear_spring_damper_p_BQ value="-1 -2 0"/>"#,
+            p,
+        ),
         p,
         "outside the accepted range",
     );
@@ -143,10 +168,24 @@ fn drake_points_pitch_and_distance_are_bounded() {
         r#"<joint name="pivot" type="continuous"><parent link="world"/><child link="bar"/><axis xyz="0 0 1"/></joint>
   <mech:loop_joint name="nut" type="screw" pitch="1e300"><parent link="world"/><child link="bar"/></mech:loop_joint>"#,
     );
-    refused_at(&screw, r#"<mech:loop_joint name="nut""#, "outside the accepted range");
-    let rod = screw.replace(r#"type="screw" pitch="1e300""#, r#"type="distance" length="-1e300""#);
-    refused_at(&rod, r#"<mech:loop_joint name="nut""#, "outside the accepted range");
-    let rod = screw.replace(r#"type="screw" pitch="1e300""#, r#"type="distance" length="-1""#);
+    refused_at(
+        &screw,
+        r#"<mech:loop_joint name="nut""#,
+        "outside the accepted range",
+    );
+    let rod = screw.replace(
+        r#"type="screw" pitch="1e300""#,
+        r#"type="distance" length="-1e300""#,
+    );
+    refused_at(
+        &rod,
+        r#"<mech:loop_joint name="nut""#,
+        "outside the accepted range",
+    );
+    let rod = screw.replace(
+        r#"type="screw" pitch="1e300""#,
+        r#"type="distance" length="-1""#,
+    );
     refused_at(&rod, r#"<mech:loop_joint name="nut""#, "is negative");
 }
 
@@ -158,7 +197,11 @@ fn the_commands_refuse_the_issue_files_without_panic_or_hang() {
     let pose = dir.path().join("pose.json");
     std::fs::write(&pose, "{}").unwrap();
     let files = [
-        edit(BALL_ON_BOX, r#"<box size="1 1 1"/>"#, r#"<box size="1 -1 1"/>"#),
+        edit(
+            BALL_ON_BOX,
+            r#"<box size="1 1 1"/>"#,
+            r#"<box size="1 -1 1"/>"#,
+        ),
         edit(
             &robot("four_bar_spatial.urdf"),
             r#"<end link="coupler" xyz="0.21 0 0"/>"#,
@@ -185,7 +228,10 @@ fn the_commands_refuse_the_issue_files_without_panic_or_hang() {
                 .unwrap();
             let err = String::from_utf8_lossy(&o.stderr);
             assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
-            assert!(err.starts_with(&format!("error: {file}:")), "{args:?}: {err}");
+            assert!(
+                err.starts_with(&format!("error: {file}:")),
+                "{args:?}: {err}"
+            );
         }
     }
 }

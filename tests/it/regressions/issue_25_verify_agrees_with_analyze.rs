@@ -71,13 +71,21 @@ fn verify_accepts_what_analyze_reports_converged() {
         &tractor[at + "<joint".len()..end],
         &tractor[end + "</joint>".len()..]
     );
-    for (name, text) in [("pendulum", DISTANCE_PENDULUM.to_string()), ("tractor", renamed)] {
+    for (name, text) in [
+        ("pendulum", DISTANCE_PENDULUM.to_string()),
+        ("tractor", renamed),
+    ] {
         let file = dir.path().join(format!("{name}.urdf"));
         std::fs::write(&file, &text).unwrap();
         let result = dir.path().join(format!("{name}.json"));
         let (file, result) = (file.to_str().unwrap(), result.to_str().unwrap());
         let a = restpose(&["analyze", file, "-q", "--json", result]);
-        assert_eq!(a.status.code(), Some(0), "{}", String::from_utf8_lossy(&a.stderr));
+        assert_eq!(
+            a.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&a.stderr)
+        );
         let v = restpose(&["verify", file, "-q", "--pose", result]);
         assert_eq!(
             v.status.code(),

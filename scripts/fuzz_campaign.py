@@ -3,9 +3,9 @@
 
 Structure-aware mutants of the committed corpus (fuzz/seeds: robots/ and the tests'
 fixtures) go through `check`, `analyze` and `verify` (on analyze's own JSON) with random
-options, each run under a time limit and a memory limit. Counted as faults:
+options, each run under a CPU-time limit (a wall-clock cap behind it) and a memory limit. Counted as faults:
   - panic: exit code 101, or death by a signal (other than the time limit's);
-  - hang: a run that exceeds the time limit;
+  - hang: a run that exceeds the CPU-time limit (or the wall-clock cap);
   - non-finite: `NaN`/`inf` in any output, or a JSON number written as `null`;
   - disagreement: analyze exits 0 and verify rejects analyze's own JSON (exit 4).
 Each fault's input and command line are saved under OUT/faults/.
@@ -20,6 +20,7 @@ import random
 import re
 import resource
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -47,10 +48,12 @@ def non_finite(text):
     return NONFINITE_TEXT.findall(QUOTED.sub("", text))
 
 
-def limit_memory(bytes_):
+def limits(memory, cpu):
+    """Address space `memory` bytes and `cpu` seconds of CPU time (SIGXCPU, then SIGKILL):
+    on a loaded machine a CPU-time limit tells a hang from a slow start, a wall clock does not."""
     def apply():
-        resource.setrlimit(resource.RLIMIT_AS, (bytes_, bytes_))
-        os.nice(0)
+        resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+        resource.setrlimit(resource.RLIMIT_CPU, (int(cpu), int(cpu) + 5))
     return apply
 
 
@@ -134,9 +137,11 @@ class Campaign:
         self.counts["executions"] += 1
         try:
             p = subprocess.run(
-                cmd, capture_output=True, timeout=self.args.timeout,
-                preexec_fn=limit_memory(self.args.memory << 20), cwd=self.work,
+                cmd, capture_output=True, timeout=self.args.wall,
+                preexec_fn=limits(self.args.memory << 20, self.args.timeout), cwd=self.work,
             )
+            if p.returncode in (-signal.SIGXCPU, -signal.SIGKILL):
+                return None, p.stdout.decode(errors="replace"), p.stderr.decode(errors="replace")
             return p.returncode, p.stdout.decode(errors="replace"), p.stderr.decode(errors="replace")
         except subprocess.TimeoutExpired as e:
             return None, (e.stdout or b"").decode(errors="replace"), (e.stderr or b"").decode(errors="replace")
@@ -153,7 +158,8 @@ class Campaign:
 
     def judge(self, name, text, cmd, rc, out, err, json_path=None):
         if rc is None:
-            self.fault("hangs", name, text, cmd, f"over {self.args.timeout} s\n{err[-2000:]}")
+            self.fault("hangs", name, text, cmd,
+                       f"over {self.args.timeout} s of CPU or {self.args.wall} s of wall time\n{err[-2000:]}")
             return
         if rc == 101 or rc < 0:
             self.fault("panics", name, text, cmd, f"exit {rc}\n{err[-4000:]}")
@@ -249,7 +255,8 @@ if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--binary", default=os.path.join(ROOT, "target/release/restpose"))
     ap.add_argument("--minutes", type=float, default=30)
-    ap.add_argument("--timeout", type=float, default=20, help="per run [s]")
+    ap.add_argument("--timeout", type=float, default=20, help="CPU time per run [s]")
+    ap.add_argument("--wall", type=float, default=300, help="wall time per run [s]")
     ap.add_argument("--memory", type=int, default=4096, help="per run [MiB]")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--out", default="/tmp/restpose-campaign")

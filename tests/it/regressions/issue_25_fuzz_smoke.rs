@@ -90,7 +90,11 @@ fn the_issue_mutants_pass_the_harness() {
 
 proptest! {
     #![proptest_config(ProptestConfig {
-        cases: 96,
+        // 256 cases (a few seconds); `PROPTEST_CASES` sets another number.
+        cases: std::env::var("PROPTEST_CASES")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(256),
         failure_persistence: None,
         ..ProptestConfig::default()
     })]

@@ -449,6 +449,7 @@ pub(super) fn read(
         }
         Ok(id)
     };
+    b.file_start = (locks.clone(), initial.clone());
     for (name, dof, value) in &options.locks {
         let id = resolve(name, *dof, "lock")?;
         locks.retain(|l| !(l.joint == id && l.dof == *dof));

@@ -36,6 +36,9 @@ pub(super) struct Builder {
     pub(super) frames: FrameMap,
     pub(super) gravity_set: bool,
     pub(super) warnings: Vec<String>,
+    /// The file's own locks and initial values (`mech:lock`, `mech:initial`), before the
+    /// command line's overrides: the start at which `<child_origin auto>` frames are placed.
+    pub(super) file_start: (Vec<crate::model::Lock>, Vec<crate::model::Initial>),
 }
 
 impl Builder {
@@ -346,12 +349,18 @@ pub(super) fn import(
         frames: frames_map,
         gravity_set: false,
         warnings,
+        file_start: Default::default(),
     };
     extensions::read(&src, &ext, &urdf_joints, &mut b, options)?;
     super::foreign::read(&src, &drake_nodes, &gazebo_nodes, &mut b)?;
     if !auto_child.is_empty() {
-        // The child's joint frame that makes the joint hold at the initial guess.
-        let start = State::initial(b.model.partial());
+        // The child's joint frame that makes the joint hold at the file's initial guess: a
+        // `--initial` or `--lock` of the command line chooses a start or a held value, and
+        // does not move the joint in its links (`verify`, which has neither, then reads the
+        // same mechanism).
+        let mut own = b.model.partial().clone();
+        (own.locks, own.initial) = b.file_start.clone();
+        let start = State::initial(&own);
         for &ji in &auto_child {
             let Some(j) = b.model.joint(ji) else { continue };
             let pose =

@@ -197,6 +197,7 @@ class Campaign:
             os.remove(result)
         aopts = random_options(self.rng, "analyze", joints)
         cmd = [b, "analyze", path, "--json", result] + aopts
+        analyze_cmd = cmd
         rc, out, err = self.run(cmd)
         self.judge(name, text, cmd, rc, out, err, result)
         analyzed = rc
@@ -228,7 +229,8 @@ class Campaign:
         rc, out, err = self.run(cmd)
         self.judge(name, text, cmd, rc, out, err, vjson)
         if same and not locked and analyzed == 0 and rc == 4:
-            self.fault("disagreements", name, text, cmd, f"analyze exit 0, verify exit 4\n{err[-2000:]}")
+            self.fault("disagreements", name, text, cmd,
+                       f"analyze exit 0 ({' '.join(analyze_cmd)}), verify exit 4\n{err[-2000:]}")
 
     def report(self, started):
         c = dict(self.counts)

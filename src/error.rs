@@ -22,10 +22,13 @@ impl fmt::Display for SourceLocation {
     }
 }
 
-/// The joint an error is about, with where it is declared when the model came from a file.
+/// The joint an error is about (or the link, for a contact's row), with where it is declared
+/// when the model came from a file.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct JointSite {
-    /// Joint name.
+    /// What it is: `joint`, or `link` for a contact point's row.
+    pub kind: &'static str,
+    /// Joint name (the link's for a contact point's row).
     pub joint: String,
     /// The joint's element in the input file (`None` for a model built in code).
     pub at: Option<SourceLocation>,
@@ -34,8 +37,8 @@ pub struct JointSite {
 impl fmt::Display for JointSite {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match &self.at {
-            Some(at) => write!(f, "{at}: joint `{}` ({})", self.joint, at.element),
-            None => write!(f, "joint `{}`", self.joint),
+            Some(at) => write!(f, "{at}: {} `{}` ({})", self.kind, self.joint, at.element),
+            None => write!(f, "{} `{}`", self.kind, self.joint),
         }
     }
 }
@@ -144,11 +147,14 @@ pub enum Error {
     /// Nothing stores or releases energy while the mechanism can move: every pose is a rest
     /// pose.
     #[error(
-        "the potential energy of `{robot}` is constant: it has {dof} degree(s) of freedom but \
+        "{}the potential energy of `{robot}` is constant: it has {dof} degree(s) of freedom but \
          no moving body has mass under gravity and there is no spring, load or effort, so every \
-         pose is a rest pose (give the moving links <inertial> masses, or add springs)"
+         pose is a rest pose (give the moving links <inertial> masses, or add springs)",
+        prefix(file)
     )]
     ConstantEnergy {
+        /// The input file, when the model came from one.
+        file: Option<String>,
         /// Robot name.
         robot: String,
         /// Degrees of freedom.
@@ -231,6 +237,28 @@ pub enum Error {
         what: String,
         /// Iteration.
         iteration: usize,
+    },
+    /// The potential energy or its gradient is not finite at a configuration (a number of the
+    /// model too large for `f64` arithmetic): never reported as a result.
+    #[error(
+        "the potential energy is not finite at {at}: {term} gives a non-finite energy or force \
+         (a number of the model is too large to compute with)"
+    )]
+    NonFiniteEnergy {
+        /// Where (`the given pose`, `the initial guess`).
+        at: String,
+        /// The term that is not finite there (`spring `s``, `gravity on body `b``).
+        term: String,
+    },
+    /// The constraints are not finite at a configuration.
+    #[error("{}the constraint `{row}` is not finite at {at}", prefix(site))]
+    NonFiniteConstraint {
+        /// The joint (or contact link) of that row and where it is declared.
+        site: Option<Box<JointSite>>,
+        /// The row.
+        row: String,
+        /// Where (`the given pose`).
+        at: String,
     },
     /// `verify` on the sparse path: holding every tree-joint coordinate makes model rows
     /// redundant, so the joints' efforts cannot be told apart from the loop reactions.

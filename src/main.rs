@@ -21,7 +21,7 @@ fn main() -> ExitCode {
         Err(e) => {
             // The library's hint for a package directory, as the option that gives it.
             let hint = restpose::geometry::UNKNOWN_PACKAGE_HINT;
-            eprintln!(
+            cli::print::note!(
                 "error: {}",
                 format!("{e:#}").replace(hint, "use --package NAME=DIR")
             );

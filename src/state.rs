@@ -62,6 +62,18 @@ impl State {
     /// Forward kinematics along the spanning tree with the given joint values (missing
     /// coordinates are zero). Bodies not reached from the world start at the identity.
     pub fn from_joint_values(model: &Model, values: &JointValues) -> State {
+        State::from_joint_values_and_bodies(model, values, &[])
+    }
+
+    /// [`State::from_joint_values`] with the world poses of some bodies given: they are placed
+    /// there, and their subtrees from them. A pose file needs them for a body that a tree
+    /// joint without coordinates places (a distance or point-on-line joint, which leaves the
+    /// body free to move but reports no value).
+    pub fn from_joint_values_and_bodies(
+        model: &Model,
+        values: &JointValues,
+        bodies: &[(BodyId, Isometry3<f64>)],
+    ) -> State {
         let mut s = State {
             q: DVector::zeros(model.coordinate_count()),
             branches: Branches::default(),
@@ -100,6 +112,12 @@ impl State {
                 }
             }
         }
+        for (b, pose) in bodies {
+            if b.0 < model.bodies.len() {
+                s.set_body_pose(*b, pose);
+                placed[b.0] = true;
+            }
+        }
         let mut changed = true;
         while changed {
             changed = false;
@@ -124,6 +142,18 @@ impl State {
             }
         }
         s
+    }
+
+    /// The bodies a tree joint without coordinates places (distance, point-on-line): their
+    /// poses are not carried by joint values (see [`State::from_joint_values_and_bodies`]).
+    pub fn bodies_without_values(model: &Model) -> Vec<BodyId> {
+        model
+            .joints
+            .iter()
+            .filter(|j| j.tree && !j.merged)
+            .filter(|j| matches!(j.kind, JointKind::Distance { .. } | JointKind::PointOnLine))
+            .filter_map(|j| j.bodies[1])
+            .collect()
     }
 
     /// The initial guess: forward kinematics with the model's initial values (see

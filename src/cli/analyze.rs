@@ -28,7 +28,7 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
         }
         if a.verbose {
             for i in &loaded.ignored {
-                eprintln!("ignored: {}:{i}", a.file.display());
+                super::print::note!("ignored: {}:{i}", a.file.display());
             }
         }
     }
@@ -58,6 +58,14 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
         e => e.into(),
     })?;
     report.diagnostics.timings.import = import;
+    // Never converged on a pose `verify` rejects (module `confirm`).
+    let rejected = report
+        .converged()
+        .then(|| super::confirm::rejection(a, model, &state))
+        .flatten();
+    if rejected.is_some() {
+        report.termination = restpose::solver::Termination::RejectedByVerify;
+    }
     let export_started = std::time::Instant::now();
     let mut result = AnalysisResult::new(model, &state, &report);
     result.diagnostics.timings.export = export_started.elapsed().as_secs_f64();
@@ -88,7 +96,7 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
         || a.formats.write_mujoco_key.is_some()
         || a.formats.write_srdf.is_some()
     {
-        eprintln!(
+        super::print::note!(
             "note: --write-urdf / --write-joint-states / --write-mujoco-key / --write-srdf are \
              written only for a converged rest pose"
         );
@@ -96,8 +104,15 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
     if !a.quiet && a.stdout_outputs().is_empty() {
         print::analysis(&result);
     }
+    if let Some(why) = &rejected {
+        super::print::note!(
+            "error: {}: the solver's answer fails verify's independent checks ({why}); not reported as a rest pose",
+            a.file.display()
+        );
+        return Ok(exit::NOT_CONVERGED);
+    }
     if !result.converged {
-        eprintln!(
+        super::print::note!(
             "error: {}: did not converge ({}) after {} iterations; ‖∂V/∂v‖∞ = {:.3e}, ‖Φ‖∞ = {:.3e}, corrector failures {}, step halvings {}, re-partitions {}",
             a.file.display(),
             result.termination,
@@ -109,7 +124,7 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
             result.diagnostics.repartitions
         );
         if !result.diagnostics.free_directions.is_empty() {
-            eprintln!(
+            super::print::note!(
                 "  the energy falls without bound along: {}",
                 result.diagnostics.free_directions.join(", ")
             );

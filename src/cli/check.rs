@@ -32,14 +32,22 @@ pub(crate) fn run(a: &CheckArgs) -> anyhow::Result<u8> {
         }
         if a.verbose {
             for i in &s.ignored {
-                eprintln!("ignored: {}:{i}", a.file.display());
+                super::print::note!("ignored: {}:{i}", a.file.display());
             }
         }
     }
-    let code = if s.assembly_error.is_some() {
-        exit::INPUT
-    } else {
-        0
+    // Exit 1 always comes with an `error:` line on standard error (whatever the format).
+    let code = match &s.assembly_error {
+        Some(e) => {
+            let file = a.file.display().to_string();
+            if e.starts_with(&file) {
+                super::print::note!("error: {e}");
+            } else {
+                super::print::note!("error: {file}: {e}");
+            }
+            exit::INPUT
+        }
+        None => 0,
     };
     Ok(code)
 }

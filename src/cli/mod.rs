@@ -5,6 +5,7 @@
 pub(crate) mod analyze;
 pub(crate) mod args;
 pub(crate) mod check;
+pub(crate) mod confirm;
 pub(crate) mod exit;
 pub(crate) mod formats;
 pub(crate) mod generate;

@@ -15,6 +15,16 @@ macro_rules! out {
 }
 pub(crate) use out;
 
+/// `eprintln!` that ignores a closed standard error (EPIPE: `restpose … 2>&1 | head -c 0`)
+/// instead of panicking: the exit code stays the command's own.
+macro_rules! note {
+    ($($arg:tt)*) => {{
+        use std::io::Write;
+        let _ = writeln!(std::io::stderr().lock(), $($arg)*);
+    }};
+}
+pub(crate) use note;
+
 /// Whether an output path means standard output (`-`).
 pub(crate) fn is_stdout(path: Option<&std::path::PathBuf>) -> bool {
     path.is_some_and(|p| p.as_os_str() == "-")
@@ -39,7 +49,7 @@ pub(crate) fn warning(w: &str) {
         .nth(1)
         .and_then(|rest| rest.split('`').next())
         .unwrap_or("NAME");
-    eprintln!(
+    note!(
         "warning: {}",
         w.replace(hint, &format!("use --package {package}=DIR"))
     );

@@ -83,7 +83,13 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
         }
         None => model,
     };
-    let (state, missing) = restpose::verify::pose_state(model, &values)?;
+    // The bodies joint values cannot place (a distance or point-on-line tree joint) from the
+    // result JSON's `links`, as `analyze` wrote them.
+    let bodies = match a.pose.as_deref() {
+        Some(p) => given_bodies(model, p),
+        None => Vec::new(),
+    };
+    let (state, missing) = restpose::verify::pose_state_with_bodies(model, &values, &bodies)?;
     let held;
     let model = if locks.is_empty() {
         model
@@ -108,7 +114,7 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
         &held
     };
     if !a.quiet && !missing.is_empty() {
-        eprintln!(
+        super::print::note!(
             "warning: joints not in the pose keep their initial values: {}",
             missing.join(", ")
         );
@@ -146,9 +152,59 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
         return Ok(0);
     }
     for line in report::failures(&v.unilateral.failures) {
-        eprintln!("{}: not a rest pose: {line}", a.file.display());
+        super::print::note!("{}: not a rest pose: {line}", a.file.display());
     }
     Ok(exit::NOT_BALANCED)
+}
+
+/// The world pose of the link named like body `b` in a result JSON (`links.NAME.position`
+/// and `orientation_wxyz`), as the pose of the body.
+fn link_pose(
+    model: &restpose::Model,
+    json: &serde_json::Value,
+    b: restpose::model::BodyId,
+) -> Option<nalgebra::Isometry3<f64>> {
+    let body = model.bodies.get(b.index())?;
+    let link = json.get("links")?.get(&body.name)?;
+    let v = |key: &str, n: usize| -> Option<Vec<f64>> {
+        let a = link.get(key)?.as_array()?;
+        let v: Option<Vec<f64>> = a.iter().map(|x| x.as_f64()).collect();
+        v.filter(|v| v.len() == n && v.iter().all(|x| x.is_finite()))
+    };
+    let (p, o) = (v("position", 3)?, v("orientation_wxyz", 4)?);
+    let q = nalgebra::Quaternion::new(o[0], o[1], o[2], o[3]);
+    let body_from_link = model.link(&body.name)?.body_from_link;
+    (q.norm() > 0.0).then(|| {
+        nalgebra::Isometry3::from_parts(
+            nalgebra::Translation3::new(p[0], p[1], p[2]),
+            nalgebra::UnitQuaternion::from_quaternion(q),
+        ) * body_from_link.inverse()
+    })
+}
+
+/// The pose file as JSON, when it is one.
+fn read_json(path: &std::path::Path) -> Option<serde_json::Value> {
+    let text = std::fs::read_to_string(path).ok()?;
+    serde_json::from_str(&text).ok()
+}
+
+/// The world poses of the bodies joint values cannot place
+/// ([`restpose::State::bodies_without_values`]) in a result JSON `path`.
+fn given_bodies(
+    model: &restpose::Model,
+    path: &std::path::Path,
+) -> Vec<(restpose::model::BodyId, nalgebra::Isometry3<f64>)> {
+    let wanted = restpose::State::bodies_without_values(model);
+    if wanted.is_empty() {
+        return Vec::new();
+    }
+    let Some(json) = read_json(path) else {
+        return Vec::new();
+    };
+    wanted
+        .into_iter()
+        .filter_map(|b| link_pose(model, &json, b).map(|p| (b, p)))
+        .collect()
 }
 
 /// The pose of the floating root link in a result JSON `path` (`links.ROOT.position` and

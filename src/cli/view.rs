@@ -15,10 +15,10 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
     };
     args.quiet = true;
     let code = analyze::run(&args)?;
-    eprintln!("wrote {}", rrd.display());
+    super::print::note!("wrote {}", rrd.display());
     match std::process::Command::new("rerun").arg(&rrd).spawn() {
-        Ok(_) => eprintln!("opened it in the rerun viewer"),
-        Err(_) => eprintln!(
+        Ok(_) => super::print::note!("opened it in the rerun viewer"),
+        Err(_) => super::print::note!(
             "the `rerun` viewer is not on the PATH: `pip install rerun-sdk==0.36.3`, then `rerun {}`",
             rrd.display()
         ),

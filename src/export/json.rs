@@ -111,7 +111,8 @@ pub struct AnalysisResult {
     pub robot: String,
     /// Whether the solve converged.
     pub converged: bool,
-    /// Why it stopped (`converged`, `max_iterations`, `line_search_failed`, `unbounded`).
+    /// Why it stopped (`converged`, `max_iterations`, `line_search_failed`, `unbounded`,
+    /// `active_set_cycling`, `rejected_by_verify`).
     pub termination: String,
     /// Minimizer iterations.
     pub iterations: usize,

@@ -7,6 +7,7 @@
 //!   [`crate::kinematics`]: never wrapped into (−π, π]),
 //! - dead loads `W = fᵀ r_P`, joint efforts `W = τ θ`.
 
+pub(crate) mod finite;
 pub(crate) mod law;
 
 use crate::jet::{closed, pair_of, scatter, Pair, Scalar};

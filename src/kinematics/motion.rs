@@ -7,7 +7,7 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3, Vector4};
 
 /// Relative motion of a joint of this kind in its joint frame for coordinates `v` (see
 /// [`JointKind::value_counts`]; missing values are 0). Angles are taken as given: `Rz(θ)`
-/// for any real `θ`.
+/// for any real `θ`. A distance joint (no coordinate) holds its child at `length` along −z.
 pub(crate) fn motion(kind: JointKind, v: &[f64]) -> Isometry3<f64> {
     let at = |i: usize| v.get(i).copied().unwrap_or(0.0);
     let rz = |a: f64| UnitQuaternion::from_axis_angle(&Vector3::z_axis(), a);
@@ -38,8 +38,13 @@ pub(crate) fn motion(kind: JointKind, v: &[f64]) -> Isometry3<f64> {
         JointKind::Floating => {
             Isometry3::from_parts(t(at(0), at(1), at(2)), rotvec(at(3), at(4), at(5)))
         }
-        JointKind::Fixed | JointKind::Distance { .. } | JointKind::PointOnLine => {
-            Isometry3::identity()
+        // A distance joint placed as a tree edge: the child's point `length` below the
+        // parent's along the joint frame's −z (hanging, as a URDF chain does under the default
+        // gravity), where the rod's row `‖d‖² − L²` holds and its gradient `2 d` is not zero;
+        // at the parent's point (`d = 0`) the row would be violated and its gradient vanish.
+        JointKind::Distance { length } => {
+            Isometry3::from_parts(t(0.0, 0.0, -length), UnitQuaternion::identity())
         }
+        JointKind::Fixed | JointKind::PointOnLine => Isometry3::identity(),
     }
 }

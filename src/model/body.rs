@@ -50,4 +50,7 @@ pub struct Link {
     pub visuals: Vec<crate::geometry::Geometry>,
     /// `<collision>` geometry, in the link frame.
     pub collisions: Vec<crate::geometry::Geometry>,
+    /// The link's element in the input file (`None` for a model built in code): errors about
+    /// its contact points name it.
+    pub source: Option<crate::error::SourceLocation>,
 }

@@ -123,6 +123,7 @@ impl ModelBuilder {
             body_from_link,
             visuals,
             collisions,
+            source: None,
         });
         self.inertials.push(inertial);
         self.no_gravity.push(false);
@@ -201,12 +202,13 @@ impl ModelBuilder {
     pub fn build(mut self) -> Result<Model> {
         self.validate()?;
         aggregate_mass(&mut self.model, &self.inertials, &self.no_gravity);
+        // The numbers first: the contact points are computed from the checked shapes.
+        self.model.check_numbers()?;
         self.model.contact_points = super::contact::points(&self.model, &self.contacts)?;
         self.model.length_scale = length_scale(&self.model);
         // The builder's map of the joints pushed (the first of a name wins; joints are never
         // renamed or removed once pushed), moved rather than rebuilt.
         self.model.joint_names = std::mem::take(&mut self.joint_names);
-        self.model.check_numbers()?;
         Ok(self.model)
     }
 }

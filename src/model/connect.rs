@@ -122,6 +122,13 @@ impl ModelBuilder {
         }
     }
 
+    /// Records where link `link` (an index of [`ModelBuilder::add_link`]) is declared.
+    pub fn set_link_source(&mut self, link: usize, source: SourceLocation) {
+        if let Some(l) = self.model.links.get_mut(link) {
+            l.source = Some(source);
+        }
+    }
+
     /// Replaces the child-side joint frame of `joint` (a loop joint closed at the initial
     /// guess).
     pub fn set_child_frame(&mut self, joint: JointId, child_from_joint: Isometry3<f64>) {

@@ -46,6 +46,12 @@ impl Obstacle {
         world_from_shape: Isometry3<f64>,
         shape: &ShapeKind,
     ) -> Result<Self, String> {
+        if let Some((attribute, value)) = super::numeric::bad_size(shape) {
+            return Err(format!(
+                "its {attribute} {value:e} is negative or larger than {:e} m",
+                super::LARGEST_LENGTH
+            ));
+        }
         let hull = match shape {
             ShapeKind::Mesh {
                 path: Some(path),

@@ -11,14 +11,34 @@ impl Model {
     /// The joint `id` and its element in the input file.
     pub fn joint_site(&self, id: JointId) -> Option<JointSite> {
         self.joints.get(id.0).map(|j| JointSite {
+            kind: "joint",
             joint: j.name.clone(),
             at: j.source.clone(),
         })
     }
 
-    /// The joint of the constraint row named `row` (`None` for a normalization row or a name
-    /// that is no joint row of this model).
+    /// The file the model was read from (`None` for a model built in code).
+    pub fn source_file(&self) -> Option<String> {
+        let links = self.links.iter().filter_map(|l| l.source.as_ref());
+        let joints = self.joints.iter().filter_map(|j| j.source.as_ref());
+        links.chain(joints).next().map(|s| s.file.clone())
+    }
+
+    /// The joint of the constraint row named `row`, or the link of a contact point's row
+    /// (`link.contact[k]@ground`); `None` for a normalization row or a name that is no joint
+    /// or contact row of this model.
     pub fn row_site(&self, row: &str) -> Option<JointSite> {
+        if let Some((link, _)) = row
+            .split_once('@')
+            .and_then(|(head, _)| head.rsplit_once(".contact["))
+        {
+            let l = self.link(link)?;
+            return Some(JointSite {
+                kind: "link",
+                joint: l.name.clone(),
+                at: l.source.clone(),
+            });
+        }
         let (joint, suffix) = row.rsplit_once('.')?;
         if suffix == "normalization" {
             return None;

@@ -184,6 +184,7 @@ pub(crate) fn project(
             Err(Error::Inconsistent {
                 site: model
                     .row_site(sys.problem.cons.row_name(start))
+                    .or_else(|| model.row_site(sys.problem.cons.row_name(row)))
                     .map(Box::new),
                 row: sys.problem.cons.row_name(row).to_string(),
                 residual,

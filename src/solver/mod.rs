@@ -20,6 +20,7 @@
 //!   (1985) 451–464.
 
 mod assemble;
+pub(crate) mod finite;
 mod inequality;
 mod kkt_direction;
 mod load_steps;
@@ -40,6 +41,7 @@ pub use report::{
     ActiveLimit, Contact, ContactState, Diagnostics, Iterate, Mode, Reaction, Report, Sizes,
     Stability, Termination, Timings, Verdict,
 };
+pub(crate) use stability::eigen;
 pub(crate) use stability::verdict::{stability_of, stability_on, stability_verdict};
 
 use crate::constraints::unilateral::Active;
@@ -201,6 +203,7 @@ pub(crate) fn solve_round(
     }
     if dof0 > 0 && !crate::forces::has_energy(model) {
         return Err(Error::ConstantEnergy {
+            file: model.source_file(),
             robot: model.name.clone(),
             dof: dof0,
         });
@@ -218,9 +221,9 @@ pub(crate) fn solve_round(
     };
     let iteration = out.history.last().map_or(0, |h| h.iteration);
     if !out.eval.energy.total.is_finite() {
-        return Err(Error::NonFinite {
-            what: "potential energy".into(),
-            iteration,
+        return Err(Error::NonFiniteEnergy {
+            at: format!("iteration {iteration} of the solve"),
+            term: crate::forces::finite::non_finite_term(model, &sys.problem.cons.branches, &out.q),
         });
     }
     if let Some(i) = out.q.iter().position(|x| !x.is_finite()) {

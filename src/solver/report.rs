@@ -17,6 +17,10 @@ pub enum Termination {
     Unbounded,
     /// The active set of joint stops and contacts kept changing (`max_iterations` changes).
     ActiveSetCycling,
+    /// The solver's own tests passed but the independent checks of `verify` reject the pose
+    /// (set by their caller: `restpose analyze` runs them on every answer before it reports it
+    /// converged).
+    RejectedByVerify,
 }
 
 impl Termination {
@@ -28,6 +32,7 @@ impl Termination {
             Termination::LineSearchFailed => "line_search_failed",
             Termination::Unbounded => "unbounded",
             Termination::ActiveSetCycling => "active_set_cycling",
+            Termination::RejectedByVerify => "rejected_by_verify",
         }
     }
 }

@@ -233,7 +233,7 @@ pub(super) fn drake_joint<'a>(
                 .children()
                 .find(|c| c.is_element() && c.tag_name().name() == "screw_thread_pitch")
                 .ok_or_else(|| src.error(node, format!("drake joint `{name}`: a screw joint needs <drake:screw_thread_pitch value>")))?;
-            let per_rev = src.f64_opt(p, "value")?.ok_or_else(|| src.error(p, "<drake:screw_thread_pitch> needs `value`"))?;
+            let per_rev = src.length_opt(p, "value")?.ok_or_else(|| src.error(p, "<drake:screw_thread_pitch> needs `value`"))?;
             JointKind::Screw { pitch: per_rev / (2.0 * std::f64::consts::PI) }
         }
         other => {
@@ -277,15 +277,27 @@ fn loop_kind(src: &Source, node: Node) -> Result<JointKind> {
         "spherical" | "ball" => JointKind::Spherical,
         "planar" => JointKind::Planar,
         "screw" => JointKind::Screw {
-            pitch: src.f64_or(node, "pitch", 0.0)?,
+            pitch: src.length_opt(node, "pitch")?.unwrap_or(0.0),
         },
         "distance" => JointKind::Distance {
-            length: src.f64_opt(node, "length")?.ok_or_else(|| {
-                src.error(
-                    node,
-                    format!("{}: a distance joint needs `length`", src.describe(node)),
-                )
-            })?,
+            length: match src.length_opt(node, "length")? {
+                Some(l) if l >= 0.0 => l,
+                Some(l) => {
+                    return Err(src.error(
+                        node,
+                        format!(
+                            "{}: a distance joint's `length` {l} is negative",
+                            src.describe(node)
+                        ),
+                    ))
+                }
+                None => {
+                    return Err(src.error(
+                        node,
+                        format!("{}: a distance joint needs `length`", src.describe(node)),
+                    ))
+                }
+            },
         },
         "point_on_line" => JointKind::PointOnLine,
         other => {
@@ -412,7 +424,7 @@ pub(super) fn drake_ball_constraint<'a>(
         .map_or_else(|| format!("ball_constraint_{index}"), str::to_string);
     let point = |tag: &str| -> Result<Isometry3<f64>> {
         let (c, _) = drake_part(src, node, tag, "value")?;
-        let p = src.vec3_opt(c, "value")?.unwrap_or_default();
+        let p = src.position_or(c, "value", Vector3::zeros())?;
         Ok(Isometry3::translation(p.x, p.y, p.z))
     };
     let (na, a) = drake_part(src, node, "ball_constraint_body_A", "name")?;

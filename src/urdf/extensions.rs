@@ -155,11 +155,20 @@ pub(super) fn read(
                 b.warnings.push(w);
                 continue;
             }
+            let multiplier = src.f64_or(m, "multiplier", 1.0)?;
+            let offset = src.f64_or(m, "offset", 0.0)?;
+            src.within(
+                m,
+                "multiplier",
+                &[multiplier],
+                crate::model::LARGEST_MAGNITUDE,
+            )?;
+            src.within(m, "offset", &[offset], crate::model::LARGEST_LENGTH)?;
             b.model.add_mimic(Mimic {
                 joint: id,
                 reference,
-                multiplier: src.f64_or(m, "multiplier", 1.0)?,
-                offset: src.f64_or(m, "offset", 0.0)?,
+                multiplier,
+                offset,
             });
         }
     }
@@ -218,8 +227,8 @@ pub(super) fn read(
                 let mut se = Vec::new();
                 for e in ends {
                     let (body, bfl) = b.link_ref(src, e, "link")?;
-                    let p =
-                        bfl * nalgebra::Point3::from(src.vec3_or(e, "xyz", Vector3::zeros())?);
+                    let p = bfl
+                        * nalgebra::Point3::from(src.position_or(e, "xyz", Vector3::zeros())?);
                     se.push(SpringEnd {
                         body,
                         point: p.coords,
@@ -249,6 +258,9 @@ pub(super) fn read(
                 };
                 let law = force_law(src, n, &format!("spring `{name}`"))?;
                 let ends = [se[0].clone(), se[1].clone()];
+                if let Some(w) = super::foreign::coincident_ends(&name, &ends) {
+                    b.warnings.push(src.warning(n, w));
+                }
                 b.model.add_spring(Spring {
                     name,
                     ends,
@@ -284,7 +296,7 @@ pub(super) fn read(
                 }
                 let (body, bfl) = b.link_ref(src, n, "link")?;
                 let point =
-                    bfl * nalgebra::Point3::from(src.vec3_or(n, "xyz", Vector3::zeros())?);
+                    bfl * nalgebra::Point3::from(src.position_or(n, "xyz", Vector3::zeros())?);
                 let force = src.vec3_or(n, "force", Vector3::zeros())?;
                 if let Some(body) = body {
                     b.model.add_load(Load {
@@ -317,8 +329,8 @@ pub(super) fn read(
             }
             "ground" => {
                 let name = n.attribute("name").unwrap_or("floor");
-                let origin = src.vec3_or(n, "xyz", Vector3::zeros())?;
-                let normal = src.vec3_or(n, "normal", Vector3::z())?;
+                let origin = src.position_or(n, "xyz", Vector3::zeros())?;
+                let normal = src.position_or(n, "normal", Vector3::z())?;
                 b.model
                     .add_ground(name, origin, normal)
                     .map_err(|e| src.error(n, e.to_string()))?;
@@ -437,6 +449,7 @@ pub(super) fn read(
         }
         Ok(id)
     };
+    b.file_start = (locks.clone(), initial.clone());
     for (name, dof, value) in &options.locks {
         let id = resolve(name, *dof, "lock")?;
         locks.retain(|l| !(l.joint == id && l.dof == *dof));

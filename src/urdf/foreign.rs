@@ -6,7 +6,9 @@ use super::edges::drake_part;
 use super::import::Builder;
 use super::xml::{child, parse_f64, Source};
 use crate::error::Result;
-use crate::model::{ForceLaw, JointSpring, Spring, SpringEnd, SpringMode};
+use crate::model::{
+    ForceLaw, JointSpring, Spring, SpringEnd, SpringMode, LARGEST_LENGTH, LARGEST_MAGNITUDE,
+};
 use roxmltree::Node;
 
 pub(super) fn read(src: &Source, drake: &[Node], gazebo: &[Node], b: &mut Builder) -> Result<()> {
@@ -18,20 +20,29 @@ pub(super) fn read(src: &Source, drake: &[Node], gazebo: &[Node], b: &mut Builde
         let name = n
             .attribute("name")
             .map_or_else(|| format!("linear_spring_damper_{k}"), str::to_string);
-        let value = |tag: &str| -> Result<f64> {
+        // A number within `±bound`, not negative unless `signed`, at its element.
+        let value = |tag: &str, bound: f64, signed: bool| -> Result<f64> {
             let (c, v) = drake_part(src, n, tag, "value")?;
-            parse_f64(v).ok_or_else(|| {
+            let x = parse_f64(v).ok_or_else(|| {
                 src.error(
                     c,
                     format!("<drake:{tag}> value \"{v}\" is not a finite number"),
                 )
-            })
+            })?;
+            if !signed && x < 0.0 {
+                return Err(src.error(
+                    c,
+                    format!("spring `{name}`: <drake:{tag}> value {x} is negative"),
+                ));
+            }
+            src.within(c, "value", &[x], bound)?;
+            Ok(x)
         };
         let end = |body: &str, point: &str| -> Result<SpringEnd> {
             let (c, _) = drake_part(src, n, body, "name")?;
             let (body, bfl) = b.link_ref(src, c, "name")?;
             let (pc, _) = drake_part(src, n, point, "value")?;
-            let p = src.vec3_opt(pc, "value")?.unwrap_or_default();
+            let p = src.position_or(pc, "value", nalgebra::Vector3::zeros())?;
             Ok(SpringEnd {
                 body,
                 point: (bfl * nalgebra::Point3::from(p)).coords,
@@ -41,8 +52,11 @@ pub(super) fn read(src: &Source, drake: &[Node], gazebo: &[Node], b: &mut Builde
             end("linear_spring_damper_body_A", "linear_spring_damper_p_AP")?,
             end("linear_spring_damper_body_B", "linear_spring_damper_p_BQ")?,
         ];
-        let free_length = value("linear_spring_damper_free_length")?;
-        let stiffness = value("linear_spring_damper_stiffness")?;
+        if let Some(w) = coincident_ends(&name, &ends) {
+            b.warnings.push(src.warning(n, w));
+        }
+        let free_length = value("linear_spring_damper_free_length", LARGEST_LENGTH, false)?;
+        let stiffness = value("linear_spring_damper_stiffness", LARGEST_MAGNITUDE, false)?;
         b.model.add_spring(Spring {
             name,
             ends,
@@ -92,4 +106,18 @@ pub(super) fn read(src: &Source, drake: &[Node], gazebo: &[Node], b: &mut Builde
         });
     }
     Ok(())
+}
+
+/// The warning for a spring whose two ends are the same point of the same body (or both of
+/// the world): its length is zero in every pose, so its force has no direction and it stores
+/// a constant energy.
+pub(super) fn coincident_ends(name: &str, ends: &[SpringEnd; 2]) -> Option<String> {
+    let [a, b] = ends;
+    let scale = a.point.amax().max(b.point.amax()).max(1.0);
+    (a.body == b.body && (a.point - b.point).amax() <= 1e-12 * scale).then(|| {
+        format!(
+            "spring `{name}`: both ends are the same point of the same {}: its length is zero in every pose and its force has no direction (it does nothing)",
+            if a.body.is_some() { "body" } else { "world frame" }
+        )
+    })
 }

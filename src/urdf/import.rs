@@ -36,6 +36,9 @@ pub(super) struct Builder {
     pub(super) frames: FrameMap,
     pub(super) gravity_set: bool,
     pub(super) warnings: Vec<String>,
+    /// The file's own locks and initial values (`mech:lock`, `mech:initial`), before the
+    /// command line's overrides: the start at which `<child_origin auto>` frames are placed.
+    pub(super) file_start: (Vec<crate::model::Lock>, Vec<crate::model::Initial>),
 }
 
 impl Builder {
@@ -293,6 +296,7 @@ pub(super) fn import(
             l.visuals,
             l.collisions,
         );
+        model.set_link_source(i, src.location(link_nodes[i]));
     }
 
     // Joints, in document order by kind of element.
@@ -345,13 +349,19 @@ pub(super) fn import(
         frames: frames_map,
         gravity_set: false,
         warnings,
+        file_start: Default::default(),
     };
     extensions::read(&src, &ext, &urdf_joints, &mut b, options)?;
     super::foreign::read(&src, &drake_nodes, &gazebo_nodes, &mut b)?;
     super::servo::add(&mut b, options)?;
     if !auto_child.is_empty() {
-        // The child's joint frame that makes the joint hold at the initial guess.
-        let start = State::initial(b.model.partial());
+        // The child's joint frame that makes the joint hold at the file's initial guess: a
+        // `--initial` or `--lock` of the command line chooses a start or a held value, and
+        // does not move the joint in its links (`verify`, which has neither, then reads the
+        // same mechanism).
+        let mut own = b.model.partial().clone();
+        (own.locks, own.initial) = b.file_start.clone();
+        let start = State::initial(&own);
         for &ji in &auto_child {
             let Some(j) = b.model.joint(ji) else { continue };
             let pose =
@@ -374,8 +384,12 @@ pub(super) fn import(
 
 /// Places a [`crate::Error::InvalidNumber`] of the built model at its element in the file: the
 /// element named by it (a `name`, `joint` or `link` attribute), at its child element named
-/// like the attribute when it has one (`<mass>`, `<inertia>`), else at `<robot>`.
+/// like the attribute when it has one (`<mass>`, `<inertia>`), else at `<robot>`. An
+/// [`crate::Error::Model`] is placed by [`locate_model`].
 fn locate_invalid(src: &Source, robot: Node, e: crate::Error) -> crate::Error {
+    if let crate::Error::Model(message) = &e {
+        return locate_model(src, robot, message);
+    }
     let crate::Error::InvalidNumber {
         name, attribute, ..
     } = &e
@@ -401,4 +415,39 @@ fn locate_invalid(src: &Source, robot: Node, e: crate::Error) -> crate::Error {
         .or(element)
         .unwrap_or(robot);
     src.error(node, e.to_string())
+}
+
+/// Places a builder's message about an element (`link `arm` is selected for contact but has
+/// no <collision> geometry`, `spring `s` …`) at that element: the first ``KIND `NAME` `` of
+/// the message names it; a link's contact problem is placed at its `<mech:contact>`.
+fn locate_model(src: &Source, robot: Node, message: &str) -> crate::Error {
+    let mut parts = message.splitn(3, '`');
+    let (head, name) = (parts.next().unwrap_or(""), parts.next().unwrap_or(""));
+    let kind = head.split_whitespace().last().unwrap_or("");
+    let tags: &[&str] = match kind {
+        "link" if message.contains("contact") => &["contact", "link"],
+        "link" => &["link", "obstacle"],
+        "spring" => &["spring", "linear_spring_damper"],
+        "joint" | "on" => &["joint", "loop_joint", "joint_spring", "joint_effort"],
+        "load" => &["force"],
+        "ground" => &["ground"],
+        _ => &[],
+    };
+    let named = |n: &Node| {
+        n.is_element()
+            && !name.is_empty()
+            && ["name", "joint", "link"]
+                .iter()
+                .any(|a| n.attribute(*a) == Some(name))
+    };
+    let node = tags
+        .iter()
+        .find_map(|t| {
+            robot
+                .descendants()
+                .find(|n| named(n) && n.tag_name().name() == *t)
+        })
+        .or_else(|| robot.descendants().find(|n| named(n)))
+        .unwrap_or(robot);
+    src.error(node, message.to_string())
 }

@@ -7,7 +7,7 @@
 use super::xml::{child, parse_f64, Source};
 use crate::error::Result;
 use crate::geometry::{Geometry, PackagePaths, ShapeKind};
-use crate::model::Inertial;
+use crate::model::{Inertial, LARGEST_LENGTH};
 use nalgebra::{Matrix3, Vector3};
 use roxmltree::Node;
 
@@ -52,6 +52,7 @@ fn read_geometry(
                 ),
             ));
         }
+        src.within(s, attr, &[v], LARGEST_LENGTH)?;
         Ok(v)
     };
     let shape = match s.tag_name().name() {
@@ -59,6 +60,10 @@ fn read_geometry(
             let size = src
                 .vec3_opt(s, "size")?
                 .ok_or_else(|| src.error(s, format!("link `{link}`: <box> needs `size`")))?;
+            if let Some(v) = size.iter().find(|v| **v < 0.0) {
+                return Err(src.error(s, format!("link `{link}`: <box> has a negative size {v}")));
+            }
+            src.within(s, "size", size.as_slice(), LARGEST_LENGTH)?;
             ShapeKind::Box { size }
         }
         "cylinder" => ShapeKind::Cylinder {
@@ -75,6 +80,7 @@ fn read_geometry(
         "mesh" => {
             let uri = src.req(s, "filename")?.to_string();
             let scale = mesh_scale(src, s, link, warnings)?;
+            src.within(s, "scale", scale.as_slice(), LARGEST_LENGTH)?;
             let path = match packages.resolve(&uri) {
                 Ok(p) => Some(p),
                 Err(why) => {

@@ -24,6 +24,10 @@ struct Element {
     children: &'static [Child],
 }
 
+/// The child elements that may appear more than once (a spring's two `<end>`s, counted where
+/// they are read; a force table's rows); any other child appears at most once.
+const REPEATABLE: &[&str] = &["point", "end"];
+
 const FRAME: &[&str] = &["xyz", "rpy", "quat_xyzw"];
 
 const POINT: Child = Child {
@@ -205,12 +209,24 @@ fn check_node(
             ));
         }
     }
+    let mut seen: Vec<&str> = Vec::new();
     for c in node.children().filter(|c| c.is_element()) {
         let ns = c.tag_name().namespace();
         if !(ns.is_none() || ns == Some(MECH_NS)) {
             continue;
         }
         let name = c.tag_name().name();
+        if seen.contains(&name) && !REPEATABLE.contains(&name) {
+            let named = node
+                .attribute("name")
+                .map(|n| format!(" `{n}`"))
+                .unwrap_or_default();
+            return Err(src.error(
+                c,
+                format!("{what}{named} has a second <{name}>: it takes one"),
+            ));
+        }
+        seen.push(name);
         let Some(spec) = children.iter().find(|s| s.name == name) else {
             return Err(src.error(
                 c,

@@ -2,6 +2,7 @@
 //! line, column and element.
 
 use crate::error::{Error, Result};
+use crate::model::LARGEST_LENGTH;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use roxmltree::Node;
 
@@ -179,6 +180,43 @@ impl<'a> Source<'a> {
         Ok(self.array_opt::<3>(node, attr)?.map(Vector3::from))
     }
 
+    /// An error unless every value is within `±bound` (the importer's number ranges of
+    /// [`crate::model::LARGEST_LENGTH`] and [`crate::model::LARGEST_MAGNITUDE`]).
+    pub(crate) fn within(&self, node: Node, attr: &str, values: &[f64], bound: f64) -> Result<()> {
+        match values.iter().find(|v| !(v.is_finite() && v.abs() <= bound)) {
+            None => Ok(()),
+            Some(v) => Err(self.error(
+                node,
+                format!(
+                    "{}: attribute `{attr}` = {v:e} is outside the accepted range [−{bound:e}, {bound:e}]",
+                    self.describe(node)
+                ),
+            )),
+        }
+    }
+
+    /// A position or length 3-vector \[m\] with a default: finite and within
+    /// ±[`LARGEST_LENGTH`].
+    pub(crate) fn position_or(
+        &self,
+        node: Node,
+        attr: &str,
+        default: Vector3<f64>,
+    ) -> Result<Vector3<f64>> {
+        let v = self.vec3_or(node, attr, default)?;
+        self.within(node, attr, v.as_slice(), LARGEST_LENGTH)?;
+        Ok(v)
+    }
+
+    /// An optional length \[m\] (a distance, a pitch): finite and within ±[`LARGEST_LENGTH`].
+    pub(crate) fn length_opt(&self, node: Node, attr: &str) -> Result<Option<f64>> {
+        let v = self.f64_opt(node, attr)?;
+        if let Some(x) = v {
+            self.within(node, attr, &[x], LARGEST_LENGTH)?;
+        }
+        Ok(v)
+    }
+
     /// A 3-vector with a default.
     pub(crate) fn vec3_or(
         &self,
@@ -194,10 +232,13 @@ impl<'a> Source<'a> {
         let Some(node) = node else {
             return Ok(Isometry3::identity());
         };
-        let xyz = self.vec3_or(node, "xyz", Vector3::zeros())?;
+        let xyz = self.position_or(node, "xyz", Vector3::zeros())?;
         let rot = if let Some(q) = self.array_opt::<4>(node, "quat_xyzw")? {
-            let quat = nalgebra::Quaternion::new(q[3], q[0], q[1], q[2]);
-            if quat.norm() == 0.0 {
+            // Scaled by its largest component first, so that the norm cannot overflow.
+            let big = q.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            let quat =
+                nalgebra::Quaternion::new(q[3], q[0], q[1], q[2]) / big.max(f64::MIN_POSITIVE);
+            if big == 0.0 {
                 return Err(self.error(
                     node,
                     format!("{}: `quat_xyzw` is zero", self.describe(node)),
@@ -220,14 +261,17 @@ impl<'a> Source<'a> {
     ) -> Result<Vector3<f64>> {
         let Some(node) = node else { return Ok(default) };
         let a = self.vec3_or(node, "xyz", default)?;
-        let n = a.norm();
-        if n < 1e-12 {
+        // Scaled by its largest component first, so that the norm cannot overflow (an axis
+        // of 1e200 would have an infinite norm and normalize to zero).
+        let big = a.amax();
+        if big < 1e-12 {
             return Err(self.error(
                 node,
                 format!("{} has a zero-length axis", self.describe(owner)),
             ));
         }
-        Ok(a / n)
+        let a = a / big;
+        Ok(a / a.norm())
     }
 }
 

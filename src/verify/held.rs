@@ -364,7 +364,9 @@ fn lexicographic(
     let (z1, null) = if a_mat.nrows() == 0 {
         (DVector::zeros(d), DMatrix::identity(d, d))
     } else {
-        let svd = a_mat.clone().svd(true, true);
+        let Some(svd) = crate::solver::eigen::svd(a_mat.clone(), true, true) else {
+            return DVector::from_element(d, f64::NAN);
+        };
         let top = svd.singular_values.max();
         let eps = 1e-10 * top.max(1e-300);
         let z1 = svd.solve(&(-a), eps).unwrap_or_else(|_| DVector::zeros(d));
@@ -375,7 +377,9 @@ fn lexicographic(
         // Complete the basis: N = I − V_r V_rᵀ, orthonormalized by its own SVD.
         let v_r = v_t.rows(0, rank).transpose();
         let proj = &full - &v_r * v_r.transpose();
-        let psvd = proj.svd(true, false);
+        let Some(psvd) = crate::solver::eigen::svd(proj, true, false) else {
+            return DVector::from_element(d, f64::NAN);
+        };
         let u = psvd.u.unwrap_or_else(|| DMatrix::zeros(d, 0));
         let cols: Vec<usize> = (0..psvd.singular_values.len())
             .filter(|&k| psvd.singular_values[k] > 0.5)
@@ -389,7 +393,9 @@ fn lexicographic(
     // Stage 2: y minimizing ‖b + B z₁ + B N y‖.
     let bn = b_mat * &null;
     let rhs = -(b + b_mat * &z1);
-    let svd = bn.svd(true, true);
+    let Some(svd) = crate::solver::eigen::svd(bn, true, true) else {
+        return DVector::from_element(null.ncols(), f64::NAN) * 0.0 + z1;
+    };
     let eps = 1e-10 * svd.singular_values.max().max(1e-300);
     let y = svd
         .solve(&rhs, eps)

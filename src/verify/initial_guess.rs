@@ -72,6 +72,7 @@ fn sparse_dof(model: &Model, start: State, cons: Constraints) -> Result<usize> {
         sys = System::new(model, cons, Backend::Sparse);
         state
     };
+    crate::solver::finite::guard(model, &state, "the assembled initial guess")?;
     if super::potential_energy(model, &state).is_none() {
         return Err(
             crate::forces::undefined_term(model, &state.branches, &state.q).unwrap_or(

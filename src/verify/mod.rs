@@ -42,7 +42,7 @@ mod unilateral;
 use closure::closures;
 pub use closure::Closure;
 pub use initial_guess::{check, ModelCheck};
-pub use pose::{parse_pose, pose_state, read_pose};
+pub use pose::{parse_pose, pose_state, pose_state_with_bodies, read_pose};
 pub use unilateral::{UnilateralCheck, Unilaterals};
 
 use crate::error::Result;
@@ -158,6 +158,7 @@ pub fn potential_energy(model: &Model, state: &State) -> Option<f64> {
 /// [`Error::ForceTableOutOfRange`](crate::Error::ForceTableOutOfRange) if the energy cannot be evaluated,
 /// [`Error::SingularPartition`](crate::Error::SingularPartition) if the constraint Jacobian is singular there.
 pub fn balance(model: &Model, state: &State) -> Result<Balance> {
+    crate::solver::finite::guard(model, state, "the given pose")?;
     if sparse_path(model) {
         let r = {
             let locks = crate::solver::lock_values(model);
@@ -212,7 +213,14 @@ pub fn verify_with_options(
     tol: &Tolerances,
     uni: &Unilaterals,
 ) -> Result<Verification> {
-    run::verify_on(model, state, tol, uni, sparse_path(model), false)
+    run::verify_on(
+        model,
+        state,
+        tol,
+        uni,
+        sparse_path(model),
+        Eigenvalues::WhenCheap,
+    )
 }
 
 /// [`verify_with_options`] on the path `linear_algebra` says: `Auto` as
@@ -249,6 +257,9 @@ pub enum Eigenvalues {
     /// Always the lowest eigenvalues and mode shapes (above 200 degrees of freedom on the
     /// sparse path, the low end found by Lanczos, as `analyze` reports them).
     Always,
+    /// No stability verdict (`stability` is `None`): the balance checks only, as `analyze`
+    /// runs them on its own answer.
+    Skip,
 }
 
 /// [`verify_using`] with the eigenvalues `eigenvalues` asks for.
@@ -267,14 +278,7 @@ pub fn verify_reporting(
         crate::solver::LinearAlgebra::Dense => false,
         crate::solver::LinearAlgebra::Sparse => true,
     };
-    run::verify_on(
-        model,
-        state,
-        tol,
-        uni,
-        sparse,
-        eigenvalues == Eigenvalues::Always,
-    )
+    run::verify_on(model, state, tol, uni, sparse, eigenvalues)
 }
 
 /// Brings `state` onto `Φ = 0` by a damped Newton iteration that changes the dependent

@@ -184,6 +184,18 @@ fn has_content(doc: &str) -> bool {
 /// [`Error::UnknownJoint`] for a joint the model does not have, [`Error::ValueCount`] for a
 /// value list of the wrong length.
 pub fn pose_state(model: &Model, values: &JointValues) -> Result<(State, Vec<String>)> {
+    pose_state_with_bodies(model, values, &[])
+}
+
+/// [`pose_state`] with the world poses of the bodies that joint values cannot place
+/// ([`State::bodies_without_values`]), as a result JSON's `links` give them.
+/// # Errors
+/// As [`pose_state`].
+pub fn pose_state_with_bodies(
+    model: &Model,
+    values: &JointValues,
+    bodies: &[(crate::model::BodyId, nalgebra::Isometry3<f64>)],
+) -> Result<(State, Vec<String>)> {
     let mut all = crate::solver::initial_values(model);
     // `joint_id` looks names up in the model's map: a pose names every joint.
     for (name, v) in values {
@@ -214,7 +226,10 @@ pub fn pose_state(model: &Model, values: &JointValues) -> Result<(State, Vec<Str
         })
         .map(|j| j.name.clone())
         .collect();
-    Ok((State::from_joint_values(model, &all), missing))
+    Ok((
+        State::from_joint_values_and_bodies(model, &all, bodies),
+        missing,
+    ))
 }
 
 #[cfg(test)]

@@ -46,8 +46,11 @@ pub(super) fn verify_on(
     tol: &Tolerances,
     uni: &Unilaterals,
     sparse: bool,
-    eigenvalues: bool,
+    eigenvalues: super::Eigenvalues,
 ) -> Result<Verification> {
+    let skip = eigenvalues == super::Eigenvalues::Skip;
+    let eigenvalues = eigenvalues == super::Eigenvalues::Always;
+    crate::solver::finite::guard(model, state, "the given pose")?;
     // The forces on both paths from the sparse partition (module `held`): one computation,
     // so the dense and the sparse path report the same numbers (a pose balanced to the
     // solver's gradient tolerance leaves the forces determined to about that, and partitions
@@ -75,7 +78,7 @@ pub(super) fn verify_on(
         let tau = tol.force + tol.relative * force_scale;
         // Without a stop or contact touching, the verdict on this partition.
         let (held, stability) = std::thread::scope(|s| {
-            let verdict = (assembled && list.is_empty()).then(|| {
+            let verdict = (assembled && list.is_empty() && !skip).then(|| {
                 s.spawn(|| {
                     crate::solver::stability_of(&mut sys, &state.q, &part, &eval, eigenvalues)
                 })
@@ -167,6 +170,7 @@ pub(super) fn verify_on(
     };
     let stability = match (passed, sparse) {
         (false, _) => None,
+        _ if skip => None,
         (true, true) if strong.is_empty() && weak.is_empty() => stability,
         (true, _) => {
             crate::solver::stability_verdict(model, state, &strong, &weak, backend, eigenvalues)

@@ -3,7 +3,14 @@ use super::*;
 use crate::urdf::{load_str, ImportOptions};
 
 fn verify_on(m: &Model, s: &State, tol: &Tolerances, sparse: bool) -> Result<Verification> {
-    super::run::verify_on(m, s, tol, &Unilaterals::default(), sparse, false)
+    super::run::verify_on(
+        m,
+        s,
+        tol,
+        &Unilaterals::default(),
+        sparse,
+        super::Eigenvalues::WhenCheap,
+    )
 }
 
 fn load(text: &str) -> Model {

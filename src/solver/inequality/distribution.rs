@@ -64,19 +64,22 @@ pub(crate) fn spread(
             j.row_mut(r).scale_mut(*dr);
         }
     }
-    let eig = (&j * j.transpose()).symmetric_eigen();
-    let top = eig.eigenvalues.amax();
-    let null: Vec<usize> = (0..m)
-        .filter(|&k| eig.eigenvalues[k] <= 1e-12 * top)
-        .collect();
+    let (values, vectors) = crate::solver::eigen::symmetric_eigen(&(&j * j.transpose()));
+    let top = values.amax();
+    if !top.is_finite() {
+        return;
+    }
+    let null: Vec<usize> = (0..m).filter(|&k| values[k] <= 1e-12 * top).collect();
     if null.is_empty() {
         return;
     }
     // K: columns D ŷ (module docs); K_u its stop and contact rows.
-    let k = DMatrix::from_fn(m, null.len(), |r, c| d[r] * eig.eigenvectors[(r, null[c])]);
+    let k = DMatrix::from_fn(m, null.len(), |r, c| d[r] * vectors[(r, null[c])]);
     let ku = DMatrix::from_fn(rows.len(), null.len(), |r, c| k[(rows[r], c)]);
     let lu = DVector::from_fn(rows.len(), |r, _| mu[rows[r]]);
-    let svd = ku.svd(true, true);
+    let Some(svd) = crate::solver::eigen::svd(ku, true, true) else {
+        return;
+    };
     let eps = 1e-12 * svd.singular_values.amax().max(1e-300);
     let Ok(z) = svd.solve(&(-lu), eps) else {
         return;

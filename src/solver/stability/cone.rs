@@ -71,7 +71,9 @@ pub(crate) fn minimum(h: &DMatrix<f64>, weak: &[DMatrix<f64>], eig_tol: f64) -> 
                     r += 1;
                 }
             }
-            let svd = a.svd(false, true);
+            let Some(svd) = super::eigen::svd(a, false, true) else {
+                continue;
+            };
             let smax = svd.singular_values.max();
             if let Some(vt) = svd.v_t {
                 for (i, &s) in svd.singular_values.iter().enumerate() {

@@ -134,7 +134,7 @@ pub(crate) fn joint_spectrum(
         rows[r].iter().map(|&(g, x)| x * z[(g, c)]).sum()
     });
     // An orthonormal basis of T's range, then the rows with the most independent motion.
-    let svd = t.clone().svd(true, false);
+    let svd = super::eigen::svd(t.clone(), true, false)?;
     let u = svd.u.as_ref()?;
     let top = svd.singular_values.max();
     let rank = svd

@@ -7,3 +7,8 @@ mod issue_21_falls_found_at_once;
 mod issue_21_free_arm_converges_directly;
 mod issue_21_ground_start;
 mod issue_21_verify_forces_and_stability;
+mod issue_25_closed_pipe;
+mod issue_25_fuzz_smoke;
+mod issue_25_located_errors;
+mod issue_25_unbounded_numbers;
+mod issue_25_verify_agrees_with_analyze;

@@ -1,0 +1,42 @@
+//! The guard every check of a pose passes first: `q`, `Φ(q)`, `Φ_q(q)`, `V(q)` and `∇V(q)`
+//! finite. Nothing non-finite reaches a decomposition (nalgebra's SVD panics on NaN and
+//! iterates without end on ±1e308) or a report (JSON has no NaN): the error names the row or
+//! the energy term instead.
+
+use crate::constraints::{Constraints, Triplets};
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::state::State;
+use nalgebra::DVector;
+
+/// [`Error::NonFiniteConstraint`] or [`Error::NonFiniteEnergy`] unless the constraints and the
+/// energy of `model` (its locks held) are finite at `state`; `at` says where (`the given pose`).
+pub(crate) fn guard(model: &Model, state: &State, at: &str) -> Result<()> {
+    let q = &state.q;
+    if q.iter().any(|x| !x.is_finite()) {
+        return Err(Error::NonFiniteEnergy {
+            at: at.into(),
+            term: crate::forces::finite::non_finite_term(model, &state.branches, q),
+        });
+    }
+    let cons = Constraints::new(model, &crate::solver::lock_values(model))
+        .on_branches(state.branches.clone());
+    let mut phi = DVector::zeros(cons.len());
+    let mut jac = Triplets::default();
+    cons.evaluate(model, q, &mut phi, Some(&mut jac));
+    let bad_entry = jac.entries.iter().find(|e| !e.2.is_finite()).map(|e| e.0);
+    if let Some(r) = phi.iter().position(|x| !x.is_finite()).or(bad_entry) {
+        let row = cons.row_name(r).to_string();
+        return Err(Error::NonFiniteConstraint {
+            site: model.row_site(&row).map(Box::new),
+            row,
+            at: at.into(),
+        });
+    }
+    let mut g = DVector::zeros(q.len());
+    // An undefined force-table term has its own error, raised by the checks themselves.
+    let Some(e) = crate::forces::potential(model, &state.branches, q, &mut g, None) else {
+        return Ok(());
+    };
+    crate::forces::finite::check(model, &state.branches, q, e.total, &g, at)
+}

@@ -92,6 +92,13 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
     for f in &v.unilateral.failures {
         eprintln!("{}: not a rest pose: {f}", a.file.display());
     }
+    // Only the checks that failed: a pose refused for its friction alone is balanced.
+    let out_of_balance = v.constraint_residual > tol.constraint
+        || v.unassigned > v.effort_tolerance
+        || v.imbalance.iter().any(|i| i.effort.abs() > v.effort_tolerance);
+    if !out_of_balance && !v.unilateral.failures.is_empty() {
+        return Ok(exit::NOT_BALANCED);
+    }
     if let Some(m) = &v.max_imbalance {
         eprintln!(
             "{}: not a rest pose: largest imbalance {:.3e} at joint `{}` (dof {}), constraint residual {:.3e}",

@@ -4,18 +4,19 @@
 //! rows are redundant (a box flat on four vertices: four rows for three degrees of freedom) the
 //! partition's multipliers `μ_b` are one solution (basic: zero on the redundant rows). Every
 //! solution is `μ = μ_b + K z`, `K` a basis of the null space of `Φ_qᵀ` (the self-equilibrated
-//! combinations of the rows). restpose reports the one whose stop and contact multipliers `λ`
-//! (rows `u`) have the least norm:
-//!
-//! `z = −K_u⁺ μ_b,u`, `μ = μ_b + K z`,
-//!
-//! so the symmetric box gets `m g / 4` on each vertex, and the joint reactions follow the same
-//! distribution (the equality rows' part of `K z`). If that distribution would make a contact
-//! pull or a stop push the wrong way (below `−threshold`), the basic one is kept. `K` comes from
-//! the eigenvectors of `D Φ_q Φ_qᵀ D` (`D` normalizing the rows) with eigenvalues below
-//! `10⁻¹²` of the largest (rounding leaves about `10⁻¹⁶` on the zero ones); models above
-//! `MAX_ROWS` rows keep the basic distribution.
+//! combinations of the rows). With `K_u` its stop and contact rows, the distributions of the
+//! stop and contact multipliers are `λ = λ_b + K_u z`, which module `friction` searches for
+//! the one needing the least friction (every contact pushing, every stop within its
+//! effort), ties broken by the least norm: the symmetric box gets `m g / 4` on each vertex and
+//! no friction, and the joint reactions follow the same distribution (the equality rows' part
+//! of `K z`). Where no distribution keeps every contact pushing the basic one is kept (the
+//! active-set iteration then releases the one pulling hardest). `K` comes from the
+//! eigenvectors of `D Φ_q Φ_qᵀ D` (`D` normalizing the rows) with eigenvalues below `10⁻¹²`
+//! of the largest (rounding leaves about `10⁻¹⁶` on the zero ones); models above `MAX_ROWS`
+//! rows keep the basic distribution.
 
+use super::friction;
+use crate::constraints::unilateral::{Active, Unilateral};
 use crate::constraints::{BlockKind, Constraints, Triplets};
 use crate::model::Model;
 use nalgebra::{DMatrix, DVector};
@@ -23,34 +24,46 @@ use nalgebra::{DMatrix, DVector};
 /// Largest number of rows redistributed (the eigen-decomposition is `O(m³)`).
 const MAX_ROWS: usize = 600;
 
-/// The rows of the stops and contacts in `cons`, and which of them are sign-constrained (the
-/// first row of each: a normal force or a stop's effort).
-fn unilateral_rows(cons: &Constraints) -> (Vec<usize>, Vec<bool>) {
-    let (mut rows, mut signed) = (Vec::new(), Vec::new());
+/// The rows of the stops and contacts in `cons`, and each stop and contact with the friction
+/// coefficient of a sticking contact.
+fn unilateral_rows(
+    model: &Model,
+    cons: &Constraints,
+    options: &super::Options,
+) -> (Vec<usize>, Vec<(Active, Option<f64>)>) {
+    let (mut rows, mut items) = (Vec::new(), Vec::new());
     for b in &cons.blocks {
         if let BlockKind::Unilateral(a) = &b.kind {
             for k in 0..a.row_count() {
                 rows.push(b.first + k);
-                signed.push(k == 0);
             }
+            let mu = match a.row {
+                Unilateral::Contact { point, .. } if a.anchor.is_some() => {
+                    model.contact_points[point].settings.mu.or(options.mu)
+                }
+                _ => None,
+            };
+            items.push((*a, mu));
         }
     }
-    (rows, signed)
+    (rows, items)
 }
 
-/// Replaces the full multiplier vector `mu` (basic: zero on redundant rows) by the one whose
-/// stop and contact multipliers have the least norm (module docs), when that keeps their signs.
+/// Replaces the full multiplier vector `mu` (basic: zero on redundant rows) by the
+/// distribution of module `friction` (the least friction, then the least norm, with every
+/// contact pushing), when one exists; returns its `required_mu` (`None` without sticking
+/// contacts or when the basic distribution is kept).
 pub(crate) fn spread(
     model: &Model,
     cons: &Constraints,
     q: &DVector<f64>,
     mu: &mut DVector<f64>,
-    threshold: f64,
-) {
-    let (rows, signed) = unilateral_rows(cons);
+    options: &super::Options,
+) -> Option<f64> {
+    let (rows, items) = unilateral_rows(model, cons, options);
     let m = cons.len();
     if rows.is_empty() || m > MAX_ROWS {
-        return;
+        return None;
     }
     let mut phi = DVector::zeros(m);
     let mut jac = Triplets::default();
@@ -70,24 +83,37 @@ pub(crate) fn spread(
         .filter(|&k| eig.eigenvalues[k] <= 1e-12 * top)
         .collect();
     if null.is_empty() {
-        return;
+        return None;
     }
-    // K: columns D ŷ (module docs); K_u its stop and contact rows.
+    // K: columns D ŷ (module docs); K_u its stop and contact rows, replaced by an
+    // orthonormal basis U of its range (K_u = U Σ Vᵀ, so K_u z = U y for z = V Σ⁻¹ y).
     let k = DMatrix::from_fn(m, null.len(), |r, c| d[r] * eig.eigenvectors[(r, null[c])]);
     let ku = DMatrix::from_fn(rows.len(), null.len(), |r, c| k[(rows[r], c)]);
-    let lu = DVector::from_fn(rows.len(), |r, _| mu[rows[r]]);
     let svd = ku.svd(true, true);
-    let eps = 1e-12 * svd.singular_values.amax().max(1e-300);
-    let Ok(z) = svd.solve(&(-lu), eps) else {
-        return;
+    let (Some(u), Some(vt)) = (&svd.u, &svd.v_t) else {
+        return None;
     };
-    let spread = &*mu + &k * z;
-    if rows
-        .iter()
-        .zip(&signed)
-        .any(|(&r, &s)| s && spread[r] < -threshold)
-    {
-        return;
-    }
-    *mu = spread;
+    let smax = svd.singular_values.amax();
+    let keep: Vec<usize> = (0..svd.singular_values.len())
+        .filter(|&i| svd.singular_values[i] > 1e-10 * smax && smax > 0.0)
+        .collect();
+    let (holders, coefficients, weight) = friction::holders_of(model, &items);
+    let support = friction::Support {
+        base: DVector::from_fn(rows.len(), |r, _| mu[rows[r]]),
+        null: DMatrix::from_fn(rows.len(), keep.len(), |r, c| u[(r, keep[c])]),
+        holders,
+        mu: coefficients,
+        weight,
+    };
+    let out = friction::distribute(&support, super::active_set::force_scale(model))?;
+    let y = &out.forces - &support.base;
+    let y = support.null.transpose() * y;
+    let z = DVector::from_fn(null.len(), |r, _| {
+        keep.iter()
+            .enumerate()
+            .map(|(c, &i)| vt[(i, r)] * y[c] / svd.singular_values[i])
+            .sum::<f64>()
+    });
+    *mu += &k * z;
+    out.required_mu
 }

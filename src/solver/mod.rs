@@ -16,8 +16,11 @@
 
 mod active_set;
 mod assemble;
+pub mod balance;
+mod conic;
 mod cone;
 mod distribution;
+pub(crate) mod friction;
 mod eigen;
 mod guard;
 mod minimize;
@@ -36,8 +39,8 @@ mod unbounded;
 pub use mode_animation::mode_animation;
 pub use options::{Limits, LinearAlgebra, Method, Options};
 pub use report::{
-    ActiveLimit, Contact, ContactState, Diagnostics, Iterate, Reaction, Report, Sizes, Stability,
-    Termination, Timings, Verdict,
+    ActiveLimit, Contact, ContactState, Diagnostics, FrictionVerdict, Iterate, Reaction, Report,
+    Sizes, Stability, Termination, Timings, Verdict,
 };
 
 use crate::constraints::unilateral::Active;
@@ -340,6 +343,8 @@ pub(crate) struct Round {
     pub(crate) blocked: Option<Vec<usize>>,
     /// Multipliers of the rows of each active inequality.
     pub(crate) multipliers: Vec<(Active, Vec<f64>)>,
+    /// The friction the mechanism needs, where module `friction` chose the distribution.
+    pub(crate) required_mu: Option<f64>,
 }
 
 /// Minimizes from an assembled `q` with the active inequalities `active` as rows, stopping
@@ -422,9 +427,9 @@ pub(crate) fn solve_round(
     for (k, &row) in out.part.rows.iter().enumerate() {
         mu[row] = out.eval.mu[k];
     }
+    let mut required_mu = None;
     if !active.is_empty() && !out.part.redundant.is_empty() {
-        let threshold = options.force_tolerance * active_set::force_scale(model);
-        distribution::spread(model, &sys.problem.cons, &out.q, &mut mu, threshold);
+        required_mu = distribution::spread(model, &sys.problem.cons, &out.q, &mut mu, options);
     }
     let reactions = reactions::reactions(&sys, &out.q, &mu);
     let multipliers = active_set::active_multipliers(&sys.problem.cons, &mu);
@@ -472,11 +477,14 @@ pub(crate) fn solve_round(
         contacts: Vec::new(),
         active_limits: Vec::new(),
         active_set_changes: 0,
+        friction: None,
+        balance: None,
     };
     Ok(Round {
         state,
         report,
         blocked,
         multipliers,
+        required_mu,
     })
 }

@@ -40,7 +40,8 @@
 use crate::constraints::unilateral::{self, Active, Anchor, Unilateral};
 use crate::jet::{pair_of, scatter};
 use crate::model::{Friction, Model};
-use crate::solver::{ActiveLimit, Contact, ContactState, Limits};
+use crate::solver::friction;
+use crate::solver::{ActiveLimit, Contact, ContactState, FrictionVerdict, Limits};
 use crate::state::State;
 use nalgebra::{DMatrix, DVector, Vector3};
 
@@ -81,6 +82,9 @@ pub struct UnilateralCheck {
     pub complementarity: f64,
     /// Why the stops and contacts refuse the pose (empty when they do not).
     pub failures: Vec<String>,
+    /// The friction verdict, with sticking contacts (module `solver::friction`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction: Option<FrictionVerdict>,
 }
 
 impl UnilateralCheck {
@@ -89,6 +93,7 @@ impl UnilateralCheck {
     /// rows that would have had to pull are not a failure when the pose passes without them.
     pub(super) fn settle(&mut self, eps: f64, balanced: bool) -> bool {
         let holds = self.penetration <= eps
+            && !self.friction.as_ref().is_some_and(|f| f.slipping)
             && self
                 .contacts
                 .iter()
@@ -327,10 +332,16 @@ pub(super) fn check(
     let negative: Vec<usize> = (0..cols.len())
         .filter(|&i| signed[i] && free_forces[i] < -tau)
         .collect();
-    let forces = if negative.is_empty() || m.nrows() == 0 {
-        free_forces.clone()
-    } else {
-        unscale(&nnls(&m, &rhs, &signed))
+    // Every least-squares balance is `free + null(M) y`: module `solver::friction` picks the
+    // distribution needing the least friction (then the least norm), as analyze does.
+    let items: Vec<(Active, Option<f64>)> = list.iter().map(|t| (t.active, t.mu)).collect();
+    let chosen = distribution(model, &m, &free_forces, &norms, &items);
+    let required = chosen.as_ref().and_then(|d| d.required_mu);
+    let negative = if chosen.is_some() { Vec::new() } else { negative };
+    let forces = match chosen {
+        Some(d) => d.forces,
+        None if negative.is_empty() || m.nrows() == 0 => free_forces.clone(),
+        None => unscale(&nnls(&m, &rhs, &signed)),
     };
     // The generalized force the rows carry, in scaled coordinates.
     let mut k = 0;
@@ -349,6 +360,17 @@ pub(super) fn check(
         describe(model, state, t, &lambda, tau, &mut out);
         k += cols.len();
     }
+    let sticking: Vec<(f64, Option<f64>)> = list
+        .iter()
+        .filter(|t| matches!(t.active.row, Unilateral::Contact { .. }))
+        .zip(&out.contacts)
+        .filter(|(t, _)| t.active.anchor.is_some())
+        .map(|(t, c)| (c.required_friction, t.mu))
+        .collect();
+    out.friction = friction::verdict(&sticking, required);
+    if let Some(v) = out.friction.as_ref().filter(|v| v.slipping) {
+        out.failures.push(slipping(v));
+    }
     // Name the rows that would have to pull, for the failure message (only meaningful when
     // the non-negative forces then leave an imbalance: the caller decides).
     let mut k = 0;
@@ -360,6 +382,69 @@ pub(super) fn check(
         k += t.rows.len();
     }
     (out, carried, strong, weak)
+}
+
+/// The failure of a pose whose contacts cannot hold it.
+pub(super) fn slipping(v: &FrictionVerdict) -> String {
+    match v.mu {
+        Some(mu) => format!(
+            "the contacts cannot hold the pose: no forces inside their friction cones balance it (required_mu = {:.6} > mu = {mu})",
+            v.required_mu
+        ),
+        None => format!(
+            "the contacts cannot hold the pose: no forces inside their friction cones balance it (required_mu = {:.6}; the sticking contacts marked slipping need more than their mu)",
+            v.required_mu
+        ),
+    }
+}
+
+/// The distribution of module `solver::friction` among the least-squares balances
+/// `free + null(M) y` (`M`'s columns normalized by `norms`), `None` where none keeps every
+/// contact pushing.
+fn distribution(
+    model: &Model,
+    m: &DMatrix<f64>,
+    free: &DVector<f64>,
+    norms: &[f64],
+    items: &[(Active, Option<f64>)],
+) -> Option<friction::Distribution> {
+    let k = m.ncols();
+    let unscaled = |v: DVector<f64>| {
+        let mut v = DVector::from_fn(k, |i, _| if norms[i] > 0.0 { v[i] / norms[i] } else { 0.0 });
+        let n = v.norm();
+        if n > 0.0 {
+            v /= n;
+        }
+        v
+    };
+    let mut null = Vec::new();
+    if m.nrows() == 0 {
+        null.extend((0..k).map(|i| unscaled(DVector::from_fn(k, |r, _| f64::from(u8::from(r == i))))));
+    } else {
+        // Candidates from the eigenvalues of MᵀM (rounding leaves about 10⁻¹⁶ of the largest
+        // on the zero ones), kept where ‖M v‖ is at rounding level.
+        let eig = (m.transpose() * m).symmetric_eigen();
+        let top = eig.eigenvalues.amax().max(1e-300);
+        for (i, &e) in eig.eigenvalues.iter().enumerate() {
+            let v = eig.eigenvectors.column(i).into_owned();
+            if e <= 1e-10 * top && (m * &v).norm() <= 1e-10 * top.sqrt() {
+                null.push(unscaled(v));
+            }
+        }
+    }
+    let (holders, mu, weight) = friction::holders_of(model, items);
+    let support = friction::Support {
+        base: free.clone(),
+        null: if null.is_empty() {
+            DMatrix::zeros(k, 0)
+        } else {
+            DMatrix::from_columns(&null)
+        },
+        holders,
+        mu,
+        weight,
+    };
+    friction::distribute(&support, friction::force_scale(model))
 }
 
 /// The failure of a stop or contact `u` that would have to pull with `force` to hold the pose.
@@ -391,15 +476,21 @@ pub(super) fn describe(
             joint,
             bound,
             value,
-        } => out.active_limits.push(ActiveLimit {
-            joint: model.joints[joint.0].name.clone(),
-            bound: bound.name().into(),
-            value,
-            effort: match bound {
+        } => {
+            let effort = match bound {
                 unilateral::Bound::Lower => lambda[0],
                 unilateral::Bound::Upper => -lambda[0],
-            },
-        }),
+            };
+            let (effort_limit, exceeds_effort_limit) = friction::effort_check(model, joint, effort);
+            out.active_limits.push(ActiveLimit {
+                joint: model.joints[joint.0].name.clone(),
+                bound: bound.name().into(),
+                value,
+                effort,
+                effort_limit,
+                exceeds_effort_limit,
+            })
+        }
         Unilateral::Contact { point, ground } => {
             let c = &model.contact_points[point];
             let x = unilateral::point_world(model, point, &state.q);
@@ -410,26 +501,14 @@ pub(super) fn describe(
                 ft = t1 * lambda[1] + t2 * lambda[2];
             }
             let fnorm = lambda[0];
-            let required = if ft.norm() <= tau {
-                0.0
-            } else if fnorm > 0.0 {
-                ft.norm() / fnorm
-            } else {
-                f64::MAX
-            };
+            let tiny = 1e-12 * friction::force_scale(model);
+            let required = friction::needs_mu(fnorm, if ft.norm() <= tiny { 0.0 } else { ft.norm() });
+            let _ = tau;
             let state_ = match (t.active.anchor, t.mu) {
                 (None, _) => ContactState::Touching,
-                (Some(_), Some(mu)) if required > mu => ContactState::Slipping,
+                (Some(_), Some(mu)) if friction::slips(required, mu) => ContactState::Slipping,
                 (Some(_), _) => ContactState::Sticking,
             };
-            if state_ == ContactState::Slipping {
-                out.failures.push(format!(
-                    "`{}`: needs friction coefficient {:.4} > mu = {}",
-                    unilateral::name(model, &t.active.row),
-                    required,
-                    t.mu.unwrap_or_default()
-                ));
-            }
             let x = x - normal * c.radius;
             out.contacts.push(Contact {
                 link: c.link.clone(),

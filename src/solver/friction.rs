@@ -167,7 +167,7 @@ pub(crate) fn slips(needs: f64, mu: f64) -> bool {
 }
 
 /// The largest need `max_i ‖t_i‖ / (c_i n_i)` of `forces` over the sticking contacts with a
-/// weight `c_i` (`1 / μ_i` or 1), relative to the force scale `eps` below which a friction
+/// weight `c_i` (`μ_i` or 1), relative to the force scale `eps` below which a friction
 /// force counts as none.
 fn largest_need(support: &Support, c: &[Option<f64>], forces: &DVector<f64>, eps: f64) -> f64 {
     let mut worst: f64 = 0.0;
@@ -177,7 +177,7 @@ fn largest_need(support: &Support, c: &[Option<f64>], forces: &DVector<f64>, eps
             if let Some(ci) = c[i] {
                 let t = forces[first + 1].hypot(forces[first + 2]);
                 let t = if t <= eps { 0.0 } else { t };
-                worst = worst.max(needs_mu(forces[first].max(0.0), t) * ci);
+                worst = worst.max(needs_mu(forces[first].max(0.0), t) / ci);
             }
             i += 1;
         }
@@ -363,7 +363,7 @@ fn distribute_within(support: &Support, scale: f64) -> Option<Distribution> {
         None => {
             // Different coefficients: the best use of each contact's own.
             if slipping_with(support, &sticks, &out.forces, scale) {
-                let c: Vec<Option<f64>> = sticks.iter().map(|m| m.map(|m| 1.0 / m.max(1e-300))).collect();
+                let c: Vec<Option<f64>> = sticks.to_vec();
                 if let Some((usage, z)) = least_need(support, &c, scale) {
                     if usage <= 1.0 + MU_TOLERANCE {
                         let best = at(support, &z);
@@ -415,3 +415,7 @@ fn pushes(support: &Support, forces: &DVector<f64>, scale: f64) -> bool {
     })
 }
 
+
+#[cfg(test)]
+#[path = "friction_tests.rs"]
+mod tests;

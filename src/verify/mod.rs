@@ -32,6 +32,7 @@ mod dense;
 mod pose;
 mod rank;
 mod reduced;
+mod friction;
 mod unilateral;
 mod unilateral_sparse;
 

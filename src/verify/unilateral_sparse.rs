@@ -124,6 +124,18 @@ pub(super) fn check(
         out.complementarity = out.complementarity.max((t.gap * lambda[0]).abs());
         describe(model, state, t, &lambda, tau, &mut out);
     }
+    // The sparse path keeps its one distribution (no search among the indeterminate ones).
+    let sticking: Vec<(f64, Option<f64>)> = list
+        .iter()
+        .filter(|t| matches!(t.active.row, crate::constraints::unilateral::Unilateral::Contact { .. }))
+        .zip(&out.contacts)
+        .filter(|(t, _)| t.active.anchor.is_some())
+        .map(|(t, c)| (c.required_friction, t.mu))
+        .collect();
+    out.friction = crate::solver::friction::verdict(&sticking, None);
+    if let Some(v) = out.friction.as_ref().filter(|v| v.slipping) {
+        out.failures.push(super::friction::slipping(v));
+    }
     for (i, f) in named {
         out.failures.push(pulling(model, &list[i].active.row, f));
     }

@@ -276,7 +276,8 @@ pub(crate) fn solve(
         report.diagnostics.load_steps = 1;
         report.active_set_changes = changes;
         let sticking = describe(model, options, &state, &round.multipliers, &mut report);
-        report.friction = super::friction::verdict(&sticking, round.required_mu);
+        report.friction = super::friction::verdict(&sticking, round.chosen);
+        super::friction::settle_states(&mut report.contacts, report.friction.as_ref());
         report.balance = super::balance::Balance::of(model, &state, &report.contacts);
         // Judged with every active row held; where some touch without a force, on the
         // critical cone instead (module `cone`).

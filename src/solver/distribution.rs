@@ -52,14 +52,14 @@ fn unilateral_rows(
 /// Replaces the full multiplier vector `mu` (basic: zero on redundant rows) by the
 /// distribution of module `friction` (the least friction, then the least norm, with every
 /// contact pushing), when one exists; returns its `required_mu` (`None` without sticking
-/// contacts or when the basic distribution is kept).
+/// contacts) and whether it slips (`None` when the basic distribution is kept).
 pub(crate) fn spread(
     model: &Model,
     cons: &Constraints,
     q: &DVector<f64>,
     mu: &mut DVector<f64>,
     options: &super::Options,
-) -> Option<f64> {
+) -> Option<(Option<f64>, bool)> {
     let (rows, items) = unilateral_rows(model, cons, options);
     let m = cons.len();
     if rows.is_empty() || m > MAX_ROWS {
@@ -115,5 +115,5 @@ pub(crate) fn spread(
             .sum::<f64>()
     });
     *mu += &k * z;
-    out.required_mu
+    Some((out.required_mu, out.slipping))
 }

@@ -44,13 +44,18 @@ pub(crate) use super::active_set::force_scale;
 use super::conic::{self, Affine, Goal};
 pub(crate) use super::conic::Holder;
 use crate::constraints::unilateral::{Active, Unilateral};
-use super::report::FrictionVerdict;
+use super::report::{Contact, ContactState, FrictionVerdict};
 use crate::model::{JointId, Model};
 use nalgebra::{DMatrix, DVector};
 
 /// Relative tolerance of the verdict: a contact slips when it needs more than
 /// `μ + MU_TOLERANCE · max(1, μ)`.
 pub(crate) const MU_TOLERANCE: f64 = 1e-9;
+
+/// Relative slack of the friction bound in the least-norm choice: where the distributions
+/// needing exactly `required_mu` form a set without interior (a crate on a slope: every
+/// corner's force parallel to gravity), the interior-point solver needs some room.
+const TIE_SLACK: f64 = 1e-6;
 
 /// Iterations of the Dinkelbach-type loop at most.
 const MAX_ROUNDS: usize = 30;
@@ -119,12 +124,13 @@ pub(crate) fn effort_limit(model: &Model, joint: JointId) -> Option<f64> {
 }
 
 /// The verdict from the sticking contacts of the distribution reported, each with the
-/// coefficient it needs and the one it has: `required` where module `friction` chose the
-/// distribution (else the largest need: the distribution is the only one).
+/// coefficient it needs and the one it has, and `chosen` (`required_mu`, slipping) where
+/// [`distribute`] chose the distribution (else from the needs: it is the only one).
 pub(crate) fn verdict(
     sticking: &[(f64, Option<f64>)],
-    required: Option<f64>,
+    chosen: Option<(Option<f64>, bool)>,
 ) -> Option<FrictionVerdict> {
+    let required = chosen.and_then(|c| c.0);
     let first = sticking.first()?.1;
     let required_mu =
         required.unwrap_or_else(|| sticking.iter().map(|s| s.0).fold(0.0, f64::max));
@@ -137,10 +143,23 @@ pub(crate) fn verdict(
         required_mu,
         mu,
         margin: mu.map(|m| m - required_mu),
-        slipping: sticking
-            .iter()
-            .any(|&(n, m)| m.is_some_and(|m| slips(n, m))),
+        slipping: match chosen {
+            Some((_, slipping)) => slipping,
+            None => sticking
+                .iter()
+                .any(|&(n, m)| m.is_some_and(|m| slips(n, m))),
+        },
     })
+}
+
+/// Contacts marked slipping only where the verdict is (with the least-norm choice's slack a
+/// contact may need `10⁻⁶` more than `required_mu` while the mechanism holds).
+pub(crate) fn settle_states(contacts: &mut [Contact], verdict: Option<&FrictionVerdict>) {
+    if verdict.is_some_and(|v| !v.slipping) {
+        for c in contacts.iter_mut().filter(|c| c.state == ContactState::Slipping) {
+            c.state = ContactState::Sticking;
+        }
+    }
 }
 
 /// A stop's effort limit and whether `effort` exceeds it (beyond `10⁻⁹` of it).
@@ -273,7 +292,7 @@ fn least_norm(
     let bound = if s <= 1e-12 {
         0.0
     } else {
-        s * (1.0 + 1e-10)
+        s * (1.0 + TIE_SLACK)
     };
     let Some((z, _)) = conic::solve(
         &f,
@@ -286,7 +305,7 @@ fn least_norm(
     };
     let lam = at(support, &z);
     let worst = largest_need(support, c, &lam, 1e-12 * scale);
-    if worst > s * (1.0 + 1e-9) + 1e-12 {
+    if worst > s * (1.0 + 2.0 * TIE_SLACK) + 1e-12 {
         return fallback.clone();
     }
     lam
@@ -350,7 +369,7 @@ fn distribute_within(support: &Support, scale: f64) -> Option<Distribution> {
     let (required, z) = least_need(support, &ones, scale)?;
     let best = at(support, &z);
     let forces = least_norm(support, &ones, required, &best, scale);
-    let required_mu = (!sticks.is_empty()).then(|| largest_need(support, &ones, &forces, 1e-12 * scale));
+    let required_mu = (!sticks.is_empty()).then_some(required);
     let common = common_mu(&sticks);
     let mut out = Distribution {
         forces,

@@ -343,8 +343,8 @@ pub(crate) struct Round {
     pub(crate) blocked: Option<Vec<usize>>,
     /// Multipliers of the rows of each active inequality.
     pub(crate) multipliers: Vec<(Active, Vec<f64>)>,
-    /// The friction the mechanism needs, where module `friction` chose the distribution.
-    pub(crate) required_mu: Option<f64>,
+    /// `required_mu` and slipping, where module `friction` chose the distribution.
+    pub(crate) chosen: Option<(Option<f64>, bool)>,
 }
 
 /// Minimizes from an assembled `q` with the active inequalities `active` as rows, stopping
@@ -427,9 +427,9 @@ pub(crate) fn solve_round(
     for (k, &row) in out.part.rows.iter().enumerate() {
         mu[row] = out.eval.mu[k];
     }
-    let mut required_mu = None;
+    let mut chosen = None;
     if !active.is_empty() && !out.part.redundant.is_empty() {
-        required_mu = distribution::spread(model, &sys.problem.cons, &out.q, &mut mu, options);
+        chosen = distribution::spread(model, &sys.problem.cons, &out.q, &mut mu, options);
     }
     let reactions = reactions::reactions(&sys, &out.q, &mu);
     let multipliers = active_set::active_multipliers(&sys.problem.cons, &mu);
@@ -485,6 +485,6 @@ pub(crate) fn solve_round(
         report,
         blocked,
         multipliers,
-        required_mu,
+        chosen,
     })
 }

@@ -74,3 +74,29 @@ pub(super) fn distribution(
     friction::distribute(&support, friction::force_scale(model))
 }
 
+
+/// The distribution of module `solver::friction` among `lambda + dirs t` (the sparse path's
+/// basic forces of the touching rows and their self-equilibrated combinations), `None` where
+/// none keeps every contact pushing.
+pub(super) fn choose(
+    model: &Model,
+    lambda: &DVector<f64>,
+    dirs: &DMatrix<f64>,
+    items: &[(Active, Option<f64>)],
+) -> Option<friction::Distribution> {
+    let svd = dirs.clone().svd(true, false);
+    let u = svd.u?;
+    let top = svd.singular_values.amax();
+    let keep: Vec<usize> = (0..svd.singular_values.len())
+        .filter(|&i| svd.singular_values[i] > 1e-10 * top && top > 0.0)
+        .collect();
+    let (holders, mu, weight) = friction::holders_of(model, items);
+    let support = friction::Support {
+        base: lambda.clone(),
+        null: DMatrix::from_fn(lambda.len(), keep.len(), |r, c| u[(r, keep[c])]),
+        holders,
+        mu,
+        weight,
+    };
+    friction::distribute(&support, friction::force_scale(model))
+}

@@ -336,7 +336,7 @@ pub(super) fn check(
     // distribution needing the least friction (then the least norm), as analyze does.
     let items: Vec<(Active, Option<f64>)> = list.iter().map(|t| (t.active, t.mu)).collect();
     let chosen = super::friction::distribution(model, &m, &free_forces, &norms, &items);
-    let required = chosen.as_ref().and_then(|d| d.required_mu);
+    let verdict = chosen.as_ref().map(|d| (d.required_mu, d.slipping));
     let negative = if chosen.is_some() { Vec::new() } else { negative };
     let forces = match chosen {
         Some(d) => d.forces,
@@ -367,7 +367,8 @@ pub(super) fn check(
         .filter(|(t, _)| t.active.anchor.is_some())
         .map(|(t, c)| (c.required_friction, t.mu))
         .collect();
-    out.friction = friction::verdict(&sticking, required);
+    out.friction = friction::verdict(&sticking, verdict);
+    friction::settle_states(&mut out.contacts, out.friction.as_ref());
     if let Some(v) = out.friction.as_ref().filter(|v| v.slipping) {
         out.failures.push(super::friction::slipping(v));
     }

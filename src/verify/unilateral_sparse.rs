@@ -91,8 +91,9 @@ pub(super) fn check(
     let mut on = vec![true; list.len()];
     let mut forces = Vec::new();
     let mut named = Vec::new();
+    let mut chosen = None;
     for round in 0..ROUNDS {
-        forces = multipliers(model, state, locks, &list, &on)?;
+        (forces, chosen) = multipliers(model, state, locks, &list, &on)?;
         let negative: Vec<usize> = (0..list.len())
             .filter(|&i| on[i] && forces[i][0] < -tau)
             .collect();
@@ -132,7 +133,8 @@ pub(super) fn check(
         .filter(|(t, _)| t.active.anchor.is_some())
         .map(|(t, c)| (c.required_friction, t.mu))
         .collect();
-    out.friction = crate::solver::friction::verdict(&sticking, None);
+    out.friction = crate::solver::friction::verdict(&sticking, chosen);
+    crate::solver::friction::settle_states(&mut out.contacts, out.friction.as_ref());
     if let Some(v) = out.friction.as_ref().filter(|v| v.slipping) {
         out.failures.push(super::friction::slipping(v));
     }
@@ -149,14 +151,15 @@ pub(super) fn check(
 }
 
 /// The forces of the touching rows `list` (those with `on`; 0 on the others), per inequality
-/// (`g` first, then the tangential rows), from one sparse partition with the equality rows.
+/// (`g` first, then the tangential rows), from one sparse partition with the equality rows,
+/// and (`required_mu`, slipping) where module `solver::friction` chose among them.
 fn multipliers(
     model: &Model,
     state: &State,
     locks: &[(JointId, usize, f64)],
     list: &[Touching],
     on: &[bool],
-) -> Result<Vec<Vec<f64>>> {
+) -> Result<(Vec<Vec<f64>>, Option<(Option<f64>, bool)>)> {
     let kept: Vec<usize> = (0..list.len()).filter(|&i| on[i]).collect();
     let active: Vec<Active> = kept.iter().map(|&i| list[i].active).collect();
     let cons = Constraints::new(model, locks)
@@ -235,6 +238,17 @@ fn multipliers(
                 }
             }
         }
+        // Module `solver::friction` picks among `λ + dirs t` (as the dense path and analyze);
+        // the least-norm one below where no distribution keeps every contact pushing.
+        let items: Vec<(Active, Option<f64>)> =
+            kept.iter().map(|&i| (list[i].active, list[i].mu)).collect();
+        if let Some(chosen) = super::friction::choose(model, &lambda, &dirs, &items) {
+            let mut out: Vec<Vec<f64>> = list.iter().map(|t| vec![0.0; t.rows.len()]).collect();
+            for (r, &(i, k)) in which.iter().enumerate() {
+                out[i][k] = chosen.forces[r];
+            }
+            return Ok((out, Some((chosen.required_mu, chosen.slipping))));
+        }
         let w = DMatrix::from_diagonal(&DVector::from_vec(weight));
         let kw = dirs.transpose() * &w;
         let normal = &kw * &dirs;
@@ -248,5 +262,5 @@ fn multipliers(
     for (r, &(i, k)) in which.iter().enumerate() {
         out[i][k] = lambda[r];
     }
-    Ok(out)
+    Ok((out, None))
 }

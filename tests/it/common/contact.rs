@@ -2,6 +2,7 @@
 
 use nalgebra::Vector3;
 use restpose::model::Friction;
+use restpose::solver::ContactState;
 use restpose::verify::{verify_using, Tolerances, Unilaterals, Verification};
 use restpose::LinearAlgebra;
 use restpose::State;
@@ -59,17 +60,22 @@ fn assert_paths_agree(name: &str, d: &Verification, s: &Verification) {
         .map(|c| c.normal_force.abs())
         .chain(du.active_limits.iter().map(|l| l.effort.abs()))
         .fold(1e-12f64, f64::max);
+    // Sticking contacts on a statically indeterminate support: both paths choose the same
+    // distribution (least friction, then least norm) by an interior-point solve, which agrees
+    // to its accuracy (1e-7 of the largest force).
+    let sticking = du.contacts.iter().any(|c| c.state != ContactState::Touching);
+    let each = if sticking { 1e-7 } else { 1e-9 };
     for (a, b) in du.contacts.iter().zip(&su.contacts) {
         assert_eq!((&a.link, a.state), (&b.link, b.state), "{name}");
         assert!(
-            (a.normal_force - b.normal_force).abs() <= 1e-9 * big,
+            (a.normal_force - b.normal_force).abs() <= each * big,
             "{name} `{}`: dense {} sparse {}",
             a.link,
             a.normal_force,
             b.normal_force
         );
         let ft = Vector3::from(a.tangential_force) - Vector3::from(b.tangential_force);
-        assert!(ft.norm() <= 1e-9 * big, "{name} `{}`: {ft}", a.link);
+        assert!(ft.norm() <= each * big, "{name} `{}`: {ft}", a.link);
     }
     for (a, b) in du.active_limits.iter().zip(&su.active_limits) {
         assert_eq!((&a.joint, &a.bound), (&b.joint, &b.bound), "{name}");

@@ -95,7 +95,9 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
     // Only the checks that failed: a pose refused for its friction alone is balanced.
     let out_of_balance = v.constraint_residual > tol.constraint
         || v.unassigned > v.effort_tolerance
-        || v.imbalance.iter().any(|i| i.effort.abs() > v.effort_tolerance);
+        || v.imbalance
+            .iter()
+            .any(|i| i.effort.abs() > v.effort_tolerance);
     if !out_of_balance && !v.unilateral.failures.is_empty() {
         return Ok(exit::NOT_BALANCED);
     }

@@ -99,9 +99,7 @@ pub(crate) fn convex_hull(mut points: Vec<Vector2<f64>>) -> Vec<Vector2<f64>> {
     if points.len() < 3 {
         return points;
     }
-    let cross = |o: &Vector2<f64>, a: &Vector2<f64>, b: &Vector2<f64>| {
-        (a - o).perp(&(b - o))
-    };
+    let cross = |o: &Vector2<f64>, a: &Vector2<f64>, b: &Vector2<f64>| (a - o).perp(&(b - o));
     let tol = 1e-12 * scale * scale;
     let mut hull: Vec<Vector2<f64>> = Vec::with_capacity(2 * points.len());
     for pass in 0..2 {
@@ -150,7 +148,9 @@ pub(crate) fn signed_distance(hull: &[Vector2<f64>], p: &Vector2<f64>) -> f64 {
                 .clone()
                 .map(|(a, b)| to_segment(&a, &b))
                 .fold(f64::INFINITY, f64::min);
-            let inside = edges.into_iter().all(|(a, b)| (b - a).perp(&(p - a)) >= 0.0);
+            let inside = edges
+                .into_iter()
+                .all(|(a, b)| (b - a).perp(&(p - a)) >= 0.0);
             if inside {
                 distance
             } else {
@@ -168,16 +168,27 @@ mod tests {
     /// interior and collinear points dropped from the hull.
     #[test]
     fn square_margins() {
-        let pts: Vec<Vector2<f64>> = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0), (0.5, 0.5), (0.5, 0.0)]
-            .iter()
-            .map(|&(x, y)| Vector2::new(x, y))
-            .collect();
+        let pts: Vec<Vector2<f64>> = [
+            (0.0, 0.0),
+            (1.0, 0.0),
+            (1.0, 1.0),
+            (0.0, 1.0),
+            (0.5, 0.5),
+            (0.5, 0.0),
+        ]
+        .iter()
+        .map(|&(x, y)| Vector2::new(x, y))
+        .collect();
         let hull = convex_hull(pts);
         assert_eq!(hull.len(), 4, "{hull:?}");
         assert!((signed_distance(&hull, &Vector2::new(0.3, 0.5)) - 0.3).abs() < 1e-15);
         assert!(signed_distance(&hull, &Vector2::new(1.0, 0.5)).abs() < 1e-15);
         assert!((signed_distance(&hull, &Vector2::new(2.0, 2.0)) + 2f64.sqrt()).abs() < 1e-15);
-        let seg = convex_hull(vec![Vector2::new(0.0, 0.0), Vector2::new(1.0, 0.0), Vector2::new(2.0, 0.0)]);
+        let seg = convex_hull(vec![
+            Vector2::new(0.0, 0.0),
+            Vector2::new(1.0, 0.0),
+            Vector2::new(2.0, 0.0),
+        ]);
         assert_eq!(seg.len(), 2);
         assert!((signed_distance(&seg, &Vector2::new(1.0, 0.5)) + 0.5).abs() < 1e-15);
     }

@@ -22,8 +22,7 @@
 
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
-    DefaultSettings, DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus,
-    SupportedConeT,
+    DefaultSettings, DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
 };
 use nalgebra::{DMatrix, DVector};
 
@@ -202,7 +201,10 @@ pub(crate) fn solve(f: &Affine, goal: &Goal) -> Option<(DVector<f64>, f64)> {
     let mut solver = DefaultSolver::new(&p, &q, &a, &rows.b, &rows.cones, settings()).ok()?;
     solver.solve();
     let sol = &solver.solution;
-    if !matches!(sol.status, SolverStatus::Solved | SolverStatus::AlmostSolved) {
+    if !matches!(
+        sol.status,
+        SolverStatus::Solved | SolverStatus::AlmostSolved
+    ) {
         return None;
     }
     let z = DVector::from_fn(k, |r, _| sol.x[r]);
@@ -227,6 +229,10 @@ fn csc(m: &DMatrix<f64>) -> CscMatrix<f64> {
 
 /// The upper triangle of a symmetric matrix, as Clarabel takes `P`.
 fn csc_upper(m: &DMatrix<f64>) -> CscMatrix<f64> {
-    let upper = DMatrix::from_fn(m.nrows(), m.ncols(), |r, c| if r <= c { m[(r, c)] } else { 0.0 });
+    let upper = DMatrix::from_fn(
+        m.nrows(),
+        m.ncols(),
+        |r, c| if r <= c { m[(r, c)] } else { 0.0 },
+    );
     csc(&upper)
 }

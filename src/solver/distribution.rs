@@ -90,7 +90,7 @@ pub(crate) fn spread(
     let k = DMatrix::from_fn(m, null.len(), |r, c| d[r] * eig.eigenvectors[(r, null[c])]);
     let ku = DMatrix::from_fn(rows.len(), null.len(), |r, c| k[(rows[r], c)]);
     let svd = ku.svd(true, true);
-    let (Some(u), Some(vt)) = (&svd.u, &svd.v_t) else {
+    let (Some(u), Some(_)) = (&svd.u, &svd.v_t) else {
         return None;
     };
     let smax = svd.singular_values.amax();
@@ -106,14 +106,12 @@ pub(crate) fn spread(
         weight,
     };
     let out = friction::distribute(&support, super::active_set::force_scale(model))?;
-    let y = &out.forces - &support.base;
-    let y = support.null.transpose() * y;
-    let z = DVector::from_fn(null.len(), |r, _| {
-        keep.iter()
-            .enumerate()
-            .map(|(c, &i)| vt[(i, r)] * y[c] / svd.singular_values[i])
-            .sum::<f64>()
-    });
+    let eps = 1e-10 * smax;
+    let z = svd.solve(&(&out.forces - &support.base), eps).ok()?;
     *mu += &k * z;
+    // The stop and contact rows exactly as chosen (the equality rows follow through `K z`).
+    for (r, &row) in rows.iter().enumerate() {
+        mu[row] = out.forces[r];
+    }
     Some((out.required_mu, out.slipping))
 }

@@ -41,10 +41,10 @@
 //!   problems with Coulomb friction, *ZAMM* 77 (1997) 267–279 (the friction cones).
 
 pub(crate) use super::active_set::force_scale;
-use super::conic::{self, Affine, Goal};
 pub(crate) use super::conic::Holder;
-use crate::constraints::unilateral::{Active, Unilateral};
+use super::conic::{self, Affine, Goal};
 use super::report::{Contact, ContactState, FrictionVerdict};
+use crate::constraints::unilateral::{Active, Unilateral};
 use crate::model::{JointId, Model};
 use nalgebra::{DMatrix, DVector};
 
@@ -87,13 +87,16 @@ pub(crate) struct Distribution {
     pub(crate) slipping: bool,
 }
 
+/// Holders (first row, kind), coefficients and least-norm weights of a support's rows.
+pub(crate) type Rows = (Vec<(usize, Holder)>, Vec<Option<f64>>, Vec<f64>);
+
+/// `required_mu` and whether the pose slips, as [`distribute`] chose.
+pub(crate) type Chosen = Option<(Option<f64>, bool)>;
+
 /// The holders, coefficients and least-norm weights of the stops and contacts `items` (each
 /// with its coefficient when it sticks), rows in their order: a sticking contact has three
 /// rows, a stop's row weighs `1/L` when it is an angle (its effort in N m).
-pub(crate) fn holders_of(
-    model: &Model,
-    items: &[(Active, Option<f64>)],
-) -> (Vec<(usize, Holder)>, Vec<Option<f64>>, Vec<f64>) {
+pub(crate) fn holders_of(model: &Model, items: &[(Active, Option<f64>)]) -> Rows {
     let (mut holders, mut mu, mut weight) = (Vec::new(), Vec::new(), Vec::new());
     for (a, m) in items {
         let first = weight.len();
@@ -108,12 +111,18 @@ pub(crate) fn holders_of(
                     1.0
                 },
             ),
-            Unilateral::Contact { .. } if a.anchor.is_some() => (Holder::Stick { c: Some(1.0) }, 1.0),
+            Unilateral::Contact { .. } if a.anchor.is_some() => {
+                (Holder::Stick { c: Some(1.0) }, 1.0)
+            }
             Unilateral::Contact { .. } => (Holder::Smooth, 1.0),
         };
         weight.extend(std::iter::repeat_n(w, h.rows()));
         holders.push((first, h));
-        mu.push(if matches!(h, Holder::Stick { .. }) { *m } else { None });
+        mu.push(if matches!(h, Holder::Stick { .. }) {
+            *m
+        } else {
+            None
+        });
     }
     (holders, mu, weight)
 }
@@ -132,8 +141,7 @@ pub(crate) fn verdict(
 ) -> Option<FrictionVerdict> {
     let required = chosen.and_then(|c| c.0);
     let first = sticking.first()?.1;
-    let required_mu =
-        required.unwrap_or_else(|| sticking.iter().map(|s| s.0).fold(0.0, f64::max));
+    let required_mu = required.unwrap_or_else(|| sticking.iter().map(|s| s.0).fold(0.0, f64::max));
     let mu = if sticking.iter().all(|s| s.1 == first) {
         first
     } else {
@@ -156,7 +164,10 @@ pub(crate) fn verdict(
 /// contact may need `10⁻⁶` more than `required_mu` while the mechanism holds).
 pub(crate) fn settle_states(contacts: &mut [Contact], verdict: Option<&FrictionVerdict>) {
     if verdict.is_some_and(|v| !v.slipping) {
-        for c in contacts.iter_mut().filter(|c| c.state == ContactState::Slipping) {
+        for c in contacts
+            .iter_mut()
+            .filter(|c| c.state == ContactState::Slipping)
+        {
             c.state = ContactState::Sticking;
         }
     }
@@ -165,7 +176,10 @@ pub(crate) fn settle_states(contacts: &mut [Contact], verdict: Option<&FrictionV
 /// A stop's effort limit and whether `effort` exceeds it (beyond `10⁻⁹` of it).
 pub(crate) fn effort_check(model: &Model, joint: JointId, effort: f64) -> (Option<f64>, bool) {
     let limit = effort_limit(model, joint);
-    (limit, limit.is_some_and(|l| effort.abs() > l * (1.0 + 1e-9)))
+    (
+        limit,
+        limit.is_some_and(|l| effort.abs() > l * (1.0 + 1e-9)),
+    )
 }
 
 /// The friction coefficient a contact with normal force `n` and friction force of magnitude
@@ -405,7 +419,12 @@ fn common_mu(sticks: &[Option<f64>]) -> Option<Option<f64>> {
 }
 
 /// Whether some sticking contact of `forces` needs more than its own coefficient.
-fn slipping_with(support: &Support, sticks: &[Option<f64>], forces: &DVector<f64>, scale: f64) -> bool {
+fn slipping_with(
+    support: &Support,
+    sticks: &[Option<f64>],
+    forces: &DVector<f64>,
+    scale: f64,
+) -> bool {
     let mut i = 0;
     let mut any = false;
     for &(first, h) in &support.holders {
@@ -433,7 +452,6 @@ fn pushes(support: &Support, forces: &DVector<f64>, scale: f64) -> bool {
             }
     })
 }
-
 
 #[cfg(test)]
 #[path = "friction_tests.rs"]

@@ -15,7 +15,11 @@ struct Touch {
 
 /// An orthonormal tangent basis of `n`.
 fn tangents(n: &Vector3<f64>) -> [Vector3<f64>; 2] {
-    let a = if n.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
+    let a = if n.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
     let t1 = n.cross(&a).normalize();
     [t1, n.cross(&t1)]
 }
@@ -178,14 +182,20 @@ fn a_box_on_a_slope_needs_tan_alpha() {
         let d = distribute(&s, 15.7).unwrap();
         let need = d.required_mu.unwrap();
         let tan = f64::tan(alpha);
-        assert!((need - tan).abs() <= 1e-9 * tan.max(1.0), "{alpha}: {need} vs {tan}");
+        assert!(
+            (need - tan).abs() <= 1e-9 * tan.max(1.0),
+            "{alpha}: {need} vs {tan}"
+        );
         assert_eq!(d.slipping, slips(tan, 0.5));
         // Balanced: G λ = G λ₀.
         assert!((&g * &d.forces - &g * &s.base).amax() < 1e-9);
         let sides = 64;
         let inscribed = pyramid_mu(&g, &s, sides);
         let circumscribed = inscribed * (std::f64::consts::PI / sides as f64).cos();
-        assert!(need <= inscribed + 1e-8 && need >= circumscribed - 1e-8, "{need} {inscribed}");
+        assert!(
+            need <= inscribed + 1e-8 && need >= circumscribed - 1e-8,
+            "{need} {inscribed}"
+        );
         if alpha == 0.0 {
             // A level floor: no friction at all, m g / 4 per corner by symmetry... of the
             // least-norm distribution.
@@ -227,13 +237,19 @@ fn a_ladder_against_a_wall() {
         let expect = 0.5 / beta.tan();
         assert!((need - expect).abs() < 1e-9, "{beta}: {need} vs {expect}");
         let inscribed = pyramid_mu(&g, &s, 64);
-        assert!(need <= inscribed + 1e-8 && inscribed < need * 1.002, "{need} {inscribed}");
+        assert!(
+            need <= inscribed + 1e-8 && inscribed < need * 1.002,
+            "{need} {inscribed}"
+        );
         let (g, s) = support(&make(true), 100.0, 0.0, None);
         let need = distribute(&s, 100.0).unwrap().required_mu.unwrap();
         let expect = 1.0 / beta.cos() - beta.tan();
         assert!((need - expect).abs() < 1e-9, "{beta}: {need} vs {expect}");
         let inscribed = pyramid_mu(&g, &s, 64);
-        assert!(need <= inscribed + 1e-8 && inscribed < need * 1.002, "{need} {inscribed}");
+        assert!(
+            need <= inscribed + 1e-8 && inscribed < need * 1.002,
+            "{need} {inscribed}"
+        );
     }
 }
 
@@ -243,7 +259,12 @@ fn a_ladder_against_a_wall() {
 fn slips_exactly_below_required_mu() {
     let alpha = 0.35f64;
     let tan = alpha.tan();
-    for (mu, slipping) in [(tan, false), (tan + 1e-9, false), (tan - 1e-8, true), (0.2, true)] {
+    for (mu, slipping) in [
+        (tan, false),
+        (tan + 1e-9, false),
+        (tan - 1e-8, true),
+        (0.2, true),
+    ] {
         let (_, s) = support(&box_corners(0.15, -0.05, true), 15.7, alpha, Some(mu));
         let d = distribute(&s, 15.7).unwrap();
         assert_eq!(d.slipping, slipping, "{mu}");

@@ -17,11 +17,11 @@
 mod active_set;
 mod assemble;
 pub mod balance;
-mod conic;
 mod cone;
+mod conic;
 mod distribution;
-pub(crate) mod friction;
 mod eigen;
+pub(crate) mod friction;
 mod guard;
 mod minimize;
 mod mode_animation;

@@ -98,7 +98,10 @@ pub(super) fn resolve(
 /// none; urdfdom requires it but many files write 0).
 pub(super) fn effort_limit(src: &Source, node: Node) -> Option<f64> {
     let l = child(node, "limit")?;
-    src.f64_opt(l, "effort").ok().flatten().filter(|e| *e > 0.0 && e.is_finite())
+    src.f64_opt(l, "effort")
+        .ok()
+        .flatten()
+        .filter(|e| *e > 0.0 && e.is_finite())
 }
 
 /// Position limits from `<limit lower upper>` (a missing bound is 0, as in urdfdom);

@@ -46,7 +46,9 @@ pub(super) fn distribution(
     };
     let mut null = Vec::new();
     if m.nrows() == 0 {
-        null.extend((0..k).map(|i| unscaled(DVector::from_fn(k, |r, _| f64::from(u8::from(r == i))))));
+        null.extend(
+            (0..k).map(|i| unscaled(DVector::from_fn(k, |r, _| f64::from(u8::from(r == i))))),
+        );
     } else {
         // Candidates from the eigenvalues of MᵀM (rounding leaves about 10⁻¹⁶ of the largest
         // on the zero ones), kept where ‖M v‖ is at rounding level.
@@ -73,7 +75,6 @@ pub(super) fn distribution(
     };
     friction::distribute(&support, friction::force_scale(model))
 }
-
 
 /// The distribution of module `solver::friction` among `lambda + dirs t` (the sparse path's
 /// basic forces of the touching rows and their self-equilibrated combinations), `None` where

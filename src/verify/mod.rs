@@ -29,10 +29,10 @@
 mod check;
 mod closure;
 mod dense;
+mod friction;
 mod pose;
 mod rank;
 mod reduced;
-mod friction;
 mod unilateral;
 mod unilateral_sparse;
 

@@ -337,7 +337,11 @@ pub(super) fn check(
     let items: Vec<(Active, Option<f64>)> = list.iter().map(|t| (t.active, t.mu)).collect();
     let chosen = super::friction::distribution(model, &m, &free_forces, &norms, &items);
     let verdict = chosen.as_ref().map(|d| (d.required_mu, d.slipping));
-    let negative = if chosen.is_some() { Vec::new() } else { negative };
+    let negative = if chosen.is_some() {
+        Vec::new()
+    } else {
+        negative
+    };
     let forces = match chosen {
         Some(d) => d.forces,
         None if negative.is_empty() || m.nrows() == 0 => free_forces.clone(),
@@ -440,7 +444,8 @@ pub(super) fn describe(
             }
             let fnorm = lambda[0];
             let tiny = 1e-12 * friction::force_scale(model);
-            let required = friction::needs_mu(fnorm, if ft.norm() <= tiny { 0.0 } else { ft.norm() });
+            let required =
+                friction::needs_mu(fnorm, if ft.norm() <= tiny { 0.0 } else { ft.norm() });
             let _ = tau;
             let state_ = match (t.active.anchor, t.mu) {
                 (None, _) => ContactState::Touching,

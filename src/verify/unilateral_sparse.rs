@@ -128,7 +128,12 @@ pub(super) fn check(
     // The sparse path keeps its one distribution (no search among the indeterminate ones).
     let sticking: Vec<(f64, Option<f64>)> = list
         .iter()
-        .filter(|t| matches!(t.active.row, crate::constraints::unilateral::Unilateral::Contact { .. }))
+        .filter(|t| {
+            matches!(
+                t.active.row,
+                crate::constraints::unilateral::Unilateral::Contact { .. }
+            )
+        })
         .zip(&out.contacts)
         .filter(|(t, _)| t.active.anchor.is_some())
         .map(|(t, c)| (c.required_friction, t.mu))
@@ -159,7 +164,7 @@ fn multipliers(
     locks: &[(JointId, usize, f64)],
     list: &[Touching],
     on: &[bool],
-) -> Result<(Vec<Vec<f64>>, Option<(Option<f64>, bool)>)> {
+) -> Result<(Vec<Vec<f64>>, crate::solver::friction::Chosen)> {
     let kept: Vec<usize> = (0..list.len()).filter(|&i| on[i]).collect();
     let active: Vec<Active> = kept.iter().map(|&i| list[i].active).collect();
     let cons = Constraints::new(model, locks)

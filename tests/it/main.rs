@@ -10,6 +10,7 @@ mod common;
 mod contact;
 mod degenerate;
 mod engineering;
+mod friction;
 mod golden;
 mod importer;
 mod importer_fuzz;

@@ -63,7 +63,10 @@ fn assert_paths_agree(name: &str, d: &Verification, s: &Verification) {
     // Sticking contacts on a statically indeterminate support: both paths choose the same
     // distribution (least friction, then least norm) by an interior-point solve, which agrees
     // to its accuracy (1e-7 of the largest force).
-    let sticking = du.contacts.iter().any(|c| c.state != ContactState::Touching);
+    let sticking = du
+        .contacts
+        .iter()
+        .any(|c| c.state != ContactState::Touching);
     let each = if sticking { 1e-7 } else { 1e-9 };
     for (a, b) in du.contacts.iter().zip(&su.contacts) {
         assert_eq!((&a.link, a.state), (&b.link, b.state), "{name}");

@@ -202,6 +202,9 @@ pub(super) fn log_balance(rec: &rerun::RecordingStream, model: &Model, report: &
                 rerun::Color::from_rgb(230, 30, 30)
             }])
             .with_radii([0.025 * l as f32])
-            .with_labels([format!("centre of mass, margin {:.4} m", b.stability_margin)]),
+            .with_labels([format!(
+                "centre of mass, margin {:.4} m",
+                b.stability_margin
+            )]),
     )
 }

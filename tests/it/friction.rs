@@ -120,3 +120,62 @@ fn a_crate_on_a_ramp_sticks_from_tan_alpha() {
         );
     }
 }
+
+/// The Solo-12 (joint springs, sticking feet) standing on slopes of 0, 0.1, 0.2, 0.3 rad
+/// (gravity tilted about y): a `required_mu` is reported; analyze sticks at exactly that
+/// coefficient and slips 1 % below, and verify agrees on both; the stability margin equals the
+/// distance, computed here, from the centre of mass's projection to the nearest edge of the
+/// feet's rectangle.
+#[test]
+fn solo12_on_slopes_reports_required_mu_and_margin() {
+    let dir = env!("CARGO_MANIFEST_DIR");
+    for alpha in [0.0f64, 0.1, 0.2, 0.3] {
+        let opts = ImportOptions {
+            floating_base: true,
+            gravity: nalgebra::Vector3::new(-9.81 * alpha.sin(), 0.0, -9.81 * alpha.cos()),
+            ..Default::default()
+        };
+        let path = format!("{dir}/robots/solo12/solo12_ground.urdf");
+        let m = restpose::urdf::load_file(std::path::Path::new(&path), &opts)
+            .unwrap()
+            .model;
+        let (s, r) = restpose::solve(&m, &stick(10.0)).unwrap();
+        assert!(r.converged(), "{alpha}: {:?}", r.termination);
+        let need = r.friction.as_ref().unwrap().required_mu;
+        assert!(need > 0.0 && need < 1.0, "{alpha}: {need}");
+        for (mu, slipping) in [(need, false), (0.99 * need, true)] {
+            let (s2, r2) = restpose::solve(&m, &stick(mu)).unwrap();
+            assert_eq!(r2.friction.unwrap().slipping, slipping, "{alpha} {mu}");
+            let v = verify_with_options(&m, &s2, &Tolerances::default(), &unilaterals(mu)).unwrap();
+            assert_eq!(
+                v.passed, !slipping,
+                "{alpha} {mu}: {:?}",
+                v.unilateral.failures
+            );
+        }
+        let b = r.balance.unwrap();
+        assert_eq!(b.support_polygon.len(), 4);
+        // Gravity is in the x-z plane: the projection keeps y, and the polygon's edges are
+        // the feet's x and y extremes in the projected plane.
+        let down = m.gravity.normalize();
+        let e1 = nalgebra::Vector3::y().cross(&down).normalize();
+        let flat = |p: [f64; 3]| {
+            let p = nalgebra::Vector3::from(p);
+            (p.dot(&e1), p.y)
+        };
+        let feet: Vec<(f64, f64)> = r.contacts.iter().map(|c| flat(c.point_world)).collect();
+        let (cx, cy) = flat(b.centre_of_mass);
+        let xmin = feet.iter().map(|f| f.0).fold(f64::MAX, f64::min);
+        let xmax = feet.iter().map(|f| f.0).fold(f64::MIN, f64::max);
+        let ymin = feet.iter().map(|f| f.1).fold(f64::MAX, f64::min);
+        let ymax = feet.iter().map(|f| f.1).fold(f64::MIN, f64::max);
+        let expect = (cx - xmin).min(xmax - cx).min(cy - ymin).min(ymax - cy);
+        // The feet form a rectangle only to the solve's accuracy.
+        assert!(
+            (b.stability_margin - expect).abs() < 1e-6,
+            "{alpha}: {} vs {expect}",
+            b.stability_margin
+        );
+        let _ = s;
+    }
+}

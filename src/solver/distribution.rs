@@ -89,27 +89,31 @@ pub(crate) fn spread(
     // orthonormal basis U of its range (K_u = U Σ Vᵀ, so K_u z = U y for z = V Σ⁻¹ y).
     let k = DMatrix::from_fn(m, null.len(), |r, c| d[r] * eig.eigenvectors[(r, null[c])]);
     let ku = DMatrix::from_fn(rows.len(), null.len(), |r, c| k[(rows[r], c)]);
-    let svd = ku.svd(true, true);
-    let (Some(u), Some(_)) = (&svd.u, &svd.v_t) else {
-        return None;
-    };
-    let smax = svd.singular_values.amax();
-    let keep: Vec<usize> = (0..svd.singular_values.len())
-        .filter(|&i| svd.singular_values[i] > 1e-10 * smax && smax > 0.0)
+    // An orthonormal basis of range(K_u) from the eigenvectors of K_uᵀ K_u = V Λ Vᵀ:
+    // U = K_u V Λ^(-1/2), and K_u z = U y for z = V Λ^(-1/2) y. (nalgebra's SVD was seen to
+    // lose accuracy on K_u with repeated singular values: 3e-2 recomposition error on the
+    // level box.)
+    let eig = (ku.transpose() * &ku).symmetric_eigen();
+    let lmax = eig.eigenvalues.amax();
+    let keep: Vec<usize> = (0..eig.eigenvalues.len())
+        .filter(|&i| eig.eigenvalues[i] > 1e-20 * lmax && lmax > 0.0)
         .collect();
+    let map = DMatrix::from_fn(null.len(), keep.len(), |r, c| {
+        eig.eigenvectors[(r, keep[c])] / eig.eigenvalues[keep[c]].sqrt()
+    });
     let (holders, coefficients, weight) = friction::holders_of(model, &items);
     let support = friction::Support {
         base: DVector::from_fn(rows.len(), |r, _| mu[rows[r]]),
-        null: DMatrix::from_fn(rows.len(), keep.len(), |r, c| u[(r, keep[c])]),
+        null: &ku * &map,
         holders,
         mu: coefficients,
         weight,
     };
     let out = friction::distribute(&support, super::active_set::force_scale(model))?;
-    let eps = 1e-10 * smax;
-    let z = svd.solve(&(&out.forces - &support.base), eps).ok()?;
-    *mu += &k * z;
-    // The stop and contact rows exactly as chosen (the equality rows follow through `K z`).
+    let y = support.null.transpose() * (&out.forces - &support.base);
+    *mu += &k * (&map * y);
+    // The stop and contact rows exactly as chosen (`K z` reproduces them to rounding; the
+    // equality rows follow through it).
     for (r, &row) in rows.iter().enumerate() {
         mu[row] = out.forces[r];
     }

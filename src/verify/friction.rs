@@ -85,16 +85,21 @@ pub(super) fn choose(
     dirs: &DMatrix<f64>,
     items: &[(Active, Option<f64>)],
 ) -> Option<friction::Distribution> {
-    let svd = dirs.clone().svd(true, false);
-    let u = svd.u?;
-    let top = svd.singular_values.amax();
-    let keep: Vec<usize> = (0..svd.singular_values.len())
-        .filter(|&i| svd.singular_values[i] > 1e-10 * top && top > 0.0)
+    // An orthonormal basis of range(dirs) from the eigenvectors of dirsᵀ dirs (nalgebra's SVD
+    // loses accuracy with repeated singular values).
+    let eig = (dirs.transpose() * dirs).symmetric_eigen();
+    let top = eig.eigenvalues.amax();
+    let keep: Vec<usize> = (0..eig.eigenvalues.len())
+        .filter(|&i| eig.eigenvalues[i] > 1e-20 * top && top > 0.0)
         .collect();
+    let basis = dirs
+        * DMatrix::from_fn(dirs.ncols(), keep.len(), |r, c| {
+            eig.eigenvectors[(r, keep[c])] / eig.eigenvalues[keep[c]].sqrt()
+        });
     let (holders, mu, weight) = friction::holders_of(model, items);
     let support = friction::Support {
         base: lambda.clone(),
-        null: DMatrix::from_fn(lambda.len(), keep.len(), |r, c| u[(r, keep[c])]),
+        null: basis,
         holders,
         mu,
         weight,

@@ -216,9 +216,7 @@ pub(crate) fn analysis(r: &AnalysisResult) {
             );
         }
     }
-    if r.slipping {
-        out!("  warning: a sticking contact needs more friction than its coefficient mu: the mechanism would slide from this pose");
-    }
+    friction_and_balance(r.friction.as_ref(), r.balance.as_ref());
     if !r.reactions.is_empty() {
         out!();
         out!("  reaction on child at joint origin (world)   force [N]                          torque [N m]");
@@ -274,6 +272,15 @@ pub(crate) fn stops_and_contacts(
                 l.effort
             );
         }
+        for l in limits.iter().filter(|l| l.exceeds_effort_limit) {
+            out!(
+                "  warning: joint `{}` needs {:.4} on its {} stop, above its effort limit {}: the actuator cannot hold this pose",
+                l.joint,
+                l.effort.abs(),
+                l.bound,
+                l.effort_limit.unwrap_or_default()
+            );
+        }
     }
     if !idle.is_empty() {
         let names: Vec<&str> = idle.iter().take(6).map(|l| l.joint.as_str()).collect();
@@ -326,6 +333,46 @@ pub(crate) fn stops_and_contacts(
         }
         let total: f64 = contacts.iter().map(|c| c.normal_force).sum();
         out!("  total normal force {total:.6} N");
+    }
+}
+
+/// The friction verdict and the balance of a free mechanism (analyze and verify).
+pub(crate) fn friction_and_balance(
+    f: Option<&restpose::solver::FrictionVerdict>,
+    b: Option<&restpose::solver::balance::Balance>,
+) {
+    if let Some(f) = f {
+        let given = match (f.mu, f.margin) {
+            (Some(mu), Some(m)) => format!(" (mu {mu}, margin {m:+.3e})"),
+            _ => String::new(),
+        };
+        out!(
+            "  friction: required_mu {:.6}{given}: {}",
+            f.required_mu,
+            if f.slipping {
+                "SLIPPING, no contact forces inside the friction cones balance this pose"
+            } else {
+                "the contacts hold the pose"
+            }
+        );
+    }
+    if let Some(b) = b {
+        let c = b.centre_of_mass;
+        let p = b.com_projection;
+        out!(
+            "  balance: centre of mass [{:.5}, {:.5}, {:.5}], projected along gravity [{:.5}, {:.5}, {:.5}]",
+            c[0], c[1], c[2], p[0], p[1], p[2]
+        );
+        out!(
+            "  support polygon {} corners, stability margin {:.6} m{}",
+            b.support_polygon.len(),
+            b.stability_margin,
+            if b.stability_margin < 0.0 {
+                " (the centre of mass is outside the support polygon)"
+            } else {
+                ""
+            }
+        );
     }
 }
 

@@ -118,6 +118,7 @@ pub(crate) fn verification(robot: &str, v: &Verification, tol: &Tolerances) {
     stops_and_contacts(&v.unilateral.active_limits, &v.unilateral.contacts, &|_| {
         None
     });
+    super::print::friction_and_balance(v.unilateral.friction.as_ref(), None);
     if v.unilateral.contacts.len() + v.unilateral.active_limits.len() > 0 {
         out!(
             "  penetration {:.3e}, complementarity max |g λ| {:.3e} J",

@@ -180,6 +180,7 @@ mod tests {
             tree: false,
             merged: false,
             limits: None,
+            effort_limit: None,
             source: None,
         }
     }

@@ -3,8 +3,10 @@
 use super::configuration::{configuration_of, values as values_only, Convention};
 use crate::forces::Energy;
 use crate::model::{JointKind, Model};
+use crate::solver::balance::Balance;
 use crate::solver::{
-    ActiveLimit, Contact, ContactState, Diagnostics, Iterate, Reaction, Report, Stability,
+    ActiveLimit, Contact, ContactState, Diagnostics, FrictionVerdict, Iterate, Reaction, Report,
+    Stability,
 };
 use crate::state::State;
 use serde::ser::SerializeMap;
@@ -161,9 +163,16 @@ pub struct AnalysisResult {
     pub contacts: Vec<Contact>,
     /// Joints resting on a stop: `{joint, bound, value, effort}`.
     pub active_limits: Vec<ActiveLimit>,
-    /// Whether some sticking contact needs more friction than its coefficient `mu` (it would
-    /// slide: the pose is not a rest pose the contacts can hold).
+    /// Whether no contact forces inside the friction cones (with the coefficients `mu`)
+    /// balance the pose: the mechanism would slide from it.
     pub slipping: bool,
+    /// The friction verdict with sticking contacts: `{required_mu, mu, margin, slipping}`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction: Option<FrictionVerdict>,
+    /// A free mechanism on its contacts: `{centre_of_mass, com_projection, support_polygon,
+    /// stability_margin}`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub balance: Option<Balance>,
     /// Bodies, coordinates, constraint rows.
     pub bodies: usize,
     /// Cartesian coordinates (7 per body).
@@ -242,10 +251,13 @@ impl AnalysisResult {
             limit_violations,
             contacts: report.contacts.clone(),
             active_limits: report.active_limits.clone(),
-            slipping: report
-                .contacts
-                .iter()
-                .any(|c| c.state == ContactState::Slipping),
+            slipping: report.friction.as_ref().is_some_and(|f| f.slipping)
+                || report
+                    .contacts
+                    .iter()
+                    .any(|c| c.state == ContactState::Slipping),
+            friction: report.friction.clone(),
+            balance: report.balance.clone(),
             robot: model.name.clone(),
             converged: report.converged(),
             termination: report.termination.as_str().to_string(),

@@ -214,6 +214,7 @@ mod tests {
             tree: false,
             merged: false,
             limits: None,
+            effort_limit: None,
             source: None,
         };
         for seed in 0..5 {

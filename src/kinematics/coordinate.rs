@@ -66,6 +66,7 @@ mod tests {
             tree: true,
             merged: false,
             limits: None,
+            effort_limit: None,
             source: None,
         }
     }

@@ -93,6 +93,7 @@ impl ModelBuilder {
             tree: true,
             merged: false,
             limits: None,
+            effort_limit: None,
             source: None,
         }
     }

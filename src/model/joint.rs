@@ -84,6 +84,9 @@ pub struct Joint {
     pub merged: bool,
     /// Position limits `[lower, upper]` of the first coordinate, if any.
     pub limits: Option<[f64; 2]>,
+    /// The actuator's effort limit (URDF `<limit effort>`) \[N m or N\]: a joint resting on a
+    /// stop with a larger effort is flagged (the actuator cannot hold the pose).
+    pub effort_limit: Option<f64>,
     /// The joint's element in the input file (`None` for a joint built in code).
     pub source: Option<SourceLocation>,
 }

@@ -20,7 +20,10 @@
 //!   (1985) 451–464.
 
 mod assemble;
+pub mod balance;
+mod conic;
 pub(crate) mod finite;
+pub(crate) mod friction;
 mod inequality;
 mod kkt_direction;
 mod load_steps;
@@ -38,8 +41,8 @@ mod unbounded;
 pub use mode_animation::mode_animation;
 pub use options::{ContactPolicy, Limits, LinearAlgebra, Method, Options, Progress, ProgressFn};
 pub use report::{
-    ActiveLimit, Contact, ContactState, Diagnostics, Iterate, Mode, Reaction, Report, Sizes,
-    Stability, Termination, Timings, Verdict,
+    ActiveLimit, Contact, ContactState, Diagnostics, FrictionVerdict, Iterate, Mode, Reaction,
+    Report, Sizes, Stability, Termination, Timings, Verdict,
 };
 pub(crate) use stability::eigen;
 pub(crate) use stability::verdict::{stability_of, stability_on, stability_verdict};
@@ -171,6 +174,8 @@ pub(crate) struct Round {
     pub(crate) blocked: Option<Vec<usize>>,
     /// Multipliers of the rows of each active inequality.
     pub(crate) multipliers: Vec<(Active, Vec<f64>)>,
+    /// `required_mu` and slipping, where module `friction` chose the distribution.
+    pub(crate) chosen: Option<(Option<f64>, bool)>,
 }
 
 /// Minimizes from an assembled `q` with the active inequalities `active` as rows, stopping
@@ -254,9 +259,9 @@ pub(crate) fn solve_round(
     for (k, &row) in out.part.rows.iter().enumerate() {
         mu[row] = out.eval.mu[k];
     }
+    let mut chosen = None;
     if !active.is_empty() && !out.part.redundant.is_empty() {
-        let threshold = options.force_tolerance * active_set::force_scale(model);
-        distribution::spread(model, &sys.problem.cons, &out.q, &mut mu, threshold);
+        chosen = distribution::spread(model, &sys.problem.cons, &out.q, &mut mu, options);
     }
     let reactions = reactions::reactions(&sys, &out.q, &mu);
     let multipliers = active_set::active_multipliers(&sys.problem.cons, &mu);
@@ -309,11 +314,14 @@ pub(crate) fn solve_round(
         contacts: Vec::new(),
         active_limits: Vec::new(),
         active_set_changes: 0,
+        friction: None,
+        balance: None,
     };
     Ok(Round {
         state,
         report,
         blocked,
         multipliers,
+        chosen,
     })
 }

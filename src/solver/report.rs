@@ -272,8 +272,9 @@ pub enum ContactState {
     /// Held tangentially where it first touched, within its friction coefficient (or none is
     /// given).
     Sticking,
-    /// Held tangentially, but needing more friction than its coefficient `mu`: the rest pose
-    /// found is not one the contact can hold; it would slide.
+    /// Held tangentially, needing more friction than its coefficient `mu` in the distribution
+    /// reported, when no distribution within the coefficients balances the pose (module
+    /// `solver::friction`): it would slide.
     Slipping,
 }
 
@@ -294,7 +295,8 @@ pub struct Contact {
     pub normal_force: f64,
     /// Tangential (friction) force the ground exerts on the link, world frame \[N\].
     pub tangential_force: [f64; 3],
-    /// Friction coefficient the contact needs, `|f_t| / f_n` (0 when frictionless).
+    /// Friction coefficient the contact needs in the distribution reported, `|f_t| / f_n` (0
+    /// when frictionless): its `needs_mu`.
     pub required_friction: f64,
     /// Touching, sticking or slipping.
     pub state: ContactState,
@@ -312,6 +314,25 @@ pub struct ActiveLimit {
     /// Generalized force the stop exerts on the joint coordinate \[N m or N\]: positive on a
     /// lower stop, negative on an upper one.
     pub effort: f64,
+    /// The joint's effort limit (URDF `<limit effort>`) \[N m or N\], when given.
+    pub effort_limit: Option<f64>,
+    /// Whether `|effort|` exceeds `effort_limit`: the actuator cannot hold this pose.
+    pub exceeds_effort_limit: bool,
+}
+
+/// The friction verdict of a pose with sticking contacts (module `solver::friction`).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct FrictionVerdict {
+    /// The smallest friction coefficient, common to every sticking contact, for which forces
+    /// balancing the pose exist (each contact inside its friction cone, each stop within its
+    /// joint's effort limit).
+    pub required_mu: f64,
+    /// The coefficient given to every sticking contact, when they share one.
+    pub mu: Option<f64>,
+    /// `mu − required_mu`, when they share one.
+    pub margin: Option<f64>,
+    /// Whether no distribution within the given coefficients balances the pose.
+    pub slipping: bool,
 }
 
 /// The solve's report.
@@ -349,6 +370,11 @@ pub struct Report {
     pub active_limits: Vec<ActiveLimit>,
     /// Changes of the set of active stops and contacts (additions and releases).
     pub active_set_changes: usize,
+    /// The friction verdict, with sticking contacts.
+    pub friction: Option<FrictionVerdict>,
+    /// Support polygon, centre of mass and stability margin of a free mechanism standing on
+    /// its contacts.
+    pub balance: Option<crate::solver::balance::Balance>,
 }
 
 impl Report {

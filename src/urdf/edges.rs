@@ -95,6 +95,16 @@ pub(super) fn resolve(
     ))
 }
 
+/// The effort limit `<limit effort>` of a joint element (absent, unreadable or not positive:
+/// none; urdfdom requires it but many files write 0).
+pub(super) fn effort_limit(src: &Source, node: Node) -> Option<f64> {
+    let l = child(node, "limit")?;
+    src.f64_opt(l, "effort")
+        .ok()
+        .flatten()
+        .filter(|e| *e > 0.0 && e.is_finite())
+}
+
 /// The axis of a URDF joint. Fixed, floating and spherical joints have none: urdfdom does not
 /// read it, so whatever is written there (often `0 0 0` from CAD exporters) is ignored, with a
 /// warning when it could not have been an axis.

@@ -333,6 +333,7 @@ pub(super) fn import(
             tree: tree_edge,
             merged,
             limits: e.limits,
+            effort_limit: super::edges::effort_limit(&src, e.node),
             source: Some(src.location(e.node)),
         });
         if e.auto_child_origin {

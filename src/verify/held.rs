@@ -78,6 +78,9 @@ pub(super) struct Held {
     /// The inequalities (index in the list) whose normal force would pull in the first
     /// round, with that force.
     pub(super) pulling: Vec<(usize, f64)>,
+    /// `(required_mu, slipping)` of the friction distribution chosen (module
+    /// `solver::friction`), where sticking contacts carry the load without efforts.
+    pub(super) friction: crate::solver::friction::Chosen,
 }
 
 /// The forces holding `state`: efforts of the joint coordinates `coords` (joint, dof, value),
@@ -155,6 +158,7 @@ pub(super) fn held(
         unassigned: r.unassigned,
         forces,
         pulling: free.2,
+        friction: free.0.chosen,
     })
 }
 
@@ -202,6 +206,9 @@ struct Multipliers {
     unassigned: f64,
     /// Whether the multipliers were made unique (at most [`MAX_DEPENDENT`] dependent rows).
     resolved: bool,
+    /// `(required_mu, slipping)` where sticking contacts carry the load and no effort is
+    /// chosen: the distribution of module `solver::friction` (the one `analyze` reports).
+    chosen: crate::solver::friction::Chosen,
 }
 
 /// The multipliers of the model's rows, the locks `all` (the first `model_locks` the model's
@@ -282,6 +289,8 @@ fn solve_once(
     }
     let dependent = &part.redundant;
     let resolved = dependent.len() <= MAX_DEPENDENT;
+    // The touching rows' self-equilibrated directions and their effect on every row.
+    let mut directions: Option<(DMatrix<f64>, DMatrix<f64>)> = None;
     if !dependent.is_empty()
         && dependent.len() <= MAX_DEPENDENT
         && !(free.is_empty() && touch.is_empty())
@@ -336,7 +345,42 @@ fn solve_once(
         }
         let at = |rows: &[usize]| DVector::from_iterator(rows.len(), rows.iter().map(|&r| mu[r]));
         let z = lexicographic(&k_free, &at(&free), &k_touch, &at(&touch));
-        mu += k_all * z;
+        mu += &k_all * z;
+        directions = Some((k_touch, k_all));
+    }
+    // Sticking contacts without efforts to choose: among the balancing forces, the
+    // distribution needing the least friction, then the least norm (module
+    // `solver::friction`, as `analyze`), and the friction verdict with it.
+    let sticks = kept.iter().any(|&i| {
+        list[i].active.anchor.is_some()
+            && matches!(
+                list[i].active.row,
+                crate::constraints::unilateral::Unilateral::Contact { .. }
+            )
+    });
+    let mut chosen = None;
+    if free.is_empty() && sticks {
+        let base = DVector::from_iterator(touch.len(), touch.iter().map(|&r| mu[r]));
+        let dirs = directions
+            .as_ref()
+            .map_or_else(|| DMatrix::zeros(touch.len(), 0), |d| d.0.clone());
+        let items: Vec<_> = kept.iter().map(|&i| (list[i].active, list[i].mu)).collect();
+        if let Some(d) = super::friction::choose(model, &base, &dirs, &items) {
+            if let Some((k_touch, k_all)) = &directions {
+                let step = &d.forces - &base;
+                if let Some(svd) = crate::solver::eigen::svd(k_touch.clone(), true, true) {
+                    let eps = 1e-12 * svd.singular_values.amax().max(1e-300);
+                    if let Ok(z) = svd.solve(&step, eps) {
+                        mu += k_all * z;
+                    }
+                }
+                // The touching rows exactly as chosen (`K z` reproduces them to rounding).
+                for (k, &r) in touch.iter().enumerate() {
+                    mu[r] = d.forces[k];
+                }
+            }
+            chosen = Some((d.required_mu, d.slipping));
+        }
     }
     let mut forces: Vec<Vec<f64>> = list.iter().map(|t| vec![0.0; t.rows.len()]).collect();
     for (&f, &i) in touch_firsts.iter().zip(&kept) {
@@ -349,6 +393,7 @@ fn solve_once(
         forces,
         unassigned,
         resolved,
+        chosen,
     })
 }
 

@@ -31,6 +31,7 @@
 
 mod closure;
 mod dense;
+mod friction;
 mod held;
 mod initial_guess;
 mod pose;

@@ -128,6 +128,7 @@ pub(super) fn verify_on(
         &list,
         &held.forces,
         &held.pulling,
+        held.friction,
         effort_tolerance,
         &mut contact,
     );

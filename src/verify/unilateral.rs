@@ -24,7 +24,8 @@
 use crate::constraints::unilateral::{self, Active, Anchor, Unilateral};
 use crate::jet::pair_of;
 use crate::model::Model;
-use crate::solver::{ActiveLimit, Contact, ContactPolicy, ContactState};
+use crate::solver::friction;
+use crate::solver::{ActiveLimit, Contact, ContactPolicy, ContactState, FrictionVerdict};
 use crate::state::State;
 use nalgebra::Vector3;
 
@@ -47,6 +48,9 @@ pub struct UnilateralCheck {
     /// stop, stops or contacts that would have to pull, slipping contacts, the constraint
     /// residual, each joint effort beyond the tolerance (largest first), the unassigned force.
     pub failures: Vec<String>,
+    /// The friction verdict, with sticking contacts (module `solver::friction`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction: Option<FrictionVerdict>,
 }
 
 impl UnilateralCheck {
@@ -58,7 +62,8 @@ impl UnilateralCheck {
             && self
                 .contacts
                 .iter()
-                .all(|c| c.state != ContactState::Slipping);
+                .all(|c| c.state != ContactState::Slipping)
+            && !self.friction.as_ref().is_some_and(|f| f.slipping);
         if balanced && holds {
             self.failures.retain(|f| !f.contains("would have to pull"));
         }
@@ -163,11 +168,19 @@ pub(super) fn report(
     list: &[Touching],
     forces: &[Vec<f64>],
     pulling_rows: &[(usize, f64)],
+    chosen: crate::solver::friction::Chosen,
     tau: f64,
     out: &mut UnilateralCheck,
 ) -> (Vec<Active>, Vec<Active>) {
     let (mut strong, mut weak) = (Vec::new(), Vec::new());
+    let mut sticking = Vec::new();
     for (t, lambda) in list.iter().zip(forces) {
+        if t.active.anchor.is_some() && matches!(t.active.row, Unilateral::Contact { .. }) {
+            let ft = (lambda[1] * lambda[1] + lambda[2] * lambda[2]).sqrt();
+            let small = 1e-12 * friction::force_scale(model);
+            let ft = if ft <= small { 0.0 } else { ft };
+            sticking.push((friction::needs_mu(lambda[0], ft), t.mu));
+        }
         if lambda[0] > tau {
             strong.push(t.active);
         } else {
@@ -178,6 +191,13 @@ pub(super) fn report(
     }
     for &(i, f) in pulling_rows {
         out.failures.push(pulling(model, &list[i].active.row, f));
+    }
+    // The verdict of the cone feasibility problem (module `solver::friction`), the same
+    // routine `analyze` calls: slipping only when no forces inside the cones balance the pose.
+    out.friction = friction::verdict(&sticking, chosen);
+    friction::settle_states(&mut out.contacts, out.friction.as_ref());
+    if let Some(v) = out.friction.as_ref().filter(|v| v.slipping) {
+        out.failures.push(super::friction::slipping(v));
     }
     (strong, weak)
 }
@@ -219,6 +239,8 @@ fn describe(
                 unilateral::Bound::Lower => lambda[0],
                 unilateral::Bound::Upper => -lambda[0],
             },
+            effort_limit: friction::effort_check(model, joint, lambda[0]).0,
+            exceeds_effort_limit: friction::effort_check(model, joint, lambda[0]).1,
         }),
         Unilateral::Contact { point, ground } => {
             let c = &model.contact_points[point];
@@ -230,26 +252,13 @@ fn describe(
                 ft = t1 * lambda[1] + t2 * lambda[2];
             }
             let fnorm = lambda[0];
-            let required = if ft.norm() <= tau {
-                0.0
-            } else if fnorm > 0.0 {
-                ft.norm() / fnorm
-            } else {
-                f64::MAX
-            };
+            let required =
+                friction::needs_mu(fnorm, if ft.norm() <= tau { 0.0 } else { ft.norm() });
             let state_ = match (t.active.anchor, t.mu) {
                 (None, _) => ContactState::Touching,
-                (Some(_), Some(mu)) if required > mu => ContactState::Slipping,
+                (Some(_), Some(mu)) if friction::slips(required, mu) => ContactState::Slipping,
                 (Some(_), _) => ContactState::Sticking,
             };
-            if state_ == ContactState::Slipping {
-                out.failures.push(format!(
-                    "`{}`: needs friction coefficient {:.4} > mu = {}",
-                    unilateral::name(model, &t.active.row),
-                    required,
-                    t.mu.unwrap_or_default()
-                ));
-            }
             let x = x - normal * c.radius;
             out.contacts.push(Contact {
                 link: c.link.clone(),

@@ -5,7 +5,10 @@
 //! Each contact is a point coloured by its state (yellow touching, green sticking, red
 //! slipping) with an arrow of the force the ground exerts on the link,
 //! `f = f_n n + f_t`, scaled so the largest is one characteristic length. A joint resting on a
-//! stop is a labelled orange point at its origin (and its axis arrow is orange).
+//! stop is a labelled orange point at its origin (and its axis arrow is orange). A free
+//! mechanism standing on its contacts shows its support polygon (cyan, closed) and the
+//! projection of its centre of mass along gravity (a point labelled with the stability
+//! margin, cyan inside the polygon, red outside).
 
 use super::shapes::{f3, sanitize};
 use crate::model::Model;
@@ -162,4 +165,46 @@ pub(super) fn log_stops(
         )?;
     }
     Ok(())
+}
+
+/// Logs the support polygon and the centre of mass's projection (`report.balance`).
+pub(super) fn log_balance(rec: &rerun::RecordingStream, model: &Model, report: &Report) -> Logged {
+    let Some(b) = &report.balance else {
+        return Ok(());
+    };
+    let l = model.length_scale;
+    let cyan = rerun::Color::from_rgb(0, 190, 220);
+    let corners: Vec<[f32; 3]> = b
+        .support_polygon
+        .iter()
+        .map(|p| f3(&Vector3::from(*p)))
+        .collect();
+    let n = corners.len();
+    let edges: Vec<[[f32; 3]; 2]> = (0..n)
+        .filter(|&i| n > 2 || i + 1 < n)
+        .map(|i| [corners[i], corners[(i + 1) % n]])
+        .collect();
+    if !edges.is_empty() {
+        rec.log(
+            "world/balance/support_polygon",
+            &rerun::LineStrips3D::new(edges)
+                .with_colors([cyan])
+                .with_radii([0.004 * l as f32]),
+        )?;
+    }
+    let inside = b.stability_margin >= 0.0;
+    rec.log(
+        "world/balance/com_projection",
+        &rerun::Points3D::new([f3(&Vector3::from(b.com_projection))])
+            .with_colors([if inside {
+                cyan
+            } else {
+                rerun::Color::from_rgb(230, 30, 30)
+            }])
+            .with_radii([0.025 * l as f32])
+            .with_labels([format!(
+                "centre of mass, margin {:.4} m",
+                b.stability_margin
+            )]),
+    )
 }

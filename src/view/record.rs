@@ -1,6 +1,6 @@
 //! Writing the recording.
 
-use super::contact::{log_contacts, log_grounds, log_stops, stop_color};
+use super::contact::{log_balance, log_contacts, log_grounds, log_stops, stop_color};
 use super::shapes::{f3, link_paths, log_shape, rr_err, sanitize, transform};
 use crate::error::Result;
 use crate::model::Model;
@@ -182,6 +182,7 @@ pub fn write_recording(
         }
         log_contacts(&rec, model, report)?;
         log_stops(&rec, model, state, report)?;
+        log_balance(&rec, model, report)?;
         for (k, s) in mode_frames.iter().enumerate() {
             rec.set_time_sequence("mode", k as i64);
             log_pose(&rec, model, s, &paths, &parent)?;

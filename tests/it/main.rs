@@ -11,6 +11,7 @@ mod contact;
 mod degenerate;
 mod engineering;
 mod formats;
+mod friction;
 mod golden;
 mod importer;
 mod importer_fuzz;

@@ -305,7 +305,10 @@ pub(crate) fn solve(
         report.diagnostics.free_directions = own.free_directions;
         report.diagnostics.load_steps = 1;
         report.active_set_changes = changes;
-        describe(model, options, &state, &round.multipliers, &mut report);
+        let sticking = describe(model, options, &state, &round.multipliers, &mut report);
+        report.friction = crate::solver::friction::verdict(&sticking, round.chosen);
+        crate::solver::friction::settle_states(&mut report.contacts, report.friction.as_ref());
+        report.balance = crate::solver::balance::Balance::of(model, &state, &report.contacts);
         // Judged with every active row held; where some touch without a force, on the
         // critical cone instead (module `cone`).
         let (strong, weak) = split(model, &round.multipliers, threshold);
@@ -334,14 +337,16 @@ pub(crate) fn solve(
     }
 }
 
-/// Fills the report's `contacts` and `active_limits` from the multipliers of the active rows.
+/// Fills the report's `contacts` and `active_limits` from the multipliers of the active rows;
+/// returns each sticking contact's need and coefficient.
 fn describe(
     model: &Model,
     options: &Options,
     state: &crate::State,
     multipliers: &[(Active, Vec<f64>)],
     report: &mut crate::solver::Report,
-) {
+) -> Vec<(f64, Option<f64>)> {
+    let mut sticking = Vec::new();
     use crate::solver::report::{ActiveLimit, Contact, ContactState};
     for (a, m) in multipliers {
         match a.row {
@@ -349,15 +354,22 @@ fn describe(
                 joint,
                 bound,
                 value,
-            } => report.active_limits.push(ActiveLimit {
-                joint: model.joints[joint.0].name.clone(),
-                bound: bound.name().into(),
-                value,
-                effort: match bound {
+            } => {
+                let effort = match bound {
                     unilateral::Bound::Lower => m[0],
                     unilateral::Bound::Upper => -m[0],
-                },
-            }),
+                };
+                let (effort_limit, exceeds_effort_limit) =
+                    crate::solver::friction::effort_check(model, joint, effort);
+                report.active_limits.push(ActiveLimit {
+                    joint: model.joints[joint.0].name.clone(),
+                    bound: bound.name().into(),
+                    value,
+                    effort,
+                    effort_limit,
+                    exceeds_effort_limit,
+                })
+            }
             Unilateral::Contact { point, ground } => {
                 let c = &model.contact_points[point];
                 let x = unilateral::point_world(model, point, &state.q);
@@ -369,19 +381,22 @@ fn describe(
                     ft = t1 * m[1] + t2 * m[2];
                 }
                 let fnorm = m[0];
-                let required = if ft.norm() == 0.0 {
-                    0.0
-                } else if fnorm > 0.0 {
-                    ft.norm() / fnorm
-                } else {
-                    f64::INFINITY
-                };
+                let tiny = 1e-12 * force_scale(model);
+                let required = crate::solver::friction::needs_mu(
+                    fnorm,
+                    if ft.norm() <= tiny { 0.0 } else { ft.norm() },
+                );
                 let mu = options.contact().mu_of(&c.settings);
                 let contact_state = match (a.anchor, mu) {
                     (None, _) => ContactState::Touching,
-                    (Some(_), Some(mu)) if required > mu => ContactState::Slipping,
+                    (Some(_), Some(mu)) if crate::solver::friction::slips(required, mu) => {
+                        ContactState::Slipping
+                    }
                     (Some(_), _) => ContactState::Sticking,
                 };
+                if a.anchor.is_some() {
+                    sticking.push((required, mu));
+                }
                 let p = touch_point(model, a, &state.q).unwrap_or_default();
                 report.contacts.push(Contact {
                     link: c.link.clone(),
@@ -391,14 +406,11 @@ fn describe(
                     gap,
                     normal_force: fnorm,
                     tangential_force: ft.into(),
-                    required_friction: if required.is_finite() {
-                        required
-                    } else {
-                        f64::MAX
-                    },
+                    required_friction: required,
                     state: contact_state,
                 });
             }
         }
     }
+    sticking
 }

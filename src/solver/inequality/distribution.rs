@@ -4,53 +4,66 @@
 //! rows are redundant (a box flat on four vertices: four rows for three degrees of freedom) the
 //! partition's multipliers `μ_b` are one solution (basic: zero on the redundant rows). Every
 //! solution is `μ = μ_b + K z`, `K` a basis of the null space of `Φ_qᵀ` (the self-equilibrated
-//! combinations of the rows). restpose reports the one whose stop and contact multipliers `λ`
-//! (rows `u`) have the least norm:
-//!
-//! `z = −K_u⁺ μ_b,u`, `μ = μ_b + K z`,
-//!
-//! so the symmetric box gets `m g / 4` on each vertex, and the joint reactions follow the same
-//! distribution (the equality rows' part of `K z`). If that distribution would make a contact
-//! pull or a stop push the wrong way (below `−threshold`), the basic one is kept. `K` comes from
-//! the eigenvectors of `D Φ_q Φ_qᵀ D` (`D` normalizing the rows) with eigenvalues below
-//! `10⁻¹²` of the largest (rounding leaves about `10⁻¹⁶` on the zero ones); models above
-//! `MAX_ROWS` rows keep the basic distribution.
+//! combinations of the rows). With `K_u` its stop and contact rows, the distributions of the
+//! stop and contact multipliers are `λ = λ_b + K_u z`, which module `friction` searches for
+//! the one needing the least friction (every contact pushing, every stop within its
+//! effort), ties broken by the least norm: the symmetric box gets `m g / 4` on each vertex and
+//! no friction, and the joint reactions follow the same distribution (the equality rows' part
+//! of `K z`). Where no distribution keeps every contact pushing the basic one is kept (the
+//! active-set iteration then releases the one pulling hardest). `K` comes from the
+//! eigenvectors of `D Φ_q Φ_qᵀ D` (`D` normalizing the rows) with eigenvalues below `10⁻¹²`
+//! of the largest (rounding leaves about `10⁻¹⁶` on the zero ones); models above `MAX_ROWS`
+//! rows keep the basic distribution.
 
+use crate::constraints::unilateral::{Active, Unilateral};
 use crate::constraints::{BlockKind, Constraints, Triplets};
 use crate::model::Model;
+use crate::solver::friction;
 use nalgebra::{DMatrix, DVector};
 
 /// Largest number of rows redistributed (the eigen-decomposition is `O(m³)`).
 const MAX_ROWS: usize = 600;
 
-/// The rows of the stops and contacts in `cons`, and which of them are sign-constrained (the
-/// first row of each: a normal force or a stop's effort).
-fn unilateral_rows(cons: &Constraints) -> (Vec<usize>, Vec<bool>) {
-    let (mut rows, mut signed) = (Vec::new(), Vec::new());
+/// The rows of the stops and contacts in `cons`, and each stop and contact with the friction
+/// coefficient of a sticking contact.
+fn unilateral_rows(
+    model: &Model,
+    cons: &Constraints,
+    options: &crate::solver::Options,
+) -> (Vec<usize>, Vec<(Active, Option<f64>)>) {
+    let (mut rows, mut items) = (Vec::new(), Vec::new());
     for b in &cons.blocks {
         if let BlockKind::Unilateral(a) = &b.kind {
             for k in 0..a.row_count() {
                 rows.push(b.first + k);
-                signed.push(k == 0);
             }
+            let mu = match a.row {
+                Unilateral::Contact { point, .. } if a.anchor.is_some() => {
+                    model.contact_points[point].settings.mu.or(options.mu)
+                }
+                _ => None,
+            };
+            items.push((*a, mu));
         }
     }
-    (rows, signed)
+    (rows, items)
 }
 
-/// Replaces the full multiplier vector `mu` (basic: zero on redundant rows) by the one whose
-/// stop and contact multipliers have the least norm (module docs), when that keeps their signs.
+/// Replaces the full multiplier vector `mu` (basic: zero on redundant rows) by the
+/// distribution of module `friction` (the least friction, then the least norm, with every
+/// contact pushing), when one exists; returns its `required_mu` (`None` without sticking
+/// contacts) and whether it slips (`None` when the basic distribution is kept).
 pub(crate) fn spread(
     model: &Model,
     cons: &Constraints,
     q: &DVector<f64>,
     mu: &mut DVector<f64>,
-    threshold: f64,
-) {
-    let (rows, signed) = unilateral_rows(cons);
+    options: &crate::solver::Options,
+) -> Option<(Option<f64>, bool)> {
+    let (rows, items) = unilateral_rows(model, cons, options);
     let m = cons.len();
     if rows.is_empty() || m > MAX_ROWS {
-        return;
+        return None;
     }
     let mut phi = DVector::zeros(m);
     let mut jac = Triplets::default();
@@ -67,30 +80,49 @@ pub(crate) fn spread(
     let (values, vectors) = crate::solver::eigen::symmetric_eigen(&(&j * j.transpose()));
     let top = values.amax();
     if !top.is_finite() {
-        return;
+        return None;
     }
     let null: Vec<usize> = (0..m).filter(|&k| values[k] <= 1e-12 * top).collect();
     if null.is_empty() {
-        return;
+        return None;
     }
-    // K: columns D ŷ (module docs); K_u its stop and contact rows.
+    // K: columns D ŷ (module docs); K_u its stop and contact rows, replaced by an
+    // orthonormal basis U of its range (K_u = U Σ Vᵀ, so K_u z = U y for z = V Σ⁻¹ y).
     let k = DMatrix::from_fn(m, null.len(), |r, c| d[r] * vectors[(r, null[c])]);
     let ku = DMatrix::from_fn(rows.len(), null.len(), |r, c| k[(rows[r], c)]);
-    let lu = DVector::from_fn(rows.len(), |r, _| mu[rows[r]]);
-    let Some(svd) = crate::solver::eigen::svd(ku, true, true) else {
-        return;
-    };
-    let eps = 1e-12 * svd.singular_values.amax().max(1e-300);
-    let Ok(z) = svd.solve(&(-lu), eps) else {
-        return;
-    };
-    let spread = &*mu + &k * z;
-    if rows
-        .iter()
-        .zip(&signed)
-        .any(|(&r, &s)| s && spread[r] < -threshold)
-    {
-        return;
+    // An orthonormal basis of range(K_u) from the eigenvectors of K_uᵀ K_u = V Λ Vᵀ:
+    // U = K_u V Λ^(-1/2), and K_u z = U y for z = V Λ^(-1/2) y. (nalgebra's SVD was seen to
+    // lose accuracy on K_u with repeated singular values: 3e-2 recomposition error on the
+    // level box.)
+    let (eig_values, eig_vectors) = crate::solver::eigen::symmetric_eigen(&(ku.transpose() * &ku));
+    let lmax = eig_values.amax();
+    if !lmax.is_finite() {
+        return None;
     }
-    *mu = spread;
+    let keep: Vec<usize> = (0..eig_values.len())
+        .filter(|&i| eig_values[i] > 1e-20 * lmax && lmax > 0.0)
+        .collect();
+    let map = DMatrix::from_fn(null.len(), keep.len(), |r, c| {
+        eig_vectors[(r, keep[c])] / eig_values[keep[c]].sqrt()
+    });
+    let (holders, coefficients, weight) = friction::holders_of(model, &items);
+    let support = friction::Support {
+        base: DVector::from_fn(rows.len(), |r, _| mu[rows[r]]),
+        null: &ku * &map,
+        holders,
+        mu: coefficients,
+        weight,
+    };
+    let out = friction::distribute(
+        &support,
+        crate::solver::inequality::active_set::force_scale(model),
+    )?;
+    let y = support.null.transpose() * (&out.forces - &support.base);
+    *mu += &k * (&map * y);
+    // The stop and contact rows exactly as chosen (`K z` reproduces them to rounding; the
+    // equality rows follow through it).
+    for (r, &row) in rows.iter().enumerate() {
+        mu[row] = out.forces[r];
+    }
+    Some((out.required_mu, out.slipping))
 }

@@ -1,0 +1,287 @@
+//! Tests of module `friction` on rigid bodies whose contact wrenches are written here:
+//! closed forms (a body on a slope, a ladder against a wall) and an independent solution of
+//! the same problem (bisection on `μ` of a linear program over many-sided pyramids, solved by
+//! a small simplex method written here).
+
+use super::*;
+use nalgebra::Vector3;
+
+/// A contact of a rigid body: point, unit normal, whether it sticks.
+struct Touch {
+    p: Vector3<f64>,
+    n: Vector3<f64>,
+    stick: bool,
+}
+
+/// An orthonormal tangent basis of `n`.
+fn tangents(n: &Vector3<f64>) -> [Vector3<f64>; 2] {
+    let a = if n.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    let t1 = n.cross(&a).normalize();
+    [t1, n.cross(&t1)]
+}
+
+/// The wrench columns `[d; p × d]` of each force row, and the support of a body of weight
+/// `w` (gravity `−w ẑ` rotated by `tilt` about y) at its origin on `touches`.
+fn support(touches: &[Touch], w: f64, tilt: f64, mu: Option<f64>) -> (DMatrix<f64>, Support) {
+    let mut cols = Vec::new();
+    let mut holders = Vec::new();
+    let mut mus = Vec::new();
+    for t in touches {
+        holders.push((
+            cols.len(),
+            if t.stick {
+                Holder::Stick { c: Some(1.0) }
+            } else {
+                Holder::Smooth
+            },
+        ));
+        mus.push(if t.stick { mu } else { None });
+        let mut dirs = vec![t.n];
+        if t.stick {
+            dirs.extend(tangents(&t.n));
+        }
+        for d in dirs {
+            let m = t.p.cross(&d);
+            cols.push(DVector::from_vec(vec![d.x, d.y, d.z, m.x, m.y, m.z]));
+        }
+    }
+    let g = DMatrix::from_columns(&cols);
+    let weight = Vector3::new(-w * tilt.sin(), 0.0, -w * tilt.cos());
+    let rhs = DVector::from_vec(vec![-weight.x, -weight.y, -weight.z, 0.0, 0.0, 0.0]);
+    let base = g.clone().pseudo_inverse(1e-12).unwrap() * &rhs;
+    let eig = (g.transpose() * &g).symmetric_eigen();
+    let top = eig.eigenvalues.amax();
+    let null: Vec<DVector<f64>> = (0..g.ncols())
+        .filter(|&i| eig.eigenvalues[i] <= 1e-10 * top)
+        .map(|i| eig.eigenvectors.column(i).into_owned())
+        .collect();
+    let k = g.ncols();
+    let s = Support {
+        base,
+        null: if null.is_empty() {
+            DMatrix::zeros(k, 0)
+        } else {
+            DMatrix::from_columns(&null)
+        },
+        holders,
+        mu: mus,
+        weight: vec![1.0; k],
+    };
+    (g, s)
+}
+
+/// Feasibility of `{A x = b, x ≥ 0}` by phase 1 of the simplex method (Bland's rule).
+fn lp_feasible(a: &DMatrix<f64>, b: &DVector<f64>) -> bool {
+    let (m, n) = (a.nrows(), a.ncols());
+    // Tableau [A I | b] with b ≥ 0, minimizing the sum of the artificials.
+    let mut t = DMatrix::zeros(m + 1, n + m + 1);
+    for r in 0..m {
+        let s = if b[r] < 0.0 { -1.0 } else { 1.0 };
+        for c in 0..n {
+            t[(r, c)] = s * a[(r, c)];
+        }
+        t[(r, n + r)] = 1.0;
+        t[(r, n + m)] = s * b[r];
+    }
+    let mut basis: Vec<usize> = (n..n + m).collect();
+    for c in 0..=n + m {
+        let sum: f64 = (0..m).map(|r| t[(r, c)]).sum();
+        t[(m, c)] = if c >= n && c < n + m { 0.0 } else { -sum };
+    }
+    let scale = b.amax().max(1.0);
+    for _ in 0..10_000 {
+        let Some(enter) = (0..n + m).find(|&c| t[(m, c)] < -1e-11) else {
+            break;
+        };
+        let leave = (0..m)
+            .filter(|&r| t[(r, enter)] > 1e-12)
+            .min_by(|&r1, &r2| {
+                let q1 = t[(r1, n + m)] / t[(r1, enter)];
+                let q2 = t[(r2, n + m)] / t[(r2, enter)];
+                q1.total_cmp(&q2).then(basis[r1].cmp(&basis[r2]))
+            });
+        let Some(leave) = leave else { break };
+        let piv = t[(leave, enter)];
+        for c in 0..=n + m {
+            t[(leave, c)] /= piv;
+        }
+        for r in 0..=m {
+            if r != leave {
+                let f = t[(r, enter)];
+                if f != 0.0 {
+                    for c in 0..=n + m {
+                        t[(r, c)] -= f * t[(leave, c)];
+                    }
+                }
+            }
+        }
+        basis[leave] = enter;
+    }
+    -t[(m, n + m)] <= 1e-9 * scale
+}
+
+/// Whether forces inside `sides`-sided pyramids of half-aperture `mu` (edges on the cone of
+/// `mu`: inscribed) balance the body.
+fn pyramid_feasible(g: &DMatrix<f64>, s: &Support, mu: f64, sides: usize) -> bool {
+    // Variables: per sticking contact `sides` edge weights, per smooth one its normal force.
+    let rhs = g * &s.base;
+    let mut cols = Vec::new();
+    for &(first, h) in &s.holders {
+        let n = g.column(first).into_owned();
+        match h {
+            Holder::Stick { .. } => {
+                let (t1, t2) = (g.column(first + 1), g.column(first + 2));
+                for j in 0..sides {
+                    let a = std::f64::consts::TAU * j as f64 / sides as f64;
+                    cols.push(&n + (t1 * a.cos() + t2 * a.sin()) * mu);
+                }
+            }
+            _ => cols.push(n),
+        }
+    }
+    lp_feasible(&DMatrix::from_columns(&cols), &rhs)
+}
+
+/// The smallest `mu` for which the pyramids balance the body, by bisection.
+fn pyramid_mu(g: &DMatrix<f64>, s: &Support, sides: usize) -> f64 {
+    let (mut lo, mut hi) = (0.0, 4.0);
+    for _ in 0..40 {
+        let mid = 0.5 * (lo + hi);
+        if pyramid_feasible(g, s, mid, sides) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    hi
+}
+
+/// A 0.5 × 0.4 box's four bottom corners, the centre of mass `h` above their plane and
+/// shifted by `dx`.
+fn box_corners(h: f64, dx: f64, stick: bool) -> Vec<Touch> {
+    [(-0.25, -0.2), (0.25, -0.2), (-0.25, 0.2), (0.25, 0.2)]
+        .iter()
+        .map(|&(x, y)| Touch {
+            p: Vector3::new(x - dx, y, -h),
+            n: Vector3::z(),
+            stick,
+        })
+        .collect()
+}
+
+/// A box on a slope of `α` (gravity tilted by `α`): `required_mu = tan α`, and the pyramid
+/// bisection brackets it (inscribed pyramids need more, circumscribed less).
+#[test]
+fn a_box_on_a_slope_needs_tan_alpha() {
+    for alpha in [0.0, 0.1, 0.2, 0.35] {
+        let (g, s) = support(&box_corners(0.15, 0.03, true), 15.7, alpha, Some(0.5));
+        let d = distribute(&s, 15.7).unwrap();
+        let need = d.required_mu.unwrap();
+        let tan = f64::tan(alpha);
+        assert!(
+            (need - tan).abs() <= 1e-9 * tan.max(1.0),
+            "{alpha}: {need} vs {tan}"
+        );
+        assert_eq!(d.slipping, slips(tan, 0.5));
+        // Balanced: G λ = G λ₀.
+        assert!((&g * &d.forces - &g * &s.base).amax() < 1e-9);
+        let sides = 64;
+        let inscribed = pyramid_mu(&g, &s, sides);
+        let circumscribed = inscribed * (std::f64::consts::PI / sides as f64).cos();
+        assert!(
+            need <= inscribed + 1e-8 && need >= circumscribed - 1e-8,
+            "{need} {inscribed}"
+        );
+        if alpha == 0.0 {
+            // A level floor: no friction at all, m g / 4 per corner by symmetry... of the
+            // least-norm distribution.
+            for &(first, _) in &s.holders {
+                assert!(d.forces[first + 1].abs() + d.forces[first + 2].abs() < 1e-9);
+            }
+        }
+    }
+}
+
+/// A uniform ladder of length 2 at angle β to the floor, its feet at `y = ±0.2` on the floor
+/// and its top against a wall (normal −x). Friction at the floor only: `μ = cot β / 2`; at
+/// both ends: `tan β = (1 − μ²) / (2 μ)`, `μ = sec β − tan β`.
+#[test]
+fn a_ladder_against_a_wall() {
+    for beta in [1.0f64, 1.2, 1.35] {
+        let (c, s_) = (beta.cos(), beta.sin());
+        // Origin at the ladder's middle (its centre of mass).
+        let foot = Vector3::new(-c, 0.0, -s_);
+        let top = Vector3::new(c, 0.0, s_);
+        let make = |wall_sticks: bool| {
+            let mut t = Vec::new();
+            for y in [-0.2, 0.2] {
+                t.push(Touch {
+                    p: foot + Vector3::new(0.0, y, 0.0),
+                    n: Vector3::z(),
+                    stick: true,
+                });
+                t.push(Touch {
+                    p: top + Vector3::new(0.0, y, 0.0),
+                    n: -Vector3::x(),
+                    stick: wall_sticks,
+                });
+            }
+            t
+        };
+        let (g, s) = support(&make(false), 100.0, 0.0, None);
+        let need = distribute(&s, 100.0).unwrap().required_mu.unwrap();
+        let expect = 0.5 / beta.tan();
+        assert!((need - expect).abs() < 1e-9, "{beta}: {need} vs {expect}");
+        let inscribed = pyramid_mu(&g, &s, 64);
+        assert!(
+            need <= inscribed + 1e-8 && inscribed < need * 1.002,
+            "{need} {inscribed}"
+        );
+        let (g, s) = support(&make(true), 100.0, 0.0, None);
+        let need = distribute(&s, 100.0).unwrap().required_mu.unwrap();
+        let expect = 1.0 / beta.cos() - beta.tan();
+        assert!((need - expect).abs() < 1e-9, "{beta}: {need} vs {expect}");
+        let inscribed = pyramid_mu(&g, &s, 64);
+        assert!(
+            need <= inscribed + 1e-8 && inscribed < need * 1.002,
+            "{need} {inscribed}"
+        );
+    }
+}
+
+/// The verdict at a given `μ`: sticking from `required_mu` on (to `10⁻⁹`), slipping below;
+/// the forces reported when slipping are the least-friction ones.
+#[test]
+fn slips_exactly_below_required_mu() {
+    let alpha = 0.35f64;
+    let tan = alpha.tan();
+    for (mu, slipping) in [
+        (tan, false),
+        (tan + 1e-9, false),
+        (tan - 1e-8, true),
+        (0.2, true),
+    ] {
+        let (_, s) = support(&box_corners(0.15, -0.05, true), 15.7, alpha, Some(mu));
+        let d = distribute(&s, 15.7).unwrap();
+        assert_eq!(d.slipping, slipping, "{mu}");
+    }
+    // Different coefficients: the corners needing more may rely on the others.
+    let (_, mut s) = support(&box_corners(0.15, 0.0, true), 15.7, alpha, None);
+    s.mu = vec![Some(0.3), Some(0.3), Some(0.6), Some(0.6)];
+    let d = distribute(&s, 15.7).unwrap();
+    assert!(!d.slipping, "{d:?}");
+    s.mu = vec![Some(0.3), Some(0.3), Some(0.3), Some(0.3)];
+    assert!(distribute(&s, 15.7).unwrap().slipping);
+}
+
+/// A contact that would have to pull: no distribution.
+#[test]
+fn no_distribution_when_a_contact_must_pull() {
+    // The centre of mass outside the corners (shifted by 0.4 m).
+    let (_, s) = support(&box_corners(0.15, 0.4, false), 10.0, 0.0, None);
+    assert!(distribute(&s, 10.0).is_none());
+}

@@ -119,6 +119,7 @@ fn build(py: Python<'_>, e: &Error) -> PyResult<PyErr> {
             residual,
             row,
             iterations,
+            ..
         } => {
             site(&attrs, s.as_deref())?;
             attrs.set_item("row", row)?;
@@ -137,7 +138,8 @@ fn build(py: Python<'_>, e: &Error) -> PyResult<PyErr> {
             attrs.set_item("residual", residual)?;
             "AssemblyError"
         }
-        Error::ConstantEnergy { robot, dof } => {
+        Error::ConstantEnergy { robot, dof, file } => {
+            attrs.set_item("file", file)?;
             attrs.set_item("robot", robot)?;
             attrs.set_item("dof", dof)?;
             "ConstantEnergyError"

@@ -12,6 +12,17 @@ pub type Triangles = (Vec<[f64; 3]>, Vec<[u32; 3]>);
 /// reader holds the whole file, so the cap bounds the memory a mesh can take.
 pub const MAX_MESH_BYTES: u64 = 256 << 20;
 
+/// Whether `bytes` is a binary STL: an 80-byte header, a triangle count `n` (little-endian
+/// `u32`) and exactly `50 n` bytes of triangles. An ASCII file cannot match by accident (its
+/// bytes 80–83 are text, a count of at least 0x20202020).
+fn is_binary_stl(bytes: &[u8]) -> bool {
+    let Some(count) = bytes.get(80..84) else {
+        return false;
+    };
+    let n = u32::from_le_bytes([count[0], count[1], count[2], count[3]]) as u64;
+    84 + 50 * n == bytes.len() as u64
+}
+
 /// Triangles of a mesh file, scaled.
 ///
 /// # Errors
@@ -30,9 +41,21 @@ pub fn load_mesh(path: &Path, scale: &Vector3<f64>) -> Result<Triangles, Geometr
             bytes: meta.len(),
         });
     }
-    let scene = mesh_loader::Loader::default()
-        .load(path)
-        .map_err(|e| GeometryError::read(path, &e))?;
+    let bytes = std::fs::read(path).map_err(|e| GeometryError::read(path, &e))?;
+    let is_stl = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("stl"));
+    let loader = mesh_loader::Loader::default();
+    let scene = if is_stl && is_binary_stl(&bytes) {
+        // A binary STL whose 80-byte header starts with "solid" is read as ASCII by
+        // `mesh-loader` and refused: the header carries no geometry, so it is blanked.
+        let mut bytes = bytes;
+        bytes[..80].fill(0);
+        loader.load_stl_from_slice(&bytes, path)
+    } else {
+        loader.load_from_slice(&bytes, path)
+    }
+    .map_err(|e| GeometryError::read(path, &e))?;
     let mut vertices = Vec::new();
     let mut faces = Vec::new();
     for m in &scene.meshes {
@@ -94,3 +117,41 @@ pub fn convex_hull_of(points: &[Vector3<f64>]) -> Result<Triangles3, GeometryErr
 
 /// Vertices and index triples of a convex hull.
 pub type Triangles3 = (Vec<Vector3<f64>>, Vec<[u32; 3]>);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A binary STL of one triangle whose header starts with "solid" (as example-robot-data's
+    /// `solo_foot.stl`): read as binary, not refused as malformed ASCII.
+    #[test]
+    fn a_binary_stl_whose_header_says_solid_is_read_as_binary() {
+        let mut bytes = vec![0u8; 84];
+        bytes[..11].copy_from_slice(b"solid part ");
+        bytes[80..84].copy_from_slice(&1u32.to_le_bytes());
+        for v in [
+            [0.0f32, 0.0, 1.0],
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 2.0, 0.0],
+        ] {
+            for x in v {
+                bytes.extend_from_slice(&x.to_le_bytes());
+            }
+        }
+        bytes.extend_from_slice(&[0, 0]);
+        assert!(is_binary_stl(&bytes));
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("foot.stl");
+        std::fs::write(&path, &bytes).unwrap();
+        let (vertices, faces) = load_mesh(&path, &Vector3::new(1.0, 1.0, 1.0)).unwrap();
+        assert_eq!(faces.len(), 1);
+        assert!(vertices.contains(&[0.0, 2.0, 0.0]), "{vertices:?}");
+        // An ASCII STL is still read as ASCII.
+        let ascii = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 3 0\nendloop\nendfacet\nendsolid t\n";
+        assert!(!is_binary_stl(ascii.as_bytes()));
+        std::fs::write(&path, ascii).unwrap();
+        let (vertices, _) = load_mesh(&path, &Vector3::new(1.0, 1.0, 1.0)).unwrap();
+        assert!(vertices.contains(&[0.0, 3.0, 0.0]), "{vertices:?}");
+    }
+}

@@ -175,19 +175,13 @@ pub(super) fn report(
     let (mut strong, mut weak) = (Vec::new(), Vec::new());
     let mut sticking = Vec::new();
     for (t, lambda) in list.iter().zip(forces) {
-        if t.active.anchor.is_some() && matches!(t.active.row, Unilateral::Contact { .. }) {
-            let ft = (lambda[1] * lambda[1] + lambda[2] * lambda[2]).sqrt();
-            let small = 1e-12 * friction::force_scale(model);
-            let ft = if ft <= small { 0.0 } else { ft };
-            sticking.push((friction::needs_mu(lambda[0], ft), t.mu));
-        }
         if lambda[0] > tau {
             strong.push(t.active);
         } else {
             weak.push(t.active);
         }
         out.complementarity = out.complementarity.max((t.gap * lambda[0]).abs());
-        describe(model, state, t, lambda, tau, out);
+        sticking.extend(describe(model, state, t, lambda, tau, out));
     }
     for &(i, f) in pulling_rows {
         out.failures.push(pulling(model, &list[i].active.row, f));
@@ -216,8 +210,8 @@ fn pulling(model: &Model, u: &Unilateral, force: f64) -> String {
     )
 }
 
-/// Adds the contact or stop `t` with its forces `lambda` to `out`, and a failure for a sticking
-/// contact needing more than its friction coefficient.
+/// Adds the contact or stop `t` with its forces `lambda` to `out`; returns, for a sticking
+/// contact, the friction coefficient it needs and the one it has.
 fn describe(
     model: &Model,
     state: &State,
@@ -225,23 +219,28 @@ fn describe(
     lambda: &[f64],
     tau: f64,
     out: &mut UnilateralCheck,
-) {
+) -> Option<(f64, Option<f64>)> {
     match t.active.row {
         Unilateral::Limit {
             joint,
             bound,
             value,
-        } => out.active_limits.push(ActiveLimit {
-            joint: model.joints[joint.0].name.clone(),
-            bound: bound.name().into(),
-            value,
-            effort: match bound {
-                unilateral::Bound::Lower => lambda[0],
-                unilateral::Bound::Upper => -lambda[0],
-            },
-            effort_limit: friction::effort_check(model, joint, lambda[0]).0,
-            exceeds_effort_limit: friction::effort_check(model, joint, lambda[0]).1,
-        }),
+        } => {
+            let (effort_limit, exceeds_effort_limit) =
+                friction::effort_check(model, joint, lambda[0]);
+            out.active_limits.push(ActiveLimit {
+                joint: model.joints[joint.0].name.clone(),
+                bound: bound.name().into(),
+                value,
+                effort: match bound {
+                    unilateral::Bound::Lower => lambda[0],
+                    unilateral::Bound::Upper => -lambda[0],
+                },
+                effort_limit,
+                exceeds_effort_limit,
+            });
+            None
+        }
         Unilateral::Contact { point, ground } => {
             let c = &model.contact_points[point];
             let x = unilateral::point_world(model, point, &state.q);
@@ -271,6 +270,7 @@ fn describe(
                 required_friction: required,
                 state: state_,
             });
+            t.active.anchor.map(|_| (required, t.mu))
         }
     }
 }

@@ -348,6 +348,7 @@ fn describe(
 ) -> Vec<(f64, Option<f64>)> {
     let mut sticking = Vec::new();
     use crate::solver::report::{ActiveLimit, Contact, ContactState};
+    let tiny = 1e-12 * force_scale(model);
     for (a, m) in multipliers {
         match a.row {
             Unilateral::Limit {
@@ -381,7 +382,6 @@ fn describe(
                     ft = t1 * m[1] + t2 * m[2];
                 }
                 let fnorm = m[0];
-                let tiny = 1e-12 * force_scale(model);
                 let required = crate::solver::friction::needs_mu(
                     fnorm,
                     if ft.norm() <= tiny { 0.0 } else { ft.norm() },

@@ -261,7 +261,15 @@ pub(crate) fn solve_round(
     }
     let mut chosen = None;
     if !active.is_empty() && !out.part.redundant.is_empty() {
-        chosen = distribution::spread(model, &sys.problem.cons, &out.q, &mut mu, options);
+        chosen = distribution::spread(
+            model,
+            &sys.problem.cons,
+            &out.q,
+            &out.part,
+            &out.eval.factors,
+            &mut mu,
+            options,
+        );
     }
     let reactions = reactions::reactions(&sys, &out.q, &mu);
     let multipliers = active_set::active_multipliers(&sys.problem.cons, &mu);

@@ -279,6 +279,11 @@ pub(crate) struct AnalyzeArgs {
     /// Stop at an unstable stationary point instead of leaving it.
     #[arg(long)]
     pub(crate) allow_unstable: bool,
+    /// Report the lowest eigenvalues and mode shapes of the stability verdict at any size.
+    /// Without it, above 200 degrees of freedom on the sparse path the verdict comes from the
+    /// inertia of the shifted KKT matrix alone (faster; `eigenvalues` and `modes` empty).
+    #[arg(long)]
+    pub(crate) eigenvalues: bool,
     #[command(flatten)]
     pub(crate) contact: ContactArgs,
     /// Print only errors.
@@ -333,6 +338,7 @@ impl AnalyzeArgs {
             constraint_tolerance: self.constraint_tolerance,
             max_iterations: self.max_iterations,
             allow_unstable: self.allow_unstable,
+            eigenvalues: self.eigenvalues,
             load_steps: self.load_steps,
             ..Default::default()
         }

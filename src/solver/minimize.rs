@@ -37,7 +37,8 @@ use super::inequality::active_set::Guard;
 use super::options::{Method, Options};
 use super::partition::Partition;
 use super::report::{Diagnostics, Iterate, Termination};
-use super::stability::spectrum::{spectrum, Spectrum};
+use super::stability::at_rest::for_minimizer;
+use super::stability::spectrum::Spectrum;
 use super::system::{Backend, Eval, System};
 use nalgebra::{DMatrix, DVector};
 
@@ -48,6 +49,9 @@ pub(crate) struct Outcome {
     /// Reduced-Hessian eigenvalues and eigenvectors at `q`, when the convergence test
     /// computed them.
     pub(crate) eigen: Option<Spectrum>,
+    /// The inertia verdict and tolerance at `q` where the convergence test took it instead of
+    /// the Lanczos spectrum (module `stability::at_rest`).
+    pub(crate) inertia: Option<(super::report::Verdict, f64)>,
     /// The accepted iterates, when `Options::record_iterates` is set.
     pub(crate) iterates: Vec<DVector<f64>>,
     pub(crate) eval: Eval,
@@ -183,6 +187,7 @@ pub(crate) fn minimize(
     let mut linear_steps = 0;
     let mut descent = super::unbounded::LinearDescent::default();
     let mut eigen = None;
+    let mut inertia = None;
     let mut iterates = Vec::new();
     let mut blocked = None;
     // The step length the line search starts from: 1, or after a step the corrector could
@@ -214,8 +219,9 @@ pub(crate) fn minimize(
         let mut negative_curvature = None;
         let dof = part.independent.len();
         let dense_newton = options.method == Method::Newton && sys.backend == Backend::Dense;
-        let eig =
-            (dof > 0 && (dense_newton || gnorm <= gtol)).then(|| spectrum(sys, &q, &part, &eval));
+        let eig = (dof > 0 && (dense_newton || gnorm <= gtol))
+            .then(|| for_minimizer(sys, &q, &part, &eval, options.allow_unstable, &mut inertia))
+            .flatten();
         if gnorm <= gtol {
             match &eig {
                 Some(e) if !options.allow_unstable => match e.lowest() {
@@ -462,6 +468,10 @@ pub(crate) fn minimize(
     Some(Outcome {
         q,
         part,
+        // Taken at `q` only where the loop stopped on convergence.
+        inertia: (termination == Termination::Converged && eigen.is_none())
+            .then_some(inertia)
+            .flatten(),
         eigen,
         iterates,
         eval,

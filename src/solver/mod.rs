@@ -247,7 +247,18 @@ pub(crate) fn solve_round(
     let stability_started = std::time::Instant::now();
     // A round stopped by an inequality is not a rest pose: the active-set iteration goes on
     // from it (and judges stability itself if it ends there).
+    // Where the minimizer judged by the KKT inertia (many degrees of freedom), that verdict,
+    // unless eigenvalues are asked for (module `stability::at_rest`).
     let stability = (dof > 0 && out.blocked.is_none()).then(|| {
+        if let (Some((verdict, tolerance)), false) = (out.inertia, options.eigenvalues) {
+            diagnostics.eigenvalues_by = "inertia".into();
+            return Stability {
+                verdict,
+                tolerance,
+                eigenvalues: Vec::new(),
+                modes: Vec::new(),
+            };
+        }
         let eig = out
             .eigen
             .clone()

@@ -125,6 +125,12 @@ pub struct Options {
     /// Stop at a stationary point even if it is unstable (default: false: leave saddles and
     /// maxima along the direction of negative curvature).
     pub allow_unstable: bool,
+    /// Report the lowest eigenvalues and mode shapes of the stability verdict at any size
+    /// (default: false: above 200 degrees of freedom on the sparse path the verdict comes
+    /// from the inertia of the shifted KKT matrix alone, `eigenvalues` and `modes` empty and
+    /// `diagnostics.eigenvalues_by` `"inertia"`; below, they are exact and cheap and always
+    /// reported).
+    pub eigenvalues: bool,
     /// Dense or sparse linear algebra (default: automatic by size).
     pub linear_algebra: LinearAlgebra,
     /// Keep the configuration of every accepted iterate in [`crate::Report::iterates`] (for the
@@ -181,6 +187,7 @@ impl Default for Options {
             max_step: 0.3,
             load_steps: 0,
             allow_unstable: false,
+            eigenvalues: false,
             record_iterates: false,
             linear_algebra: LinearAlgebra::Auto,
             limits: ContactPolicy::default().limits,

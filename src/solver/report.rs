@@ -203,8 +203,10 @@ pub struct Diagnostics {
     pub constraint_residual: f64,
     /// Linear algebra used: `"dense"` or `"sparse"` (see [`crate::solver::LinearAlgebra`]).
     pub linear_algebra: String,
-    /// How the stability eigenvalues were found: `"exact"` (the reduced Hessian decomposed) or
-    /// `"lanczos"` (its low end only, for many degrees of freedom); empty without any.
+    /// How the stability eigenvalues were found: `"exact"` (the reduced Hessian decomposed),
+    /// `"lanczos"` (its low end only, for many degrees of freedom), or `"inertia"` (none: the
+    /// verdict from the inertia of the shifted KKT matrix, many degrees of freedom without
+    /// [`Options::eigenvalues`](crate::Options::eigenvalues)); empty without a verdict.
     pub eigenvalues_by: String,
     /// Wall time of each phase \[s\].
     pub timings: Timings,
@@ -235,6 +237,9 @@ impl Diagnostics {
         self.step_halvings += other.step_halvings;
         self.repartitions += other.repartitions;
         self.negative_curvature_steps += other.negative_curvature_steps;
+        // The time spent judging stability (every round's and stage's rest), so that the
+        // caller's `iterations` (the rest of the solve) does not count it.
+        self.timings.stability += other.timings.stability;
     }
 }
 

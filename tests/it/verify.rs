@@ -214,8 +214,8 @@ fn verify_accepts_analyze_answers_at_1000_links() {
         );
         // verify's stability verdict (from its balance check's partition; above 200 degrees
         // of freedom from the shifted KKT inertia by default, without eigenvalues) is
-        // analyze's; asked for, the smallest eigenvalues (Lanczos) are analyze's too, with the
-        // same verdict and tolerance.
+        // analyze's, with the same tolerance; asked for, the smallest eigenvalues (Lanczos)
+        // are analyze's too (asked for there too), with the same verdict and tolerance.
         let full = restpose::verify::verify_reporting(
             &m,
             &s,
@@ -231,8 +231,21 @@ fn verify_accepts_analyze_answers_at_1000_links() {
             report.stability.as_ref().unwrap(),
         );
         assert_eq!(vs.verdict, rs.verdict, "{family}");
+        // (The pose read back from the JSON differs from the solver's by rounding.)
+        assert!(
+            (vs.tolerance - rs.tolerance).abs() <= 1e-9 * rs.tolerance,
+            "{family}"
+        );
         assert_eq!(vs.verdict, restpose::solver::Verdict::Stable, "{family}");
         assert!(vs.eigenvalues.is_empty() && vs.modes.is_empty(), "{family}");
+        assert!(rs.eigenvalues.is_empty(), "{family}");
+        assert_eq!(report.diagnostics.eigenvalues_by, "inertia", "{family}");
+        let asked = restpose::Options {
+            eigenvalues: true,
+            ..Default::default()
+        };
+        let (_, report) = restpose::solve(&m, &asked).unwrap();
+        let rs = report.stability.as_ref().unwrap();
         assert_eq!(fs.verdict, vs.verdict, "{family}");
         assert_eq!(fs.tolerance, vs.tolerance, "{family}");
         assert!(!fs.eigenvalues.is_empty(), "{family}");

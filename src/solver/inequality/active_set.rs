@@ -283,15 +283,18 @@ pub(crate) fn solve(
         if cycling {
             report.termination = crate::solver::Termination::ActiveSetCycling;
         }
+        let mut judging = 0.0;
         // A round stopped at an inequality or a roll limit has no verdict of its own.
         if (cycling || rolled_too_far) && round.blocked.is_some() {
+            let judged = std::time::Instant::now();
             report.stability = crate::solver::stability_on(
                 model,
                 &state,
                 &active,
                 Backend::of(model, options),
-                true,
+                options.eigenvalues,
             );
+            judging = judged.elapsed().as_secs_f64();
         }
         report.iterations = iterations;
         (report.history, report.iterates) = (history, iterates);
@@ -311,6 +314,7 @@ pub(crate) fn solve(
         report.balance = crate::solver::balance::Balance::of(model, &state, &report.contacts);
         // Judged with every active row held; where some touch without a force, on the
         // critical cone instead (module `cone`).
+        let judged = std::time::Instant::now();
         let (strong, weak) = split(model, &round.multipliers, threshold);
         if report.converged() && !weak.is_empty() {
             report.stability = crate::solver::stability_verdict(
@@ -319,7 +323,7 @@ pub(crate) fn solve(
                 &strong,
                 &weak,
                 Backend::of(model, options),
-                true,
+                options.eigenvalues,
             );
         }
         // Stops and contacts carrying a force that leave no feasible motion: a strict
@@ -330,9 +334,10 @@ pub(crate) fn solve(
                 &state,
                 &strong,
                 Backend::of(model, options),
-                true,
+                options.eigenvalues,
             );
         }
+        report.diagnostics.timings.stability += judging + judged.elapsed().as_secs_f64();
         return Ok((state, report));
     }
 }

@@ -8,10 +8,13 @@
 //!   (sparse, many degrees of freedom); also used by the minimizer to leave saddles.
 //! - `inertia`: the verdict from the inertia of the shifted KKT matrix, without eigenvalues.
 //! - `cone`: the verdict on the critical cone, where stops and contacts touch without force.
+//! - `at_rest`: what the minimizer computes at a point: the exact spectrum where cheap, else
+//!   the inertia verdict, and Lanczos only to leave a saddle.
 //! - `verdict`: the verdict and mode shapes from the eigenpairs, and the entry points.
 //! - `joint_space`: the reported eigenvalues and modes in joint coordinates,
 //!   `H_θ = T⁻ᵀ Ĥ T⁻¹` (physical units, independent of the partition).
 
+pub(crate) mod at_rest;
 pub(crate) mod cone;
 pub(crate) mod eigen;
 pub(crate) mod inertia;

@@ -50,7 +50,8 @@ use super::unilateral::Touching;
 use crate::constraints::{BlockKind, Constraints, Triplets};
 use crate::error::{Error, Result};
 use crate::model::{JointId, Model};
-use crate::solver::system::{Backend, System};
+use crate::solver::partition::Partition;
+use crate::solver::system::{Backend, Eval, System};
 use crate::state::State;
 use nalgebra::{DMatrix, DVector};
 
@@ -97,6 +98,7 @@ pub(super) fn held(
     coords: &[(JointId, usize, f64)],
     backend: Backend,
     tau: f64,
+    free: Option<Multipliers>,
 ) -> Result<Held> {
     let locks = crate::solver::lock_values(model);
     let mut all = locks.clone();
@@ -117,9 +119,13 @@ pub(super) fn held(
     }
     // First without locking the joints: where that balances the pose, no effort is needed
     // and these are the forces (the least-norm ones among those needing none).
-    let free = with_rounds(list, tau, |on| {
-        solve_once(model, state, list, on, &locks, locks.len(), backend, None)
-    })?;
+    // Nothing touching: the caller may have these multipliers already ([`free_of`]).
+    let free = match free {
+        Some(m) if list.is_empty() => (m, Vec::new(), Vec::new()),
+        _ => with_rounds(list, tau, |on| {
+            solve_once(model, state, list, on, &locks, locks.len(), backend, None)
+        })?,
+    };
     let locked_solve = if free.0.unassigned <= tau {
         None
     } else {
@@ -200,7 +206,7 @@ fn with_rounds(
 
 /// One solve's multipliers: per lock of `all`, per inequality of `list`, and the unassigned
 /// force.
-struct Multipliers {
+pub(super) struct Multipliers {
     locks: Vec<f64>,
     forces: Vec<Vec<f64>>,
     unassigned: f64,
@@ -209,6 +215,32 @@ struct Multipliers {
     /// `(required_mu, slipping)` where sticking contacts carry the load and no effort is
     /// chosen: the distribution of module `solver::friction` (the one `analyze` reports).
     chosen: crate::solver::friction::Chosen,
+}
+
+/// The multipliers of the first solve of [`held`] where nothing touches (the model's rows
+/// and locks alone), from the system of those rows already partitioned and evaluated at the
+/// pose (`verify`'s balance check, module `reduced`, builds the same system `solve_once`
+/// would: the same rows, scaling and partition). No row's multiplier is chosen there (no
+/// joint lock, no touching row), so they are the basic ones.
+pub(super) fn free_of(sys: &System, part: &Partition, eval: &Eval) -> Multipliers {
+    let mut mu = DVector::zeros(sys.problem.cons.len());
+    for (k, &r) in part.rows.iter().enumerate() {
+        mu[r] = eval.mu[k];
+    }
+    Multipliers {
+        locks: sys
+            .problem
+            .cons
+            .blocks
+            .iter()
+            .filter(|b| matches!(b.kind, BlockKind::Lock { .. }))
+            .map(|b| mu[b.first])
+            .collect(),
+        forces: Vec::new(),
+        unassigned: eval.grad_v.amax(),
+        resolved: part.redundant.len() <= MAX_DEPENDENT,
+        chosen: None,
+    }
 }
 
 /// The multipliers of the model's rows, the locks `all` (the first `model_locks` the model's

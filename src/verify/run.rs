@@ -76,14 +76,16 @@ pub(super) fn verify_on(
         } = r;
         let assembled = phi.amax() <= tol.constraint;
         let tau = tol.force + tol.relative * force_scale;
-        // Without a stop or contact touching, the verdict on this partition.
+        // Without a stop or contact touching, the forces' first solve is this system's
+        // (`held::free_of`), and the verdict is judged on this partition.
+        let free = list.is_empty().then(|| held::free_of(&sys, &part, &eval));
         let (held, stability) = std::thread::scope(|s| {
             let verdict = (assembled && list.is_empty() && !skip).then(|| {
                 s.spawn(|| {
                     crate::solver::stability_of(&mut sys, &state.q, &part, &eval, eigenvalues)
                 })
             });
-            let held = held::held(model, state, &list, &values, backend, tau)?;
+            let held = held::held(model, state, &list, &values, backend, tau, free)?;
             let passed = passes(phi.amax(), &held, force_scale, tol);
             // A panic there is re-raised here, as if the verdict had been computed on
             // this thread.
@@ -110,7 +112,7 @@ pub(super) fn verify_on(
         let projected_gradient = (p.null.transpose() * &p.grad_s).amax();
         let force_scale = p.grad_s.amax();
         let tau = tol.force + tol.relative * force_scale;
-        let held = held::held(model, state, &list, &values, backend, tau)?;
+        let held = held::held(model, state, &list, &values, backend, tau, None)?;
         (
             p.phi,
             p.energy,

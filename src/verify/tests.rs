@@ -98,3 +98,35 @@ fn sparse_and_dense_verdicts_agree_with_loops_and_spherical_joints() {
         assert!(v.passed, "stewart, sparse {sparse}: {v:?}");
     }
 }
+
+/// Where nothing touches, the first solve of the forces that hold a pose is the balance
+/// check's own system: taken from it (`held::free_of`) the efforts, the unassigned force and
+/// the resolution are those `held` finds with its own partition, on a chain and a ladder (with
+/// redundant rows), at a rest and off it.
+#[test]
+fn held_from_the_balance_checks_system_is_held_from_its_own() {
+    for text in [
+        crate::generate::chain(30, false),
+        crate::generate::ladder(5),
+    ] {
+        let model = load(&text);
+        let (rest, _) = crate::solver::solve(&model, &Default::default()).unwrap();
+        for state in [rest, bent(&model)] {
+            let locks = crate::solver::lock_values(&model);
+            let r = super::reduced::reduced(&model, &state, &locks).unwrap();
+            let values: Vec<_> = super::run::tree_coordinates(&model, &state)
+                .iter()
+                .map(|c| (c.0, c.1, c.2.v))
+                .collect();
+            let tau = 1e-9 * r.force_scale.max(1.0);
+            let backend = crate::solver::system::Backend::Sparse;
+            let own = super::held::held(&model, &state, &[], &values, backend, tau, None).unwrap();
+            let free = super::held::free_of(&r.sys, &r.part, &r.eval);
+            let given =
+                super::held::held(&model, &state, &[], &values, backend, tau, Some(free)).unwrap();
+            assert_eq!(own.efforts, given.efforts, "{}", model.name);
+            assert_eq!(own.unassigned, given.unassigned, "{}", model.name);
+            assert_eq!(own.locked, given.locked, "{}", model.name);
+        }
+    }
+}

@@ -50,10 +50,11 @@ pub(crate) fn inertia_verdict(
     part: &Partition,
     eval: &Eval,
 ) -> Option<(Verdict, f64)> {
-    // Assembles `Ŵ` and the KKT matrix (and factors it unshifted, which is not needed here:
-    // singular when the pose is neutral).
-    sys.factor_kkt(q, part, eval, true, 0.0);
-    sys.work.kkt.as_ref()?;
+    // Assembles `Ŵ` and the KKT matrix; only its shifted factorizations are needed (the
+    // unshifted one is singular where the pose is neutral).
+    if !sys.assemble_kkt(q, part, eval) {
+        return None;
+    }
     let tol = 1e-10 * largest_eigenvalue(sys, part, eval).max(1.0);
     if !tol.is_finite() {
         return None;

@@ -26,30 +26,40 @@ impl System<'_> {
         fresh: bool,
         delta: f64,
     ) -> Factored {
-        if fresh {
-            self.lagrangian_blocks(q, part, eval);
-            self.triplets(q);
-            self.augment(part);
-            let (m, n) = (self.problem.cons.len(), q.len());
-            if !self.work.kkt.as_ref().is_some_and(|k| {
-                k.fits(part, self.work.jac.entries.len(), self.work.hess.keys.len())
-            }) {
-                self.work.kkt = Kkt::new(part, m, n, &self.work.jac.entries, &self.work.hess);
-            }
-            let Some(kkt) = self.work.kkt.as_mut() else {
-                return Factored::None;
-            };
-            kkt.assemble(
-                &self.work.jac.entries,
-                &self.problem.scaling.rows,
-                &self.problem.scaling.columns,
-                &self.work.hess,
-            );
+        if fresh && !self.assemble_kkt(q, part, eval) {
+            return Factored::None;
         }
         self.work
             .kkt
             .as_mut()
             .map_or(Factored::None, |k| k.factor(delta))
+    }
+
+    /// Assembles `W` at `q` and the KKT matrix (as [`System::factor_kkt`]) without factoring
+    /// it; false if its structure cannot be built.
+    pub(crate) fn assemble_kkt(&mut self, q: &DVector<f64>, part: &Partition, eval: &Eval) -> bool {
+        self.lagrangian_blocks(q, part, eval);
+        self.triplets(q);
+        self.augment(part);
+        let (m, n) = (self.problem.cons.len(), q.len());
+        if !self
+            .work
+            .kkt
+            .as_ref()
+            .is_some_and(|k| k.fits(part, self.work.jac.entries.len(), self.work.hess.keys.len()))
+        {
+            self.work.kkt = Kkt::new(part, m, n, &self.work.jac.entries, &self.work.hess);
+        }
+        let Some(kkt) = self.work.kkt.as_mut() else {
+            return false;
+        };
+        kkt.assemble(
+            &self.work.jac.entries,
+            &self.problem.scaling.rows,
+            &self.problem.scaling.columns,
+            &self.work.hess,
+        );
+        true
     }
 
     /// Adds `Φ_qᵀ D R D Φ_q` over the independent rows to the block Hessian (see

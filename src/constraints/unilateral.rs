@@ -238,6 +238,27 @@ pub(crate) fn rows(
     }
 }
 
+/// The coordinate a stop of `joint` bounds (its first), read on its branch; `None` if the
+/// joint has none.
+pub(crate) fn limit_angle(
+    model: &Model,
+    joint: JointId,
+    q: &DVector<f64>,
+    branches: &Branches,
+) -> Option<f64> {
+    let j = &model.joints[joint.0];
+    let pair = pair_of(&j.bodies, q, false);
+    Some(coordinate(j, &pair, 0, branches.get(joint, 0))?.v)
+}
+
+/// The gap of a stop at `value` on the `bound` side, the coordinate at `theta`.
+pub(crate) fn limit_gap(theta: f64, bound: Bound, value: f64) -> f64 {
+    match bound {
+        Bound::Lower => theta - value,
+        Bound::Upper => value - theta,
+    }
+}
+
 /// `g(q)` (value only); `None` where a joint coordinate is undefined.
 pub(crate) fn gap(
     model: &Model,
@@ -252,15 +273,11 @@ pub(crate) fn gap(
             joint,
             bound,
             value,
-        } => {
-            let j = &model.joints[joint.0];
-            let pair = pair_of(&j.bodies, q, false);
-            let theta = coordinate(j, &pair, 0, branches.get(joint, 0))?.v;
-            Some(match bound {
-                Bound::Lower => theta - value,
-                Bound::Upper => value - theta,
-            })
-        }
+        } => Some(limit_gap(
+            limit_angle(model, joint, q, branches)?,
+            bound,
+            value,
+        )),
         Unilateral::Contact { point, ground } => {
             let x = point_world(model, point, q);
             let (origin, normal) = surface(model, ground, &x);

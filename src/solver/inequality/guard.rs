@@ -12,6 +12,7 @@
 use super::active_set::dimensionless;
 use crate::constraints::unilateral::{self, Active, Unilateral};
 use crate::kinematics::Branches;
+use crate::model::JointId;
 use crate::model::Model;
 use crate::solver::options::Options;
 use crate::solver::partition::Partition;
@@ -83,6 +84,18 @@ impl<'m> Guard<'m> {
     /// Dimensionless gap of inequality `k` (against an obstacle: to its plane of `planes`; a
     /// roll limit's margin after the inactive ones).
     fn gap(&self, k: usize, q: &DVector<f64>, branches: &Branches) -> f64 {
+        self.gap_sharing(k, q, branches, &mut None)
+    }
+
+    /// [`Guard::gap`], with the joint angle of the last stop evaluated in `last` (a joint's
+    /// lower and upper stops are consecutive and read the same angle: computed once).
+    fn gap_sharing(
+        &self,
+        k: usize,
+        q: &DVector<f64>,
+        branches: &Branches,
+        last: &mut Option<(JointId, f64)>,
+    ) -> f64 {
         let Some(u) = self.inactive.get(k) else {
             return self.rolls[k - self.inactive.len()].margin(self.model, q);
         };
@@ -91,6 +104,21 @@ impl<'m> Guard<'m> {
                 n.dot(&(unilateral::point_world(self.model, *point, q) - o))
                     - self.model.contact_points[*point].radius
             }
+            (
+                _,
+                Unilateral::Limit {
+                    joint,
+                    bound,
+                    value,
+                },
+            ) => {
+                let theta = match *last {
+                    Some((j, theta)) if j == *joint => Some(theta),
+                    _ => unilateral::limit_angle(self.model, *joint, q, branches),
+                };
+                *last = theta.map(|t| (*joint, t));
+                theta.map_or(f64::INFINITY, |t| unilateral::limit_gap(t, *bound, *value))
+            }
             _ => unilateral::gap(self.model, u, q, branches).unwrap_or(f64::INFINITY),
         };
         dimensionless(self.model, u, g)
@@ -98,8 +126,9 @@ impl<'m> Guard<'m> {
 
     /// The lowest dimensionless gap and its inequality.
     fn lowest(&self, q: &DVector<f64>, branches: &Branches) -> Option<(usize, f64)> {
+        let mut last = None;
         (0..self.len())
-            .map(|k| (k, self.gap(k, q, branches)))
+            .map(|k| (k, self.gap_sharing(k, q, branches, &mut last)))
             .min_by(|a, b| a.1.total_cmp(&b.1))
     }
 
@@ -107,7 +136,11 @@ impl<'m> Guard<'m> {
     /// boundary (a linear descent may then end on it, and is not unbounded).
     pub(crate) fn approaching(&self, sys: &System, from: &DVector<f64>, to: &DVector<f64>) -> bool {
         let b = &sys.problem.cons.branches;
-        (0..self.len()).any(|k| self.gap(k, to, b) < self.gap(k, from, b) - self.tol)
+        let (mut at_to, mut at_from) = (None, None);
+        (0..self.len()).any(|k| {
+            self.gap_sharing(k, to, b, &mut at_to)
+                < self.gap_sharing(k, from, b, &mut at_from) - self.tol
+        })
     }
 
     /// Whether `q` violates one of the inequalities by more than the tolerance.

@@ -10,35 +10,23 @@
 //!    exact reduced Hessian replaced by their magnitudes, floored (dense), or the KKT direction
 //!    (sparse); BFGS / DFP `d = −B ∇f` (module `quasi_newton`); steepest descent when `d` is
 //!    not a descent direction.
-//! 4. **Step cap** ([`cap_step`]): the tangent step `δq = Z d` limited on the motion of the
+//! 4. **Step cap** (module `step_cap`): the tangent step `δq = Z d` limited on the motion of the
 //!    whole mechanism (every body's Euler parameters by `max_step`, its origin by
 //!    `10 max_step ℓ`, `ℓ` the larger of the length scale and the mechanism's extent).
-//! 5. **Line search and corrector** (module `line_search`): backtracking from `α = 1` until
-//!    the Armijo condition holds, each trial brought back onto `Φ = 0` by the Newton corrector
-//!    and halved when the corrector fails (paper step (f)). With a sparse partition that has
-//!    second-pass choices (contact or stop rows pivoted on their bodies, module
-//!    `sparse::partition`), after a step on which the corrector failed the next search starts
-//!    from the `α` that was accepted instead of 1, and that start doubles after each step
-//!    taken in full (a trust radius for the corrector: a long rope's first steps swing its
-//!    lower links far enough to leave the corrector's reach, and halving from 1 every time
-//!    costs two or three failed corrections per iteration). Elsewhere it starts from 1
-//!    (applied to every model, this heuristic sent a far start of the tractor-trailer, limits
-//!    enforced, to another equilibrium). With a guard, a step that would violate an inactive
-//!    inequality is cut where the first one reaches its boundary, and the minimization stops
-//!    there (`Outcome::blocked`: the inequality update is the caller's, folder `inequality`).
+//! 5. **Line search and corrector** (module `line_search`): backtracking until the Armijo
+//!    condition holds, each trial brought back onto `Φ = 0` by the Newton corrector and halved
+//!    when the corrector fails (paper step (f)), from `α = 1`, or with second-pass choices in a
+//!    sparse partition from the reach the corrector last managed ([`Search::reach`]). With a
+//!    guard, a step that would violate an inactive inequality is cut where the first one
+//!    reaches its boundary, and the minimization stops there (`Outcome::blocked`: the
+//!    inequality update is the caller's, folder `inequality`).
 //! 6. **Accept** ([`accept_step`]): quasi-Newton update, and the unbounded test (a linear
 //!    descent that goes on, module `unbounded`).
 //! 7. **Refresh the partition** ([`refresh_partition`], paper step (b)): anew when `Φ_u` is
-//!    ill-conditioned. A dense partition is also compared with a fresh full pivoting after a
-//!    step where the smallest-to-largest pivot ratio of `Φ_u` has fallen below [`PIVOT_DRIFT`]
-//!    of its value where the partition was made, and replaced if that one differs: as the
-//!    mechanism moves, the dependent coordinates chosen at the start lose their hold (an Euler
-//!    parameter near a turning point), `H = −Φ_u⁻¹ Φ_v` grows, the reduced Hessian's
-//!    eigenvalues spread with it and its floor swallows the physical curvatures (a UR5
-//!    swinging down from horizontal stalled at ‖∇f‖ = 10⁻² for 200 iterations). A sparse
-//!    partition with second-pass choices is recomputed after every step and replaced when
-//!    those choices have changed. When the line search finds no step, the coordinates are
-//!    re-partitioned once at the current point; a second failure ends the minimization.
+//!    ill-conditioned, when its pivots have drifted ([`PIVOT_DRIFT`]) and a fresh full
+//!    pivoting differs, or when a sparse partition's second-pass choices change. When the
+//!    line search finds no step, the coordinates are re-partitioned once at the current
+//!    point; a second failure ends the minimization.
 //!
 //! ## References
 //! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §3.1, §3.4, §6.1.
@@ -52,6 +40,7 @@ use super::partition::Partition;
 use super::quasi_newton::QuasiNewton;
 use super::report::{Diagnostics, Iterate, Termination};
 use super::stability::spectrum::{spectrum, Spectrum};
+use super::step_cap::{cap_step, Step};
 use super::system::{Backend, Eval, System};
 use super::unbounded::LinearDescent;
 use nalgebra::DVector;
@@ -80,7 +69,11 @@ pub(crate) struct Outcome {
 const GRADIENT_FLOOR: f64 = 1e-13;
 
 /// A dense partition whose smallest-to-largest pivot ratio of `Φ_u` has fallen below this
-/// fraction of its value where the partition was made is checked against a fresh one.
+/// fraction of its value where the partition was made is checked against a fresh one: as the
+/// mechanism moves, the dependent coordinates chosen at the start lose their hold (an Euler
+/// parameter near a turning point), `H = −Φ_u⁻¹ Φ_v` grows, the reduced Hessian's eigenvalues
+/// spread with it and its floor swallows the physical curvatures (a UR5 swinging down from
+/// horizontal stalled at ‖∇f‖ = 10⁻² for 200 iterations).
 const PIVOT_DRIFT: f64 = 0.85;
 
 /// The minimizer's state between iterations.
@@ -94,8 +87,14 @@ struct Search {
     history: Vec<Iterate>,
     iterates: Vec<DVector<f64>>,
     iteration: usize,
-    /// The step length the line search starts from: 1, or after a step the corrector could
-    /// not follow in full, the fraction that it could, doubled after each full success.
+    /// The step length the line search starts from with second-pass choices in a sparse
+    /// partition (contact or stop rows pivoted on their bodies, module `sparse::partition`):
+    /// 1, or after a step the corrector could not follow in full, the fraction that it could,
+    /// doubled after each full success. A trust radius for the corrector: a long rope's first
+    /// steps swing its lower links out of the corrector's reach, and halving from 1 every
+    /// time costs two or three failed corrections per iteration. Elsewhere the search starts
+    /// from 1 (applied to every model, this sent a far start of the tractor-trailer, limits
+    /// enforced, to another equilibrium).
     reach: f64,
     /// The pivot ratio of `Φ_u` where the partition was made ([`PIVOT_DRIFT`]).
     pivot_reference: Option<f64>,
@@ -115,15 +114,6 @@ enum Test {
     Saddle(DVector<f64>),
     /// Not stationary.
     Continue,
-}
-
-/// The step of one iteration after the cap: reduced `d`, tangent `δq = Z d`, whether the cap
-/// shortened it, and the length `ℓ` it was capped with.
-struct Step {
-    d: DVector<f64>,
-    dq: DVector<f64>,
-    capped: bool,
-    length: f64,
 }
 
 /// Minimizes from `q`; with a `guard`, a step that would violate one of its inequalities is
@@ -182,7 +172,7 @@ pub(crate) fn minimize(
             break;
         }
         let d = reduced_step(sys, &mut s, eig.as_ref(), negative_curvature, options);
-        let step = cap_step(sys, &s, d, options);
+        let step = cap_step(sys, &s.part, &s.eval, &s.q, d, options);
         let slope = s.eval.grad_v.dot(&step.d);
         let failures_before = s.diag.corrector_failures;
         // From the step length the corrector last managed (with second-pass choices in the
@@ -339,38 +329,6 @@ fn reduced_step(
     d
 }
 
-/// Stage 4: the tangent step `δq = Z d`, with `d` and `δq` shortened so that every body's
-/// Euler parameters change by at most `max_step` (about 2·max_step rad of rotation) and its
-/// origin by at most 10·max_step lengths `ℓ`, `ℓ` the larger of the characteristic length and
-/// the extent of the mechanism (the diagonal of the bounding box of the body origins): in a
-/// long chain, small joint rotations move the far links by about the chain's length, and a
-/// cap in link lengths would make the iteration count grow with N.
-fn cap_step(sys: &System, s: &Search, mut d: DVector<f64>, options: &Options) -> Step {
-    let mut dq = sys.tangent_step(&s.part, &s.eval, &d);
-    let l = sys.problem.model.length_scale.max(extent(&s.q));
-    let (mut rot, mut pos) = (0.0f64, 0.0f64);
-    for (i, x) in dq.iter().enumerate() {
-        if i % 7 < 3 {
-            pos = pos.max(x.abs() / l);
-        } else {
-            rot = rot.max(x.abs());
-        }
-    }
-    let factor =
-        (options.max_step / rot.max(1e-300)).min(10.0 * options.max_step / pos.max(1e-300));
-    let capped = factor < 1.0;
-    if capped {
-        d *= factor;
-        dq *= factor;
-    }
-    Step {
-        d,
-        dq,
-        capped,
-        length: l,
-    }
-}
-
 /// Stage 6: moves to the accepted trial point: the line search's next start, the quasi-Newton
 /// update, the joint branches followed; returns whether the descent is unbounded (a linear
 /// descent that is not heading for an inequality, a vanishing energy, a body far away).
@@ -477,19 +435,4 @@ fn same_split(a: &Partition, b: &Partition) -> bool {
         x
     };
     sorted(&a.dependent) == sorted(&b.dependent) && sorted(&a.rows) == sorted(&b.rows)
-}
-
-/// The diagonal of the bounding box of the body origins.
-fn extent(q: &DVector<f64>) -> f64 {
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for b in 0..q.len() / 7 {
-        for k in 0..3 {
-            lo[k] = lo[k].min(q[7 * b + k]);
-            hi[k] = hi[k].max(q[7 * b + k]);
-        }
-    }
-    (0..3)
-        .map(|k| (hi[k] - lo[k]).max(0.0).powi(2))
-        .sum::<f64>()
-        .sqrt()
 }

@@ -37,6 +37,7 @@ mod reactions;
 mod report;
 pub(crate) mod sparse;
 mod stability;
+mod step_cap;
 pub(crate) mod system;
 mod unbounded;
 

@@ -6,12 +6,35 @@
 use crate::constraints::{Constraints, Triplets};
 use crate::error::{Error, Result};
 use crate::model::Model;
+use crate::solver::system::System;
 use crate::state::State;
 use nalgebra::DVector;
 
 /// [`Error::NonFiniteConstraint`] or [`Error::NonFiniteEnergy`] unless the constraints and the
 /// energy of `model` (its locks held) are finite at `state`; `at` says where (`the given pose`).
 pub(crate) fn guard(model: &Model, state: &State, at: &str) -> Result<()> {
+    finite_coordinates(model, state, at)?;
+    let cons = Constraints::new(model, &crate::solver::lock_values(model))
+        .on_branches(state.branches.clone());
+    let mut phi = DVector::zeros(cons.len());
+    let mut jac = Triplets::default();
+    cons.evaluate(model, &state.q, &mut phi, Some(&mut jac));
+    finite_rows(model, &cons, &phi, &jac, at)?;
+    finite_energy(model, state, at)
+}
+
+/// [`guard`] with the rows of `sys` (the model's rows and locks on the state's branches, as
+/// [`guard`] builds them), evaluated into its scratch: the partition and evaluation that
+/// follow at the same point reuse them instead of evaluating them again.
+pub(crate) fn guard_system(sys: &mut System, state: &State, at: &str) -> Result<()> {
+    let model = sys.problem.model;
+    finite_coordinates(model, state, at)?;
+    sys.triplets(&state.q);
+    finite_rows(model, &sys.problem.cons, &sys.work.phi, &sys.work.jac, at)?;
+    finite_energy(model, state, at)
+}
+
+fn finite_coordinates(model: &Model, state: &State, at: &str) -> Result<()> {
     let q = &state.q;
     if q.iter().any(|x| !x.is_finite()) {
         return Err(Error::NonFiniteEnergy {
@@ -19,11 +42,16 @@ pub(crate) fn guard(model: &Model, state: &State, at: &str) -> Result<()> {
             term: crate::forces::finite::non_finite_term(model, &state.branches, q),
         });
     }
-    let cons = Constraints::new(model, &crate::solver::lock_values(model))
-        .on_branches(state.branches.clone());
-    let mut phi = DVector::zeros(cons.len());
-    let mut jac = Triplets::default();
-    cons.evaluate(model, q, &mut phi, Some(&mut jac));
+    Ok(())
+}
+
+fn finite_rows(
+    model: &Model,
+    cons: &Constraints,
+    phi: &DVector<f64>,
+    jac: &Triplets,
+    at: &str,
+) -> Result<()> {
     let bad_entry = jac.entries.iter().find(|e| !e.2.is_finite()).map(|e| e.0);
     if let Some(r) = phi.iter().position(|x| !x.is_finite()).or(bad_entry) {
         let row = cons.row_name(r).to_string();
@@ -33,6 +61,11 @@ pub(crate) fn guard(model: &Model, state: &State, at: &str) -> Result<()> {
             at: at.into(),
         });
     }
+    Ok(())
+}
+
+fn finite_energy(model: &Model, state: &State, at: &str) -> Result<()> {
+    let q = &state.q;
     let mut g = DVector::zeros(q.len());
     // An undefined force-table term has its own error, raised by the checks themselves.
     let Some(e) = crate::forces::potential(model, &state.branches, q, &mut g, None) else {

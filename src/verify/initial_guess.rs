@@ -72,7 +72,8 @@ fn sparse_dof(model: &Model, start: State, cons: Constraints) -> Result<usize> {
         sys = System::new(model, cons, Backend::Sparse);
         state
     };
-    crate::solver::finite::guard(model, &state, "the assembled initial guess")?;
+    // The rows evaluated for the guard at `state` are the partition's and the rank count's.
+    crate::solver::finite::guard_system(&mut sys, &state, "the assembled initial guess")?;
     if super::potential_energy(model, &state).is_none() {
         return Err(
             crate::forces::undefined_term(model, &state.branches, &state.q).unwrap_or(
@@ -89,11 +90,7 @@ fn sparse_dof(model: &Model, start: State, cons: Constraints) -> Result<usize> {
     let fast = if coupled {
         None
     } else {
-        let mut phi = nalgebra::DVector::zeros(sys.problem.cons.len());
-        let mut jac = crate::constraints::Triplets::default();
-        sys.problem
-            .cons
-            .evaluate(model, &state.q, &mut phi, Some(&mut jac));
+        let jac = &sys.work.jac;
         let scaling = &sys.problem.scaling;
         super::rank::free_columns(
             model,

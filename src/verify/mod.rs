@@ -159,8 +159,8 @@ pub fn potential_energy(model: &Model, state: &State) -> Option<f64> {
 /// [`Error::ForceTableOutOfRange`](crate::Error::ForceTableOutOfRange) if the energy cannot be evaluated,
 /// [`Error::SingularPartition`](crate::Error::SingularPartition) if the constraint Jacobian is singular there.
 pub fn balance(model: &Model, state: &State) -> Result<Balance> {
-    crate::solver::finite::guard(model, state, "the given pose")?;
     if sparse_path(model) {
+        // The finiteness guard inside, on the rows it evaluates anyway.
         let r = {
             let locks = crate::solver::lock_values(model);
             reduced::reduced(model, state, &locks)?
@@ -172,6 +172,7 @@ pub fn balance(model: &Model, state: &State) -> Result<Balance> {
             dof: r.dof,
         });
     }
+    crate::solver::finite::guard(model, state, "the given pose")?;
     let p = dense::project(model, state)?;
     let pg = p.null.transpose() * &p.grad_s;
     Ok(Balance {

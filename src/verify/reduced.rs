@@ -39,13 +39,25 @@ pub(super) struct Reduced<'a> {
     pub(super) eval: Eval,
 }
 
-/// Partitions and evaluates the rows of `model` plus its `locks` at `q` on the sparse path.
+/// Partitions and evaluates the rows of `model` plus its `locks` at `q` on the sparse path,
+/// after the finiteness guard on those rows (`solver::finite`; they are evaluated once for
+/// both).
+///
+/// # Errors
+/// The guard's [`Error::NonFiniteConstraint`] or [`Error::NonFiniteEnergy`]; an undefined
+/// energy term; [`Error::SingularPartition`] if `Φ_u` is singular.
 pub(super) fn reduced<'a>(
     model: &'a Model,
     state: &State,
     locks: &[(JointId, usize, f64)],
 ) -> Result<Reduced<'a>> {
     let q = &state.q;
+    let mut sys = System::new(
+        model,
+        Constraints::new(model, locks).on_branches(state.branches.clone()),
+        Backend::Sparse,
+    );
+    crate::solver::finite::guard_system(&mut sys, state, "the given pose")?;
     let mut g = DVector::zeros(q.len());
     potential(model, &state.branches, q, &mut g, None).ok_or_else(|| {
         crate::forces::undefined_term(model, &state.branches, q).unwrap_or(
@@ -60,11 +72,6 @@ pub(super) fn reduced<'a>(
         .iter()
         .zip(&scale)
         .fold(0.0f64, |a, (x, s)| a.max((x * s).abs()));
-    let mut sys = System::new(
-        model,
-        Constraints::new(model, locks).on_branches(state.branches.clone()),
-        Backend::Sparse,
-    );
     let part = sys.partition(q);
     let eval = sys
         .evaluate(q, &part)

@@ -50,7 +50,15 @@ pub(super) fn verify_on(
 ) -> Result<Verification> {
     let skip = eigenvalues == super::Eigenvalues::Skip;
     let eigenvalues = eigenvalues == super::Eigenvalues::Always;
-    crate::solver::finite::guard(model, state, "the given pose")?;
+    // Every check passes the finiteness guard first: on the sparse path with the rows of the
+    // balance check's system (evaluated once for both, module `reduced`).
+    let reduced = if sparse {
+        let locks = crate::solver::lock_values(model);
+        Some(reduced::reduced(model, state, &locks)?)
+    } else {
+        crate::solver::finite::guard(model, state, "the given pose")?;
+        None
+    };
     // The forces on both paths from the sparse partition (module `held`): one computation,
     // so the dense and the sparse path report the same numbers (a pose balanced to the
     // solver's gradient tolerance leaves the forces determined to about that, and partitions
@@ -60,69 +68,68 @@ pub(super) fn verify_on(
     let list = unilateral::touching(model, state, uni, tol.constraint, &mut contact);
     let coords = tree_coordinates(model, state);
     let values: Vec<_> = coords.iter().map(|c| (c.0, c.1, c.2.v)).collect();
-    let (phi, energy, projected_gradient, force_scale, closure, held, stability) = if sparse {
-        let locks = crate::solver::lock_values(model);
-        let r = reduced::reduced(model, state, &locks)?;
-        let closure = closures(model, &r.sys.problem.cons, &r.phi, tol.constraint);
-        let reduced::Reduced {
-            phi,
-            energy,
-            reduced_gradient,
-            force_scale,
-            mut sys,
-            part,
-            eval,
-            ..
-        } = r;
-        let assembled = phi.amax() <= tol.constraint;
-        let tau = tol.force + tol.relative * force_scale;
-        // Without a stop or contact touching, the forces' first solve is this system's
-        // (`held::free_of`), and the verdict is judged on this partition.
-        let free = list.is_empty().then(|| held::free_of(&sys, &part, &eval));
-        let (held, stability) = std::thread::scope(|s| {
-            let verdict = (assembled && list.is_empty() && !skip).then(|| {
-                s.spawn(|| {
-                    crate::solver::stability_of(&mut sys, &state.q, &part, &eval, eigenvalues)
-                })
-            });
-            let held = held::held(model, state, &list, &values, backend, tau, free)?;
-            let passed = passes(phi.amax(), &held, force_scale, tol);
-            // A panic there is re-raised here, as if the verdict had been computed on
-            // this thread.
-            let stability = match verdict {
-                Some(h) if passed => h
-                    .join()
-                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
-                _ => None,
-            };
-            Ok::<_, Error>((held, stability))
-        })?;
-        (
-            phi,
-            energy,
-            reduced_gradient,
-            force_scale,
-            closure,
-            held,
-            stability,
-        )
-    } else {
-        let p = super::dense::project(model, state)?;
-        let closure = closures(model, &p.cons, &p.phi, tol.constraint);
-        let projected_gradient = (p.null.transpose() * &p.grad_s).amax();
-        let force_scale = p.grad_s.amax();
-        let tau = tol.force + tol.relative * force_scale;
-        let held = held::held(model, state, &list, &values, backend, tau, None)?;
-        (
-            p.phi,
-            p.energy,
-            projected_gradient,
-            force_scale,
-            closure,
-            held,
-            None,
-        )
-    };
+    let (phi, energy, projected_gradient, force_scale, closure, held, stability) =
+        if let Some(r) = reduced {
+            let closure = closures(model, &r.sys.problem.cons, &r.phi, tol.constraint);
+            let reduced::Reduced {
+                phi,
+                energy,
+                reduced_gradient,
+                force_scale,
+                mut sys,
+                part,
+                eval,
+                ..
+            } = r;
+            let assembled = phi.amax() <= tol.constraint;
+            let tau = tol.force + tol.relative * force_scale;
+            // Without a stop or contact touching, the forces' first solve is this system's
+            // (`held::free_of`), and the verdict is judged on this partition.
+            let free = list.is_empty().then(|| held::free_of(&sys, &part, &eval));
+            let (held, stability) = std::thread::scope(|s| {
+                let verdict = (assembled && list.is_empty() && !skip).then(|| {
+                    s.spawn(|| {
+                        crate::solver::stability_of(&mut sys, &state.q, &part, &eval, eigenvalues)
+                    })
+                });
+                let held = held::held(model, state, &list, &values, backend, tau, free)?;
+                let passed = passes(phi.amax(), &held, force_scale, tol);
+                // A panic there is re-raised here, as if the verdict had been computed on
+                // this thread.
+                let stability = match verdict {
+                    Some(h) if passed => h
+                        .join()
+                        .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
+                    _ => None,
+                };
+                Ok::<_, Error>((held, stability))
+            })?;
+            (
+                phi,
+                energy,
+                reduced_gradient,
+                force_scale,
+                closure,
+                held,
+                stability,
+            )
+        } else {
+            let p = super::dense::project(model, state)?;
+            let closure = closures(model, &p.cons, &p.phi, tol.constraint);
+            let projected_gradient = (p.null.transpose() * &p.grad_s).amax();
+            let force_scale = p.grad_s.amax();
+            let tau = tol.force + tol.relative * force_scale;
+            let held = held::held(model, state, &list, &values, backend, tau, None)?;
+            (
+                p.phi,
+                p.energy,
+                projected_gradient,
+                force_scale,
+                closure,
+                held,
+                None,
+            )
+        };
     let effort_tolerance = tol.force + tol.relative * force_scale;
     let (strong, weak) = unilateral::report(
         model,

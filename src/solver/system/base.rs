@@ -46,7 +46,7 @@ impl<'a> System<'a> {
     }
 
     /// `Φ(q)` and the triplets of `Φ_q(q)` into the scratch (kept if they are at `q`).
-    pub(super) fn triplets(&mut self, q: &DVector<f64>) {
+    pub(crate) fn triplets(&mut self, q: &DVector<f64>) {
         let work = &mut self.work;
         if work.jac_at.len() == q.len() && work.jac_at == *q {
             return;

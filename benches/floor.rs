@@ -209,7 +209,10 @@ fn main() {
         let mut sum = 0.0;
         let t_floor = best(reps, || sum += black_box(floor.iterate()));
         black_box(sum);
-        for (name, algebra) in [("sparse", LinearAlgebra::Sparse)] {
+        for (name, algebra) in [
+            ("sparse", LinearAlgebra::Sparse),
+            ("tree", LinearAlgebra::Tree),
+        ] {
             let reps = if n > 2000 { 1 } else { 3 };
             match restpose_iteration(n, algebra, reps) {
                 Some((t, it)) => println!(

@@ -36,6 +36,7 @@ mod report;
 pub(crate) mod sparse;
 mod stability;
 pub(crate) mod system;
+pub(crate) mod tree;
 mod unbounded;
 
 pub use mode_animation::mode_animation;

@@ -26,6 +26,10 @@ pub enum LinearAlgebra {
     /// Sparse partition, sparse LU (faer), Newton steps from the sparse KKT system. `O(N)` per
     /// iteration for chains, trees and ladders.
     Sparse,
+    /// The sparse partition, with `Φ_u` and the KKT system factored body by body along the
+    /// kinematic tree (fixed-size blocks, no fill; loops as a small dense border). The sparse
+    /// path where a partition does not fit a tree.
+    Tree,
 }
 
 /// Whether URDF joint limits hold the joints (part of a [`ContactPolicy`]).

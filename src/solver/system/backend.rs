@@ -28,6 +28,9 @@ pub(crate) enum Backend {
     Dense,
     /// Sparse matrices (module `sparse`).
     Sparse,
+    /// The sparse partition with tree-structured factors (module `tree`; the sparse factors
+    /// where a partition does not fit a tree).
+    Tree,
 }
 
 impl Backend {
@@ -39,6 +42,7 @@ impl Backend {
             }
             LinearAlgebra::Auto | LinearAlgebra::Dense => Backend::Dense,
             LinearAlgebra::Sparse => Backend::Sparse,
+            LinearAlgebra::Tree => Backend::Tree,
         }
     }
 
@@ -47,11 +51,12 @@ impl Backend {
         Self::choose(model, options.linear_algebra)
     }
 
-    /// `"dense"` or `"sparse"` (as the report's diagnostics name it).
+    /// `"dense"`, `"sparse"` or `"tree"` (as the report's diagnostics name it).
     pub(crate) fn name(self) -> &'static str {
         match self {
             Backend::Dense => "dense",
             Backend::Sparse => "sparse",
+            Backend::Tree => "tree",
         }
     }
 
@@ -65,7 +70,7 @@ impl Backend {
     ) -> Partition {
         let scaling = &problem.scaling;
         match self {
-            Backend::Sparse => crate::solver::sparse::partition::partition(
+            Backend::Sparse | Backend::Tree => crate::solver::sparse::partition::partition(
                 problem.model,
                 problem.cons.len(),
                 coordinates,

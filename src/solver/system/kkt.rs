@@ -2,11 +2,14 @@
 //! rows, with `W` augmented by `Φ_qᵀ D R D Φ_q` (same solution, same inertia), factored by
 //! LDLᵀ with a shift `δ` or by LU as a fall-back (module `sparse::kkt`).
 
+use super::kkt_matrix::KktMatrix;
+use super::Backend;
 use super::{Eval, System};
 use crate::jet::HessianSink;
 use crate::model::BodyId;
 use crate::solver::partition::Partition;
 use crate::solver::sparse::kkt::{Factored, Kkt};
+use crate::solver::tree::kkt::TreeKkt;
 use nalgebra::DVector;
 
 impl System<'_> {
@@ -31,10 +34,25 @@ impl System<'_> {
             self.triplets(q);
             self.augment(part);
             let (m, n) = (self.problem.cons.len(), q.len());
-            if !self.work.kkt.as_ref().is_some_and(|k| {
-                k.fits(part, self.work.jac.entries.len(), self.work.hess.keys.len())
-            }) {
-                self.work.kkt = Kkt::new(part, m, n, &self.work.jac.entries, &self.work.hess);
+            let (triplets, blocks) = (self.work.jac.entries.len(), self.work.hess.keys.len());
+            if !self
+                .work
+                .kkt
+                .as_ref()
+                .is_some_and(|k| k.fits(part, triplets, blocks))
+            {
+                let (entries, hess) = (&self.work.jac.entries, &self.work.hess);
+                let tree = (self.backend == Backend::Tree
+                    && self.work.tree_kkt_refused != Some((part.id, triplets)))
+                .then(|| TreeKkt::new(part, m, n, entries, hess))
+                .flatten();
+                if tree.is_none() && self.backend == Backend::Tree {
+                    self.work.tree_kkt_refused = Some((part.id, triplets));
+                }
+                self.work.kkt = match tree {
+                    Some(t) => Some(KktMatrix::Tree(t)),
+                    None => Kkt::new(part, m, n, entries, hess).map(KktMatrix::Sparse),
+                };
             }
             let Some(kkt) = self.work.kkt.as_mut() else {
                 return Factored::None;

@@ -7,6 +7,15 @@
 /// block `a` (both triangles given; the upper one is left as it was); the number of negative
 /// pivots, or `None` on a zero or non-finite pivot.
 pub(crate) fn ldlt(a: &mut [f64], d: usize) -> Option<usize> {
+    match d {
+        13 => ldlt_with(a, 13, &mut [0.0; 13]),
+        14 => ldlt_with(a, 14, &mut [0.0; 14]),
+        8 => ldlt_with(a, 8, &mut [0.0; 8]),
+        _ => ldlt_any(a, d),
+    }
+}
+
+fn ldlt_any(a: &mut [f64], d: usize) -> Option<usize> {
     if d <= 64 {
         ldlt_with(a, d, &mut [0.0; 64])
     } else {
@@ -15,7 +24,9 @@ pub(crate) fn ldlt(a: &mut [f64], d: usize) -> Option<usize> {
 }
 
 /// [`ldlt`] with the scratch `v` (at least `d` long).
+#[inline(always)]
 fn ldlt_with(a: &mut [f64], d: usize, v: &mut [f64]) -> Option<usize> {
+    let (a, v) = (&mut a[..d * d], &mut v[..d]);
     let mut negative = 0;
     for j in 0..d {
         for k in 0..j {
@@ -43,6 +54,21 @@ fn ldlt_with(a: &mut [f64], d: usize, v: &mut [f64]) -> Option<usize> {
 
 /// `x ← A⁻¹ x` for the factors of [`ldlt`]; `x` is `d × w` row-major (`w` right sides).
 pub(crate) fn ldlt_solve(f: &[f64], d: usize, x: &mut [f64], w: usize) {
+    // Constant sizes of a chain's blocks, so that the loops are unrolled.
+    match (d, w) {
+        (13, 1) => ldlt_solve_impl(f, 13, x, 1),
+        (13, 7) => ldlt_solve_impl(f, 13, x, 7),
+        (14, 1) => ldlt_solve_impl(f, 14, x, 1),
+        (14, 7) => ldlt_solve_impl(f, 14, x, 7),
+        (8, 1) => ldlt_solve_impl(f, 8, x, 1),
+        (8, 7) => ldlt_solve_impl(f, 8, x, 7),
+        _ => ldlt_solve_impl(f, d, x, w),
+    }
+}
+
+#[inline(always)]
+fn ldlt_solve_impl(f: &[f64], d: usize, x: &mut [f64], w: usize) {
+    let (f, x) = (&f[..d * d], &mut x[..d * w]);
     for i in 0..d {
         for k in 0..i {
             let l = f[i * d + k];
@@ -74,6 +100,17 @@ pub(crate) fn ldlt_solve(f: &[f64], d: usize, x: &mut [f64], w: usize) {
 /// `P A = L U` in place with partial pivoting (`piv[k]`: the row swapped into `k`); `false` on
 /// a zero or non-finite pivot.
 pub(crate) fn lu(a: &mut [f64], d: usize, piv: &mut [u16]) -> bool {
+    match d {
+        6 => lu_impl(a, 6, piv),
+        7 => lu_impl(a, 7, piv),
+        13 => lu_impl(a, 13, piv),
+        _ => lu_impl(a, d, piv),
+    }
+}
+
+#[inline(always)]
+fn lu_impl(a: &mut [f64], d: usize, piv: &mut [u16]) -> bool {
+    let (a, piv) = (&mut a[..d * d], &mut piv[..d]);
     for k in 0..d {
         let mut p = k;
         let mut best = a[k * d + k].abs();
@@ -109,6 +146,18 @@ pub(crate) fn lu(a: &mut [f64], d: usize, piv: &mut [u16]) -> bool {
 
 /// `x ← A⁻¹ x` for the factors of [`lu`]; `x` is `d × w` row-major.
 pub(crate) fn lu_solve(f: &[f64], piv: &[u16], d: usize, x: &mut [f64], w: usize) {
+    match (d, w) {
+        (6, 1) => lu_solve_impl(f, piv, 6, x, 1),
+        (7, 1) => lu_solve_impl(f, piv, 7, x, 1),
+        (13, 1) => lu_solve_impl(f, piv, 13, x, 1),
+        (13, 7) => lu_solve_impl(f, piv, 13, x, 7),
+        _ => lu_solve_impl(f, piv, d, x, w),
+    }
+}
+
+#[inline(always)]
+fn lu_solve_impl(f: &[f64], piv: &[u16], d: usize, x: &mut [f64], w: usize) {
+    let (f, piv, x) = (&f[..d * d], &piv[..d], &mut x[..d * w]);
     for k in 0..d {
         let p = piv[k] as usize;
         if p != k {
@@ -145,6 +194,16 @@ pub(crate) fn lu_solve(f: &[f64], piv: &[u16], d: usize, x: &mut [f64], w: usize
 
 /// `x ← A⁻ᵀ x` for the factors of [`lu`] (one right side): `Uᵀ y = x`, `Lᵀ z = y`, `x = Pᵀ z`.
 pub(crate) fn lu_solve_transpose(f: &[f64], piv: &[u16], d: usize, x: &mut [f64]) {
+    match d {
+        6 => lu_solve_transpose_impl(f, piv, 6, x),
+        7 => lu_solve_transpose_impl(f, piv, 7, x),
+        _ => lu_solve_transpose_impl(f, piv, d, x),
+    }
+}
+
+#[inline(always)]
+fn lu_solve_transpose_impl(f: &[f64], piv: &[u16], d: usize, x: &mut [f64]) {
+    let (f, piv, x) = (&f[..d * d], &piv[..d], &mut x[..d]);
     for i in 0..d {
         let mut s = x[i];
         for k in 0..i {
@@ -163,6 +222,73 @@ pub(crate) fn lu_solve_transpose(f: &[f64], piv: &[u16], d: usize, x: &mut [f64]
         let p = piv[k] as usize;
         if p != k {
             x.swap(k, p);
+        }
+    }
+}
+
+/// `out −= Cᵀ y` for a `d × w` row-major `C`.
+pub(crate) fn sub_tr_mul(c: &[f64], y: &[f64], out: &mut [f64], d: usize, w: usize) {
+    match (d, w) {
+        (13, 7) => sub_tr_mul_impl(c, y, out, 13, 7),
+        (14, 7) => sub_tr_mul_impl(c, y, out, 14, 7),
+        _ => sub_tr_mul_impl(c, y, out, d, w),
+    }
+}
+
+#[inline(always)]
+fn sub_tr_mul_impl(c: &[f64], y: &[f64], out: &mut [f64], d: usize, w: usize) {
+    let (c, y, out) = (&c[..d * w], &y[..d], &mut out[..w]);
+    for k in 0..d {
+        let yk = y[k];
+        for b in 0..w {
+            out[b] -= c[k * w + b] * yk;
+        }
+    }
+}
+
+/// `x −= X y` for a `d × w` row-major `X`.
+pub(crate) fn sub_mul(xm: &[f64], y: &[f64], x: &mut [f64], d: usize, w: usize) {
+    match (d, w) {
+        (13, 7) => sub_mul_impl(xm, y, x, 13, 7),
+        (14, 7) => sub_mul_impl(xm, y, x, 14, 7),
+        (13, 13) => sub_mul_impl(xm, y, x, 13, 13),
+        _ => sub_mul_impl(xm, y, x, d, w),
+    }
+}
+
+#[inline(always)]
+fn sub_mul_impl(xm: &[f64], y: &[f64], x: &mut [f64], d: usize, w: usize) {
+    let (xm, y, x) = (&xm[..d * w], &y[..w], &mut x[..d]);
+    for a in 0..d {
+        let mut sum = 0.0;
+        for b in 0..w {
+            sum += xm[a * w + b] * y[b];
+        }
+        x[a] -= sum;
+    }
+}
+
+/// `p −= Cᵀ X` into the leading `w × w` block of the `dp × dp` row-major `p`, for `d × w`
+/// row-major `C` and `X` (the Schur update of a parent's block).
+pub(crate) fn sub_tr_mul_block(c: &[f64], x: &[f64], p: &mut [f64], d: usize, w: usize, dp: usize) {
+    match (d, w, dp) {
+        (13, 7, 13) => sub_tr_mul_block_impl(c, x, p, 13, 7, 13),
+        (14, 7, 14) => sub_tr_mul_block_impl(c, x, p, 14, 7, 14),
+        _ => sub_tr_mul_block_impl(c, x, p, d, w, dp),
+    }
+}
+
+#[inline(always)]
+fn sub_tr_mul_block_impl(c: &[f64], x: &[f64], p: &mut [f64], d: usize, w: usize, dp: usize) {
+    let (c, x, p) = (&c[..d * w], &x[..d * w], &mut p[..dp * dp]);
+    for k in 0..d {
+        for a in 0..w {
+            let cka = c[k * w + a];
+            if cka != 0.0 {
+                for b in 0..w {
+                    p[a * dp + b] -= cka * x[k * w + b];
+                }
+            }
         }
     }
 }

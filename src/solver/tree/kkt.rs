@@ -220,7 +220,6 @@ impl TreeKkt {
         let s = &self.shape;
         self.factors.copy_from_slice(&self.values[..s.flat_len]);
         let mut negative = 0;
-        let mut schur = [0.0f64; 14 * 14];
         for i in 0..s.at.len() {
             let (d, w) = (s.d[i], s.w[i]);
             let (fd, rest) = self.factors.split_at_mut(s.diag_at[i] + d * d);
@@ -238,31 +237,19 @@ impl TreeKkt {
                 continue;
             }
             // X_i = K_i⁻¹ C_i in the coupling slot; K_p −= C_iᵀ X_i.
-            let c0 = s.coup_at[i] - s.diag_at[i] - d * d;
-            let x = &mut rest[c0..c0 + d * w];
+            let base = s.diag_at[i] + d * d;
+            let (before, after) = rest.split_at_mut(s.coup_at[i] - base);
+            let x = &mut after[..d * w];
             let c = &self.values[s.coup_at[i]..s.coup_at[i] + d * w];
             if lu {
                 dense::lu_solve(blk, piv, d, x, w);
             } else {
                 dense::ldlt_solve(blk, d, x, w);
             }
-            for a in 0..w {
-                for b in 0..w {
-                    let mut sum = 0.0;
-                    for k in 0..d {
-                        sum += c[k * w + a] * x[k * w + b];
-                    }
-                    schur[a * w + b] = sum;
-                }
-            }
             let p = p as usize;
             let dp = s.d[p];
-            let pblk = &mut self.factors[s.diag_at[p]..s.diag_at[p] + dp * dp];
-            for a in 0..w {
-                for b in 0..w {
-                    pblk[a * dp + b] -= schur[a * w + b];
-                }
-            }
+            let pblk = &mut before[s.diag_at[p] - base..s.diag_at[p] - base + dp * dp];
+            dense::sub_tr_mul_block(c, x, pblk, d, w, dp);
         }
         if s.border.is_empty() {
             return Some(negative);
@@ -303,14 +290,7 @@ impl TreeKkt {
             // r_p −= C_iᵀ y_i (the coupling's original values).
             let pa = s.at[p as usize] - at - d;
             let c = &self.values[s.coup_at[i]..s.coup_at[i] + d * w];
-            for k in 0..d {
-                let yk = y[k];
-                if yk != 0.0 {
-                    for b in 0..w {
-                        tail[pa + b] -= c[k * w + b] * yk;
-                    }
-                }
-            }
+            dense::sub_tr_mul(c, y, &mut tail[pa..pa + w], d, w);
         }
         for i in (0..nodes).rev() {
             let p = s.parent[i];
@@ -320,13 +300,8 @@ impl TreeKkt {
             let (at, d, w) = (s.at[i], s.d[i], s.w[i]);
             let pa = s.at[p as usize];
             let xm = &self.factors[s.coup_at[i]..s.coup_at[i] + d * w];
-            for a in 0..d {
-                let mut sum = 0.0;
-                for b in 0..w {
-                    sum += xm[a * w + b] * x[pa + b];
-                }
-                x[at + a] -= sum;
-            }
+            let (head, tail) = x.split_at_mut(pa);
+            dense::sub_mul(xm, &tail[..w], &mut head[at..at + d], d, w);
         }
     }
 
@@ -351,24 +326,12 @@ impl TreeKkt {
         for i in 0..s.at.len() {
             let (at, d, w) = (s.at[i], s.d[i], s.w[i]);
             let blk = &self.values[s.diag_at[i]..s.diag_at[i] + d * d];
-            for a in 0..d {
-                let mut sum = 0.0;
-                for b in 0..d {
-                    sum += blk[a * d + b] * x[at + b];
-                }
-                r[at + a] -= sum;
-            }
+            dense::sub_mul(blk, &x[at..at + d], &mut r[at..at + d], d, d);
             if s.parent[i] != u32::MAX {
                 let pa = s.at[s.parent[i] as usize];
                 let c = &self.values[s.coup_at[i]..s.coup_at[i] + d * w];
-                for a in 0..d {
-                    let mut sum = 0.0;
-                    for b in 0..w {
-                        sum += c[a * w + b] * x[pa + b];
-                        r[pa + b] -= c[a * w + b] * x[at + a];
-                    }
-                    r[at + a] -= sum;
-                }
+                dense::sub_mul(c, &x[pa..pa + w], &mut r[at..at + d], d, w);
+                dense::sub_tr_mul(c, &x[at..at + d], &mut r[pa..pa + w], d, w);
             }
         }
         s.border.sub_product(&self.values[s.flat_len..], x, r);

@@ -50,7 +50,8 @@ mirror! {
 mirror! {
     /// Linear algebra of the solver (`restpose::LinearAlgebra`).
     LinearAlgebra = LibLinearAlgebra {
-        /// Dense up to 40 bodies (280 coordinates), sparse above (default).
+        /// Dense up to 40 bodies (280 coordinates); above, tree without closed loops, sparse
+        /// with them (default).
         Auto,
         /// Dense matrices: full-pivoting partition, dense LU, exact reduced Hessian. `O(N³)`.
         Dense,

@@ -34,11 +34,19 @@ pub(crate) enum Backend {
 }
 
 impl Backend {
-    /// The backend `choice` asks for; automatic: by the size of `model`.
+    /// The backend `choice` asks for; automatic: by the size of `model`, and above
+    /// [`SPARSE_FROM_COORDINATES`] the tree factors for a mechanism without closed loops (its
+    /// partitions fit a tree: `O(N)` with fixed-size blocks, faster than the general sparse
+    /// factors on chains and ropes, BENCHMARKS.md), the sparse ones with loops (a ladder's
+    /// thousand loops would not fit a small border).
     pub(crate) fn choose(model: &Model, choice: LinearAlgebra) -> Self {
         match choice {
             LinearAlgebra::Auto if model.coordinate_count() > SPARSE_FROM_COORDINATES => {
-                Backend::Sparse
+                if model.joints.iter().all(|j| j.tree || j.merged) {
+                    Backend::Tree
+                } else {
+                    Backend::Sparse
+                }
             }
             LinearAlgebra::Auto | LinearAlgebra::Dense => Backend::Dense,
             LinearAlgebra::Sparse => Backend::Sparse,

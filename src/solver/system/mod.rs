@@ -32,6 +32,7 @@ mod workspace;
 pub(crate) use backend::Backend;
 pub(crate) use base::System;
 pub(crate) use factors::Factors;
+#[cfg(test)]
 pub(crate) use kkt_matrix::KktMatrix;
 pub(crate) use problem::{coordinate_scale, Problem, Scaling};
 pub(crate) use reduced::Eval;

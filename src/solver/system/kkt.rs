@@ -141,7 +141,18 @@ impl System<'_> {
                 pending = Some((bodies, crate::jet::LMat::zeros()));
             }
             if let Some((_, acc)) = pending.as_mut() {
-                *acc += g * g.transpose() * rho;
+                // `acc += g gᵀ ρ` in place, entry by entry in the same order of operations
+                // (no 14 × 14 temporaries), over the row's nonzero entries only.
+                for j in 0..g.len() {
+                    if g[j] == 0.0 {
+                        continue;
+                    }
+                    for i in 0..g.len() {
+                        if g[i] != 0.0 {
+                            acc[(i, j)] += g[i] * g[j] * rho;
+                        }
+                    }
+                }
             }
         }
         if let Some((b, acc)) = pending.take() {

@@ -43,6 +43,10 @@ pub(crate) struct TreeKkt {
     border_piv: Vec<u16>,
     kind: Factored,
     lu_only: bool,
+    /// Blocks not yet copied from the values in this factorization (scratch).
+    fresh: Vec<bool>,
+    /// Row sums of `|K|` in tree-space order (scratch).
+    row_sums: Vec<f64>,
     knorm: f64,
     scratch: RefCell<Scratch>,
 }
@@ -82,6 +86,8 @@ impl TreeKkt {
             border_piv: vec![0; shape.border.size()],
             kind: Factored::None,
             lu_only: false,
+            fresh: vec![true; shape.at.len()],
+            row_sums: vec![0.0; dim],
             knorm: 0.0,
             scratch: RefCell::new(Scratch {
                 x: Vec::with_capacity(dim),
@@ -167,7 +173,6 @@ impl TreeKkt {
             self.values[s as usize] += delta - self.delta;
         }
         self.delta = delta;
-        self.knorm = self.norm();
         self.kind = Factored::None;
         if !self.lu_only {
             if let Some(negative) = self.factor_blocks(false) {
@@ -191,38 +196,50 @@ impl TreeKkt {
         self.kind
     }
 
-    /// `‖K‖∞` from the stored blocks (couplings count for both of their rows).
-    fn norm(&self) -> f64 {
+    /// Factors every block (LU if `lu`, else LDLᵀ); the number of negative pivots, or `None`.
+    /// Also sets `‖K‖∞`.
+    fn factor_blocks(&mut self, lu: bool) -> Option<usize> {
+        let negative = self.factor_tree(lu);
+        self.knorm = self.row_sums.iter().fold(0.0f64, |a, &x| a.max(x));
+        let negative = negative?;
+        self.factor_border(lu, negative)
+    }
+
+    /// The tree part of [`TreeKkt::factor_blocks`] (and the row sums).
+    fn factor_tree(&mut self, lu: bool) -> Option<usize> {
         let s = &self.shape;
-        let mut rows = vec![0.0f64; s.n + s.rows];
+        // Each block is copied from the values when first touched (its own turn, or its first
+        // child's update), so that a body's values are read once, while in cache.
+        let fresh = &mut self.fresh;
+        fresh.iter_mut().for_each(|f| *f = true);
+        let (values, factors) = (&self.values, &mut self.factors);
+        // ‖K‖∞ (for the backward error of solves), row sums taken while the blocks are in
+        // cache: couplings count for both of their rows.
+        let sums = &mut self.row_sums;
+        sums.iter_mut().for_each(|x| *x = 0.0);
+        s.border.add_row_sums(&values[s.flat_len..], sums);
+        let mut negative = 0;
         for i in 0..s.at.len() {
             let (at, d, w) = (s.at[i], s.d[i], s.w[i]);
+            if std::mem::take(&mut fresh[i]) {
+                let r = s.diag_at[i]..s.diag_at[i] + d * d;
+                factors[r.clone()].copy_from_slice(&values[r]);
+            }
             for a in 0..d {
-                for b in 0..d {
-                    rows[at + a] += self.values[s.diag_at[i] + a * d + b].abs();
-                }
-                if s.parent[i] != u32::MAX {
-                    let pa = s.at[s.parent[i] as usize];
+                let row = &values[s.diag_at[i] + a * d..s.diag_at[i] + a * d + d];
+                sums[at + a] += row.iter().map(|v| v.abs()).sum::<f64>();
+            }
+            if s.parent[i] != u32::MAX {
+                let pa = s.at[s.parent[i] as usize];
+                for a in 0..d {
                     for b in 0..w {
-                        let v = self.values[s.coup_at[i] + a * w + b].abs();
-                        rows[at + a] += v;
-                        rows[pa + b] += v;
+                        let v = values[s.coup_at[i] + a * w + b].abs();
+                        sums[at + a] += v;
+                        sums[pa + b] += v;
                     }
                 }
             }
-        }
-        s.border.add_row_sums(&self.values[s.flat_len..], &mut rows);
-        rows.iter().fold(0.0f64, |a, &x| a.max(x))
-    }
-
-    /// Factors every block (LU if `lu`, else LDLᵀ); the number of negative pivots, or `None`.
-    fn factor_blocks(&mut self, lu: bool) -> Option<usize> {
-        let s = &self.shape;
-        self.factors.copy_from_slice(&self.values[..s.flat_len]);
-        let mut negative = 0;
-        for i in 0..s.at.len() {
-            let (d, w) = (s.d[i], s.w[i]);
-            let (fd, rest) = self.factors.split_at_mut(s.diag_at[i] + d * d);
+            let (fd, rest) = factors.split_at_mut(s.diag_at[i] + d * d);
             let blk = &mut fd[s.diag_at[i]..];
             let piv = &mut self.piv[s.at[i]..s.at[i] + d];
             if lu {
@@ -240,7 +257,8 @@ impl TreeKkt {
             let base = s.diag_at[i] + d * d;
             let (before, after) = rest.split_at_mut(s.coup_at[i] - base);
             let x = &mut after[..d * w];
-            let c = &self.values[s.coup_at[i]..s.coup_at[i] + d * w];
+            let c = &values[s.coup_at[i]..s.coup_at[i] + d * w];
+            x.copy_from_slice(c);
             if lu {
                 dense::lu_solve(blk, piv, d, x, w);
             } else {
@@ -248,9 +266,20 @@ impl TreeKkt {
             }
             let p = p as usize;
             let dp = s.d[p];
+            if fresh[p] {
+                fresh[p] = false;
+                let r = s.diag_at[p]..s.diag_at[p] + dp * dp;
+                before[r.start - base..r.end - base].copy_from_slice(&values[r]);
+            }
             let pblk = &mut before[s.diag_at[p] - base..s.diag_at[p] - base + dp * dp];
             dense::sub_tr_mul_block(c, x, pblk, d, w, dp);
         }
+        Some(negative)
+    }
+
+    /// The border part of [`TreeKkt::factor_blocks`], after the tree's `negative` pivots.
+    fn factor_border(&mut self, lu: bool, negative: usize) -> Option<usize> {
+        let s = &self.shape;
         if s.border.is_empty() {
             return Some(negative);
         }

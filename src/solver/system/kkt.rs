@@ -50,8 +50,10 @@ impl System<'_> {
                     self.work.tree_kkt_refused = Some((part.id, triplets));
                 }
                 self.work.kkt = match tree {
-                    Some(t) => Some(KktMatrix::Tree(t)),
-                    None => Kkt::new(part, m, n, entries, hess).map(KktMatrix::Sparse),
+                    Some(t) => Some(KktMatrix::Tree(Box::new(t))),
+                    None => {
+                        Kkt::new(part, m, n, entries, hess).map(|k| KktMatrix::Sparse(Box::new(k)))
+                    }
                 };
             }
             let Some(kkt) = self.work.kkt.as_mut() else {

@@ -10,9 +10,9 @@ use crate::solver::tree::kkt::TreeKkt;
 /// The KKT matrix, its values and factors.
 pub(crate) enum KktMatrix {
     /// faer's simplicial LDLᵀ (LU as the fallback).
-    Sparse(Kkt),
+    Sparse(Box<Kkt>),
     /// Block LDLᵀ along the tree (block LU as the fallback).
-    Tree(TreeKkt),
+    Tree(Box<TreeKkt>),
 }
 
 macro_rules! both {

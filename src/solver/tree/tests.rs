@@ -26,8 +26,11 @@ fn solo12() -> Model {
         .model
 }
 
+/// Joint locks `(joint, coordinate, value)`.
+type Locks = Vec<(JointId, usize, f64)>;
+
 /// `(name, model, locks)`.
-fn cases() -> Vec<(&'static str, Model, Vec<(JointId, usize, f64)>)> {
+fn cases() -> Vec<(&'static str, Model, Locks)> {
     vec![
         (
             "chain",

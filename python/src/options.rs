@@ -148,7 +148,7 @@ pub(crate) fn linear_algebra(s: &str) -> PyResult<LinearAlgebra> {
         "sparse" => Ok(LinearAlgebra::Sparse),
         "tree" => Ok(LinearAlgebra::Tree),
         _ => Err(argument(format!(
-            "linear_algebra = {s:?}: expected \"auto\", \"dense\" or \"sparse\""
+            "linear_algebra = {s:?}: expected \"auto\", \"dense\", \"sparse\" or \"tree\""
         ))),
     }
 }

@@ -13,6 +13,7 @@ mod curvature;
 mod force;
 mod joint;
 mod joint_kind;
+mod joint_types;
 mod mass;
 mod numeric;
 mod obstacle;
@@ -30,6 +31,7 @@ pub use force::{
 };
 pub use joint::{Joint, JointId, JointKind};
 pub(crate) use joint_kind::MAX_SCALAR_COORDINATES;
+pub use joint_types::{joint_type, Declared, JointType, JOINT_TYPES};
 pub use mass::Inertial;
 pub use numeric::{LARGEST_GRAVITY, LARGEST_LENGTH, LARGEST_MAGNITUDE};
 pub use obstacle::Obstacle;

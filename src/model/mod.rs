@@ -9,7 +9,6 @@ mod body;
 mod builder;
 mod connect;
 mod contact;
-mod curvature;
 mod force;
 mod joint;
 mod joint_kind;

@@ -4,7 +4,7 @@
 //! a small simplex method written here).
 
 use super::*;
-use nalgebra::Vector3;
+use nalgebra::{DMatrix, Vector3};
 
 /// A contact of a rigid body: point, unit normal, whether it sticks.
 struct Touch {
@@ -60,7 +60,13 @@ fn support(touches: &[Touch], w: f64, tilt: f64, mu: Option<f64>) -> (DMatrix<f6
         .map(|i| eig.eigenvectors.column(i).into_owned())
         .collect();
     let k = g.ncols();
+    // Contacts with one normal are on one plane ground (module `friction_shortcut`).
+    let plane = touches
+        .iter()
+        .map(|t| touches.iter().position(|u| u.n == t.n))
+        .collect();
     let s = Support {
+        plane,
         base,
         null: if null.is_empty() {
             DMatrix::zeros(k, 0)
@@ -284,4 +290,40 @@ fn no_distribution_when_a_contact_must_pull() {
     // The centre of mass outside the corners (shifted by 0.4 m).
     let (_, s) = support(&box_corners(0.15, 0.4, false), 10.0, 0.0, None);
     assert!(distribute(&s, 10.0).is_none());
+}
+
+/// The shortcuts of module `friction_shortcut` (closed form without friction, the start at the
+/// lower bound `‖F_t‖ / F_n`) give what the cone programs alone give: the box on slopes with
+/// and without the contacts' plane (which disables both), the same `required_mu` (1e-9) and
+/// forces (1e-6 of the weight: the least-norm choice's slack).
+#[test]
+fn shortcuts_agree_with_the_cone_programs() {
+    for alpha in [0.0, 0.1, 0.35] {
+        for dx in [0.0, 0.03] {
+            let (_, s) = support(&box_corners(0.15, dx, true), 15.7, alpha, Some(0.5));
+            let fast = distribute(&s, 15.7).unwrap();
+            let slow = distribute(
+                &Support {
+                    plane: vec![None; s.plane.len()],
+                    ..s
+                },
+                15.7,
+            )
+            .unwrap();
+            let (a, b) = (fast.required_mu.unwrap(), slow.required_mu.unwrap());
+            assert!((a - b).abs() <= 1e-9, "{alpha} {dx}: {a} vs {b}");
+            assert!(
+                (&fast.forces - &slow.forces).amax() <= 1e-6 * 15.7,
+                "{alpha} {dx}: {} vs {}",
+                fast.forces,
+                slow.forces
+            );
+            assert_eq!(fast.slipping, slow.slipping);
+        }
+    }
+    // The lower bound of a box on one ground is tan α; none for the ladder (its floor's total
+    // force depends on the wall's share).
+    let (_, s) = support(&box_corners(0.15, 0.03, true), 15.7, 0.2, None);
+    let b = crate::solver::friction_shortcut::lower_bound(&s).unwrap();
+    assert!((b - f64::tan(0.2)).abs() < 1e-12, "{b}");
 }

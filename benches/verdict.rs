@@ -17,8 +17,9 @@
 //! - `a1-servo`: example-robot-data's A1 with `--servo all=200` about its SRDF `standing`
 //!   state (when `~/.cache/restpose-corpus` holds the unpacked corpus of scripts/corpus.sh).
 //!
-//! Prints per case and binary the median and the lower quartile of the wall time [ms], and the
-//! ratio of medians against this build.
+//! Prints per case and binary the median and the lower quartile of the wall time [ms] (the
+//! lower quartile is the steadier on a loaded machine), their ratios to this build's
+//! (`median_ratio` > 1: that binary is slower) and this build's time minus that binary's.
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
@@ -202,16 +203,18 @@ fn main() {
             }
         }
         let medians: Vec<f64> = times.iter_mut().map(|t| quantile(t, 0.5)).collect();
+        let q1: Vec<f64> = times.iter_mut().map(|t| quantile(t, 0.25)).collect();
         for (k, (name, _)) in bins.iter().enumerate() {
-            let q1 = quantile(&mut times[k], 0.25);
             println!(
-                "verdict {:<18} {:<6} median_ms={:.3} q1_ms={:.3} ratio_to_this={:.3} this_minus_ms={:+.3}",
+                "verdict {:<18} {:<6} median_ms={:.3} q1_ms={:.3} median_ratio={:.3} q1_ratio={:.3} this_minus_median_ms={:+.3} this_minus_q1_ms={:+.3}",
                 case.name,
                 name,
                 medians[k] * 1e3,
-                q1 * 1e3,
+                q1[k] * 1e3,
                 medians[k] / medians[0],
+                q1[k] / q1[0],
                 (medians[0] - medians[k]) * 1e3,
+                (q1[0] - q1[k]) * 1e3,
             );
         }
     }

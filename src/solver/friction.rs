@@ -201,7 +201,7 @@ fn least_need(support: &Support, c: &[Option<f64>], scale: f64) -> Option<(f64, 
         .all(|x| x.is_none_or(|v| v == 1.0))
         .then(|| friction_shortcut::lower_bound(support))
         .flatten();
-    if let Some(b) = bound {
+    if let Some((b, _)) = bound {
         // (Infeasible for one bound, `level` is infeasible for every bound: no distribution
         // keeps the contacts pushing.)
         let (z, _) = conic::solve(&f, &Goal::Level { s: b, w: &w0 })?;
@@ -340,14 +340,31 @@ fn distribute_within(support: &Support, scale: f64) -> Option<Distribution> {
             slipping,
         });
     }
-    if let Some(forces) =
-        friction_shortcut::without_friction(support, scale, |f| pushes(support, f, scale))
-    {
-        return Some(Distribution {
-            forces,
-            required_mu: (!sticks.is_empty()).then_some(0.0),
-            slipping: false,
-        });
+    // The lower bound (0 without one), reached in closed form where it can be.
+    let bound = friction_shortcut::lower_bound(support);
+    let (b, group) = bound.as_ref().map_or((0.0, &[][..]), |(b, g)| (*b, &g[..]));
+    let eps = 1e-12 * scale;
+    if let Some(forces) = friction_shortcut::at_bound(
+        support,
+        (b, group),
+        scale,
+        |f| pushes(support, f, scale),
+        |f| largest_need(support, &ones, f, eps),
+    ) {
+        let need = largest_need(support, &ones, &forces, eps);
+        let slipping = match common_mu(&sticks) {
+            Some(Some(mu)) => slips(need, mu),
+            Some(None) => false,
+            None => slipping_with(support, &sticks, &forces, scale),
+        };
+        // (Different coefficients and a contact beyond its own: the cone programs weigh them.)
+        if !slipping || common_mu(&sticks).is_some() {
+            return Some(Distribution {
+                forces,
+                required_mu: (!sticks.is_empty()).then_some(need),
+                slipping,
+            });
+        }
     }
     let (required, z) = least_need(support, &ones, scale)?;
     let best = at(support, &z);

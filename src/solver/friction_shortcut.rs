@@ -1,16 +1,4 @@
-//! What the friction verdict (module `friction`) can decide without cone programs, or with
-//! one instead of several.
-//!
-//! **No friction needed.** The least-norm distribution without any friction force,
-//!
-//! ```text
-//! min_z ½ ‖D λ(z)‖²   s.t.   t_i(z) = 0   (every sticking contact),
-//! ```
-//!
-//! is a least-squares problem with linear equality constraints, solved here in closed form
-//! (null-space method). Where it keeps every contact pushing and every stop within its limit,
-//! the inequalities of the cone program `least(0)` are inactive at it, so it is that program's
-//! answer: `required_mu = 0` (a box on a level floor, a robot standing symmetrically).
+//! What the friction verdict (module `friction`) can decide without cone programs.
 //!
 //! **A lower bound.** Sticking contacts on one plane ground share the ground's frame
 //! `(n̂, t̂₁, t̂₂)`: their rows are force components in it. Where the group's total
@@ -19,27 +7,31 @@
 //! of a rigid body on one ground do), every distribution needs
 //!
 //! ```text
-//! max_i ‖t_i‖ / n_i  ≥  Σ_i ‖t_i‖ / Σ_i n_i  ≥  ‖F_t‖ / F_n,
+//! max_i ‖t_i‖ / n_i  ≥  Σ_i ‖t_i‖ / Σ_i n_i  ≥  ‖F_t‖ / F_n  =: b,
 //! ```
 //!
-//! so `required_mu ≥ ‖F_t‖ / F_n` (`tan α` on a slope of `α`). The iteration of module
-//! `friction` starts from a distribution within that bound when the cone program
-//! `level(bound)` finds one, and stops there: the bound is reached (a crate or a robot with
-//! locked joints on a slope: one cone program instead of five to eight).
+//! so `required_mu ≥ b` (`tan α` on a slope of `α`; `b = 0` where no group qualifies).
+//!
+//! **Reaching it in closed form.** A distribution needing at most `b` makes both inequalities
+//! equalities: every friction force of the group is `t_i = b n_i û` (`û = F_t / ‖F_t‖`, all
+//! parallel to the total, each at exactly `b`); with `b = 0` every sticking contact's friction
+//! force is zero. These are linear equalities in `z`, so the least-norm distribution
+//!
+//! ```text
+//! min_z ½ ‖D λ(z)‖²   s.t.   those equalities
+//! ```
+//!
+//! is a least-squares problem with linear equality constraints, solved here in closed form
+//! (null-space method). Where it keeps every contact pushing, every stop within its limit and
+//! every other sticking contact within `b`, the remaining constraints of the verdict are
+//! inactive at it, so it is the verdict's answer: `required_mu = b`, and among the
+//! distributions needing `b` the one of least norm (a box on a level floor: no friction and
+//! no cone program; a crate or a robot with locked joints on a slope: every foot's force
+//! parallel to gravity). Otherwise the cone programs decide.
 
 use super::conic::Holder;
 use super::friction::Support;
 use nalgebra::{DMatrix, DVector};
-
-/// The rows `first + 1`, `first + 2` of every sticking contact (weights `Some`).
-fn friction_rows(support: &Support) -> Vec<usize> {
-    support
-        .holders
-        .iter()
-        .filter(|(_, h)| matches!(h, Holder::Stick { c: Some(_) }))
-        .flat_map(|&(first, _)| [first + 1, first + 2])
-        .collect()
-}
 
 /// An orthonormal basis of the null space of `a` (columns) and a least-squares solution `x`
 /// of `a x = b`, from the eigen-decomposition of `aᵀ a` (eigenvalues below `10⁻¹²` of the
@@ -76,44 +68,70 @@ fn solve_with_null(
     Some((x, null))
 }
 
-/// The least-norm distribution without friction force (module docs), when it keeps every
-/// contact pushing and every stop within its limit (`pushes`); `None` otherwise (no such
-/// distribution, or one the cone program must find).
-pub(crate) fn without_friction(
+/// The least-norm distribution needing exactly `bound` (module docs; `group`: the first rows
+/// of the contacts whose total gives the bound, unused when `bound` is 0), when it keeps every
+/// contact pushing and every stop within its limit (`pushes`) and needs no more than `bound`
+/// (`need`); `None` otherwise (the cone programs decide).
+pub(crate) fn at_bound(
     support: &Support,
+    (bound, group): (f64, &[usize]),
     scale: f64,
     pushes: impl Fn(&DVector<f64>) -> bool,
+    need: impl Fn(&DVector<f64>) -> f64,
 ) -> Option<DVector<f64>> {
-    let rows = friction_rows(support);
     let (base, null) = (&support.base, &support.null);
-    let k = null.ncols();
-    // t(z) = T base + T N z = 0: z = z_p + Z y.
-    let tn = DMatrix::from_fn(rows.len(), k, |r, c| null[(rows[r], c)]);
-    let tb = DVector::from_fn(rows.len(), |r, _| -base[rows[r]]);
-    let (zp, zn) = solve_with_null(&tn, &tb, 1e-12 * scale)?;
+    let m = base.len();
+    // Equality rows e·λ = 0 over the multipliers.
+    let mut rows: Vec<Vec<(usize, f64)>> = Vec::new();
+    if bound == 0.0 {
+        for &(first, h) in &support.holders {
+            if matches!(h, Holder::Stick { c: Some(_) }) {
+                rows.push(vec![(first + 1, 1.0)]);
+                rows.push(vec![(first + 2, 1.0)]);
+            }
+        }
+    } else {
+        let t: [f64; 2] = [1, 2].map(|j| group.iter().map(|f| base[f + j]).sum());
+        let norm = t[0].hypot(t[1]);
+        if norm <= 0.0 {
+            return None;
+        }
+        for &first in group {
+            for j in 0..2 {
+                rows.push(vec![(first + 1 + j, 1.0), (first, -bound * t[j] / norm)]);
+            }
+        }
+    }
+    let e = DMatrix::from_fn(rows.len(), m, |r, c| {
+        rows[r].iter().filter(|x| x.0 == c).map(|x| x.1).sum()
+    });
+    // e (base + N z) = 0: z = z_p + Z y.
+    let en = &e * null;
+    let (zp, zn) = solve_with_null(&en, &(-(&e * base)), 1e-12 * scale)?;
     // min_y ½ ‖D (base + N z_p + N Z y)‖².
     let d = DVector::from_column_slice(&support.weight);
-    let fixed = (base + null * &zp).component_mul(&d);
     let lam = if zn.ncols() == 0 {
         base + null * &zp
     } else {
-        let a = DMatrix::from_fn(base.len(), zn.ncols(), |r, _| d[r]).component_mul(&(null * &zn));
+        let fixed = (base + null * &zp).component_mul(&d);
+        let a = DMatrix::from_fn(m, zn.ncols(), |r, _| d[r]).component_mul(&(null * &zn));
         let (y, _) = solve_with_null(&a, &(-&fixed), f64::INFINITY)?;
         base + null * (&zp + &zn * y)
     };
-    let friction = rows.iter().map(|&r| lam[r].abs()).fold(0.0, f64::max);
-    (friction <= 1e-12 * scale && pushes(&lam)).then_some(lam)
+    let off = (&e * &lam).amax();
+    let within = need(&lam) <= bound + 1e-12 * bound.max(1.0);
+    (off <= 1e-12 * scale && within && pushes(&lam)).then_some(lam)
 }
 
 /// The largest lower bound `‖F_t‖ / F_n` over the groups of sticking contacts on one plane
-/// ground whose total force does not depend on the distribution (module docs); `None` when no
-/// group qualifies.
-pub(crate) fn lower_bound(support: &Support) -> Option<f64> {
+/// ground whose total force does not depend on the distribution (module docs), with the first
+/// rows of that group; `None` when no group qualifies.
+pub(crate) fn lower_bound(support: &Support) -> Option<(f64, Vec<usize>)> {
     let mut planes: Vec<usize> = support.plane.iter().flatten().copied().collect();
     planes.sort_unstable();
     planes.dedup();
     let null = &support.null;
-    let mut best: Option<f64> = None;
+    let mut best: Option<(f64, Vec<usize>)> = None;
     for p in planes {
         let firsts: Vec<usize> = support
             .holders
@@ -132,11 +150,13 @@ pub(crate) fn lower_bound(support: &Support) -> Option<f64> {
             }
         }
         // The columns of N are orthonormal (entries at most 1): a sum below 10⁻⁹ is zero.
-        if moving > 1e-9 || total[0] <= 0.0 {
+        if firsts.is_empty() || moving > 1e-9 || total[0] <= 0.0 {
             continue;
         }
         let bound = total[1].hypot(total[2]) / total[0];
-        best = Some(best.map_or(bound, |b: f64| b.max(bound)));
+        if best.as_ref().is_none_or(|b| bound > b.0) {
+            best = Some((bound, firsts));
+        }
     }
     best
 }

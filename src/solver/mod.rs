@@ -28,15 +28,18 @@ mod friction_shortcut;
 mod friction_support;
 mod inequality;
 mod kkt_direction;
+mod line_search;
 mod load_steps;
 mod minimize;
 mod mode_animation;
 mod options;
 pub(crate) mod partition;
+mod quasi_newton;
 mod reactions;
 mod report;
 pub(crate) mod sparse;
 mod stability;
+mod step_cap;
 pub(crate) mod system;
 mod unbounded;
 

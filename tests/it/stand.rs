@@ -41,7 +41,7 @@ fn tilted(alpha: f64) -> Vector3<f64> {
 fn centre_of_mass(model: &restpose::Model, state: &restpose::State) -> (Vector3<f64>, f64) {
     let (mut sum, mut mass) = (Vector3::zeros(), 0.0);
     for id in model.body_ids() {
-        let b = &model.bodies[id.index()];
+        let b = &model.bodies()[id.index()];
         sum += b.mass * (state.body_pose(id) * nalgebra::Point3::from(b.com)).coords;
         mass += b.mass;
     }
@@ -108,7 +108,7 @@ fn a_locked_solo12_on_slopes_needs_tan_alpha() {
             (com - Vector3::from(b.centre_of_mass)).amax() < 1e-12,
             "{alpha}"
         );
-        let down = m.gravity.normalize();
+        let down = m.gravity().normalize();
         let e1 = Vector3::y().cross(&down).normalize();
         let e2 = down.cross(&e1);
         let flat = |p: &Vector3<f64>| (p.dot(&e1), p.dot(&e2));
@@ -146,7 +146,7 @@ fn a_locked_solo12_on_slopes_needs_tan_alpha() {
             })
             .collect();
         let sides = 64;
-        let (lo, inscribed) = least_mu(&touches, &com, &(mass * m.gravity), sides);
+        let (lo, inscribed) = least_mu(&touches, &com, &(mass * m.gravity()), sides);
         assert!(inscribed - lo < 1e-9, "{alpha}: [{lo}, {inscribed}]");
         let circumscribed = inscribed * (std::f64::consts::PI / sides as f64).cos();
         assert!(

@@ -340,6 +340,9 @@ fn distribute_within(support: &Support, scale: f64) -> Option<Distribution> {
             slipping,
         });
     }
+    if friction_shortcut::nothing_pushes_on_a_line(support, scale) {
+        return None;
+    }
     // The lower bound (0 without one), reached in closed form where it can be.
     let bound = friction_shortcut::lower_bound(support);
     let (b, group) = bound.as_ref().map_or((0.0, &[][..]), |(b, g)| (*b, &g[..]));

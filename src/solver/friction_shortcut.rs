@@ -28,6 +28,10 @@
 //! distributions needing `b` the one of least norm (a box on a level floor: no friction and
 //! no cone program; a crate or a robot with locked joints on a slope: every foot's force
 //! parallel to gravity). Otherwise the cone programs decide.
+//!
+//! **No pushing distribution on a line.** Where the distributions form a line (one
+//! self-equilibrated combination), whether one keeps every contact pushing is an intersection
+//! of intervals.
 
 use super::conic::Holder;
 use super::friction::Support;
@@ -159,4 +163,35 @@ pub(crate) fn lower_bound(support: &Support) -> Option<(f64, Vec<usize>)> {
         }
     }
     best
+}
+
+/// Whether no distribution keeps every contact pushing and every stop within its limit, decided
+/// without a cone program when the distributions form a line (`N` one column): each row bounds
+/// `z` to an interval, and their intersection is empty even with a slack of `10⁻⁹` of the force
+/// scale (`false` in every other case: the cone programs decide).
+pub(crate) fn nothing_pushes_on_a_line(support: &Support, scale: f64) -> bool {
+    if support.null.ncols() != 1 {
+        return false;
+    }
+    let tol = 1e-9 * scale;
+    let (mut lo, mut hi, mut never) = (f64::NEG_INFINITY, f64::INFINITY, false);
+    // a + k z ≥ 0 for each bound (a the row at z = 0 plus the slack; N's column has unit
+    // norm, and entries below 10⁻¹² of it are rounding).
+    let mut bound = |a: f64, k: f64| {
+        if k > 1e-12 {
+            lo = lo.max(-a / k);
+        } else if k < -1e-12 {
+            hi = hi.min(-a / k);
+        } else {
+            never |= a < 0.0;
+        }
+    };
+    for &(first, h) in &support.holders {
+        let (b, k) = (support.base[first], support.null[(first, 0)]);
+        bound(b + tol, k);
+        if let Holder::Stop { limit: Some(l) } = h {
+            bound(l - b + tol, -k);
+        }
+    }
+    never || lo > hi
 }

@@ -328,3 +328,26 @@ fn shortcuts_agree_with_the_cone_programs() {
     let b = crate::solver::friction_shortcut::lower_bound(&s).unwrap().0;
     assert!((b - f64::tan(0.2)).abs() < 1e-12, "{b}");
 }
+
+/// Two contacts (the distributions a line: the squeeze between them): no pushing distribution
+/// when the centre of mass lies beyond one of them, decided by intervals as by the cone
+/// program.
+#[test]
+fn nothing_pushes_on_a_line_as_the_cone_program_says() {
+    for (dx, expect) in [(0.0, false), (0.1, false), (0.4, true), (-0.3, true)] {
+        let touches: Vec<Touch> = [-0.25, 0.25]
+            .iter()
+            .map(|&x| Touch {
+                p: Vector3::new(x - dx, 0.0, -0.15),
+                n: Vector3::z(),
+                stick: true,
+            })
+            .collect();
+        let (_, s) = support(&touches, 10.0, 0.0, None);
+        assert_eq!(s.null.ncols(), 1);
+        let fast = crate::solver::friction_shortcut::nothing_pushes_on_a_line(&s, 10.0);
+        let ones = vec![Some(1.0); 2];
+        let cone = least_need(&s, &ones, 10.0).is_none();
+        assert_eq!((fast, cone), (expect, expect), "{dx}");
+    }
+}

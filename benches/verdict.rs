@@ -17,6 +17,10 @@
 //! - `a1-servo`: example-robot-data's A1 with `--servo all=200` about its SRDF `standing`
 //!   state (when `~/.cache/restpose-corpus` holds the unpacked corpus of scripts/corpus.sh).
 //!
+//! With `--instructions`, each case is also run once by each binary under valgrind's callgrind
+//! (when `valgrind` is on the PATH): the instructions executed, a count that does not drift
+//! with the machine's load, and their ratio to this build's.
+//!
 //! Prints per case and binary the median and the lower quartile of the wall time [ms] (the
 //! lower quartile is the steadier on a loaded machine), their ratios to this build's
 //! (`median_ratio` > 1: that binary is slower) and this build's time minus that binary's.
@@ -148,6 +152,20 @@ fn run(exe: &Path, case: &Case) -> f64 {
     wall
 }
 
+/// Instructions executed by one run under callgrind (`None` without valgrind).
+fn instructions(exe: &Path, case: &Case) -> Option<u64> {
+    let out = Command::new("valgrind")
+        .args(["--tool=callgrind", "--callgrind-out-file=/dev/null"])
+        .arg(exe)
+        .args(&case.args)
+        .current_dir(&case.dir)
+        .output()
+        .ok()?;
+    let text = String::from_utf8_lossy(&out.stderr);
+    let at = text.find("Collected : ")? + "Collected : ".len();
+    text[at..].split_whitespace().next()?.parse().ok()
+}
+
 fn quantile(v: &mut [f64], q: f64) -> f64 {
     v.sort_by(f64::total_cmp);
     v[((v.len() - 1) as f64 * q).round() as usize]
@@ -163,6 +181,7 @@ fn main() {
         .find_map(|a| a.parse().ok())
         .unwrap_or(60)
         .max(1);
+    let counted = args.iter().any(|a| a == "--instructions");
     let mut bins: Vec<(String, PathBuf)> = vec![("this".into(), PathBuf::from(EXE))];
     let named: Vec<(String, PathBuf)> = args
         .iter()
@@ -193,6 +212,20 @@ fn main() {
             "{}: no friction verdict",
             case.name
         );
+        if counted {
+            let counts: Vec<Option<u64>> =
+                bins.iter().map(|(_, b)| instructions(b, &case)).collect();
+            for ((name, _), n) in bins.iter().zip(&counts) {
+                if let (Some(n), Some(Some(this))) = (n, counts.first()) {
+                    println!(
+                        "verdict {:<18} {:<6} instructions={n} instructions_ratio={:.3}",
+                        case.name,
+                        name,
+                        *n as f64 / *this as f64
+                    );
+                }
+            }
+        }
         for (_, b) in &bins {
             run(b, &case); // warm the file cache
         }

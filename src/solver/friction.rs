@@ -198,7 +198,7 @@ fn least_need(support: &Support, c: &[Option<f64>], scale: f64) -> Option<(f64, 
     // A distribution within the lower bound of module `friction_shortcut` needs exactly it.
     let bound = c
         .iter()
-        .all(|x| x.is_none_or(|v| v == 1.0))
+        .all(|x| *x == Some(1.0))
         .then(|| friction_shortcut::lower_bound(support))
         .flatten();
     if let Some((b, _)) = bound {

@@ -312,13 +312,13 @@ pub(crate) fn stops_and_contacts(
         for c in &shown {
             let p = c.point_world;
             out!(
-                "  {:<32} [{:>10.5}, {:>10.5}, {:>10.5}]   {:>14.4}  {:>8.4}   {}",
+                "  {:<32} [{:>10.5}, {:>10.5}, {:>10.5}]   {:>14.4}  {:>8}   {}",
                 format!("{} @ {}", c.link, c.ground),
                 p[0],
                 p[1],
                 p[2],
                 c.normal_force,
-                c.required_friction,
+                mu_text(c.required_friction, 4),
                 serde_json::to_value(c.state)
                     .ok()
                     .and_then(|v| v.as_str().map(str::to_owned))
@@ -336,6 +336,16 @@ pub(crate) fn stops_and_contacts(
     }
 }
 
+/// A friction coefficient with `digits` decimals; `unbounded` for a contact that would carry
+/// friction without pushing (the need `f64::MAX` of `solver::friction::needs_mu`).
+fn mu_text(mu: f64, digits: usize) -> String {
+    if mu >= f64::MAX {
+        "unbounded".into()
+    } else {
+        format!("{mu:.digits$}")
+    }
+}
+
 /// The friction verdict and the balance of a free mechanism (analyze and verify).
 pub(crate) fn friction_and_balance(
     f: Option<&restpose::solver::FrictionVerdict>,
@@ -343,12 +353,15 @@ pub(crate) fn friction_and_balance(
 ) {
     if let Some(f) = f {
         let given = match (f.mu, f.margin) {
-            (Some(mu), Some(m)) => format!(" (mu {mu}, margin {m:+.3e})"),
+            (Some(mu), Some(m)) if m.is_finite() && m.abs() < 1e300 => {
+                format!(" (mu {mu}, margin {m:+.3e})")
+            }
+            (Some(mu), Some(_)) => format!(" (mu {mu})"),
             _ => String::new(),
         };
         out!(
-            "  friction: required_mu {:.6}{given}: {}",
-            f.required_mu,
+            "  friction: required_mu {}{given}: {}",
+            mu_text(f.required_mu, 6),
             if f.slipping {
                 "SLIPPING, no contact forces inside the friction cones balance this pose"
             } else {

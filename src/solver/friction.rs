@@ -43,10 +43,11 @@
 pub(crate) use super::active_set::force_scale;
 pub(crate) use super::conic::Holder;
 use super::conic::{self, Affine, Goal};
+use super::friction_shortcut;
+pub(crate) use super::friction_support::{effort_limit, holders_of, Support};
 use super::report::{Contact, ContactState, FrictionVerdict};
-use crate::constraints::unilateral::{Active, Unilateral};
 use crate::model::{JointId, Model};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 
 /// Relative tolerance of the verdict: a contact slips when it needs more than
 /// `μ + MU_TOLERANCE · max(1, μ)`.
@@ -60,21 +61,6 @@ const TIE_SLACK: f64 = 1e-6;
 /// Iterations of the Dinkelbach-type loop at most.
 const MAX_ROUNDS: usize = 30;
 
-/// The stops and contacts of a pose with every distribution that balances it.
-pub(crate) struct Support {
-    /// One balancing distribution `λ₀` (every row of every holder).
-    pub(crate) base: DVector<f64>,
-    /// Self-equilibrated combinations `N` (columns; may be empty).
-    pub(crate) null: DMatrix<f64>,
-    /// First row and kind of each stop and contact, in row order.
-    pub(crate) holders: Vec<(usize, Holder)>,
-    /// The friction coefficient of each sticking contact (by holder; `None` elsewhere or where
-    /// none is given).
-    pub(crate) mu: Vec<Option<f64>>,
-    /// Weight of each row in the least-norm choice (`D`).
-    pub(crate) weight: Vec<f64>,
-}
-
 /// The distribution chosen and the verdict.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct Distribution {
@@ -87,50 +73,8 @@ pub(crate) struct Distribution {
     pub(crate) slipping: bool,
 }
 
-/// Holders (first row, kind), coefficients and least-norm weights of a support's rows.
-pub(crate) type Rows = (Vec<(usize, Holder)>, Vec<Option<f64>>, Vec<f64>);
-
 /// `required_mu` and whether the pose slips, as [`distribute`] chose.
 pub(crate) type Chosen = Option<(Option<f64>, bool)>;
-
-/// The holders, coefficients and least-norm weights of the stops and contacts `items` (each
-/// with its coefficient when it sticks), rows in their order: a sticking contact has three
-/// rows, a stop's row weighs `1/L` when it is an angle (its effort in N m).
-pub(crate) fn holders_of(model: &Model, items: &[(Active, Option<f64>)]) -> Rows {
-    let (mut holders, mut mu, mut weight) = (Vec::new(), Vec::new(), Vec::new());
-    for (a, m) in items {
-        let first = weight.len();
-        let (h, w) = match a.row {
-            Unilateral::Limit { joint, .. } => (
-                Holder::Stop {
-                    limit: effort_limit(model, joint),
-                },
-                if model.joints[joint.0].kind.is_angle(0) {
-                    1.0 / model.length_scale
-                } else {
-                    1.0
-                },
-            ),
-            Unilateral::Contact { .. } if a.anchor.is_some() => {
-                (Holder::Stick { c: Some(1.0) }, 1.0)
-            }
-            Unilateral::Contact { .. } => (Holder::Smooth, 1.0),
-        };
-        weight.extend(std::iter::repeat_n(w, h.rows()));
-        holders.push((first, h));
-        mu.push(if matches!(h, Holder::Stick { .. }) {
-            *m
-        } else {
-            None
-        });
-    }
-    (holders, mu, weight)
-}
-
-/// The joint's `effort` limit (URDF `<limit effort>`) as a bound on its stop's multiplier.
-pub(crate) fn effort_limit(model: &Model, joint: JointId) -> Option<f64> {
-    model.joints[joint.0].effort_limit.filter(|e| *e > 0.0)
-}
 
 /// The verdict from the sticking contacts of the distribution reported, each with the
 /// coefficient it needs and the one it has, and `chosen` (`required_mu`, slipping) where
@@ -250,8 +194,23 @@ fn least_need(support: &Support, c: &[Option<f64>], scale: f64) -> Option<(f64, 
     };
     let eps = 1e-12 * scale;
     let sticks = c.iter().filter(|x| x.is_some()).count();
-    // z₀: the least largest friction force (bound s = 0, weights the force scale).
     let w0 = vec![scale; sticks];
+    // A distribution within the lower bound of module `friction_shortcut` needs exactly it.
+    let bound = c
+        .iter()
+        .all(|x| *x == Some(1.0))
+        .then(|| friction_shortcut::lower_bound(support))
+        .flatten();
+    if let Some((b, _)) = bound {
+        // (Infeasible for one bound, `level` is infeasible for every bound: no distribution
+        // keeps the contacts pushing.)
+        let (z, _) = conic::solve(&f, &Goal::Level { s: b, w: &w0 })?;
+        let s = largest_need(support, c, &at(support, &z), eps);
+        if s <= b + 1e-11 * b.max(1.0) {
+            return Some((s, z));
+        }
+    }
+    // z₀: the least largest friction force (bound s = 0, weights the force scale).
     let (mut z, _) = conic::solve(&f, &Goal::Level { s: 0.0, w: &w0 })?;
     let mut s = largest_need(support, c, &at(support, &z), eps);
     if !s.is_finite() || s >= f64::MAX {
@@ -350,6 +309,7 @@ pub(crate) fn distribute(support: &Support, scale: f64) -> Option<Distribution> 
                 .collect(),
             mu: support.mu.clone(),
             weight: support.weight.clone(),
+            plane: support.plane.clone(),
         };
         distribute_within(&free, scale)
     })
@@ -379,6 +339,35 @@ fn distribute_within(support: &Support, scale: f64) -> Option<Distribution> {
             required_mu: required,
             slipping,
         });
+    }
+    if friction_shortcut::nothing_pushes_on_a_line(support, scale) {
+        return None;
+    }
+    // The lower bound (0 without one), reached in closed form where it can be.
+    let bound = friction_shortcut::lower_bound(support);
+    let (b, group) = bound.as_ref().map_or((0.0, &[][..]), |(b, g)| (*b, &g[..]));
+    let eps = 1e-12 * scale;
+    if let Some(forces) = friction_shortcut::at_bound(
+        support,
+        (b, group),
+        scale,
+        |f| pushes(support, f, scale),
+        |f| largest_need(support, &ones, f, eps),
+    ) {
+        let need = largest_need(support, &ones, &forces, eps);
+        let slipping = match common_mu(&sticks) {
+            Some(Some(mu)) => slips(need, mu),
+            Some(None) => false,
+            None => slipping_with(support, &sticks, &forces, scale),
+        };
+        // (Different coefficients and a contact beyond its own: the cone programs weigh them.)
+        if !slipping || common_mu(&sticks).is_some() {
+            return Some(Distribution {
+                forces,
+                required_mu: (!sticks.is_empty()).then_some(need),
+                slipping,
+            });
+        }
     }
     let (required, z) = least_need(support, &ones, scale)?;
     let best = at(support, &z);

@@ -4,7 +4,7 @@
 //! a small simplex method written here).
 
 use super::*;
-use nalgebra::Vector3;
+use nalgebra::{DMatrix, Vector3};
 
 /// A contact of a rigid body: point, unit normal, whether it sticks.
 struct Touch {
@@ -60,7 +60,13 @@ fn support(touches: &[Touch], w: f64, tilt: f64, mu: Option<f64>) -> (DMatrix<f6
         .map(|i| eig.eigenvectors.column(i).into_owned())
         .collect();
     let k = g.ncols();
+    // Contacts with one normal are on one plane ground (module `friction_shortcut`).
+    let plane = touches
+        .iter()
+        .map(|t| touches.iter().position(|u| u.n == t.n))
+        .collect();
     let s = Support {
+        plane,
         base,
         null: if null.is_empty() {
             DMatrix::zeros(k, 0)
@@ -284,4 +290,64 @@ fn no_distribution_when_a_contact_must_pull() {
     // The centre of mass outside the corners (shifted by 0.4 m).
     let (_, s) = support(&box_corners(0.15, 0.4, false), 10.0, 0.0, None);
     assert!(distribute(&s, 10.0).is_none());
+}
+
+/// The closed form of module `friction_shortcut` (the least-norm distribution at the lower
+/// bound `‖F_t‖ / F_n`) gives what the cone programs alone give on the box on slopes: the
+/// same `required_mu` (1e-9) and forces (1e-5 of the weight: the cone path's least-norm
+/// choice has a slack of 1e-6 on the bound).
+#[test]
+fn shortcuts_agree_with_the_cone_programs() {
+    for alpha in [0.0, 0.1, 0.35] {
+        for dx in [0.0, 0.03] {
+            let (_, s) = support(&box_corners(0.15, dx, true), 15.7, alpha, Some(0.5));
+            let fast = distribute(&s, 15.7).unwrap();
+            // The cone programs alone: least need, then least norm within it.
+            let ones = vec![Some(1.0); 4];
+            let (need, z) = least_need(&s, &ones, 15.7).unwrap();
+            let forces = least_norm(&s, &ones, need, &at(&s, &z), 15.7);
+            let a = fast.required_mu.unwrap();
+            assert!((a - need).abs() <= 1e-9, "{alpha} {dx}: {a} vs {need}");
+            assert!(
+                (&fast.forces - &forces).amax() <= 1e-5 * 15.7,
+                "{alpha} {dx}: {} vs {}",
+                fast.forces,
+                forces
+            );
+            // Every loaded corner's force parallel to gravity: each needs tan α exactly.
+            for &(first, _) in &s.holders {
+                let t = fast.forces[first + 1].hypot(fast.forces[first + 2]);
+                assert!((t - f64::tan(alpha) * fast.forces[first]).abs() < 1e-12 * 15.7);
+            }
+            assert_eq!(fast.slipping, slips(need, 0.5));
+        }
+    }
+    // The lower bound of a box on one ground is tan α; none for the ladder (its floor's total
+    // force depends on the wall's share).
+    let (_, s) = support(&box_corners(0.15, 0.03, true), 15.7, 0.2, None);
+    let b = crate::solver::friction_shortcut::lower_bound(&s).unwrap().0;
+    assert!((b - f64::tan(0.2)).abs() < 1e-12, "{b}");
+}
+
+/// Two contacts (the distributions a line: the squeeze between them): no pushing distribution
+/// when the centre of mass lies beyond one of them, decided by intervals as by the cone
+/// program.
+#[test]
+fn nothing_pushes_on_a_line_as_the_cone_program_says() {
+    for (dx, expect) in [(0.0, false), (0.1, false), (0.4, true), (-0.3, true)] {
+        let touches: Vec<Touch> = [-0.25, 0.25]
+            .iter()
+            .map(|&x| Touch {
+                p: Vector3::new(x - dx, 0.0, -0.15),
+                n: Vector3::z(),
+                stick: true,
+            })
+            .collect();
+        let (_, s) = support(&touches, 10.0, 0.0, None);
+        assert_eq!(s.null.ncols(), 1);
+        let fast = crate::solver::friction_shortcut::nothing_pushes_on_a_line(&s, 10.0);
+        let ones = vec![Some(1.0); 2];
+        let cone = least_need(&s, &ones, 10.0).is_none();
+        assert_eq!((fast, cone), (expect, expect), "{dx}");
+    }
 }

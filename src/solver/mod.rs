@@ -24,6 +24,8 @@ pub mod balance;
 mod conic;
 pub(crate) mod finite;
 pub(crate) mod friction;
+mod friction_shortcut;
+mod friction_support;
 mod inequality;
 mod kkt_direction;
 mod line_search;

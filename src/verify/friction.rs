@@ -50,13 +50,6 @@ pub(super) fn choose(
             vectors[(r, keep[c])] / values[keep[c]].sqrt()
         })
     };
-    let (holders, mu, weight) = friction::holders_of(model, items);
-    let support = friction::Support {
-        base: lambda.clone(),
-        null: basis,
-        holders,
-        mu,
-        weight,
-    };
+    let support = friction::holders_of(model, items).support(lambda.clone(), basis);
     friction::distribute(&support, friction::force_scale(model))
 }

@@ -27,6 +27,7 @@ mod regressions;
 mod robots;
 mod servo;
 mod sparse;
+mod stand;
 mod stdout_outputs;
 mod verify;
 #[cfg(feature = "viewer")]

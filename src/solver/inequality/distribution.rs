@@ -106,14 +106,8 @@ pub(crate) fn spread(
     let map = DMatrix::from_fn(k.ncols(), keep.len(), |r, c| {
         eig_vectors[(r, keep[c])] / eig_values[keep[c]].sqrt()
     });
-    let (holders, coefficients, weight) = friction::holders_of(model, &items);
-    let support = friction::Support {
-        base: DVector::from_fn(rows.len(), |r, _| mu[rows[r]]),
-        null: &ku * &map,
-        holders,
-        mu: coefficients,
-        weight,
-    };
+    let support = friction::holders_of(model, &items)
+        .support(DVector::from_fn(rows.len(), |r, _| mu[rows[r]]), &ku * &map);
     let out = friction::distribute(
         &support,
         crate::solver::inequality::active_set::force_scale(model),

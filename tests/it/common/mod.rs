@@ -3,6 +3,7 @@
 pub(crate) mod builders;
 pub(crate) mod contact;
 pub(crate) mod energies;
+pub(crate) mod pyramid;
 
 use restpose::state::State;
 use restpose::urdf::{load_file, load_str, ImportOptions};

@@ -34,6 +34,7 @@
 //!   *Computer Journal* 6 (1963) 163–168.
 
 use super::inequality::active_set::Guard;
+use super::inequality::release::Release;
 use super::options::{Method, Options};
 use super::partition::Partition;
 use super::report::{Diagnostics, Iterate, Termination};
@@ -57,6 +58,9 @@ pub(crate) struct Outcome {
     /// The inactive inequalities (indices into the guard's list) that stopped the last step: `q`
     /// is on its boundary.
     pub(crate) blocked: Option<Vec<usize>>,
+    /// The active inequalities (indices into the round's active list) to release: the round
+    /// ended before it was stationary (module `inequality::release`).
+    pub(crate) released: Vec<usize>,
 }
 
 /// Relative rounding floor of the reduced gradient: the convergence test uses
@@ -67,6 +71,10 @@ const GRADIENT_FLOOR: f64 = 1e-13;
 /// A dense partition whose smallest-to-largest pivot ratio of `Φ_u` has fallen below this
 /// fraction of its value where the partition was made is checked against a fresh one.
 const PIVOT_DRIFT: f64 = 0.85;
+
+/// Up to this many degrees of freedom the sparse path too steps by the exact reduced Hessian's
+/// eigen-decomposition, not the shifted KKT system (whose shift cut Tiago's steps 200-fold).
+const EXACT_NEWTON_DOF: usize = 64;
 
 /// Whether two partitions choose the same dependent coordinates and rows (in any order).
 fn same_split(a: &Partition, b: &Partition) -> bool {
@@ -168,6 +176,7 @@ pub(crate) fn minimize(
     mut part: Partition,
     options: &Options,
     guard: Option<&Guard>,
+    release: Option<&Release>,
 ) -> Option<Outcome> {
     let mut diag = Diagnostics {
         load_steps: 1,
@@ -185,6 +194,7 @@ pub(crate) fn minimize(
     let mut eigen = None;
     let mut iterates = Vec::new();
     let mut blocked = None;
+    let mut released = Vec::new();
     // The step length the line search starts from: 1, or after a step the corrector could
     // not follow in full, the fraction that it could, doubled after each full success.
     let mut reach = 1.0f64;
@@ -211,9 +221,18 @@ pub(crate) fn minimize(
                 report(iteration, eval.energy.total, gnorm);
             }
         }
+        // Active rows pulling hard leave before the round is stationary (`release`).
+        if gnorm > gtol {
+            if let Some(r) = release.and_then(|r| r.early(sys, &part, &eval)) {
+                released = r;
+                termination = Termination::Converged;
+                break;
+            }
+        }
         let mut negative_curvature = None;
         let dof = part.independent.len();
-        let dense_newton = options.method == Method::Newton && sys.backend == Backend::Dense;
+        let dense_newton = options.method == Method::Newton
+            && (sys.backend == Backend::Dense || dof <= EXACT_NEWTON_DOF);
         let eig =
             (dof > 0 && (dense_newton || gnorm <= gtol)).then(|| spectrum(sys, &q, &part, &eval));
         if gnorm <= gtol {
@@ -469,6 +488,7 @@ pub(crate) fn minimize(
         history,
         diagnostics: diag,
         blocked,
+        released,
     })
 }
 

@@ -3,7 +3,7 @@
 Run by scripts/pinocchio_corpus.sh (which provides the venv with `pin` and the corpus). For
 every URDF of example-robot-data 6.0.0, hanging from its fixed base (`--load-steps 1`, the
 direct solve), and for the legged robots with an SRDF standing state, standing on the ground
-(`--floating-base --ground --servo all=K --srdf FILE --srdf-state NAME`):
+(`--floating-base --ground --friction stick --servo all=K --srdf FILE --srdf-state NAME`):
 
   1. `restpose analyze -q --json` gives the rest pose (`q_pinocchio`), the link frames, the
      energy, the stops' efforts, the servos' torques and the contact forces;
@@ -153,7 +153,7 @@ def cases():
             yield name, f, False, ["--package", f"example-robot-data={ERD}/.."]
     for urdf, srdf, state in STANDING:
         yield (f"{urdf} standing ({state})", f"{ERD}/{urdf}", True,
-               ["--floating-base", "--ground", "--servo", f"all={SERVO}",
+               ["--floating-base", "--ground", "--friction", "stick", "--servo", f"all={SERVO}",
                 "--srdf", f"{ERD}/{srdf}", "--srdf-state", state,
                 "--package", f"example-robot-data={ERD}/.."])
 

@@ -173,7 +173,7 @@ fn child(spec: &str) {
         },
         ..Default::default()
     };
-    let runs = if model.bodies.len() > 2000 { 1 } else { 3 };
+    let runs = if model.bodies().len() > 2000 { 1 } else { 3 };
     let mut best = f64::INFINITY;
     let mut report = None;
     for _ in 0..runs {
@@ -199,7 +199,7 @@ fn child(spec: &str) {
     };
     println!(
         "{name} {} {} {} {best} {peak} {} {gradient:.1e}",
-        model.bodies.len(),
+        model.bodies().len(),
         r.dof,
         r.iterations,
         r.diagnostics.linear_algebra

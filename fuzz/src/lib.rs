@@ -353,7 +353,7 @@ pub fn exercise(text: &str, choices: &Choices) -> Reached {
         }
     };
     let model = &loaded.model;
-    if model.bodies.len() > MAX_BODIES {
+    if model.bodies().len() > MAX_BODIES {
         return Reached::Large;
     }
     let _ = restpose::verify::check(model);

@@ -55,7 +55,7 @@ impl ModelBuilder {
                 name: name.into(),
                 suggestion: restpose::names::closest(
                     name,
-                    b.partial().joints.iter().map(|j| j.name.as_str()),
+                    b.partial().joints().iter().map(|j| j.name.as_str()),
                 )
                 .map(str::to_owned),
             })

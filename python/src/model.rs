@@ -149,32 +149,40 @@ impl Model {
     /// Robot name (``<robot name>``).
     #[getter]
     fn name(&self) -> &str {
-        &self.model().name
+        &self.model().name()
     }
 
     /// Names of every joint, in model order (URDF ``<joint>`` elements in file order, then
     /// loop joints), as in ``Result.joint_names``.
     #[getter]
     fn joint_names(&self) -> Vec<String> {
-        self.model().joints.iter().map(|j| j.name.clone()).collect()
+        self.model()
+            .joints()
+            .iter()
+            .map(|j| j.name.clone())
+            .collect()
     }
 
     /// Names of every link, in model order.
     #[getter]
     fn link_names(&self) -> Vec<String> {
-        self.model().links.iter().map(|l| l.name.clone()).collect()
+        self.model()
+            .links()
+            .iter()
+            .map(|l| l.name.clone())
+            .collect()
     }
 
     /// Number of moving rigid bodies (links welded by fixed joints are one body).
     #[getter]
     fn body_count(&self) -> usize {
-        self.model().bodies.len()
+        self.model().bodies().len()
     }
 
     /// Gravity in the world frame [m/s²].
     #[getter]
     fn gravity(&self) -> [f64; 3] {
-        self.model().gravity.into()
+        self.model().gravity().into()
     }
 
     /// The importer's warnings (repaired input, ignored content that may matter).
@@ -346,10 +354,10 @@ impl Model {
         let m = self.model();
         format!(
             "<restpose.Model {:?}: {} bodies, {} joints, {} links>",
-            m.name,
-            m.bodies.len(),
-            m.joints.len(),
-            m.links.len()
+            m.name(),
+            m.bodies().len(),
+            m.joints().len(),
+            m.links().len()
         )
     }
 }

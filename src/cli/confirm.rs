@@ -18,8 +18,8 @@ pub(crate) fn rejection(a: &AnalyzeArgs, model: &Model, state: &State) -> Option
         .filter(|(_, v)| !v.is_empty())
         .collect();
     // And the floating bases, whose poses `verify` reads from the JSON's `links` too.
-    let mut moved = vec![false; model.bodies.len()];
-    for j in model.joints.iter().filter(|j| j.tree && !j.merged) {
+    let mut moved = vec![false; model.bodies().len()];
+    for j in model.joints().iter().filter(|j| j.tree && !j.merged) {
         if let Some(c) = j.bodies[1] {
             moved[c.index()] = true;
         }

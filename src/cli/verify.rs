@@ -29,7 +29,10 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
             .joint_id(&name)
             .ok_or_else(|| model.unknown_joint("joint", &name))
             .with_context(|| format!("--joint {j}"))?;
-        let n = model.joint(id).kind.scalar_coordinates().max(dof + 1);
+        let n = model
+            .get_joint(id)
+            .map_or(0, |j| j.kind.scalar_coordinates())
+            .max(dof + 1);
         let v = values.entry(name).or_insert_with(|| vec![0.0; n]);
         if v.len() <= dof {
             v.resize(dof + 1, 0.0);
@@ -76,9 +79,7 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
     let based;
     let model = match a.pose.as_deref().and_then(|p| base_pose(model, p)) {
         Some(pose) => {
-            let mut m = model.clone();
-            m.base_pose = Some(pose);
-            based = m;
+            based = model.with_base_pose(pose);
             &based
         }
         None => model,
@@ -98,17 +99,17 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
         let now: std::collections::HashMap<String, Vec<f64>> =
             state.joint_values(model).into_iter().collect();
         for (id, dof) in locks {
-            let name = &model.joint(id).name;
+            let name = model.get_joint(id).map_or("?", |j| j.name.as_str());
             let value = now.get(name).and_then(|v| v.get(dof)).copied();
-            if value.is_none() {
-                bail!("--lock {name}[{dof}]: the joint has no coordinate {dof}");
-            }
-            m.locks.retain(|l| !(l.joint == id && l.dof == dof));
-            m.locks.push(restpose::model::Lock {
+            let lock = restpose::model::Lock {
                 joint: id,
                 dof,
                 value,
-            });
+            };
+            match (value, m.with_lock(lock)) {
+                (Some(_), Some(held)) => m = held,
+                _ => bail!("--lock {name}[{dof}]: the joint has no coordinate {dof}"),
+            }
         }
         held = m;
         &held
@@ -143,9 +144,9 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
     }
     if !print::is_stdout(a.json.as_ref()) {
         if a.quiet {
-            report::verdict(&model.name, &v);
+            report::verdict(model.name(), &v);
         } else {
-            report::verification(&model.name, &v, &tol);
+            report::verification(model.name(), &v, &tol);
         }
     }
     if v.passed {
@@ -164,7 +165,7 @@ fn link_pose(
     json: &serde_json::Value,
     b: restpose::model::BodyId,
 ) -> Option<nalgebra::Isometry3<f64>> {
-    let body = model.bodies.get(b.index())?;
+    let body = model.bodies().get(b.index())?;
     let link = json.get("links")?.get(&body.name)?;
     let v = |key: &str, n: usize| -> Option<Vec<f64>> {
         let a = link.get(key)?.as_array()?;
@@ -213,14 +214,14 @@ fn given_bodies(
 fn base_pose(model: &restpose::Model, path: &std::path::Path) -> Option<nalgebra::Isometry3<f64>> {
     // The bodies some tree joint moves, in one pass (a scan of the joints per body was
     // `O(N²)` name comparisons: 10 % of `verify` at 10,000 links).
-    let mut moved = vec![false; model.bodies.len()];
-    for j in model.joints.iter().filter(|j| j.tree && !j.merged) {
+    let mut moved = vec![false; model.bodies().len()];
+    for j in model.joints().iter().filter(|j| j.tree && !j.merged) {
         if let Some(c) = j.bodies[1] {
             moved[c.index()] = true;
         }
     }
     let root = model
-        .bodies
+        .bodies()
         .iter()
         .zip(&moved)
         .find(|(_, &m)| !m)

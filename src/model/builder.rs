@@ -11,7 +11,7 @@
 //! and coordinate index it was given, so a made-up id is an error, never a panic later.
 
 use super::mass::{aggregate_mass, Inertial};
-use super::{Body, BodyId, ContactSettings, Joint, JointId, Link, Mimic, Model};
+use super::{Body, BodyId, ContactSettings, Joint, JointId, Link, Mimic, Model, Shared};
 use crate::error::Result;
 use crate::geometry::Geometry;
 use crate::names::NameMap;
@@ -55,24 +55,24 @@ impl ModelBuilder {
         ModelBuilder {
             model: Model {
                 name: name.into(),
-                bodies: Vec::new(),
-                links: Vec::new(),
-                joints: Vec::new(),
-                springs: Vec::new(),
-                joint_springs: Vec::new(),
-                servos: Vec::new(),
-                loads: Vec::new(),
-                efforts: Vec::new(),
-                locks: Vec::new(),
-                mimics: Vec::new(),
-                initial: Vec::new(),
+                bodies: Shared::default(),
+                links: Shared::default(),
+                joints: Shared::default(),
+                springs: Shared::default(),
+                joint_springs: Shared::default(),
+                servos: Shared::default(),
+                loads: Shared::default(),
+                efforts: Shared::default(),
+                locks: Shared::default(),
+                mimics: Shared::default(),
+                initial: Shared::default(),
                 gravity: Vector3::new(0.0, 0.0, -9.81),
-                grounds: Vec::new(),
-                obstacles: Vec::new(),
-                contact_points: Vec::new(),
+                grounds: Shared::default(),
+                obstacles: Shared::default(),
+                contact_points: Shared::default(),
                 length_scale: 1.0,
                 base_pose: None,
-                joint_names: NameMap::default(),
+                joint_names: Default::default(),
             },
             inertials: Vec::new(),
             no_gravity: Vec::new(),
@@ -204,11 +204,11 @@ impl ModelBuilder {
         aggregate_mass(&mut self.model, &self.inertials, &self.no_gravity);
         // The numbers first: the contact points are computed from the checked shapes.
         self.model.check_numbers()?;
-        self.model.contact_points = super::contact::points(&self.model, &self.contacts)?;
+        self.model.contact_points = super::contact::points(&self.model, &self.contacts)?.into();
         self.model.length_scale = length_scale(&self.model);
         // The builder's map of the joints pushed (the first of a name wins; joints are never
         // renamed or removed once pushed), moved rather than rebuilt.
-        self.model.joint_names = std::mem::take(&mut self.joint_names);
+        self.model.joint_names = std::mem::take(&mut self.joint_names).into();
         Ok(self.model)
     }
 }

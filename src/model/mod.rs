@@ -16,6 +16,7 @@ mod joint_kind;
 mod mass;
 mod numeric;
 mod obstacle;
+mod shared;
 mod site;
 mod validate;
 
@@ -32,52 +33,155 @@ pub(crate) use joint_kind::MAX_SCALAR_COORDINATES;
 pub use mass::Inertial;
 pub use numeric::{LARGEST_GRAVITY, LARGEST_LENGTH, LARGEST_MAGNITUDE};
 pub use obstacle::Obstacle;
+pub(crate) use shared::Shared;
 
 use nalgebra::Vector3;
 
 /// A validated mechanism (built by [`ModelBuilder`], which the URDF importer drives);
-/// immutable once built.
+/// immutable once built: the library's users read it through the accessors ([`Model::bodies`],
+/// [`Model::joints`], …). The lists are [`Shared`] between copies (a load step's model shares
+/// everything but the loads it scales).
 #[derive(Clone, Debug)]
 pub struct Model {
     /// Robot name from `<robot name>`.
-    pub name: String,
+    pub(crate) name: String,
     /// Moving rigid bodies (7 coordinates each).
-    pub bodies: Vec<Body>,
+    pub(crate) bodies: Shared<Body>,
     /// Every URDF link, with the body carrying it.
-    pub links: Vec<Link>,
+    pub(crate) links: Shared<Link>,
     /// Every joint: URDF joints (fixed ones merged into bodies included) and loop joints.
-    pub joints: Vec<Joint>,
+    pub(crate) joints: Shared<Joint>,
     /// Translational point-to-point springs.
-    pub springs: Vec<Spring>,
+    pub(crate) springs: Shared<Spring>,
     /// Springs on joint coordinates.
-    pub joint_springs: Vec<JointSpring>,
+    pub(crate) joint_springs: Shared<JointSpring>,
     /// Position servos (their springs are the last entries of `joint_springs`).
-    pub servos: Vec<Servo>,
+    pub(crate) servos: Shared<Servo>,
     /// Constant dead loads.
-    pub loads: Vec<Load>,
+    pub(crate) loads: Shared<Load>,
     /// Constant generalized forces on joint coordinates.
-    pub efforts: Vec<Effort>,
+    pub(crate) efforts: Shared<Effort>,
     /// Held joint coordinates.
-    pub locks: Vec<Lock>,
+    pub(crate) locks: Shared<Lock>,
     /// Linear couplings between joint coordinates.
-    pub mimics: Vec<Mimic>,
+    pub(crate) mimics: Shared<Mimic>,
     /// Initial guesses of joint coordinates.
-    pub initial: Vec<Initial>,
+    pub(crate) initial: Shared<Initial>,
     /// Gravity in the world frame \[m/s²\].
-    pub gravity: Vector3<f64>,
+    pub(crate) gravity: Vector3<f64>,
     /// Ground planes (`mech:ground`).
-    pub grounds: Vec<Ground>,
+    pub(crate) grounds: Shared<Ground>,
     /// Collision shapes of world-fixed links that contact points rest on (`mech:obstacle`).
-    pub obstacles: Vec<Obstacle>,
+    pub(crate) obstacles: Shared<Obstacle>,
     /// Points of the links that touch the grounds (from their collision shapes).
-    pub contact_points: Vec<ContactPoint>,
+    pub(crate) contact_points: Shared<ContactPoint>,
     /// Characteristic length of the mechanism \[m\], used to scale position coordinates.
-    pub length_scale: f64,
+    pub(crate) length_scale: f64,
     /// Start pose of the root link in the world when the base floats (`mech:base`; `None`:
     /// the identity).
-    pub base_pose: Option<nalgebra::Isometry3<f64>>,
+    pub(crate) base_pose: Option<nalgebra::Isometry3<f64>>,
     /// Joint ids by name (the first joint of a name wins), built by the builder.
-    pub(crate) joint_names: crate::names::NameMap<String, JointId>,
+    pub(crate) joint_names: std::sync::Arc<crate::names::NameMap<String, JointId>>,
+}
+
+/// Read access for the library's users (the crate reads the fields).
+impl Model {
+    /// Robot name from `<robot name>`.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Moving rigid bodies (7 coordinates each), indexed by [`BodyId`].
+    pub fn bodies(&self) -> &[Body] {
+        &self.bodies
+    }
+
+    /// Every URDF link, with the body carrying it.
+    pub fn links(&self) -> &[Link] {
+        &self.links
+    }
+
+    /// Every joint, indexed by [`JointId`]: URDF joints (fixed ones merged into bodies
+    /// included) and loop joints.
+    pub fn joints(&self) -> &[Joint] {
+        &self.joints
+    }
+
+    /// Translational point-to-point springs.
+    pub fn springs(&self) -> &[Spring] {
+        &self.springs
+    }
+
+    /// Springs on joint coordinates (servos' springs last).
+    pub fn joint_springs(&self) -> &[JointSpring] {
+        &self.joint_springs
+    }
+
+    /// Position servos (their springs are the last entries of [`Model::joint_springs`]).
+    pub fn servos(&self) -> &[Servo] {
+        &self.servos
+    }
+
+    /// Constant dead loads.
+    pub fn loads(&self) -> &[Load] {
+        &self.loads
+    }
+
+    /// Constant generalized forces on joint coordinates.
+    pub fn efforts(&self) -> &[Effort] {
+        &self.efforts
+    }
+
+    /// Held joint coordinates.
+    pub fn locks(&self) -> &[Lock] {
+        &self.locks
+    }
+
+    /// Linear couplings between joint coordinates.
+    pub fn mimics(&self) -> &[Mimic] {
+        &self.mimics
+    }
+
+    /// Initial guesses of joint coordinates.
+    pub fn initial(&self) -> &[Initial] {
+        &self.initial
+    }
+
+    /// Gravity in the world frame \[m/s²\].
+    pub fn gravity(&self) -> Vector3<f64> {
+        self.gravity
+    }
+
+    /// Ground planes (`mech:ground`).
+    pub fn grounds(&self) -> &[Ground] {
+        &self.grounds
+    }
+
+    /// Collision shapes of world-fixed links that contact points rest on (`mech:obstacle`).
+    pub fn obstacles(&self) -> &[Obstacle] {
+        &self.obstacles
+    }
+
+    /// Points of the links that touch the grounds and obstacles.
+    pub fn contact_points(&self) -> &[ContactPoint] {
+        &self.contact_points
+    }
+
+    /// Characteristic length of the mechanism \[m\], used to scale position coordinates.
+    pub fn length_scale(&self) -> f64 {
+        self.length_scale
+    }
+
+    /// Start pose of the root link in the world when the base floats (`mech:base`; `None`:
+    /// the identity).
+    pub fn base_pose(&self) -> Option<&nalgebra::Isometry3<f64>> {
+        self.base_pose.as_ref()
+    }
+
+    /// The joint with this id, `None` for an id out of range.
+    pub fn get_joint(&self, id: JointId) -> Option<&Joint> {
+        self.joints.get(id.0)
+    }
 }
 
 impl Model {
@@ -124,13 +228,14 @@ impl Model {
         self.links.iter().find(|l| l.name == name)
     }
 
-    /// The joint with this id.
-    pub fn joint(&self, id: JointId) -> &Joint {
+    /// The joint with this id (an id the crate made: in range by construction; users call
+    /// the checked [`Model::get_joint`]).
+    pub(crate) fn joint(&self, id: JointId) -> &Joint {
         &self.joints[id.0]
     }
 
     /// The same model with gravity, dead loads and joint efforts scaled by `factor` (load
-    /// stepping).
+    /// stepping). Only the loads and efforts are copied; every other list is [`Shared`].
     pub fn with_load_factor(&self, factor: f64) -> Model {
         let mut m = self.clone();
         m.gravity *= factor;
@@ -140,6 +245,37 @@ impl Model {
         for e in &mut m.efforts {
             e.value *= factor;
         }
+        m
+    }
+
+    /// The same model with its floating base starting at `pose` (as `mech:base` places it).
+    pub fn with_base_pose(&self, pose: nalgebra::Isometry3<f64>) -> Model {
+        let mut m = self.clone();
+        m.base_pose = Some(pose);
+        m
+    }
+
+    /// The same model with the coordinate `lock.dof` of `lock.joint` held (replacing a lock
+    /// of that coordinate); `None` when the joint id is out of range or the joint has no such
+    /// coordinate.
+    pub fn with_lock(&self, lock: Lock) -> Option<Model> {
+        let joint = self.get_joint(lock.joint)?;
+        if lock.dof >= joint.kind.scalar_coordinates() {
+            return None;
+        }
+        let mut m = self.clone();
+        m.locks
+            .retain(|l| !(l.joint == lock.joint && l.dof == lock.dof));
+        m.locks.push(lock);
+        Some(m)
+    }
+
+    /// The same model without joint springs (servos, whose springs they are, included): the
+    /// efforts a pose needs without them are then the springs' torques.
+    pub fn without_joint_springs(&self) -> Model {
+        let mut m = self.clone();
+        m.joint_springs = Shared::default();
+        m.servos = Shared::default();
         m
     }
 

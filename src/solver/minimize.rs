@@ -1,32 +1,32 @@
-//! Unconstrained minimization of `f(v̂) = V(u(v̂), v̂)` over the scaled independent coordinates.
+//! Unconstrained minimization of `f(v̂) = V(u(v̂), v̂)` over the scaled independent coordinates
+//! (paper steps (c)–(f)), one iteration in named stages, as [`minimize`] reads:
 //!
-//! Each iteration picks a direction `d` (Newton: `−Ĥ⁻¹ ∇f` with the eigenvalues of the exact
-//! reduced Hessian replaced by their magnitudes, floored; BFGS / DFP: `−B ∇f` with the inverse
-//! update), caps `‖d‖∞` at `max_step`, and backtracks from `α = 1` until the Armijo condition
-//! `f(v̂ + α d) ≤ f + 10⁻⁴ α ∇fᵀ d` holds. With a sparse partition that has second-pass
-//! choices (contact or stop rows pivoted on their bodies, module `sparse::partition`), after a
-//! step on which the corrector failed the next line search starts from the `α` that was
-//! accepted instead of 1, and that start doubles after each step taken in full (a trust radius
-//! for the corrector: a long rope's first steps swing its lower links far enough to leave the
-//! corrector's reach, and halving from 1 every time costs two or three failed corrections per
-//! iteration). Elsewhere it starts from 1 (applied to every model, this heuristic sent a far
-//! start of the tractor-trailer, limits enforced, to another equilibrium). A trial point starts from the first-order prediction
-//! `q + α Z d` and is brought back onto `Φ = 0` by the Newton corrector; trial energies are
-//! compared through the Lagrangian `V − μᵀΦ`, which removes the first-order effect of the
-//! corrector's remaining residual (otherwise `μ·Φ` can exceed the decrease a Newton step
-//! promises near the minimum); if the corrector fails
-//! the step is halved (paper step (f)). When no step is found, the coordinates are
-//! re-partitioned once at the current point. A dense partition is also compared with a fresh
-//! full pivoting after a step where the smallest-to-largest pivot ratio of `Φ_u` has fallen
-//! below [`PIVOT_DRIFT`] of its value where the partition was made, and replaced if that one
-//! differs: as the mechanism moves, the dependent coordinates chosen at the start lose their
-//! hold (an Euler parameter near a turning point), `H = −Φ_u⁻¹ Φ_v` grows, the reduced
-//! Hessian's eigenvalues spread with it and its floor swallows the physical curvatures (a
-//! UR5 swinging down from horizontal stalled at ‖∇f‖ = 10⁻² for 200 iterations). a sparse partition with second-pass choices for
-//! contact or stop rows (module `sparse::partition`) is recomputed after every step and
-//! replaced when those choices have changed. At a stationary point with a negative reduced
-//! Hessian eigenvalue (a saddle or maximum) the search leaves along its eigenvector, unless
-//! `allow_unstable` is set.
+//! 1. **Record** the iterate (history, progress callback).
+//! 2. **Convergence test** ([`convergence_test`]): `‖∇f‖∞ ≤ max(gradient_tolerance,
+//!    10⁻¹³ Σ|V_k|)` and, unless `allow_unstable` is set, no negative eigenvalue of the reduced
+//!    Hessian; at a saddle or maximum the search leaves along the eigenvector of the most
+//!    negative one.
+//! 3. **Reduced step** ([`reduced_step`]): Newton `d = −Ĥ⁻¹ ∇f` with the eigenvalues of the
+//!    exact reduced Hessian replaced by their magnitudes, floored (dense), or the KKT direction
+//!    (sparse); BFGS / DFP `d = −B ∇f` (module `quasi_newton`); steepest descent when `d` is
+//!    not a descent direction.
+//! 4. **Step cap** (module `step_cap`): the tangent step `δq = Z d` limited on the motion of the
+//!    whole mechanism (every body's Euler parameters by `max_step`, its origin by
+//!    `10 max_step ℓ`, `ℓ` the larger of the length scale and the mechanism's extent).
+//! 5. **Line search and corrector** (module `line_search`): backtracking until the Armijo
+//!    condition holds, each trial brought back onto `Φ = 0` by the Newton corrector and halved
+//!    when the corrector fails (paper step (f)), from `α = 1`, or with second-pass choices in a
+//!    sparse partition from the reach the corrector last managed ([`Search::reach`]). With a
+//!    guard, a step that would violate an inactive inequality is cut where the first one
+//!    reaches its boundary, and the minimization stops there (`Outcome::blocked`: the
+//!    inequality update is the caller's, folder `inequality`).
+//! 6. **Accept** ([`accept_step`]): quasi-Newton update, and the unbounded test (a linear
+//!    descent that goes on, module `unbounded`).
+//! 7. **Refresh the partition** ([`refresh_partition`], paper step (b)): anew when `Φ_u` is
+//!    ill-conditioned, when its pivots have drifted ([`PIVOT_DRIFT`]) and a fresh full
+//!    pivoting differs, or when a sparse partition's second-pass choices change. When the
+//!    line search finds no step, the coordinates are re-partitioned once at the current
+//!    point; a second failure ends the minimization.
 //!
 //! ## References
 //! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §3.1, §3.4, §6.1.
@@ -35,12 +35,16 @@
 
 use super::inequality::active_set::Guard;
 use super::inequality::release::Release;
+use super::line_search::{line_search, Line, Trial};
 use super::options::{Method, Options};
 use super::partition::Partition;
+use super::quasi_newton::QuasiNewton;
 use super::report::{Diagnostics, Iterate, Termination};
 use super::stability::spectrum::{spectrum, Spectrum};
+use super::step_cap::{cap_step, Step};
 use super::system::{Backend, Eval, System};
-use nalgebra::{DMatrix, DVector};
+use super::unbounded::LinearDescent;
+use nalgebra::DVector;
 
 /// Outcome of the minimization.
 pub(crate) struct Outcome {
@@ -69,12 +73,379 @@ pub(crate) struct Outcome {
 const GRADIENT_FLOOR: f64 = 1e-13;
 
 /// A dense partition whose smallest-to-largest pivot ratio of `Φ_u` has fallen below this
-/// fraction of its value where the partition was made is checked against a fresh one.
+/// fraction of its value where the partition was made is checked against a fresh one: as the
+/// mechanism moves, the dependent coordinates chosen at the start lose their hold (an Euler
+/// parameter near a turning point), `H = −Φ_u⁻¹ Φ_v` grows, the reduced Hessian's eigenvalues
+/// spread with it and its floor swallows the physical curvatures (a UR5 swinging down from
+/// horizontal stalled at ‖∇f‖ = 10⁻² for 200 iterations).
 const PIVOT_DRIFT: f64 = 0.85;
 
 /// Up to this many degrees of freedom the sparse path too steps by the exact reduced Hessian's
 /// eigen-decomposition, not the shifted KKT system (whose shift cut Tiago's steps 200-fold).
 const EXACT_NEWTON_DOF: usize = 64;
+
+/// The minimizer's state between iterations.
+struct Search {
+    method: Method,
+    q: DVector<f64>,
+    part: Partition,
+    eval: Eval,
+    qn: QuasiNewton,
+    diag: Diagnostics,
+    history: Vec<Iterate>,
+    iterates: Vec<DVector<f64>>,
+    iteration: usize,
+    /// The step length the line search starts from with second-pass choices in a sparse
+    /// partition (contact or stop rows pivoted on their bodies, module `sparse::partition`):
+    /// 1, or after a step the corrector could not follow in full, the fraction that it could,
+    /// doubled after each full success. A trust radius for the corrector: a long rope's first
+    /// steps swing its lower links out of the corrector's reach, and halving from 1 every
+    /// time costs two or three failed corrections per iteration. Elsewhere the search starts
+    /// from 1 (applied to every model, this sent a far start of the tractor-trailer, limits
+    /// enforced, to another equilibrium).
+    reach: f64,
+    /// The pivot ratio of `Φ_u` where the partition was made ([`PIVOT_DRIFT`]).
+    pivot_reference: Option<f64>,
+    /// The last line search failed and the partition was made afresh at `q`.
+    just_repartitioned: bool,
+    /// Consecutive full capped steps along which the gradient did not change.
+    linear_steps: usize,
+    descent: LinearDescent,
+}
+
+/// What the convergence test found.
+enum Test {
+    /// Stationary and (unless `allow_unstable`) no negative curvature: the spectrum, if
+    /// computed.
+    Converged(Option<Spectrum>),
+    /// Stationary at a saddle or maximum: the eigenvector of the most negative eigenvalue.
+    Saddle(DVector<f64>),
+    /// Not stationary.
+    Continue,
+}
+
+/// Minimizes from `q`; with a `guard`, a step that would violate one of its inequalities is
+/// cut where the first one reaches its boundary, and the minimization stops there
+/// (`Outcome::blocked`).
+pub(crate) fn minimize(
+    sys: &mut System,
+    q: DVector<f64>,
+    part: Partition,
+    options: &Options,
+    guard: Option<&Guard>,
+    release: Option<&Release>,
+) -> Option<Outcome> {
+    let mut diag = Diagnostics {
+        load_steps: 1,
+        ..Diagnostics::default()
+    };
+    let eval = sys.evaluate(&q, &part)?;
+    diag.function_evaluations += 1;
+    let mut s = Search {
+        method: options.method,
+        qn: QuasiNewton::new(part.independent.len(), options.method),
+        pivot_reference: eval.factors.pivot_ratio(),
+        q,
+        part,
+        eval,
+        diag,
+        history: Vec::new(),
+        iterates: Vec::new(),
+        iteration: 0,
+        reach: 1.0,
+        just_repartitioned: false,
+        linear_steps: 0,
+        descent: LinearDescent::default(),
+    };
+    let mut termination = Termination::MaxIterations;
+    let mut eigen = None;
+    let mut blocked = None;
+    let mut released = Vec::new();
+    loop {
+        // The gradient cannot be resolved below the rounding of the energy's terms.
+        let gtol = options
+            .gradient_tolerance
+            .max(GRADIENT_FLOOR * s.eval.energy.magnitude);
+        s.diag.gradient_tolerance = gtol;
+        record(&mut s, options, true);
+        // Active rows pulling hard leave before the round is stationary (`release`).
+        if s.eval.grad_v.amax() > gtol {
+            if let Some(r) = release.and_then(|r| r.early(sys, &s.part, &s.eval)) {
+                released = r;
+                termination = Termination::Converged;
+                break;
+            }
+        }
+        let (eig, test) = convergence_test(sys, &s, gtol, options);
+        let negative_curvature = match test {
+            Test::Converged(e) => {
+                eigen = e;
+                termination = Termination::Converged;
+                break;
+            }
+            Test::Saddle(v) => Some(v),
+            Test::Continue => None,
+        };
+        if s.iteration >= options.max_iterations {
+            break;
+        }
+        let d = reduced_step(sys, &mut s, eig.as_ref(), negative_curvature, options);
+        let step = cap_step(sys, &s.part, &s.eval, &s.q, d, options);
+        let slope = s.eval.grad_v.dot(&step.d);
+        let failures_before = s.diag.corrector_failures;
+        // From the step length the corrector last managed (with second-pass choices in the
+        // partition; from 1 otherwise).
+        let alpha = if s.part.second_pass.is_empty() {
+            1.0
+        } else {
+            s.reach
+        };
+        let line = Line {
+            q: &s.q,
+            part: &s.part,
+            eval: &s.eval,
+            dq: &step.dq,
+            slope,
+        };
+        let trial = line_search(sys, &line, alpha, guard, options, &mut s.diag);
+        match trial {
+            Some(t) if t.blocked.is_some() => {
+                blocked = t.blocked;
+                s.q = t.q;
+                sys.problem.cons.branches.follow(sys.problem.model, &s.q);
+                s.eval = t.eval;
+                s.iteration += 1;
+                break;
+            }
+            Some(t) => {
+                let alpha = t.alpha;
+                if accept_step(sys, &mut s, &step, slope, t, failures_before, guard) {
+                    termination = Termination::Unbounded;
+                    s.diag.free_directions = super::unbounded::free_directions(
+                        sys.problem.model,
+                        &s.q,
+                        &(&step.dq * alpha),
+                    );
+                    break;
+                }
+                refresh_partition(sys, &mut s)?;
+            }
+            None if !s.just_repartitioned => {
+                repartition(sys, &mut s)?;
+                s.just_repartitioned = true;
+            }
+            None => {
+                termination = Termination::LineSearchFailed;
+                break;
+            }
+        }
+    }
+    // A step accepted just before leaving the loop (blocked, unbounded) is recorded here.
+    record(&mut s, options, false);
+    s.diag.gradient_norm = s.eval.grad_v.amax();
+    s.diag.constraint_residual = sys.residual(&s.q).amax();
+    Some(Outcome {
+        q: s.q,
+        part: s.part,
+        eigen,
+        iterates: s.iterates,
+        eval: s.eval,
+        termination,
+        history: s.history,
+        diagnostics: s.diag,
+        blocked,
+        released,
+    })
+}
+
+/// Stage 1: appends the current iterate to the history (and the recorded iterates) unless it
+/// is there already; reports it to the progress callback when `report` is set.
+fn record(s: &mut Search, options: &Options, report: bool) {
+    if s.history.last().map(|h: &Iterate| h.iteration) == Some(s.iteration) {
+        return;
+    }
+    let gnorm = s.eval.grad_v.amax();
+    s.history.push(Iterate {
+        iteration: s.iteration,
+        potential_energy: s.eval.energy.total,
+        gradient_norm: gnorm,
+        ..Iterate::default()
+    });
+    if options.record_iterates {
+        s.iterates.push(s.q.clone());
+    }
+    if report {
+        if let Some(progress) = &options.progress.0 {
+            progress(s.iteration, s.eval.energy.total, gnorm);
+        }
+    }
+}
+
+/// Stage 2: the convergence test at the current point (module docs), with the reduced
+/// Hessian's spectrum when it was needed (for the test, or for a dense Newton step).
+fn convergence_test(
+    sys: &mut System,
+    s: &Search,
+    gtol: f64,
+    options: &Options,
+) -> (Option<Spectrum>, Test) {
+    let gnorm = s.eval.grad_v.amax();
+    let dof = s.part.independent.len();
+    let dense_newton = options.method == Method::Newton
+        && (sys.backend == Backend::Dense || dof <= EXACT_NEWTON_DOF);
+    let eig =
+        (dof > 0 && (dense_newton || gnorm <= gtol)).then(|| spectrum(sys, &s.q, &s.part, &s.eval));
+    if gnorm > gtol {
+        return (eig, Test::Continue);
+    }
+    let test = match &eig {
+        Some(e) if !options.allow_unstable => match e.lowest() {
+            Some((imin, lmin)) if lmin < -e.tolerance() => {
+                Test::Saddle(e.vectors.column(imin).into_owned())
+            }
+            _ => Test::Converged(Some(e.clone())),
+        },
+        _ => Test::Converged(eig.clone()),
+    };
+    (eig, test)
+}
+
+/// Stage 3: the reduced step `d` (module docs): along the negative-curvature direction at a
+/// saddle, else Newton or quasi-Newton; steepest descent (and a reset quasi-Newton matrix)
+/// when that is not a descent direction.
+fn reduced_step(
+    sys: &mut System,
+    s: &mut Search,
+    eig: Option<&Spectrum>,
+    negative_curvature: Option<DVector<f64>>,
+    options: &Options,
+) -> DVector<f64> {
+    let dof = s.part.independent.len();
+    let g = &s.eval.grad_v;
+    let d = if let Some(nc) = negative_curvature {
+        s.diag.negative_curvature_steps += 1;
+        let sign = if nc.dot(g) > 0.0 { -1.0 } else { 1.0 };
+        let scale = sign * options.max_step / nc.amax().max(1e-300);
+        nc * scale
+    } else {
+        match (eig, options.method) {
+            (Some(e), Method::Newton) if e.exact => {
+                let floor = 1e-8 * e.values.amax().max(1e-12);
+                let mut d = DVector::zeros(dof);
+                for i in 0..dof {
+                    let v = e.vectors.column(i);
+                    d -= v * (v.dot(g) / e.values[i].abs().max(floor));
+                }
+                d
+            }
+            (_, Method::Newton) => super::kkt_direction::kkt_direction(sys, &s.q, &s.part, &s.eval),
+            _ => -(&s.qn.binv * g),
+        }
+    };
+    if d.dot(g) > 0.0 {
+        s.qn = QuasiNewton::new(dof, options.method);
+        return -g.clone();
+    }
+    d
+}
+
+/// Stage 6: moves to the accepted trial point: the line search's next start, the quasi-Newton
+/// update, the joint branches followed; returns whether the descent is unbounded (a linear
+/// descent that is not heading for an inequality, a vanishing energy, a body far away).
+fn accept_step(
+    sys: &mut System,
+    s: &mut Search,
+    step: &Step,
+    slope: f64,
+    t: Trial,
+    failures_before: usize,
+    guard: Option<&Guard>,
+) -> bool {
+    let alpha = t.alpha;
+    s.reach = if s.diag.corrector_failures > failures_before {
+        alpha
+    } else if alpha == s.reach {
+        (2.0 * s.reach).min(1.0)
+    } else {
+        s.reach
+    };
+    let gnorm = s.eval.grad_v.amax();
+    let ds = &step.d * alpha;
+    let y = &t.eval.grad_v - &s.eval.grad_v;
+    // Full capped steps that leave the gradient unchanged: the energy falls linearly along a
+    // direction of zero curvature.
+    if step.capped && alpha == 1.0 && y.amax() <= 1e-9 * gnorm {
+        s.linear_steps += 1;
+    } else {
+        s.linear_steps = 0;
+    }
+    s.qn.update(s.method, &ds, &y);
+    let linear = s
+        .descent
+        .record(slope * alpha, &(&step.dq * alpha), step.length);
+    // A linear descent toward an inequality may end on it.
+    let may_be_stopped = guard.is_some_and(|g| g.approaching(sys, &s.q, &t.q));
+    s.q = t.q;
+    sys.problem.cons.branches.follow(sys.problem.model, &s.q);
+    s.eval = t.eval;
+    s.iteration += 1;
+    s.just_repartitioned = false;
+    let q = &s.q;
+    (!may_be_stopped && (linear || s.linear_steps >= 5))
+        || s.eval.energy.total < -1e15
+        || (0..q.len()).any(|i| i % 7 < 3 && q[i].abs() > 1e6 * sys.problem.model.length_scale)
+}
+
+/// Stage 7: re-partitions when `Φ_u` has become ill-conditioned, or (a dense partition) when
+/// its pivots have drifted and a fresh full pivoting differs, or (a sparse partition with
+/// second-pass choices) when the partition at `q` makes other ones. (Not on any change: where
+/// a carried row ends in the final full pivoting among nearly equal levers would flip from
+/// step to step.) `None` when the evaluation at `q` fails.
+fn refresh_partition(sys: &mut System, s: &mut Search) -> Option<()> {
+    let drifted = match (s.eval.factors.pivot_ratio(), s.pivot_reference) {
+        (Some(now), Some(reference)) => now < PIVOT_DRIFT * reference,
+        _ => false,
+    };
+    if s.eval.factors.ill_conditioned() {
+        repartition(sys, s)?;
+    } else if drifted {
+        // The dependent coordinates chosen at the start of this partition are losing their
+        // hold: a fresh full pivoting at `q`, adopted if it differs.
+        let fresh = sys.partition(&s.q);
+        if !same_split(&fresh, &s.part) {
+            adopt(sys, s, fresh)?;
+        }
+        s.pivot_reference = s.eval.factors.pivot_ratio();
+    } else if !s.part.second_pass.is_empty() {
+        let fresh = sys.partition(&s.q);
+        if fresh.second_pass != s.part.second_pass {
+            adopt(sys, s, fresh)?;
+        }
+    }
+    Some(())
+}
+
+/// A fresh partition at `q` (paper step (b)), its evaluation, and a reset quasi-Newton
+/// approximation. `None` when the evaluation fails.
+fn repartition(sys: &mut System, s: &mut Search) -> Option<()> {
+    let part = sys.partition(&s.q);
+    s.diag.repartitions += 1;
+    s.eval = sys.evaluate(&s.q, &part)?;
+    s.qn = QuasiNewton::new(part.independent.len(), s.method);
+    s.part = part;
+    s.pivot_reference = s.eval.factors.pivot_ratio();
+    Some(())
+}
+
+/// Replaces the partition by `fresh`, evaluated at `q`, with a reset quasi-Newton
+/// approximation. `None` when the evaluation fails.
+fn adopt(sys: &mut System, s: &mut Search, fresh: Partition) -> Option<()> {
+    s.diag.repartitions += 1;
+    s.eval = sys.evaluate(&s.q, &fresh)?;
+    s.part = fresh;
+    s.qn = QuasiNewton::new(s.part.independent.len(), s.method);
+    Some(())
+}
 
 /// Whether two partitions choose the same dependent coordinates and rows (in any order).
 fn same_split(a: &Partition, b: &Partition) -> bool {
@@ -84,416 +455,4 @@ fn same_split(a: &Partition, b: &Partition) -> bool {
         x
     };
     sorted(&a.dependent) == sorted(&b.dependent) && sorted(&a.rows) == sorted(&b.rows)
-}
-
-/// The inverse-Hessian approximation of BFGS / DFP in the current independent coordinates.
-struct QuasiNewton {
-    binv: DMatrix<f64>,
-    /// No update yet: the first one rescales the identity (Nocedal & Wright eq. 6.20).
-    fresh: bool,
-}
-
-impl QuasiNewton {
-    /// The identity for BFGS / DFP; empty for Newton, which has no use for it (a dense
-    /// `dof × dof` matrix would dominate time and memory on large models).
-    fn new(dof: usize, method: Method) -> Self {
-        let dim = if method == Method::Newton { 0 } else { dof };
-        QuasiNewton {
-            binv: DMatrix::identity(dim, dim),
-            fresh: true,
-        }
-    }
-}
-
-fn quasi_newton_update(
-    method: Method,
-    b: &mut DMatrix<f64>,
-    s: &DVector<f64>,
-    y: &DVector<f64>,
-    first: bool,
-) {
-    let ys = y.dot(s);
-    if ys <= 1e-14 * s.norm() * y.norm() || ys <= 0.0 {
-        return;
-    }
-    if first {
-        let n = b.nrows();
-        *b = DMatrix::identity(n, n) * (ys / y.dot(y));
-    }
-    match method {
-        Method::Bfgs => {
-            let rho = 1.0 / ys;
-            let by = &*b * y;
-            let yby = y.dot(&by);
-            // (I − ρ s yᵀ) B (I − ρ y sᵀ) + ρ s sᵀ, expanded.
-            *b += (s * s.transpose()) * (rho * rho * yby + rho)
-                - (&by * s.transpose() + s * by.transpose()) * rho;
-        }
-        Method::Dfp => {
-            let by = &*b * y;
-            let yby = y.dot(&by);
-            *b += s * s.transpose() / ys - &by * by.transpose() / yby;
-        }
-        Method::Newton => {}
-    }
-}
-
-/// A fresh partition at `q`, its evaluation, and a reset quasi-Newton approximation.
-fn repartition(
-    sys: &mut System,
-    q: &DVector<f64>,
-    method: Method,
-    diag: &mut Diagnostics,
-) -> Option<(Partition, Eval, QuasiNewton)> {
-    let part = sys.partition(q);
-    diag.repartitions += 1;
-    let eval = sys.evaluate(q, &part)?;
-    let qn = QuasiNewton::new(part.independent.len(), method);
-    Some((part, eval, qn))
-}
-
-/// The diagonal of the bounding box of the body origins.
-fn extent(q: &DVector<f64>) -> f64 {
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for b in 0..q.len() / 7 {
-        for k in 0..3 {
-            lo[k] = lo[k].min(q[7 * b + k]);
-            hi[k] = hi[k].max(q[7 * b + k]);
-        }
-    }
-    (0..3)
-        .map(|k| (hi[k] - lo[k]).max(0.0).powi(2))
-        .sum::<f64>()
-        .sqrt()
-}
-
-/// Minimizes from `q`; with a `guard`, a step that would violate one of its inequalities is
-/// cut where the first one reaches its boundary, and the minimization stops there
-/// (`Outcome::blocked`).
-pub(crate) fn minimize(
-    sys: &mut System,
-    mut q: DVector<f64>,
-    mut part: Partition,
-    options: &Options,
-    guard: Option<&Guard>,
-    release: Option<&Release>,
-) -> Option<Outcome> {
-    let mut diag = Diagnostics {
-        load_steps: 1,
-        ..Diagnostics::default()
-    };
-    let mut eval = sys.evaluate(&q, &part)?;
-    diag.function_evaluations += 1;
-    let mut history = Vec::new();
-    let mut qn = QuasiNewton::new(part.independent.len(), options.method);
-    let mut just_repartitioned = false;
-    let mut termination = Termination::MaxIterations;
-    let mut iteration = 0;
-    let mut linear_steps = 0;
-    let mut descent = super::unbounded::LinearDescent::default();
-    let mut eigen = None;
-    let mut iterates = Vec::new();
-    let mut blocked = None;
-    let mut released = Vec::new();
-    // The step length the line search starts from: 1, or after a step the corrector could
-    // not follow in full, the fraction that it could, doubled after each full success.
-    let mut reach = 1.0f64;
-    let mut pivot_reference = eval.factors.pivot_ratio();
-    loop {
-        let f = eval.merit;
-        let gnorm = eval.grad_v.amax();
-        // The gradient cannot be resolved below the rounding of the energy's terms.
-        let gtol = options
-            .gradient_tolerance
-            .max(GRADIENT_FLOOR * eval.energy.magnitude);
-        diag.gradient_tolerance = gtol;
-        if history.last().map(|h: &Iterate| h.iteration) != Some(iteration) {
-            history.push(Iterate {
-                iteration,
-                potential_energy: eval.energy.total,
-                gradient_norm: gnorm,
-                ..Iterate::default()
-            });
-            if options.record_iterates {
-                iterates.push(q.clone());
-            }
-            if let Some(report) = &options.progress.0 {
-                report(iteration, eval.energy.total, gnorm);
-            }
-        }
-        // Active rows pulling hard leave before the round is stationary (`release`).
-        if gnorm > gtol {
-            if let Some(r) = release.and_then(|r| r.early(sys, &part, &eval)) {
-                released = r;
-                termination = Termination::Converged;
-                break;
-            }
-        }
-        let mut negative_curvature = None;
-        let dof = part.independent.len();
-        let dense_newton = options.method == Method::Newton
-            && (sys.backend == Backend::Dense || dof <= EXACT_NEWTON_DOF);
-        let eig =
-            (dof > 0 && (dense_newton || gnorm <= gtol)).then(|| spectrum(sys, &q, &part, &eval));
-        if gnorm <= gtol {
-            match &eig {
-                Some(e) if !options.allow_unstable => match e.lowest() {
-                    Some((imin, lmin)) if lmin < -e.tolerance() => {
-                        negative_curvature = Some(e.vectors.column(imin).into_owned());
-                    }
-                    _ => {
-                        eigen = Some(e.clone());
-                        termination = Termination::Converged;
-                        break;
-                    }
-                },
-                _ => {
-                    eigen = eig.clone();
-                    termination = Termination::Converged;
-                    break;
-                }
-            }
-        }
-        if iteration >= options.max_iterations {
-            break;
-        }
-        let g = &eval.grad_v;
-        let mut d = if let Some(nc) = negative_curvature {
-            diag.negative_curvature_steps += 1;
-            let s = if nc.dot(g) > 0.0 { -1.0 } else { 1.0 };
-            let scale = s * options.max_step / nc.amax().max(1e-300);
-            nc * scale
-        } else {
-            match (&eig, options.method) {
-                (Some(e), Method::Newton) if e.exact => {
-                    let floor = 1e-8 * e.values.amax().max(1e-12);
-                    let mut d = DVector::zeros(dof);
-                    for i in 0..dof {
-                        let v = e.vectors.column(i);
-                        d -= v * (v.dot(g) / e.values[i].abs().max(floor));
-                    }
-                    d
-                }
-                (_, Method::Newton) => super::kkt_direction::kkt_direction(sys, &q, &part, &eval),
-                _ => -(&qn.binv * g),
-            }
-        };
-        if d.dot(g) > 0.0 {
-            d = -g.clone();
-            qn = QuasiNewton::new(dof, options.method);
-        }
-        // Step limit on the motion of the whole mechanism, not on v alone: every body's Euler
-        // parameters change by at most `max_step` (about 2·max_step rad of rotation) and its
-        // origin by at most 10·max_step lengths `ℓ`, `ℓ` the larger of the characteristic
-        // length and the extent of the mechanism (the diagonal of the bounding box of the body
-        // origins): in a long chain, small joint rotations move the far links by about the
-        // chain's length, and a cap in link lengths would make the iteration count grow with N.
-        let mut dq = sys.tangent_step(&part, &eval, &d);
-        let l = sys.problem.model.length_scale.max(extent(&q));
-        let (mut rot, mut pos) = (0.0f64, 0.0f64);
-        for (i, x) in dq.iter().enumerate() {
-            if i % 7 < 3 {
-                pos = pos.max(x.abs() / l);
-            } else {
-                rot = rot.max(x.abs());
-            }
-        }
-        let factor =
-            (options.max_step / rot.max(1e-300)).min(10.0 * options.max_step / pos.max(1e-300));
-        let capped = factor < 1.0;
-        if capped {
-            d *= factor;
-            dq *= factor;
-        }
-        let slope = g.dot(&d);
-        let failures_before = diag.corrector_failures;
-        // Backtracking line search, from the step length the corrector last managed (with
-        // second-pass choices in the partition; from 1 otherwise).
-        let mut alpha = if part.second_pass.is_empty() {
-            1.0
-        } else {
-            reach
-        };
-        let mut accepted = None;
-        for _ in 0..40 {
-            let mut qt = &q + &dq * alpha;
-            if sys
-                .correct_from(
-                    &mut qt,
-                    &part,
-                    options.constraint_tolerance,
-                    options.max_corrector_iterations,
-                    Some(&eval.factors),
-                )
-                .is_err()
-            {
-                diag.corrector_failures += 1;
-                diag.step_halvings += 1;
-                alpha *= 0.5;
-                continue;
-            }
-            if let Some(guard) = guard.filter(|g| g.violated(sys, &qt)) {
-                // Cut the step where the first inequality reaches its boundary.
-                if let Some((qb, k)) =
-                    guard.boundary(sys, &q, &dq, alpha, Some(&qt), &part, options, &eval)
-                {
-                    if let Some(eb) = sys.evaluate(&qb, &part) {
-                        diag.function_evaluations += 1;
-                        if eb.merit <= f + roundoff_of(&eval, &eb) {
-                            accepted = Some((qb, eb, 0.0));
-                            blocked = Some(k);
-                            break;
-                        }
-                    }
-                }
-                diag.step_halvings += 1;
-                alpha *= 0.5;
-                continue;
-            }
-            let Some(et) = sys.evaluate(&qt, &part) else {
-                diag.step_halvings += 1;
-                alpha *= 0.5;
-                continue;
-            };
-            diag.function_evaluations += 1;
-            let ft = et.merit;
-            // Rounding error of V: relative to the size of its terms, not of their sum.
-            let roundoff =
-                1e-12 * eval.energy.magnitude.max(et.energy.magnitude) + f64::MIN_POSITIVE;
-            let armijo = ft <= f + 1e-4 * alpha * slope;
-            let flat = (ft - f).abs() <= roundoff && et.grad_v.amax() < 0.5 * gnorm;
-            if ft.is_finite() && (armijo || flat) {
-                accepted = Some((qt, et, alpha));
-                break;
-            }
-            // Quadratic interpolation of f along d, safeguarded.
-            let denom = 2.0 * (ft - f - slope * alpha);
-            let next = if denom > 0.0 {
-                -slope * alpha * alpha / denom
-            } else {
-                0.5 * alpha
-            };
-            alpha = next.clamp(0.1 * alpha, 0.5 * alpha);
-            diag.step_halvings += 1;
-        }
-        match accepted {
-            Some((qt, et, _)) if blocked.is_some() => {
-                q = qt;
-                sys.problem.cons.branches.follow(sys.problem.model, &q);
-                eval = et;
-                iteration += 1;
-                break;
-            }
-            Some((qt, et, alpha)) => {
-                reach = if diag.corrector_failures > failures_before {
-                    alpha
-                } else if alpha == reach {
-                    (2.0 * reach).min(1.0)
-                } else {
-                    reach
-                };
-                let s = &d * alpha;
-                let y = &et.grad_v - &eval.grad_v;
-                // Full capped steps that leave the gradient unchanged: the energy falls
-                // linearly along a direction of zero curvature.
-                if capped && alpha == 1.0 && y.amax() <= 1e-9 * gnorm {
-                    linear_steps += 1;
-                } else {
-                    linear_steps = 0;
-                }
-                quasi_newton_update(options.method, &mut qn.binv, &s, &y, qn.fresh);
-                qn.fresh = false;
-                let linear = descent.record(slope * alpha, &(&dq * alpha), l);
-                // A linear descent toward an inequality may end on it.
-                let may_be_stopped = guard.is_some_and(|g| g.approaching(sys, &q, &qt));
-                q = qt;
-                sys.problem.cons.branches.follow(sys.problem.model, &q);
-                eval = et;
-                iteration += 1;
-                just_repartitioned = false;
-                if (!may_be_stopped && (linear || linear_steps >= 5))
-                    || eval.energy.total < -1e15
-                    || (0..q.len())
-                        .any(|i| i % 7 < 3 && q[i].abs() > 1e6 * sys.problem.model.length_scale)
-                {
-                    termination = Termination::Unbounded;
-                    diag.free_directions =
-                        super::unbounded::free_directions(sys.problem.model, &q, &(&dq * alpha));
-                    break;
-                }
-                // Re-partition when Φ_u becomes ill-conditioned, or (a sparse partition with
-                // second-pass choices) when the partition at `q` makes other ones. (Not on
-                // any change: where a carried row ends in the final full pivoting among
-                // nearly equal levers would flip from step to step.)
-                let drifted = match (eval.factors.pivot_ratio(), pivot_reference) {
-                    (Some(now), Some(reference)) => now < PIVOT_DRIFT * reference,
-                    _ => false,
-                };
-                if eval.factors.ill_conditioned() {
-                    (part, eval, qn) = repartition(sys, &q, options.method, &mut diag)?;
-                    pivot_reference = eval.factors.pivot_ratio();
-                } else if drifted {
-                    // The dependent coordinates chosen at the start of this partition are
-                    // losing their hold: a fresh full pivoting at `q`, adopted if it differs.
-                    let fresh = sys.partition(&q);
-                    if !same_split(&fresh, &part) {
-                        diag.repartitions += 1;
-                        eval = sys.evaluate(&q, &fresh)?;
-                        part = fresh;
-                        qn = QuasiNewton::new(part.independent.len(), options.method);
-                    }
-                    pivot_reference = eval.factors.pivot_ratio();
-                } else if !part.second_pass.is_empty() {
-                    let fresh = sys.partition(&q);
-                    if fresh.second_pass != part.second_pass {
-                        diag.repartitions += 1;
-                        eval = sys.evaluate(&q, &fresh)?;
-                        part = fresh;
-                        qn = QuasiNewton::new(part.independent.len(), options.method);
-                    }
-                }
-            }
-            None if !just_repartitioned => {
-                (part, eval, qn) = repartition(sys, &q, options.method, &mut diag)?;
-                pivot_reference = eval.factors.pivot_ratio();
-                just_repartitioned = true;
-            }
-            None => {
-                termination = Termination::LineSearchFailed;
-                break;
-            }
-        }
-    }
-    // A step accepted just before leaving the loop (blocked, unbounded) is recorded here.
-    if history.last().map(|h: &Iterate| h.iteration) != Some(iteration) {
-        history.push(Iterate {
-            iteration,
-            potential_energy: eval.energy.total,
-            gradient_norm: eval.grad_v.amax(),
-            ..Iterate::default()
-        });
-        if options.record_iterates {
-            iterates.push(q.clone());
-        }
-    }
-    diag.gradient_norm = eval.grad_v.amax();
-    diag.constraint_residual = sys.residual(&q).amax();
-    Some(Outcome {
-        q,
-        part,
-        eigen,
-        iterates,
-        eval,
-        termination,
-        history,
-        diagnostics: diag,
-        blocked,
-        released,
-    })
-}
-
-/// Rounding error of the merit function between two evaluations: relative to the size of the
-/// energy's terms, not of their sum.
-fn roundoff_of(a: &Eval, b: &Eval) -> f64 {
-    1e-12 * a.energy.magnitude.max(b.energy.magnitude) + f64::MIN_POSITIVE
 }

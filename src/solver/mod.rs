@@ -26,15 +26,18 @@ pub(crate) mod finite;
 pub(crate) mod friction;
 mod inequality;
 mod kkt_direction;
+mod line_search;
 mod load_steps;
 mod minimize;
 mod mode_animation;
 mod options;
 pub(crate) mod partition;
+mod quasi_newton;
 mod reactions;
 mod report;
 pub(crate) mod sparse;
 mod stability;
+mod step_cap;
 pub(crate) mod system;
 mod unbounded;
 

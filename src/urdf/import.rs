@@ -361,7 +361,8 @@ pub(super) fn import(
         // does not move the joint in its links (`verify`, which has neither, then reads the
         // same mechanism).
         let mut own = b.model.partial().clone();
-        (own.locks, own.initial) = b.file_start.clone();
+        let (locks, initial) = b.file_start.clone();
+        (own.locks, own.initial) = (locks.into(), initial.into());
         let start = State::initial(&own);
         for &ji in &auto_child {
             let Some(j) = b.model.joint(ji) else { continue };

@@ -154,7 +154,7 @@ pub fn read_urdf_text(path: impl AsRef<Path>, options: &ImportOptions) -> Result
 /// </link><joint name="j" type="revolute"><parent link="base"/><child link="arm"/>
 ///   <axis xyz="0 0 1"/></joint></robot>"#;
 /// let loaded = restpose::urdf::load_str(urdf, "arm.urdf", &Default::default()).unwrap();
-/// assert_eq!(loaded.model.bodies.len(), 1);
+/// assert_eq!(loaded.model.bodies().len(), 1);
 /// ```
 pub fn load_str(text: &str, file: &str, options: &ImportOptions) -> Result<Loaded> {
     import::import(text, file, None, options)

@@ -11,13 +11,13 @@ use restpose::{Model, Options};
 /// The two models have the same bodies, joints and force elements; the importer's model also
 /// has the `world` link, which carries no body.
 fn assert_same_model(built: &Model, imported: &Model) {
-    assert_eq!(built.name, imported.name);
+    assert_eq!(built.name(), imported.name());
     assert_eq!(
-        format!("{:?}", built.bodies),
-        format!("{:?}", imported.bodies)
+        format!("{:?}", built.bodies()),
+        format!("{:?}", imported.bodies())
     );
-    assert_eq!(built.joints.len(), imported.joints.len());
-    for (a, b) in built.joints.iter().zip(&imported.joints) {
+    assert_eq!(built.joints().len(), imported.joints().len());
+    for (a, b) in built.joints().iter().zip(imported.joints()) {
         assert_eq!(
             (&a.name, a.kind, a.bodies, a.tree, a.merged, a.limits),
             (&b.name, b.kind, b.bodies, b.tree, b.merged, b.limits)
@@ -33,34 +33,34 @@ fn assert_same_model(built: &Model, imported: &Model) {
         }
     }
     assert_eq!(
-        format!("{:?}", built.joint_springs),
-        format!("{:?}", imported.joint_springs)
+        format!("{:?}", built.joint_springs()),
+        format!("{:?}", imported.joint_springs())
     );
     for (what, a, b) in [
         (
             "springs",
-            format!("{:?}", built.springs),
-            format!("{:?}", imported.springs),
+            format!("{:?}", built.springs()),
+            format!("{:?}", imported.springs()),
         ),
         (
             "locks",
-            format!("{:?}", built.locks),
-            format!("{:?}", imported.locks),
+            format!("{:?}", built.locks()),
+            format!("{:?}", imported.locks()),
         ),
         (
             "initial",
-            format!("{:?}", built.initial),
-            format!("{:?}", imported.initial),
+            format!("{:?}", built.initial()),
+            format!("{:?}", imported.initial()),
         ),
         (
             "gravity",
-            format!("{:?}", built.gravity),
-            format!("{:?}", imported.gravity),
+            format!("{:?}", built.gravity()),
+            format!("{:?}", imported.gravity()),
         ),
         (
             "length",
-            format!("{:?}", built.length_scale),
-            format!("{:?}", imported.length_scale),
+            format!("{:?}", built.length_scale()),
+            format!("{:?}", imported.length_scale()),
         ),
     ] {
         assert_eq!(a, b, "{what}");
@@ -72,7 +72,7 @@ fn assert_same_rest(built: &Model, imported: &Model) {
     let (sa, ra) = restpose::solve(built, &Options::default()).unwrap();
     let (sb, rb) = restpose::solve(imported, &Options::default()).unwrap();
     assert!(ra.converged() && rb.converged());
-    assert_eq!(ra.iterations, rb.iterations, "{}", built.name);
+    assert_eq!(ra.iterations, rb.iterations, "{}", built.name());
     assert_eq!(ra.independent_coordinates, rb.independent_coordinates);
     assert!((ra.energy.total - rb.energy.total).abs() < 1e-12 * (1.0 + rb.energy.total.abs()));
     for ((n, a), (_, b)) in sa.joint_values(built).iter().zip(sb.joint_values(imported)) {
@@ -145,9 +145,9 @@ fn built_four_bar_is_the_urdf_four_bar() {
     let built = builder.build().unwrap();
     let start = |name: &str| {
         built
-            .initial
+            .initial()
             .iter()
-            .find(|i| built.joint(i.joint).name == name)
+            .find(|i| built.get_joint(i.joint).unwrap().name == name)
             .unwrap()
             .value
     };

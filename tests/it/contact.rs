@@ -260,7 +260,7 @@ fn solo12_stands_like_the_independent_rigid_contact_solution() {
             );
         }
         let base = s.link_pose(&m, "base_link").unwrap();
-        let ground = m.grounds[0].origin.z;
+        let ground = m.grounds()[0].origin.z;
         assert_abs_diff_eq!(
             base.translation.vector.z - ground,
             rigid["base"]["height"].as_f64().unwrap(),
@@ -472,7 +472,7 @@ fn verify_accepts_solo12_standing_and_refuses_it_sunk() {
             assert!(!check(&m, &s, Friction::None).passed);
         }
         let mut sunk = s.clone();
-        for b in 0..m.bodies.len() {
+        for b in 0..m.bodies().len() {
             sunk.q[7 * b + 2] -= 2e-3;
         }
         let v = check(&m, &sunk, friction);
@@ -808,7 +808,7 @@ const BALL_ON_BOX: &str = r#"<robot name="ball_on_box" xmlns:mech="urn:urdf-mech
 #[test]
 fn a_ball_rests_on_a_fixed_box() {
     let m = model_from(BALL_ON_BOX);
-    assert_eq!(m.obstacles.len(), 1);
+    assert_eq!(m.obstacles().len(), 1);
     let (s, r) = solve(&m);
     let th = s.joint(&m, "pivot").unwrap()[0];
     assert_abs_diff_eq!(th, (0.2f64 / 0.5).asin(), epsilon = 1e-9);

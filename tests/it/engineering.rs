@@ -172,7 +172,7 @@ fn merged_fixed_links_report_their_poses() {
       <mech:joint_spring joint="shoulder" stiffness="50"/>
     </robot>"#;
     let m = model_from(text);
-    assert_eq!(m.bodies.len(), 1, "arm, tool and tip are one body");
+    assert_eq!(m.bodies().len(), 1, "arm, tool and tip are one body");
     let (s, r) = solve(&m);
     assert_eq!(r.dof, 1);
     let th = s.joint(&m, "shoulder").unwrap()[0];

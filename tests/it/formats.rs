@@ -67,7 +67,7 @@ fn q_vectors_follow_mujoco_and_pinocchio_orders_and_quaternions() {
     let names: Vec<Option<String>> = configuration(&model, &state, Convention::Mujoco)
         .unwrap()
         .into_iter()
-        .map(|e| e.joint.map(|j| model.joint(j).name.clone()))
+        .map(|e| e.joint.map(|j| model.get_joint(j).unwrap().name.clone()))
         .collect();
     assert_eq!(names[..7], vec![None; 7][..]);
     assert_eq!(
@@ -274,7 +274,7 @@ fn bullet_and_urdfdom_limit_conventions() {
         &Default::default(),
     )
     .unwrap();
-    assert_eq!(bullet.model.joints[0].limits, None);
+    assert_eq!(bullet.model.joints()[0].limits, None);
     assert_eq!(bullet.warnings.len(), 1);
     assert!(
         bullet.warnings[0].starts_with("b.urdf:3:1: joint `j`")
@@ -288,7 +288,7 @@ fn bullet_and_urdfdom_limit_conventions() {
         &Default::default(),
     )
     .unwrap();
-    assert_eq!(bare.model.joints[0].limits, Some([0.0, 0.0]));
+    assert_eq!(bare.model.joints()[0].limits, Some([0.0, 0.0]));
     assert!(
         bare.warnings[0].starts_with("u.urdf:3:1: joint `j`")
             && bare.warnings[0].contains("[0, 0]"),
@@ -302,7 +302,7 @@ fn bullet_and_urdfdom_limit_conventions() {
     )
     .unwrap();
     assert!(fine.warnings.is_empty());
-    assert_eq!(fine.model.joints[0].limits, Some([-1.0, 1.0]));
+    assert_eq!(fine.model.joints()[0].limits, Some([-1.0, 1.0]));
 }
 
 /// Joint names with `&`, `<` and `"` survive the URDF write-back: the written file reads back
@@ -312,7 +312,7 @@ fn write_back_escapes_joint_names() {
     let text = r#"<robot name="r"><link name="base"/><link name="arm"><inertial><origin xyz="1 0 0"/><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
 <joint name="a&amp;b&lt;&quot;c" type="continuous"><parent link="base"/><child link="arm"/><axis xyz="0 1 0"/></joint></robot>"#;
     let model = load_str(text, "e.urdf", &Default::default()).unwrap().model;
-    assert_eq!(model.joints[0].name, "a&b<\"c");
+    assert_eq!(model.joints()[0].name, "a&b<\"c");
     let values: HashMap<String, Vec<f64>> = [("a&b<\"c".to_string(), vec![0.7])].into();
     let state = State::from_joint_values(&model, &values);
     let out = restpose::urdf::with_initial_pose(text, "e.urdf", &model, &state).unwrap();

@@ -157,7 +157,7 @@ fn solo12_on_slopes_reports_required_mu_and_margin() {
         assert_eq!(b.support_polygon.len(), 4);
         // Gravity is in the x-z plane: the projection keeps y, and the polygon's edges are
         // the feet's x and y extremes in the projected plane.
-        let down = m.gravity.normalize();
+        let down = m.gravity().normalize();
         let e1 = nalgebra::Vector3::y().cross(&down).normalize();
         let flat = |p: [f64; 3]| {
             let p = nalgebra::Vector3::from(p);

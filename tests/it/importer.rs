@@ -161,7 +161,7 @@ fn ball_constraint_frames_and_auto_child_origin() {
     );
     let m = model_from(&ball);
     assert!(m
-        .joints
+        .joints()
         .iter()
         .any(|j| j.name == "ball_constraint_0" && !j.tree));
     let (s, r) = solve(&m);
@@ -177,7 +177,7 @@ fn loop_element_becomes_a_tree_edge_when_needed() {
       <mech:loop_joint name="hinge" type="revolute"><parent link="world"/><child link="p"/><axis xyz="0 1 0"/></mech:loop_joint>
       <mech:joint_spring joint="hinge" stiffness="5" reference="0.5"/></robot>"#;
     let m = model_from(text);
-    assert!(m.joint(m.joint_id("hinge").unwrap()).tree);
+    assert!(m.get_joint(m.joint_id("hinge").unwrap()).unwrap().tree);
     let (s, _) = solve(&m);
     let th = s.joint(&m, "hinge").unwrap()[0];
     // 5 (θ − 0.5) = −m g sin θ · 1 m (a rotation about +y moves the bob towards +x, up).
@@ -203,7 +203,7 @@ fn massless_fixed_chains_and_inertia_warning() {
     }
     text += "</robot>";
     let l = load_str(&text, "f.urdf", &ImportOptions::default()).unwrap();
-    assert_eq!(l.model.bodies.len(), 1);
+    assert_eq!(l.model.bodies().len(), 1);
     assert!(
         l.warnings
             .iter()
@@ -233,7 +233,7 @@ fn link_gravity_distance_and_point_on_line() {
       <mech:link_gravity link="b" enabled="false"/></robot>"#;
     let m = model_from(text);
     assert_eq!(
-        m.bodies
+        m.bodies()
             .iter()
             .find(|b| b.name == "b")
             .unwrap()
@@ -307,7 +307,7 @@ fn zero_axis_on_fixed_joint_is_ignored() {
         "{:?}",
         l.warnings
     );
-    assert_eq!(l.model.bodies.len(), 1, "mount is welded to the world");
+    assert_eq!(l.model.bodies().len(), 1, "mount is welded to the world");
     let (s, _) = solve(&l.model);
     assert_abs_diff_eq!(
         s.joint(&l.model, "hinge").unwrap()[0],
@@ -331,7 +331,7 @@ fn mimic_in_fixed_joint_is_ignored() {
         "<mimic joint=\"hinge\" multiplier=\"2\"/></joint>",
     );
     let l = load_str(&pendulum(&fixed, ""), "t.urdf", &ImportOptions::default()).unwrap();
-    assert!(l.model.mimics.is_empty());
+    assert!(l.model.mimics().is_empty());
     assert!(
         l.warnings.iter().any(|w| w.starts_with("t.urdf:5:")
             && w.contains("`weld` (fixed) has no scalar coordinate; <mimic> ignored")),
@@ -349,7 +349,7 @@ fn mimic_of_missing_joint_leaves_the_joint_independent() {
         "<axis xyz=\"0 1 0\"/>\n<mimic joint=\"ghost\"/></joint>",
     );
     let l = load_str(&text, "t.urdf", &ImportOptions::default()).unwrap();
-    assert!(l.model.mimics.is_empty());
+    assert!(l.model.mimics().is_empty());
     assert!(
         l.warnings
             .iter()
@@ -381,7 +381,7 @@ fn late_xml_declaration_is_accepted() {
         "{:?}",
         l.warnings
     );
-    assert_eq!(l.model.bodies.len(), 1);
+    assert_eq!(l.model.bodies().len(), 1);
     let bad = text.replace("<mass value=\"1\"/>", "<mass value=\"-1\"/>");
     let e = load_str(&bad, "t.urdf", &ImportOptions::default()).unwrap_err();
     assert!(e.to_string().starts_with("t.urdf:7:"), "{e}");
@@ -470,7 +470,7 @@ fn undeclared_foreign_prefix_is_declared() {
         "{:?}",
         l.warnings
     );
-    assert_eq!(l.model.bodies.len(), 1);
+    assert_eq!(l.model.bodies().len(), 1);
 }
 
 /// A continuous joint has no position limits (urdfdom and ROS ignore them): a `<limit>` with
@@ -483,7 +483,7 @@ fn continuous_joint_position_limits_are_ignored() {
     );
     let l = load_str(&text, "t.urdf", &ImportOptions::default()).unwrap();
     let j = l.model.joint_id("hinge").unwrap();
-    assert_eq!(l.model.joint(j).limits, None);
+    assert_eq!(l.model.get_joint(j).unwrap().limits, None);
     assert!(l
         .warnings
         .iter()

@@ -98,7 +98,7 @@ fn undeclared_prefix_is_repaired_with_a_warning() {
     let text = format!("<robot name=\"r\">\n<link name=\"world\"/><link name=\"a\"/>{J}<mech:gravity xyz=\"0 0 -1\"/></robot>");
     let l = load_str(&text, "t.urdf", &ImportOptions::default()).unwrap();
     assert!(l.warnings.iter().any(|w| w.contains("mech")));
-    assert_eq!(l.model.gravity.z, -1.0);
+    assert_eq!(l.model.gravity().z, -1.0);
 }
 
 #[test]
@@ -165,7 +165,8 @@ fn mech_prefix_bound_elsewhere_is_a_warning() {
         l.warnings
     );
     assert_eq!(
-        l.model.gravity.z, -9.81,
+        l.model.gravity().z,
+        -9.81,
         "the foreign mech:gravity is ignored"
     );
 }

@@ -105,7 +105,7 @@ fn inertia_from_mesh_geometry_in_every_format() {
         };
         let l = load_file(&file, &opts).unwrap();
         assert!(l.warnings.is_empty(), "{ext}: {:?}", l.warnings);
-        let b = &l.model.bodies[0];
+        let b = &l.model.bodies()[0];
         assert_abs_diff_eq!(b.mass, 8.0, epsilon = 1e-9);
         assert_abs_diff_eq!(b.com.x, 0.5, epsilon = 1e-9);
         assert_abs_diff_eq!(b.com.z, 0.0, epsilon = 1e-9);
@@ -125,7 +125,7 @@ fn inertia_from_mesh_geometry_in_every_format() {
         ..Default::default()
     };
     assert_abs_diff_eq!(
-        load_file(&file, &opts).unwrap().model.bodies[0].mass,
+        load_file(&file, &opts).unwrap().model.bodies()[0].mass,
         8.0,
         epsilon = 1e-9
     );
@@ -139,7 +139,7 @@ fn inertia_from_mesh_geometry_in_every_format() {
         ..Default::default()
     };
     assert_abs_diff_eq!(
-        load_file(&file, &opts).unwrap().model.bodies[0].mass,
+        load_file(&file, &opts).unwrap().model.bodies()[0].mass,
         8.0,
         epsilon = 1e-9
     );
@@ -153,7 +153,7 @@ fn missing_mesh_is_a_warning() {
     let file = dir.path().join("arm.urdf");
     std::fs::write(&file, arm("package://nowhere/cube.stl")).unwrap();
     let l = load_file(&file, &ImportOptions::default()).unwrap();
-    assert_eq!(l.model.bodies[0].mass, 0.0);
+    assert_eq!(l.model.bodies()[0].mass, 0.0);
     assert!(
         l.warnings.iter().any(|w| w.contains("arm.urdf:2:")
             && w.contains("mesh not found")
@@ -236,7 +236,7 @@ fn oversized_mesh_is_refused_without_reading_it() {
         ..Default::default()
     };
     let l = load_file(&file, &opts).unwrap();
-    assert_eq!(l.model.bodies[0].mass, 0.0);
+    assert_eq!(l.model.bodies()[0].mass, 0.0);
     assert!(
         l.warnings.iter().any(|w| w.contains("huge.stl")
             && w.contains(&format!("{len} bytes"))

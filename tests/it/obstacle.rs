@@ -133,7 +133,7 @@ fn a_box_rests_on_a_fixed_mesh_obstacle() {
     )
     .unwrap();
     let m = load_file(&urdf, &ImportOptions::default()).unwrap().model;
-    assert_eq!(m.obstacles.len(), 1);
+    assert_eq!(m.obstacles().len(), 1);
     let (s, r) = solve(&m);
     let mg = 2.0 * 9.81;
     assert_abs_diff_eq!(r.energy.total, mg * 0.85, epsilon = mg * 1e-9);

@@ -35,10 +35,10 @@ fn gazebo_transmission_file_loads_its_springs_and_meshes() {
     );
     let l = restpose::urdf::load_file(&path, &Default::default()).unwrap();
     assert!(l.warnings.is_empty(), "{:?}", l.warnings);
-    assert_eq!(l.model.joint_springs.len(), 3);
+    assert_eq!(l.model.joint_springs().len(), 3);
     let meshes = l
         .model
-        .links
+        .links()
         .iter()
         .flat_map(|k| k.visuals.iter().chain(&k.collisions))
         .filter(|g| {
@@ -83,11 +83,10 @@ fn panda_mimic_finger_follows() {
 fn ur5_spring_torques_equal_gravity_torques() {
     let m = robot("ur5_class");
     let (s, _) = solve(&m);
-    let mut no_springs = m.clone();
-    no_springs.joint_springs.clear();
+    let no_springs = m.without_joint_springs();
     let v = restpose::verify::verify(&no_springs, &s, &Default::default()).unwrap();
-    for js in &m.joint_springs {
-        let j = m.joint(js.joint);
+    for js in m.joint_springs() {
+        let j = m.get_joint(js.joint).unwrap();
         let theta = s.joint(&m, &j.name).unwrap()[0];
         let restpose::model::ForceLaw::Linear { stiffness, .. } = js.law else {
             continue;

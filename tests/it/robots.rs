@@ -160,7 +160,7 @@ fn solve_with_initial_options(
 }
 
 fn max_link_distance(m: &restpose::Model, a: &restpose::State, b: &restpose::State) -> f64 {
-    m.links
+    m.links()
         .iter()
         .map(|l| {
             let (pa, pb) = (

@@ -74,12 +74,12 @@ fn the_reference_comes_from_the_request_then_the_reference_pose_then_the_initial
         reference: r,
     };
     let from_pose = bar(vec![all(None)], vec![("pivot".into(), 0.25)]);
-    assert_eq!(from_pose.servos.len(), 1);
-    assert_eq!(from_pose.servos[0].reference, 0.25);
+    assert_eq!(from_pose.servos().len(), 1);
+    assert_eq!(from_pose.servos()[0].reference, 0.25);
     let own = bar(vec![all(Some(-0.5))], vec![("pivot".into(), 0.25)]);
-    assert_eq!(own.servos[0].reference, -0.5);
+    assert_eq!(own.servos()[0].reference, -0.5);
     let initial = bar(vec![all(None)], Vec::new());
-    assert_eq!(initial.servos[0].reference, 0.0);
+    assert_eq!(initial.servos()[0].reference, 0.0);
     // A later request on the same joint replaces the earlier one (and its spring).
     let twice = bar(
         vec![
@@ -92,9 +92,9 @@ fn the_reference_comes_from_the_request_then_the_reference_pose_then_the_initial
         ],
         Vec::new(),
     );
-    assert_eq!(twice.servos.len(), 1);
-    assert_eq!(twice.joint_springs.len(), 1);
-    assert_eq!(twice.servos[0].stiffness, 7.0);
+    assert_eq!(twice.servos().len(), 1);
+    assert_eq!(twice.joint_springs().len(), 1);
+    assert_eq!(twice.servos()[0].stiffness, 7.0);
 }
 
 #[test]

@@ -13,7 +13,7 @@ fn solve_with(model: &Model, la: LinearAlgebra) -> (restpose::State, restpose::R
     assert!(
         r.converged(),
         "{} ({la:?}): {:?}",
-        model.name,
+        model.name(),
         r.termination
     );
     (s, r)
@@ -41,21 +41,21 @@ fn sparse_and_dense_paths_agree_on_every_robot_and_generated_family() {
         assert!(
             (rs.energy.total - v).abs() <= 1e-9 * (1.0 + v.abs()),
             "{}: V dense {v} sparse {}",
-            m.name,
+            m.name(),
             rs.energy.total
         );
-        assert_eq!(rs.dof, rd.dof, "{}", m.name);
+        assert_eq!(rs.dof, rd.dof, "{}", m.name());
         assert_eq!(
             rs.redundant_constraints.len(),
             rd.redundant_constraints.len(),
             "{}",
-            m.name
+            m.name()
         );
         assert_eq!(
             rs.stability.as_ref().map(|s| &s.verdict),
             rd.stability.as_ref().map(|s| &s.verdict),
             "{}",
-            m.name
+            m.name()
         );
         let jd = sd.joint_values(m);
         let js = ss.joint_values(m);
@@ -64,7 +64,7 @@ fn sparse_and_dense_paths_agree_on_every_robot_and_generated_family() {
                 assert!(
                     (x - y).abs() < 1e-6,
                     "{}: {name} dense {x} sparse {y}",
-                    m.name
+                    m.name()
                 );
             }
         }

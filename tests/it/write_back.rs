@@ -39,7 +39,7 @@ fn written_urdf_starts_at_rest_and_keeps_the_rest_of_the_file() {
             "{name}: {} iterations from the written pose",
             r2.iterations
         );
-        for l in &m.links {
+        for l in m.links() {
             let (a, b) = (
                 rest.link_pose(&m, &l.name).unwrap(),
                 s2.link_pose(&m2, &l.name).unwrap(),
@@ -130,7 +130,7 @@ fn every_robot_round_trips_joint_states_through_verify() {
             .unwrap()
             .model;
         let values = restpose::verify::parse_pose(&text, "rest.yaml").unwrap();
-        for j in &m.joints {
+        for j in m.joints() {
             let n = restpose::export::json::coordinate_units(j.kind).len();
             if n > 0 {
                 assert_eq!(

@@ -29,8 +29,8 @@ fn options(args: &[(&str, &str)], packages: &[&str]) -> ImportOptions {
 fn assert_same_robot(expanded: &restpose::Model, reference: &restpose::Model, masses: bool) {
     let a = restpose::state::State::initial(expanded);
     let b = restpose::state::State::initial(reference);
-    assert_eq!(expanded.links.len(), reference.links.len());
-    for l in &reference.links {
+    assert_eq!(expanded.links().len(), reference.links().len());
+    for l in reference.links() {
         let pa = a
             .link_pose(expanded, &l.name)
             .unwrap_or_else(|| panic!("link `{}` missing from the expansion", l.name));
@@ -48,7 +48,7 @@ fn assert_same_robot(expanded: &restpose::Model, reference: &restpose::Model, ma
     // Same joints; limits to the 12 digits a published URDF is printed with.
     let sorted = |m: &restpose::Model| {
         let mut v: Vec<_> = m
-            .joints
+            .joints()
             .iter()
             .map(|j| (j.name.clone(), j.kind.name(), j.limits))
             .collect();
@@ -68,9 +68,9 @@ fn assert_same_robot(expanded: &restpose::Model, reference: &restpose::Model, ma
             (x, y) => assert_eq!(x, y, "joint `{}`", a.0),
         }
     }
-    for body in reference.bodies.iter().filter(|_| masses) {
+    for body in reference.bodies().iter().filter(|_| masses) {
         let other = expanded
-            .bodies
+            .bodies()
             .iter()
             .find(|b| b.name == body.name)
             .unwrap();
@@ -103,7 +103,7 @@ fn a1_xacro_expands_to_unitrees_published_urdf() {
     // The 12 leg joints, in the published file's limits.
     assert_eq!(
         x.model
-            .joints
+            .joints()
             .iter()
             .filter(|j| j.kind.name() == "revolute")
             .count(),

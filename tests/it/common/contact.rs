@@ -9,7 +9,7 @@ use restpose::State;
 /// Asserts that `verify` accepts `s` (with `friction`).
 pub(crate) fn assert_verified_contacts(m: &restpose::Model, s: &State, friction: Friction) {
     let v = check(m, s, friction);
-    assert!(v.passed, "{}: {v:?}", m.name);
+    assert!(v.passed, "{}: {v:?}", m.name());
 }
 
 pub(crate) fn check(m: &restpose::Model, s: &State, friction: Friction) -> Verification {
@@ -33,7 +33,7 @@ pub(crate) fn verify_with_options(
 ) -> restpose::Result<Verification> {
     let d = verify_using(m, s, tol, uni, LinearAlgebra::Dense)?;
     let sp = verify_using(m, s, tol, uni, LinearAlgebra::Sparse)?;
-    assert_paths_agree(&m.name, &d, &sp);
+    assert_paths_agree(m.name(), &d, &sp);
     Ok(d)
 }
 

@@ -29,7 +29,7 @@ pub(crate) fn solve(model: &Model) -> (State, Report) {
     assert!(
         r.converged(),
         "{} did not converge: {:?}",
-        model.name,
+        model.name(),
         r.termination
     );
     (s, r)
@@ -43,13 +43,13 @@ pub(crate) fn assert_verified_minimum(model: &Model, state: &State) {
     assert!(
         b.constraint_residual < 1e-10,
         "{}: ‖Φ‖∞ = {:e}",
-        model.name,
+        model.name(),
         b.constraint_residual
     );
     assert!(
         b.projected_gradient < 1e-6,
         "{}: projected gradient {:e}",
-        model.name,
+        model.name(),
         b.projected_gradient
     );
     let v0 = b.potential_energy;
@@ -78,7 +78,7 @@ pub(crate) fn assert_verified_minimum(model: &Model, state: &State) {
         assert!(
             v >= v0 - 1e-12 * (1.0 + v0.abs()),
             "{}: trial {trial}: a feasible perturbation of size {moved:e} lowers the energy from {v0} to {v}",
-            model.name
+            model.name()
         );
     }
 }

@@ -30,10 +30,10 @@ fn a_floating_base_with_no_ground_is_unbounded_before_any_iteration() {
         let dirs = &report.diagnostics.free_directions;
         assert_eq!(dirs.len(), 1, "{name}: {dirs:?}");
         // The pull: gravity on every body plus the dead loads.
-        let mass: f64 = model.bodies.iter().map(|b| b.gravity_mass).sum();
-        let pull = model.gravity * mass
+        let mass: f64 = model.bodies().iter().map(|b| b.gravity_mass).sum();
+        let pull = model.gravity() * mass
             + model
-                .loads
+                .loads()
                 .iter()
                 .map(|l| l.force)
                 .sum::<nalgebra::Vector3<f64>>();
@@ -105,7 +105,7 @@ fn max_iterations_bounds_every_round_and_load_step_together() {
                 ..Default::default()
             };
             let (_, full) = restpose::solve(model, &unlimited).unwrap();
-            assert!(full.converged(), "{}: {:?}", model.name, full.termination);
+            assert!(full.converged(), "{}: {:?}", model.name(), full.termination);
             for budget in [1, 2, full.iterations.saturating_sub(1)] {
                 let (_, r) = restpose::solve(
                     model,
@@ -118,14 +118,14 @@ fn max_iterations_bounds_every_round_and_load_step_together() {
                 assert!(
                     r.iterations <= budget,
                     "{}: {} iterations with max_iterations {budget}, {steps} load step(s)",
-                    model.name,
+                    model.name(),
                     r.iterations
                 );
                 if budget < full.iterations {
                     assert!(
                         !r.converged(),
                         "{}: budget {budget}, {steps} step(s)",
-                        model.name
+                        model.name()
                     );
                 }
             }
@@ -149,7 +149,7 @@ fn a_robot_on_a_frictionless_slope_slides_without_bound_and_is_told_at_once() {
     assert_eq!(report.iterations, 0);
     let dirs = &report.diagnostics.free_directions;
     assert_eq!(dirs.len(), 1, "{dirs:?}");
-    let mass: f64 = model.bodies.iter().map(|b| b.gravity_mass).sum();
+    let mass: f64 = model.bodies().iter().map(|b| b.gravity_mass).sum();
     let pull = mass * 9.81 * alpha.sin();
     assert!(
         dirs[0].contains("sliding along (1.000, 0.000, 0.000)")

@@ -48,7 +48,7 @@ fn with_no_base_pose_the_robot_starts_on_the_ground_and_settles() {
     let (state, report) = restpose::solve(&model, &Options::default()).unwrap();
     assert!(report.converged(), "{:?}", report.termination);
     assert_eq!(report.contacts.len(), 4);
-    let weight: f64 = model.bodies.iter().map(|b| b.gravity_mass).sum::<f64>() * 9.81;
+    let weight: f64 = model.bodies().iter().map(|b| b.gravity_mass).sum::<f64>() * 9.81;
     let total: f64 = report.contacts.iter().map(|c| c.normal_force).sum();
     assert!(
         (total - weight).abs() < 1e-8 * weight,

@@ -31,7 +31,7 @@ fn verify_on(m: &Model, s: &State, la: LinearAlgebra) -> restpose::verify::Verif
 /// The generalized force of joint `name`'s coordinate in `r.reactions`: the reaction torque
 /// on the child about the joint's axis (world), for a revolute joint.
 fn lock_effort(m: &Model, s: &State, r: &restpose::Report, name: &str) -> f64 {
-    let j = m.joint(m.joint_id(name).unwrap());
+    let j = m.get_joint(m.joint_id(name).unwrap()).unwrap();
     let child = j.bodies[1].unwrap().index();
     let q = &s.q;
     let p = nalgebra::Vector4::new(
@@ -65,24 +65,26 @@ fn verify_gives_analyzes_forces_on_a_floating_base() {
     let values: JointValues = rest.joint_values(&free).into_iter().collect();
     let mut names = Vec::new();
     for j in free
-        .joints
+        .joints()
         .iter()
         .filter(|j| j.tree && j.kind.scalar_coordinates() == 1)
     {
         let id = free.joint_id(&j.name).unwrap();
         let shift = if j.name.contains("HFE") { 0.3 } else { 0.0 };
-        locked.locks.push(Lock {
-            joint: id,
-            dof: 0,
-            value: Some(values[&j.name][0] + shift),
-        });
+        locked = locked
+            .with_lock(Lock {
+                joint: id,
+                dof: 0,
+                value: Some(values[&j.name][0] + shift),
+            })
+            .unwrap();
         names.push(j.name.clone());
     }
     assert_eq!(names.len(), 12);
     let (s, r) = restpose::solve_from(&locked, rest.clone(), &Options::default()).unwrap();
     assert!(r.converged(), "{:?}", r.termination);
     assert_eq!(r.contacts.len(), 4, "{:?}", r.contacts);
-    let weight: f64 = free.bodies.iter().map(|b| b.gravity_mass).sum::<f64>() * 9.81;
+    let weight: f64 = free.bodies().iter().map(|b| b.gravity_mass).sum::<f64>() * 9.81;
     let total: f64 = r.contacts.iter().map(|c| c.normal_force).sum();
     assert_abs_diff_eq!(total, weight, epsilon = 1e-6 * weight);
     let knee = lock_effort(&locked, &s, &r, "FL_HFE");

@@ -1,0 +1,134 @@
+//! The backtracking line search of the minimizer along a reduced step `d` (tangent step
+//! `δq = Z d`), the paper's step (d)–(f).
+//!
+//! A trial point starts from the first-order prediction `q + α δq` and is brought back onto
+//! `Φ = 0` by the Newton corrector (paper step (e.1)); if the corrector fails, the step is
+//! halved (step (f)). A corrected point is accepted when the Armijo condition
+//! `f(v̂ + α d) ≤ f + 10⁻⁴ α ∇fᵀ d` holds, or when `f` is flat to rounding and the gradient
+//! has halved; otherwise `α` shrinks by safeguarded quadratic interpolation (to between
+//! 0.1 and 0.5 of itself). Trial energies are compared through the Lagrangian `V − μᵀΦ`
+//! (`Eval::merit`), which removes the first-order effect of the corrector's remaining
+//! residual. With a guard, a trial point that violates an inactive inequality is replaced by
+//! the point where the first one reaches its boundary, accepted if it does not raise `f`
+//! beyond rounding.
+//!
+//! ## References
+//! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §3.1, §3.5.
+
+use super::inequality::active_set::Guard;
+use super::options::Options;
+use super::partition::Partition;
+use super::report::Diagnostics;
+use super::system::{Eval, System};
+use nalgebra::DVector;
+
+/// Trial step lengths before the search gives up.
+const MAX_TRIALS: usize = 40;
+
+/// The search line: the point `q`, its evaluation, the tangent step `δq` and the slope
+/// `∇fᵀ d` of the merit along it.
+pub(crate) struct Line<'a> {
+    pub(crate) q: &'a DVector<f64>,
+    pub(crate) part: &'a Partition,
+    pub(crate) eval: &'a Eval,
+    pub(crate) dq: &'a DVector<f64>,
+    pub(crate) slope: f64,
+}
+
+/// A point the line search accepted.
+pub(crate) struct Trial {
+    pub(crate) q: DVector<f64>,
+    pub(crate) eval: Eval,
+    /// The step length taken (0 for a step cut at an inequality's boundary).
+    pub(crate) alpha: f64,
+    /// The inactive inequalities (indices into the guard's list) whose boundary cut the step.
+    pub(crate) blocked: Option<Vec<usize>>,
+}
+
+/// Backtracks along `line` from the step length `alpha` (module docs); `None` when no step
+/// length was accepted within [`MAX_TRIALS`] trials.
+pub(crate) fn line_search(
+    sys: &mut System,
+    line: &Line,
+    mut alpha: f64,
+    guard: Option<&Guard>,
+    options: &Options,
+    diag: &mut Diagnostics,
+) -> Option<Trial> {
+    let (q, part, eval, dq, slope) = (line.q, line.part, line.eval, line.dq, line.slope);
+    let f = eval.merit;
+    let gnorm = eval.grad_v.amax();
+    for _ in 0..MAX_TRIALS {
+        let mut qt = q + dq * alpha;
+        if sys
+            .correct_from(
+                &mut qt,
+                part,
+                options.constraint_tolerance,
+                options.max_corrector_iterations,
+                Some(&eval.factors),
+            )
+            .is_err()
+        {
+            diag.corrector_failures += 1;
+            diag.step_halvings += 1;
+            alpha *= 0.5;
+            continue;
+        }
+        if let Some(guard) = guard.filter(|g| g.violated(sys, &qt)) {
+            // Cut the step where the first inequality reaches its boundary.
+            if let Some((qb, k)) = guard.boundary(sys, q, dq, alpha, Some(&qt), part, options, eval)
+            {
+                if let Some(eb) = sys.evaluate(&qb, part) {
+                    diag.function_evaluations += 1;
+                    if eb.merit <= f + roundoff_of(eval, &eb) {
+                        return Some(Trial {
+                            q: qb,
+                            eval: eb,
+                            alpha: 0.0,
+                            blocked: Some(k),
+                        });
+                    }
+                }
+            }
+            diag.step_halvings += 1;
+            alpha *= 0.5;
+            continue;
+        }
+        let Some(et) = sys.evaluate(&qt, part) else {
+            diag.step_halvings += 1;
+            alpha *= 0.5;
+            continue;
+        };
+        diag.function_evaluations += 1;
+        let ft = et.merit;
+        // Rounding error of V: relative to the size of its terms, not of their sum.
+        let roundoff = 1e-12 * eval.energy.magnitude.max(et.energy.magnitude) + f64::MIN_POSITIVE;
+        let armijo = ft <= f + 1e-4 * alpha * slope;
+        let flat = (ft - f).abs() <= roundoff && et.grad_v.amax() < 0.5 * gnorm;
+        if ft.is_finite() && (armijo || flat) {
+            return Some(Trial {
+                q: qt,
+                eval: et,
+                alpha,
+                blocked: None,
+            });
+        }
+        // Quadratic interpolation of f along d, safeguarded.
+        let denom = 2.0 * (ft - f - slope * alpha);
+        let next = if denom > 0.0 {
+            -slope * alpha * alpha / denom
+        } else {
+            0.5 * alpha
+        };
+        alpha = next.clamp(0.1 * alpha, 0.5 * alpha);
+        diag.step_halvings += 1;
+    }
+    None
+}
+
+/// Rounding error of the merit function between two evaluations: relative to the size of the
+/// energy's terms, not of their sum.
+fn roundoff_of(a: &Eval, b: &Eval) -> f64 {
+    1e-12 * a.energy.magnitude.max(b.energy.magnitude) + f64::MIN_POSITIVE
+}

@@ -10,7 +10,7 @@
 # same pinned versions). RESTPOSE: the binary (default: built here with cargo).
 # Exits 0 when every pose agrees with Pinocchio, 1 on a disagreement, 2 when PyPI is
 # unreachable and the venv does not exist yet (nothing could be checked). A warm run takes
-# about a minute.
+# about 30 s.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 

@@ -25,7 +25,7 @@ _Path = Union[str, PathLike[str]]
 _Vec3 = Union[Sequence[float], npt.ArrayLike]
 _Values = Mapping[str, Union[float, None, Sequence[Optional[float]]]]
 _Method = str  # "newton" | "bfgs" | "dfp"
-_LinearAlgebra = str  # "auto" | "dense" | "sparse"
+_LinearAlgebra = str  # "auto" | "dense" | "sparse" | "tree"
 
 def load(
     path: _Path,

@@ -212,7 +212,7 @@ impl Model {
     /// Solves for the stable rest pose; the GIL is released while the solver runs.
     ///
     /// Keyword arguments are the command line's solver options: ``method`` (``"newton"``,
-    /// ``"bfgs"``, ``"dfp"``), ``linear_algebra`` (``"auto"``, ``"dense"``, ``"sparse"``),
+    /// ``"bfgs"``, ``"dfp"``), ``linear_algebra`` (``"auto"``, ``"dense"``, ``"sparse"``, ``"tree"``),
     /// ``tolerance`` (scaled reduced gradient [J]), ``constraint_tolerance`` (‖Φ‖∞),
     /// ``max_iterations``, ``load_steps`` (0: automatic), ``allow_unstable``, ``limits``
     /// (``"enforce"``, ``"ignore"``), ``friction`` (``"none"``, ``"stick"``), ``mu``.

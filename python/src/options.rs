@@ -140,14 +140,15 @@ pub(crate) fn method(s: &str) -> PyResult<Method> {
     }
 }
 
-/// `"auto"`, `"dense"`, `"sparse"`.
+/// `"auto"`, `"dense"`, `"sparse"`, `"tree"`.
 pub(crate) fn linear_algebra(s: &str) -> PyResult<LinearAlgebra> {
     match s.to_ascii_lowercase().as_str() {
         "auto" => Ok(LinearAlgebra::Auto),
         "dense" => Ok(LinearAlgebra::Dense),
         "sparse" => Ok(LinearAlgebra::Sparse),
+        "tree" => Ok(LinearAlgebra::Tree),
         _ => Err(argument(format!(
-            "linear_algebra = {s:?}: expected \"auto\", \"dense\" or \"sparse\""
+            "linear_algebra = {s:?}: expected \"auto\", \"dense\", \"sparse\" or \"tree\""
         ))),
     }
 }

@@ -39,6 +39,7 @@ pub(crate) mod sparse;
 mod stability;
 mod step_cap;
 pub(crate) mod system;
+pub(crate) mod tree;
 mod unbounded;
 
 pub use mode_animation::mode_animation;

@@ -18,7 +18,8 @@ pub enum Method {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum LinearAlgebra {
-    /// Dense up to 40 bodies (280 coordinates), sparse above (default).
+    /// Dense up to 40 bodies (280 coordinates); above, tree without closed loops, sparse
+    /// with them (default).
     #[default]
     Auto,
     /// Dense matrices: full-pivoting partition, dense LU, exact reduced Hessian. `O(N³)`.
@@ -26,6 +27,10 @@ pub enum LinearAlgebra {
     /// Sparse partition, sparse LU (faer), Newton steps from the sparse KKT system. `O(N)` per
     /// iteration for chains, trees and ladders.
     Sparse,
+    /// The sparse partition, with `Φ_u` and the KKT system factored body by body along the
+    /// kinematic tree (fixed-size blocks, no fill; loops as a small dense border). The sparse
+    /// path where a partition does not fit a tree.
+    Tree,
 }
 
 /// Whether URDF joint limits hold the joints (part of a [`ContactPolicy`]).

@@ -201,7 +201,8 @@ pub struct Diagnostics {
     /// Final raw `‖Φ‖∞` \[m or rad\] (the tolerance applies to the dimensionless `‖D Φ‖∞`,
     /// module `system::residual`).
     pub constraint_residual: f64,
-    /// Linear algebra used: `"dense"` or `"sparse"` (see [`crate::solver::LinearAlgebra`]).
+    /// Linear algebra used: `"dense"`, `"sparse"` or `"tree"` (see
+    /// [`crate::solver::LinearAlgebra`]).
     pub linear_algebra: String,
     /// How the stability eigenvalues were found: `"exact"` (the reduced Hessian decomposed) or
     /// `"lanczos"` (its low end only, for many degrees of freedom); empty without any.

@@ -143,7 +143,7 @@ pub struct Verification {
 
 /// Whether `model` is verified on the sparse path (module `reduced`).
 fn sparse_path(model: &Model) -> bool {
-    Backend::choose(model, crate::solver::LinearAlgebra::Auto) == Backend::Sparse
+    Backend::choose(model, crate::solver::LinearAlgebra::Auto) != Backend::Dense
 }
 
 /// Potential energy of a state \[J\], `None` where a force table is out of its range.
@@ -277,7 +277,7 @@ pub fn verify_reporting(
     let sparse = match linear_algebra {
         crate::solver::LinearAlgebra::Auto => sparse_path(model),
         crate::solver::LinearAlgebra::Dense => false,
-        crate::solver::LinearAlgebra::Sparse => true,
+        crate::solver::LinearAlgebra::Sparse | crate::solver::LinearAlgebra::Tree => true,
     };
     run::verify_on(model, state, tol, uni, sparse, eigenvalues)
 }

@@ -197,7 +197,7 @@ fn library_strings_name_no_command_line_option() {
 /// The folders of the solver wing (issue 20): each is a signpost, its `mod.rs` a `//!` module
 /// doc naming what is inside, then only `mod` lines and re-exports (`use`), the code in the
 /// files it lists.
-const SOLVER_FOLDERS: &[&str] = &["inequality", "sparse", "stability", "system"];
+const SOLVER_FOLDERS: &[&str] = &["inequality", "sparse", "stability", "system", "tree"];
 
 /// The lines of `text` that are neither module docs, attributes, `mod` declarations nor `use`
 /// re-exports (a grouped `use` spanning lines counted as one).

@@ -219,7 +219,12 @@ fn linear_algebra_flag_selects_the_path() {
     assert_eq!(gen.status.code(), Some(0));
     std::fs::write(&urdf, &gen.stdout).unwrap();
     let mut energies = Vec::new();
-    for (flag, expected) in [("auto", "sparse"), ("dense", "dense"), ("sparse", "sparse")] {
+    for (flag, expected) in [
+        ("auto", "tree"),
+        ("dense", "dense"),
+        ("sparse", "sparse"),
+        ("tree", "tree"),
+    ] {
         let out = dir.path().join(format!("{flag}.json"));
         let st = restpose()
             .arg("analyze")

@@ -28,17 +28,29 @@ pub(crate) enum Backend {
     Dense,
     /// Sparse matrices (module `sparse`).
     Sparse,
+    /// The sparse partition with tree-structured factors (module `tree`; the sparse factors
+    /// where a partition does not fit a tree).
+    Tree,
 }
 
 impl Backend {
-    /// The backend `choice` asks for; automatic: by the size of `model`.
+    /// The backend `choice` asks for; automatic: by the size of `model`, and above
+    /// [`SPARSE_FROM_COORDINATES`] the tree factors for a mechanism without closed loops (its
+    /// partitions fit a tree: `O(N)` with fixed-size blocks, faster than the general sparse
+    /// factors on chains and ropes, BENCHMARKS.md), the sparse ones with loops (a ladder's
+    /// thousand loops would not fit a small border).
     pub(crate) fn choose(model: &Model, choice: LinearAlgebra) -> Self {
         match choice {
             LinearAlgebra::Auto if model.coordinate_count() > SPARSE_FROM_COORDINATES => {
-                Backend::Sparse
+                if model.joints.iter().all(|j| j.tree || j.merged) {
+                    Backend::Tree
+                } else {
+                    Backend::Sparse
+                }
             }
             LinearAlgebra::Auto | LinearAlgebra::Dense => Backend::Dense,
             LinearAlgebra::Sparse => Backend::Sparse,
+            LinearAlgebra::Tree => Backend::Tree,
         }
     }
 
@@ -47,11 +59,12 @@ impl Backend {
         Self::choose(model, options.linear_algebra)
     }
 
-    /// `"dense"` or `"sparse"` (as the report's diagnostics name it).
+    /// `"dense"`, `"sparse"` or `"tree"` (as the report's diagnostics name it).
     pub(crate) fn name(self) -> &'static str {
         match self {
             Backend::Dense => "dense",
             Backend::Sparse => "sparse",
+            Backend::Tree => "tree",
         }
     }
 
@@ -65,7 +78,7 @@ impl Backend {
     ) -> Partition {
         let scaling = &problem.scaling;
         match self {
-            Backend::Sparse => crate::solver::sparse::partition::partition(
+            Backend::Sparse | Backend::Tree => crate::solver::sparse::partition::partition(
                 problem.model,
                 problem.cons.len(),
                 coordinates,

@@ -1,11 +1,13 @@
 //! The factors of `Φ_u` and the values of `Φ_v` at one configuration: `Φ_u x = b`,
-//! `Φ_uᵀ x = b`, `Φ_v x` and `Φ_vᵀ y`, dense (nalgebra's LU with partial pivoting) or sparse
-//! (faer's sparse LU).
+//! `Φ_uᵀ x = b`, `Φ_v x` and `Φ_vᵀ y`, dense (nalgebra's LU with partial pivoting), sparse
+//! (faer's sparse LU) or block triangular along the tree (module `tree::phi_u`).
 
 use super::{Backend, System};
 use crate::solver::partition::Partition;
 use crate::solver::sparse::factor::{SparseFactors, Split};
+use crate::solver::tree::phi_u::{TreeLu, TreeSplit};
 use nalgebra::{DMatrix, DVector, LU};
+use std::sync::Arc;
 
 /// The factorization of `Φ_u` and the values of `Φ_v` at one configuration.
 #[derive(Clone)]
@@ -17,6 +19,8 @@ pub(crate) enum Factors {
     },
     /// faer's sparse LU.
     Sparse(SparseFactors),
+    /// Block triangular along the tree (shared with the pool that reuses its buffers).
+    Tree(Arc<TreeLu>),
 }
 
 impl Factors {
@@ -31,6 +35,10 @@ impl Factors {
                 }
             }
             Factors::Sparse(f) => {
+                let mut x = b.clone();
+                f.solve(x.as_mut_slice()).then_some(x)
+            }
+            Factors::Tree(f) => {
                 let mut x = b.clone();
                 f.solve(x.as_mut_slice()).then_some(x)
             }
@@ -50,6 +58,10 @@ impl Factors {
                 let mut x = b;
                 f.solve_transpose(x.as_mut_slice()).then_some(x)
             }
+            Factors::Tree(f) => {
+                let mut x = b;
+                f.solve_transpose(x.as_mut_slice()).then_some(x)
+            }
         }
     }
 
@@ -58,6 +70,7 @@ impl Factors {
         match self {
             Factors::Dense { phi_v, .. } => phi_v * x,
             Factors::Sparse(f) => DVector::from_vec(f.phi_v_mul(x.as_slice(), rows)),
+            Factors::Tree(f) => DVector::from_vec(f.phi_v_mul(x.as_slice(), rows)),
         }
     }
 
@@ -66,6 +79,7 @@ impl Factors {
         match self {
             Factors::Dense { phi_v, .. } => phi_v.transpose() * y,
             Factors::Sparse(f) => DVector::from_vec(f.phi_v_tr_mul(y.as_slice(), dof)),
+            Factors::Tree(f) => DVector::from_vec(f.phi_v_tr_mul(y.as_slice(), dof)),
         }
     }
 
@@ -78,7 +92,7 @@ impl Factors {
                 let d = lu.u().diagonal().abs();
                 Some(if d.is_empty() { 1.0 } else { d.min() / d.max() })
             }
-            Factors::Sparse(_) => None,
+            Factors::Sparse(_) | Factors::Tree(_) => None,
         }
     }
 
@@ -91,7 +105,7 @@ impl Factors {
                 let d = lu.u().diagonal().abs();
                 !d.is_empty() && d.min() < 1e-8 * d.max()
             }
-            Factors::Sparse(_) => false,
+            Factors::Sparse(_) | Factors::Tree(_) => false,
         }
     }
 }
@@ -113,7 +127,24 @@ impl System<'_> {
         let n = self.problem.model.coordinate_count();
         let m = self.problem.cons.len();
         let work = &mut self.work;
-        if self.backend == Backend::Sparse {
+        if self.backend == Backend::Tree {
+            let entries = &work.jac.entries;
+            if !work
+                .tree_split
+                .as_ref()
+                .is_some_and(|s| s.fits(part, entries.len()))
+                && work.tree_refused != Some((part.id, entries.len()))
+            {
+                work.tree_split = TreeSplit::new(part, m, n, entries);
+                if work.tree_split.is_none() {
+                    work.tree_refused = Some((part.id, entries.len()));
+                }
+            }
+            if let Some(split) = work.tree_split.as_mut() {
+                return Some(Factors::Tree(split.factor(entries)));
+            }
+        }
+        if self.backend != Backend::Dense {
             let entries = &work.jac.entries;
             if !work
                 .split

@@ -2,11 +2,14 @@
 //! rows, with `W` augmented by `Φ_qᵀ D R D Φ_q` (same solution, same inertia), factored by
 //! LDLᵀ with a shift `δ` or by LU as a fall-back (module `sparse::kkt`).
 
+use super::kkt_matrix::KktMatrix;
+use super::Backend;
 use super::{Eval, System};
 use crate::jet::HessianSink;
 use crate::model::BodyId;
 use crate::solver::partition::Partition;
 use crate::solver::sparse::kkt::{Factored, Kkt};
+use crate::solver::tree::kkt::TreeKkt;
 use nalgebra::DVector;
 
 impl System<'_> {
@@ -31,10 +34,27 @@ impl System<'_> {
             self.triplets(q);
             self.augment(part);
             let (m, n) = (self.problem.cons.len(), q.len());
-            if !self.work.kkt.as_ref().is_some_and(|k| {
-                k.fits(part, self.work.jac.entries.len(), self.work.hess.keys.len())
-            }) {
-                self.work.kkt = Kkt::new(part, m, n, &self.work.jac.entries, &self.work.hess);
+            let (triplets, blocks) = (self.work.jac.entries.len(), self.work.hess.keys.len());
+            if !self
+                .work
+                .kkt
+                .as_ref()
+                .is_some_and(|k| k.fits(part, triplets, blocks))
+            {
+                let (entries, hess) = (&self.work.jac.entries, &self.work.hess);
+                let tree = (self.backend == Backend::Tree
+                    && self.work.tree_kkt_refused != Some((part.id, triplets)))
+                .then(|| TreeKkt::new(part, m, n, entries, hess))
+                .flatten();
+                if tree.is_none() && self.backend == Backend::Tree {
+                    self.work.tree_kkt_refused = Some((part.id, triplets));
+                }
+                self.work.kkt = match tree {
+                    Some(t) => Some(KktMatrix::Tree(Box::new(t))),
+                    None => {
+                        Kkt::new(part, m, n, entries, hess).map(|k| KktMatrix::Sparse(Box::new(k)))
+                    }
+                };
             }
             let Some(kkt) = self.work.kkt.as_mut() else {
                 return Factored::None;
@@ -123,7 +143,18 @@ impl System<'_> {
                 pending = Some((bodies, crate::jet::LMat::zeros()));
             }
             if let Some((_, acc)) = pending.as_mut() {
-                *acc += g * g.transpose() * rho;
+                // `acc += g gᵀ ρ` in place, entry by entry in the same order of operations
+                // (no 14 × 14 temporaries), over the row's nonzero entries only.
+                for j in 0..g.len() {
+                    if g[j] == 0.0 {
+                        continue;
+                    }
+                    for i in 0..g.len() {
+                        if g[i] != 0.0 {
+                            acc[(i, j)] += g[i] * g[j] * rho;
+                        }
+                    }
+                }
             }
         }
         if let Some((b, acc)) = pending.take() {

@@ -21,6 +21,7 @@ mod base;
 mod corrector;
 mod factors;
 mod kkt;
+mod kkt_matrix;
 mod problem;
 mod reduced;
 pub(crate) mod residual;
@@ -31,6 +32,8 @@ mod workspace;
 pub(crate) use backend::Backend;
 pub(crate) use base::System;
 pub(crate) use factors::Factors;
+#[cfg(test)]
+pub(crate) use kkt_matrix::KktMatrix;
 pub(crate) use problem::{coordinate_scale, Problem, Scaling};
 pub(crate) use reduced::Eval;
 pub(crate) use workspace::Workspace;

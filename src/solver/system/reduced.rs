@@ -202,7 +202,7 @@ impl System<'_> {
         part: &Partition,
         eval: &Eval,
     ) -> DMatrix<f64> {
-        let hr = if self.backend == Backend::Sparse {
+        let hr = if self.backend != Backend::Dense {
             self.lagrangian_blocks(q, part, eval);
             let dof = part.independent.len();
             let mut hr = DMatrix::zeros(dof, dof);

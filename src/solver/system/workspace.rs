@@ -2,10 +2,11 @@
 //! they were taken at, the sparse split of `Φ_q` into `Φ_u` and `Φ_v`, the KKT system and the
 //! block-sparse Hessian of the Lagrangian `W = V_qq − Σ μ_k Φ_k,qq`.
 
+use super::kkt_matrix::KktMatrix;
 use crate::constraints::Triplets;
 use crate::solver::sparse::factor::Split;
 use crate::solver::sparse::hessian::BlockHessian;
-use crate::solver::sparse::kkt::Kkt;
+use crate::solver::tree::phi_u::TreeSplit;
 use nalgebra::DVector;
 
 /// Scratch buffers of a [`super::System`].
@@ -18,8 +19,14 @@ pub(crate) struct Workspace {
     pub(crate) jac_at: DVector<f64>,
     /// The symbolic split of `Φ_q` under the last partition (sparse path).
     pub(crate) split: Option<Split>,
-    /// The KKT system of the last assembly (sparse path).
-    pub(crate) kkt: Option<Kkt>,
+    /// The KKT system of the last assembly (sparse path; tree backend: tree-structured where
+    /// the partition fits).
+    pub(crate) kkt: Option<KktMatrix>,
+    /// The block-triangular split of `Φ_q` under the last partition (tree backend).
+    pub(crate) tree_split: Option<TreeSplit>,
+    /// The partition id and triplet count that did not fit a tree (tree backend: sparse).
+    pub(crate) tree_refused: Option<(usize, usize)>,
+    pub(crate) tree_kkt_refused: Option<(usize, usize)>,
     /// `W` in body blocks (sparse path).
     pub(crate) hess: BlockHessian,
 }
@@ -33,6 +40,9 @@ impl Workspace {
             jac_at: DVector::zeros(0),
             split: None,
             kkt: None,
+            tree_split: None,
+            tree_refused: None,
+            tree_kkt_refused: None,
             hess: BlockHessian::default(),
         }
     }

@@ -1,0 +1,355 @@
+//! Small dense kernels on row-major blocks (`a[i · d + j]`, `d ≤ 14` on the tree, any `d` for
+//! a border): symmetric `A = L D Lᵀ` without pivoting (its negative pivots count the negative
+//! eigenvalues: Sylvester's law of inertia) and `P A = L U` with partial pivoting, in place,
+//! with their solves. No allocation.
+
+/// `A = L D Lᵀ` in place (`L` unit lower below the diagonal, `D` on it) of the symmetric `d × d`
+/// block `a` (both triangles given; the upper one is left as it was); the number of negative
+/// pivots, or `None` on a zero or non-finite pivot.
+pub(crate) fn ldlt(a: &mut [f64], d: usize) -> Option<usize> {
+    match d {
+        13 => ldlt_with(a, 13, &mut [0.0; 13]),
+        14 => ldlt_with(a, 14, &mut [0.0; 14]),
+        8 => ldlt_with(a, 8, &mut [0.0; 8]),
+        _ => ldlt_any(a, d),
+    }
+}
+
+fn ldlt_any(a: &mut [f64], d: usize) -> Option<usize> {
+    if d <= 64 {
+        ldlt_with(a, d, &mut [0.0; 64])
+    } else {
+        ldlt_with(a, d, &mut vec![0.0; d])
+    }
+}
+
+/// [`ldlt`] with the scratch `v` (at least `d` long).
+#[inline(always)]
+fn ldlt_with(a: &mut [f64], d: usize, v: &mut [f64]) -> Option<usize> {
+    let (a, v) = (&mut a[..d * d], &mut v[..d]);
+    let mut negative = 0;
+    for j in 0..d {
+        for k in 0..j {
+            v[k] = a[j * d + k] * a[k * d + k];
+        }
+        let mut djj = a[j * d + j];
+        for k in 0..j {
+            djj -= a[j * d + k] * v[k];
+        }
+        if !djj.is_finite() || djj == 0.0 {
+            return None;
+        }
+        a[j * d + j] = djj;
+        negative += usize::from(djj < 0.0);
+        for i in j + 1..d {
+            let mut s = a[i * d + j];
+            for k in 0..j {
+                s -= a[i * d + k] * v[k];
+            }
+            a[i * d + j] = s / djj;
+        }
+    }
+    Some(negative)
+}
+
+/// `x ← A⁻¹ x` for the factors of [`ldlt`]; `x` is `d × w` row-major (`w` right sides).
+pub(crate) fn ldlt_solve(f: &[f64], d: usize, x: &mut [f64], w: usize) {
+    // Constant sizes of a chain's blocks, so that the loops are unrolled.
+    match (d, w) {
+        (13, 1) => ldlt_solve_impl(f, 13, x, 1),
+        (13, 7) => ldlt_solve_impl(f, 13, x, 7),
+        (14, 1) => ldlt_solve_impl(f, 14, x, 1),
+        (14, 7) => ldlt_solve_impl(f, 14, x, 7),
+        (8, 1) => ldlt_solve_impl(f, 8, x, 1),
+        (8, 7) => ldlt_solve_impl(f, 8, x, 7),
+        _ => ldlt_solve_impl(f, d, x, w),
+    }
+}
+
+#[inline(always)]
+fn ldlt_solve_impl(f: &[f64], d: usize, x: &mut [f64], w: usize) {
+    let (f, x) = (&f[..d * d], &mut x[..d * w]);
+    for i in 0..d {
+        for k in 0..i {
+            let l = f[i * d + k];
+            if l != 0.0 {
+                for c in 0..w {
+                    x[i * w + c] -= l * x[k * w + c];
+                }
+            }
+        }
+    }
+    for i in 0..d {
+        let p = 1.0 / f[i * d + i];
+        for c in 0..w {
+            x[i * w + c] *= p;
+        }
+    }
+    for i in (0..d).rev() {
+        for k in i + 1..d {
+            let l = f[k * d + i];
+            if l != 0.0 {
+                for c in 0..w {
+                    x[i * w + c] -= l * x[k * w + c];
+                }
+            }
+        }
+    }
+}
+
+/// `P A = L U` in place with partial pivoting (`piv[k]`: the row swapped into `k`); `false` on
+/// a zero or non-finite pivot.
+pub(crate) fn lu(a: &mut [f64], d: usize, piv: &mut [u16]) -> bool {
+    match d {
+        6 => lu_impl(a, 6, piv),
+        7 => lu_impl(a, 7, piv),
+        13 => lu_impl(a, 13, piv),
+        _ => lu_impl(a, d, piv),
+    }
+}
+
+#[inline(always)]
+fn lu_impl(a: &mut [f64], d: usize, piv: &mut [u16]) -> bool {
+    let (a, piv) = (&mut a[..d * d], &mut piv[..d]);
+    for k in 0..d {
+        let mut p = k;
+        let mut best = a[k * d + k].abs();
+        for i in k + 1..d {
+            let v = a[i * d + k].abs();
+            if v > best {
+                best = v;
+                p = i;
+            }
+        }
+        piv[k] = p as u16;
+        if !best.is_finite() || best == 0.0 {
+            return false;
+        }
+        if p != k {
+            for c in 0..d {
+                a.swap(k * d + c, p * d + c);
+            }
+        }
+        let inv = 1.0 / a[k * d + k];
+        for i in k + 1..d {
+            let l = a[i * d + k] * inv;
+            a[i * d + k] = l;
+            if l != 0.0 {
+                for c in k + 1..d {
+                    a[i * d + c] -= l * a[k * d + c];
+                }
+            }
+        }
+    }
+    true
+}
+
+/// `x ← A⁻¹ x` for the factors of [`lu`]; `x` is `d × w` row-major.
+pub(crate) fn lu_solve(f: &[f64], piv: &[u16], d: usize, x: &mut [f64], w: usize) {
+    match (d, w) {
+        (6, 1) => lu_solve_impl(f, piv, 6, x, 1),
+        (7, 1) => lu_solve_impl(f, piv, 7, x, 1),
+        (13, 1) => lu_solve_impl(f, piv, 13, x, 1),
+        (13, 7) => lu_solve_impl(f, piv, 13, x, 7),
+        _ => lu_solve_impl(f, piv, d, x, w),
+    }
+}
+
+#[inline(always)]
+fn lu_solve_impl(f: &[f64], piv: &[u16], d: usize, x: &mut [f64], w: usize) {
+    let (f, piv, x) = (&f[..d * d], &piv[..d], &mut x[..d * w]);
+    for k in 0..d {
+        let p = piv[k] as usize;
+        if p != k {
+            for c in 0..w {
+                x.swap(k * w + c, p * w + c);
+            }
+        }
+    }
+    for i in 0..d {
+        for k in 0..i {
+            let l = f[i * d + k];
+            if l != 0.0 {
+                for c in 0..w {
+                    x[i * w + c] -= l * x[k * w + c];
+                }
+            }
+        }
+    }
+    for i in (0..d).rev() {
+        for k in i + 1..d {
+            let u = f[i * d + k];
+            if u != 0.0 {
+                for c in 0..w {
+                    x[i * w + c] -= u * x[k * w + c];
+                }
+            }
+        }
+        let p = 1.0 / f[i * d + i];
+        for c in 0..w {
+            x[i * w + c] *= p;
+        }
+    }
+}
+
+/// `x ← A⁻ᵀ x` for the factors of [`lu`] (one right side): `Uᵀ y = x`, `Lᵀ z = y`, `x = Pᵀ z`.
+pub(crate) fn lu_solve_transpose(f: &[f64], piv: &[u16], d: usize, x: &mut [f64]) {
+    match d {
+        6 => lu_solve_transpose_impl(f, piv, 6, x),
+        7 => lu_solve_transpose_impl(f, piv, 7, x),
+        _ => lu_solve_transpose_impl(f, piv, d, x),
+    }
+}
+
+#[inline(always)]
+fn lu_solve_transpose_impl(f: &[f64], piv: &[u16], d: usize, x: &mut [f64]) {
+    let (f, piv, x) = (&f[..d * d], &piv[..d], &mut x[..d]);
+    for i in 0..d {
+        let mut s = x[i];
+        for k in 0..i {
+            s -= f[k * d + i] * x[k];
+        }
+        x[i] = s / f[i * d + i];
+    }
+    for i in (0..d).rev() {
+        let mut s = x[i];
+        for k in i + 1..d {
+            s -= f[k * d + i] * x[k];
+        }
+        x[i] = s;
+    }
+    for k in (0..d).rev() {
+        let p = piv[k] as usize;
+        if p != k {
+            x.swap(k, p);
+        }
+    }
+}
+
+/// `out −= Cᵀ y` for a `d × w` row-major `C`.
+pub(crate) fn sub_tr_mul(c: &[f64], y: &[f64], out: &mut [f64], d: usize, w: usize) {
+    match (d, w) {
+        (13, 7) => sub_tr_mul_impl(c, y, out, 13, 7),
+        (14, 7) => sub_tr_mul_impl(c, y, out, 14, 7),
+        _ => sub_tr_mul_impl(c, y, out, d, w),
+    }
+}
+
+#[inline(always)]
+fn sub_tr_mul_impl(c: &[f64], y: &[f64], out: &mut [f64], d: usize, w: usize) {
+    let (c, y, out) = (&c[..d * w], &y[..d], &mut out[..w]);
+    for k in 0..d {
+        let yk = y[k];
+        for b in 0..w {
+            out[b] -= c[k * w + b] * yk;
+        }
+    }
+}
+
+/// `x −= X y` for a `d × w` row-major `X`.
+pub(crate) fn sub_mul(xm: &[f64], y: &[f64], x: &mut [f64], d: usize, w: usize) {
+    match (d, w) {
+        (13, 7) => sub_mul_impl(xm, y, x, 13, 7),
+        (14, 7) => sub_mul_impl(xm, y, x, 14, 7),
+        (13, 13) => sub_mul_impl(xm, y, x, 13, 13),
+        _ => sub_mul_impl(xm, y, x, d, w),
+    }
+}
+
+#[inline(always)]
+fn sub_mul_impl(xm: &[f64], y: &[f64], x: &mut [f64], d: usize, w: usize) {
+    let (xm, y, x) = (&xm[..d * w], &y[..w], &mut x[..d]);
+    for a in 0..d {
+        let mut sum = 0.0;
+        for b in 0..w {
+            sum += xm[a * w + b] * y[b];
+        }
+        x[a] -= sum;
+    }
+}
+
+/// `p −= Cᵀ X` into the leading `w × w` block of the `dp × dp` row-major `p`, for `d × w`
+/// row-major `C` and `X` (the Schur update of a parent's block).
+pub(crate) fn sub_tr_mul_block(c: &[f64], x: &[f64], p: &mut [f64], d: usize, w: usize, dp: usize) {
+    match (d, w, dp) {
+        (13, 7, 13) => sub_tr_mul_block_impl(c, x, p, 13, 7, 13),
+        (14, 7, 14) => sub_tr_mul_block_impl(c, x, p, 14, 7, 14),
+        _ => sub_tr_mul_block_impl(c, x, p, d, w, dp),
+    }
+}
+
+#[inline(always)]
+fn sub_tr_mul_block_impl(c: &[f64], x: &[f64], p: &mut [f64], d: usize, w: usize, dp: usize) {
+    let (c, x, p) = (&c[..d * w], &x[..d * w], &mut p[..dp * dp]);
+    for k in 0..d {
+        for a in 0..w {
+            let cka = c[k * w + a];
+            if cka != 0.0 {
+                for b in 0..w {
+                    p[a * dp + b] -= cka * x[k * w + b];
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{DMatrix, DVector};
+
+    fn sample(d: usize, seed: u64) -> DMatrix<f64> {
+        let mut s = seed;
+        let mut r = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+        };
+        DMatrix::from_fn(d, d, |_, _| r())
+    }
+
+    fn row_major(m: &DMatrix<f64>) -> Vec<f64> {
+        m.transpose().as_slice().to_vec()
+    }
+
+    #[test]
+    fn ldlt_solves_and_counts_negative_eigenvalues() {
+        for d in [1, 6, 13, 70] {
+            let b = sample(d, d as u64);
+            let a = &b + b.transpose();
+            let mut f = row_major(&a);
+            let negative = ldlt(&mut f, d).expect("nonsingular");
+            let eig = a.clone().symmetric_eigenvalues();
+            assert_eq!(negative, eig.iter().filter(|&&x| x < 0.0).count());
+            let x0 = DVector::from_fn(d, |i, _| (i as f64 + 1.0).sin());
+            let mut x = (&a * &x0).as_slice().to_vec();
+            ldlt_solve(&f, d, &mut x, 1);
+            for i in 0..d {
+                assert!((x[i] - x0[i]).abs() < 1e-8, "d {d}: {} vs {}", x[i], x0[i]);
+            }
+        }
+    }
+
+    #[test]
+    fn lu_solves_both_ways() {
+        for d in [1, 6, 13, 20] {
+            let a = sample(d, 7 + d as u64);
+            let mut f = row_major(&a);
+            let mut piv = vec![0u16; d];
+            assert!(lu(&mut f, d, &mut piv));
+            let x0 = DVector::from_fn(d, |i, _| (i as f64 + 2.0).cos());
+            // Two right sides at once: x0 and 2 x0.
+            let ax = &a * &x0;
+            let mut x: Vec<f64> = (0..d).flat_map(|i| [ax[i], 2.0 * ax[i]]).collect();
+            lu_solve(&f, &piv, d, &mut x, 2);
+            let mut t = (a.transpose() * &x0).as_slice().to_vec();
+            lu_solve_transpose(&f, &piv, d, &mut t);
+            for i in 0..d {
+                assert!((x[2 * i] - x0[i]).abs() < 1e-9);
+                assert!((x[2 * i + 1] - 2.0 * x0[i]).abs() < 1e-9);
+                assert!((t[i] - x0[i]).abs() < 1e-9);
+            }
+        }
+    }
+}

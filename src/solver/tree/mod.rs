@@ -1,0 +1,22 @@
+//! Tree-structured factorizations (`--linear-algebra tree`): the KKT matrix of a Newton step
+//! and `Φ_u` factored body by body along the kinematic tree, leaves first, with fixed-size
+//! dense blocks and no fill, in `O(N)` for `N` bodies; the few unknowns that do not fit the
+//! tree (loop rows, bodies a loop couples) form a border eliminated last through its dense
+//! Schur complement.
+//!
+//! - `dense`: the block kernels (LDLᵀ without pivoting, LU with partial pivoting);
+//! - `phi_u`: `Φ_u` as a block upper triangular matrix (corrector, multipliers, tangent steps);
+//! - `shape`: the KKT matrix's nodes, parents, border and value slots, once per partition;
+//! - `kkt`: its block LDLᵀ (block LU as the fallback), solves and refinement;
+//! - `border`: the dense Schur complement of the border.
+//!
+//! The sparse path (module `sparse`) stays the reference and the fallback: where a partition's
+//! structure does not fit (a border above its limit), the system uses it instead.
+
+mod border;
+pub(crate) mod dense;
+pub(crate) mod kkt;
+pub(crate) mod phi_u;
+mod shape;
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,365 @@
+//! `Φ_u` of a tree as a block-triangular matrix, factored block by block.
+//!
+//! The partition pivots row `rows[k]` at column `dependent[k]`; a **node** is a maximal run of
+//! consecutive pivots on one body's columns. With `Φ_u` indexed by pivot position on both
+//! sides, node `i` holds the square diagonal block `A_ii` (its rows × its columns). On a tree
+//! each node's rows reach only its own body and its parent (a joint, a stop) or nothing else (a
+//! normalization, a contact): bodies are eliminated leaves first, so every entry lies in a node
+//! at or after the row's own, and `Φ_u` is block upper triangular:
+//!
+//! ```text
+//! Φ_u x = r:   x_i = A_ii⁻¹ (r_i − Σ_{j>i} A_ij x_j)        (last node first)
+//! Φ_uᵀ μ = g:  μ_i = A_ii⁻ᵀ (g_i − Σ_{j<i} A_jiᵀ μ_j)       (first node first)
+//! ```
+//!
+//! with one LU with partial pivoting per diagonal block (`≤ 7 × 7`) and no fill. Nodes with an
+//! entry before their own (the rows closing a loop, pivoted last) form a **border** `B`; with
+//! `T` the rest, `Φ_u = [T C; R D]` is solved through the dense Schur complement
+//! `S = D − R T⁻¹ C` (module `border`).
+
+use super::border::Border;
+use super::dense;
+use crate::solver::partition::Partition;
+use std::sync::Arc;
+
+/// Borders larger than this (pivot positions) are not factored here (the general sparse LU
+/// is used instead).
+pub(crate) const MAX_BORDER: usize = 64;
+
+/// The block structure of `Φ_u` under one partition (built once per partition).
+pub(crate) struct Shape {
+    /// Number of pivots (the order of `Φ_u`).
+    order: usize,
+    /// Node `i` covers the pivot positions `span[i].0 .. span[i].1` (tree nodes only).
+    span: Vec<(usize, usize)>,
+    /// Offset of node `i`'s diagonal block in the flat diagonal values.
+    diag_at: Vec<usize>,
+    /// Off-diagonal entries of `T` `(row position, column position)`, grouped by row node:
+    /// node `i`'s are `off[off_at[i] .. off_at[i + 1]]`.
+    off: Vec<(u32, u32)>,
+    off_at: Vec<usize>,
+    border: Border,
+}
+
+/// Where a Jacobian triplet goes.
+#[derive(Clone, Copy)]
+enum Slot {
+    None,
+    Diag(u32),
+    Off(u32),
+    Border(u32),
+    PhiV(u32),
+}
+
+/// The split of the Jacobian's triplets under one partition into the blocks of `Φ_u` and the
+/// entries of `Φ_v`, and a pool of factor buffers (reused once no evaluation holds them).
+pub(crate) struct TreeSplit {
+    id: usize,
+    triplets: usize,
+    shape: Arc<Shape>,
+    slots: Vec<Slot>,
+    /// `(row position, independent position)` of the `Φ_v` entries.
+    v_at: Vec<(usize, usize)>,
+    pool: Vec<Arc<TreeLu>>,
+}
+
+/// The factors of `Φ_u` and the values of `Φ_v` at one configuration.
+pub(crate) struct TreeLu {
+    shape: Arc<Shape>,
+    diag: Vec<f64>,
+    piv: Vec<u16>,
+    off: Vec<f64>,
+    border: Vec<f64>,
+    border_piv: Vec<u16>,
+    phi_v: Vec<(usize, usize, f64)>,
+    ok: bool,
+}
+
+impl TreeSplit {
+    /// The structure of `Φ_u` under `part` for the triplets `entries` of an `m × n` Jacobian;
+    /// `None` if it is not block triangular up to a border of at most [`MAX_BORDER`] pivots.
+    pub(crate) fn new(
+        part: &Partition,
+        m: usize,
+        n: usize,
+        entries: &[(usize, usize, f64)],
+    ) -> Option<Self> {
+        let order = part.rows.len();
+        let mut row_pos = vec![u32::MAX; m];
+        for (k, &r) in part.rows.iter().enumerate() {
+            row_pos[r] = k as u32;
+        }
+        let mut col_pos = vec![u32::MAX; n];
+        for (k, &c) in part.dependent.iter().enumerate() {
+            col_pos[c] = k as u32;
+        }
+        let mut ind_pos = vec![u32::MAX; n];
+        for (k, &c) in part.independent.iter().enumerate() {
+            ind_pos[c] = k as u32;
+        }
+        // Runs of pivots on one body.
+        let mut run_of = vec![0u32; order];
+        let mut runs = 0u32;
+        for k in 0..order {
+            if k > 0 && part.dependent[k] / 7 != part.dependent[k - 1] / 7 {
+                runs += 1;
+            }
+            run_of[k] = runs;
+        }
+        let runs = if order == 0 { 0 } else { runs as usize + 1 };
+        // A run with an entry in an earlier run's column goes to the border.
+        let mut bordered = vec![false; runs];
+        for e in entries {
+            let (p, q) = (row_pos[e.0], col_pos[e.1]);
+            if p != u32::MAX && q != u32::MAX && run_of[q as usize] < run_of[p as usize] {
+                bordered[run_of[p as usize] as usize] = true;
+            }
+        }
+        let border_positions: Vec<usize> = (0..order)
+            .filter(|&k| bordered[run_of[k] as usize])
+            .collect();
+        if border_positions.len() > MAX_BORDER {
+            return None;
+        }
+        // Tree nodes: the runs not in the border (a run's positions are consecutive).
+        let mut node_of = vec![u32::MAX; order];
+        let mut span: Vec<(usize, usize)> = Vec::new();
+        let mut last_run = u32::MAX;
+        for k in 0..order {
+            if bordered[run_of[k] as usize] {
+                continue;
+            }
+            if run_of[k] != last_run {
+                span.push((k, k));
+                last_run = run_of[k];
+            }
+            if let Some(s) = span.last_mut() {
+                s.1 = k + 1;
+            }
+            node_of[k] = (span.len() - 1) as u32;
+        }
+        let nodes = span.len();
+        let mut diag_at = vec![0usize];
+        for i in 0..nodes {
+            let d = span[i].1 - span[i].0;
+            diag_at.push(diag_at[i] + d * d);
+        }
+        // Off-diagonal entries of T, grouped by row node (counting sort).
+        let mut count = vec![0usize; nodes + 1];
+        let mut border = Border::new(&border_positions, order);
+        let mut slots = vec![Slot::None; entries.len()];
+        let mut v_at = Vec::new();
+        let mut pending = Vec::new();
+        for (t, e) in entries.iter().enumerate() {
+            let p = row_pos[e.0];
+            if p == u32::MAX {
+                continue;
+            }
+            let q = col_pos[e.1];
+            if q == u32::MAX {
+                if ind_pos[e.1] != u32::MAX {
+                    slots[t] = Slot::PhiV(v_at.len() as u32);
+                    v_at.push((p as usize, ind_pos[e.1] as usize));
+                }
+                continue;
+            }
+            let (p, q) = (p as usize, q as usize);
+            let (np, nq) = (node_of[p], node_of[q]);
+            if np == u32::MAX || nq == u32::MAX {
+                slots[t] = Slot::Border(border.add(p, q) as u32);
+            } else if np == nq {
+                let i = np as usize;
+                let (a, b) = (p - span[i].0, q - span[i].0);
+                let d = span[i].1 - span[i].0;
+                slots[t] = Slot::Diag((diag_at[i] + a * d + b) as u32);
+            } else {
+                count[np as usize + 1] += 1;
+                pending.push((t, p, q));
+            }
+        }
+        for i in 0..nodes {
+            count[i + 1] += count[i];
+        }
+        let off_at = count.clone();
+        let mut off = vec![(0u32, 0u32); pending.len()];
+        for &(t, p, q) in &pending {
+            let i = node_of[p] as usize;
+            let at = count[i];
+            count[i] += 1;
+            off[at] = (p as u32, q as u32);
+            slots[t] = Slot::Off(at as u32);
+        }
+        Some(TreeSplit {
+            id: part.id,
+            triplets: entries.len(),
+            shape: Arc::new(Shape {
+                order,
+                span,
+                diag_at,
+                off,
+                off_at,
+                border,
+            }),
+            slots,
+            v_at,
+            pool: Vec::new(),
+        })
+    }
+
+    /// Whether this split was built for `part` and a Jacobian of `triplets` entries.
+    pub(crate) fn fits(&self, part: &Partition, triplets: usize) -> bool {
+        self.triplets == triplets && self.id == part.id
+    }
+
+    /// Refills the blocks from `entries` and factors them, in a buffer of the pool that no
+    /// evaluation holds any more (a new one if all are held).
+    pub(crate) fn factor(&mut self, entries: &[(usize, usize, f64)]) -> Arc<TreeLu> {
+        let shape = &self.shape;
+        let free = self.pool.iter().position(|f| Arc::strong_count(f) == 1);
+        let mut lu = match free {
+            Some(k) => self.pool.swap_remove(k),
+            None => Arc::new(TreeLu {
+                shape: shape.clone(),
+                diag: vec![0.0; *shape.diag_at.last().unwrap_or(&0)],
+                piv: vec![0; shape.order],
+                off: vec![0.0; shape.off.len()],
+                border: vec![0.0; shape.border.len()],
+                border_piv: vec![0; shape.border.size()],
+                phi_v: self.v_at.iter().map(|&(r, c)| (r, c, 0.0)).collect(),
+                ok: false,
+            }),
+        };
+        if let Some(f) = Arc::get_mut(&mut lu) {
+            f.diag.iter_mut().for_each(|v| *v = 0.0);
+            f.off.iter_mut().for_each(|v| *v = 0.0);
+            f.border.iter_mut().for_each(|v| *v = 0.0);
+            f.phi_v.iter_mut().for_each(|v| v.2 = 0.0);
+            for (slot, e) in self.slots.iter().zip(entries) {
+                match *slot {
+                    Slot::None => {}
+                    Slot::Diag(s) => f.diag[s as usize] += e.2,
+                    Slot::Off(s) => f.off[s as usize] += e.2,
+                    Slot::Border(s) => f.border[s as usize] += e.2,
+                    Slot::PhiV(s) => f.phi_v[s as usize].2 += e.2,
+                }
+            }
+            f.ok = f.factor_blocks();
+        }
+        self.pool.push(lu.clone());
+        // Keep at most a few buffers (the current point, trial points of a line search).
+        if self.pool.len() > 4 {
+            if let Some(k) = self.pool.iter().position(|f| Arc::strong_count(f) == 1) {
+                self.pool.swap_remove(k);
+            }
+        }
+        lu
+    }
+}
+
+impl TreeLu {
+    /// Factors the diagonal blocks, then the border's Schur complement.
+    fn factor_blocks(&mut self) -> bool {
+        let shape = self.shape.clone();
+        for i in 0..shape.span.len() {
+            let (a, b) = shape.span[i];
+            let d = b - a;
+            let blk = &mut self.diag[shape.diag_at[i]..shape.diag_at[i + 1]];
+            if !dense::lu(blk, d, &mut self.piv[a..b]) {
+                return false;
+            }
+        }
+        if shape.border.is_empty() {
+            return true;
+        }
+        let (mut border, mut piv) = (
+            std::mem::take(&mut self.border),
+            std::mem::take(&mut self.border_piv),
+        );
+        let ok = shape
+            .border
+            .factor(&mut border, &mut piv, |x, t| self.tree_solve(x, t), false)
+            .is_some();
+        (self.border, self.border_piv) = (border, piv);
+        ok
+    }
+
+    /// `T x = r` (or `Tᵀ x = r`) in place over the tree positions (border positions untouched).
+    fn tree_solve(&self, x: &mut [f64], transpose: bool) {
+        let s = &*self.shape;
+        let nodes = s.span.len();
+        if !transpose {
+            for i in (0..nodes).rev() {
+                for k in s.off_at[i]..s.off_at[i + 1] {
+                    let (p, q) = s.off[k];
+                    x[p as usize] -= self.off[k] * x[q as usize];
+                }
+                let (a, b) = s.span[i];
+                let blk = &self.diag[s.diag_at[i]..s.diag_at[i + 1]];
+                dense::lu_solve(blk, &self.piv[a..b], b - a, &mut x[a..b], 1);
+            }
+        } else {
+            for i in 0..nodes {
+                let (a, b) = s.span[i];
+                let blk = &self.diag[s.diag_at[i]..s.diag_at[i + 1]];
+                dense::lu_solve_transpose(blk, &self.piv[a..b], b - a, &mut x[a..b]);
+                for k in s.off_at[i]..s.off_at[i + 1] {
+                    let (p, q) = s.off[k];
+                    x[q as usize] -= self.off[k] * x[p as usize];
+                }
+            }
+        }
+    }
+
+    fn solve_with(&self, x: &mut [f64], transpose: bool) -> bool {
+        if x.is_empty() {
+            return true;
+        }
+        if !self.ok {
+            return false;
+        }
+        let s = &*self.shape;
+        if s.border.is_empty() {
+            self.tree_solve(x, transpose);
+        } else {
+            s.border
+                .solve(&self.border, &self.border_piv, x, transpose, |y, t| {
+                    self.tree_solve(y, t)
+                });
+        }
+        x.iter().all(|v| v.is_finite())
+    }
+
+    /// Pivots in the border (0 on a tree).
+    #[cfg(test)]
+    pub(crate) fn border_size(&self) -> usize {
+        self.shape.border.size()
+    }
+
+    /// `Φ_u x = b` in place; `false` if `Φ_u` is singular.
+    pub(crate) fn solve(&self, b: &mut [f64]) -> bool {
+        self.solve_with(b, false)
+    }
+
+    /// `Φ_uᵀ x = b` in place; `false` if `Φ_u` is singular.
+    pub(crate) fn solve_transpose(&self, b: &mut [f64]) -> bool {
+        self.solve_with(b, true)
+    }
+
+    /// `Φ_v x` (length: independent rows).
+    pub(crate) fn phi_v_mul(&self, x: &[f64], r: usize) -> Vec<f64> {
+        let mut y = vec![0.0; r];
+        for &(i, j, v) in &self.phi_v {
+            y[i] += v * x[j];
+        }
+        y
+    }
+
+    /// `Φ_vᵀ y` (length: degrees of freedom).
+    pub(crate) fn phi_v_tr_mul(&self, y: &[f64], dof: usize) -> Vec<f64> {
+        let mut x = vec![0.0; dof];
+        for &(i, j, v) in &self.phi_v {
+            x[j] += v * y[i];
+        }
+        x
+    }
+}

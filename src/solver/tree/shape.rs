@@ -1,0 +1,284 @@
+//! The block structure of the KKT matrix on a tree, built once per partition: its nodes (a
+//! body's 7 coordinates and the rows pivoted at it), each node's parent, the border, and the
+//! slot of every value.
+//!
+//! The unknowns are numbered like the KKT solve's right side: coordinates `0 .. n`, then the
+//! partition's rows `n + k`. In the elimination order of the sparse LDLᵀ (each body's
+//! coordinates when the partition first pivots on it, followed by the rows of that run of
+//! pivots) a node couples to later nodes through the Hessian blocks of the terms it shares and
+//! through the Jacobian entries of its rows. A node coupled to one later node (its parent) is
+//! eliminated without fill; where it is coupled to more, all but the first go to the border
+//! (module `border`), with the rows pivoted away from their body's run (loop rows).
+
+use super::border::Border;
+use crate::solver::partition::Partition;
+use crate::solver::sparse::hessian::BlockHessian;
+use std::collections::HashMap;
+
+/// Borders larger than this (unknowns) are not factored here (the general sparse LDLᵀ is used
+/// instead).
+pub(crate) const MAX_BORDER: usize = 96;
+
+/// Where a value goes: `flat` slots below `flat_len`, border slots above, or nowhere (the
+/// mirror of a coupling entry, which the block elimination reads from its transpose).
+pub(crate) const SKIP: u32 = u32::MAX;
+
+/// The structure of the tree KKT matrix.
+pub(crate) struct Shape {
+    /// Coordinates `n` and rows.
+    pub(crate) n: usize,
+    pub(crate) rows: usize,
+    /// `perm[t]`: the unknown at tree-space position `t` (tree nodes, then the border).
+    pub(crate) perm: Vec<usize>,
+    /// Node `i`: its first tree-space position, its size `d`, its parent (`u32::MAX`: none),
+    /// the width `w` of its coupling to the parent (the parent's leading unknowns it reaches).
+    pub(crate) at: Vec<usize>,
+    pub(crate) d: Vec<usize>,
+    pub(crate) parent: Vec<u32>,
+    pub(crate) w: Vec<usize>,
+    /// Offsets of each node's `d × d` diagonal block and `d × w` coupling in the flat values.
+    pub(crate) diag_at: Vec<usize>,
+    pub(crate) coup_at: Vec<usize>,
+    pub(crate) flat_len: usize,
+    /// The tree-space size (the border follows).
+    pub(crate) tree_len: usize,
+    pub(crate) border: Border,
+    /// Slots of each Hessian block's entries and of each Jacobian triplet (`(row, column)` and
+    /// its mirror), and of each coordinate's diagonal.
+    pub(crate) block_slots: Vec<[u32; 49]>,
+    pub(crate) jac_slots: Vec<[u32; 2]>,
+    pub(crate) diag_slots: Vec<u32>,
+}
+
+impl Shape {
+    /// The structure for `part` of an `m × n` Jacobian given by `entries` and the blocks of
+    /// `hess`; `None` if the border would exceed [`MAX_BORDER`].
+    pub(crate) fn new(
+        part: &Partition,
+        m: usize,
+        n: usize,
+        entries: &[(usize, usize, f64)],
+        hess: &BlockHessian,
+    ) -> Option<Self> {
+        let rows = part.rows.len();
+        let dim = n + rows;
+        let nb = n / 7;
+        let mut row_pos = vec![u32::MAX; m];
+        for (k, &r) in part.rows.iter().enumerate() {
+            row_pos[r] = k as u32;
+        }
+        // Nodes in elimination order; `owner[u]`: the node of unknown `u` (MAX: border row).
+        let mut body_node = vec![u32::MAX; nb];
+        let mut members: Vec<Vec<usize>> = Vec::new();
+        let mut owner = vec![u32::MAX; dim];
+        for (k, &c) in part.dependent.iter().enumerate() {
+            let b = c / 7;
+            if body_node[b] == u32::MAX {
+                body_node[b] = members.len() as u32;
+                members.push((7 * b..7 * b + 7).collect());
+            }
+            let i = body_node[b] as usize;
+            if i + 1 == members.len() {
+                members[i].push(n + k);
+            }
+        }
+        for b in 0..nb {
+            if body_node[b] == u32::MAX {
+                body_node[b] = members.len() as u32;
+                members.push((7 * b..7 * b + 7).collect());
+            }
+        }
+        for (i, m) in members.iter().enumerate() {
+            for &u in m {
+                owner[u] = i as u32;
+            }
+        }
+        let nodes = members.len();
+        // Node couplings: every pair of unknowns with a value.
+        let mut pairs: Vec<(u32, u32)> = Vec::new();
+        for &(a, b) in &hess.keys {
+            pairs.push((body_node[a], body_node[b]));
+        }
+        for e in entries {
+            if row_pos[e.0] != u32::MAX {
+                pairs.push((owner[n + row_pos[e.0] as usize], body_node[e.1 / 7]));
+            }
+        }
+        let mut later: Vec<Vec<u32>> = vec![Vec::new(); nodes];
+        for &(a, b) in &pairs {
+            if a != u32::MAX && b != u32::MAX && a != b {
+                let (lo, hi) = (a.min(b), a.max(b));
+                later[lo as usize].push(hi);
+            }
+        }
+        let mut in_border = vec![false; nodes];
+        let mut parent = vec![u32::MAX; nodes];
+        for i in 0..nodes {
+            if in_border[i] {
+                continue;
+            }
+            let l = &mut later[i];
+            l.sort_unstable();
+            l.dedup();
+            let mut kept = None;
+            for &j in l.iter() {
+                if in_border[j as usize] {
+                    continue;
+                }
+                match kept {
+                    None => kept = Some(j),
+                    Some(_) => in_border[j as usize] = true,
+                }
+            }
+            parent[i] = kept.unwrap_or(u32::MAX);
+        }
+        // Parents bordered after their children were kept: none.
+        for i in 0..nodes {
+            if parent[i] != u32::MAX && in_border[parent[i] as usize] {
+                parent[i] = u32::MAX;
+            }
+        }
+        let mut border_unknowns: Vec<usize> = (0..dim).filter(|&u| owner[u] == u32::MAX).collect();
+        for (i, m) in members.iter().enumerate() {
+            if in_border[i] {
+                border_unknowns.extend_from_slice(m);
+            }
+        }
+        if border_unknowns.len() > MAX_BORDER {
+            return None;
+        }
+        // Tree-space positions: kept nodes in order, then the border.
+        let mut tpos = vec![0usize; dim];
+        let mut perm = Vec::with_capacity(dim);
+        let mut node_map = vec![u32::MAX; nodes];
+        let (mut at, mut d, mut par) = (Vec::new(), Vec::new(), Vec::new());
+        for (i, m) in members.iter().enumerate() {
+            if in_border[i] {
+                continue;
+            }
+            node_map[i] = at.len() as u32;
+            at.push(perm.len());
+            d.push(m.len());
+            for &u in m {
+                tpos[u] = perm.len();
+                perm.push(u);
+            }
+        }
+        for i in 0..nodes {
+            if !in_border[i] {
+                par.push(if parent[i] == u32::MAX {
+                    u32::MAX
+                } else {
+                    node_map[parent[i] as usize]
+                });
+            }
+        }
+        let tree_len = perm.len();
+        for &u in &border_unknowns {
+            tpos[u] = perm.len();
+            perm.push(u);
+        }
+        let kept = at.len();
+        let mut node_of = vec![u32::MAX; dim];
+        for i in 0..kept {
+            for t in at[i]..at[i] + d[i] {
+                node_of[t] = i as u32;
+            }
+        }
+        // Coupling widths: the parent's leading unknowns reached.
+        let mut w = vec![0usize; kept];
+        let mut reach = |u1: usize, u2: usize| {
+            let (t1, t2) = (tpos[u1], tpos[u2]);
+            let (a, b) = (node_of[t1], node_of[t2]);
+            if a != u32::MAX && b != u32::MAX && a != b {
+                let (c, p, tp) = if par[a as usize] == b {
+                    (a, b, t2)
+                } else {
+                    (b, a, t1)
+                };
+                w[c as usize] = w[c as usize].max(tp - at[p as usize] + 1);
+            }
+        };
+        for &(a, b) in &hess.keys {
+            reach(7 * a + 6, 7 * b + 6);
+        }
+        for e in entries {
+            if row_pos[e.0] != u32::MAX {
+                reach(n + row_pos[e.0] as usize, e.1);
+            }
+        }
+        let mut diag_at = Vec::with_capacity(kept + 1);
+        let mut coup_at = Vec::with_capacity(kept + 1);
+        let mut flat = 0;
+        for i in 0..kept {
+            diag_at.push(flat);
+            flat += d[i] * d[i];
+        }
+        for i in 0..kept {
+            coup_at.push(flat);
+            flat += d[i] * w[i];
+        }
+        let mut border = Border::new(&(tree_len..dim).collect::<Vec<_>>(), dim);
+        let mut border_slot: HashMap<(usize, usize), u32> = HashMap::new();
+        let mut locate = |u1: usize, u2: usize| -> Option<u32> {
+            let (t1, t2) = (tpos[u1], tpos[u2]);
+            if t1 >= tree_len || t2 >= tree_len {
+                let next = border_slot.len() as u32;
+                let s = *border_slot.entry((t1, t2)).or_insert(next);
+                if s == next {
+                    border.add(t1, t2);
+                }
+                return Some(flat as u32 + s);
+            }
+            let (a, b) = (node_of[t1] as usize, node_of[t2] as usize);
+            let (l1, l2) = (t1 - at[a], t2 - at[b]);
+            if a == b {
+                Some((diag_at[a] + l1 * d[a] + l2) as u32)
+            } else if par[a] == b as u32 {
+                Some((coup_at[a] + l1 * w[a] + l2) as u32)
+            } else if par[b] == a as u32 {
+                Some(SKIP)
+            } else {
+                None
+            }
+        };
+        let mut block_slots = Vec::with_capacity(hess.keys.len());
+        for &(a, b) in &hess.keys {
+            let mut s = [SKIP; 49];
+            for i in 0..7 {
+                for j in 0..7 {
+                    s[7 * i + j] = locate(7 * a + i, 7 * b + j)?;
+                }
+            }
+            block_slots.push(s);
+        }
+        let mut jac_slots = Vec::with_capacity(entries.len());
+        for e in entries {
+            jac_slots.push(match row_pos[e.0] {
+                u32::MAX => [SKIP, SKIP],
+                k => {
+                    let r = n + k as usize;
+                    [locate(r, e.1)?, locate(e.1, r)?]
+                }
+            });
+        }
+        let diag_slots = (0..n).map(|c| locate(c, c)).collect::<Option<Vec<_>>>()?;
+        Some(Shape {
+            n,
+            rows,
+            perm,
+            at,
+            d,
+            parent: par,
+            w,
+            diag_at,
+            coup_at,
+            flat_len: flat,
+            tree_len,
+            border,
+            block_slots,
+            jac_slots,
+            diag_slots,
+        })
+    }
+}

@@ -1,0 +1,188 @@
+//! The tree factors against the sparse ones (the reference): multipliers, reduced gradient,
+//! tangent steps, KKT solutions and inertia at the same points and partitions, on a chain,
+//! a chain with locked joints (extra rows on bodies, like stops), a branched tree (Solo-12,
+//! base welded), and loops (a spatial four-bar, a ladder: the border); and whole solves.
+use crate::constraints::Constraints;
+use crate::model::{JointId, Model};
+use crate::solver::sparse::kkt::Factored;
+use crate::solver::system::{Backend, Factors, KktMatrix, System};
+use crate::solver::{LinearAlgebra, Options};
+use crate::urdf::{load_file, load_str, ImportOptions};
+use nalgebra::DVector;
+
+fn from_text(text: &str) -> Model {
+    load_str(text, "tree.urdf", &ImportOptions::default())
+        .expect("model loads")
+        .model
+}
+
+fn solo12() -> Model {
+    solo12_with(ImportOptions::default())
+}
+
+fn solo12_with(options: ImportOptions) -> Model {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/robots/solo12/solo12_ground.urdf"
+    );
+    load_file(path, &options).expect("solo12 loads").model
+}
+
+/// Joint locks `(joint, coordinate, value)`.
+type Locks = Vec<(JointId, usize, f64)>;
+
+/// `(name, model, locks)`.
+fn cases() -> Vec<(&'static str, Model, Locks)> {
+    vec![
+        (
+            "chain",
+            from_text(&crate::generate::chain(12, false)),
+            vec![],
+        ),
+        (
+            "chain with locks",
+            from_text(&crate::generate::chain(9, false)),
+            vec![(JointId(2), 0, 0.2), (JointId(6), 0, -0.1)],
+        ),
+        ("solo12", solo12(), vec![]),
+        (
+            "four-bar",
+            from_text(include_str!("../../../robots/four_bar_spatial.urdf")),
+            vec![],
+        ),
+        ("ladder", from_text(&crate::generate::ladder(3)), vec![]),
+    ]
+}
+
+fn close(a: &DVector<f64>, b: &DVector<f64>, tol: f64) -> bool {
+    a.len() == b.len() && (a - b).amax() <= tol * (1.0 + a.amax())
+}
+
+#[test]
+fn tree_factors_match_the_sparse_ones() {
+    for (name, model, locks) in cases() {
+        let q0 = crate::solver::initial_state(&model).q;
+        let q = crate::solver::assemble_only(&model, q0, &mut Default::default(), &[])
+            .expect("assembles");
+        let mut sparse = System::new(&model, Constraints::new(&model, &locks), Backend::Sparse);
+        let mut tree = System::new(&model, Constraints::new(&model, &locks), Backend::Tree);
+        let part = sparse.partition(&q);
+        assert_eq!(part.dependent, tree.partition(&q).dependent, "{name}");
+        // The locks move the point off the manifold: a corrector step first (both backends).
+        let mut q = q;
+        sparse
+            .correct(&mut q, &part, 1e-12, 20)
+            .unwrap_or_else(|_| panic!("{name}: corrector"));
+        let es = sparse.evaluate(&q, &part).expect("sparse evaluation");
+        let et = tree.evaluate(&q, &part).expect("tree evaluation");
+        let Factors::Tree(f) = &et.factors else {
+            panic!("{name}: tree factors");
+        };
+        let loops = matches!(name, "four-bar" | "ladder");
+        assert_eq!(
+            f.border_size() > 0,
+            loops,
+            "{name}: Φ_u border {}",
+            f.border_size()
+        );
+        assert!(
+            close(&es.mu, &et.mu, 1e-9),
+            "{name}: μ {} vs {}",
+            es.mu,
+            et.mu
+        );
+        assert!(close(&es.grad_v, &et.grad_v, 1e-9), "{name}: ∇f");
+        let dv = DVector::from_fn(part.independent.len(), |i, _| (i as f64 + 0.5).sin());
+        let (zs, zt) = (
+            sparse.tangent_step(&part, &es, &dv),
+            tree.tangent_step(&part, &et, &dv),
+        );
+        assert!(close(&zs, &zt, 1e-9), "{name}: Z δv");
+        // The corrector (Φ_u solves) from a perturbed point lands on the same q.
+        let mut qs = &q + &zs * 1e-3;
+        let mut qt = qs.clone();
+        sparse
+            .correct(&mut qs, &part, 1e-12, 20)
+            .expect("sparse corrects");
+        tree.correct(&mut qt, &part, 1e-12, 20)
+            .expect("tree corrects");
+        assert!(close(&qs, &qt, 1e-9), "{name}: corrector");
+        // KKT: same step and same inertia, LDLᵀ and LU.
+        let fs = sparse.factor_kkt(&q, &part, &es, true, 1e-3);
+        let ft = tree.factor_kkt(&q, &part, &et, true, 1e-3);
+        let Some(KktMatrix::Tree(k)) = &tree.work.kkt else {
+            panic!("{name}: tree KKT");
+        };
+        assert_eq!(
+            k.border_size() > 0,
+            loops,
+            "{name}: border {}",
+            k.border_size()
+        );
+        assert_eq!(fs, ft, "{name}: factored (inertia)");
+        assert!(matches!(ft, Factored::Ldlt { .. }), "{name}: {ft:?}");
+        let b = DVector::from_fn(q.len(), |i, _| (0.3 * i as f64).cos());
+        let xs = sparse.kkt_solve(&b).expect("sparse KKT solve");
+        let xt = tree.kkt_solve(&b).expect("tree KKT solve");
+        assert!(close(&xs, &xt, 1e-9), "{name}: KKT solution");
+        assert_eq!(tree.kkt_fall_back_to_lu(), Factored::Lu, "{name}");
+        let xl = tree.kkt_solve(&b).expect("tree KKT solve by LU");
+        assert!(close(&xs, &xl, 1e-9), "{name}: KKT solution by LU");
+    }
+}
+
+#[test]
+fn tree_solves_match_the_sparse_ones() {
+    use crate::model::Friction::{None as Frictionless, Stick};
+    let standing = solo12_with(ImportOptions {
+        floating_base: true,
+        ground: true,
+        ..ImportOptions::default()
+    });
+    let models = [
+        (
+            "chain",
+            from_text(&crate::generate::chain(60, false)),
+            Frictionless,
+        ),
+        (
+            "ladder",
+            from_text(&crate::generate::ladder(6)),
+            Frictionless,
+        ),
+        ("rope", from_text(&crate::generate::rope(30)), Frictionless),
+        ("solo12", solo12(), Frictionless),
+        // Sticking feet: a unique rest pose (frictionless, the base could slide).
+        ("solo12 standing on the ground", standing, Stick),
+        // 60 loops: a border too large for the tree factors, so the sparse ones.
+        (
+            "long ladder",
+            from_text(&crate::generate::ladder(60)),
+            Frictionless,
+        ),
+    ];
+    for (name, model, friction) in models {
+        let solve = |linear_algebra| {
+            let options = Options {
+                linear_algebra,
+                friction,
+                ..Options::default()
+            };
+            crate::solver::solve(&model, &options).expect("solves")
+        };
+        let (ss, rs) = solve(LinearAlgebra::Sparse);
+        let (st, rt) = solve(LinearAlgebra::Tree);
+        assert_eq!(rt.diagnostics.linear_algebra, "tree");
+        assert_eq!(rs.termination, rt.termination, "{name}");
+        assert_eq!(rs.iterations, rt.iterations, "{name}");
+        assert!(
+            close(&ss.q, &st.q, 1e-9),
+            "{name}: final pose differs by {:e}",
+            (&ss.q - &st.q).amax()
+        );
+        assert!(
+            (rs.energy.total - rt.energy.total).abs() <= 1e-9 * (1.0 + rs.energy.total.abs()),
+            "{name}"
+        );
+    }
+}

@@ -198,7 +198,8 @@ class CheckReport(_Json):
 
 class Verification(_Json):
     """Whether a pose is a rest pose (``restpose verify``): ``passed``,
-    ``constraint_residual``, ``imbalance`` (the effort each joint coordinate needs),
+    ``constraint_residual`` (raw ‖Φ‖∞), ``scaled_constraint_residual`` (‖DΦ‖∞, what
+    ``constraint_tolerance`` bounds), ``imbalance`` (the effort each joint coordinate needs),
     ``max_imbalance``, ``unassigned``, ``projected_gradient``, ``potential_energy``,
     ``stability``, ``tolerances``, ``effort_tolerance``, ``contacts``, ``active_limits``,
     ``failures``. ``to_json()`` equals ``restpose verify --json -``."""
@@ -212,6 +213,7 @@ class Verification(_Json):
     }
     passed: bool
     constraint_residual: float
+    scaled_constraint_residual: float
     imbalance: List[Imbalance]
     max_imbalance: Optional[Imbalance]
     unassigned: float
@@ -232,7 +234,7 @@ class Verification(_Json):
         residual, what the stops and contacts refuse)."""
         lines = [
             f"{'passed' if self.passed else 'NOT a rest pose'}: constraint residual "
-            f"{self.constraint_residual:.3e} (tolerance {self.tolerances['constraint']:.1e}), "
+            f"{self.scaled_constraint_residual:.3e} (tolerance {self.tolerances['constraint']:.1e}), "
             f"effort tolerance {self.effort_tolerance:.3e}"
         ]
         worst = sorted(self.imbalance, key=lambda i: -abs(i.effort))[:5]

@@ -213,7 +213,7 @@ impl Model {
     ///
     /// Keyword arguments are the command line's solver options: ``method`` (``"newton"``,
     /// ``"bfgs"``, ``"dfp"``), ``linear_algebra`` (``"auto"``, ``"dense"``, ``"sparse"``, ``"tree"``),
-    /// ``tolerance`` (scaled reduced gradient [J]), ``constraint_tolerance`` (‖Φ‖∞),
+    /// ``tolerance`` (scaled reduced gradient [J]), ``constraint_tolerance`` (‖DΦ‖∞, dimensionless),
     /// ``max_iterations``, ``load_steps`` (0: automatic), ``allow_unstable``, ``limits``
     /// (``"enforce"``, ``"ignore"``), ``friction`` (``"none"``, ``"stick"``), ``mu``.
     ///
@@ -273,7 +273,7 @@ impl Model {
     /// joint_states). Returns a ``restpose.Verification`` (``passed``, the effort each joint
     /// needs, …; ``to_json()`` is ``restpose verify --json``). The GIL is released while it
     /// runs. Options as ``restpose verify``.
-    #[pyo3(signature = (pose, *, force_tolerance=1e-6, constraint_tolerance=1e-8,
+    #[pyo3(signature = (pose, *, force_tolerance=1e-6, constraint_tolerance=1e-10,
         limits="enforce", friction="none", mu=None, linear_algebra="auto", eigenvalues=false))]
     fn verify<'py>(
         slf: &Bound<'py, Self>,

@@ -187,9 +187,9 @@ pub(crate) struct VerifyArgs {
     /// largest generalized force on any coordinate.
     #[arg(long, default_value_t = Tolerances::default().force, value_parser = parse::positive)]
     pub(crate) force_tolerance: f64,
-    /// Largest raw constraint violation ‖Φ‖∞ for the pose to pass [m or rad] (a check of the
-    /// given pose in its own units; `analyze --constraint-tolerance` is the solver's
-    /// dimensionless target instead).
+    /// Largest dimensionless constraint residual ‖DΦ‖∞ for the pose to pass (each row in m^k
+    /// divided by L^k, L the characteristic length; the residual and default of `analyze
+    /// --constraint-tolerance`); a stop or contact touches within it in the same scaling.
     #[arg(long, default_value_t = Tolerances::default().constraint, value_parser = parse::positive)]
     pub(crate) constraint_tolerance: f64,
     /// Write the verification as JSON to this file (`-`: standard output, which then carries

@@ -4,7 +4,8 @@
 //! JSON: the joint values, and the world poses of the bodies joint values cannot place. An
 //! answer they reject is reported as `rejected_by_verify` (exit 3), never as converged.
 //!
-//! Tolerances: `verify`'s defaults, with the constraint tolerance no tighter than the solve's.
+//! Tolerances: `verify`'s defaults, with the constraint tolerance (on the same `‖DΦ‖∞`) no
+//! tighter than the solve's.
 
 use super::args::AnalyzeArgs;
 use restpose::verify::{Eigenvalues, Tolerances, Unilaterals};
@@ -66,8 +67,11 @@ pub(crate) fn rejection(a: &AnalyzeArgs, model: &Model, state: &State) -> Option
     if v.unassigned > v.effort_tolerance {
         why.push(format!("unassigned generalized force {:.3e}", v.unassigned));
     }
-    if v.constraint_residual > tol.constraint {
-        why.push(format!("constraint residual {:.3e}", v.constraint_residual));
+    if v.scaled_constraint_residual > tol.constraint {
+        why.push(format!(
+            "constraint residual ‖DΦ‖∞ = {:.3e}",
+            v.scaled_constraint_residual
+        ));
     }
     if why.is_empty() {
         why.push("the pose does not pass".into());

@@ -67,7 +67,7 @@ pub(crate) fn verification(robot: &str, v: &Verification, tol: &Tolerances) {
     verdict(robot, v);
     out!(
         "  constraint residual {:.3e} (tolerance {:.1e}), potential energy {:.9} J",
-        v.constraint_residual,
+        v.scaled_constraint_residual,
         tol.constraint,
         v.potential_energy
     );

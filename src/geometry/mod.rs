@@ -13,10 +13,13 @@
 //!
 //! - `shape`: the shapes; `package`: mesh URIs to files; `mesh`: mesh files to triangles and
 //!   convex hulls; `hull`: a convex hull's closest points and normals (obstacles);
+//!   `surface`: the signed distance to a shape's surface (closest point and normal, the
+//!   obstacles' gap rows); `curvature`: its Hessian;
 //!   `contact`: the contact points of a collision shape; `distance`: parry3d's signed
 //!   distances (independent checks); `mass`: mass properties; `error`: what can go wrong.
 
 mod contact;
+mod curvature;
 mod distance;
 mod error;
 mod hull;
@@ -24,8 +27,10 @@ mod mass;
 mod mesh;
 mod package;
 mod shape;
+mod surface;
 
 pub use contact::{contact_points, CYLINDER_RIM_POINTS};
+pub(crate) use curvature::curvature;
 pub use distance::{parry_cylinder_signed_distance, parry_signed_distance};
 pub use error::GeometryError;
 pub use hull::Hull;
@@ -33,3 +38,4 @@ pub use mass::mass_properties;
 pub use mesh::{convex_hull, convex_hull_of, load_mesh, Triangles, Triangles3, MAX_MESH_BYTES};
 pub use package::{PackagePaths, UNKNOWN_PACKAGE_HINT};
 pub use shape::{Geometry, ShapeKind};
+pub(crate) use surface::tangent_plane;

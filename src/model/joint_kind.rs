@@ -1,6 +1,6 @@
-//! `impl JointKind` in one place: its type name (URDF and the result JSON), how many values
-//! each kind takes and which of its coordinates are angles. (The string→kind tables of the
-//! importer are in `urdf/edges.rs`: `<joint type>` and `mech:loop_joint type`.)
+//! `impl JointKind` in one place: its type name (URDF and the result JSON, from the one table
+//! of type names in `joint_types.rs`), how many values each kind takes and which of its
+//! coordinates are angles.
 
 use super::JointKind;
 
@@ -8,22 +8,10 @@ use super::JointKind;
 pub(crate) const MAX_SCALAR_COORDINATES: usize = 3;
 
 impl JointKind {
-    /// The type name used in URDF and in the result JSON.
+    /// The type name used in URDF and in the result JSON (its first line in
+    /// [`super::JOINT_TYPES`]).
     pub fn name(&self) -> &'static str {
-        match self {
-            JointKind::Revolute => "revolute",
-            JointKind::Continuous => "continuous",
-            JointKind::Prismatic => "prismatic",
-            JointKind::Fixed => "fixed",
-            JointKind::Floating => "floating",
-            JointKind::Planar => "planar",
-            JointKind::Spherical => "spherical",
-            JointKind::Universal => "universal",
-            JointKind::Cylindrical => "cylindrical",
-            JointKind::Screw { .. } => "screw",
-            JointKind::Distance { .. } => "distance",
-            JointKind::PointOnLine => "point_on_line",
-        }
+        super::joint_types::name_of(self)
     }
 
     /// Number of scalar joint coordinates that springs, efforts, locks and initial values can
@@ -79,26 +67,28 @@ impl JointKind {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+
+    /// One of every kind (the unit tests' list: add a new kind here).
+    pub(crate) const KINDS: [JointKind; 12] = [
+        JointKind::Revolute,
+        JointKind::Continuous,
+        JointKind::Prismatic,
+        JointKind::Fixed,
+        JointKind::Floating,
+        JointKind::Planar,
+        JointKind::Spherical,
+        JointKind::Universal,
+        JointKind::Cylindrical,
+        JointKind::Screw { pitch: 0.01 },
+        JointKind::Distance { length: 1.0 },
+        JointKind::PointOnLine,
+    ];
 
     #[test]
     fn angles_are_scalar_coordinates_and_counts_agree() {
-        let kinds = [
-            JointKind::Revolute,
-            JointKind::Continuous,
-            JointKind::Prismatic,
-            JointKind::Fixed,
-            JointKind::Floating,
-            JointKind::Planar,
-            JointKind::Spherical,
-            JointKind::Universal,
-            JointKind::Cylindrical,
-            JointKind::Screw { pitch: 0.01 },
-            JointKind::Distance { length: 1.0 },
-            JointKind::PointOnLine,
-        ];
-        for k in kinds {
+        for k in KINDS {
             let n = k.scalar_coordinates();
             assert!(n <= MAX_SCALAR_COORDINATES);
             for dof in n..MAX_SCALAR_COORDINATES + 1 {

@@ -9,7 +9,7 @@
 use super::limits::{limits, urdf_limits};
 use super::xml::{child, Source};
 use crate::error::Result;
-use crate::model::JointKind;
+use crate::model::{joint_type, JointKind};
 use crate::names::NameMap;
 use nalgebra::{Isometry3, Vector3};
 use roxmltree::Node;
@@ -152,38 +152,32 @@ fn ends(src: &Source, node: Node, frames: &Frames, name: &str) -> Result<[End; 2
     Ok([side("parent")?, side("child")?])
 }
 
-/// URDF joint types.
+/// The kind of a URDF `<joint type>`, from the one table of type names
+/// ([`crate::model::JOINT_TYPES`], column `urdf`); `ball` is read as `spherical` with a
+/// warning.
 pub(super) fn urdf_kind(
     src: &Source,
     node: Node,
     ty: &str,
     warnings: &mut Vec<String>,
 ) -> Result<JointKind> {
-    Ok(match ty {
-        "revolute" => JointKind::Revolute,
-        "continuous" => JointKind::Continuous,
-        "prismatic" => JointKind::Prismatic,
-        "fixed" => JointKind::Fixed,
-        "floating" => JointKind::Floating,
-        "planar" => JointKind::Planar,
-        "spherical" => JointKind::Spherical,
-        "ball" => {
-            warnings.push(src.warning(
-                node,
-                format!(
-                    "{} has type \"ball\", read as \"spherical\"",
-                    src.describe(node)
-                ),
-            ));
-            JointKind::Spherical
-        }
-        other => {
-            return Err(src.error(
-                node,
-                format!("{} has an unknown type \"{other}\"", src.describe(node)),
-            ))
-        }
-    })
+    let Some(t) = joint_type(ty).filter(|t| t.declared.urdf) else {
+        return Err(src.error(
+            node,
+            format!("{} has an unknown type \"{ty}\"", src.describe(node)),
+        ));
+    };
+    if t.kind.name() != t.name {
+        warnings.push(src.warning(
+            node,
+            format!(
+                "{} has type \"{ty}\", read as \"{}\"",
+                src.describe(node),
+                t.kind.name()
+            ),
+        ));
+    }
+    Ok(t.kind)
 }
 
 /// A URDF `<joint>` (tree edge).
@@ -234,11 +228,8 @@ pub(super) fn drake_joint<'a>(
 ) -> Result<Edge<'a>> {
     let name = src.req(node, "name")?.to_string();
     let ty = src.req(node, "type")?;
-    let kind = match ty {
-        "ball" => JointKind::Spherical,
-        "universal" => JointKind::Universal,
-        "planar" => JointKind::Planar,
-        "screw" => {
+    let kind = match joint_type(ty).filter(|t| t.declared.drake).map(|t| t.kind) {
+        Some(JointKind::Screw { .. }) => {
             let p = node
                 .children()
                 .find(|c| c.is_element() && c.tag_name().name() == "screw_thread_pitch")
@@ -246,8 +237,9 @@ pub(super) fn drake_joint<'a>(
             let per_rev = src.length_opt(p, "value")?.ok_or_else(|| src.error(p, "<drake:screw_thread_pitch> needs `value`"))?;
             JointKind::Screw { pitch: per_rev / (2.0 * std::f64::consts::PI) }
         }
-        other => {
-            return Err(src.error(node, format!("drake joint `{name}` has type \"{other}\"; drake:joint types are ball, universal, planar and screw (use <joint> for the others)")))
+        Some(kind) => kind,
+        None => {
+            return Err(src.error(node, format!("drake joint `{name}` has type \"{ty}\"; drake:joint types are ball, universal, planar and screw (use <joint> for the others)")))
         }
     };
     let [(parent, pf, parent_link), (child_i, cf, child_link)] = ends(src, node, frames, &name)?;
@@ -274,22 +266,22 @@ pub(super) fn drake_joint<'a>(
     })
 }
 
-/// `mech:loop_joint` types.
+/// The kind of a `<mech:loop_joint type>` (the table [`crate::model::JOINT_TYPES`], column
+/// `loop_joint`), with its parameters.
 fn loop_kind(src: &Source, node: Node) -> Result<JointKind> {
     let ty = src.req(node, "type")?;
-    Ok(match ty {
-        "fixed" => JointKind::Fixed,
-        "revolute" => JointKind::Revolute,
-        "continuous" => JointKind::Continuous,
-        "prismatic" => JointKind::Prismatic,
-        "cylindrical" => JointKind::Cylindrical,
-        "universal" => JointKind::Universal,
-        "spherical" | "ball" => JointKind::Spherical,
-        "planar" => JointKind::Planar,
-        "screw" => JointKind::Screw {
+    let Some(t) = joint_type(ty).filter(|t| t.declared.loop_joint) else {
+        return Err(src.error(
+            node,
+            format!("{} has an unknown type \"{ty}\"", src.describe(node)),
+        ));
+    };
+    // The parameters of the kinds that have some, from the element's attributes.
+    Ok(match t.kind {
+        JointKind::Screw { .. } => JointKind::Screw {
             pitch: src.length_opt(node, "pitch")?.unwrap_or(0.0),
         },
-        "distance" => JointKind::Distance {
+        JointKind::Distance { .. } => JointKind::Distance {
             length: match src.length_opt(node, "length")? {
                 Some(l) if l >= 0.0 => l,
                 Some(l) => {
@@ -309,13 +301,7 @@ fn loop_kind(src: &Source, node: Node) -> Result<JointKind> {
                 }
             },
         },
-        "point_on_line" => JointKind::PointOnLine,
-        other => {
-            return Err(src.error(
-                node,
-                format!("{} has an unknown type \"{other}\"", src.describe(node)),
-            ))
-        }
+        kind => kind,
     })
 }
 

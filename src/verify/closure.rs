@@ -1,7 +1,8 @@
 //! The closure error of each joint at a pose: the largest violation of its position rows
 //! \[m\] (a distance joint's squared-length row `|d|² − L²` as `|Φ| / 2L`) and of its
 //! orientation rows (sine of the angle error) \[rad\], for loop joints always and for tree
-//! joints when above the tolerance.
+//! joints when above the tolerance (on `‖D Φ‖∞`: the position error over the characteristic
+//! length).
 
 use crate::constraints::{joint, BlockKind, Constraints};
 use crate::model::Model;
@@ -44,7 +45,8 @@ pub(super) fn closures(
                 _ => pos = pos.max(r),
             }
         }
-        if !j.tree || pos.max(rot) > tol {
+        // The constraint tolerance bounds `‖D Φ‖∞`: positions over the characteristic length.
+        if !j.tree || (pos / model.length_scale).max(rot) > tol {
             closure.push(Closure {
                 joint: j.name.clone(),
                 loop_joint: !j.tree,

@@ -23,7 +23,8 @@
 //! ones by the dense basis `N` (module `dense`).
 //!
 //! ## Tolerances
-//! A pose passes when `‖Φ‖∞ ≤ constraint` and every effort (and the unassigned force) is at
+//! A pose passes when `‖D Φ‖∞ ≤ constraint` (the solver's dimensionless residual, module
+//! `solver::system::residual`) and every effort (and the unassigned force) is at
 //! most `force + relative · F`, with `F = ‖S ∇V‖∞` the largest generalized force on any
 //! coordinate \[J\]: the rounding of the efforts grows with the forces they balance (a
 //! 10,000-link chain carries 10⁸ N m at its base), so an absolute tolerance alone would reject
@@ -75,8 +76,11 @@ pub struct Tolerances {
     /// Largest joint effort (or unassigned generalized force) a balanced pose may need
     /// \[N m or N\] (default: 1e-6).
     pub force: f64,
-    /// Largest raw constraint violation `‖Φ‖∞` \[m or rad\] (default: 1e-8; the solver's own
-    /// tolerance is on the dimensionless `‖D Φ‖∞`, module `solver::system::residual`).
+    /// Largest constraint residual `‖D Φ‖∞` (dimensionless: a row in m^k divided by `L^k`, `L`
+    /// the characteristic length; the one residual of module `solver::system::residual`, which
+    /// `analyze --constraint-tolerance` bounds too; default 1e-10, the solver's). A gap of a
+    /// stop or contact touches when it is within `constraint` in the same scaling (`L ε` for a
+    /// gap in m, `ε` in rad).
     pub constraint: f64,
     /// Effort tolerance relative to the largest generalized force `‖S ∇V‖∞`, added to `force`
     /// (default: 1e-9).
@@ -87,7 +91,7 @@ impl Default for Tolerances {
     fn default() -> Self {
         Tolerances {
             force: 1e-6,
-            constraint: 1e-8,
+            constraint: crate::solver::system::residual::TOLERANCE,
             relative: 1e-9,
         }
     }
@@ -114,8 +118,10 @@ pub struct Verification {
     pub robot: String,
     /// Constraint residual and tolerance met, and no joint needs more than the force tolerance.
     pub passed: bool,
-    /// `‖Φ‖∞`.
+    /// `‖Φ‖∞` \[m or rad\], raw.
     pub constraint_residual: f64,
+    /// `‖D Φ‖∞` (dimensionless): the residual [`Tolerances::constraint`] bounds.
+    pub scaled_constraint_residual: f64,
     /// Per joint with constraint rows: loop joints always, tree joints when violated.
     pub closure: Vec<Closure>,
     /// Per tree-joint scalar coordinate.

@@ -9,7 +9,7 @@ use crate::error::Error;
 use crate::error::Result;
 use crate::jet::pair_of;
 use crate::model::{JointId, Model};
-use crate::solver::system::Backend;
+use crate::solver::system::{Backend, Scaling};
 use crate::state::State;
 
 /// The scalar coordinates of the tree joints: `(joint, dof, value)` and their gradients.
@@ -60,10 +60,12 @@ pub(super) fn verify_on(
     let list = unilateral::touching(model, state, uni, tol.constraint, &mut contact);
     let coords = tree_coordinates(model, state);
     let values: Vec<_> = coords.iter().map(|c| (c.0, c.1, c.2.v)).collect();
-    let (phi, energy, projected_gradient, force_scale, closure, held, stability) = if sparse {
+    let (phi, scaled, energy, projected_gradient, force_scale, closure, held, stability) = if sparse
+    {
         let locks = crate::solver::lock_values(model);
         let r = reduced::reduced(model, state, &locks)?;
         let closure = closures(model, &r.sys.problem.cons, &r.phi, tol.constraint);
+        let scaled = r.sys.problem.scaling.residual(&r.phi);
         let reduced::Reduced {
             phi,
             energy,
@@ -74,7 +76,7 @@ pub(super) fn verify_on(
             eval,
             ..
         } = r;
-        let assembled = phi.amax() <= tol.constraint;
+        let assembled = scaled <= tol.constraint;
         let tau = tol.force + tol.relative * force_scale;
         // Without a stop or contact touching, the verdict on this partition.
         let (held, stability) = std::thread::scope(|s| {
@@ -84,7 +86,7 @@ pub(super) fn verify_on(
                 })
             });
             let held = held::held(model, state, &list, &values, backend, tau)?;
-            let passed = passes(phi.amax(), &held, force_scale, tol);
+            let passed = passes(scaled, &held, force_scale, tol);
             // A panic there is re-raised here, as if the verdict had been computed on
             // this thread.
             let stability = match verdict {
@@ -97,6 +99,7 @@ pub(super) fn verify_on(
         })?;
         (
             phi,
+            scaled,
             energy,
             reduced_gradient,
             force_scale,
@@ -107,12 +110,14 @@ pub(super) fn verify_on(
     } else {
         let p = super::dense::project(model, state)?;
         let closure = closures(model, &p.cons, &p.phi, tol.constraint);
+        let scaled = Scaling::new(model, &p.cons).residual(&p.phi);
         let projected_gradient = (p.null.transpose() * &p.grad_s).amax();
         let force_scale = p.grad_s.amax();
         let tau = tol.force + tol.relative * force_scale;
         let held = held::held(model, state, &list, &values, backend, tau)?;
         (
             p.phi,
+            scaled,
             p.energy,
             projected_gradient,
             force_scale,
@@ -148,12 +153,12 @@ pub(super) fn verify_on(
         .max_by(|a, b| a.effort.abs().total_cmp(&b.effort.abs()))
         .cloned();
     let constraint_residual = phi.amax();
-    let balanced = passes(constraint_residual, &held, force_scale, tol);
+    let balanced = passes(scaled, &held, force_scale, tol);
     let passed = contact.settle(tol.constraint, balanced) && balanced;
     if !balanced {
         imbalance_failures(
             model,
-            constraint_residual,
+            scaled,
             &imbalance,
             held.unassigned,
             effort_tolerance,
@@ -181,6 +186,7 @@ pub(super) fn verify_on(
         robot: model.name.clone(),
         passed,
         constraint_residual,
+        scaled_constraint_residual: scaled,
         closure,
         imbalance,
         max_imbalance,
@@ -195,7 +201,7 @@ pub(super) fn verify_on(
     })
 }
 
-/// The failures of the balance, appended to `failures`: the constraint residual, each effort
+/// The failures of the balance, appended to `failures`: the constraint residual `‖D Φ‖∞`, each effort
 /// beyond the tolerance (largest first), the unassigned force.
 fn imbalance_failures(
     model: &Model,
@@ -208,7 +214,7 @@ fn imbalance_failures(
 ) {
     if residual > tol.constraint {
         failures.push(format!(
-            "constraint residual {residual:.3e} beyond the tolerance {:.1e}",
+            "constraint residual ‖D Φ‖∞ = {residual:.3e} beyond the tolerance {:.1e}",
             tol.constraint
         ));
     }
@@ -240,7 +246,7 @@ fn imbalance_failures(
     }
 }
 
-/// Whether a pose passes: `‖Φ‖∞` within the constraint tolerance, every effort of a coordinate
+/// Whether a pose passes: `‖D Φ‖∞` within the constraint tolerance, every effort of a coordinate
 /// no lock holds and the unassigned force within `force + relative · force_scale`.
 fn passes(residual: f64, held: &held::Held, force_scale: f64, tol: &Tolerances) -> bool {
     let effort_tolerance = tol.force + tol.relative * force_scale;

@@ -3,7 +3,8 @@
 //!
 //! Every inequality `g_k(q) ≥ 0` of the model (module `constraints::unilateral`: joint stops,
 //! contact points against the grounds) is evaluated at the pose. With `ε` the constraint
-//! tolerance (m or rad):
+//! tolerance (on `‖D Φ‖∞`: below, `g_k` is the gap scaled as its row, a gap in m divided by
+//! the characteristic length):
 //! - `g_k < −ε`: the pose goes through a stop or into a ground, and fails;
 //! - `|g_k| ≤ ε`: the inequality touches and may carry a force `λ_k ≥ 0` (a stop's effort, a
 //!   contact's normal force). A sticking contact also carries a tangential force `f_t`, through
@@ -42,6 +43,10 @@ pub struct UnilateralCheck {
     pub active_limits: Vec<ActiveLimit>,
     /// The largest violation `max(0, −g_k)` of any inequality \[m or rad\].
     pub penetration: f64,
+    /// The same scaled as its row (a gap in m divided by the characteristic length): what
+    /// the constraint tolerance bounds.
+    #[serde(skip)]
+    pub(crate) scaled_penetration: f64,
     /// The largest `|g_k λ_k|` of the touching inequalities \[J\].
     pub complementarity: f64,
     /// Why the pose fails (empty when it passes): points inside a ground or joints beyond a
@@ -58,7 +63,7 @@ impl UnilateralCheck {
     /// (`balanced`): nothing beyond `eps` through a stop or a ground, no contact slipping. The
     /// rows that would have had to pull are not a failure when the pose passes without them.
     pub(super) fn settle(&mut self, eps: f64, balanced: bool) -> bool {
-        let holds = self.penetration <= eps
+        let holds = self.scaled_penetration <= eps
             && self
                 .contacts
                 .iter()
@@ -101,12 +106,15 @@ pub(super) fn touching(
         let Some(g) = unilateral::gap(model, &u, &state.q, &state.branches) else {
             continue;
         };
-        if g > eps {
+        // The gap scaled as its row (module `solver::system::residual`).
+        let scaled = g / model.length_scale.powi(unilateral::length_power(model, &u));
+        if scaled > eps {
             continue;
         }
         let what = unilateral::name(model, &u);
-        if g < -eps {
+        if scaled < -eps {
             out.penetration = out.penetration.max(-g);
+            out.scaled_penetration = out.scaled_penetration.max(-scaled);
             out.failures.push(match u {
                 Unilateral::Limit { .. } => {
                     format!("`{what}`: the joint is beyond its stop by {:.3e}", -g)

@@ -288,3 +288,43 @@ fn signpost_check_finds_code() {
     let text = "//! doc\nmod a;\npub(crate) use a::{\n    B,\n};\nfn f() {}\n";
     assert_eq!(code_lines(text), vec![(6, "fn f() {}".to_owned())]);
 }
+
+/// One table of joint type names (issue 20): no file of `src/` but `model/joint_types.rs`
+/// matches a joint type name as a string (`"revolute" =>`, `"ball" |`); the importer and the
+/// exports look names up in `JOINT_TYPES` or call `JointKind::name`.
+#[test]
+fn joint_type_names_are_matched_in_one_table() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    let table = src.join("model").join("joint_types.rs");
+    let names: Vec<&str> = restpose::model::JOINT_TYPES
+        .iter()
+        .map(|t| t.name)
+        .collect();
+    assert!(names.contains(&"revolute") && names.contains(&"ball"));
+    let mut problems = Vec::new();
+    for file in files.iter().filter(|f| **f != table) {
+        let text = std::fs::read_to_string(file).expect("source is readable");
+        for (n, line) in text.lines().enumerate() {
+            let code = line.trim_start();
+            if code.starts_with("//") {
+                continue;
+            }
+            for name in &names {
+                let quoted = format!("\"{name}\"");
+                let arm = [" =>", " |"]
+                    .iter()
+                    .any(|tail| code.contains(&format!("{quoted}{tail}")));
+                if arm {
+                    problems.push(format!("{}:{}: {}", file.display(), n + 1, code));
+                }
+            }
+        }
+    }
+    assert!(
+        problems.is_empty(),
+        "joint type names matched outside model/joint_types.rs:\n{}",
+        problems.join("\n")
+    );
+}

@@ -11,12 +11,14 @@
 //! applies to (`Options::constraint_tolerance`, default [`TOLERANCE`]): the assembly, the
 //! corrector (over the partition's independent rows, [`Scaling::residual_over`], then over
 //! every row with the floor [`REDUNDANT_FLOOR`]), and the gaps of the stops and contacts (a
-//! gap in m divided by `L`, as its row). `verify` uses the same scaling for its closure of a
-//! given pose.
+//! gap in m divided by `L`, as its row). `verify`'s tolerance (`Tolerances::constraint`, the
+//! same default) bounds the same `‖D Φ‖∞` of a given pose over every row, and the gaps of its
+//! stops and contacts in the same scaling, so `analyze --constraint-tolerance` and
+//! `verify --constraint-tolerance` mean one thing.
 //!
 //! What is *reported* as `constraint_residual` (the analysis's diagnostics, `verify`) is the
-//! raw `‖Φ‖∞` in m or rad, a JSON field kept as it was; `verify --constraint-tolerance` is a
-//! bound on that raw value (a check of a given pose, in the pose's own units, default 1e-8).
+//! raw `‖Φ‖∞` in m or rad, a JSON field kept as it was; `verify` reports `‖D Φ‖∞` beside it
+//! as `scaled_constraint_residual`.
 
 use super::problem::Scaling;
 use nalgebra::DVector;

@@ -1,5 +1,5 @@
 //! Curvature of an obstacle's signed distance: the Hessian `K = ∇²d(x)` that the gap row
-//! `g = d(x(q)) − ρ` needs beyond its tangent plane (module `model::obstacle`):
+//! `g = d(x(q)) − ρ` needs beyond its tangent plane (module `surface`):
 //!
 //! `∇²g = (∂x/∂q)ᵀ K (∂x/∂q) + Σ_k n_k ∇²x_k`.
 //!
@@ -19,35 +19,35 @@
 //! plane's Hessian). Where `d` is not twice differentiable (a point exactly on an edge,
 //! a vertex or the axis) `K = 0` too.
 
-use super::obstacle::Obstacle;
-use crate::geometry::ShapeKind;
-use nalgebra::{Matrix3, Point3, Vector3};
+use super::ShapeKind;
+use nalgebra::{Isometry3, Matrix3, Point3, Vector3};
 
-impl Obstacle {
-    /// The Hessian of the signed distance to the surface at the world point `x` (world
-    /// frame).
-    pub(crate) fn curvature(&self, x: &Vector3<f64>) -> Matrix3<f64> {
-        let p = self
-            .world_from_shape
-            .inverse_transform_point(&Point3::from(*x))
-            .coords;
-        let k = match &self.shape {
-            ShapeKind::Sphere { .. } => point(&p, &Vector3::zeros()),
-            ShapeKind::Capsule { length, .. } => {
-                let h = length / 2.0;
-                if p.z.abs() < h {
-                    side(&p)
-                } else {
-                    point(&p, &Vector3::new(0.0, 0.0, p.z.clamp(-h, h)))
-                }
+/// The Hessian of the signed distance to the surface of `shape` (placed at
+/// `world_from_shape`) at the world point `x` (world frame).
+pub(crate) fn curvature(
+    world_from_shape: &Isometry3<f64>,
+    shape: &ShapeKind,
+    x: &Vector3<f64>,
+) -> Matrix3<f64> {
+    let p = world_from_shape
+        .inverse_transform_point(&Point3::from(*x))
+        .coords;
+    let k = match shape {
+        ShapeKind::Sphere { .. } => point(&p, &Vector3::zeros()),
+        ShapeKind::Capsule { length, .. } => {
+            let h = length / 2.0;
+            if p.z.abs() < h {
+                side(&p)
+            } else {
+                point(&p, &Vector3::new(0.0, 0.0, p.z.clamp(-h, h)))
             }
-            ShapeKind::Box { size } => box_curvature(&p, &(size / 2.0)),
-            ShapeKind::Cylinder { radius, length } => cylinder(&p, *radius, length / 2.0),
-            ShapeKind::Mesh { .. } => Matrix3::zeros(),
-        };
-        let r = self.world_from_shape.rotation.to_rotation_matrix();
-        r.matrix() * k * r.matrix().transpose()
-    }
+        }
+        ShapeKind::Box { size } => box_curvature(&p, &(size / 2.0)),
+        ShapeKind::Cylinder { radius, length } => cylinder(&p, *radius, length / 2.0),
+        ShapeKind::Mesh { .. } => Matrix3::zeros(),
+    };
+    let r = world_from_shape.rotation.to_rotation_matrix();
+    r.matrix() * k * r.matrix().transpose()
 }
 
 /// `(I − n nᵀ) / r` of the distance to the point `c`.
@@ -72,7 +72,7 @@ fn side(p: &Vector3<f64>) -> Matrix3<f64> {
 }
 
 /// The box `[−h, h]`: zero on a face (or inside), a line's on an edge, a point's at a vertex
-/// (the regions of `obstacle::box_plane`).
+/// (the regions of `surface::box_plane`).
 fn box_curvature(p: &Vector3<f64>, h: &Vector3<f64>) -> Matrix3<f64> {
     let excess = p.abs() - h;
     let scale = 1e-12 * h.amax();
@@ -121,16 +121,15 @@ fn cylinder(p: &Vector3<f64>, radius: f64, h: f64) -> Matrix3<f64> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::surface::tests::Placed;
     use super::*;
-    use nalgebra::Isometry3;
 
     /// `K` equals central second differences of the signed distance `n·(x − c)` of the tangent
     /// plane, in every region of every shape, the shape turned and moved.
     #[test]
     fn curvature_matches_second_differences_of_the_distance() {
         let at = Isometry3::new(Vector3::new(0.3, -0.2, 0.1), Vector3::new(0.2, -0.4, 0.3));
-        let obstacle = |shape| Obstacle {
-            link: "o".into(),
+        let obstacle = |shape| Placed {
             world_from_shape: at,
             shape,
             hull: None,
@@ -175,7 +174,7 @@ mod tests {
                 let (c, n) = o.tangent_plane(y);
                 n.dot(&(y - c))
             };
-            let k = o.curvature(&x);
+            let k = curvature(&o.world_from_shape, &o.shape, &x);
             let e = 1e-4;
             for i in 0..3 {
                 for j in 0..3 {

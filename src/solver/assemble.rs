@@ -39,6 +39,11 @@ fn newton(
         let rows_residual =
             |sys: &System, phi: &DVector<f64>| sys.problem.scaling.residual_over(phi, &part.rows);
         let res = rows_residual(sys, &phi);
+        // The redundant rows hold only to rounding once the independent ones do: accepted at
+        // the corrector's floor (a contact made active within the gap tolerance is one).
+        if res <= tol && sys.dimensionless_residual() <= tol.max(REDUNDANT_FLOOR) {
+            return Ok(q);
+        }
         if res <= tol {
             // The redundant rows hold only to rounding of the independent ones, or to the
             // gaps below the tolerance at which touching contacts were taken as active:

@@ -34,6 +34,7 @@
 //!   *Computer Journal* 6 (1963) 163–168.
 
 use super::inequality::active_set::Guard;
+use super::inequality::release::Release;
 use super::line_search::{line_search, Line, Trial};
 use super::options::{Method, Options};
 use super::partition::Partition;
@@ -65,6 +66,9 @@ pub(crate) struct Outcome {
     /// The inactive inequalities (indices into the guard's list) that stopped the last step: `q`
     /// is on its boundary.
     pub(crate) blocked: Option<Vec<usize>>,
+    /// The active inequalities (indices into the round's active list) to release: the round
+    /// ended before it was stationary (module `inequality::release`).
+    pub(crate) released: Vec<usize>,
 }
 
 /// Relative rounding floor of the reduced gradient: the convergence test uses
@@ -79,6 +83,10 @@ const GRADIENT_FLOOR: f64 = 1e-13;
 /// spread with it and its floor swallows the physical curvatures (a UR5 swinging down from
 /// horizontal stalled at ‖∇f‖ = 10⁻² for 200 iterations).
 const PIVOT_DRIFT: f64 = 0.85;
+
+/// Up to this many degrees of freedom the sparse path too steps by the exact reduced Hessian's
+/// eigen-decomposition, not the shifted KKT system (whose shift cut Tiago's steps 200-fold).
+const EXACT_NEWTON_DOF: usize = 64;
 
 /// The minimizer's state between iterations.
 struct Search {
@@ -129,6 +137,7 @@ pub(crate) fn minimize(
     part: Partition,
     options: &Options,
     guard: Option<&Guard>,
+    release: Option<&Release>,
 ) -> Option<Outcome> {
     let mut diag = Diagnostics {
         load_steps: 1,
@@ -156,6 +165,7 @@ pub(crate) fn minimize(
     let mut eigen = None;
     let mut inertia = None;
     let mut blocked = None;
+    let mut released = Vec::new();
     loop {
         // The gradient cannot be resolved below the rounding of the energy's terms.
         let gtol = options
@@ -163,6 +173,14 @@ pub(crate) fn minimize(
             .max(GRADIENT_FLOOR * s.eval.energy.magnitude);
         s.diag.gradient_tolerance = gtol;
         record(&mut s, options, true);
+        // Active rows pulling hard leave before the round is stationary (`release`).
+        if s.eval.grad_v.amax() > gtol {
+            if let Some(r) = release.and_then(|r| r.early(sys, &s.part, &s.eval)) {
+                released = r;
+                termination = Termination::Converged;
+                break;
+            }
+        }
         let (eig, test) = convergence_test(sys, &s, gtol, options);
         let negative_curvature = match test {
             Test::Converged(e, v) => {
@@ -243,6 +261,7 @@ pub(crate) fn minimize(
         history: s.history,
         diagnostics: s.diag,
         blocked,
+        released,
     })
 }
 
@@ -279,7 +298,8 @@ fn convergence_test(
 ) -> (Option<Spectrum>, Test) {
     let gnorm = s.eval.grad_v.amax();
     let dof = s.part.independent.len();
-    let dense_newton = options.method == Method::Newton && sys.backend == Backend::Dense;
+    let dense_newton = options.method == Method::Newton
+        && (sys.backend == Backend::Dense || dof <= EXACT_NEWTON_DOF);
     // On the Lanczos path the inertia verdict, and the spectrum only to leave a saddle
     // (module `stability::at_rest`).
     let mut verdict = None;

@@ -168,7 +168,7 @@ pub(crate) fn solve_assembled(
     if !active_set::inequalities(model, options).is_empty() {
         return active_set::solve(model, start, locks, options);
     }
-    let round = solve_round(model, start, locks, &[], None, options)?;
+    let round = solve_round(model, start, locks, &[], None, None, options)?;
     Ok((round.state, round.report))
 }
 
@@ -178,6 +178,9 @@ pub(crate) struct Round {
     pub(crate) report: Report,
     /// The inactive inequalities (indices into the guard's list) that stopped the last step.
     pub(crate) blocked: Option<Vec<usize>>,
+    /// The active inequalities (indices into the active list) that leave before the round
+    /// was stationary (module `inequality::release`).
+    pub(crate) released: Vec<usize>,
     /// Multipliers of the rows of each active inequality.
     pub(crate) multipliers: Vec<(Active, Vec<f64>)>,
     /// `required_mu` and slipping, where module `friction` chose the distribution.
@@ -192,6 +195,7 @@ pub(crate) fn solve_round(
     locks: &[(JointId, usize, f64)],
     active: &[Active],
     guard: Option<&active_set::Guard>,
+    release: Option<&inequality::release::Release>,
     options: &Options,
 ) -> Result<Round> {
     let q = start.q;
@@ -220,7 +224,7 @@ pub(crate) fn solve_round(
         });
     }
     let rank = part.rows.len();
-    let Some(out) = minimize::minimize(&mut sys, q.clone(), part, options, guard) else {
+    let Some(out) = minimize::minimize(&mut sys, q.clone(), part, options, guard, release) else {
         return Err(
             crate::forces::undefined_term(model, &start.branches, &q).unwrap_or(
                 Error::SingularPartition {
@@ -255,7 +259,7 @@ pub(crate) fn solve_round(
     // from it (and judges stability itself if it ends there).
     // Where the minimizer judged by the KKT inertia (many degrees of freedom), that verdict,
     // unless eigenvalues are asked for (module `stability::at_rest`).
-    let stability = (dof > 0 && out.blocked.is_none()).then(|| {
+    let stability = (dof > 0 && out.blocked.is_none() && out.released.is_empty()).then(|| {
         if let (Some((verdict, tolerance)), false) = (out.inertia, options.eigenvalues) {
             diagnostics.eigenvalues_by = "inertia".into();
             return Stability {
@@ -277,7 +281,7 @@ pub(crate) fn solve_round(
         mu[row] = out.eval.mu[k];
     }
     let mut chosen = None;
-    if !active.is_empty() && !out.part.redundant.is_empty() {
+    if !active.is_empty() && !out.part.redundant.is_empty() && out.released.is_empty() {
         chosen = distribution::spread(
             model,
             &sys.problem.cons,
@@ -291,6 +295,7 @@ pub(crate) fn solve_round(
     let reactions = reactions::reactions(&sys, &out.q, &mu);
     let multipliers = active_set::active_multipliers(&sys.problem.cons, &mu);
     let blocked = out.blocked;
+    let released = out.released;
     diagnostics.timings.stability = stability_started.elapsed().as_secs_f64();
     let mut history = out.history;
     for h in &mut history {
@@ -346,6 +351,7 @@ pub(crate) fn solve_round(
         state,
         report,
         blocked,
+        released,
         multipliers,
         chosen,
     })

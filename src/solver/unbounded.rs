@@ -49,7 +49,7 @@ pub(crate) fn fall_at_start(
         max_iterations: 0,
         ..options.clone()
     };
-    let round = super::solve_round(model, start.clone(), locks, &[], None, &options)?;
+    let round = super::solve_round(model, start.clone(), locks, &[], None, None, &options)?;
     let mut report = round.report;
     report.termination = super::Termination::Unbounded;
     report.diagnostics.free_directions = directions;

@@ -8,8 +8,10 @@
 //!   `|g_k| ≤ tol`; every inequality within `tol` of its boundary there joins `A`, and the
 //!   partition is recomputed;
 //! - at a stationary point, the multipliers `λ_k` of the active rows (`V_qᵀ = Φ_qᵀ μ`) are the
-//!   stops' efforts and the contacts' normal forces; the one most negative below
-//!   `−force_tolerance · F` (`F` the weight and loads of the mechanism) leaves `A`;
+//!   stops' efforts and the contacts' normal forces; those below `−force_tolerance · F` (`F`
+//!   the weight and loads of the mechanism) leave `A`: all of them the first time, later only
+//!   the most negative; a round also ends before it is stationary when a multiplier pulls
+//!   hard relative to the reduced gradient (module `release`);
 //! - it stops when every `λ_k ≥ −force_tolerance · F` and every `g_k ≥ −tol`
 //!   (complementarity `g_k λ_k = 0` holds by construction: active rows have `g = 0`, inactive
 //!   ones `λ = 0`), or after `max_iterations` changes of `A` after the start (reported as
@@ -111,25 +113,9 @@ pub(crate) fn active_multipliers(
         .collect()
 }
 
-/// The inequality whose multiplier is most negative relative to `scale` (a stop's effort in
-/// N m divided by the characteristic length), if below `−threshold`.
-pub(crate) fn to_release(
-    model: &Model,
-    multipliers: &[(Active, Vec<f64>)],
-    threshold: f64,
-) -> Option<usize> {
-    multipliers
-        .iter()
-        .enumerate()
-        .map(|(i, (a, m))| (i, scaled_force(model, a, m)))
-        .filter(|&(_, l)| l < -threshold)
-        .min_by(|a, b| a.1.total_cmp(&b.1))
-        .map(|(i, _)| i)
-}
-
 /// The multiplier of an active row's inequality, a stop's torque divided by the
 /// characteristic length so that it compares with forces.
-fn scaled_force(model: &Model, a: &Active, m: &[f64]) -> f64 {
+pub(crate) fn scaled_force(model: &Model, a: &Active, m: &[f64]) -> f64 {
     match a.row {
         Unilateral::Limit { joint, .. } if model.joints[joint.0].kind.is_angle(0) => {
             m[0] / model.length_scale
@@ -139,7 +125,7 @@ fn scaled_force(model: &Model, a: &Active, m: &[f64]) -> f64 {
 }
 
 /// The active rows that carry a force above `threshold` (strongly active) and those that do
-/// not (weakly active), with the multipliers' scaling of [`to_release`].
+/// not (weakly active), with the multipliers' scaling of [`scaled_force`].
 pub(crate) fn split(
     model: &Model,
     multipliers: &[(Active, Vec<f64>)],
@@ -205,6 +191,9 @@ pub(crate) fn solve(
     let mut counters = crate::solver::Diagnostics::default();
     let (mut history, mut iterates) = (Vec::new(), Vec::new());
     let mut rounds = 0;
+    // The inequalities released once already (they leave again only alone, at a stationary
+    // point: module `release`).
+    let mut released_before: Vec<Unilateral> = Vec::new();
     loop {
         let mut branches = state.branches.clone();
         let q = crate::solver::assemble::project(
@@ -226,12 +215,14 @@ pub(crate) fn solve(
             max_iterations: options.max_iterations.saturating_sub(iterations),
             ..options.clone()
         };
+        let release = super::release::Release::new(model, &active, &released_before, threshold);
         let round = crate::solver::solve_round(
             model,
             crate::State { q, branches },
             locks,
             &active,
             Some(&guard),
+            Some(&release),
             &budget,
         )?;
         iterations += round.report.iterations;
@@ -247,6 +238,18 @@ pub(crate) fn solve(
             std::mem::take(&mut report.iterates),
         );
         let cycling = changes - initial >= options.max_iterations;
+        if !round.released.is_empty() && !cycling {
+            // Rows pulling hard before the round was stationary (module `release`).
+            let mut gone = round.released.clone();
+            gone.sort_unstable();
+            for &i in gone.iter().rev() {
+                released_before.push(active[i].row);
+                active.remove(i);
+                changes += 1;
+            }
+            super::rolling::record_touches(model, &active, &state.q, &mut touched);
+            continue;
+        }
         let mut rolled_too_far = false;
         if let (Some(hit), false) = (&round.blocked, cycling) {
             // A sphere that reached its roll limit is re-anchored where it touches now.
@@ -266,10 +269,26 @@ pub(crate) fn solve(
             rolled_too_far = true;
         }
         if report.converged() && !cycling && !rolled_too_far {
-            if let Some(i) = to_release(model, &round.multipliers, threshold) {
-                active.remove(i);
+            let mut gone = super::release::all_to_release(model, &round.multipliers, threshold);
+            // Several at once only among rows never released before (module `release`).
+            let fresh: Vec<usize> = gone
+                .iter()
+                .copied()
+                .filter(|&i| !released_before.contains(&active[i].row))
+                .collect();
+            if fresh.is_empty() {
+                gone.truncate(1);
+            } else {
+                gone = fresh;
+            }
+            if !gone.is_empty() {
+                gone.sort_unstable();
+                for &i in gone.iter().rev() {
+                    released_before.push(active[i].row);
+                    active.remove(i);
+                    changes += 1;
+                }
                 super::rolling::record_touches(model, &active, &state.q, &mut touched);
-                changes += 1;
                 continue;
             }
             if super::rolling::reanchor(model, options, &mut active, &touched, &state.q) {
@@ -284,8 +303,9 @@ pub(crate) fn solve(
             report.termination = crate::solver::Termination::ActiveSetCycling;
         }
         let mut judging = 0.0;
-        // A round stopped at an inequality or a roll limit has no verdict of its own.
-        if (cycling || rolled_too_far) && round.blocked.is_some() {
+        // A round stopped at an inequality or a roll limit, or before it was stationary, has
+        // no verdict of its own.
+        if (cycling || rolled_too_far) && (round.blocked.is_some() || !round.released.is_empty()) {
             let judged = std::time::Instant::now();
             report.stability = crate::solver::stability_on(
                 model,

@@ -3,10 +3,12 @@
 //!
 //! - `active_set`: the iteration (which inequality joins, which leaves, when it stops).
 //! - `guard`: where a step first reaches an inactive inequality's boundary.
+//! - `release`: when active rows leave (early, before a round is stationary; several at once).
 //! - `rolling`: sticking spheres re-anchored where they touch after rolling.
 //! - `distribution`: the least-norm force distribution of a statically indeterminate support.
 
 pub(crate) mod active_set;
 pub(crate) mod distribution;
 pub(crate) mod guard;
+pub(crate) mod release;
 pub(crate) mod rolling;

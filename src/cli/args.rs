@@ -189,9 +189,14 @@ pub(crate) struct VerifyArgs {
     pub(crate) force_tolerance: f64,
     /// Largest dimensionless constraint residual ‖DΦ‖∞ for the pose to pass (each row in m^k
     /// divided by L^k, L the characteristic length; the residual and default of `analyze
-    /// --constraint-tolerance`); a stop or contact touches within it in the same scaling.
+    /// --constraint-tolerance`).
     #[arg(long, default_value_t = Tolerances::default().constraint, value_parser = parse::positive)]
     pub(crate) constraint_tolerance: f64,
+    /// Band of a stop's or contact's gap, scaled as its row (m divided by L, or rad), within
+    /// which it touches and beyond which through a stop or a ground the pose fails: the band
+    /// in which analyze's active set takes an inequality as touching.
+    #[arg(long, default_value_t = Tolerances::default().gap, value_parser = parse::positive)]
+    pub(crate) gap_tolerance: f64,
     /// Write the verification as JSON to this file (`-`: standard output, which then carries
     /// only the JSON: no report).
     #[arg(long, value_name = "OUT.json")]

@@ -123,6 +123,7 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
     let tol = restpose::verify::Tolerances {
         force: a.force_tolerance,
         constraint: a.constraint_tolerance,
+        gap: a.gap_tolerance,
         ..Default::default()
     };
     let uni = a.contact.policy();

@@ -40,7 +40,7 @@ use nalgebra::Vector3;
 
 /// A validated mechanism (built by [`ModelBuilder`], which the URDF importer drives);
 /// immutable once built: the library's users read it through the accessors ([`Model::bodies`],
-/// [`Model::joints`], …). The lists are [`Shared`] between copies (a load step's model shares
+/// [`Model::joints`], …). The lists are shared (copy-on-write) between copies (a load step's model shares
 /// everything but the loads it scales).
 #[derive(Clone, Debug)]
 pub struct Model {
@@ -236,7 +236,7 @@ impl Model {
     }
 
     /// The same model with gravity, dead loads and joint efforts scaled by `factor` (load
-    /// stepping). Only the loads and efforts are copied; every other list is [`Shared`].
+    /// stepping). Only the loads and efforts are copied; every other list is shared.
     pub fn with_load_factor(&self, factor: f64) -> Model {
         let mut m = self.clone();
         m.gravity *= factor;

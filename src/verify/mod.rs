@@ -79,9 +79,14 @@ pub struct Tolerances {
     /// Largest constraint residual `‖D Φ‖∞` (dimensionless: a row in m^k divided by `L^k`, `L`
     /// the characteristic length; the one residual of module `solver::system::residual`, which
     /// `analyze --constraint-tolerance` bounds too; default 1e-10, the solver's). A gap of a
-    /// stop or contact touches when it is within `constraint` in the same scaling (`L ε` for a
-    /// gap in m, `ε` in rad).
+    /// stop or contact is judged by `gap` instead.
     pub constraint: f64,
+    /// The band of a stop's or contact's gap, scaled as its row (`L ε` for a gap in m, `ε` in
+    /// rad), within which it touches, and beyond which through a stop or a ground it fails:
+    /// the band in which the solver's active set takes an inequality as touching
+    /// (`solver::Options::gap_tolerance`, the same default 1e-9), so that every contact set
+    /// `analyze` chooses is one `verify` reads the same way.
+    pub gap: f64,
     /// Effort tolerance relative to the largest generalized force `‖S ∇V‖∞`, added to `force`
     /// (default: 1e-9).
     pub relative: f64,
@@ -92,6 +97,7 @@ impl Default for Tolerances {
         Tolerances {
             force: 1e-6,
             constraint: crate::solver::system::residual::TOLERANCE,
+            gap: crate::solver::Options::default().gap_tolerance,
             relative: 1e-9,
         }
     }

@@ -65,7 +65,7 @@ pub(super) fn verify_on(
     // differ in where they put the rest).
     let backend = Backend::Sparse;
     let mut contact = unilateral::UnilateralCheck::default();
-    let list = unilateral::touching(model, state, uni, tol.constraint, &mut contact);
+    let list = unilateral::touching(model, state, uni, tol.gap, &mut contact);
     let coords = tree_coordinates(model, state);
     let values: Vec<_> = coords.iter().map(|c| (c.0, c.1, c.2.v)).collect();
     let (phi, scaled, energy, projected_gradient, force_scale, closure, held, stability) =
@@ -162,7 +162,7 @@ pub(super) fn verify_on(
         .cloned();
     let constraint_residual = phi.amax();
     let balanced = passes(scaled, &held, force_scale, tol);
-    let passed = contact.settle(tol.constraint, balanced) && balanced;
+    let passed = contact.settle(tol.gap, balanced) && balanced;
     if !balanced {
         imbalance_failures(
             model,

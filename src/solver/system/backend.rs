@@ -35,14 +35,22 @@ pub(crate) enum Backend {
 
 impl Backend {
     /// The backend `choice` asks for; automatic: by the size of `model`, and above
-    /// [`SPARSE_FROM_COORDINATES`] the tree factors for a mechanism without closed loops (its
-    /// partitions fit a tree: `O(N)` with fixed-size blocks, faster than the general sparse
-    /// factors on chains and ropes, BENCHMARKS.md), the sparse ones with loops (a ladder's
-    /// thousand loops would not fit a small border).
+    /// [`SPARSE_FROM_COORDINATES`] the tree factors for a mechanism without closed loops,
+    /// joint stops or contact points (its partitions fit a tree: `O(N)` with fixed-size blocks,
+    /// faster than the general sparse factors on chains, BENCHMARKS.md), the sparse ones
+    /// otherwise: a ladder's thousand loops would not fit a small border, and with stops
+    /// (Romeo hanging onto its finger stops) the tree factors' last Newton steps stall at a
+    /// reduced gradient of 3.7e-8 (tolerance 1e-8) where the sparse ones converge in 17
+    /// iterations; until that is understood, rows that the active set adds keep the sparse
+    /// factors unless `--linear-algebra tree` asks for the tree.
     pub(crate) fn choose(model: &Model, choice: LinearAlgebra) -> Self {
         match choice {
             LinearAlgebra::Auto if model.coordinate_count() > SPARSE_FROM_COORDINATES => {
-                if model.joints.iter().all(|j| j.tree || j.merged) {
+                let tree = model
+                    .joints
+                    .iter()
+                    .all(|j| (j.tree || j.merged) && j.limits.is_none());
+                if tree && model.contact_points.is_empty() {
                     Backend::Tree
                 } else {
                     Backend::Sparse
@@ -88,5 +96,44 @@ impl Backend {
             ),
             Backend::Dense => partition(&jac.to_dense(), &scaling.rows, &scaling.columns),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::urdf::{load_str, ImportOptions};
+
+    fn model(text: &str) -> Model {
+        load_str(text, "chain.urdf", &ImportOptions::default())
+            .unwrap()
+            .model
+    }
+
+    /// The automatic choice: the tree factors for a long open chain, the sparse ones once the
+    /// same chain has stops (rows the active set adds) or contact points, dense when small.
+    #[test]
+    fn automatic_choice_keeps_the_tree_factors_to_chains_without_inequalities() {
+        let free = crate::generate::chain(60, false);
+        assert_eq!(
+            Backend::choose(&model(&free), LinearAlgebra::Auto),
+            Backend::Tree
+        );
+        let limited = free
+            .replace("type=\"continuous\"", "type=\"revolute\"")
+            .replace(
+                "<axis ",
+                "<limit lower=\"-3\" upper=\"3\" effort=\"1\" velocity=\"1\"/><axis ",
+            );
+        assert_ne!(limited, free);
+        let m = model(&limited);
+        assert!(m.joints.iter().any(|j| j.limits.is_some()));
+        assert_eq!(Backend::choose(&m, LinearAlgebra::Auto), Backend::Sparse);
+        assert_eq!(Backend::choose(&m, LinearAlgebra::Tree), Backend::Tree);
+        let small = crate::generate::chain(10, false);
+        assert_eq!(
+            Backend::choose(&model(&small), LinearAlgebra::Auto),
+            Backend::Dense
+        );
     }
 }

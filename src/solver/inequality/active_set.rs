@@ -194,22 +194,29 @@ pub(crate) fn solve(
     // The inequalities released once already (they leave again only alone, at a stationary
     // point: module `release`).
     let mut released_before: Vec<Unilateral> = Vec::new();
+    // The contacts that let go of a floating body in the last round (module `let_go`).
+    let mut let_go: Vec<Unilateral> = Vec::new();
+    // The inequalities the last step met (module `guard`: some may be false hits).
+    let mut hits: Vec<Unilateral> = Vec::new();
     loop {
         let mut branches = state.branches.clone();
-        let q = crate::solver::assemble::project(
+        let q = super::guard::project_past_false_hits(
             model,
             state.q,
             &mut branches,
             locks,
-            &active,
+            &mut active,
+            &std::mem::take(&mut hits),
             options,
+            tol,
         )?;
         let inactive: Vec<Unilateral> = all
             .iter()
             .filter(|u| !active.iter().any(|a| a.row == **u))
             .copied()
             .collect();
-        let guard = Guard::new(model, options, inactive, &active, tol, &q);
+        let guard = Guard::new(model, options, inactive, &active, tol, &q)
+            .with_true_gaps(&std::mem::take(&mut let_go));
         // `max_iterations` bounds the iterations of all rounds together.
         let budget = Options {
             max_iterations: options.max_iterations.saturating_sub(iterations),
@@ -259,6 +266,7 @@ pub(crate) fn solve(
             }
             for &k in hit.iter().filter(|&&k| !guard.is_roll_limit(k)) {
                 active.push(activate(model, options, guard.inactive[k], &state.q));
+                hits.push(guard.inactive[k]);
                 changes += 1;
             }
             super::rolling::record_touches(model, &active, &state.q, &mut touched);
@@ -268,7 +276,29 @@ pub(crate) fn solve(
             report.termination = crate::solver::Termination::Unbounded;
             rolled_too_far = true;
         }
-        if report.converged() && !cycling && !rolled_too_far {
+        // A round whose line search failed while active rows pull (a box sliding over the
+        // edge of a finite ramp, its contacts at the edge pulling it back) is not a rest
+        // either: those rows leave as at a stationary point, and the next round goes on.
+        let failed = report.termination == crate::solver::Termination::LineSearchFailed;
+        let stuck = failed
+            && !super::release::all_to_release(model, &round.multipliers, threshold).is_empty();
+        // Or while its contacts no longer hold a floating body (module `let_go`).
+        let hanging = if failed && !stuck && !cycling && !rolled_too_far {
+            super::let_go::opened(model, &active, &state)
+        } else {
+            Vec::new()
+        };
+        let_go = hanging.iter().map(|&i| active[i].row).collect();
+        if !hanging.is_empty() {
+            for &i in hanging.iter().rev() {
+                released_before.push(active[i].row);
+                active.remove(i);
+                changes += 1;
+            }
+            super::rolling::record_touches(model, &active, &state.q, &mut touched);
+            continue;
+        }
+        if (report.converged() || stuck) && !cycling && !rolled_too_far {
             let mut gone = super::release::all_to_release(model, &round.multipliers, threshold);
             // Several at once only among rows never released before (module `release`).
             let fresh: Vec<usize> = gone

@@ -71,6 +71,20 @@ impl<'m> Guard<'m> {
         }
     }
 
+    /// The guard with the contacts `rows` that let go of a floating body (module `let_go`)
+    /// guarded by their true gap instead of the obstacle's tangent plane: at an edge of the
+    /// obstacle that plane is one of two faces, and the motion that opens the gap may cross
+    /// it. Along such a motion the signed distance to the convex obstacle grows from the
+    /// start, so it cannot be stepped through.
+    pub(crate) fn with_true_gaps(mut self, rows: &[Unilateral]) -> Self {
+        for (k, u) in self.inactive.iter().enumerate() {
+            if rows.contains(u) {
+                self.planes[k] = None;
+            }
+        }
+        self
+    }
+
     /// Number of guarded inequalities: the inactive ones, then the roll limits.
     fn len(&self) -> usize {
         self.inactive.len() + self.rolls.len()
@@ -245,6 +259,45 @@ impl<'m> Guard<'m> {
         }
         Some((q_lo, touching))
     }
+}
+
+/// Projects `q` onto the joints and the `active` rows (`assemble::project`). A step is guarded
+/// against an obstacle's tangent plane at the round's start, which extends past the
+/// obstacle's edges: a box tipping over the edge of a finite ramp meets the plane of the top
+/// face beyond the edge, 0.089 m from the ramp. If the projection fails, the rows of `hits`
+/// (just added where a step met its plane) whose true gap is open beyond `tol` leave `active`
+/// again and the projection is retried; the next round guards them against the tangent plane
+/// at the new point.
+///
+/// # Errors
+/// As `assemble::project`, when the retry fails too or no such row was added.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn project_past_false_hits(
+    model: &Model,
+    q: DVector<f64>,
+    branches: &mut Branches,
+    locks: &[(JointId, usize, f64)],
+    active: &mut Vec<Active>,
+    hits: &[Unilateral],
+    options: &Options,
+    tol: f64,
+) -> crate::Result<DVector<f64>> {
+    let start = (!hits.is_empty()).then(|| (q.clone(), branches.clone()));
+    let first = crate::solver::assemble::project(model, q, branches, locks, active, options);
+    let (Err(_), Some((q, from))) = (&first, start) else {
+        return first;
+    };
+    let before = active.len();
+    active.retain(|a| {
+        !hits.contains(&a.row)
+            || unilateral::gap(model, &a.row, &q, &from)
+                .is_none_or(|g| dimensionless(model, &a.row, g) <= tol)
+    });
+    if active.len() == before {
+        return first;
+    }
+    *branches = from;
+    crate::solver::assemble::project(model, q, branches, locks, active, options)
 }
 
 #[cfg(test)]

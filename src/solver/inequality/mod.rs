@@ -4,11 +4,13 @@
 //! - `active_set`: the iteration (which inequality joins, which leaves, when it stops).
 //! - `guard`: where a step first reaches an inactive inequality's boundary.
 //! - `release`: when active rows leave (early, before a round is stationary; several at once).
+//! - `let_go`: contacts that no longer hold a floating body when a round stalls.
 //! - `rolling`: sticking spheres re-anchored where they touch after rolling.
 //! - `distribution`: the least-norm force distribution of a statically indeterminate support.
 
 pub(crate) mod active_set;
 pub(crate) mod distribution;
 pub(crate) mod guard;
+pub(crate) mod let_go;
 pub(crate) mod release;
 pub(crate) mod rolling;

@@ -8,6 +8,7 @@ mod issue_21_free_arm_converges_directly;
 mod issue_21_ground_start;
 mod issue_21_stops_leave_together;
 mod issue_21_verify_forces_and_stability;
+mod issue_22_off_the_ramp;
 mod issue_25_closed_pipe;
 mod issue_25_fuzz_smoke;
 mod issue_25_located_errors;

@@ -1,0 +1,121 @@
+//! Regression (issue 22, item 3): a 1 kg box on a finite frictionless ramp (a world-fixed box
+//! obstacle tilted by 0.3 rad) has no rest: it slides to the ramp's edge and falls off. The
+//! solve ended `line_search_failed` after 17 iterations and 406 corrector failures, with two
+//! contacts at the edge pulling (normal force −1.4495 N): a round whose line search fails
+//! kept its active set, so the pulling rows never left. Such rows now leave as at a stationary
+//! point; contacts hanging on the edge that a translation along the pull opens let go (module
+//! `inequality::let_go`), and the free fall that follows is reported `unbounded`, within the
+//! iteration limit, naming the box.
+
+use restpose::model::Friction;
+use restpose::urdf::{load_file, ImportOptions};
+use restpose::{Options, Termination};
+
+/// The ramp (2 × 2 × 0.2 m, pitched by `TILT` about y, centred on the world origin) and the
+/// 0.4 × 0.3 × 0.2 m box.
+fn ramp() -> String {
+    format!(
+        r#"<robot name="box_on_tilted_box" xmlns:mech="urn:urdf-mech:1">
+  <link name="world"/>
+  <link name="ramp">
+    <collision><origin rpy="0 {TILT} 0"/><geometry><box size="2 2 0.2"/></geometry></collision>
+  </link>
+  <joint name="ramp_mount" type="fixed"><parent link="world"/><child link="ramp"/></joint>
+  <link name="box">
+    <inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="0.4 0.3 0.2"/></geometry></collision>
+  </link>
+  <joint name="free" type="floating"><parent link="world"/><child link="box"/></joint>
+  <mech:obstacle link="ramp"/>
+  <mech:contact link="box"/>
+</robot>
+"#
+    )
+}
+
+const TILT: f64 = 0.3;
+
+/// The lowest point of the ramp, `−(sin α · 1 + cos α · 0.1)` m, less the box's half
+/// diagonal: a box centre below this is clear of the ramp.
+fn below_the_ramp() -> f64 {
+    let half_diagonal = (0.2f64 * 0.2 + 0.15 * 0.15 + 0.1 * 0.1).sqrt();
+    -(TILT.sin() + TILT.cos() * 0.1) - half_diagonal
+}
+
+fn frictionless() -> Options {
+    Options {
+        friction: Friction::None,
+        ..Default::default()
+    }
+}
+
+fn solve(urdf: &str) -> (restpose::State, restpose::Report) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("ramp.urdf");
+    std::fs::write(&path, urdf).unwrap();
+    let model = load_file(&path, &ImportOptions::default()).unwrap().model;
+    restpose::solve(&model, &frictionless()).unwrap()
+}
+
+fn assert_falls_off(report: &restpose::Report, what: &str) {
+    assert_eq!(report.termination, Termination::Unbounded, "{what}");
+    assert!(
+        report.iterations <= Options::default().max_iterations,
+        "{what}: {} iterations",
+        report.iterations
+    );
+    let dirs = &report.diagnostics.free_directions;
+    assert!(
+        dirs.iter().any(|d| d.contains("body `box`")),
+        "{what}: {dirs:?}"
+    );
+}
+
+/// The case of the issue (`restpose analyze ramp.urdf --friction none`; its `--base-xyz`
+/// places a floating root link, and the box is a child of `world`, so it starts at the
+/// origin, inside the ramp, and is pushed out onto its faces): the box slides to the edge,
+/// the edge contacts pull, then hang, then let go; it falls clear of the ramp.
+#[test]
+fn a_box_pushed_out_onto_a_finite_frictionless_ramp_falls_off_unbounded() {
+    let (state, report) = solve(&ramp());
+    assert_falls_off(&report, "from the origin");
+    // Independent check: the box's centre is below every point of the ramp by more than its
+    // half diagonal (it fell off; it does not hang on the edge).
+    let z = state.q[2];
+    assert!(z < below_the_ramp(), "box centre z = {z}");
+    // Along gravity: the last step named is a fall straight down.
+    let dirs = &report.diagnostics.free_directions;
+    assert!(
+        dirs.iter()
+            .any(|d| d.contains("body `box` translating along (0.000, 0.000, -1.000)")),
+        "{dirs:?}"
+    );
+}
+
+/// The command line of the issue gives the same answer, in the JSON.
+#[test]
+fn analyze_reports_the_box_off_the_ramp_unbounded() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("ramp.urdf");
+    std::fs::write(&path, ramp()).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_restpose"))
+        .args(["analyze", "--friction", "none", "--json", "-"])
+        .arg(&path)
+        .args([
+            "--base-xyz",
+            "0.062",
+            "0",
+            "0.2006",
+            "--base-rpy",
+            "0",
+            "0.3",
+            "0",
+        ])
+        .output()
+        .unwrap();
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["termination"], "unbounded", "{json}");
+    assert!(json["iterations"].as_u64().unwrap() <= 200, "{json}");
+    // Not converged: exit 3.
+    assert_eq!(out.status.code(), Some(3));
+}

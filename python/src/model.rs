@@ -149,7 +149,7 @@ impl Model {
     /// Robot name (``<robot name>``).
     #[getter]
     fn name(&self) -> &str {
-        &self.model().name()
+        self.model().name()
     }
 
     /// Names of every joint, in model order (URDF ``<joint>`` elements in file order, then

@@ -149,7 +149,7 @@ impl Model {
     /// Robot name (``<robot name>``).
     #[getter]
     fn name(&self) -> &str {
-        &self.model().name()
+        self.model().name()
     }
 
     /// Names of every joint, in model order (URDF ``<joint>`` elements in file order, then
@@ -274,12 +274,14 @@ impl Model {
     /// needs, …; ``to_json()`` is ``restpose verify --json``). The GIL is released while it
     /// runs. Options as ``restpose verify``.
     #[pyo3(signature = (pose, *, force_tolerance=1e-6, constraint_tolerance=1e-10,
-        limits="enforce", friction="none", mu=None, linear_algebra="auto", eigenvalues=false))]
+        gap_tolerance=1e-9, limits="enforce", friction="none", mu=None, linear_algebra="auto",
+        eigenvalues=false))]
     fn verify<'py>(
         slf: &Bound<'py, Self>,
         pose: &Bound<'py, PyAny>,
         force_tolerance: f64,
         constraint_tolerance: f64,
+        gap_tolerance: f64,
         limits: &str,
         friction: &str,
         mu: Option<f64>,
@@ -290,9 +292,11 @@ impl Model {
         let this = slf.get();
         options::positive(Some(force_tolerance), "force_tolerance")?;
         options::positive(Some(constraint_tolerance), "constraint_tolerance")?;
+        options::positive(Some(gap_tolerance), "gap_tolerance")?;
         let tol = Tolerances {
             force: force_tolerance,
             constraint: constraint_tolerance,
+            gap: gap_tolerance,
             ..Default::default()
         };
         let uni = Unilaterals {

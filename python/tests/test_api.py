@@ -254,6 +254,10 @@ def test_verify_and_assert_rest_pose(robots):
     bad = model.verify({"pivot": 0.0})
     assert not bad.passed and bad.max_imbalance.joint == "pivot"
     assert abs(bad.max_imbalance.effort) > 1.0
+    # the band in which a stop or contact touches, as `restpose verify --gap-tolerance`
+    assert model.verify(result, gap_tolerance=1e-6).passed
+    with pytest.raises(ValueError, match="gap_tolerance"):
+        model.verify(result, gap_tolerance=0.0)
 
 
 def test_verify_a_pose_file_like_the_command_line(robots, tmp_path):

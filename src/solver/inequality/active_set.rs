@@ -11,7 +11,9 @@
 //!   stops' efforts and the contacts' normal forces; those below `−force_tolerance · F` (`F`
 //!   the weight and loads of the mechanism) leave `A`: all of them the first time, later only
 //!   the most negative; a round also ends before it is stationary when a multiplier pulls
-//!   hard relative to the reduced gradient (module `release`);
+//!   hard relative to the reduced gradient (module `release`); a round whose line search
+//!   fails releases its pulling rows likewise, and where none pulls, the contacts that no
+//!   longer hold a floating body (module `let_go`);
 //! - it stops when every `λ_k ≥ −force_tolerance · F` and every `g_k ≥ −tol`
 //!   (complementarity `g_k λ_k = 0` holds by construction: active rows have `g = 0`, inactive
 //!   ones `λ = 0`), or after `max_iterations` changes of `A` after the start (reported as

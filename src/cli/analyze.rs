@@ -137,7 +137,7 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
 /// A joint named by `--lock` or `--initial` that the model lacks: the error names the option.
 fn with_option(a: &AnalyzeArgs, e: restpose::Error) -> anyhow::Error {
     let restpose::Error::UnknownJoint { name, .. } = &e else {
-        return e.into();
+        return a.input.explain(e);
     };
     let given =
         (a.lock.iter().map(|s| ("lock", s))).chain(a.initial.iter().map(|s| ("initial", s)));

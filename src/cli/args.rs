@@ -89,6 +89,19 @@ pub(crate) struct InputArgs {
 }
 
 impl InputArgs {
+    /// An import error with the command line's words for it: a base pose the model cannot take
+    /// (module `urdf::base`) names `--base-xyz` / `--base-rpy` and `--floating-base`.
+    pub(crate) fn explain(&self, e: restpose::Error) -> anyhow::Error {
+        let given = self.base_xyz.is_some() || self.base_rpy.is_some();
+        if given && e.to_string().contains("base pose (`base_pose`)") {
+            return anyhow::anyhow!(
+                "{e}; on the command line: --base-xyz / --base-rpy place the root link that \
+                 --floating-base lets float, --initial JOINT[DOF]=VALUE a `floating` joint's start"
+            );
+        }
+        e.into()
+    }
+
     /// The importer's options.
     pub(crate) fn options(&self) -> anyhow::Result<ImportOptions> {
         let mut opts = ImportOptions {

@@ -8,7 +8,7 @@ use restpose::urdf::load_file;
 
 /// Runs `check`: exit 0, or 1 if the initial guess does not assemble.
 pub(crate) fn run(a: &CheckArgs) -> anyhow::Result<u8> {
-    let loaded = load_file(&a.file, &a.input.options()?)?;
+    let loaded = load_file(&a.file, &a.input.options()?).map_err(|e| a.input.explain(e))?;
     let stdout_json = print::is_stdout(a.json.as_ref());
     let text = matches!(a.format, Format::Text) && !stdout_json;
     let check = restpose::verify::check(&loaded.model);

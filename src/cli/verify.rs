@@ -20,7 +20,7 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
             .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
         (loaded, values)
     });
-    let loaded = loaded?;
+    let loaded = loaded.map_err(|e| a.input.explain(e))?;
     let model = &loaded.model;
     let mut values = values.transpose()?.unwrap_or_default();
     for j in &a.joint {

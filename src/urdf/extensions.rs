@@ -418,6 +418,10 @@ pub(super) fn read(
         b.model.set_gravity(options.gravity);
     }
     if let Some(pose) = options.base_pose {
+        if !super::base::has_floating_root(b.model.partial()) {
+            let robot = src.doc.root_element();
+            return Err(src.error(robot, super::base::NO_FLOATING_ROOT));
+        }
         b.model.set_base_pose(pose);
     }
     let default = Ground::default();

@@ -6,6 +6,7 @@
 //! elements are read in one pass; the spanning tree is the URDF `<joint>` tree, and every
 //! `mech:loop_joint` closes a loop.
 
+mod base;
 mod edges;
 mod extensions;
 mod foreign;

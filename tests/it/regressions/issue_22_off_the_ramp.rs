@@ -71,9 +71,9 @@ fn assert_falls_off(report: &restpose::Report, what: &str) {
     );
 }
 
-/// The case of the issue (`restpose analyze ramp.urdf --friction none`; its `--base-xyz`
-/// places a floating root link, and the box is a child of `world`, so it starts at the
-/// origin, inside the ramp, and is pushed out onto its faces): the box slides to the edge,
+/// The case of the issue (`restpose analyze ramp.urdf --friction none`; the box is a child of
+/// `world` by a `floating` joint, so it starts at the origin, inside the ramp, and is pushed
+/// out onto its faces): the box slides to the edge,
 /// the edge contacts pull, then hang, then let go; it falls clear of the ramp.
 #[test]
 fn a_box_pushed_out_onto_a_finite_frictionless_ramp_falls_off_unbounded() {
@@ -92,30 +92,67 @@ fn a_box_pushed_out_onto_a_finite_frictionless_ramp_falls_off_unbounded() {
     );
 }
 
-/// The command line of the issue gives the same answer, in the JSON.
+/// The command line of the issue gives the same answer, in the JSON; the base pose it was
+/// tried with (`--base-xyz`, `--base-rpy`) places a floating root link, which this model does
+/// not have: an input error naming the file and the remedy, not a silently ignored option.
 #[test]
 fn analyze_reports_the_box_off_the_ramp_unbounded() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("ramp.urdf");
     std::fs::write(&path, ramp()).unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_restpose"))
-        .args(["analyze", "--friction", "none", "--json", "-"])
-        .arg(&path)
-        .args([
-            "--base-xyz",
-            "0.062",
-            "0",
-            "0.2006",
-            "--base-rpy",
-            "0",
-            "0.3",
-            "0",
-        ])
-        .output()
-        .unwrap();
+    let analyze = |extra: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_restpose"))
+            .args(["analyze", "--friction", "none", "--json", "-"])
+            .arg(&path)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let out = analyze(&[]);
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(json["termination"], "unbounded", "{json}");
     assert!(json["iterations"].as_u64().unwrap() <= 200, "{json}");
     // Not converged: exit 3.
     assert_eq!(out.status.code(), Some(3));
+    let placed = analyze(&[
+        "--base-xyz",
+        "0.062",
+        "0",
+        "0.2006",
+        "--base-rpy",
+        "0",
+        "0.3",
+        "0",
+    ]);
+    assert_eq!(placed.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&placed.stderr);
+    assert!(
+        err.contains("ramp.urdf:1:1:")
+            && err.contains("--base-xyz")
+            && err.contains("has none")
+            && err.contains("--floating-base"),
+        "{err}"
+    );
+    assert!(placed.stdout.is_empty(), "no half-written output");
+}
+
+/// A base pose given to the importer for a model whose root is fixed to the world is refused
+/// (it would be ignored); a file's `mech:base` is the start when the base floats and is read.
+#[test]
+fn a_base_pose_without_a_floating_root_is_refused() {
+    let placed = ImportOptions {
+        base_pose: Some(nalgebra::Isometry3::translation(0.0, 0.0, 1.0)),
+        ..Default::default()
+    };
+    let err = restpose::urdf::load_str(&ramp(), "ramp.urdf", &placed)
+        .err()
+        .expect("a base pose with no floating root must be refused")
+        .to_string();
+    assert!(err.starts_with("ramp.urdf:1:1:"), "{err}");
+    assert!(err.contains("floating root link"), "{err}");
+    let text = ramp().replace(
+        "<mech:obstacle",
+        "<mech:base xyz=\"0 0 1\"/>\n  <mech:obstacle",
+    );
+    assert!(restpose::urdf::load_str(&text, "ramp.urdf", &ImportOptions::default()).is_ok());
 }

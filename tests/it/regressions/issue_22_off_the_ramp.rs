@@ -144,10 +144,10 @@ fn a_base_pose_without_a_floating_root_is_refused() {
         base_pose: Some(nalgebra::Isometry3::translation(0.0, 0.0, 1.0)),
         ..Default::default()
     };
-    let err = restpose::urdf::load_str(&ramp(), "ramp.urdf", &placed)
-        .err()
-        .expect("a base pose with no floating root must be refused")
-        .to_string();
+    let Err(err) = restpose::urdf::load_str(&ramp(), "ramp.urdf", &placed) else {
+        panic!("a base pose with no floating root must be refused");
+    };
+    let err = err.to_string();
     assert!(err.starts_with("ramp.urdf:1:1:"), "{err}");
     assert!(err.contains("floating root link"), "{err}");
     let text = ramp().replace(

@@ -35,14 +35,15 @@ pub(crate) enum Backend {
 
 impl Backend {
     /// The backend `choice` asks for; automatic: by the size of `model`, and above
-    /// [`SPARSE_FROM_COORDINATES`] the tree factors for a mechanism without closed loops,
-    /// joint stops or contact points (its partitions fit a tree: `O(N)` with fixed-size blocks,
-    /// faster than the general sparse factors on chains, BENCHMARKS.md), the sparse ones
-    /// otherwise: a ladder's thousand loops would not fit a small border, and with stops
-    /// (Romeo hanging onto its finger stops) the tree factors' last Newton steps stall at a
-    /// reduced gradient of 3.7e-8 (tolerance 1e-8) where the sparse ones converge in 17
-    /// iterations; until that is understood, rows that the active set adds keep the sparse
-    /// factors unless `--linear-algebra tree` asks for the tree.
+    /// [`SPARSE_FROM_COORDINATES`] the tree factors for a mechanism without closed loops or
+    /// joint stops (its partitions fit a tree: `O(N)` with fixed-size blocks, faster than the
+    /// general sparse factors on chains and ropes, BENCHMARKS.md), the sparse ones otherwise:
+    /// a ladder's thousand loops would not fit a small border, and with stops (Romeo hanging
+    /// onto its finger stops) the tree factors' last Newton steps stall at a reduced gradient
+    /// of 3.7e-8 (tolerance 1e-8) where the sparse ones converge in 17 iterations; until that
+    /// is understood, models with stops keep the sparse factors unless `--linear-algebra tree`
+    /// asks for the tree. Contacts are rows on their body like a joint's (tested against the
+    /// sparse factors: a rope on the ground, Solo-12 standing).
     pub(crate) fn choose(model: &Model, choice: LinearAlgebra) -> Self {
         match choice {
             LinearAlgebra::Auto if model.coordinate_count() > SPARSE_FROM_COORDINATES => {
@@ -50,7 +51,7 @@ impl Backend {
                     .joints
                     .iter()
                     .all(|j| (j.tree || j.merged) && j.limits.is_none());
-                if tree && model.contact_points.is_empty() {
+                if tree {
                     Backend::Tree
                 } else {
                     Backend::Sparse
@@ -111,9 +112,9 @@ mod tests {
     }
 
     /// The automatic choice: the tree factors for a long open chain, the sparse ones once the
-    /// same chain has stops (rows the active set adds) or contact points, dense when small.
+    /// same chain has stops, dense when small.
     #[test]
-    fn automatic_choice_keeps_the_tree_factors_to_chains_without_inequalities() {
+    fn automatic_choice_keeps_the_tree_factors_to_open_chains_without_stops() {
         let free = crate::generate::chain(60, false);
         assert_eq!(
             Backend::choose(&model(&free), LinearAlgebra::Auto),

@@ -20,6 +20,24 @@ pub(crate) struct BlockHessian {
 }
 
 impl BlockHessian {
+    /// Adds the blocks, scaled (`D_a H_ab D_b`, `scale` the coordinate scaling), into the
+    /// values of a KKT matrix at their slots (`slots[k]` for block `k`, row-major; `u32::MAX`:
+    /// an entry the matrix does not hold). The sparse and the tree KKT matrices both assemble
+    /// their `W` block this way.
+    pub(crate) fn scatter_scaled(&self, slots: &[[u32; 49]], scale: &[f64], values: &mut [f64]) {
+        for ((&(a, b), blk), slots) in self.keys.iter().zip(&self.values).zip(slots) {
+            for i in 0..7 {
+                for j in 0..7 {
+                    let slot = slots[7 * i + j];
+                    if slot != u32::MAX {
+                        values[slot as usize] +=
+                            blk[7 * i + j] * scale[7 * a + i] * scale[7 * b + j];
+                    }
+                }
+            }
+        }
+    }
+
     /// Sets every block to zero, keeping the structure.
     pub(crate) fn clear(&mut self) {
         self.values.iter_mut().for_each(|b| *b = [0.0; 49]);

@@ -293,17 +293,7 @@ impl Kkt {
         self.delta = 0.0;
         self.sigma = 0.0;
         self.sigma_columns.clear();
-        for ((&(a, b), blk), slots) in hess.keys.iter().zip(&hess.values).zip(&self.block_slots) {
-            for i in 0..7 {
-                for j in 0..7 {
-                    let slot = slots[7 * i + j];
-                    if slot != Ix::MAX {
-                        self.values[slot as usize] +=
-                            blk[7 * i + j] * scale[7 * a + i] * scale[7 * b + j];
-                    }
-                }
-            }
-        }
+        hess.scatter_scaled(&self.block_slots, scale, &mut self.values);
         for (e, &slot) in entries.iter().zip(&self.jac_slots) {
             if slot != Ix::MAX {
                 self.values[slot as usize] += e.2 * row_scale[e.0] * scale[e.1];

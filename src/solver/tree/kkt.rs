@@ -116,17 +116,7 @@ impl TreeKkt {
         self.sigma = 0.0;
         self.sigma_columns.clear();
         let s = &self.shape;
-        for ((&(a, b), blk), slots) in hess.keys.iter().zip(&hess.values).zip(&s.block_slots) {
-            for i in 0..7 {
-                for j in 0..7 {
-                    let slot = slots[7 * i + j];
-                    if slot != SKIP {
-                        self.values[slot as usize] +=
-                            blk[7 * i + j] * scale[7 * a + i] * scale[7 * b + j];
-                    }
-                }
-            }
-        }
+        hess.scatter_scaled(&s.block_slots, scale, &mut self.values);
         for (e, slots) in entries.iter().zip(&s.jac_slots) {
             for &slot in slots {
                 if slot != SKIP {

@@ -150,19 +150,30 @@ impl SparseFactors {
 
     /// `Φ_v x` (length: independent rows).
     pub(crate) fn phi_v_mul(&self, x: &[f64], r: usize) -> Vec<f64> {
-        let mut y = vec![0.0; r];
-        for &(i, j, v) in &self.phi_v {
-            y[i] += v * x[j];
-        }
-        y
+        triplets_mul(&self.phi_v, x, r)
     }
 
     /// `Φ_vᵀ y` (length: degrees of freedom).
     pub(crate) fn phi_v_tr_mul(&self, y: &[f64], dof: usize) -> Vec<f64> {
-        let mut x = vec![0.0; dof];
-        for &(i, j, v) in &self.phi_v {
-            x[j] += v * y[i];
-        }
-        x
+        triplets_tr_mul(&self.phi_v, y, dof)
     }
+}
+
+/// `A x` for `A` given by its `(row, column, value)` triplets, `rows` long (`Φ_v x` of the
+/// sparse and the tree factors).
+pub(crate) fn triplets_mul(a: &[(usize, usize, f64)], x: &[f64], rows: usize) -> Vec<f64> {
+    let mut y = vec![0.0; rows];
+    for &(i, j, v) in a {
+        y[i] += v * x[j];
+    }
+    y
+}
+
+/// `Aᵀ y` for `A` given by its `(row, column, value)` triplets, `columns` long.
+pub(crate) fn triplets_tr_mul(a: &[(usize, usize, f64)], y: &[f64], columns: usize) -> Vec<f64> {
+    let mut x = vec![0.0; columns];
+    for &(i, j, v) in a {
+        x[j] += v * y[i];
+    }
+    x
 }

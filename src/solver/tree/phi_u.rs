@@ -347,19 +347,11 @@ impl TreeLu {
 
     /// `Φ_v x` (length: independent rows).
     pub(crate) fn phi_v_mul(&self, x: &[f64], r: usize) -> Vec<f64> {
-        let mut y = vec![0.0; r];
-        for &(i, j, v) in &self.phi_v {
-            y[i] += v * x[j];
-        }
-        y
+        crate::solver::sparse::factor::triplets_mul(&self.phi_v, x, r)
     }
 
     /// `Φ_vᵀ y` (length: degrees of freedom).
     pub(crate) fn phi_v_tr_mul(&self, y: &[f64], dof: usize) -> Vec<f64> {
-        let mut x = vec![0.0; dof];
-        for &(i, j, v) in &self.phi_v {
-            x[j] += v * y[i];
-        }
-        x
+        crate::solver::sparse::factor::triplets_tr_mul(&self.phi_v, y, dof)
     }
 }

@@ -119,7 +119,10 @@ pub(crate) fn potential(
         let j = &model.joints[js.joint.0];
         let pair = pair_of(&j.bodies, q, want_h);
         let reference = branches.get(js.joint, js.dof);
-        if let (Some((g, h)), Some(theta)) = (add.derivatives(), stacked_angle(j, &pair, js.dof)) {
+        if let Some(((g, h), theta)) = add
+            .derivatives()
+            .and_then(|d| stacked_angle(j, &pair, js.dof).map(|t| (d, t)))
+        {
             let v = on_branch(theta.v, reference);
             let (u, f, k) = law::evaluate(&js.law, SpringMode::Both, v - js.reference)?;
             stacked::scatter_angle(&j.bodies, &theta, Some((f, k)), 1.0, g, h);
@@ -139,7 +142,10 @@ pub(crate) fn potential(
         let j = &model.joints[ef.joint.0];
         let pair = pair_of(&j.bodies, q, want_h);
         let reference = branches.get(ef.joint, ef.dof);
-        if let (Some((g, h)), Some(theta)) = (add.derivatives(), stacked_angle(j, &pair, ef.dof)) {
+        if let Some(((g, h), theta)) = add
+            .derivatives()
+            .and_then(|d| stacked_angle(j, &pair, ef.dof).map(|t| (d, t)))
+        {
             let v = on_branch(theta.v, reference);
             stacked::scatter_angle(&j.bodies, &theta, None, -ef.value, g, h);
             add.value(v, -ef.value, &mut e.loads);

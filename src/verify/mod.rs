@@ -158,10 +158,11 @@ fn sparse_path(model: &Model) -> bool {
     auto_backend(model) != Backend::Dense
 }
 
-/// The linear algebra `model` is verified with by default: the solver's automatic choice
-/// (dense; the sparse partition with the sparse factors, or with the tree factors on a tree).
+/// The linear algebra `model` is verified with by default: dense as the solver's automatic
+/// choice, else the sparse partition with the tree factors on a mechanism without closed
+/// loops (stops or not), with the sparse ones otherwise ([`Backend::for_verify`]).
 fn auto_backend(model: &Model) -> Backend {
-    Backend::choose(model, crate::solver::LinearAlgebra::Auto)
+    Backend::for_verify(model)
 }
 
 /// Potential energy of a state \[J\], `None` where a force table is out of its range.

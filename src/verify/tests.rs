@@ -150,13 +150,24 @@ fn verify_through_the_tree_factors_equals_verify_through_the_sparse_ones() {
         "</robot>",
         "<mech:lock joint=\"joint3\" value=\"0.2\"/><mech:lock joint=\"joint17\"/></robot>",
     );
+    // Every joint limited to ±0.02 rad: at rest most lean on a stop.
+    let stops = crate::generate::chain(50, false)
+        .replace("type=\"continuous\"", "type=\"revolute\"")
+        .replace(
+            "<axis ",
+            "<limit lower=\"-0.02\" upper=\"0.02\" effort=\"1\" velocity=\"1\"/><axis ",
+        );
     for text in [
         crate::generate::chain(60, false),
         locked,
+        stops,
         crate::generate::ladder(4),
     ] {
         let model = load(&text);
-        let (rest, _) = crate::solver::solve(&model, &Default::default()).unwrap();
+        let (rest, report) = crate::solver::solve(&model, &Default::default()).unwrap();
+        if model.joints.iter().any(|j| j.limits.is_some()) {
+            assert!(report.active_limits.len() > 10, "{}", model.name);
+        }
         let tol = Tolerances::default();
         for state in [rest, bent(&model)] {
             let all = super::Eigenvalues::Always;

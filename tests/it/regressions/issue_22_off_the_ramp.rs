@@ -125,9 +125,9 @@ fn a_box_started_on_the_ramp_slides_off_and_falls_unbounded() {
     assert!(z < below_the_ramp(), "box centre z = {z}");
     // The energy reported is the 1 kg box's `m g z` at the state reported.
     assert!(
-        (report.potential_energy - 9.81 * z).abs() < 1e-9 * z.abs(),
+        (report.energy.total - 9.81 * z).abs() < 1e-9 * z.abs(),
         "{} vs {}",
-        report.potential_energy,
+        report.energy.total,
         9.81 * z
     );
     let dirs = &report.diagnostics.free_directions;

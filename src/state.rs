@@ -227,16 +227,7 @@ impl State {
                 Some(b) => self.body_pose(b) * j.body_from_joint[k],
                 None => j.body_from_joint[k],
             };
-            let rel = pose(0).inverse() * pose(1);
-            let r = rel.rotation;
-            match j.kind {
-                JointKind::Spherical => vec![r.w, r.i, r.j, r.k],
-                JointKind::Floating => {
-                    let t = rel.translation.vector;
-                    vec![t.x, t.y, t.z, r.w, r.i, r.j, r.k]
-                }
-                _ => vec![],
-            }
+            (j.kind.spec().values_of_motion)(&(pose(0).inverse() * pose(1)))
         }
     }
 }

@@ -33,6 +33,6 @@ mod universal;
 pub use kind::JointKind;
 pub(crate) use kind::MAX_SCALAR_COORDINATES;
 pub use spec::{Declared, Name};
-pub(crate) use spec::{Frame, Read, Row, Spec, V};
+pub(crate) use spec::{Entry, Frame, Read, Row, Spec, V};
 pub(crate) use table::spec;
 pub use table::{joint_type, joint_types, JointType, KINDS};

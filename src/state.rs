@@ -11,9 +11,10 @@
 //! 3.5 − 2π, and a solve tracks each angle continuously from its start.
 
 use crate::jet::pair_of;
+use crate::joint::TreeMotion;
 use crate::kinematics::{coordinate, motion, Branches};
 use crate::math::{euler_parameters, unit_quaternion};
-use crate::model::{BodyId, JointId, JointKind, Model};
+use crate::model::{BodyId, JointId, Model};
 use nalgebra::{DVector, Isometry3, Translation3, Vector4};
 use std::collections::HashMap;
 
@@ -26,7 +27,7 @@ pub struct State {
     pub branches: Branches,
 }
 
-/// Joint coordinate values by joint name (see [`JointKind`] for the order of coordinates).
+/// Joint coordinate values by joint name (see [`crate::model::JointKind`] for the order of coordinates).
 pub type JointValues = HashMap<String, Vec<f64>>;
 
 impl State {
@@ -151,7 +152,7 @@ impl State {
             .joints
             .iter()
             .filter(|j| j.tree && !j.merged)
-            .filter(|j| matches!(j.kind, JointKind::Distance { .. } | JointKind::PointOnLine))
+            .filter(|j| j.kind.spec().tree_motion == TreeMotion::Pose && j.kind.position_len() == 0)
             .filter_map(|j| j.bodies[1])
             .collect()
     }

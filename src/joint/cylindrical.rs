@@ -2,7 +2,8 @@
 //! `z₀·x₁, z₀·y₁, x₀·d, y₀·d`; coordinates `θ`, `d·z₀`.
 
 use super::spec::{
-    angle, at, length, name, no_values, rz, t, Frame, Read, Spec, NOT_IN_URDF, ON_AXIS, PARALLEL, V,
+    angle, at, length, name, no_values, rz, t, Frame, Read, Spec, TreeMotion, NOT_IN_URDF, ON_AXIS,
+    PARALLEL, V,
 };
 use super::JointKind;
 use nalgebra::Isometry3;
@@ -17,6 +18,7 @@ pub(super) const SPEC: Spec = Spec {
     row_names: &["axis_x", "axis_y", "slide_x", "slide_y"],
     closed_form: true,
     frame: Frame::Axis,
+    tree_motion: TreeMotion::Coordinates,
     configuration: NOT_IN_URDF,
     values_of_motion: no_values,
     motion,

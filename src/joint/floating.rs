@@ -2,7 +2,7 @@
 //! `[x, y, z, rx, ry, rz]` (a rotation vector) or `[x, y, z, w, qx, qy, qz]`.
 
 use super::spec::Entry::Value;
-use super::spec::{at, name, quat, rotvec, t, Configuration, Frame, Spec};
+use super::spec::{at, name, quat, rotvec, t, Configuration, Frame, Spec, TreeMotion};
 use super::JointKind;
 use nalgebra::Isometry3;
 
@@ -16,6 +16,7 @@ pub(super) const SPEC: Spec = Spec {
     row_names: &[],
     closed_form: false,
     frame: Frame::Origin,
+    tree_motion: TreeMotion::Pose,
     configuration: Configuration {
         mujoco: Some(&[
             Value(0),

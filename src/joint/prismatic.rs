@@ -2,7 +2,8 @@
 //! y₀·d`; coordinate `d·z₀`.
 
 use super::spec::{
-    at, length, name, no_values, t, Frame, Read, Row, Spec, ONE_VALUE, ON_AXIS, PARALLEL, V,
+    at, length, name, no_values, t, Frame, Read, Row, Spec, TreeMotion, ONE_VALUE, ON_AXIS,
+    PARALLEL, V,
 };
 use super::JointKind;
 use nalgebra::{Isometry3, UnitQuaternion};
@@ -23,6 +24,7 @@ pub(super) const SPEC: Spec = Spec {
     row_names: &["axis_x", "axis_y", "twist", "slide_x", "slide_y"],
     closed_form: true,
     frame: Frame::Axis,
+    tree_motion: TreeMotion::Coordinates,
     configuration: ONE_VALUE,
     values_of_motion: no_values,
     motion,

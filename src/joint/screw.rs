@@ -3,7 +3,8 @@
 //! the screw advances over many turns: generic jets, no closed form).
 
 use super::spec::{
-    angle, at, name, no_values, rz, t, Frame, Read, Row, Spec, NOT_IN_URDF, ON_AXIS, PARALLEL,
+    angle, at, name, no_values, rz, t, Frame, Read, Row, Spec, TreeMotion, NOT_IN_URDF, ON_AXIS,
+    PARALLEL,
 };
 use super::JointKind;
 use nalgebra::Isometry3;
@@ -24,6 +25,7 @@ pub(super) const SPEC: Spec = Spec {
     row_names: &["axis_x", "axis_y", "slide_x", "slide_y", "thread"],
     closed_form: false,
     frame: Frame::Axis,
+    tree_motion: TreeMotion::Coordinates,
     configuration: NOT_IN_URDF,
     values_of_motion: no_values,
     motion,

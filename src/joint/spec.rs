@@ -116,6 +116,20 @@ pub(crate) const ONE_VALUE: Configuration = Configuration {
     pinocchio: Some(&[Entry::Value(0)]),
 };
 
+/// What moves the child of a tree joint of this kind in joint space (the stability verdict's
+/// joint-space check, `solver::stability::joint_space`, and the poses `verify` reads).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum TreeMotion {
+    /// Its scalar coordinates (none for a fixed joint).
+    Coordinates,
+    /// Its scalar coordinates and a free rotation (spherical: three angular velocities).
+    Rotation,
+    /// The child's whole pose (three translational and three angular velocities): a floating
+    /// joint's values, or for a kind without values (distance, point-on-line) the child body's
+    /// own pose.
+    Pose,
+}
+
 /// Where a file may declare a joint of a type name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Declared {
@@ -171,6 +185,8 @@ pub(crate) struct Spec {
     pub(crate) closed_form: bool,
     /// How `<axis>` places the joint frame.
     pub(crate) frame: Frame,
+    /// What moves its child as a tree joint.
+    pub(crate) tree_motion: TreeMotion,
     /// Its entries in MuJoCo's and Pinocchio's configuration vectors.
     pub(crate) configuration: Configuration,
     /// The values of a kind without scalar coordinates (a spherical joint's quaternion, a

@@ -2,7 +2,7 @@
 //! given as a rotation vector (3 values) or a quaternion `[w, x, y, z]` (4).
 
 use super::spec::Entry::Value;
-use super::spec::{at, name, quat, rotvec, t, Configuration, Frame, Spec, POS};
+use super::spec::{at, name, quat, rotvec, t, Configuration, Frame, Spec, TreeMotion, POS};
 use super::JointKind;
 use nalgebra::Isometry3;
 
@@ -19,6 +19,7 @@ pub(super) const SPEC: Spec = Spec {
     row_names: &["pos_x", "pos_y", "pos_z"],
     closed_form: true,
     frame: Frame::Origin,
+    tree_motion: TreeMotion::Rotation,
     configuration: Configuration {
         mujoco: Some(&[Value(0), Value(1), Value(2), Value(3)]),
         pinocchio: None,

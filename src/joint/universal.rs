@@ -3,7 +3,8 @@
 //! `θ₂ = atan2(z₀·y₁, z₀·z₁)`.
 
 use super::spec::{
-    angle, at, name, no_values, rx, rz, t, Frame, Read, Spec, NOT_IN_URDF, PARALLEL, POS, V,
+    angle, at, name, no_values, rx, rz, t, Frame, Read, Spec, TreeMotion, NOT_IN_URDF, PARALLEL,
+    POS, V,
 };
 use super::JointKind;
 use nalgebra::Isometry3;
@@ -21,6 +22,7 @@ pub(super) const SPEC: Spec = Spec {
     row_names: &["pos_x", "pos_y", "pos_z", "cross"],
     closed_form: true,
     frame: Frame::TwoAxes,
+    tree_motion: TreeMotion::Coordinates,
     configuration: NOT_IN_URDF,
     values_of_motion: no_values,
     motion,

@@ -463,6 +463,25 @@ pub(super) fn read(
             value: *value,
         });
     }
+    // The reference pose (a named SRDF state, a pose file) is also the start: a robot held
+    // about its standing state starts standing, not folding its legs from the file's zero
+    // pose on the ground. It overrides `mech:initial`; `--initial` overrides it. Joints of the
+    // pose that the model lacks, or that take several coordinates, are skipped (as the
+    // servos skip them).
+    for (name, value) in &options.servo_reference {
+        let Some(id) = b.model.joint_id(name) else {
+            continue;
+        };
+        if b.model.partial().joints[id.0].kind.scalar_coordinates() != 1 {
+            continue;
+        }
+        initial.retain(|l| !(l.joint == id && l.dof == 0));
+        initial.push(Initial {
+            joint: id,
+            dof: 0,
+            value: *value,
+        });
+    }
     for (name, dof, value) in &options.initial {
         let id = resolve(name, *dof, "initial value")?;
         initial.retain(|l| !(l.joint == id && l.dof == *dof));

@@ -64,16 +64,6 @@ fn newton(
                 .unwrap_or_else(|| phi.iamax());
             return Err(Failure::Inconsistent(worst));
         }
-        if std::env::var_os("LEGS_DEBUG").is_some() {
-            eprintln!(
-                "LEGS it {it} res {res:.3e} all {:.3e} redundant {:?} pivot",
-                sys.dimensionless_residual(),
-                part.redundant
-                    .iter()
-                    .map(|&r| sys.problem.cons.row_name(r).to_string())
-                    .collect::<Vec<_>>()
-            );
-        }
         let Some(du) = sys.dependent_step(&q, &part) else {
             return Err(Failure::Stuck(it));
         };
@@ -94,25 +84,6 @@ fn newton(
             alpha *= 0.5;
         }
         if !improved {
-            if std::env::var_os("LEGS_DEBUG").is_some() {
-                let mut idx: Vec<usize> = (0..phi.len()).collect();
-                idx.sort_by(|&a, &b| {
-                    sys.problem
-                        .scaling
-                        .row_residual(&phi, b)
-                        .total_cmp(&sys.problem.scaling.row_residual(&phi, a))
-                });
-                for &r in idx.iter().take(8) {
-                    eprintln!(
-                        "LEGS stuck it {it} row {} phi {:.3e} scaled {:.3e} redundant {}",
-                        sys.problem.cons.row_name(r),
-                        phi[r],
-                        sys.problem.scaling.row_residual(&phi, r),
-                        part.redundant.contains(&r)
-                    );
-                }
-                eprintln!("LEGS res {res:.3e} tol {tol:.3e}");
-            }
             return Err(Failure::Stuck(it));
         }
     }

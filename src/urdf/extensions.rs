@@ -463,11 +463,9 @@ pub(super) fn read(
             value: *value,
         });
     }
-    // The reference pose (a named SRDF state, a pose file) is also the start: a robot held
-    // about its standing state starts standing, not folding its legs from the file's zero
-    // pose on the ground. It overrides `mech:initial`; `--initial` overrides it. Joints of the
-    // pose that the model lacks, or that take several coordinates, are skipped (as the
-    // servos skip them).
+    // The reference pose (an SRDF state, a pose file) is also the start: a robot held about
+    // its standing state starts standing. It overrides `mech:initial`, `--initial` overrides
+    // it; joints the model lacks or with several coordinates are skipped (as by the servos).
     for (name, value) in &options.servo_reference {
         let Some(id) = b.model.joint_id(name) else {
             continue;

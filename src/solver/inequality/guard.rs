@@ -159,10 +159,10 @@ impl<'m> Guard<'m> {
             .min_by(|a, b| a.1.total_cmp(&b.1))
     }
 
-    /// Whether an inequality whose gap went from `start` to `g` can stop the step: it was open
-    /// beyond the tolerance, or it has closed further (module docs of [`Guard::boundary`]).
+    /// Whether an inequality whose gap went from `start` to `g` can stop the step: all but one
+    /// at its boundary at the start (within `tol`) whose gap has not decreased since.
     fn closing(&self, start: f64, g: f64) -> bool {
-        start > self.tol || g < start
+        start.abs() > self.tol || g < start
     }
 
     /// Whether the step from `from` to `to` brings one of the inequalities closer to its

@@ -189,3 +189,46 @@ fn the_solo12_on_its_mesh_feet_stands_servoed_level_and_on_a_slope() {
         assert_verified_contacts(&model, &state, Friction::Stick);
     }
 }
+
+/// A floating robot on the ground whose joints nothing holds collapses (issue 21, the A1
+/// without servos): the Solo-12 of `robots/solo12` without its joint springs, contacts on its
+/// feet only, falls through its trunk (`unbounded`); the error names the unheld joints and the
+/// remedy. With servos about its initial (standing) pose it stands, and no such note appears.
+#[test]
+fn an_unactuated_robot_that_finds_no_rest_is_told_to_add_servos() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/robots/solo12/solo12_ground.urdf"
+    );
+    let text: String = std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter(|l| !l.contains("<mech:joint_spring"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let dir = tempfile::tempdir().unwrap();
+    let meshes = std::path::Path::new(path).parent().unwrap().join("meshes");
+    std::os::unix::fs::symlink(meshes, dir.path().join("meshes")).unwrap();
+    let file = dir.path().join("solo12_limp.urdf");
+    std::fs::write(&file, text).unwrap();
+    let run = |extra: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_restpose"))
+            .args(["analyze", "-q", "--floating-base", "--friction", "stick"])
+            .args(extra)
+            .arg(&file)
+            .output()
+            .unwrap()
+    };
+    let limp = run(&[]);
+    let err = String::from_utf8_lossy(&limp.stderr);
+    assert_eq!(limp.status.code(), Some(3), "{err}");
+    assert!(
+        err.contains("12 joints are held by no servo, spring or lock (`FL_HAA`")
+            && err.contains("--servo all=K"),
+        "{err}"
+    );
+    let held = run(&["--servo", "all=50"]);
+    let err = String::from_utf8_lossy(&held.stderr);
+    assert_eq!(held.status.code(), Some(0), "{err}");
+    assert!(!err.contains("held by no servo"), "{err}");
+}

@@ -6,6 +6,7 @@
 //! - `release`: when active rows leave (early, before a round is stationary; several at once).
 //! - `let_go`: contacts that no longer hold a floating body when a round stalls.
 //! - `patch`: rounded hulls (mesh feet) rolling on one sticking pivot.
+//! - `stall`: a round whose steps shrink towards an obstacle's edge ends.
 //! - `rolling`: sticking spheres re-anchored where they touch after rolling.
 //! - `distribution`: the least-norm force distribution of a statically indeterminate support.
 
@@ -16,3 +17,4 @@ pub(crate) mod let_go;
 pub(crate) mod patch;
 pub(crate) mod release;
 pub(crate) mod rolling;
+pub(crate) mod stall;

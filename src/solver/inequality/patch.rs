@@ -125,3 +125,79 @@ pub(crate) fn promote(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::Friction;
+    use crate::urdf::{load_str, ImportOptions};
+
+    /// A floating rod 1 × 0.01 × 0.01 m (a box: its corners at one end 0.01–0.014 m apart,
+    /// within `δ = 0.1 · 1.0001` m; the two ends 1 m apart) above a ground, sticking.
+    fn rod() -> (Model, Options, DVector<f64>) {
+        let text = r#"<robot name="rod" xmlns:mech="urn:urdf-mech:1">
+  <link name="rod"><inertial><mass value="1"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="0.08" iyz="0" izz="0.08"/></inertial>
+    <collision><geometry><box size="1 0.01 0.01"/></geometry></collision></link>
+  <mech:ground xyz="0 0 -1"/>
+</robot>"#;
+        let options = ImportOptions {
+            floating_base: true,
+            ..Default::default()
+        };
+        let model = load_str(text, "rod.urdf", &options).unwrap().model;
+        let opts = Options {
+            friction: Friction::Stick,
+            ..Default::default()
+        };
+        let q = crate::State::initial(&model).q;
+        (model, opts, q)
+    }
+
+    #[test]
+    fn the_neighbours_of_a_pivot_push_only_and_take_over_when_it_leaves() {
+        let (model, opts, q) = rod();
+        assert_eq!(model.contact_points.len(), 8);
+        let at = |x: f64| -> Vec<usize> {
+            (0..8)
+                .filter(|&k| (model.contact_points[k].point.x - x).abs() < 1e-12)
+                .collect()
+        };
+        let (near, far) = (at(-0.5), at(0.5));
+        assert_eq!((near.len(), far.len()), (4, 4));
+        let mut active: Vec<Active> = Vec::new();
+        for &k in near.iter().chain(&far[..1]) {
+            let u = Unilateral::Contact {
+                point: k,
+                ground: 0,
+            };
+            let a = activate(&model, &opts, &active, u, &q);
+            active.push(a);
+        }
+        // One pivot at each end: the first corner of the near end, the far corner.
+        let anchored: Vec<bool> = active.iter().map(|a| a.anchor.is_some()).collect();
+        assert_eq!(anchored, [true, false, false, false, true]);
+        // The near pivot leaves: its nearest neighbour takes over, held where it is.
+        let pivot = active.remove(0);
+        promote(&model, &opts, &mut active, &[pivot], &q);
+        let dist = |a: &Active| match a.row {
+            Unilateral::Contact { point, .. } => {
+                (model.contact_points[point].point - model.contact_points[near[0]].point).norm()
+            }
+            Unilateral::Limit { .. } => f64::INFINITY,
+        };
+        let nearest = (0..3)
+            .min_by(|&i, &j| dist(&active[i]).total_cmp(&dist(&active[j])))
+            .unwrap();
+        for (i, a) in active.iter().enumerate().take(3) {
+            assert_eq!(a.anchor.is_some(), i == nearest, "corner {i}");
+        }
+        assert!(active[3].anchor.is_some());
+        // Frictionless, no contact is anchored and none is promoted.
+        let none = Options::default();
+        let u = Unilateral::Contact {
+            point: near[0],
+            ground: 0,
+        };
+        assert!(activate(&model, &none, &[], u, &q).anchor.is_none());
+    }
+}

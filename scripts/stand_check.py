@@ -45,13 +45,13 @@ STIFFNESS = 200.0
 
 # name, URDF, SRDF (below ERD), how the joints are held.
 ROBOTS = [
-    ("solo12", "solo_description/robots/solo12.urdf", "solo_description/srdf/solo.srdf", "lock"),
+    ("solo12", "solo_description/robots/solo12.urdf", "solo_description/srdf/solo.srdf", "servo"),
     ("anymal_b", "anymal_b_simple_description/robots/anymal.urdf",
      "anymal_b_simple_description/srdf/anymal.srdf", "servo"),
     ("anymal_c", "anymal_c_simple_description/urdf/anymal.urdf",
      "anymal_c_simple_description/srdf/anymal.srdf", "servo"),
     ("hyq", "hyq_description/robots/hyq_no_sensors.urdf", "hyq_description/srdf/hyq.srdf",
-     "lock"),
+     "servo"),
     ("go1", "go1_description/urdf/go1.urdf", "go1_description/srdf/go1.srdf", "servo"),
     ("a1", "a1_description/urdf/a1.urdf", "a1_description/srdf/a1.srdf", "servo"),
 ]

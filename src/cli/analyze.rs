@@ -129,9 +129,46 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
                 result.diagnostics.free_directions.join(", ")
             );
         }
+        if a.input.floating_base && !model.grounds().is_empty() {
+            let free = unheld_joints(model);
+            if let Some(first) = free.first() {
+                super::print::note!(
+                    "  {} joints are held by no servo, spring or lock (`{first}`, …): a robot \
+                     without actuation collapses on the ground, and no rest was found for its \
+                     fall; to stand it, hold them like position servos: --servo all=K (about a \
+                     named state: --srdf FILE --srdf-state NAME)",
+                    free.len()
+                );
+            }
+        }
         return Ok(exit::NOT_CONVERGED);
     }
     Ok(0)
+}
+
+/// The revolute, continuous and prismatic joints that no servo, joint spring, lock or mimic
+/// holds, in file order.
+fn unheld_joints(model: &restpose::Model) -> Vec<String> {
+    use restpose::model::JointKind;
+    model
+        .joints()
+        .iter()
+        .enumerate()
+        .filter(|(_, j)| {
+            !j.merged
+                && matches!(
+                    j.kind,
+                    JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic
+                )
+        })
+        .filter(|(id, _)| {
+            !model.servos().iter().any(|s| s.joint.index() == *id)
+                && !model.joint_springs().iter().any(|s| s.joint.index() == *id)
+                && !model.locks().iter().any(|l| l.joint.index() == *id)
+                && !model.mimics().iter().any(|m| m.joint.index() == *id)
+        })
+        .map(|(_, j)| j.name.clone())
+        .collect()
 }
 
 /// A joint named by `--lock` or `--initial` that the model lacks: the error names the option.

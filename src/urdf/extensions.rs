@@ -459,6 +459,23 @@ pub(super) fn read(
             value: *value,
         });
     }
+    // The reference pose (an SRDF state, a pose file) is also the start: a robot held about
+    // its standing state starts standing. It overrides `mech:initial`, `--initial` overrides
+    // it; joints the model lacks or with several coordinates are skipped (as by the servos).
+    for (name, value) in &options.servo_reference {
+        let Some(id) = b.model.joint_id(name) else {
+            continue;
+        };
+        if b.model.partial().joints[id.0].kind.scalar_coordinates() != 1 {
+            continue;
+        }
+        initial.retain(|l| !(l.joint == id && l.dof == 0));
+        initial.push(Initial {
+            joint: id,
+            dof: 0,
+            value: *value,
+        });
+    }
     for (name, dof, value) in &options.initial {
         let id = resolve(name, *dof, "initial value")?;
         initial.retain(|l| !(l.joint == id && l.dof == *dof));

@@ -57,7 +57,9 @@ pub struct ImportOptions {
     /// Position servos (`--servo`), applied in order after the file's own elements.
     pub servos: Vec<ServoRequest>,
     /// Reference pose of the servos `(joint, value)` (`--servo-reference`, an SRDF
-    /// `group_state`): a servo without its own reference holds its joint at this value.
+    /// `group_state`): a servo without its own reference holds its joint at this value, and
+    /// the joint starts there (overriding `mech:initial`; [`ImportOptions::initial`] overrides
+    /// it).
     pub servo_reference: Vec<(String, f64)>,
     /// `--xacro-arg NAME:=VALUE`: arguments of a xacro file (feature `xacro`).
     pub xacro_args: Vec<(String, String)>,

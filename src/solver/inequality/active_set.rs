@@ -174,14 +174,14 @@ pub(crate) fn solve(
     let mut state = start;
     // Inequalities violated or touching at the start are active from the start (a sticking
     // contact that touches at the start is held where it is).
-    let mut active: Vec<Active> = all
-        .iter()
-        .filter(|u| {
-            unilateral::gap(model, u, &state.q, &state.branches)
-                .is_some_and(|g| dimensionless(model, u, g) <= tol)
-        })
-        .map(|&u| activate(model, options, u, &state.q))
-        .collect();
+    let mut active: Vec<Active> = Vec::new();
+    for u in all.iter().filter(|u| {
+        unilateral::gap(model, u, &state.q, &state.branches)
+            .is_some_and(|g| dimensionless(model, u, g) <= tol)
+    }) {
+        let a = super::patch::activate(model, options, &active, *u, &state.q);
+        active.push(a);
+    }
     // The inequalities active from the start count as changes in the report, not towards the
     // cycling guard (a rope lying on the ground starts with hundreds).
     let mut changes = active.len();
@@ -256,11 +256,13 @@ pub(crate) fn solve(
             }
             let mut gone = round.released.clone();
             gone.sort_unstable();
+            let removed: Vec<Active> = gone.iter().map(|&i| active[i]).collect();
             for &i in gone.iter().rev() {
                 released_before.push(active[i].row);
                 active.remove(i);
                 changes += 1;
             }
+            super::patch::promote(model, options, &mut active, &removed, &state.q);
             super::rolling::record_touches(model, &active, &state.q, &mut touched);
             continue;
         }
@@ -272,7 +274,9 @@ pub(crate) fn solve(
                 rolls += 1;
             }
             for &k in hit.iter().filter(|&&k| !guard.is_roll_limit(k)) {
-                active.push(activate(model, options, guard.inactive[k], &state.q));
+                let a =
+                    super::patch::activate(model, options, &active, guard.inactive[k], &state.q);
+                active.push(a);
                 hits.push(guard.inactive[k]);
                 changes += 1;
             }
@@ -297,11 +301,13 @@ pub(crate) fn solve(
         };
         let_go = hanging.iter().map(|&i| active[i].row).collect();
         if !hanging.is_empty() {
+            let removed: Vec<Active> = hanging.iter().map(|&i| active[i]).collect();
             for &i in hanging.iter().rev() {
                 released_before.push(active[i].row);
                 active.remove(i);
                 changes += 1;
             }
+            super::patch::promote(model, options, &mut active, &removed, &state.q);
             super::rolling::record_touches(model, &active, &state.q, &mut touched);
             continue;
         }
@@ -320,11 +326,13 @@ pub(crate) fn solve(
             }
             if !gone.is_empty() {
                 gone.sort_unstable();
+                let removed: Vec<Active> = gone.iter().map(|&i| active[i]).collect();
                 for &i in gone.iter().rev() {
                     released_before.push(active[i].row);
                     active.remove(i);
                     changes += 1;
                 }
+                super::patch::promote(model, options, &mut active, &removed, &state.q);
                 super::rolling::record_touches(model, &active, &state.q, &mut touched);
                 continue;
             }

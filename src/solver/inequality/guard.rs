@@ -140,10 +140,29 @@ impl<'m> Guard<'m> {
 
     /// The lowest dimensionless gap and its inequality.
     fn lowest(&self, q: &DVector<f64>, branches: &Branches) -> Option<(usize, f64)> {
+        self.lowest_closing(q, branches, None)
+    }
+
+    /// [`Guard::lowest`] over the inequalities that can stop a step from a point where their
+    /// gaps are `start`: an inequality at its boundary there (within `tol`, a row just
+    /// released) whose gap has not decreased is moving away from it and does not count.
+    fn lowest_closing(
+        &self,
+        q: &DVector<f64>,
+        branches: &Branches,
+        start: Option<&[f64]>,
+    ) -> Option<(usize, f64)> {
         let mut last = None;
         (0..self.len())
             .map(|k| (k, self.gap_sharing(k, q, branches, &mut last)))
+            .filter(|&(k, g)| start.is_none_or(|s| self.closing(s[k], g)))
             .min_by(|a, b| a.1.total_cmp(&b.1))
+    }
+
+    /// Whether an inequality whose gap went from `start` to `g` can stop the step: all but one
+    /// at its boundary at the start (within `tol`) whose gap has not decreased since.
+    fn closing(&self, start: f64, g: f64) -> bool {
+        start.abs() > self.tol || g < start
     }
 
     /// Whether the step from `from` to `to` brings one of the inequalities closer to its
@@ -195,10 +214,22 @@ impl<'m> Guard<'m> {
         // The lowest gap at each end (`None` at an end where the corrector failed), and the
         // end that moved last (Illinois: the other end's gap is halved when it stays twice).
         let (mut g_lo, mut g_hi) = (None, None);
+        // The gaps at the start: an inequality touching there (a row released at the end of
+        // the last round, whose step lifts it by less than `tol` at first) stops the step only
+        // if it closes (`closing`); else the bracket would stop at once on it.
+        let start: Vec<f64> = {
+            let b = &sys.problem.cons.branches;
+            let mut last = None;
+            (0..self.len())
+                .map(|k| self.gap_sharing(k, q, b, &mut last))
+                .collect()
+        };
         if self.falsi {
             let b = &sys.problem.cons.branches;
-            g_lo = self.lowest(q, b).map(|x| x.1);
-            g_hi = q_alpha.and_then(|qa| self.lowest(qa, b)).map(|x| x.1);
+            g_lo = self.lowest_closing(q, b, Some(&start)).map(|x| x.1);
+            g_hi = q_alpha
+                .and_then(|qa| self.lowest_closing(qa, b, Some(&start)))
+                .map(|x| x.1);
         }
         let mut last_moved_hi = None;
         for _ in 0..80 {
@@ -228,7 +259,12 @@ impl<'m> Guard<'m> {
                 (q_hi, g_hi) = (None, None);
                 continue;
             }
-            let (_, g) = self.lowest(&qm, &sys.problem.cons.branches)?;
+            let Some((_, g)) = self.lowest_closing(&qm, &sys.problem.cons.branches, Some(&start))
+            else {
+                lo = mid;
+                q_lo = qm;
+                continue;
+            };
             if g < -self.tol {
                 hi = mid;
                 q_hi = Some(qm);
@@ -252,7 +288,10 @@ impl<'m> Guard<'m> {
         }
         let branches = &sys.problem.cons.branches;
         let touching: Vec<usize> = (0..self.len())
-            .filter(|&k| self.gap(k, &q_lo, branches) <= self.tol)
+            .filter(|&k| {
+                let g = self.gap(k, &q_lo, branches);
+                g <= self.tol && self.closing(start[k], g)
+            })
             .collect();
         if touching.is_empty() {
             return None;

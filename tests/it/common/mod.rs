@@ -4,6 +4,7 @@ pub(crate) mod builders;
 pub(crate) mod contact;
 pub(crate) mod energies;
 pub(crate) mod pyramid;
+pub(crate) mod statics;
 
 use restpose::state::State;
 use restpose::urdf::{load_file, load_str, ImportOptions};

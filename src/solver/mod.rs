@@ -36,6 +36,7 @@ mod options;
 pub(crate) mod partition;
 mod quasi_newton;
 mod reactions;
+mod retraction;
 mod report;
 pub(crate) mod sparse;
 mod stability;

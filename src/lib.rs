@@ -31,6 +31,7 @@ pub mod forces;
 pub mod generate;
 pub mod geometry;
 pub(crate) mod jet;
+pub mod joint;
 pub mod kinematics;
 pub mod math;
 pub mod model;

@@ -1,23 +1,22 @@
-//! Joint constraint equations built from two primitives (Haug 1989, Nikravesh 1988):
+//! Joint constraint equations, evaluated as second-order jets from the rows each kind's file
+//! lists ([`crate::joint::Spec::rows`], Haug 1989, Nikravesh 1988):
 //!
 //! - spherical: `d = r_j + A_j s_j − r_i − A_i s_i = 0` (3 rows);
 //! - dot-1: `a_iᵀ b_j = 0` for body vectors `a_i = A_i a'`, `b_j = A_j b'`;
-//! - dot-2: `a_iᵀ d = 0`.
+//! - dot-2: `a_iᵀ d = 0`;
+//! - length `dᵀd − L²`, thread `d·z_i − h θ`.
 //!
-//! With `x, y, z` the axes of the joint frames `J` on parent `i` and child `j`:
-//! revolute = spherical + `z_i·x_j, z_i·y_j`; prismatic = `z_i·x_j, z_i·y_j, y_i·x_j, d·x_i,
-//! d·y_i`; cylindrical = `z_i·x_j, z_i·y_j, d·x_i, d·y_i`; fixed = spherical + `z_i·x_j,
-//! z_i·y_j, y_i·x_j`; universal = spherical + `z_i·x_j`; planar = `z_i·x_j, z_i·y_j, d·z_i`;
-//! screw = cylindrical + `d·z_i − h θ`; distance = `d·d − L²`; point-on-line = `d·x_i, d·y_i`.
-//!
-//! Joint frames and coordinates come from [`crate::kinematics`].
+//! These generic jets are the reference the closed forms of [`crate::jet::closed`] are tested
+//! against, and evaluate the rows without a closed form (a screw's thread). Joint frames and
+//! coordinates come from [`crate::kinematics`].
 //!
 //! ## References
 //! - E. J. Haug, *Computer-Aided Kinematics and Dynamics of Mechanical Systems* (1989), ch. 3.
 
 use crate::jet::{Pair, Scalar, Vec3Jet};
-use crate::kinematics::{angle, frames, on_branch};
-use crate::model::{Joint, JointKind};
+use crate::joint::{Row, V};
+use crate::kinematics::{angle, frames, on_branch, vector};
+use crate::model::Joint;
 use nalgebra::Vector3;
 
 fn component(pair: &Pair, d: &Vec3Jet, k: usize) -> Scalar {
@@ -36,40 +35,15 @@ pub(crate) fn row_count(joint: &Joint) -> usize {
     if joint.merged {
         return 0;
     }
-    match joint.kind {
-        JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic => 5,
-        JointKind::Fixed => 6,
-        JointKind::Floating => 0,
-        JointKind::Planar => 3,
-        JointKind::Spherical => 3,
-        JointKind::Universal | JointKind::Cylindrical => 4,
-        JointKind::Screw { .. } => 5,
-        JointKind::Distance { .. } => 1,
-        JointKind::PointOnLine => 2,
-    }
+    joint.kind.spec().rows.len()
 }
 
 /// Names of the constraint rows of a joint, in row order.
 pub(crate) fn row_names(joint: &Joint) -> &'static [&'static str] {
-    const POS: [&str; 3] = ["pos_x", "pos_y", "pos_z"];
     if joint.merged {
         return &[];
     }
-    match joint.kind {
-        JointKind::Revolute | JointKind::Continuous => {
-            &["pos_x", "pos_y", "pos_z", "axis_x", "axis_y"]
-        }
-        JointKind::Prismatic => &["axis_x", "axis_y", "twist", "slide_x", "slide_y"],
-        JointKind::Fixed => &["pos_x", "pos_y", "pos_z", "axis_x", "axis_y", "twist"],
-        JointKind::Floating => &[],
-        JointKind::Planar => &["normal_x", "normal_y", "plane"],
-        JointKind::Spherical => &POS,
-        JointKind::Universal => &["pos_x", "pos_y", "pos_z", "cross"],
-        JointKind::Cylindrical => &["axis_x", "axis_y", "slide_x", "slide_y"],
-        JointKind::Screw { .. } => &["axis_x", "axis_y", "slide_x", "slide_y", "thread"],
-        JointKind::Distance { .. } => &["length"],
-        JointKind::PointOnLine => &["line_x", "line_y"],
-    }
+    joint.kind.spec().row_names
 }
 
 /// Power of length in the unit of a joint row named `name` (`pos_x` is in m, `length` in m²,
@@ -94,60 +68,24 @@ pub(crate) fn length_power(name: &str) -> i32 {
 /// screw advances over many turns.
 pub(crate) fn rows(joint: &Joint, pair: &Pair, reference: f64, out: &mut Vec<Scalar>) {
     out.clear();
-    if joint.merged || joint.kind == JointKind::Floating {
+    let layout = joint.kind.spec().rows;
+    if joint.merged || layout.is_empty() {
         return;
     }
     let f = frames(joint, pair);
-    let spherical = |out: &mut Vec<Scalar>| {
-        for k in 0..3 {
-            out.push(component(pair, &f.d, k));
-        }
-    };
-    let parallel = |out: &mut Vec<Scalar>| {
-        out.push(pair.dot(&f.z[0], &f.x[1]));
-        out.push(pair.dot(&f.z[0], &f.y[1]));
-    };
-    let on_axis = |out: &mut Vec<Scalar>| {
-        out.push(pair.dot(&f.x[0], &f.d));
-        out.push(pair.dot(&f.y[0], &f.d));
-    };
-    match joint.kind {
-        JointKind::Revolute | JointKind::Continuous => {
-            spherical(out);
-            parallel(out);
-        }
-        JointKind::Prismatic => {
-            parallel(out);
-            out.push(pair.dot(&f.y[0], &f.x[1]));
-            on_axis(out);
-        }
-        JointKind::Fixed => {
-            spherical(out);
-            parallel(out);
-            out.push(pair.dot(&f.y[0], &f.x[1]));
-        }
-        JointKind::Planar => {
-            parallel(out);
-            out.push(pair.dot(&f.z[0], &f.d));
-        }
-        JointKind::Spherical => spherical(out),
-        JointKind::Universal => {
-            spherical(out);
-            out.push(pair.dot(&f.z[0], &f.x[1]));
-        }
-        JointKind::Cylindrical => {
-            parallel(out);
-            on_axis(out);
-        }
-        JointKind::Screw { pitch } => {
-            parallel(out);
-            on_axis(out);
-            let t = on_branch(angle(pair, &f), reference).scale(-pitch);
-            out.push(pair.dot(&f.z[0], &f.d).add(&t));
-        }
-        JointKind::Distance { length } => out.push(pair.dot(&f.d, &f.d).minus(length * length)),
-        JointKind::PointOnLine => on_axis(out),
-        JointKind::Floating => {}
+    for row in layout {
+        out.push(match *row {
+            Row::Component(k) => component(pair, &f.d, k),
+            Row::Dot(a, b) => pair.dot(vector(&f, a), vector(&f, b)),
+            Row::Length => {
+                let length = joint.kind.parameter();
+                pair.dot(&f.d, &f.d).minus(length * length)
+            }
+            Row::Thread => {
+                let t = on_branch(angle(pair, &f), reference).scale(-joint.kind.parameter());
+                pair.dot(vector(&f, V::Z0), &f.d).add(&t)
+            }
+        });
     }
 }
 
@@ -158,7 +96,7 @@ mod tests {
     use crate::jet::closed::tests::assert_same;
     use crate::jet::hess_or_zero;
     use crate::jet::testing::{check_scalar, sample_pair};
-    use crate::model::BodyId;
+    use crate::model::{BodyId, JointKind};
     use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 
     fn joint(kind: JointKind) -> Joint {

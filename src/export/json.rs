@@ -27,16 +27,7 @@ pub struct JointResult {
 /// Unit of each coordinate of a joint of this kind, in the order of
 /// [`State::joint_values`]: `"rad"`, `"m"`, or `"1"` for a quaternion component.
 pub fn coordinate_units(kind: JointKind) -> Vec<&'static str> {
-    match kind {
-        JointKind::Revolute | JointKind::Continuous | JointKind::Screw { .. } => vec!["rad"],
-        JointKind::Prismatic => vec!["m"],
-        JointKind::Universal => vec!["rad", "rad"],
-        JointKind::Cylindrical => vec!["rad", "m"],
-        JointKind::Planar => vec!["m", "m", "rad"],
-        JointKind::Spherical => vec!["1"; 4],
-        JointKind::Floating => vec!["m", "m", "m", "1", "1", "1", "1"],
-        JointKind::Fixed | JointKind::Distance { .. } | JointKind::PointOnLine => vec![],
-    }
+    kind.spec().units.to_vec()
 }
 
 /// Serializes `(name, value)` pairs as a JSON object with the keys in the given order.

@@ -20,8 +20,9 @@
 //! tests check every row here against them and against central differences.
 
 use super::{LMat, LVec, Pair, Scalar};
+use crate::joint::{Row, V};
 use crate::math::{b_matrix, rotation};
-use crate::model::{Joint, JointKind};
+use crate::model::Joint;
 use nalgebra::{Matrix3, Matrix3x4, Matrix4, Vector3};
 
 /// `Σ_k t_k r_k + A(p_k) s_k` with `B_k = B(p_k, s_k)`; `on[k]` whether side `k` enters.
@@ -229,17 +230,17 @@ pub(crate) fn dot_hessian(a: &Lin, b: &Lin, c: f64, h: &mut LMat) {
 /// `d = o₁ − o₀` and axes (`None` where not needed).
 pub(crate) struct Frames {
     /// The vectors in [`V`] order; those not needed are the constant zero.
-    vectors: [Lin; 6],
+    vectors: [Lin; 7],
 }
 
 impl Frames {
     /// The vectors `layout` uses, for the frames of `joint` at `pair`.
     fn of(joint: &Joint, pair: &Pair, layout: &[Row]) -> Self {
         let rot = Rotations::of(pair);
-        let mut need = [false; 6];
+        let mut need = [false; 7];
         for row in layout {
             match *row {
-                Row::Component(_) => need[V::D as usize] = true,
+                Row::Component(_) | Row::Length | Row::Thread => need[V::D as usize] = true,
                 Row::Dot(a, b) => {
                     need[a as usize] = true;
                     need[b as usize] = true;
@@ -250,7 +251,7 @@ impl Frames {
             let r = joint.body_from_joint[k].rotation.to_rotation_matrix();
             Lin::vector(pair, &rot, k, &r.matrix().column(i).into_owned())
         };
-        let mut vectors = [Lin::ZERO; 6];
+        let mut vectors = [Lin::ZERO; 7];
         for (v, slot) in vectors.iter_mut().enumerate() {
             if !need[v] {
                 continue;
@@ -266,7 +267,8 @@ impl Frames {
                 2 => axis(0, 1),
                 3 => axis(0, 2),
                 4 => axis(1, 0),
-                _ => axis(1, 1),
+                5 => axis(1, 1),
+                _ => axis(1, 2),
             };
         }
         Frames { vectors }
@@ -277,75 +279,17 @@ impl Frames {
     }
 }
 
-/// The 3-vectors joint rows are made of (in the order of `Frames::vectors`).
-#[derive(Clone, Copy, Debug)]
-enum V {
-    D,
-    X0,
-    Y0,
-    Z0,
-    X1,
-    Y1,
-}
-
-/// One joint row: a component of `d` or a dot product.
-#[derive(Clone, Copy, Debug)]
-enum Row {
-    Component(usize),
-    Dot(V, V),
-}
-
-const POS: [Row; 3] = [Row::Component(0), Row::Component(1), Row::Component(2)];
-const PARALLEL: [Row; 2] = [Row::Dot(V::Z0, V::X1), Row::Dot(V::Z0, V::Y1)];
-
-/// The rows of a joint in [`crate::constraints::joint::rows`] order, or `None` for a joint
-/// evaluated by the generic jets (a screw's thread row reads its angle) or without rows.
+/// The rows of a joint ([`crate::joint::Spec::rows`], in [`crate::constraints::joint::rows`]
+/// order), or `None` for a joint evaluated by the generic jets (a screw's thread row reads
+/// its angle) or without rows.
 fn layout(joint: &Joint) -> Option<&'static [Row]> {
-    use Row::*;
-    use V::*;
-    if joint.merged {
-        return None;
-    }
-    Some(match joint.kind {
-        JointKind::Revolute | JointKind::Continuous => {
-            &[POS[0], POS[1], POS[2], PARALLEL[0], PARALLEL[1]]
-        }
-        JointKind::Prismatic => &[
-            PARALLEL[0],
-            PARALLEL[1],
-            Dot(Y0, X1),
-            Dot(X0, D),
-            Dot(Y0, D),
-        ],
-        JointKind::Fixed => &[
-            POS[0],
-            POS[1],
-            POS[2],
-            PARALLEL[0],
-            PARALLEL[1],
-            Dot(Y0, X1),
-        ],
-        JointKind::Planar => &[PARALLEL[0], PARALLEL[1], Dot(Z0, D)],
-        JointKind::Spherical => &POS,
-        JointKind::Universal => &[POS[0], POS[1], POS[2], PARALLEL[0]],
-        JointKind::Cylindrical => &[PARALLEL[0], PARALLEL[1], Dot(X0, D), Dot(Y0, D)],
-        JointKind::Distance { .. } => &[Dot(D, D)],
-        JointKind::PointOnLine => &[Dot(X0, D), Dot(Y0, D)],
-        JointKind::Screw { .. } | JointKind::Floating => return None,
-    })
+    let spec = joint.kind.spec();
+    (!joint.merged && spec.closed_form).then_some(spec.rows)
 }
 
 /// Whether the rows of `joint` have a closed form here.
 pub(crate) fn supports(joint: &Joint) -> bool {
     layout(joint).is_some()
-}
-
-/// The constant subtracted from a row (`L²` of a distance joint).
-fn offset(joint: &Joint) -> f64 {
-    match joint.kind {
-        JointKind::Distance { length } => length * length,
-        _ => 0.0,
-    }
 }
 
 /// Values and gradients of the rows of `joint` into `out` (cleared first; no Hessians).
@@ -367,12 +311,15 @@ pub(crate) fn rows(joint: &Joint, pair: &Pair, out: &mut Vec<Scalar>) {
                 dot_gradient(a, b, 1.0, &mut g);
                 a.v.dot(&b.v)
             }
+            Row::Length => {
+                let d = f.get(V::D);
+                dot_gradient(d, d, 1.0, &mut g);
+                let length = joint.kind.parameter();
+                d.v.dot(&d.v) - length * length
+            }
+            Row::Thread => unreachable!("a thread row has no closed form (Spec::closed_form)"),
         };
-        out.push(Scalar {
-            v: v - offset(joint),
-            g,
-            h: None,
-        });
+        out.push(Scalar { v, g, h: None });
     }
 }
 
@@ -398,15 +345,19 @@ pub(crate) fn values(joint: &Joint, pair: &Pair, out: &mut Vec<f64>) {
         V::Z0 => axis(0, 2),
         V::X1 => axis(1, 0),
         V::Y1 => axis(1, 1),
+        V::Z1 => axis(1, 2),
     };
     let mut d = None;
     for row in layout {
-        out.push(
-            match *row {
-                Row::Component(m) => d.get_or_insert_with(|| vector(V::D))[m],
-                Row::Dot(a, b) => vector(a).dot(&vector(b)),
-            } - offset(joint),
-        );
+        out.push(match *row {
+            Row::Component(m) => d.get_or_insert_with(|| vector(V::D))[m],
+            Row::Dot(a, b) => vector(a).dot(&vector(b)),
+            Row::Length => {
+                let length = joint.kind.parameter();
+                vector(V::D).dot(&vector(V::D)) - length * length
+            }
+            Row::Thread => unreachable!("a thread row has no closed form (Spec::closed_form)"),
+        });
     }
 }
 
@@ -424,6 +375,8 @@ pub(crate) fn add_weighted_hessian(joint: &Joint, pair: &Pair, w: &[f64], h: &mu
         match *row {
             Row::Component(m) => wd[m] += c,
             Row::Dot(a, b) => dot_hessian(f.get(a), f.get(b), c, h),
+            Row::Length => dot_hessian(f.get(V::D), f.get(V::D), c, h),
+            Row::Thread => unreachable!("a thread row has no closed form (Spec::closed_form)"),
         }
     }
     if wd != Vector3::zeros() {

@@ -6,38 +6,41 @@
 //! within π of `θ_b` (`θ_b = 3.5` reads the pose at 3.5 − 2π as 3.5, not −2.78). The
 //! derivatives do not depend on the branch.
 
-use super::frames::{angle, frames};
-use crate::jet::{Pair, Scalar};
+use super::frames::{angle, frames, Frames};
+use crate::jet::{Pair, Scalar, Vec3Jet};
+use crate::joint::{Read, V};
 use crate::math::wrap_angle;
-use crate::model::{Joint, JointKind};
+use crate::model::Joint;
+
+/// The vector `v` of the joint frames `f`.
+pub(crate) fn vector(f: &Frames, v: V) -> &Vec3Jet {
+    match v {
+        V::D => &f.d,
+        V::X0 => &f.x[0],
+        V::Y0 => &f.y[0],
+        V::Z0 => &f.z[0],
+        V::X1 => &f.x[1],
+        V::Y1 => &f.y[1],
+        V::Z1 => &f.z[1],
+    }
+}
 
 /// Scalar joint coordinate `dof` read on the branch `reference` (used only if the
-/// coordinate is an angle), or `None` if the joint has no such coordinate.
+/// coordinate is an angle), or `None` if the joint has no such coordinate (its kind's
+/// [`crate::joint::Spec::coordinates`] say how it is read).
 pub(crate) fn coordinate(joint: &Joint, pair: &Pair, dof: usize, reference: f64) -> Option<Scalar> {
+    let c = joint.kind.spec().coordinates.get(dof)?;
     let f = frames(joint, pair);
-    let s = match (joint.kind, dof) {
-        (JointKind::Revolute | JointKind::Continuous | JointKind::Screw { .. }, 0) => {
-            angle(pair, &f)
-        }
-        (JointKind::Prismatic, 0) => pair.dot(&f.z[0], &f.d),
-        (JointKind::Cylindrical, 0) => angle(pair, &f),
-        (JointKind::Cylindrical, 1) => pair.dot(&f.z[0], &f.d),
-        (JointKind::Universal, 0) => angle(pair, &f),
-        (JointKind::Universal, 1) => {
-            let s = pair.dot(&f.z[0], &f.y[1]);
-            let c = pair.dot(&f.z[0], &f.z[1]);
+    let s = match c.read {
+        Read::Angle => angle(pair, &f),
+        Read::Dot(a, b) => pair.dot(vector(&f, a), vector(&f, b)),
+        Read::Atan2([a, b], [c, e]) => {
+            let s = pair.dot(vector(&f, a), vector(&f, b));
+            let c = pair.dot(vector(&f, c), vector(&f, e));
             pair.atan2(&s, &c)
         }
-        (JointKind::Planar, 0) => pair.dot(&f.x[0], &f.d),
-        (JointKind::Planar, 1) => pair.dot(&f.y[0], &f.d),
-        (JointKind::Planar, 2) => angle(pair, &f),
-        _ => return None,
     };
-    Some(if joint.kind.is_angle(dof) {
-        on_branch(s, reference)
-    } else {
-        s
-    })
+    Some(if c.angle { on_branch(s, reference) } else { s })
 }
 
 /// `θ_b + wrap(θ − θ_b)` with the derivatives of `θ`.
@@ -52,7 +55,7 @@ pub(crate) fn on_branch(mut s: Scalar, reference: f64) -> Scalar {
 mod tests {
     use super::*;
     use crate::jet::pair_of;
-    use crate::model::BodyId;
+    use crate::model::{BodyId, JointKind};
     use nalgebra::{DVector, Isometry3, UnitQuaternion, Vector3};
 
     fn revolute() -> Joint {

@@ -1,6 +1,6 @@
 //! Joint kinematics shared by the constraint equations and the forces: joint frames, joint
-//! coordinates read on a continuous branch (the [`crate::model::JointKind`] queries, how many
-//! values each joint kind takes and which of them are angles, are in `model/joint_kind.rs`).
+//! coordinates read on a continuous branch, as each kind's file under [`crate::joint`]
+//! describes them.
 //!
 //! Layering: `math → model → kinematics → {constraints, forces} → state → solver`. Constraints
 //! and forces both read joint coordinates from here and never from each other.
@@ -14,6 +14,6 @@ mod frames;
 mod motion;
 
 pub use branches::Branches;
-pub(crate) use coordinate::{coordinate, on_branch};
+pub(crate) use coordinate::{coordinate, on_branch, vector};
 pub(crate) use frames::{angle, frames};
 pub(crate) use motion::motion;

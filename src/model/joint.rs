@@ -1,12 +1,11 @@
-//! Joints: a kind and a joint frame `J` on each side.
+//! Joints: a kind ([`crate::joint`], one file per kind) and a joint frame `J` on each side.
 //!
 //! The frame `J` has its z axis along the joint axis (for a universal joint x is the second
 //! axis; for a planar joint z is the plane normal). At zero displacement the two `J` frames
-//! coincide; the relative motion of the child's `J` in the parent's `J` is
-//! `Rz(θ)` (revolute), `Tz(d)` (prismatic), `Rz(θ) Tz(d)` (cylindrical),
-//! `Rz(θ₁) Rx(θ₂)` (universal), `T(x, y, 0) Rz(θ)` (planar), `Rz(θ) Tz(h θ)` (screw).
+//! coincide; the relative motion of the child's `J` in the parent's `J` is given in the
+//! kind's file.
 
-use super::BodyId;
+use super::{BodyId, JointKind};
 use crate::error::SourceLocation;
 use nalgebra::Isometry3;
 
@@ -26,41 +25,6 @@ impl JointId {
     pub fn index(self) -> usize {
         self.0
     }
-}
-
-/// Joint type.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum JointKind {
-    /// Rotation about z, limited.
-    Revolute,
-    /// Rotation about z, unlimited.
-    Continuous,
-    /// Translation along z.
-    Prismatic,
-    /// No relative motion.
-    Fixed,
-    /// Six degrees of freedom, no constraint.
-    Floating,
-    /// Translation in the x-y plane and rotation about z.
-    Planar,
-    /// Rotation about a common point.
-    Spherical,
-    /// Rotation about z of the parent and x of the child.
-    Universal,
-    /// Rotation about and translation along z.
-    Cylindrical,
-    /// Rotation about z coupled to translation along z: `d = pitch θ`.
-    Screw {
-        /// Pitch \[m/rad\].
-        pitch: f64,
-    },
-    /// The two joint origins stay `length` apart (massless rod).
-    Distance {
-        /// Rod length \[m\].
-        length: f64,
-    },
-    /// The child's joint origin stays on the parent's z line.
-    PointOnLine,
 }
 
 /// A joint between a parent and a child body.

@@ -11,8 +11,6 @@ mod connect;
 mod contact;
 mod force;
 mod joint;
-mod joint_kind;
-mod joint_types;
 mod mass;
 mod numeric;
 mod obstacle;
@@ -21,6 +19,8 @@ mod site;
 mod validate;
 
 pub use crate::geometry::Hull;
+pub(crate) use crate::joint::MAX_SCALAR_COORDINATES;
+pub use crate::joint::{joint_type, joint_types, Declared, JointKind, JointType};
 pub use body::{Body, BodyId, Link};
 pub use builder::ModelBuilder;
 pub use connect::axis_frame;
@@ -28,9 +28,7 @@ pub use contact::{ContactPoint, ContactSettings, Friction, Ground};
 pub use force::{
     Effort, ForceLaw, Initial, JointSpring, Load, Lock, Mimic, Servo, Spring, SpringEnd, SpringMode,
 };
-pub use joint::{Joint, JointId, JointKind};
-pub(crate) use joint_kind::MAX_SCALAR_COORDINATES;
-pub use joint_types::{joint_type, Declared, JointType, JOINT_TYPES};
+pub use joint::{Joint, JointId};
 pub use mass::Inertial;
 pub use numeric::{LARGEST_GRAVITY, LARGEST_LENGTH, LARGEST_MAGNITUDE};
 pub use obstacle::Obstacle;

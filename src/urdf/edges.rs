@@ -9,6 +9,7 @@
 use super::limits::{limits, urdf_limits};
 use super::xml::{child, Source};
 use crate::error::Result;
+use crate::joint::Frame;
 use crate::model::{joint_type, JointKind};
 use crate::names::NameMap;
 use nalgebra::{Isometry3, Vector3};
@@ -115,10 +116,7 @@ fn urdf_axis(
     warnings: &mut Vec<String>,
 ) -> Result<Vector3<f64>> {
     let a = child(node, "axis");
-    if matches!(
-        kind,
-        JointKind::Fixed | JointKind::Floating | JointKind::Spherical
-    ) {
+    if kind.spec().frame == Frame::Origin {
         if let Some(a) = a {
             if src.axis(Some(a), node, Vector3::x()).is_err() {
                 warnings.push(src.warning(
@@ -153,7 +151,7 @@ fn ends(src: &Source, node: Node, frames: &Frames, name: &str) -> Result<[End; 2
 }
 
 /// The kind of a URDF `<joint type>`, from the one table of type names
-/// ([`crate::model::JOINT_TYPES`], column `urdf`); `ball` is read as `spherical` with a
+/// ([`crate::joint`], column `urdf`); `ball` is read as `spherical` with a
 /// warning.
 pub(super) fn urdf_kind(
     src: &Source,
@@ -266,7 +264,7 @@ pub(super) fn drake_joint<'a>(
     })
 }
 
-/// The kind of a `<mech:loop_joint type>` (the table [`crate::model::JOINT_TYPES`], column
+/// The kind of a `<mech:loop_joint type>` (the table [`crate::joint`], column
 /// `loop_joint`), with its parameters.
 fn loop_kind(src: &Source, node: Node) -> Result<JointKind> {
     let ty = src.req(node, "type")?;

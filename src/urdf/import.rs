@@ -19,6 +19,7 @@ use super::xml::{is_mech, Source};
 use super::{ImportOptions, Loaded};
 use crate::error::Result;
 use crate::geometry::PackagePaths;
+use crate::joint::Frame;
 use crate::math::align_z;
 use crate::model::{BodyId, Joint, JointId, JointKind, ModelBuilder};
 use crate::names::NameMap;
@@ -67,8 +68,8 @@ pub(super) fn joint_axes(
     axis: Vector3<f64>,
     axis2: Vector3<f64>,
 ) -> UnitQuaternion<f64> {
-    match kind {
-        JointKind::Universal => {
+    match kind.spec().frame {
+        Frame::TwoAxes => {
             let x = (axis2 - axis * axis.dot(&axis2))
                 .try_normalize(1e-9)
                 .unwrap_or_else(|| align_z(&axis) * Vector3::x());
@@ -78,11 +79,8 @@ pub(super) fn joint_axes(
         }
         // No axis: J is the joint origin frame itself, so that spherical and floating joint
         // values are expressed in it.
-        JointKind::Spherical
-        | JointKind::Floating
-        | JointKind::Fixed
-        | JointKind::Distance { .. } => UnitQuaternion::identity(),
-        _ => align_z(&axis),
+        Frame::Origin => UnitQuaternion::identity(),
+        Frame::Axis => align_z(&axis),
     }
 }
 

@@ -9,6 +9,7 @@
 
 pub(crate) mod finite;
 pub(crate) mod law;
+mod stacked;
 
 use crate::jet::{closed, pair_of, scatter, Pair, Scalar};
 use crate::kinematics::{coordinate, Branches};
@@ -61,15 +62,14 @@ pub(crate) fn potential(
     branches: &Branches,
     q: &DVector<f64>,
     grad: &mut DVector<f64>,
-    mut hess: Option<&mut dyn crate::jet::HessianSink>,
+    hess: Option<&mut dyn crate::jet::HessianSink>,
 ) -> Option<Energy> {
     let want_h = hess.is_some();
     let mut e = Energy::default();
-    let mut magnitude = 0.0;
-    let mut add = |bodies: &[Option<BodyId>; 2], s: &Scalar, c: f64, slot: &mut f64| {
-        *slot += c * s.v;
-        magnitude += (c * s.v).abs();
-        scatter(bodies, s, c, grad, hess.as_deref_mut());
+    let mut add = Sum {
+        magnitude: 0.0,
+        grad,
+        hess,
     };
     for (i, b) in model.bodies.iter().enumerate() {
         if b.gravity_mass == 0.0 {
@@ -78,14 +78,25 @@ pub(crate) fn potential(
         let bodies = [Some(BodyId(i)), None];
         let pair = pair_of(&bodies, q, want_h);
         let w = -b.gravity_mass * model.gravity;
+        if let Some((g, h)) = add.derivatives() {
+            let v = stacked::weighted_point(&bodies, &pair, &b.gravity_com, &w, g, h);
+            add.value(v, 1.0, &mut e.gravity);
+            continue;
+        }
         let s = closed::weighted_point(&pair, 0, &b.gravity_com, &w);
-        add(&bodies, &s, 1.0, &mut e.gravity);
+        add.term(&bodies, &s, 1.0, &mut e.gravity);
     }
     for l in &model.loads {
         let bodies = [Some(l.body), None];
         let pair = pair_of(&bodies, q, want_h);
-        let s = closed::weighted_point(&pair, 0, &l.point, &(-l.force));
-        add(&bodies, &s, 1.0, &mut e.loads);
+        let w = -l.force;
+        if let Some((g, h)) = add.derivatives() {
+            let v = stacked::weighted_point(&bodies, &pair, &l.point, &w, g, h);
+            add.value(v, 1.0, &mut e.loads);
+            continue;
+        }
+        let s = closed::weighted_point(&pair, 0, &l.point, &w);
+        add.term(&bodies, &s, 1.0, &mut e.loads);
     }
     for s in &model.springs {
         let bodies = [s.ends[0].body, s.ends[1].body];
@@ -102,14 +113,25 @@ pub(crate) fn potential(
             continue;
         }
         let len = l2.compose(l, 0.5 / l, -0.25 / (l * l * l));
-        add(&bodies, &len.compose(u, f, k), 1.0, &mut e.springs);
+        add.term(&bodies, &len.compose(u, f, k), 1.0, &mut e.springs);
     }
     for js in &model.joint_springs {
         let j = &model.joints[js.joint.0];
         let pair = pair_of(&j.bodies, q, want_h);
-        let theta = joint_coordinate(j, &pair, js.dof, branches.get(js.joint, js.dof))?;
+        let reference = branches.get(js.joint, js.dof);
+        if let Some(((g, h), theta)) = add
+            .derivatives()
+            .and_then(|d| stacked_angle(j, &pair, js.dof).map(|t| (d, t)))
+        {
+            let v = on_branch(theta.v, reference);
+            let (u, f, k) = law::evaluate(&js.law, SpringMode::Both, v - js.reference)?;
+            stacked::scatter_angle(&j.bodies, &theta, Some((f, k)), 1.0, g, h);
+            add.value(u, 1.0, &mut e.joint_springs);
+            continue;
+        }
+        let theta = joint_coordinate(j, &pair, js.dof, reference)?;
         let (u, f, k) = law::evaluate(&js.law, SpringMode::Both, theta.v - js.reference)?;
-        add(
+        add.term(
             &j.bodies,
             &theta.compose(u, f, k),
             1.0,
@@ -119,12 +141,72 @@ pub(crate) fn potential(
     for ef in &model.efforts {
         let j = &model.joints[ef.joint.0];
         let pair = pair_of(&j.bodies, q, want_h);
-        let theta = joint_coordinate(j, &pair, ef.dof, branches.get(ef.joint, ef.dof))?;
-        add(&j.bodies, &theta, -ef.value, &mut e.loads);
+        let reference = branches.get(ef.joint, ef.dof);
+        if let Some(((g, h), theta)) = add
+            .derivatives()
+            .and_then(|d| stacked_angle(j, &pair, ef.dof).map(|t| (d, t)))
+        {
+            let v = on_branch(theta.v, reference);
+            stacked::scatter_angle(&j.bodies, &theta, None, -ef.value, g, h);
+            add.value(v, -ef.value, &mut e.loads);
+            continue;
+        }
+        let theta = joint_coordinate(j, &pair, ef.dof, reference)?;
+        add.term(&j.bodies, &theta, -ef.value, &mut e.loads);
     }
     e.total = e.gravity + e.springs + e.joint_springs + e.loads;
-    e.magnitude += magnitude;
+    e.magnitude += add.magnitude;
     Some(e)
+}
+
+/// The sums of [`potential`]: `Σ |c V_k|`, the gradient and the Hessian sink.
+struct Sum<'g, 'h> {
+    magnitude: f64,
+    grad: &'g mut DVector<f64>,
+    hess: Option<&'h mut dyn crate::jet::HessianSink>,
+}
+
+impl<'h> Sum<'_, 'h> {
+    /// Adds `c f` (value into `slot`, gradient and Hessian into the sums).
+    fn term(&mut self, bodies: &[Option<BodyId>; 2], s: &Scalar, c: f64, slot: &mut f64) {
+        self.value(s.v, c, slot);
+        scatter(bodies, s, c, self.grad, self.hess.as_deref_mut());
+    }
+
+    /// Adds the value `c v` of a term whose derivatives were added already.
+    fn value(&mut self, v: f64, c: f64, slot: &mut f64) {
+        *slot += c * v;
+        self.magnitude += (c * v).abs();
+    }
+
+    /// The gradient and the Hessian sink, when the Hessian is wanted.
+    fn derivatives(
+        &mut self,
+    ) -> Option<(&mut DVector<f64>, &mut (dyn crate::jet::HessianSink + 'h))> {
+        let grad = &mut *self.grad;
+        self.hess.as_deref_mut().map(|h| (grad, h))
+    }
+}
+
+/// A revolute angle (`dof` 0 of a revolute or continuous joint) with its Hessian on the stack
+/// (module `stacked`), `None` for any other coordinate.
+fn stacked_angle(joint: &crate::model::Joint, pair: &Pair, dof: usize) -> Option<stacked::Angle> {
+    use crate::model::JointKind;
+    matches!(
+        (joint.kind, dof),
+        (JointKind::Revolute | JointKind::Continuous, 0)
+    )
+    .then(|| stacked::revolute_angle(joint, pair))
+}
+
+/// The angle `v` read on the branch `reference` ([`crate::kinematics::on_branch`]).
+fn on_branch(v: f64, reference: f64) -> f64 {
+    let s = Scalar {
+        v,
+        g: crate::jet::LVec::zeros(),
+        h: None,
+    };
+    crate::kinematics::on_branch(s, reference).v
 }
 
 /// The error naming the first force table evaluated outside its range at `q` (tables with

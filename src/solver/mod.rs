@@ -203,7 +203,7 @@ pub(crate) fn solve_round(
     let cons = Constraints::new(model, locks)
         .with_active(model, active)
         .on_branches(start.branches.clone());
-    let mut sys = System::new(model, cons, Backend::of(model, options));
+    let mut sys = System::new(model, cons, Backend::of_round(model, options, active));
     let part = sys.partition(&q);
     let dof0 = part.independent.len();
     if options.method != Method::Newton && dof0 > QUASI_NEWTON_DOF_LIMIT {

@@ -155,7 +155,14 @@ pub struct Verification {
 
 /// Whether `model` is verified on the sparse path (module `reduced`).
 fn sparse_path(model: &Model) -> bool {
-    Backend::choose(model, crate::solver::LinearAlgebra::Auto) != Backend::Dense
+    auto_backend(model) != Backend::Dense
+}
+
+/// The linear algebra `model` is verified with by default: dense as the solver's automatic
+/// choice, else the sparse partition with the tree factors on a mechanism without closed
+/// loops (stops or not), with the sparse ones otherwise ([`Backend::for_verify`]).
+fn auto_backend(model: &Model) -> Backend {
+    Backend::for_verify(model)
 }
 
 /// Potential energy of a state \[J\], `None` where a force table is out of its range.
@@ -175,7 +182,7 @@ pub fn balance(model: &Model, state: &State) -> Result<Balance> {
         // The finiteness guard inside, on the rows it evaluates anyway.
         let r = {
             let locks = crate::solver::lock_values(model);
-            reduced::reduced(model, state, &locks)?
+            reduced::reduced(model, state, &locks, auto_backend(model))?
         };
         return Ok(Balance {
             constraint_residual: r.phi.amax(),
@@ -232,14 +239,15 @@ pub fn verify_with_options(
         state,
         tol,
         uni,
-        sparse_path(model),
+        auto_backend(model),
         Eigenvalues::WhenCheap,
     )
 }
 
 /// [`verify_with_options`] on the path `linear_algebra` says: `Auto` as
-/// [`verify_with_options`] (sparse above 40 bodies), `Dense` the dense null-space basis,
-/// `Sparse` the solver's sparse partition (modules `dense`, `reduced`).
+/// [`verify_with_options`] (the solver's automatic choice), `Dense` the dense null-space basis,
+/// `Sparse` the solver's sparse partition and factors, `Tree` that partition with the tree
+/// factors where it fits a tree (modules `dense`, `reduced`, `solver::tree`).
 /// # Errors
 /// As [`verify`].
 pub fn verify_using(
@@ -287,12 +295,13 @@ pub fn verify_reporting(
     linear_algebra: crate::solver::LinearAlgebra,
     eigenvalues: Eigenvalues,
 ) -> Result<Verification> {
-    let sparse = match linear_algebra {
-        crate::solver::LinearAlgebra::Auto => sparse_path(model),
-        crate::solver::LinearAlgebra::Dense => false,
-        crate::solver::LinearAlgebra::Sparse | crate::solver::LinearAlgebra::Tree => true,
+    let backend = match linear_algebra {
+        crate::solver::LinearAlgebra::Auto => auto_backend(model),
+        crate::solver::LinearAlgebra::Dense => Backend::Dense,
+        crate::solver::LinearAlgebra::Sparse => Backend::Sparse,
+        crate::solver::LinearAlgebra::Tree => Backend::Tree,
     };
-    run::verify_on(model, state, tol, uni, sparse, eigenvalues)
+    run::verify_on(model, state, tol, uni, backend, eigenvalues)
 }
 
 /// Brings `state` onto `Φ = 0` by a damped Newton iteration that changes the dependent

@@ -39,8 +39,8 @@ pub(super) struct Reduced<'a> {
     pub(super) eval: Eval,
 }
 
-/// Partitions and evaluates the rows of `model` plus its `locks` at `q` on the sparse path,
-/// after the finiteness guard on those rows (`solver::finite`; they are evaluated once for
+/// Partitions and evaluates the rows of `model` plus its `locks` at `q` on the sparse path
+/// (the sparse partition, factored by `backend`: the sparse or the tree factors), after the finiteness guard on those rows (`solver::finite`; they are evaluated once for
 /// both).
 ///
 /// # Errors
@@ -50,12 +50,13 @@ pub(super) fn reduced<'a>(
     model: &'a Model,
     state: &State,
     locks: &[(JointId, usize, f64)],
+    backend: Backend,
 ) -> Result<Reduced<'a>> {
     let q = &state.q;
     let mut sys = System::new(
         model,
         Constraints::new(model, locks).on_branches(state.branches.clone()),
-        Backend::Sparse,
+        backend,
     );
     crate::solver::finite::guard_system(&mut sys, state, "the given pose")?;
     let mut g = DVector::zeros(q.len());

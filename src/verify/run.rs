@@ -34,7 +34,9 @@ pub(super) fn tree_coordinates(
     coords
 }
 
-/// [`super::verify`] on the dense (`sparse = false`) or the sparse path.
+/// [`super::verify`] on the dense (`backend` [`Backend::Dense`]) or the sparse path (the
+/// solver's sparse partition, factored by `backend`: [`Backend::Sparse`] or, where the
+/// partition fits a tree, [`Backend::Tree`]).
 ///
 /// On the sparse path the stability verdict reuses the partition and evaluation of the
 /// balance check, and is computed on a second thread while the forces are (kept only when
@@ -45,16 +47,17 @@ pub(super) fn verify_on(
     state: &State,
     tol: &Tolerances,
     uni: &Unilaterals,
-    sparse: bool,
+    backend: Backend,
     eigenvalues: super::Eigenvalues,
 ) -> Result<Verification> {
+    let sparse = backend != Backend::Dense;
     let skip = eigenvalues == super::Eigenvalues::Skip;
     let eigenvalues = eigenvalues == super::Eigenvalues::Always;
     // Every check passes the finiteness guard first: on the sparse path with the rows of the
     // balance check's system (evaluated once for both, module `reduced`).
     let reduced = if sparse {
         let locks = crate::solver::lock_values(model);
-        Some(reduced::reduced(model, state, &locks)?)
+        Some(reduced::reduced(model, state, &locks, backend)?)
     } else {
         crate::solver::finite::guard(model, state, "the given pose")?;
         None
@@ -62,8 +65,13 @@ pub(super) fn verify_on(
     // The forces on both paths from the sparse partition (module `held`): one computation,
     // so the dense and the sparse path report the same numbers (a pose balanced to the
     // solver's gradient tolerance leaves the forces determined to about that, and partitions
-    // differ in where they put the rest).
-    let backend = Backend::Sparse;
+    // differ in where they put the rest). The tree factors of that partition where the
+    // balance check uses them (the same numbers to rounding; module `solver::tree`).
+    let forces_backend = if backend == Backend::Tree {
+        Backend::Tree
+    } else {
+        Backend::Sparse
+    };
     let mut contact = unilateral::UnilateralCheck::default();
     let list = unilateral::touching(model, state, uni, tol.gap, &mut contact);
     let coords = tree_coordinates(model, state);
@@ -93,7 +101,7 @@ pub(super) fn verify_on(
                         crate::solver::stability_of(&mut sys, &state.q, &part, &eval, eigenvalues)
                     })
                 });
-                let held = held::held(model, state, &list, &values, backend, tau, free)?;
+                let held = held::held(model, state, &list, &values, forces_backend, tau, free)?;
                 let passed = passes(scaled, &held, force_scale, tol);
                 // A panic there is re-raised here, as if the verdict had been computed on
                 // this thread.
@@ -122,7 +130,7 @@ pub(super) fn verify_on(
             let projected_gradient = (p.null.transpose() * &p.grad_s).amax();
             let force_scale = p.grad_s.amax();
             let tau = tol.force + tol.relative * force_scale;
-            let held = held::held(model, state, &list, &values, backend, tau, None)?;
+            let held = held::held(model, state, &list, &values, forces_backend, tau, None)?;
             (
                 p.phi,
                 scaled,
@@ -177,16 +185,17 @@ pub(super) fn verify_on(
     // The sparse path judged the stability beside the forces where no stop or contact
     // touches; otherwise it is judged here, on the tangent space of those that carry a force
     // and the critical cone of those that touch without one (`solver::cone`).
-    let backend = if sparse {
-        crate::solver::system::Backend::Sparse
-    } else {
-        crate::solver::system::Backend::Dense
-    };
     let stability = match (passed, sparse) {
         (false, _) => None,
         _ if skip => None,
         (true, true) if strong.is_empty() && weak.is_empty() => stability,
         (true, _) => {
+            // With stops or contacts touching: the sparse factors, as before the tree ones.
+            let backend = if sparse {
+                Backend::Sparse
+            } else {
+                Backend::Dense
+            };
             crate::solver::stability_verdict(model, state, &strong, &weak, backend, eigenvalues)
         }
     };

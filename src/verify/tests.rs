@@ -3,14 +3,22 @@ use super::*;
 use crate::urdf::{load_str, ImportOptions};
 
 fn verify_on(m: &Model, s: &State, tol: &Tolerances, sparse: bool) -> Result<Verification> {
-    super::run::verify_on(
-        m,
-        s,
-        tol,
-        &Unilaterals::default(),
-        sparse,
-        super::Eigenvalues::WhenCheap,
-    )
+    let backend = if sparse {
+        crate::solver::system::Backend::Sparse
+    } else {
+        crate::solver::system::Backend::Dense
+    };
+    verify_by(m, s, tol, backend, super::Eigenvalues::WhenCheap)
+}
+
+fn verify_by(
+    m: &Model,
+    s: &State,
+    tol: &Tolerances,
+    backend: crate::solver::system::Backend,
+    eigenvalues: super::Eigenvalues,
+) -> Result<Verification> {
+    super::run::verify_on(m, s, tol, &Unilaterals::default(), backend, eigenvalues)
 }
 
 fn load(text: &str) -> Model {
@@ -113,13 +121,13 @@ fn held_from_the_balance_checks_system_is_held_from_its_own() {
         let (rest, _) = crate::solver::solve(&model, &Default::default()).unwrap();
         for state in [rest, bent(&model)] {
             let locks = crate::solver::lock_values(&model);
-            let r = super::reduced::reduced(&model, &state, &locks).unwrap();
+            let backend = crate::solver::system::Backend::Sparse;
+            let r = super::reduced::reduced(&model, &state, &locks, backend).unwrap();
             let values: Vec<_> = super::run::tree_coordinates(&model, &state)
                 .iter()
                 .map(|c| (c.0, c.1, c.2.v))
                 .collect();
             let tau = 1e-9 * r.force_scale.max(1.0);
-            let backend = crate::solver::system::Backend::Sparse;
             let own = super::held::held(&model, &state, &[], &values, backend, tau, None).unwrap();
             let free = super::held::free_of(&r.sys, &r.part, &r.eval);
             let given =
@@ -127,6 +135,88 @@ fn held_from_the_balance_checks_system_is_held_from_its_own() {
             assert_eq!(own.efforts, given.efforts, "{}", model.name);
             assert_eq!(own.unassigned, given.unassigned, "{}", model.name);
             assert_eq!(own.locked, given.locked, "{}", model.name);
+        }
+    }
+}
+
+/// `verify` through the tree factors equals `verify` through the sparse ones (the same
+/// partition, other factors): the same verdicts, efforts, reduced gradient and energy to
+/// 1e-9 relative (eigenvalues 1e-7), on a chain and a chain with locked joints, at rest and
+/// bent; a ladder (whose loops do not fit the tree factors' border) too.
+#[test]
+fn verify_through_the_tree_factors_equals_verify_through_the_sparse_ones() {
+    use crate::solver::system::Backend;
+    let locked = crate::generate::chain(50, false).replace(
+        "</robot>",
+        "<mech:lock joint=\"joint3\" value=\"0.2\"/><mech:lock joint=\"joint17\"/></robot>",
+    );
+    // Every joint limited to ±0.02 rad: at rest most lean on a stop.
+    let stops = crate::generate::chain(50, false)
+        .replace("type=\"continuous\"", "type=\"revolute\"")
+        .replace(
+            "<axis ",
+            "<limit lower=\"-0.02\" upper=\"0.02\" effort=\"1\" velocity=\"1\"/><axis ",
+        );
+    for text in [
+        crate::generate::chain(60, false),
+        locked,
+        stops,
+        crate::generate::ladder(4),
+    ] {
+        let model = load(&text);
+        let (rest, report) = crate::solver::solve(&model, &Default::default()).unwrap();
+        if model.joints.iter().any(|j| j.limits.is_some()) {
+            assert!(report.active_limits.len() > 10, "{}", model.name);
+        }
+        let tol = Tolerances::default();
+        for state in [rest, bent(&model)] {
+            let all = super::Eigenvalues::Always;
+            let s = verify_by(&model, &state, &tol, Backend::Sparse, all).unwrap();
+            let t = verify_by(&model, &state, &tol, Backend::Tree, all).unwrap();
+            let what = &model.name;
+            assert_eq!(s.passed, t.passed, "{what}");
+            let close = |a: f64, b: f64, scale: f64| (a - b).abs() <= 1e-9 * scale.max(1.0);
+            assert!(close(
+                s.potential_energy,
+                t.potential_energy,
+                s.potential_energy.abs()
+            ));
+            assert!(
+                close(s.projected_gradient, t.projected_gradient, s.force_scale),
+                "{what}"
+            );
+            assert!(close(s.unassigned, t.unassigned, s.force_scale), "{what}");
+            assert_eq!(s.imbalance.len(), t.imbalance.len());
+            let scale = s
+                .imbalance
+                .iter()
+                .fold(0.0f64, |a, i| a.max(i.effort.abs()));
+            assert!(
+                scale > 0.0 || s.passed,
+                "{what}: efforts all zero off the rest"
+            );
+            for (a, b) in s.imbalance.iter().zip(&t.imbalance) {
+                assert_eq!((&a.joint, a.dof, a.locked), (&b.joint, b.dof, b.locked));
+                assert!(
+                    close(a.effort, b.effort, scale),
+                    "{what} {}: {} vs {}",
+                    a.joint,
+                    a.effort,
+                    b.effort
+                );
+            }
+            match (&s.stability, &t.stability) {
+                (Some(a), Some(b)) => {
+                    assert_eq!(a.verdict, b.verdict, "{what}");
+                    assert_eq!(a.eigenvalues.len(), b.eigenvalues.len(), "{what}");
+                    let top = a.eigenvalues.iter().fold(0.0f64, |x, e| x.max(e.abs()));
+                    for (x, y) in a.eigenvalues.iter().zip(&b.eigenvalues) {
+                        assert!((x - y).abs() <= 1e-7 * top.max(1.0), "{what}: {x} vs {y}");
+                    }
+                }
+                (None, None) => {}
+                _ => panic!("{what}: a verdict on one path only"),
+            }
         }
     }
 }

@@ -27,6 +27,7 @@
 
 use super::hessian::BlockHessian;
 use super::pattern::{Ix, Pattern, NONE};
+use super::shifts::Shifts;
 use crate::solver::partition::Partition;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
@@ -66,12 +67,8 @@ pub(crate) struct Kkt {
     jac_slots: Vec<Ix>,
     diag_slots: Vec<usize>,
     values: Vec<f64>,
-    /// The shift `δ` now added to the diagonal of the `W` block in `values`.
-    delta: f64,
-    /// The shift `−σ` on the independent coordinates' diagonal (see [`Kkt::shift_independent`])
-    /// and those coordinates.
-    sigma: f64,
-    sigma_columns: Vec<usize>,
+    /// The shifts `δ` and `−σ` now in `values` (see [`Kkt::shift_independent`]).
+    shifts: Shifts,
     /// `‖K‖∞` of the factored matrix (for the backward error of solves).
     knorm: f64,
     /// The full (both triangles) permuted matrix for the LU fallback, built on its first use:
@@ -260,9 +257,7 @@ impl Kkt {
             jac_slots,
             diag_slots,
             values: vec![0.0; nnz],
-            delta: 0.0,
-            sigma: 0.0,
-            sigma_columns: Vec::new(),
+            shifts: Shifts::default(),
             knorm: 0.0,
             full: None,
             lu: None,
@@ -290,9 +285,7 @@ impl Kkt {
         hess: &BlockHessian,
     ) {
         self.values.iter_mut().for_each(|v| *v = 0.0);
-        self.delta = 0.0;
-        self.sigma = 0.0;
-        self.sigma_columns.clear();
+        self.shifts.clear();
         hess.scatter_scaled(&self.block_slots, scale, &mut self.values);
         for (e, &slot) in entries.iter().zip(&self.jac_slots) {
             if slot != Ix::MAX {
@@ -303,16 +296,7 @@ impl Kkt {
 
     /// The largest diagonal entry of the (scaled) `W` block.
     pub(crate) fn max_diagonal(&self) -> f64 {
-        let mut shifted = vec![0.0; self.diag_slots.len()];
-        for &c in &self.sigma_columns {
-            shifted[c] = self.sigma;
-        }
-        self.diag_slots
-            .iter()
-            .zip(&shifted)
-            .fold(0.0f64, |a, (&s, &sigma)| {
-                a.max((self.values[s] - self.delta + sigma).abs())
-            })
+        self.shifts.max_diagonal(&self.diag_slots, &self.values)
     }
 
     /// Subtracts `σ` from the diagonal of the (scaled) `W` block at the coordinates `columns`
@@ -321,15 +305,8 @@ impl Kkt {
     /// negative pivots minus `rows` count the eigenvalues of `Ĥ` below `σ`. Cleared by
     /// [`Kkt::assemble`].
     pub(crate) fn shift_independent(&mut self, columns: &[usize], sigma: f64) {
-        for &c in &self.sigma_columns {
-            self.values[self.diag_slots[c]] += self.sigma;
-        }
-        self.sigma_columns.clear();
-        self.sigma_columns.extend_from_slice(columns);
-        self.sigma = sigma;
-        for &c in &self.sigma_columns {
-            self.values[self.diag_slots[c]] -= sigma;
-        }
+        self.shifts
+            .shift_independent(&self.diag_slots, &mut self.values, columns, sigma);
     }
 
     /// Factors the matrix with `δ` added to the diagonal of the `W` block: LDLᵀ without
@@ -340,10 +317,8 @@ impl Kkt {
     /// pivot is zero or not finite, LU with partial pivoting instead.
     pub(crate) fn factor(&mut self, delta: f64) -> Factored {
         // The shift in place (no copy of the values): add the change since the last one.
-        for &s in &self.diag_slots {
-            self.values[s] += delta - self.delta;
-        }
-        self.delta = delta;
+        self.shifts
+            .shift_all(&self.diag_slots, &mut self.values, delta);
         // ‖K‖∞: row sums of |K| from the upper triangle (each off-diagonal entry twice).
         let sym = self.pattern.symbolic();
         let (ptr, idx) = (sym.col_ptr(), sym.row_idx());

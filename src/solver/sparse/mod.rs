@@ -20,3 +20,4 @@ pub(crate) mod partition;
 #[cfg(test)]
 mod partition_tests;
 pub(crate) mod pattern;
+pub(crate) mod shifts;

@@ -141,12 +141,14 @@ impl Elimination {
         self.rows[r] = pivot_row;
     }
 
-    /// The best threshold-passing pivot among active rows `cands` in the free columns `cols`.
+    /// The best threshold-passing pivot among active rows `cands` in the free columns `cols`
+    /// (`entries`: scratch).
     fn best_pivot(
         &self,
         cands: &[usize],
         threshold: f64,
         cols: impl Fn(usize) -> bool,
+        entries: &mut Vec<(usize, f64)>,
     ) -> Option<(usize, usize)> {
         let mut best: Option<(usize, usize, f64)> = None;
         for &r in cands {
@@ -154,13 +156,15 @@ impl Elimination {
                 continue;
             }
             let rmax = self.row_max(r);
-            let mut entries: Vec<(usize, f64)> = self.rows[r]
-                .iter()
-                .copied()
-                .filter(|&(c, _)| self.free[c] && cols(c))
-                .collect();
+            entries.clear();
+            entries.extend(
+                self.rows[r]
+                    .iter()
+                    .copied()
+                    .filter(|&(c, _)| self.free[c] && cols(c)),
+            );
             entries.sort_unstable_by_key(|e| e.0);
-            for (c, v) in entries {
+            for &(c, v) in entries.iter() {
                 let a = v.abs();
                 if a > self.tol
                     && a >= threshold * rmax
@@ -222,7 +226,8 @@ pub(crate) fn partition(
     scale: &[f64],
 ) -> Partition {
     let nb = n / 7;
-    let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); m];
+    // Room for a row on two bodies and some fill (no regrowth on trees).
+    let mut rows: Vec<Vec<(usize, f64)>> = (0..m).map(|_| Vec::with_capacity(16)).collect();
     for &(r, c, v) in entries {
         let a = v * row_scale[r] * scale[c];
         match rows[r].iter_mut().find(|e| e.0 == c) {
@@ -275,13 +280,15 @@ pub(crate) fn partition(
     // The rows pivoted in the second pass and the bodies they were pivoted at, and the rows
     // carried on and the bodies that refused them.
     let mut second_pass = Vec::new();
+    let (mut cands, mut entries) = (Vec::new(), Vec::new());
     for b in elimination_order(model) {
         let mut taken = 0;
         while taken < 7 {
-            let mut cands = el.body_rows[b].clone();
+            cands.clear();
+            cands.extend_from_slice(&el.body_rows[b]);
             cands.sort_unstable();
             cands.dedup();
-            match el.best_pivot(&cands, THRESHOLD, |c| c / 7 == b) {
+            match el.best_pivot(&cands, THRESHOLD, |c| c / 7 == b, &mut entries) {
                 Some((r, c)) => el.pivot(r, c),
                 None => break,
             }
@@ -334,7 +341,7 @@ pub(crate) fn partition(
         if left.is_empty() {
             break;
         }
-        match el.best_pivot(&left, THRESHOLD, |_| true) {
+        match el.best_pivot(&left, THRESHOLD, |_| true, &mut entries) {
             Some((r, c)) => el.pivot(r, c),
             None => {
                 // No entry passes the threshold test: plain full pivoting.

@@ -47,11 +47,7 @@ impl Backend {
     pub(crate) fn choose(model: &Model, choice: LinearAlgebra) -> Self {
         match choice {
             LinearAlgebra::Auto if model.coordinate_count() > SPARSE_FROM_COORDINATES => {
-                let tree = model
-                    .joints
-                    .iter()
-                    .all(|j| (j.tree || j.merged) && j.limits.is_none());
-                if tree {
+                if open(model) && model.joints.iter().all(|j| j.limits.is_none()) {
                     Backend::Tree
                 } else {
                     Backend::Sparse
@@ -66,6 +62,45 @@ impl Backend {
     /// The backend of a solve with `options` (its `linear_algebra`; automatic: by size).
     pub(crate) fn of(model: &Model, options: &crate::solver::Options) -> Self {
         Self::choose(model, options.linear_algebra)
+    }
+
+    /// The backend of one round of a solve with `options` whose active inequalities are
+    /// `active`: [`Backend::of`], but with the automatic choice the tree factors also for a
+    /// mechanism without closed loops whose joint stops are all inactive in this round (a
+    /// chain whose limits are never reached: the stops are then only the guard's, outside the
+    /// linear algebra). A round with a stop active keeps the sparse factors (see
+    /// [`Backend::choose`]).
+    pub(crate) fn of_round(
+        model: &Model,
+        options: &crate::solver::Options,
+        active: &[crate::constraints::unilateral::Active],
+    ) -> Self {
+        let chosen = Self::of(model, options);
+        let stop = active.iter().any(|a| {
+            matches!(
+                a.row,
+                crate::constraints::unilateral::Unilateral::Limit { .. }
+            )
+        });
+        if options.linear_algebra == LinearAlgebra::Auto
+            && chosen == Backend::Sparse
+            && !stop
+            && open(model)
+        {
+            Backend::Tree
+        } else {
+            chosen
+        }
+    }
+
+    /// The automatic backend of `verify` at a pose: [`Backend::choose`], but the tree factors
+    /// for every mechanism without closed loops above the dense size, stops or not (they
+    /// factor the same sparse partition, and give the same efforts and forces to rounding).
+    pub(crate) fn for_verify(model: &Model) -> Self {
+        match Self::choose(model, LinearAlgebra::Auto) {
+            Backend::Sparse if open(model) => Backend::Tree,
+            chosen => chosen,
+        }
     }
 
     /// `"dense"`, `"sparse"` or `"tree"` (as the report's diagnostics name it).
@@ -98,6 +133,11 @@ impl Backend {
             Backend::Dense => partition(&jac.to_dense(), &scaling.rows, &scaling.columns),
         }
     }
+}
+
+/// Whether `model` has no closed loop (every joint a tree joint or merged).
+fn open(model: &Model) -> bool {
+    model.joints.iter().all(|j| j.tree || j.merged)
 }
 
 #[cfg(test)]

@@ -22,6 +22,7 @@ use super::shape::{Shape, SKIP};
 use crate::solver::partition::Partition;
 use crate::solver::sparse::hessian::BlockHessian;
 use crate::solver::sparse::kkt::Factored;
+use crate::solver::sparse::shifts::Shifts;
 use std::cell::RefCell;
 
 /// The tree KKT matrix under one partition: its structure, values and factors.
@@ -32,9 +33,8 @@ pub(crate) struct TreeKkt {
     blocks: usize,
     /// Assembled values (shifted): the flat blocks, then the border entries.
     values: Vec<f64>,
-    delta: f64,
-    sigma: f64,
-    sigma_columns: Vec<usize>,
+    /// The shifts `δ` and `−σ` now in `values`.
+    shifts: Shifts,
     /// Factors: the flat blocks (`L D` or `L U` in place; `X_i` in the coupling slots), the
     /// border's values and `S`, the pivots of LU.
     factors: Vec<f64>,
@@ -77,9 +77,7 @@ impl TreeKkt {
             triplets: entries.len(),
             blocks: hess.keys.len(),
             values: vec![0.0; total],
-            delta: 0.0,
-            sigma: 0.0,
-            sigma_columns: Vec::new(),
+            shifts: Shifts::default(),
             factors: vec![0.0; shape.flat_len],
             border: vec![0.0; shape.border.len()],
             piv: vec![0; shape.tree_len],
@@ -112,9 +110,7 @@ impl TreeKkt {
         hess: &BlockHessian,
     ) {
         self.values.iter_mut().for_each(|v| *v = 0.0);
-        self.delta = 0.0;
-        self.sigma = 0.0;
-        self.sigma_columns.clear();
+        self.shifts.clear();
         let s = &self.shape;
         hess.scatter_scaled(&s.block_slots, scale, &mut self.values);
         for (e, slots) in entries.iter().zip(&s.jac_slots) {
@@ -128,41 +124,23 @@ impl TreeKkt {
 
     /// The largest diagonal entry of the (scaled) `W` block.
     pub(crate) fn max_diagonal(&self) -> f64 {
-        let mut shifted = vec![0.0; self.shape.diag_slots.len()];
-        for &c in &self.sigma_columns {
-            shifted[c] = self.sigma;
-        }
-        self.shape
-            .diag_slots
-            .iter()
-            .zip(&shifted)
-            .fold(0.0f64, |a, (&s, &sigma)| {
-                a.max((self.values[s as usize] - self.delta + sigma).abs())
-            })
+        self.shifts
+            .max_diagonal(&self.shape.diag_slots, &self.values)
     }
 
     /// Subtracts `σ` from the diagonal of the independent coordinates `columns` in place of
     /// the last such shift (see `sparse::kkt::Kkt::shift_independent`).
     pub(crate) fn shift_independent(&mut self, columns: &[usize], sigma: f64) {
-        for &c in &self.sigma_columns {
-            self.values[self.shape.diag_slots[c] as usize] += self.sigma;
-        }
-        self.sigma_columns.clear();
-        self.sigma_columns.extend_from_slice(columns);
-        self.sigma = sigma;
-        for &c in &self.sigma_columns {
-            self.values[self.shape.diag_slots[c] as usize] -= sigma;
-        }
+        self.shifts
+            .shift_independent(&self.shape.diag_slots, &mut self.values, columns, sigma);
     }
 
     /// Factors the matrix with `δ` added to the diagonal of the `W` block: block LDLᵀ (with the
     /// number of negative pivots), or block LU with partial pivoting where LDLᵀ meets a zero
     /// pivot or after [`TreeKkt::fall_back_to_lu`].
     pub(crate) fn factor(&mut self, delta: f64) -> Factored {
-        for &s in &self.shape.diag_slots {
-            self.values[s as usize] += delta - self.delta;
-        }
-        self.delta = delta;
+        self.shifts
+            .shift_all(&self.shape.diag_slots, &mut self.values, delta);
         self.kind = Factored::None;
         if !self.lu_only {
             if let Some(negative) = self.factor_blocks(false) {

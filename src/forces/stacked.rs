@@ -1,0 +1,237 @@
+//! The energy terms whose Hessians every Newton iteration forms, evaluated with their local
+//! Hessians on the stack instead of the boxed ones of [`crate::jet::Scalar`]: gravity and dead
+//! loads `wᵀ (r + A(p) s)`, and joint springs and efforts on revolute angles
+//! `θ = atan2(y₀ · x₁, x₀ · x₁)`.
+//!
+//! The operations are those of the generic path entry by entry, in the same order (so the
+//! results are the same to the last bit): `∇²θ = sym(m)`,
+//!
+//! `m = (∇S ∇Cᵀ − ∇C ∇Sᵀ + C ∇²S − S ∇²C) / ρ − ∇θ ∇ρᵀ / ρ`,   `ρ = S² + C²`,
+//!
+//! and a spring `U(θ)` adds `U'' ∇θ ∇θᵀ + U' ∇²θ`; but `θ` depends on the Euler parameters
+//! only, so its Hessian is formed over those 8 coordinates of the pair (not 14), and no term
+//! allocates.
+
+use crate::jet::closed::{dot_gradient, dot_hessian, linear_gradient, linear_hessian};
+use crate::jet::closed::{Lin, Rotations};
+use crate::jet::{global_index, HessianSink, LMat, LVec, Pair, NL};
+use crate::model::{BodyId, Joint};
+use nalgebra::{DVector, SMatrix, Vector3};
+
+/// The Euler-parameter coordinates of a body pair (local indices).
+const P: [usize; 8] = [3, 4, 5, 6, 10, 11, 12, 13];
+
+/// `c ∇f` into `grad` and `c ∇²f` into `hess` (as [`crate::jet::scatter`]).
+fn scatter(
+    bodies: &[Option<BodyId>; 2],
+    g: &LVec,
+    h: &LMat,
+    c: f64,
+    grad: &mut DVector<f64>,
+    hess: &mut dyn HessianSink,
+) {
+    for i in 0..NL {
+        if let Some(gi) = global_index(bodies, i) {
+            grad[gi] += c * g[i];
+        }
+    }
+    hess.add_block(bodies, h, c);
+}
+
+/// `wᵀ (r_k + A(p_k) s)` of side `k` with its gradient into `grad` and Hessian into `hess`
+/// (as [`crate::jet::closed::weighted_point`] and [`crate::jet::scatter`] with `c = 1`);
+/// returns the value.
+pub(crate) fn weighted_point(
+    bodies: &[Option<BodyId>; 2],
+    pair: &Pair,
+    s: &Vector3<f64>,
+    w: &Vector3<f64>,
+    grad: &mut DVector<f64>,
+    hess: &mut dyn HessianSink,
+) -> f64 {
+    let rot = Rotations::of(pair);
+    let p = Lin::point(pair, &rot, 0, s);
+    let mut g = LVec::zeros();
+    linear_gradient(&p, w, &mut g);
+    let mut h = LMat::zeros();
+    linear_hessian(&p, w, &mut h);
+    scatter(bodies, &g, &h, 1.0, grad, hess);
+    w.dot(&p.v)
+}
+
+/// A revolute angle `θ` (not yet on its branch), its gradient and its Hessian over [`P`].
+pub(crate) struct Angle {
+    pub(crate) v: f64,
+    pub(crate) g: LVec,
+    pub(crate) h: SMatrix<f64, 8, 8>,
+}
+
+/// `θ` of the revolute `joint` at `pair` (as [`crate::jet::closed::revolute_angle`]).
+pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair) -> Angle {
+    let rot = Rotations::of(pair);
+    let axis = |k: usize, i: usize| {
+        let r = joint.body_from_joint[k].rotation.to_rotation_matrix();
+        Lin::vector(pair, &rot, k, &r.matrix().column(i).into_owned())
+    };
+    let (x0, y0, x1) = (axis(0, 0), axis(0, 1), axis(1, 0));
+    let dot = |a: &Lin, b: &Lin, h: &mut LMat| {
+        let mut g = LVec::zeros();
+        dot_gradient(a, b, 1.0, &mut g);
+        dot_hessian(a, b, 1.0, h);
+        (a.v.dot(&b.v), g)
+    };
+    let (mut hs, mut hc) = (LMat::zeros(), LMat::zeros());
+    let (s, gs) = dot(&y0, &x1, &mut hs);
+    let (c, gc) = dot(&x0, &x1, &mut hc);
+    // `Pair::atan2`, over the Euler parameters.
+    let rho = s * s + c * c;
+    let n = gs * (c / rho) - gc * (s / rho);
+    let drho = gs * (2.0 * s) + gc * (2.0 * c);
+    let mut m = SMatrix::<f64, 8, 8>::zeros();
+    for (a, &i) in P.iter().enumerate() {
+        for (b, &j) in P.iter().enumerate() {
+            let x = gs[i] * gc[j] - gc[i] * gs[j] + hs[(i, j)] * c - hc[(i, j)] * s;
+            m[(a, b)] = x / rho - n[i] * drho[j] / rho;
+        }
+    }
+    let mut h = SMatrix::<f64, 8, 8>::zeros();
+    for a in 0..8 {
+        for b in 0..8 {
+            h[(a, b)] = (m[(a, b)] + m[(b, a)]) * 0.5;
+        }
+    }
+    Angle {
+        v: s.atan2(c),
+        g: n,
+        h,
+    }
+}
+
+/// `c U(θ)` for `U` given by `(u, du, ddu)` at `θ` (`Scalar::compose`; `None`: `U = θ`):
+/// its gradient into `grad` and Hessian into `hess`.
+pub(crate) fn scatter_angle(
+    bodies: &[Option<BodyId>; 2],
+    theta: &Angle,
+    law: Option<(f64, f64)>,
+    c: f64,
+    grad: &mut DVector<f64>,
+    hess: &mut dyn HessianSink,
+) {
+    let mut h = LMat::zeros();
+    let g = match law {
+        Some((du, ddu)) => {
+            for (a, &i) in P.iter().enumerate() {
+                for (b, &j) in P.iter().enumerate() {
+                    h[(i, j)] = theta.g[i] * theta.g[j] * ddu + theta.h[(a, b)] * du;
+                }
+            }
+            theta.g * du
+        }
+        None => {
+            for (a, &i) in P.iter().enumerate() {
+                for (b, &j) in P.iter().enumerate() {
+                    h[(i, j)] = theta.h[(a, b)];
+                }
+            }
+            theta.g
+        }
+    };
+    scatter(bodies, &g, &h, c, grad, hess);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::jet::testing::sample_pair;
+    use crate::jet::{hess_or_zero, Pair};
+    use nalgebra::{DMatrix, Isometry3, Translation3, UnitQuaternion};
+
+    fn joint() -> Joint {
+        Joint {
+            name: "j".into(),
+            kind: crate::model::JointKind::Revolute,
+            parent_link: "a".into(),
+            child_link: "b".into(),
+            bodies: [Some(BodyId(0)), Some(BodyId(1))],
+            body_from_joint: [
+                Isometry3::from_parts(
+                    Translation3::new(0.1, 0.2, -0.3),
+                    UnitQuaternion::from_euler_angles(0.3, -0.2, 0.9),
+                ),
+                Isometry3::from_parts(
+                    Translation3::new(-0.2, 0.05, 0.4),
+                    UnitQuaternion::from_euler_angles(-0.5, 0.4, 0.1),
+                ),
+            ],
+            tree: false,
+            merged: false,
+            limits: None,
+            effort_limit: None,
+            source: None,
+        }
+    }
+
+    fn hessian_of(
+        pair: &Pair,
+        f: &dyn Fn(&Pair, &mut DVector<f64>, &mut DMatrix<f64>),
+    ) -> (DVector<f64>, DMatrix<f64>) {
+        let _ = pair;
+        let mut g = DVector::zeros(14);
+        let mut h = DMatrix::zeros(14, 14);
+        f(pair, &mut g, &mut h);
+        (g, h)
+    }
+
+    /// The stacked terms equal the boxed generic path bit for bit: gradient and Hessian of a
+    /// revolute spring `U(θ)`, of an effort `−τ θ` and of a weighted point.
+    #[test]
+    fn stacked_terms_equal_the_boxed_path_bit_for_bit() {
+        let j = joint();
+        let bodies = j.bodies;
+        for seed in 0..6 {
+            let mut pair = sample_pair(seed);
+            pair.hess = true;
+            let (du, ddu) = (0.7 + seed as f64, -1.3 * seed as f64);
+            // Spring: boxed.
+            let theta = crate::jet::closed::revolute_angle(&j, &pair);
+            let boxed = theta.compose(0.0, du, ddu);
+            let (g0, h0) = hessian_of(&pair, &|_, g, h| {
+                crate::jet::scatter(&bodies, &boxed, 1.0, g, Some(h as &mut dyn HessianSink));
+            });
+            let stacked = revolute_angle(&j, &pair);
+            assert_eq!(stacked.v, theta.v);
+            let (g1, h1) = hessian_of(&pair, &|_, g, h| {
+                scatter_angle(&bodies, &stacked, Some((du, ddu)), 1.0, g, h);
+            });
+            assert_eq!(g0, g1, "seed {seed}");
+            assert_eq!(h0, h1, "seed {seed}");
+            assert!(h1.amax() > 0.0);
+            // Effort: `−τ θ`.
+            let tau = -2.5;
+            let (g0, h0) = hessian_of(&pair, &|_, g, h| {
+                crate::jet::scatter(&bodies, &theta, tau, g, Some(h as &mut dyn HessianSink));
+            });
+            let (g1, h1) = hessian_of(&pair, &|_, g, h| {
+                scatter_angle(&bodies, &stacked, None, tau, g, h);
+            });
+            assert_eq!((g0, h0), (g1, h1), "seed {seed}");
+            // Weighted point.
+            let one = [Some(BodyId(1)), None];
+            let (s, w) = (Vector3::new(0.3, -0.1, 0.25), Vector3::new(1.0, -2.0, 9.81));
+            let boxed = crate::jet::closed::weighted_point(&pair, 0, &s, &w);
+            assert!(hess_or_zero(&boxed.h).amax() > 0.0);
+            let (g0, h0) = hessian_of(&pair, &|_, g, h| {
+                crate::jet::scatter(&one, &boxed, 1.0, g, Some(h as &mut dyn HessianSink));
+            });
+            let mut v = 0.0;
+            let (g1, h1) = {
+                let mut g = DVector::zeros(14);
+                let mut h = DMatrix::zeros(14, 14);
+                v += weighted_point(&one, &pair, &s, &w, &mut g, &mut h);
+                (g, h)
+            };
+            assert_eq!(v, boxed.v);
+            assert_eq!((g0, h0), (g1, h1), "seed {seed}");
+        }
+    }
+}

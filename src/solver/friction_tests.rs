@@ -1,10 +1,18 @@
 //! Tests of module `friction` on rigid bodies whose contact wrenches are written here:
 //! closed forms (a body on a slope, a ladder against a wall) and an independent solution of
-//! the same problem (bisection on `μ` of a linear program over many-sided pyramids, solved by
-//! a small simplex method written here).
+//! the same problem (bisection on `μ` of a linear program over many-sided pyramids). The
+//! linear program is the integration tests' oracle, `tests/it/common/pyramid.rs` (phase 1 of
+//! the simplex method, each answer certified by its final basis or a Farkas vector), shared
+//! here so that one implementation answers both; these tests need the crate's private
+//! `Support`, so they stay unit tests.
 
 use super::*;
 use nalgebra::{DMatrix, Vector3};
+
+/// The shared oracle (its rigid-body helpers are the integration tests').
+#[allow(dead_code)]
+#[path = "../../tests/it/common/pyramid.rs"]
+mod pyramid;
 
 /// A contact of a rigid body: point, unit normal, whether it sticks.
 struct Touch {
@@ -80,59 +88,10 @@ fn support(touches: &[Touch], w: f64, tilt: f64, mu: Option<f64>) -> (DMatrix<f6
     (g, s)
 }
 
-/// Feasibility of `{A x = b, x ≥ 0}` by phase 1 of the simplex method (Bland's rule).
-fn lp_feasible(a: &DMatrix<f64>, b: &DVector<f64>) -> bool {
-    let (m, n) = (a.nrows(), a.ncols());
-    // Tableau [A I | b] with b ≥ 0, minimizing the sum of the artificials.
-    let mut t = DMatrix::zeros(m + 1, n + m + 1);
-    for r in 0..m {
-        let s = if b[r] < 0.0 { -1.0 } else { 1.0 };
-        for c in 0..n {
-            t[(r, c)] = s * a[(r, c)];
-        }
-        t[(r, n + r)] = 1.0;
-        t[(r, n + m)] = s * b[r];
-    }
-    let mut basis: Vec<usize> = (n..n + m).collect();
-    for c in 0..=n + m {
-        let sum: f64 = (0..m).map(|r| t[(r, c)]).sum();
-        t[(m, c)] = if c >= n && c < n + m { 0.0 } else { -sum };
-    }
-    let scale = b.amax().max(1.0);
-    for _ in 0..10_000 {
-        let Some(enter) = (0..n + m).find(|&c| t[(m, c)] < -1e-11) else {
-            break;
-        };
-        let leave = (0..m)
-            .filter(|&r| t[(r, enter)] > 1e-12)
-            .min_by(|&r1, &r2| {
-                let q1 = t[(r1, n + m)] / t[(r1, enter)];
-                let q2 = t[(r2, n + m)] / t[(r2, enter)];
-                q1.total_cmp(&q2).then(basis[r1].cmp(&basis[r2]))
-            });
-        let Some(leave) = leave else { break };
-        let piv = t[(leave, enter)];
-        for c in 0..=n + m {
-            t[(leave, c)] /= piv;
-        }
-        for r in 0..=m {
-            if r != leave {
-                let f = t[(r, enter)];
-                if f != 0.0 {
-                    for c in 0..=n + m {
-                        t[(r, c)] -= f * t[(leave, c)];
-                    }
-                }
-            }
-        }
-        basis[leave] = enter;
-    }
-    -t[(m, n + m)] <= 1e-9 * scale
-}
-
 /// Whether forces inside `sides`-sided pyramids of half-aperture `mu` (edges on the cone of
-/// `mu`: inscribed) balance the body.
-fn pyramid_feasible(g: &DMatrix<f64>, s: &Support, mu: f64, sides: usize) -> bool {
+/// `mu`: inscribed) balance the body; `None` where the oracle cannot certify either answer
+/// (within rounding of the boundary).
+fn pyramid_feasible(g: &DMatrix<f64>, s: &Support, mu: f64, sides: usize) -> Option<bool> {
     // Variables: per sticking contact `sides` edge weights, per smooth one its normal force.
     let rhs = g * &s.base;
     let mut cols = Vec::new();
@@ -149,20 +108,25 @@ fn pyramid_feasible(g: &DMatrix<f64>, s: &Support, mu: f64, sides: usize) -> boo
             _ => cols.push(n),
         }
     }
-    lp_feasible(&DMatrix::from_columns(&cols), &rhs)
+    pyramid::lp_feasible(&DMatrix::from_columns(&cols), &rhs)
 }
 
-/// The smallest `mu` for which the pyramids balance the body, by bisection.
+/// The smallest `mu` for which the pyramids balance the body, by bisection (as the oracle's
+/// `least_mu`): the upper end of the bracket, feasible.
 fn pyramid_mu(g: &DMatrix<f64>, s: &Support, sides: usize) -> f64 {
     let (mut lo, mut hi) = (0.0, 4.0);
     for _ in 0..40 {
         let mid = 0.5 * (lo + hi);
-        if pyramid_feasible(g, s, mid, sides) {
-            hi = mid;
-        } else {
-            lo = mid;
+        match pyramid_feasible(g, s, mid, sides) {
+            Some(true) => hi = mid,
+            Some(false) => lo = mid,
+            None => break,
         }
     }
+    assert!(
+        hi - lo < 1e-6,
+        "bracket [{lo}, {hi}] not certified narrower"
+    );
     hi
 }
 

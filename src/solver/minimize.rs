@@ -23,7 +23,8 @@
 //!    reaches its boundary, and the minimization stops there (`Outcome::blocked`: the
 //!    inequality update is the caller's, folder `inequality`).
 //! 6. **Accept** ([`accept_step`]): quasi-Newton update, and the unbounded test (a linear
-//!    descent that goes on, module `unbounded`).
+//!    descent that goes on, module `unbounded`); with inequalities, the stall test (steps
+//!    shrinking towards an obstacle's edge end the round, module `inequality::stall`).
 //! 7. **Refresh the partition** ([`refresh_partition`], paper step (b)): anew when `Φ_u` is
 //!    ill-conditioned, when its pivots have drifted ([`PIVOT_DRIFT`]) and a fresh full
 //!    pivoting differs, or when a sparse partition's second-pass choices change. When the
@@ -234,6 +235,7 @@ pub(crate) fn minimize(
             }
             Some(t) => {
                 let alpha = t.alpha;
+                let before = s.eval.grad_v.amax();
                 if accept_step(sys, &mut s, &step, slope, t, failures_before, guard) {
                     termination = Termination::Unbounded;
                     s.diag.free_directions = super::unbounded::free_directions(
@@ -241,6 +243,15 @@ pub(crate) fn minimize(
                         &s.q,
                         &(&step.dq * alpha),
                     );
+                    break;
+                }
+                // Steps shrinking towards an obstacle's edge (module `inequality::stall`).
+                if let Some(r) = release.filter(|r| r.stalled(alpha, before, s.eval.grad_v.amax()))
+                {
+                    // The rows carried past the edge leave (`released` with a failed line
+                    // search: the caller guards them by their true gap).
+                    released = r.opened_at_stall(&s.q, &step.dq, &sys.problem.cons.branches);
+                    termination = Termination::LineSearchFailed;
                     break;
                 }
                 refresh_partition(sys, &mut s)?;

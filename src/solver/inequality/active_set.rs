@@ -248,7 +248,12 @@ pub(crate) fn solve(
         );
         let cycling = changes - initial >= options.max_iterations;
         if !round.released.is_empty() && !cycling {
-            // Rows pulling hard before the round was stationary (module `release`).
+            // Rows pulling hard before the round was stationary (module `release`), or rows
+            // carried past an obstacle's edge by a stalled round (module `stall`: its line
+            // search is reported failed), guarded by their true gap next.
+            if report.termination == crate::solver::Termination::LineSearchFailed {
+                let_go = round.released.iter().map(|&i| active[i].row).collect();
+            }
             let mut gone = round.released.clone();
             gone.sort_unstable();
             for &i in gone.iter().rev() {

@@ -5,6 +5,7 @@
 //! - `guard`: where a step first reaches an inactive inequality's boundary.
 //! - `release`: when active rows leave (early, before a round is stationary; several at once).
 //! - `let_go`: contacts that no longer hold a floating body when a round stalls.
+//! - `stall`: a round whose steps shrink towards an obstacle's edge ends.
 //! - `rolling`: sticking spheres re-anchored where they touch after rolling.
 //! - `distribution`: the least-norm force distribution of a statically indeterminate support.
 
@@ -14,3 +15,4 @@ pub(crate) mod guard;
 pub(crate) mod let_go;
 pub(crate) mod release;
 pub(crate) mod rolling;
+pub(crate) mod stall;

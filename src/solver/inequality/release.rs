@@ -10,6 +10,22 @@
 //! than `‖∂V/∂v‖∞ / η`: the energy gained by leaving the row then dominates what is left to gain
 //! in the current subspace.
 //!
+//! `L` is the lever of a unit of dimensionless gap where relaxing a contact moves its body as a
+//! whole (a floating base). A contact on a chain held by the world turns the links next to it,
+//! whose lever is their own length: a rope of 1,000 links 0.05 m long has `L` = 50 m, and its
+//! lift-off contacts, pulling for a few iterations while the hanging part settles, were released
+//! one per round and came back one per round (37 rounds where 11 suffice). There the rate is
+//! taken per unit of the motion that relaxing the row causes with the independent coordinates
+//! held, in the scaled coordinates of the reduced gradient,
+//!
+//! `e_k = λ_k / ‖S⁻¹ Φ_u⁻¹ e_k‖₂`
+//!
+//! (`S⁻¹` dividing positions by `ℓ`): the directional derivative of the energy along that
+//! motion, comparable with the reduced gradient's components.
+//! Applied to the contacts of floating bases as well, the same rate changed the paths of
+//! standing robots, for the worse on balance (iCub and Talos `half_sitting` ending at
+//! `max_iterations`), so those keep `λ_k L`.
+//!
 //! At a stationary point every row pulling beyond the tolerance leaves at once (not only the
 //! one pulling hardest): a hanging humanoid starts with a dozen limits touching at 0 that all
 //! pull, and releasing them one per converged round cost a full Newton solve each.
@@ -33,19 +49,25 @@ use crate::constraints::BlockKind;
 use crate::model::Model;
 use crate::solver::partition::Partition;
 use crate::solver::system::{Eval, System};
+use nalgebra::DVector;
 
 /// The subspace tolerance `η`: a round ends early when a pulling row's energy rate exceeds
 /// `‖∂V/∂v‖∞ / η`.
 pub(crate) const SUBSPACE_TOLERANCE: f64 = 0.5;
 
-/// The early-release test of one round.
+/// The early-release test of one round, and its stall test (module `stall`).
 pub(crate) struct Release<'m> {
     model: &'m Model,
     /// Per active inequality (in the order of the round's active list): whether it may leave
     /// before the round is stationary.
     eligible: Vec<bool>,
+    /// Per active inequality: a contact on a body that joints connect to the world (its rate
+    /// is taken per unit of motion, module docs).
+    held_chain: Vec<bool>,
     /// The complementarity tolerance `force_tolerance · F` \[N\].
     threshold: f64,
+    /// Whether the round stalls at an obstacle's edge.
+    stall: super::stall::Stall,
 }
 
 impl<'m> Release<'m> {
@@ -57,14 +79,42 @@ impl<'m> Release<'m> {
         released_before: &[Unilateral],
         threshold: f64,
     ) -> Self {
+        let (root, world) = crate::solver::unbounded::groups(model);
         Release {
             model,
             eligible: active
                 .iter()
                 .map(|a| !released_before.contains(&a.row))
                 .collect(),
+            held_chain: active
+                .iter()
+                .map(|a| match a.row {
+                    Unilateral::Contact { point, .. } => {
+                        root[model.contact_points[point].body.0] == world
+                    }
+                    Unilateral::Limit { .. } => false,
+                })
+                .collect(),
             threshold,
+            stall: super::stall::Stall::new(model, active),
         }
+    }
+
+    /// Records an accepted step of length `alpha` (the reduced gradient `before` and `after`
+    /// it); whether the round has stalled at an obstacle's edge (module `stall`).
+    pub(crate) fn stalled(&self, alpha: f64, before: f64, after: f64) -> bool {
+        self.stall.record(alpha, before, after)
+    }
+
+    /// At a stall, the active contacts that the tangent step `dq` from `q` carries past an
+    /// obstacle's edge (module `stall`).
+    pub(crate) fn opened_at_stall(
+        &self,
+        q: &DVector<f64>,
+        dq: &DVector<f64>,
+        branches: &crate::kinematics::Branches,
+    ) -> Vec<usize> {
+        self.stall.opened(self.model, q, dq, branches)
     }
 
     /// The active inequalities (indices into the round's active list) to release now, or
@@ -95,13 +145,35 @@ impl<'m> Release<'m> {
                 continue;
             }
             let scaled = super::active_set::scaled_force(self.model, a, &[eval.mu[k]]);
-            let rate = scaled * self.model.length_scale;
-            if scaled < -self.threshold && -rate * SUBSPACE_TOLERANCE > gnorm {
-                out.push(i);
+            let pulls_hard = |rate: f64| -rate * SUBSPACE_TOLERANCE > gnorm;
+            if scaled >= -self.threshold || !pulls_hard(scaled * self.model.length_scale) {
+                continue;
             }
+            // On a chain held by the world, per unit of the motion (module docs).
+            if self.held_chain.get(i).copied().unwrap_or(false)
+                && !pulls_hard(eval.mu[k] / motion(sys, part, eval, k))
+            {
+                continue;
+            }
+            out.push(i);
         }
         (!out.is_empty()).then_some(out)
     }
+}
+
+/// `‖S⁻¹ Φ_u⁻¹ e_k‖₂`: the motion of the dependent coordinates, scaled as the reduced
+/// gradient's, when row `k` of `Φ_u` is relaxed by one unit with the independent coordinates
+/// held (infinite if `Φ_u` cannot be solved).
+fn motion(sys: &System, part: &Partition, eval: &Eval, k: usize) -> f64 {
+    let mut e = DVector::zeros(part.rows.len());
+    e[k] = 1.0;
+    eval.factors.solve(&e).map_or(f64::INFINITY, |x| {
+        x.iter()
+            .zip(&part.dependent)
+            .map(|(v, &c)| (v / sys.problem.scaling.columns[c]).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    })
 }
 
 /// Every active inequality (index into the multipliers' list) pulling beyond `threshold`

@@ -29,7 +29,7 @@ fn tangents(n: &Vector3<f64>) -> [Vector3<f64>; 2] {
 /// phase-1 duals `Bᵀ y = c_B` satisfy Farkas' lemma, `Aᵀ y ≤ 0` and `bᵀ y > 0` (each to
 /// `10⁻¹³`: rounding). `None` when neither certificate holds (at the boundary of
 /// feasibility, within rounding).
-fn lp_feasible(a: &DMatrix<f64>, b: &DVector<f64>) -> Option<bool> {
+pub(crate) fn lp_feasible(a: &DMatrix<f64>, b: &DVector<f64>) -> Option<bool> {
     let (m, n) = (a.nrows(), a.ncols());
     // Rows scaled to unit norm and signed so that b ≥ 0.
     let mut a = a.clone();

@@ -92,6 +92,60 @@ fn a_box_pushed_out_onto_a_finite_frictionless_ramp_falls_off_unbounded() {
     );
 }
 
+/// The model of `tests/it/obstacle.rs` (`on_tilted_box`): the box started flat on the ramp's
+/// face, 0.21 m along its normal from the centre (`mech:initial`). Frictionless, it slides down
+/// the face to the lower edge, tips over it and falls. Each vertex sliding across the edge took
+/// geometrically shrinking steps (the corrector cannot keep it on the face past the edge), and
+/// the box, its upper vertices hanging on the ramp's lower back edge, stalled there until
+/// `max_iterations` (100 iterations, 2,033 corrector failures). A round whose steps halve
+/// while the reduced gradient stays now ends; the vertices its step carries past the edge let
+/// go (module `inequality::stall`).
+#[test]
+fn a_box_started_on_the_ramp_slides_off_and_falls_unbounded() {
+    let n = (TILT.sin(), TILT.cos());
+    let at = (n.0 * 0.21, n.1 * 0.21);
+    let urdf = ramp().replace(
+        "<mech:obstacle",
+        &format!(
+            "<mech:initial joint=\"free\" value=\"{} 0 {} {} 0 {} 0\"/>\n  <mech:obstacle",
+            at.0,
+            at.1,
+            (TILT / 2.0).cos(),
+            (TILT / 2.0).sin()
+        ),
+    );
+    let (state, report) = solve(&urdf);
+    assert_falls_off(&report, "from the ramp's face");
+    // Well within the limit: a few iterations per vertex leaving the edge, not the limit.
+    assert!(report.iterations <= 40, "{} iterations", report.iterations);
+    // Independent check: it left the ramp, over its lower edge (x beyond the edge's
+    // `cos α · 1 − sin α · 0.1`), and is below every point of the ramp.
+    let (x, z) = (state.q[0], state.q[2]);
+    assert!(x > TILT.cos() - TILT.sin() * 0.1, "box centre x = {x}");
+    assert!(z < below_the_ramp(), "box centre z = {z}");
+    // The energy reported is the 1 kg box's `m g z` at the state reported.
+    assert!(
+        (report.energy.total - 9.81 * z).abs() < 1e-9 * z.abs(),
+        "{} vs {}",
+        report.energy.total,
+        9.81 * z
+    );
+    let dirs = &report.diagnostics.free_directions;
+    assert!(
+        dirs.iter().any(|d| {
+            d.strip_prefix("body `box` translating along (")
+                .and_then(|r| r.split(')').next())
+                .map(|v| {
+                    v.split(", ")
+                        .filter_map(|c| c.parse::<f64>().ok())
+                        .collect::<Vec<_>>()
+                })
+                .is_some_and(|v| v.len() == 3 && v[2] < -0.9)
+        }),
+        "down: {dirs:?}"
+    );
+}
+
 /// The command line of the issue gives the same answer, in the JSON; the base pose it was
 /// tried with (`--base-xyz`, `--base-rpy`) places a floating root link, which this model does
 /// not have: an input error naming the file and the remedy, not a silently ignored option.

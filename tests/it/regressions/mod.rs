@@ -15,3 +15,4 @@ mod issue_25_fuzz_smoke;
 mod issue_25_located_errors;
 mod issue_25_unbounded_numbers;
 mod issue_25_verify_agrees_with_analyze;
+mod issue_26_rope_rounds;

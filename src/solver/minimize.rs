@@ -14,9 +14,8 @@
 //!    whole mechanism (every body's Euler parameters by `max_step`, its origin by
 //!    `10 max_step ℓ`, `ℓ` the larger of the length scale and the mechanism's extent).
 //! 5. **Line search and corrector** (module `line_search`): backtracking until the Armijo
-//!    condition holds along the search path (module `retraction`: the bodies moved rigidly
-//!    along the spanning tree, every tree joint turning from `θ` to `θ + α θ̇`), each trial
-//!    brought back onto `Φ = 0` by the Newton corrector and halved
+//!    condition holds along the search path (module `retraction`: every tree joint turns from
+//!    `θ` to `θ + α θ̇`), each trial brought back onto `Φ = 0` by the corrector and halved
 //!    when the corrector fails (paper step (f)), from `α = 1`, or with second-pass choices in a
 //!    sparse partition from the reach the corrector last managed ([`Search::reach`]). With a
 //!    guard, a step that would violate an inactive inequality is cut where the first one
@@ -43,6 +42,7 @@ use super::options::{Method, Options};
 use super::partition::Partition;
 use super::quasi_newton::QuasiNewton;
 use super::report::{Diagnostics, Iterate, Termination};
+use super::retraction::independent_change;
 use super::stability::at_rest::for_minimizer;
 use super::stability::spectrum::Spectrum;
 use super::step_cap::{cap_step, Step};
@@ -87,11 +87,9 @@ const GRADIENT_FLOOR: f64 = 1e-13;
 /// horizontal stalled at ‖∇f‖ = 10⁻² for 200 iterations).
 const PIVOT_DRIFT: f64 = 0.85;
 
-/// The dense Newton step divides by the reduced Hessian's eigenvalue magnitudes, floored at this
-/// fraction of the largest (the rounding of the eigenvalues, `ε ‖Ĥ‖` amplified by the
-/// conditioning of `Z`, is below it). At 10⁻⁸ the floor shortened the steps along near-neutral
-/// directions (iCub's hip yaws under its hanging legs, at 1.2·10⁻¹⁰ of the largest) some 80-fold,
-/// and the solve crawled at the rate `1 − λ/floor` for hundreds of iterations.
+/// The dense Newton step's floor on the eigenvalue magnitudes, a fraction of the largest. At
+/// 10⁻⁸ it cut the steps along near-neutral directions (iCub's hip yaws, 1.2·10⁻¹⁰ of the
+/// largest) 80-fold and the solve crawled at the rate `1 − λ/floor`.
 const EIGENVALUE_FLOOR: f64 = 1e-12;
 
 /// Up to this many degrees of freedom the sparse path too steps by the exact reduced Hessian's
@@ -410,16 +408,8 @@ fn accept_step(
         s.reach
     };
     let gnorm = s.eval.grad_v.amax();
-    // The step actually taken in the scaled independent coordinates (the search path is not a
-    // straight line in them: module `retraction`).
     let columns = &sys.problem.scaling.columns;
-    let ds = DVector::from_iterator(
-        s.part.independent.len(),
-        s.part
-            .independent
-            .iter()
-            .map(|&c| (t.q[c] - s.q[c]) / columns[c]),
-    );
+    let ds = independent_change(&s.part.independent, columns, &s.q, &t.q);
     let y = &t.eval.grad_v - &s.eval.grad_v;
     // Full capped steps that leave the gradient unchanged: the energy falls linearly along a
     // direction of zero curvature.

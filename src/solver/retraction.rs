@@ -110,6 +110,20 @@ impl Retraction {
     }
 }
 
+/// The change of the scaled independent coordinates `v̂ = S⁻¹ v` from `q` to `qt` (the path is
+/// not a straight line in them): the step a quasi-Newton update was taken over.
+pub(crate) fn independent_change(
+    independent: &[usize],
+    columns: &[f64],
+    q: &DVector<f64>,
+    qt: &DVector<f64>,
+) -> DVector<f64> {
+    DVector::from_iterator(
+        independent.len(),
+        independent.iter().map(|&c| (qt[c] - q[c]) / columns[c]),
+    )
+}
+
 /// The origin of body `b` in `q` (or its velocity in a tangent).
 fn position(q: &DVector<f64>, b: usize) -> Vector3<f64> {
     q.fixed_rows::<3>(7 * b).into_owned()

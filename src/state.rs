@@ -11,9 +11,10 @@
 //! 3.5 − 2π, and a solve tracks each angle continuously from its start.
 
 use crate::jet::pair_of;
+use crate::joint::TreeMotion;
 use crate::kinematics::{coordinate, motion, Branches};
 use crate::math::{euler_parameters, unit_quaternion};
-use crate::model::{BodyId, JointId, JointKind, Model};
+use crate::model::{BodyId, JointId, Model};
 use nalgebra::{DVector, Isometry3, Translation3, Vector4};
 use std::collections::HashMap;
 
@@ -26,7 +27,7 @@ pub struct State {
     pub branches: Branches,
 }
 
-/// Joint coordinate values by joint name (see [`JointKind`] for the order of coordinates).
+/// Joint coordinate values by joint name (see [`crate::model::JointKind`] for the order of coordinates).
 pub type JointValues = HashMap<String, Vec<f64>>;
 
 impl State {
@@ -151,7 +152,7 @@ impl State {
             .joints
             .iter()
             .filter(|j| j.tree && !j.merged)
-            .filter(|j| matches!(j.kind, JointKind::Distance { .. } | JointKind::PointOnLine))
+            .filter(|j| j.kind.spec().tree_motion == TreeMotion::Pose && j.kind.position_len() == 0)
             .filter_map(|j| j.bodies[1])
             .collect()
     }
@@ -227,16 +228,7 @@ impl State {
                 Some(b) => self.body_pose(b) * j.body_from_joint[k],
                 None => j.body_from_joint[k],
             };
-            let rel = pose(0).inverse() * pose(1);
-            let r = rel.rotation;
-            match j.kind {
-                JointKind::Spherical => vec![r.w, r.i, r.j, r.k],
-                JointKind::Floating => {
-                    let t = rel.translation.vector;
-                    vec![t.x, t.y, t.z, r.w, r.i, r.j, r.k]
-                }
-                _ => vec![],
-            }
+            (j.kind.spec().values_of_motion)(&(pose(0).inverse() * pose(1)))
         }
     }
 }

@@ -14,6 +14,7 @@
 //! the mimic constraint holds at `m θ_ref + offset`). The floating base is the pose of the
 //! root link in the world, `world_from_root = (x, y, z, quaternion)`.
 
+use crate::joint::Entry as Value;
 use crate::model::{JointId, JointKind, Model};
 use crate::state::State;
 
@@ -136,20 +137,24 @@ pub fn values(entries: &[Entry]) -> Vec<f64> {
     entries.iter().map(|e| e.value).collect()
 }
 
-/// A joint's entries from its restpose coordinates `v` (see [`State::joint_values`]).
+/// A joint's entries from its restpose coordinates `v` (see [`State::joint_values`]), as its
+/// kind's file says ([`crate::joint::Spec::configuration`]); `None` if the tool does not read
+/// the kind from a URDF.
 fn joint_entries(kind: JointKind, v: &[f64], convention: Convention) -> Option<Vec<f64>> {
     let at = |i: usize| v.get(i).copied().unwrap_or(0.0);
-    Some(match (kind, convention) {
-        (JointKind::Fixed, _) => vec![],
-        (JointKind::Revolute | JointKind::Prismatic, _) => vec![at(0)],
-        (JointKind::Continuous, Convention::Mujoco) => vec![at(0)],
-        (JointKind::Continuous, Convention::Pinocchio) => vec![at(0).cos(), at(0).sin()],
-        // restpose: [w, x, y, z]; [x, y, z, w, qx, qy, qz] for floating.
-        (JointKind::Spherical, Convention::Mujoco) => vec![at(0), at(1), at(2), at(3)],
-        (JointKind::Floating, Convention::Mujoco) => (0..7).map(at).collect(),
-        (JointKind::Floating, Convention::Pinocchio) => {
-            vec![at(0), at(1), at(2), at(4), at(5), at(6), at(3)]
-        }
-        _ => return None,
-    })
+    let c = kind.spec().configuration;
+    let entries = match convention {
+        Convention::Mujoco => c.mujoco,
+        Convention::Pinocchio => c.pinocchio,
+    }?;
+    Some(
+        entries
+            .iter()
+            .map(|e| match *e {
+                Value::Value(i) => at(i),
+                Value::Cos(i) => at(i).cos(),
+                Value::Sin(i) => at(i).sin(),
+            })
+            .collect(),
+    )
 }

@@ -142,8 +142,8 @@ pub(crate) fn scatter_angle(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::jet::hess_or_zero;
     use crate::jet::testing::sample_pair;
-    use crate::jet::{hess_or_zero, Pair};
     use nalgebra::{DMatrix, Isometry3, Translation3, UnitQuaternion};
 
     fn joint() -> Joint {
@@ -171,14 +171,13 @@ mod tests {
         }
     }
 
+    /// The gradient and Hessian over two bodies that `f` adds to zeros.
     fn hessian_of(
-        pair: &Pair,
-        f: &dyn Fn(&Pair, &mut DVector<f64>, &mut DMatrix<f64>),
+        f: impl Fn(&mut DVector<f64>, &mut DMatrix<f64>),
     ) -> (DVector<f64>, DMatrix<f64>) {
-        let _ = pair;
         let mut g = DVector::zeros(14);
         let mut h = DMatrix::zeros(14, 14);
-        f(pair, &mut g, &mut h);
+        f(&mut g, &mut h);
         (g, h)
     }
 
@@ -195,12 +194,12 @@ mod tests {
             // Spring: boxed.
             let theta = crate::jet::closed::revolute_angle(&j, &pair);
             let boxed = theta.compose(0.0, du, ddu);
-            let (g0, h0) = hessian_of(&pair, &|_, g, h| {
+            let (g0, h0) = hessian_of(|g, h| {
                 crate::jet::scatter(&bodies, &boxed, 1.0, g, Some(h as &mut dyn HessianSink));
             });
             let stacked = revolute_angle(&j, &pair);
             assert_eq!(stacked.v, theta.v);
-            let (g1, h1) = hessian_of(&pair, &|_, g, h| {
+            let (g1, h1) = hessian_of(|g, h| {
                 scatter_angle(&bodies, &stacked, Some((du, ddu)), 1.0, g, h);
             });
             assert_eq!(g0, g1, "seed {seed}");
@@ -208,10 +207,10 @@ mod tests {
             assert!(h1.amax() > 0.0);
             // Effort: `−τ θ`.
             let tau = -2.5;
-            let (g0, h0) = hessian_of(&pair, &|_, g, h| {
+            let (g0, h0) = hessian_of(|g, h| {
                 crate::jet::scatter(&bodies, &theta, tau, g, Some(h as &mut dyn HessianSink));
             });
-            let (g1, h1) = hessian_of(&pair, &|_, g, h| {
+            let (g1, h1) = hessian_of(|g, h| {
                 scatter_angle(&bodies, &stacked, None, tau, g, h);
             });
             assert_eq!((g0, h0), (g1, h1), "seed {seed}");
@@ -220,7 +219,7 @@ mod tests {
             let (s, w) = (Vector3::new(0.3, -0.1, 0.25), Vector3::new(1.0, -2.0, 9.81));
             let boxed = crate::jet::closed::weighted_point(&pair, 0, &s, &w);
             assert!(hess_or_zero(&boxed.h).amax() > 0.0);
-            let (g0, h0) = hessian_of(&pair, &|_, g, h| {
+            let (g0, h0) = hessian_of(|g, h| {
                 crate::jet::scatter(&one, &boxed, 1.0, g, Some(h as &mut dyn HessianSink));
             });
             let mut v = 0.0;

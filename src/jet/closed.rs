@@ -247,9 +247,12 @@ impl Frames {
                 }
             }
         }
-        let axis = |k: usize, i: usize| {
-            let r = joint.body_from_joint[k].rotation.to_rotation_matrix();
-            Lin::vector(pair, &rot, k, &r.matrix().column(i).into_owned())
+        // Each side's joint rotation once.
+        let mut r: [Option<Matrix3<f64>>; 2] = [None, None];
+        let mut axis = |k: usize, i: usize| {
+            let jr = &joint.body_from_joint[k].rotation;
+            let r = r[k].get_or_insert_with(|| *jr.to_rotation_matrix().matrix());
+            Lin::vector(pair, &rot, k, &r.column(i).into_owned())
         };
         let mut vectors = [Lin::ZERO; 7];
         for (v, slot) in vectors.iter_mut().enumerate() {
@@ -332,25 +335,35 @@ pub(crate) fn values(joint: &Joint, pair: &Pair, out: &mut Vec<f64>) {
     };
     let a = [rotation(&pair.p[0]), rotation(&pair.p[1])];
     let f = &joint.body_from_joint;
-    // The same arithmetic as `Frames::of`: values equal those of `rows` to the last bit.
-    let axis = |k: usize, i: usize| {
-        let r = f[k].rotation.to_rotation_matrix();
-        a[k] * r.matrix().column(i).into_owned()
+    // The same arithmetic as `Frames::of`: values equal those of `rows` to the last bit. Each
+    // side's joint rotation and each vector are formed once (a revolute's `z₀` serves two
+    // rows).
+    let mut r: [Option<Matrix3<f64>>; 2] = [None, None];
+    let mut memo: [Option<Vector3<f64>>; 7] = [None; 7];
+    let mut vector = |v: V| -> Vector3<f64> {
+        if let Some(x) = memo[v as usize] {
+            return x;
+        }
+        let mut axis = |k: usize, i: usize| {
+            let r = r[k].get_or_insert_with(|| *f[k].rotation.to_rotation_matrix().matrix());
+            a[k] * r.column(i).into_owned()
+        };
+        let point = |k: usize| a[k] * f[k].translation.vector + pair.r[k];
+        let x = match v {
+            V::D => point(1) - point(0),
+            V::X0 => axis(0, 0),
+            V::Y0 => axis(0, 1),
+            V::Z0 => axis(0, 2),
+            V::X1 => axis(1, 0),
+            V::Y1 => axis(1, 1),
+            V::Z1 => axis(1, 2),
+        };
+        memo[v as usize] = Some(x);
+        x
     };
-    let point = |k: usize| a[k] * f[k].translation.vector + pair.r[k];
-    let vector = |v: V| match v {
-        V::D => point(1) - point(0),
-        V::X0 => axis(0, 0),
-        V::Y0 => axis(0, 1),
-        V::Z0 => axis(0, 2),
-        V::X1 => axis(1, 0),
-        V::Y1 => axis(1, 1),
-        V::Z1 => axis(1, 2),
-    };
-    let mut d = None;
     for row in layout {
         out.push(match *row {
-            Row::Component(m) => d.get_or_insert_with(|| vector(V::D))[m],
+            Row::Component(m) => vector(V::D)[m],
             Row::Dot(a, b) => vector(a).dot(&vector(b)),
             Row::Length => {
                 let length = joint.kind.parameter();

@@ -1,6 +1,8 @@
 //! Continuous joint: rotation about z without position limits; otherwise a revolute joint.
 
-use super::spec::{angle, name, Frame, Read, Spec, PARALLEL, POS};
+use super::spec::{
+    angle, name, no_values, Configuration, Entry, Frame, Read, Spec, TreeMotion, PARALLEL, POS,
+};
 
 pub(super) const SPEC: Spec = Spec {
     names: &[name("continuous", true, true, false)],
@@ -12,5 +14,11 @@ pub(super) const SPEC: Spec = Spec {
     row_names: &["pos_x", "pos_y", "pos_z", "axis_x", "axis_y"],
     closed_form: true,
     frame: Frame::Axis,
+    tree_motion: TreeMotion::Coordinates,
+    configuration: Configuration {
+        mujoco: Some(&[Entry::Value(0)]),
+        pinocchio: Some(&[Entry::Cos(0), Entry::Sin(0)]),
+    },
+    values_of_motion: no_values,
     motion: super::revolute::motion,
 };

@@ -1,7 +1,10 @@
 //! Cylindrical joint: rotation about and translation along z. Motion `Rz(θ) Tz(d)`; rows
 //! `z₀·x₁, z₀·y₁, x₀·d, y₀·d`; coordinates `θ`, `d·z₀`.
 
-use super::spec::{angle, at, length, name, rz, t, Frame, Read, Spec, ON_AXIS, PARALLEL, V};
+use super::spec::{
+    angle, at, length, name, no_values, rz, t, Frame, Read, Spec, TreeMotion, NOT_IN_URDF, ON_AXIS,
+    PARALLEL, V,
+};
 use super::JointKind;
 use nalgebra::Isometry3;
 
@@ -15,6 +18,9 @@ pub(super) const SPEC: Spec = Spec {
     row_names: &["axis_x", "axis_y", "slide_x", "slide_y"],
     closed_form: true,
     frame: Frame::Axis,
+    tree_motion: TreeMotion::Coordinates,
+    configuration: NOT_IN_URDF,
+    values_of_motion: no_values,
     motion,
 };
 

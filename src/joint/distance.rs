@@ -1,7 +1,7 @@
 //! Distance joint: the two joint origins stay `L` apart (a massless rod). Row `d·d − L²`; no
 //! coordinate.
 
-use super::spec::{name, t, Frame, Row, Spec};
+use super::spec::{name, no_values, t, Frame, Row, Spec, TreeMotion, NOT_IN_URDF};
 use super::JointKind;
 use nalgebra::{Isometry3, UnitQuaternion};
 
@@ -15,6 +15,9 @@ pub(super) const SPEC: Spec = Spec {
     row_names: &["length"],
     closed_form: true,
     frame: Frame::Origin,
+    tree_motion: TreeMotion::Pose,
+    configuration: NOT_IN_URDF,
+    values_of_motion: no_values,
     motion,
 };
 

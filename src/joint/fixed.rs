@@ -1,7 +1,7 @@
 //! Fixed joint: no relative motion. Rows spherical + `z₀·x₁, z₀·y₁, y₀·x₁` (a URDF fixed tree
 //! joint is welded into one body instead and adds no row).
 
-use super::spec::{name, Frame, Row, Spec, PARALLEL, POS, V};
+use super::spec::{name, no_values, Configuration, Frame, Row, Spec, TreeMotion, PARALLEL, POS, V};
 use super::JointKind;
 use nalgebra::Isometry3;
 
@@ -22,6 +22,12 @@ pub(super) const SPEC: Spec = Spec {
     row_names: &["pos_x", "pos_y", "pos_z", "axis_x", "axis_y", "twist"],
     closed_form: true,
     frame: Frame::Origin,
+    tree_motion: TreeMotion::Coordinates,
+    configuration: Configuration {
+        mujoco: Some(&[]),
+        pinocchio: Some(&[]),
+    },
+    values_of_motion: no_values,
     motion: identity,
 };
 

@@ -78,6 +78,13 @@ impl JointKind {
         self.spec().value_counts
     }
 
+    /// Number of values of a joint of this kind in the result JSON (`joints.*.position`, see
+    /// [`crate::state::State::joint_values`]): its scalar coordinates, or 4 (a spherical
+    /// joint's quaternion), 7 (a floating joint's translation and quaternion).
+    pub fn position_len(&self) -> usize {
+        self.spec().units.len()
+    }
+
     /// The kind's one parameter (a screw's pitch \[m/rad\], a distance joint's length \[m\]),
     /// 0 for the kinds without one.
     pub(crate) fn parameter(&self) -> f64 {

@@ -1,7 +1,10 @@
 //! Planar joint: translation in the x-y plane and rotation about its normal z. Motion
 //! `T(x, y, 0) Rz(θ)`; rows `z₀·x₁, z₀·y₁, z₀·d`; coordinates `x₀·d, y₀·d, θ`.
 
-use super::spec::{angle, at, length, name, rz, t, Frame, Read, Row, Spec, PARALLEL, V};
+use super::spec::{
+    angle, at, length, name, no_values, rz, t, Frame, Read, Row, Spec, TreeMotion, NOT_IN_URDF,
+    PARALLEL, V,
+};
 use super::JointKind;
 use nalgebra::Isometry3;
 
@@ -19,6 +22,9 @@ pub(super) const SPEC: Spec = Spec {
     row_names: &["normal_x", "normal_y", "plane"],
     closed_form: true,
     frame: Frame::Axis,
+    tree_motion: TreeMotion::Coordinates,
+    configuration: NOT_IN_URDF,
+    values_of_motion: no_values,
     motion,
 };
 

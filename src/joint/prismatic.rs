@@ -1,7 +1,10 @@
 //! Prismatic joint: translation along z. Motion `Tz(d)`; rows `z₀·x₁, z₀·y₁, y₀·x₁, x₀·d,
 //! y₀·d`; coordinate `d·z₀`.
 
-use super::spec::{at, length, name, t, Frame, Read, Row, Spec, ON_AXIS, PARALLEL, V};
+use super::spec::{
+    at, length, name, no_values, t, Frame, Read, Row, Spec, TreeMotion, ONE_VALUE, ON_AXIS,
+    PARALLEL, V,
+};
 use super::JointKind;
 use nalgebra::{Isometry3, UnitQuaternion};
 
@@ -21,6 +24,9 @@ pub(super) const SPEC: Spec = Spec {
     row_names: &["axis_x", "axis_y", "twist", "slide_x", "slide_y"],
     closed_form: true,
     frame: Frame::Axis,
+    tree_motion: TreeMotion::Coordinates,
+    configuration: ONE_VALUE,
+    values_of_motion: no_values,
     motion,
 };
 

@@ -1,6 +1,8 @@
 //! Revolute joint: rotation about z, limited. Motion `Rz(θ)`; rows spherical + `z₀·x₁, z₀·y₁`.
 
-use super::spec::{angle, at, name, rz, t, Frame, Read, Spec, PARALLEL, POS};
+use super::spec::{
+    angle, at, name, no_values, rz, t, Frame, Read, Spec, TreeMotion, ONE_VALUE, PARALLEL, POS,
+};
 use super::JointKind;
 use nalgebra::Isometry3;
 
@@ -14,6 +16,9 @@ pub(super) const SPEC: Spec = Spec {
     row_names: &["pos_x", "pos_y", "pos_z", "axis_x", "axis_y"],
     closed_form: true,
     frame: Frame::Axis,
+    tree_motion: TreeMotion::Coordinates,
+    configuration: ONE_VALUE,
+    values_of_motion: no_values,
     motion,
 };
 

@@ -2,7 +2,10 @@
 //! Motion `Rz(θ) Tz(h θ)`; rows cylindrical + `d·z₀ − h θ` (the angle read on its branch, so
 //! the screw advances over many turns: generic jets, no closed form).
 
-use super::spec::{angle, at, name, rz, t, Frame, Read, Row, Spec, ON_AXIS, PARALLEL};
+use super::spec::{
+    angle, at, name, no_values, rz, t, Frame, Read, Row, Spec, TreeMotion, NOT_IN_URDF, ON_AXIS,
+    PARALLEL,
+};
 use super::JointKind;
 use nalgebra::Isometry3;
 
@@ -22,6 +25,9 @@ pub(super) const SPEC: Spec = Spec {
     row_names: &["axis_x", "axis_y", "slide_x", "slide_y", "thread"],
     closed_form: false,
     frame: Frame::Axis,
+    tree_motion: TreeMotion::Coordinates,
+    configuration: NOT_IN_URDF,
+    values_of_motion: no_values,
     motion,
 };
 

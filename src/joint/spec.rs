@@ -84,6 +84,52 @@ pub(crate) enum Frame {
     Origin,
 }
 
+/// One entry of another tool's configuration vector from the values `v` of a joint (missing
+/// values are 0).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Entry {
+    /// `v[i]`.
+    Value(usize),
+    /// `cos v[i]`.
+    Cos(usize),
+    /// `sin v[i]`.
+    Sin(usize),
+}
+
+/// How MuJoCo's `qpos` and Pinocchio's `q` hold a joint of this kind, read from the same URDF
+/// (`None`: that tool does not read the kind from a URDF).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Configuration {
+    pub(crate) mujoco: Option<&'static [Entry]>,
+    pub(crate) pinocchio: Option<&'static [Entry]>,
+}
+
+/// Neither tool reads the kind from a URDF.
+pub(crate) const NOT_IN_URDF: Configuration = Configuration {
+    mujoco: None,
+    pinocchio: None,
+};
+
+/// Both tools hold the kind's one value as it is (revolute, prismatic).
+pub(crate) const ONE_VALUE: Configuration = Configuration {
+    mujoco: Some(&[Entry::Value(0)]),
+    pinocchio: Some(&[Entry::Value(0)]),
+};
+
+/// What moves the child of a tree joint of this kind in joint space (the stability verdict's
+/// joint-space check, `solver::stability::joint_space`, and the poses `verify` reads).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum TreeMotion {
+    /// Its scalar coordinates (none for a fixed joint).
+    Coordinates,
+    /// Its scalar coordinates and a free rotation (spherical: three angular velocities).
+    Rotation,
+    /// The child's whole pose (three translational and three angular velocities): a floating
+    /// joint's values, or for a kind without values (distance, point-on-line) the child body's
+    /// own pose.
+    Pose,
+}
+
 /// Where a file may declare a joint of a type name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Declared {
@@ -139,9 +185,22 @@ pub(crate) struct Spec {
     pub(crate) closed_form: bool,
     /// How `<axis>` places the joint frame.
     pub(crate) frame: Frame,
+    /// What moves its child as a tree joint.
+    pub(crate) tree_motion: TreeMotion,
+    /// Its entries in MuJoCo's and Pinocchio's configuration vectors.
+    pub(crate) configuration: Configuration,
+    /// The values of a kind without scalar coordinates (a spherical joint's quaternion, a
+    /// floating joint's translation and quaternion) read from the relative motion `M` of the
+    /// joint frames: the inverse of `motion`. Kinds with scalar coordinates read those instead.
+    pub(crate) values_of_motion: fn(&Isometry3<f64>) -> Vec<f64>,
     /// The relative motion `M(v)` of the child's `J` in the parent's `J` for the values `v`
     /// (missing values are 0; angles taken as given).
     pub(crate) motion: fn(&JointKind, &[f64]) -> Isometry3<f64>,
+}
+
+/// No values (the kinds with scalar coordinates, or none at all).
+pub(crate) fn no_values(_: &Isometry3<f64>) -> Vec<f64> {
+    vec![]
 }
 
 /// Value `i` of `v`, 0 if missing.

@@ -2,7 +2,10 @@
 //! `Rz(θ₁) Rx(θ₂)`; rows spherical + `z₀·x₁`; coordinates `θ₁` (about `z₀`) and
 //! `θ₂ = atan2(z₀·y₁, z₀·z₁)`.
 
-use super::spec::{angle, at, name, rx, rz, t, Frame, Read, Spec, PARALLEL, POS, V};
+use super::spec::{
+    angle, at, name, no_values, rx, rz, t, Frame, Read, Spec, TreeMotion, NOT_IN_URDF, PARALLEL,
+    POS, V,
+};
 use super::JointKind;
 use nalgebra::Isometry3;
 
@@ -19,6 +22,9 @@ pub(super) const SPEC: Spec = Spec {
     row_names: &["pos_x", "pos_y", "pos_z", "cross"],
     closed_form: true,
     frame: Frame::TwoAxes,
+    tree_motion: TreeMotion::Coordinates,
+    configuration: NOT_IN_URDF,
+    values_of_motion: no_values,
     motion,
 };
 

@@ -8,7 +8,7 @@
 //! torsion spring on a continuous joint winds up over several turns and its energy uses the
 //! unwrapped angle.
 
-use super::coordinate::coordinate;
+use super::coordinate::coordinate_value;
 use crate::jet::pair_of;
 use crate::model::MAX_SCALAR_COORDINATES;
 use crate::model::{JointId, Model};
@@ -55,8 +55,8 @@ impl Branches {
             let pair = pair_of(&j.bodies, q, false);
             for dof in (0..n).filter(|&d| j.kind.is_angle(d)) {
                 let id = JointId(i);
-                if let Some(s) = coordinate(j, &pair, dof, self.get(id, dof)) {
-                    self.set(id, dof, s.v);
+                if let Some(v) = coordinate_value(j, &pair, dof, self.get(id, dof)) {
+                    self.set(id, dof, v);
                 }
             }
         }

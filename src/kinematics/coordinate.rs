@@ -9,8 +9,9 @@
 use super::frames::{angle, frames, Frames};
 use crate::jet::{Pair, Scalar, Vec3Jet};
 use crate::joint::{Read, V};
-use crate::math::wrap_angle;
+use crate::math::{rotation, wrap_angle};
 use crate::model::Joint;
+use nalgebra::Vector3;
 
 /// The vector `v` of the joint frames `f`.
 pub(crate) fn vector(f: &Frames, v: V) -> &Vec3Jet {
@@ -41,6 +42,43 @@ pub(crate) fn coordinate(joint: &Joint, pair: &Pair, dof: usize, reference: f64)
         }
     };
     Some(if c.angle { on_branch(s, reference) } else { s })
+}
+
+/// The value of [`coordinate`] alone, without derivatives: the same arithmetic on the values
+/// of the frames (bit for bit the same number), for the branches followed after every step.
+pub(crate) fn coordinate_value(
+    joint: &Joint,
+    pair: &Pair,
+    dof: usize,
+    reference: f64,
+) -> Option<f64> {
+    let c = joint.kind.spec().coordinates.get(dof)?;
+    let a = [rotation(&pair.p[0]), rotation(&pair.p[1])];
+    let f = &joint.body_from_joint;
+    let axis = |k: usize, e: Vector3<f64>| a[k] * (f[k].rotation * e);
+    let vector = |v: V| match v {
+        V::D => {
+            let o = |k: usize| pair.r[k] + a[k] * f[k].translation.vector;
+            o(1) - o(0)
+        }
+        V::X0 => axis(0, Vector3::x()),
+        V::Y0 => axis(0, Vector3::y()),
+        V::Z0 => axis(0, Vector3::z()),
+        V::X1 => axis(1, Vector3::x()),
+        V::Y1 => axis(1, Vector3::y()),
+        V::Z1 => axis(1, Vector3::z()),
+    };
+    let dot = |a: V, b: V| vector(a).dot(&vector(b));
+    let v = match c.read {
+        Read::Angle => dot(V::Y0, V::X1).atan2(dot(V::X0, V::X1)),
+        Read::Dot(a, b) => dot(a, b),
+        Read::Atan2([a, b], [c, e]) => dot(a, b).atan2(dot(c, e)),
+    };
+    Some(if c.angle && reference.is_finite() {
+        reference + wrap_angle(v - reference)
+    } else {
+        v
+    })
 }
 
 /// `θ_b + wrap(θ − θ_b)` with the derivatives of `θ`.
@@ -97,5 +135,47 @@ mod tests {
                 "turned {turned} reference {reference}: {theta} ≠ {expected}"
             );
         }
+    }
+
+    /// The value alone equals the jets' value bit for bit, for every joint kind and
+    /// coordinate, on raw (non-unit) pairs and several branches.
+    #[test]
+    fn value_alone_equals_the_jets_value_bit_for_bit() {
+        let kinds = [
+            JointKind::Revolute,
+            JointKind::Continuous,
+            JointKind::Prismatic,
+            JointKind::Fixed,
+            JointKind::Floating,
+            JointKind::Planar,
+            JointKind::Spherical,
+            JointKind::Universal,
+            JointKind::Cylindrical,
+            JointKind::Screw { pitch: 0.01 },
+            JointKind::Distance { length: 0.3 },
+            JointKind::PointOnLine,
+        ];
+        let mut read = 0;
+        for kind in kinds {
+            let mut j = revolute();
+            j.kind = kind;
+            j.bodies = [Some(BodyId(0)), Some(BodyId(1))];
+            j.body_from_joint = [
+                Isometry3::new(Vector3::new(0.1, -0.2, 0.3), Vector3::new(0.3, -0.2, 0.9)),
+                Isometry3::new(Vector3::new(-0.2, 0.05, 0.4), Vector3::new(-0.5, 0.4, 0.1)),
+            ];
+            for seed in 0..4 {
+                let pair = crate::jet::testing::sample_pair(seed);
+                for dof in 0..7 {
+                    for reference in [0.0, 7.0, -2.5] {
+                        let jet = coordinate(&j, &pair, dof, reference).map(|s| s.v);
+                        let value = coordinate_value(&j, &pair, dof, reference);
+                        assert_eq!(jet, value, "{kind:?} dof {dof} seed {seed}");
+                        read += usize::from(value.is_some());
+                    }
+                }
+            }
+        }
+        assert!(read > 100);
     }
 }

@@ -9,8 +9,8 @@ use super::xml::{child, Source};
 use super::ImportOptions;
 use crate::error::Result;
 use crate::model::{
-    ContactSettings, Effort, ForceLaw, Friction, Ground, Initial, JointId, JointKind, JointSpring,
-    Load, Lock, Mimic, Spring, SpringEnd, SpringMode,
+    ContactSettings, Effort, ForceLaw, Friction, Ground, Initial, JointId, JointSpring, Load, Lock,
+    Mimic, Spring, SpringEnd, SpringMode,
 };
 use nalgebra::Vector3;
 use roxmltree::Node;
@@ -380,11 +380,7 @@ pub(super) fn read(
                         src.error(n, format!("{what} refers to an unknown joint `{name}`"))
                     })?;
                     let kind = b.model.partial().joints[joint.0].kind;
-                    let expected = match kind {
-                        JointKind::Spherical => 4,
-                        JointKind::Floating => 7,
-                        k => k.scalar_coordinates(),
-                    };
+                    let expected = kind.position_len();
                     if list != expected || n.attribute("dof").is_some() {
                         return Err(src.error(n, format!(
                             "{what}: joint `{name}` ({}) takes {expected} values in a list `value` without `dof`, got {list}",

@@ -226,8 +226,13 @@ pub(crate) fn partition(
     scale: &[f64],
 ) -> Partition {
     let nb = n / 7;
-    // Room for a row on two bodies and some fill (no regrowth on trees).
-    let mut rows: Vec<Vec<(usize, f64)>> = (0..m).map(|_| Vec::with_capacity(16)).collect();
+    // Each row allocated once, at its number of entries (no regrowth on trees, and no room
+    // beyond: on 10,000 links the rows are tens of megabytes, first touched page by page).
+    let mut count = vec![0usize; m];
+    for &(r, _, _) in entries {
+        count[r] += 1;
+    }
+    let mut rows: Vec<Vec<(usize, f64)>> = count.iter().map(|&k| Vec::with_capacity(k)).collect();
     for &(r, c, v) in entries {
         let a = v * row_scale[r] * scale[c];
         match rows[r].iter_mut().find(|e| e.0 == c) {

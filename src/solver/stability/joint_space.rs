@@ -27,7 +27,8 @@
 //! largest is ±1.
 
 use crate::jet::{global_index, pair_of, NL};
-use crate::model::{JointKind, Model};
+use crate::joint::TreeMotion;
+use crate::model::Model;
 use crate::solver::partition::Partition;
 use crate::solver::system::{Eval, System};
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix3x4, Vector4};
@@ -84,10 +85,8 @@ fn chart(model: &Model, q: &DVector<f64>) -> Vec<(String, Vec<Row>, bool)> {
                     .collect()
             })
             .collect();
-        let six = matches!(
-            j.kind,
-            JointKind::Floating | JointKind::Distance { .. } | JointKind::PointOnLine
-        );
+        let motion = j.kind.spec().tree_motion;
+        let six = motion == TreeMotion::Pose;
         let (Some(c), p, true) = (j.bodies[1], j.bodies[0], j.tree) else {
             out.push((j.name.clone(), rows, j.tree));
             continue;
@@ -95,7 +94,7 @@ fn chart(model: &Model, q: &DVector<f64>) -> Vec<(String, Vec<Row>, bool)> {
         if six {
             rows.extend(relative(translation(c.0), p.map(|p| translation(p.0))));
         }
-        if six || j.kind == JointKind::Spherical {
+        if six || motion == TreeMotion::Rotation {
             rows.extend(relative(omega(c.0), p.map(|p| omega(p.0))));
         }
         out.push((j.name.clone(), rows, true));

@@ -149,15 +149,19 @@ impl System<'_> {
             }
             if let Some((_, acc)) = pending.as_mut() {
                 // `acc += g gᵀ ρ` in place, entry by entry in the same order of operations
-                // (no 14 × 14 temporaries), over the row's nonzero entries only.
-                for j in 0..g.len() {
-                    if g[j] == 0.0 {
-                        continue;
+                // (no 14 × 14 temporaries), over the row's nonzero entries only (listed once).
+                let mut nz = [0usize; crate::jet::NL];
+                let mut count = 0;
+                for (i, &gi) in g.iter().enumerate() {
+                    if gi != 0.0 {
+                        nz[count] = i;
+                        count += 1;
                     }
-                    for i in 0..g.len() {
-                        if g[i] != 0.0 {
-                            acc[(i, j)] += g[i] * g[j] * rho;
-                        }
+                }
+                let nz = &nz[..count];
+                for &j in nz {
+                    for &i in nz {
+                        acc[(i, j)] += g[i] * g[j] * rho;
                     }
                 }
             }

@@ -174,7 +174,7 @@ def main():
         d = r["diagnostics"]
         row.update(termination=r["termination"], iterations=r["iterations"],
                    rounds=max([h.get("round", 1) for h in r["history"]] or [1]),
-                   corrector_failures=d["corrector_failures"])
+                   corrector_failures=d["corrector_failures"], energy_total=r["energy"]["total"])
         try:
             fk, de, res, scale = check(urdf, floating, r)
         except Exception as e:  # a model Pinocchio cannot build the same way is a failure

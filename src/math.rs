@@ -46,6 +46,15 @@ pub fn b_matrix(p: &Vector4<f64>, a: &Vector3<f64>) -> Matrix3x4<f64> {
     b
 }
 
+/// The quaternion product `a ⊗ b` of Euler parameters: `A(a ⊗ b) = A(a) A(b)` (the rotation `b`
+/// followed by `a`), of norm `|a| |b|`.
+pub fn compose(a: &Vector4<f64>, b: &Vector4<f64>) -> Vector4<f64> {
+    let (a0, av) = (a[0], Vector3::new(a[1], a[2], a[3]));
+    let (b0, bv) = (b[0], Vector3::new(b[1], b[2], b[3]));
+    let v = a0 * bv + b0 * av + av.cross(&bv);
+    Vector4::new(a0 * b0 - av.dot(&bv), v.x, v.y, v.z)
+}
+
 /// Euler parameters `[e0, e1, e2, e3]` of a unit quaternion.
 pub fn euler_parameters(q: &UnitQuaternion<f64>) -> Vector4<f64> {
     Vector4::new(q.w, q.i, q.j, q.k)
@@ -114,6 +123,16 @@ mod tests {
                 let fd = (rotation(&pp) * a - rotation(&pm) * a) / (2.0 * h);
                 prop_assert!((fd - b.column(m)).norm() < 1e-8);
             }
+        }
+
+        #[test]
+        fn compose_is_the_product_of_rotations(a in arb_p(), b in arb_p()) {
+            prop_assume!(a.norm() > 0.1 && b.norm() > 0.1);
+            let (a, b) = (a.normalize(), b.normalize());
+            let ab = compose(&a, &b);
+            prop_assert!((rotation(&ab) - rotation(&a) * rotation(&b)).norm() < 1e-12);
+            let q = unit_quaternion(&a) * unit_quaternion(&b);
+            prop_assert!((euler_parameters(&q) - ab).norm() < 1e-12);
         }
 
         #[test]

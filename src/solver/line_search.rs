@@ -1,9 +1,11 @@
 //! The backtracking line search of the minimizer along a reduced step `d` (tangent step
 //! `δq = Z d`), the paper's step (d)–(f).
 //!
-//! A trial point starts from the first-order prediction `q + α δq` and is brought back onto
-//! `Φ = 0` by the Newton corrector (paper step (e.1)); if the corrector fails, the step is
-//! halved (step (f)). A corrected point is accepted when the Armijo condition
+//! A trial point starts from the point `α` along `δq` on the search path (module
+//! `retraction`: the bodies moved rigidly along the spanning tree, which turns every tree
+//! joint from `θ` to `θ + α θ̇`; the paper's path is the straight line `q + α δq`) and is brought
+//! back onto `Φ = 0` by the Newton corrector (paper step (e.1)), which closes what the path
+//! leaves open (loops, contacts); if the corrector fails, the step is halved (step (f)). A corrected point is accepted when the Armijo condition
 //! `f(v̂ + α d) ≤ f + 10⁻⁴ α ∇fᵀ d` holds, or when `f` is flat to rounding and the gradient
 //! has halved; otherwise `α` shrinks by safeguarded quadratic interpolation (to between
 //! 0.1 and 0.5 of itself). Trial energies are compared through the Lagrangian `V − μᵀΦ`
@@ -59,7 +61,7 @@ pub(crate) fn line_search(
     let f = eval.merit;
     let gnorm = eval.grad_v.amax();
     for _ in 0..MAX_TRIALS {
-        let mut qt = q + dq * alpha;
+        let mut qt = sys.problem.retraction.point(q, dq, alpha);
         if sys
             .correct_from(
                 &mut qt,

@@ -37,6 +37,7 @@ pub(crate) mod partition;
 mod quasi_newton;
 mod reactions;
 mod report;
+mod retraction;
 pub(crate) mod sparse;
 mod stability;
 mod step_cap;

@@ -191,9 +191,12 @@ fn the_solo12_on_its_mesh_feet_stands_servoed_level_and_on_a_slope() {
 }
 
 /// A floating robot on the ground whose joints nothing holds collapses (issue 21, the A1
-/// without servos): the Solo-12 of `robots/solo12` without its joint springs, contacts on its
-/// feet only, falls through its trunk (`unbounded`); the error names the unheld joints and the
-/// remedy. With servos about its initial (standing) pose it stands, and no such note appears.
+/// without servos); when no rest is found, the error names the unheld joints and the remedy.
+/// The Solo-12 of `robots/solo12` without its joint springs has contacts on its feet only: it
+/// folds its legs over and rests upside down, the trunk hanging below its feet through the
+/// floor (a true rest of that model, found in about 65 iterations), so the failure is made
+/// here by an iteration limit it cannot meet. With servos about its initial (standing) pose
+/// it stands, and no such note appears.
 #[test]
 fn an_unactuated_robot_that_finds_no_rest_is_told_to_add_servos() {
     let path = concat!(
@@ -219,7 +222,7 @@ fn an_unactuated_robot_that_finds_no_rest_is_told_to_add_servos() {
             .output()
             .unwrap()
     };
-    let limp = run(&[]);
+    let limp = run(&["--max-iterations", "5"]);
     let err = String::from_utf8_lossy(&limp.stderr);
     assert_eq!(limp.status.code(), Some(3), "{err}");
     assert!(

@@ -8,13 +8,13 @@
 //!    negative one.
 //! 3. **Reduced step** ([`reduced_step`]): Newton `d = −Ĥ⁻¹ ∇f` with the eigenvalues of the
 //!    exact reduced Hessian replaced by their magnitudes, floored (dense), or the KKT direction
-//!    (sparse); BFGS / DFP `d = −B ∇f` (module `quasi_newton`); steepest descent when `d` is
+//!    (sparse); BFGS / DFP `d = −B ∇f` (module `step::quasi_newton`); steepest descent when `d` is
 //!    not a descent direction.
-//! 4. **Step cap** (module `step_cap`): the tangent step `δq = Z d` limited on the motion of the
+//! 4. **Step cap** (module `step::step_cap`): the tangent step `δq = Z d` limited on the motion of the
 //!    whole mechanism (every body's Euler parameters by `max_step`, its origin by
 //!    `10 max_step ℓ`, `ℓ` the larger of the length scale and the mechanism's extent).
-//! 5. **Line search and corrector** (module `line_search`): backtracking until the Armijo
-//!    condition holds along the search path (module `retraction`: every tree joint turns from
+//! 5. **Line search and corrector** (module `step::line_search`): backtracking until the Armijo
+//!    condition holds along the search path (module `step::retraction`: every tree joint turns from
 //!    `θ` to `θ + α θ̇`), each trial brought back onto `Φ = 0` by the corrector and halved
 //!    when the corrector fails (paper step (f)), from `α = 1`, or with second-pass choices in a
 //!    sparse partition from the reach the corrector last managed ([`Search::reach`]). With a
@@ -37,15 +37,15 @@
 
 use super::inequality::active_set::Guard;
 use super::inequality::release::Release;
-use super::line_search::{line_search, Line, Trial};
 use super::options::{Method, Options};
 use super::partition::Partition;
-use super::quasi_newton::QuasiNewton;
 use super::report::{Diagnostics, Iterate, Termination};
-use super::retraction::independent_change;
 use super::stability::at_rest::for_minimizer;
 use super::stability::spectrum::Spectrum;
-use super::step_cap::{cap_step, Step};
+use super::step::line_search::{line_search, Line, Trial};
+use super::step::quasi_newton::QuasiNewton;
+use super::step::retraction::independent_change;
+use super::step::step_cap::{cap_step, Step};
 use super::system::{Backend, Eval, System};
 use super::unbounded::LinearDescent;
 use nalgebra::DVector;
@@ -376,7 +376,9 @@ fn reduced_step(
                 }
                 d
             }
-            (_, Method::Newton) => super::kkt_direction::kkt_direction(sys, &s.q, &s.part, &s.eval),
+            (_, Method::Newton) => {
+                super::step::kkt_direction::kkt_direction(sys, &s.q, &s.part, &s.eval)
+            }
             _ => -(&s.qn.binv * g),
         }
     };

@@ -21,26 +21,19 @@
 
 mod assemble;
 pub mod balance;
-mod conic;
 pub(crate) mod finite;
 pub(crate) mod friction;
-mod friction_shortcut;
-mod friction_support;
 mod inequality;
-mod kkt_direction;
-mod line_search;
 mod load_steps;
 mod minimize;
 mod mode_animation;
 mod options;
 pub(crate) mod partition;
-mod quasi_newton;
 mod reactions;
 mod report;
-mod retraction;
 pub(crate) mod sparse;
 mod stability;
-mod step_cap;
+mod step;
 pub(crate) mod system;
 pub(crate) mod tree;
 mod unbounded;

@@ -15,15 +15,15 @@ pub(crate) struct Problem<'a> {
     pub(crate) model: &'a Model,
     pub(crate) cons: Constraints,
     pub(crate) scaling: Scaling,
-    /// The line search's path along the spanning tree (module `retraction`).
-    pub(crate) retraction: crate::solver::retraction::Retraction,
+    /// The line search's path along the spanning tree (module `step::retraction`).
+    pub(crate) retraction: crate::solver::step::retraction::Retraction,
 }
 
 impl<'a> Problem<'a> {
     pub(crate) fn new(model: &'a Model, cons: Constraints) -> Self {
         let scaling = Scaling::new(model, &cons);
         Problem {
-            retraction: crate::solver::retraction::Retraction::new(model),
+            retraction: crate::solver::step::retraction::Retraction::new(model),
             model,
             cons,
             scaling,

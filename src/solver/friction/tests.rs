@@ -11,7 +11,7 @@ use nalgebra::{DMatrix, Vector3};
 
 /// The shared oracle (its rigid-body helpers are the integration tests').
 #[allow(dead_code)]
-#[path = "../../tests/it/common/pyramid.rs"]
+#[path = "../../../tests/it/common/pyramid.rs"]
 mod pyramid;
 
 /// A contact of a rigid body: point, unit normal, whether it sticks.
@@ -68,7 +68,7 @@ fn support(touches: &[Touch], w: f64, tilt: f64, mu: Option<f64>) -> (DMatrix<f6
         .map(|i| eig.eigenvectors.column(i).into_owned())
         .collect();
     let k = g.ncols();
-    // Contacts with one normal are on one plane ground (module `friction_shortcut`).
+    // Contacts with one normal are on one plane ground (module `friction::shortcut`).
     let plane = touches
         .iter()
         .map(|t| touches.iter().position(|u| u.n == t.n))
@@ -256,7 +256,7 @@ fn no_distribution_when_a_contact_must_pull() {
     assert!(distribute(&s, 10.0).is_none());
 }
 
-/// The closed form of module `friction_shortcut` (the least-norm distribution at the lower
+/// The closed form of module `friction::shortcut` (the least-norm distribution at the lower
 /// bound `‖F_t‖ / F_n`) gives what the cone programs alone give on the box on slopes: the
 /// same `required_mu` (1e-9) and forces (1e-5 of the weight: the cone path's least-norm
 /// choice has a slack of 1e-6 on the bound).
@@ -289,7 +289,9 @@ fn shortcuts_agree_with_the_cone_programs() {
     // The lower bound of a box on one ground is tan α; none for the ladder (its floor's total
     // force depends on the wall's share).
     let (_, s) = support(&box_corners(0.15, 0.03, true), 15.7, 0.2, None);
-    let b = crate::solver::friction_shortcut::lower_bound(&s).unwrap().0;
+    let b = crate::solver::friction::shortcut::lower_bound(&s)
+        .unwrap()
+        .0;
     assert!((b - f64::tan(0.2)).abs() < 1e-12, "{b}");
 }
 
@@ -309,7 +311,7 @@ fn nothing_pushes_on_a_line_as_the_cone_program_says() {
             .collect();
         let (_, s) = support(&touches, 10.0, 0.0, None);
         assert_eq!(s.null.ncols(), 1);
-        let fast = crate::solver::friction_shortcut::nothing_pushes_on_a_line(&s, 10.0);
+        let fast = crate::solver::friction::shortcut::nothing_pushes_on_a_line(&s, 10.0);
         let ones = vec![Some(1.0); 2];
         let cone = least_need(&s, &ones, 10.0).is_none();
         assert_eq!((fast, cone), (expect, expect), "{dx}");

@@ -2,9 +2,9 @@
 //! `[W Φ_qᵀ; Φ_q 0] [δq; λ] = [−S(V_qᵀ − Φ_qᵀ μ); 0]`, its independent part the reduced Newton
 //! step `Ĥ⁻¹(−∇f)`, with `W` shifted where `Ĥ` is indefinite.
 
-use super::partition::Partition;
-use super::sparse::kkt::Factored;
-use super::system::{Eval, System};
+use crate::solver::partition::Partition;
+use crate::solver::sparse::kkt::Factored;
+use crate::solver::system::{Eval, System};
 use nalgebra::DVector;
 
 /// The Newton direction from the sparse KKT system (module `sparse::kkt`): the exact

@@ -34,7 +34,7 @@
 //! of intervals.
 
 use super::conic::Holder;
-use super::friction::Support;
+use super::support::Support;
 use nalgebra::{DMatrix, DVector};
 
 /// An orthonormal basis of the null space of `a` (columns) and a least-squares solution `x`
@@ -46,7 +46,7 @@ fn solve_with_null(
     tol: f64,
 ) -> Option<(DVector<f64>, DMatrix<f64>)> {
     let n = a.ncols();
-    let (values, vectors) = super::stability::eigen::symmetric_eigen(&(a.transpose() * a));
+    let (values, vectors) = crate::solver::stability::eigen::symmetric_eigen(&(a.transpose() * a));
     let top = values.amax();
     if !top.is_finite() {
         return None;

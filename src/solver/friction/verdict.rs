@@ -40,13 +40,13 @@
 //! - J. C. Trinkle, J.-S. Pang, S. Sudarsky, G. Lo, On dynamic multi-rigid-body contact
 //!   problems with Coulomb friction, *ZAMM* 77 (1997) 267–279 (the friction cones).
 
-pub(crate) use super::active_set::force_scale;
 pub(crate) use super::conic::Holder;
 use super::conic::{self, Affine, Goal};
-use super::friction_shortcut;
-pub(crate) use super::friction_support::{effort_limit, holders_of, Support};
-use super::report::{Contact, ContactState, FrictionVerdict};
+use super::shortcut;
+pub(crate) use super::support::{effort_limit, holders_of, Support};
 use crate::model::{JointId, Model};
+pub(crate) use crate::solver::active_set::force_scale;
+use crate::solver::report::{Contact, ContactState, FrictionVerdict};
 use nalgebra::DVector;
 
 /// Relative tolerance of the verdict: a contact slips when it needs more than
@@ -195,11 +195,11 @@ fn least_need(support: &Support, c: &[Option<f64>], scale: f64) -> Option<(f64, 
     let eps = 1e-12 * scale;
     let sticks = c.iter().filter(|x| x.is_some()).count();
     let w0 = vec![scale; sticks];
-    // A distribution within the lower bound of module `friction_shortcut` needs exactly it.
+    // A distribution within the lower bound of module `friction::shortcut` needs exactly it.
     let bound = c
         .iter()
         .all(|x| *x == Some(1.0))
-        .then(|| friction_shortcut::lower_bound(support))
+        .then(|| shortcut::lower_bound(support))
         .flatten();
     if let Some((b, _)) = bound {
         // (Infeasible for one bound, `level` is infeasible for every bound: no distribution
@@ -340,14 +340,14 @@ fn distribute_within(support: &Support, scale: f64) -> Option<Distribution> {
             slipping,
         });
     }
-    if friction_shortcut::nothing_pushes_on_a_line(support, scale) {
+    if shortcut::nothing_pushes_on_a_line(support, scale) {
         return None;
     }
     // The lower bound (0 without one), reached in closed form where it can be.
-    let bound = friction_shortcut::lower_bound(support);
+    let bound = shortcut::lower_bound(support);
     let (b, group) = bound.as_ref().map_or((0.0, &[][..]), |(b, g)| (*b, &g[..]));
     let eps = 1e-12 * scale;
-    if let Some(forces) = friction_shortcut::at_bound(
+    if let Some(forces) = shortcut::at_bound(
         support,
         (b, group),
         scale,
@@ -443,5 +443,5 @@ fn pushes(support: &Support, forces: &DVector<f64>, scale: f64) -> bool {
 }
 
 #[cfg(test)]
-#[path = "friction_tests.rs"]
+#[path = "tests.rs"]
 mod tests;

@@ -24,7 +24,7 @@ pub(crate) struct Support {
     /// Weight of each row in the least-norm choice (`D`).
     pub(crate) weight: Vec<f64>,
     /// The plane ground of each contact (by holder; `None` for stops and obstacles): contacts
-    /// on one plane share its frame (module `friction_shortcut`).
+    /// on one plane share its frame (module `friction::shortcut`).
     pub(crate) plane: Vec<Option<usize>>,
 }
 

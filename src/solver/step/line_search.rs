@@ -17,11 +17,11 @@
 //! ## References
 //! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §3.1, §3.5.
 
-use super::inequality::active_set::Guard;
-use super::options::Options;
-use super::partition::Partition;
-use super::report::Diagnostics;
-use super::system::{Eval, System};
+use crate::solver::inequality::active_set::Guard;
+use crate::solver::options::Options;
+use crate::solver::partition::Partition;
+use crate::solver::report::Diagnostics;
+use crate::solver::system::{Eval, System};
 use nalgebra::DVector;
 
 /// Trial step lengths before the search gives up.

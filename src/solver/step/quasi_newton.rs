@@ -11,7 +11,7 @@
 //! - R. Fletcher, M. J. D. Powell, A rapidly convergent descent method for minimization,
 //!   *Computer Journal* 6 (1963) 163–168.
 
-use super::options::Method;
+use crate::solver::options::Method;
 use nalgebra::{DMatrix, DVector};
 
 /// The inverse-Hessian approximation of BFGS / DFP in the current independent coordinates.

@@ -4,9 +4,9 @@
 //! `ℓ = max(L, extent)`: `L` the characteristic length, the extent the diagonal of the
 //! bounding box of the body origins.
 
-use super::options::Options;
-use super::partition::Partition;
-use super::system::{Eval, System};
+use crate::solver::options::Options;
+use crate::solver::partition::Partition;
+use crate::solver::system::{Eval, System};
 use nalgebra::DVector;
 
 /// The step of one iteration after the cap: reduced `d`, tangent `δq = Z d`, whether the cap

@@ -1,0 +1,16 @@
+//! The step of the minimizer (module `minimize`): its direction, its length and the path it
+//! follows.
+//!
+//! - `kkt_direction`: the Newton direction of the sparse path from the KKT system
+//!   `[W Φ_qᵀ; Φ_q 0] [δq; λ] = [−S(V_qᵀ − Φ_qᵀ μ); 0]`.
+//! - `quasi_newton`: the BFGS / DFP inverse-Hessian approximation `B ≈ Ĥ⁻¹`.
+//! - `step_cap`: the step limit, every body's Euler parameters moving by at most `max_step`.
+//! - `line_search`: the backtracking line search along a reduced step `d` (`δq = Z d`).
+//! - `retraction`: the search path of the line search, `δq` followed as rigid motions along
+//!   the spanning tree (`θ(α) = θ + α θ̇` on every tree joint).
+
+pub(super) mod kkt_direction;
+pub(super) mod line_search;
+pub(super) mod quasi_newton;
+pub(super) mod retraction;
+pub(super) mod step_cap;

@@ -5,14 +5,15 @@
 //!    by a damped Newton iteration that holds the joints given initial values where it can
 //!    (module `assemble`).
 //! 2. Partition `q = [u; v]` by full pivoting of `Φ_q` (module `partition`).
-//! 3. Minimize `f(v) = V(u(v), v)` (module `minimize`), with the corrector keeping `Φ = 0`.
+//! 3. Minimize `f(v) = V(u(v), v)` (module `minimize`; its direction, step limit and line
+//!    search in folder `step`), with the corrector keeping `Φ = 0`.
 //! 4. Stability from the eigenvalues of the reduced Hessian (folder `stability`); reactions
 //!    from the multipliers `μ` (`V_qᵀ = Φ_qᵀ μ`, module `reactions`).
 //!
 //! Stops and contacts (`g(q) ≥ 0`) wrap steps 2–4 in an active-set iteration (folder
-//! `inequality`). The evaluation of the partitioned problem (corrector, reduced gradient and
-//! Hessian, dense or sparse backend) is folder `system`; the large-scale linear algebra is
-//! folder `sparse`.
+//! `inequality`; the friction verdict on their forces is folder `friction`). The evaluation
+//! of the partitioned problem (corrector, reduced gradient and Hessian, dense or sparse
+//! backend) is folder `system`; the large-scale linear algebra is folder `sparse`.
 //!
 //! ## References
 //! - P. E. Nikravesh, O. K. Srinivasan, Generalized co-ordinate partitioning in static

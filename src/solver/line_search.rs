@@ -18,11 +18,9 @@
 //! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §3.1, §3.5.
 
 use super::inequality::active_set::Guard;
-use super::inequality::bend::Stop;
 use super::options::Options;
 use super::partition::Partition;
 use super::report::Diagnostics;
-use super::retraction::independent_change;
 use super::system::{Eval, System};
 use nalgebra::DVector;
 
@@ -62,16 +60,8 @@ pub(crate) fn line_search(
     let (q, part, eval, dq, slope) = (line.q, line.part, line.eval, line.dq, line.slope);
     let f = eval.merit;
     let gnorm = eval.grad_v.amax();
-    // The inactive stops the path reaches, and where (module `inequality::bend`).
-    let stops = guard.map_or_else(Vec::new, |g| g.stops(sys, q, dq));
     for _ in 0..MAX_TRIALS {
-        let caps: Vec<Stop> = stops.iter().filter(|s| s.alpha < alpha).copied().collect();
-        let mut qt = if caps.is_empty() {
-            sys.problem.retraction.point(q, dq, alpha)
-        } else {
-            let bodies: Vec<(usize, f64)> = caps.iter().map(|s| (s.body, s.alpha)).collect();
-            sys.problem.retraction.bent_point(q, dq, alpha, &bodies)
-        };
+        let mut qt = sys.problem.retraction.point(q, dq, alpha);
         if sys
             .correct_from(
                 &mut qt,
@@ -116,24 +106,14 @@ pub(crate) fn line_search(
         let ft = et.merit;
         // Rounding error of V: relative to the size of its terms, not of their sum.
         let roundoff = 1e-12 * eval.energy.magnitude.max(et.energy.magnitude) + f64::MIN_POSITIVE;
-        // Along a bent path: Armijo on the change actually taken (projected Armijo rule).
-        let armijo = if caps.is_empty() {
-            ft <= f + 1e-4 * alpha * slope
-        } else {
-            let columns = &sys.problem.scaling.columns;
-            let descent = eval
-                .grad_v
-                .dot(&independent_change(&part.independent, columns, q, &qt));
-            descent < 0.0 && ft <= f + 1e-4 * descent
-        };
+        let armijo = ft <= f + 1e-4 * alpha * slope;
         let flat = (ft - f).abs() <= roundoff && et.grad_v.amax() < 0.5 * gnorm;
         if ft.is_finite() && (armijo || flat) {
-            let reached = guard.map_or_else(Vec::new, |g| g.reached(sys, &caps, &qt));
             return Some(Trial {
                 q: qt,
                 eval: et,
                 alpha,
-                blocked: (!reached.is_empty()).then_some(reached),
+                blocked: None,
             });
         }
         // Quadratic interpolation of f along d, safeguarded.

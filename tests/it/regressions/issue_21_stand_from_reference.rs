@@ -195,8 +195,9 @@ fn the_solo12_on_its_mesh_feet_stands_servoed_level_and_on_a_slope() {
 /// The Solo-12 of `robots/solo12` without its joint springs has contacts on its feet only: it
 /// folds its legs over and rests upside down, the trunk hanging below its feet through the
 /// floor (a true rest of that model, found in about 65 iterations), so the failure is made
-/// here by an iteration limit it cannot meet. With servos about its initial (standing) pose
-/// it stands, and no such note appears.
+/// here by an iteration limit it cannot meet; without the limit it converges and analyze warns
+/// that bodies without contact points rest inside the ground. With servos about its initial
+/// (standing) pose it stands, and neither note appears.
 #[test]
 fn an_unactuated_robot_that_finds_no_rest_is_told_to_add_servos() {
     let path = concat!(
@@ -230,8 +231,37 @@ fn an_unactuated_robot_that_finds_no_rest_is_told_to_add_servos() {
             && err.contains("--servo all=K"),
         "{err}"
     );
+    // Without the iteration limit the limp robot converges, upside down through the floor;
+    // analyze warns that bodies without contact points rest inside the ground, deepest first.
+    let upside_down = std::process::Command::new(env!("CARGO_BIN_EXE_restpose"))
+        .args(["analyze", "--floating-base", "--friction", "stick"])
+        .arg(&file)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&upside_down.stderr);
+    assert_eq!(upside_down.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("9 bodies without contact points rest with their centre of mass inside a ground (`base_link` 0.3")
+            && err.contains("inside `floor`"),
+        "{err}"
+    );
     let held = run(&["--servo", "all=50"]);
     let err = String::from_utf8_lossy(&held.stderr);
     assert_eq!(held.status.code(), Some(0), "{err}");
     assert!(!err.contains("held by no servo"), "{err}");
+    let standing = std::process::Command::new(env!("CARGO_BIN_EXE_restpose"))
+        .args([
+            "analyze",
+            "--floating-base",
+            "--friction",
+            "stick",
+            "--servo",
+            "all=50",
+        ])
+        .arg(&file)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&standing.stderr);
+    assert_eq!(standing.status.code(), Some(0), "{err}");
+    assert!(!err.contains("inside a ground"), "{err}");
 }

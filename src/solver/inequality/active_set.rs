@@ -256,14 +256,13 @@ pub(crate) fn solve(
             }
             let mut gone = round.released.clone();
             gone.sort_unstable();
-            let removed: Vec<Active> = gone.iter().map(|&i| active[i]).collect();
-            for &i in gone.iter().rev() {
-                released_before.push(active[i].row);
-                active.remove(i);
-                changes += 1;
-            }
-            super::patch::promote(model, options, &mut active, &removed, &state.q);
-            super::rolling::record_touches(model, &active, &state.q, &mut touched);
+            changes += super::release::leave(
+                (model, options, &state.q),
+                &gone,
+                &mut active,
+                &mut released_before,
+                &mut touched,
+            );
             continue;
         }
         let mut rolled_too_far = false;
@@ -301,14 +300,13 @@ pub(crate) fn solve(
         };
         let_go = hanging.iter().map(|&i| active[i].row).collect();
         if !hanging.is_empty() {
-            let removed: Vec<Active> = hanging.iter().map(|&i| active[i]).collect();
-            for &i in hanging.iter().rev() {
-                released_before.push(active[i].row);
-                active.remove(i);
-                changes += 1;
-            }
-            super::patch::promote(model, options, &mut active, &removed, &state.q);
-            super::rolling::record_touches(model, &active, &state.q, &mut touched);
+            changes += super::release::leave(
+                (model, options, &state.q),
+                &hanging,
+                &mut active,
+                &mut released_before,
+                &mut touched,
+            );
             continue;
         }
         if (report.converged() || stuck) && !cycling && !rolled_too_far {
@@ -326,14 +324,13 @@ pub(crate) fn solve(
             }
             if !gone.is_empty() {
                 gone.sort_unstable();
-                let removed: Vec<Active> = gone.iter().map(|&i| active[i]).collect();
-                for &i in gone.iter().rev() {
-                    released_before.push(active[i].row);
-                    active.remove(i);
-                    changes += 1;
-                }
-                super::patch::promote(model, options, &mut active, &removed, &state.q);
-                super::rolling::record_touches(model, &active, &state.q, &mut touched);
+                changes += super::release::leave(
+                    (model, options, &state.q),
+                    &gone,
+                    &mut active,
+                    &mut released_before,
+                    &mut touched,
+                );
                 continue;
             }
             if super::rolling::reanchor(model, options, &mut active, &touched, &state.q) {

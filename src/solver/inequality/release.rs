@@ -192,3 +192,24 @@ pub(crate) fn all_to_release(
     out.sort_by(|a, b| a.1.total_cmp(&b.1));
     out.into_iter().map(|(i, _)| i).collect()
 }
+
+/// The active rows at the ascending positions `gone` leave the set: each is recorded as
+/// released once (above), a link's nearby vertices take over from a sticking pivot that left
+/// (module `patch`), and the touches of sticking contacts are renewed (module `rolling`);
+/// returns how many left (changes of the set).
+pub(super) fn leave(
+    (model, options, q): (&Model, &crate::solver::options::Options, &DVector<f64>),
+    gone: &[usize],
+    active: &mut Vec<Active>,
+    released_before: &mut Vec<Unilateral>,
+    touched: &mut Vec<super::rolling::Touch>,
+) -> usize {
+    let removed: Vec<Active> = gone.iter().map(|&i| active[i]).collect();
+    for &i in gone.iter().rev() {
+        released_before.push(active[i].row);
+        active.remove(i);
+    }
+    super::patch::promote(model, options, active, &removed, q);
+    super::rolling::record_touches(model, active, q, touched);
+    gone.len()
+}

@@ -128,7 +128,7 @@ def check(urdf, floating, r):
         held[index(s["joint"])] += s["torque"]
         terms.append(abs(s["torque"]))
     for c in r.get("contacts", []):
-        fid = model.getFrameId(c["link"])
+        fid = model.getFrameId(c["link"], pin.FrameType.BODY)
         J = pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
         arm = np.array(c["point_world"]) - data.oMf[fid].translation
         Jp = J[:3] - pin.skew(arm) @ J[3:]

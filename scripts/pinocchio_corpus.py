@@ -86,7 +86,8 @@ def analyze(urdf, extra):
 def mimics(urdf):
     """{mimic joint: (master, multiplier)} from the URDF."""
     out = {}
-    for j in ET.parse(urdf).getroot().iter("joint"):
+    # Leading blank lines before `<?xml` (urdfdom reads them; ElementTree does not).
+    for j in ET.fromstring(open(urdf, "rb").read().lstrip()).iter("joint"):
         m = j.find("mimic")
         if m is not None:
             out[j.get("name")] = (m.get("joint"), float(m.get("multiplier", "1")))

@@ -17,11 +17,17 @@ use std::path::{Path, PathBuf};
 use xacro_rs::extensions::{ExtensionHandler, FindExtension, OptEnvExtension};
 use xacro_rs::XacroProcessor;
 
-/// Whether `path` names a xacro file (`*.xacro`), or `text` declares the xacro namespace.
+/// Whether `path` names a xacro file (`*.xacro`), or `text` declares the xacro namespace and
+/// uses it (a `xacro:` element or attribute, `${…}` or `$(…)`). A URDF that only declares it,
+/// as xacro's own output keeps it (pybullet_data's `diff_ring.urdf`), is read as URDF, with
+/// the URDF reader's leniency (a late XML declaration), and its `refuse_xacro` check.
 pub fn is_xacro(path: &Path, text: &str) -> bool {
     path.extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("xacro"))
-        || text.contains("xmlns:xacro=")
+        || (text.contains("xmlns:xacro=")
+            && ["<xacro:", " xacro:", "${", "$("]
+                .iter()
+                .any(|s| text.contains(s)))
 }
 
 /// `$(find NAME)` through the user's `NAME=DIR` list; other names go to the next handler.

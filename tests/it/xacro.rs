@@ -249,3 +249,44 @@ fn cli_reads_xacro_and_names_the_file_in_errors() {
         "{e}"
     );
 }
+
+/// A URDF that declares the xacro namespace without using it (xacro's own output keeps the
+/// declaration; pybullet_data's `diff_ring.urdf`, with a blank line before `<?xml`) is read as
+/// URDF: the late declaration is accepted with its warning, as in any URDF, where the xacro
+/// reader refused it. A file that uses xacro still goes through the expansion.
+#[test]
+fn declared_but_unused_xacro_namespace_is_plain_urdf() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("exported.urdf");
+    let urdf = r#"
+<?xml version="1.0" ?>
+<robot name="r" xmlns:xacro="http://ros.org/wiki/xacro">
+  <link name="world"/>
+  <link name="arm"><inertial><origin xyz="0 0 -0.5"/><mass value="2"/>
+    <inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <joint name="hinge" type="continuous"><parent link="world"/><child link="arm"/>
+    <axis xyz="0 1 0"/></joint>
+</robot>
+"#;
+    std::fs::write(&file, urdf).unwrap();
+    let l = load_file(&file, &ImportOptions::default()).unwrap();
+    assert_eq!(l.model.bodies().len(), 1);
+    assert!(
+        l.warnings
+            .iter()
+            .any(|w| w.contains("XML declaration is not at the start")),
+        "{:?}",
+        l.warnings
+    );
+    // The same file using a property is expanded (and its mass is the property's value).
+    let used = urdf
+        .trim_start()
+        .replace(
+            "<link name=\"world\"/>",
+            "<xacro:property name=\"m\" value=\"3\"/><link name=\"world\"/>",
+        )
+        .replace("<mass value=\"2\"/>", "<mass value=\"${m}\"/>");
+    std::fs::write(&file, used).unwrap();
+    let l = load_file(&file, &ImportOptions::default()).unwrap();
+    assert_eq!(l.model.bodies()[0].mass, 3.0);
+}

@@ -301,7 +301,7 @@ def main():
                 loads, why = pinocchio_loads(urdf)
                 row["pinocchio"] = "loads" if loads else why
                 if group != "hanging":  # an honest refusal: counted, listed
-                    print(f"{name:58s} error: {err[-110:]}")
+                    print(f"{name:58s} {err.replace(PYB + '/', '')[:150]}")
                     continue
                 want = REFUSED.get(rel)
                 if want is None or want[0] not in err or (want[1] == "loads") != loads:
@@ -353,8 +353,18 @@ def main():
             if bad:
                 failures.append(f"{name}: " + "; ".join(bad))
             row["agree"] = not bad
+            # On the ground: what carries the robot (the links in contact, the base height).
+            support = ""
+            if floating:
+                links = sorted({c["link"] for c in r.get("contacts", [])})
+                support = (f"  base z {r['q_pinocchio'][2]:.3f} m, {len(links)} links in contact"
+                           f" ({', '.join(links[:4])}{', …' if len(links) > 4 else ''})")
+                row["support"] = links
             print(f"{head} {fk:8.1e} {de:8.1e} {res if converged else float('nan'):8.1e} "
-                  f"{dt:6.2f}" + ("  FAIL" if bad else ""))
+                  f"{dt:6.2f}" + ("  FAIL" if bad else "") + support)
+    print("\nstanding reference poses:")
+    for name, _, why in STANDING:
+        print(f"  {name}: {why}")
     for group in ("hanging", "standing", "loops"):
         summary(group, [x for x in rows if x["group"] == group])
     if os.environ.get("CORPUS_JSON"):

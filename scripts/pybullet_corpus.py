@@ -1,6 +1,6 @@
 """restpose's rest poses on pybullet_data (the data of the PyPI wheel pybullet 3.2.7), checked by
-Pinocchio: the sibling of scripts/pinocchio_corpus.py (whose `analyze` and `check` it uses), run
-by scripts/pybullet_corpus.sh.
+Pinocchio: the sibling of scripts/pinocchio_corpus.py (whose `check` it uses), run by
+scripts/pybullet_corpus.sh.
 
 Three kinds of solve, all by the direct solve (`--load-steps 1`):
 
@@ -9,8 +9,9 @@ Three kinds of solve, all by the direct solve (`--load-steps 1`):
             base, limits enforced, no springs (`analyze -q FILE --load-steps 1 --json`);
   standing  the legged robots on the ground held by servos about a reference pose
             (`--floating-base --ground --friction stick --servo all=K`, K = CORPUS_SERVO);
-            pybullet robots have no SRDF: the reference is the URDF's zero pose, except where
-            pybullet's own examples document a standing crouch (STANDING below says which);
+            pybullet robots have no SRDF: the reference is the URDF's zero pose, or a crouch
+            where pybullet's own examples give one (A1) or the zero pose does not stand
+            (STANDING below says which and why);
   loops     minitaur with its knee loops closed as pybullet's own minitaur environment closes
             them (`createConstraint(JOINT_POINT2POINT)` between the two lower legs of each leg,
             pivots (0, 0.005, 0.2) and (0, 0.01, 0.2) in their links), written as
@@ -25,9 +26,10 @@ gravity energy, g(q) = τ_stops + τ_servos + Σ J_cᵀ f), the loops with their
 independently: Pinocchio's loop Jacobians (the child's pivot relative to the parent's, across
 the line) and a least-squares λ must balance g(q) − τ_stops − τ_servos − Σ J_cᵀ f, the pivots
 must lie on their lines in Pinocchio's kinematics, and restpose's reported reaction forces must
-equal λ. Files that restpose or Pinocchio refuse are listed in REFUSED with the reason: a
-refusal that differs from the list (another message, a panic, a file that now loads without
-being checked) fails.
+equal λ. Files that restpose or Pinocchio refuse are listed in REFUSED and PINOCCHIO_REFUSES
+with the reason: a refusal that differs from the lists (another message, a file that now loads
+or now fails in Pinocchio) and a crash (a panic, a signal, a timeout) fail; a located error or a
+solve that does not converge on a standing or loop case is counted and listed.
 
 Environment: RESTPOSE, ERD_ROBOTS (for pinocchio_corpus), PYBULLET_DATA (pybullet_data's
 folder), CORPUS_SERVO (default 1000 N m/rad), CORPUS_TIMEOUT (s, default 120), CORPUS_RANDOM

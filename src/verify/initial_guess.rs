@@ -73,8 +73,13 @@ fn sparse_dof(model: &Model, start: State, cons: Constraints) -> Result<usize> {
         state
     };
     // The rows evaluated for the guard at `state` are the partition's and the rank count's.
-    crate::solver::finite::guard_system(&mut sys, &state, "the assembled initial guess")?;
-    if super::potential_energy(model, &state).is_none() {
+    // The guard's energy is the one that must be defined there (one evaluation for both).
+    let energy = crate::solver::finite::guard_system_energy(
+        &mut sys,
+        &state,
+        "the assembled initial guess",
+    )?;
+    if energy.is_none() {
         return Err(
             crate::forces::undefined_term(model, &state.branches, &state.q).unwrap_or(
                 Error::SingularPartition {

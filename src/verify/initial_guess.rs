@@ -63,7 +63,9 @@ fn sparse_dof(model: &Model, start: State, cons: Constraints) -> Result<usize> {
         cons.on_branches(start.branches.clone()),
         Backend::Sparse,
     );
-    sys.residual(&start.q);
+    // `Φ` with the Jacobian (the same values to the last bit): at an assembled start the
+    // guard and the count below use these triplets as they are.
+    sys.triplets(&start.q);
     let state = if sys.dimensionless_residual() <= Options::default().constraint_tolerance {
         start
     } else {

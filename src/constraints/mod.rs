@@ -387,19 +387,23 @@ mod tests {
     /// rows were given when they were stored (`joint.row`, `body.normalization`, …).
     #[test]
     fn row_names_follow_the_blocks() {
-        let urdf = r#"<robot name="r">
-            <link name="world"/>
-            <link name="a"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
-            <link name="b"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
-            <joint name="j1" type="revolute"><parent link="world"/><child link="a"/><axis xyz="0 0 1"/>
-              <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
-            <joint name="j2" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>
-              <mimic joint="j1" multiplier="2"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
-        </robot>"#;
-        let model = crate::urdf::load_str(urdf, "r.urdf", &Default::default())
-            .unwrap()
-            .model;
-        let j1 = model.joint_id("j1").unwrap();
+        use crate::model::{JointKind, Mimic, ModelBuilder};
+        use nalgebra::{Isometry3, Matrix3, Vector3};
+        let mut b = ModelBuilder::new("r");
+        let inertia = Matrix3::identity();
+        let a = b.add_rigid_body("a", 1.0, Vector3::zeros(), inertia);
+        let c = b.add_rigid_body("b", 1.0, Vector3::zeros(), inertia);
+        let f = Isometry3::identity();
+        let j1 = b.add_joint("j1", JointKind::Revolute, None, f, Some(a), f);
+        let j2 = b.add_joint("j2", JointKind::Revolute, Some(a), f, Some(c), f);
+        b.set_limits(j1, -1.0, 1.0);
+        b.add_mimic(Mimic {
+            joint: j2,
+            reference: j1,
+            multiplier: 2.0,
+            offset: 0.0,
+        });
+        let model = b.build().unwrap();
         let active = Active {
             row: Unilateral::Limit {
                 joint: j1,

@@ -49,5 +49,8 @@ pub(crate) fn run(a: &CheckArgs) -> anyhow::Result<u8> {
         }
         None => 0,
     };
+    // The process ends next: its memory goes back whole, without freeing each of a large
+    // model's names and listings one by one (3 % of `check` at 10,000 links).
+    std::mem::forget((loaded, s, listing));
     Ok(code)
 }

@@ -72,7 +72,6 @@ enum Term<'a> {
 pub(crate) struct Constraints {
     pub(crate) blocks: Vec<Block>,
     len: usize,
-    names: Vec<String>,
     /// Power of length in each row's unit (0, 1 or 2).
     length_power: Vec<i32>,
     /// The branch each joint angle is read on (lock, mimic and screw rows); the solver moves
@@ -87,7 +86,6 @@ impl Constraints {
     /// Builds the rows of `model` plus the locks `(joint, dof, value)`.
     pub(crate) fn new(model: &Model, locks: &[(JointId, usize, f64)]) -> Self {
         let mut blocks = Vec::new();
-        let mut names = Vec::new();
         let mut length_power = Vec::new();
         let mut len = 0;
         let mut push = |kind: BlockKind, count: usize, blocks: &mut Vec<Block>| {
@@ -99,32 +97,27 @@ impl Constraints {
             if count > 0 {
                 push(BlockKind::Joint(JointId(i)), count, &mut blocks);
                 for r in joint::row_names(j) {
-                    names.push(format!("{}.{}", j.name, r));
                     length_power.push(joint::length_power(r));
                 }
             }
         }
-        for (i, b) in model.bodies.iter().enumerate() {
+        for i in 0..model.bodies.len() {
             push(BlockKind::Normalization(BodyId(i)), 1, &mut blocks);
-            names.push(format!("{}.normalization", b.name));
             length_power.push(0);
         }
         for &(joint, dof, value) in locks {
             push(BlockKind::Lock { joint, dof, value }, 1, &mut blocks);
             let j = &model.joints[joint.0];
-            names.push(format!("{}.lock[{dof}]", j.name));
             length_power.push(if j.kind.is_angle(dof) { 0 } else { 1 });
         }
         for (i, m) in model.mimics.iter().enumerate() {
             push(BlockKind::Mimic(i), 1, &mut blocks);
             let j = &model.joints[m.joint.0];
-            names.push(format!("{}.mimic", j.name));
             length_power.push(if j.kind.is_angle(0) { 0 } else { 1 });
         }
         Constraints {
             blocks,
             len,
-            names,
             length_power,
             branches: Branches::default(),
             closed_form: true,
@@ -138,15 +131,8 @@ impl Constraints {
                 kind: BlockKind::Unilateral(*a),
                 first: self.len,
             });
-            let name = unilateral::name(model, &a.row);
             let power = unilateral::length_power(model, &a.row);
-            let suffixes: &[&str] = if a.anchor.is_some() {
-                &["", ".t1", ".t2"]
-            } else {
-                &[""]
-            };
-            for s in suffixes {
-                self.names.push(format!("{name}{s}"));
+            for _ in 0..a.row_count() {
                 self.length_power.push(power);
             }
             self.len += a.row_count();
@@ -170,9 +156,38 @@ impl Constraints {
         self.len
     }
 
-    /// Name of row `i` (`joint.row`, `body.normalization`, `joint.lock[dof]`, `joint.mimic`).
-    pub(crate) fn row_name(&self, i: usize) -> &str {
-        &self.names[i]
+    /// Name of row `i` of `model`'s rows (`joint.row`, `body.normalization`,
+    /// `joint.lock[dof]`, `joint.mimic`, `joint.lower_limit`, `link.contact[k]@ground.t1`),
+    /// made when asked (an error names one row; a model has tens of thousands).
+    pub(crate) fn row_name(&self, model: &Model, i: usize) -> String {
+        // The blocks are in row order: row `i` is in the last block starting at or before it.
+        let at = self.blocks.partition_point(|b| b.first <= i);
+        let Some(block) = at.checked_sub(1).map(|k| &self.blocks[k]) else {
+            return format!("row {i}");
+        };
+        let k = i - block.first;
+        match &block.kind {
+            BlockKind::Joint(id) => {
+                let j = &model.joints[id.0];
+                format!("{}.{}", j.name, joint::row_names(j).get(k).unwrap_or(&"?"))
+            }
+            BlockKind::Normalization(b) => format!("{}.normalization", model.bodies[b.0].name),
+            BlockKind::Lock { joint, dof, .. } => {
+                format!("{}.lock[{dof}]", model.joints[joint.0].name)
+            }
+            BlockKind::Mimic(m) => format!("{}.mimic", model.joints[model.mimics[*m].joint.0].name),
+            BlockKind::Unilateral(a) => {
+                let suffix = ["", ".t1", ".t2"].get(k).unwrap_or(&"");
+                format!("{}{suffix}", unilateral::name(model, &a.row))
+            }
+        }
+    }
+
+    /// Whether row `i` is a body's normalization row.
+    pub(crate) fn is_normalization(&self, i: usize) -> bool {
+        let at = self.blocks.partition_point(|b| b.first <= i);
+        at.checked_sub(1)
+            .is_some_and(|k| matches!(self.blocks[k].kind, BlockKind::Normalization(_)))
     }
 
     /// Evaluates each block's rows and hands them to `visit(row, term)`.
@@ -360,5 +375,66 @@ impl Constraints {
             }
         });
         flush(&mut pending, h);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::unilateral::{Active, Bound, Unilateral};
+    use super::*;
+
+    /// Row names are made on demand from the blocks: every kind of row, with the names the
+    /// rows were given when they were stored (`joint.row`, `body.normalization`, …).
+    #[test]
+    fn row_names_follow_the_blocks() {
+        use crate::model::{JointKind, Mimic, ModelBuilder};
+        use nalgebra::{Isometry3, Matrix3, Vector3};
+        let mut b = ModelBuilder::new("r");
+        let inertia = Matrix3::identity();
+        let a = b.add_rigid_body("a", 1.0, Vector3::zeros(), inertia);
+        let c = b.add_rigid_body("b", 1.0, Vector3::zeros(), inertia);
+        let f = Isometry3::identity();
+        let j1 = b.add_joint("j1", JointKind::Revolute, None, f, Some(a), f);
+        let j2 = b.add_joint("j2", JointKind::Revolute, Some(a), f, Some(c), f);
+        b.set_limits(j1, -1.0, 1.0);
+        b.add_mimic(Mimic {
+            joint: j2,
+            reference: j1,
+            multiplier: 2.0,
+            offset: 0.0,
+        });
+        let model = b.build().unwrap();
+        let active = Active {
+            row: Unilateral::Limit {
+                joint: j1,
+                bound: Bound::Lower,
+                value: -1.0,
+            },
+            anchor: None,
+        };
+        let cons = Constraints::new(&model, &[(j1, 0, 0.5)]).with_active(&model, &[active]);
+        let names: Vec<String> = (0..cons.len()).map(|i| cons.row_name(&model, i)).collect();
+        let expected = [
+            "j1.pos_x",
+            "j1.pos_y",
+            "j1.pos_z",
+            "j1.axis_x",
+            "j1.axis_y",
+            "j2.pos_x",
+            "j2.pos_y",
+            "j2.pos_z",
+            "j2.axis_x",
+            "j2.axis_y",
+            "a.normalization",
+            "b.normalization",
+            "j1.lock[0]",
+            "j2.mimic",
+            "j1.lower_limit",
+        ];
+        assert_eq!(names, expected);
+        let normalization: Vec<usize> = (0..cons.len())
+            .filter(|&i| cons.is_normalization(i))
+            .collect();
+        assert_eq!(normalization, [10, 11]);
     }
 }

@@ -248,7 +248,9 @@ pub(crate) fn limit_angle(
 ) -> Option<f64> {
     let j = &model.joints[joint.0];
     let pair = pair_of(&j.bodies, q, false);
-    Some(coordinate(j, &pair, 0, branches.get(joint, 0))?.v)
+    // The value alone (bit for bit the jet's value, without its 14 derivatives): the guard
+    // reads every idle stop's angle at every trial point of the line search.
+    crate::kinematics::coordinate_value(j, &pair, 0, branches.get(joint, 0))
 }
 
 /// The gap of a stop at `value` on the `bound` side, the coordinate at `theta`.

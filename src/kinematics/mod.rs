@@ -14,6 +14,6 @@ mod frames;
 mod motion;
 
 pub use branches::Branches;
-pub(crate) use coordinate::{coordinate, on_branch, vector};
+pub(crate) use coordinate::{coordinate, coordinate_value, on_branch, vector};
 pub(crate) use frames::{angle, frames};
 pub(crate) use motion::motion;

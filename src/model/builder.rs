@@ -102,6 +102,18 @@ impl ModelBuilder {
         BodyId(self.model.bodies.len() - 1)
     }
 
+    /// Room for `bodies`, `links` and `joints` more (and their names), so that importing a
+    /// large model does not regrow and copy its tables link by link.
+    pub fn reserve(&mut self, bodies: usize, links: usize, joints: usize) {
+        self.model.bodies.reserve(bodies);
+        self.model.links.reserve(links);
+        self.inertials.reserve(links);
+        self.no_gravity.reserve(links);
+        self.link_names.reserve(links);
+        self.model.joints.reserve(joints);
+        self.joint_names.reserve(joints);
+    }
+
     /// Adds a link on `body` (`None`: welded to the world) at `body_from_link`, and returns
     /// its index in [`Model::links`].
     pub fn add_link(

@@ -194,10 +194,10 @@ pub(crate) fn project(
             let start = worst_joint_row(&mut sys, &q0);
             Err(Error::Inconsistent {
                 site: model
-                    .row_site(sys.problem.cons.row_name(start))
-                    .or_else(|| model.row_site(sys.problem.cons.row_name(row)))
+                    .row_site(&sys.problem.cons.row_name(model, start))
+                    .or_else(|| model.row_site(&sys.problem.cons.row_name(model, row)))
                     .map(Box::new),
-                row: sys.problem.cons.row_name(row).to_string(),
+                row: sys.problem.cons.row_name(model, row),
                 residual,
                 loops: if loops.is_empty() {
                     "none".into()
@@ -208,7 +208,7 @@ pub(crate) fn project(
         }
         Err(Failure::Stuck(iterations)) => {
             let worst = worst_joint_row(&mut sys, &q0);
-            let row = sys.problem.cons.row_name(worst).to_string();
+            let row = sys.problem.cons.row_name(model, worst);
             // The blocks are in row order: the row is the last block starting at or before it.
             let unilateral = sys
                 .problem
@@ -241,7 +241,7 @@ pub(crate) fn project(
 fn worst_joint_row(sys: &mut System, q0: &DVector<f64>) -> usize {
     let phi = sys.residual(q0).clone();
     (0..phi.len())
-        .filter(|&r| !sys.problem.cons.row_name(r).ends_with(".normalization"))
+        .filter(|&r| !sys.problem.cons.is_normalization(r))
         .max_by(|&a, &b| {
             (phi[a] * sys.problem.scaling.rows[a])
                 .abs()

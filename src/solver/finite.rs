@@ -25,13 +25,26 @@ pub(crate) fn guard(model: &Model, state: &State, at: &str) -> Result<()> {
 
 /// [`guard`] with the rows of `sys` (the model's rows and locks on the state's branches, as
 /// [`guard`] builds them), evaluated into its scratch: the partition and evaluation that
-/// follow at the same point reuse them instead of evaluating them again.
-pub(crate) fn guard_system(sys: &mut System, state: &State, at: &str) -> Result<()> {
+/// follow at the same point reuse them instead of evaluating them again. Returns what the
+/// energy check evaluated, the energy `V` and the gradient `∇V` at `state` (`None` where a
+/// force-table term is undefined there: that error is the caller's), so that a caller needing
+/// them does not evaluate them again.
+pub(crate) fn guard_system_energy(
+    sys: &mut System,
+    state: &State,
+    at: &str,
+) -> Result<Option<(f64, DVector<f64>)>> {
     let model = sys.problem.model;
     finite_coordinates(model, state, at)?;
     sys.triplets(&state.q);
     finite_rows(model, &sys.problem.cons, &sys.work.phi, &sys.work.jac, at)?;
-    finite_energy(model, state, at)
+    let q = &state.q;
+    let mut g = DVector::zeros(q.len());
+    let Some(e) = crate::forces::potential(model, &state.branches, q, &mut g, None) else {
+        return Ok(None);
+    };
+    crate::forces::finite::check(model, &state.branches, q, e.total, &g, at)?;
+    Ok(Some((e.total, g)))
 }
 
 fn finite_coordinates(model: &Model, state: &State, at: &str) -> Result<()> {
@@ -54,7 +67,7 @@ fn finite_rows(
 ) -> Result<()> {
     let bad_entry = jac.entries.iter().find(|e| !e.2.is_finite()).map(|e| e.0);
     if let Some(r) = phi.iter().position(|x| !x.is_finite()).or(bad_entry) {
-        let row = cons.row_name(r).to_string();
+        let row = cons.row_name(model, r);
         return Err(Error::NonFiniteConstraint {
             site: model.row_site(&row).map(Box::new),
             row,

@@ -313,7 +313,7 @@ pub(crate) fn solve_round(
             .part
             .redundant
             .iter()
-            .map(|&r| sys.problem.cons.row_name(r).to_string())
+            .map(|&r| sys.problem.cons.row_name(model, r))
             .collect(),
         stability,
         reactions,

@@ -273,6 +273,7 @@ pub(super) fn import(
     // Bodies (group 0, the root's, is the world unless the base floats) and links.
     let floating = options.floating_base;
     let mut model = ModelBuilder::new(robot.attribute("name").unwrap_or("robot"));
+    model.reserve(groups.group_root.len(), link_in.len(), edges.len());
     model.set_gravity(options.gravity);
     let mut body_ids: Vec<Option<BodyId>> = Vec::with_capacity(groups.group_root.len());
     for (g, &rl) in groups.group_root.iter().enumerate() {

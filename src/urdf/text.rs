@@ -300,6 +300,12 @@ fn options() -> roxmltree::ParsingOptions {
 
 /// Refuses a xacro file: an element in a xacro namespace or an attribute with `${`.
 fn refuse_xacro(doc: &roxmltree::Document, file: &str) -> Result<()> {
+    // Neither can appear without `${` or `xacro` in the text, or an entity reference that
+    // would spell one (a byte search; the element scan walks every attribute of the file).
+    let text = doc.input_text();
+    if !text.contains("${") && !text.contains("xacro") && !text.contains('&') {
+        return Ok(());
+    }
     for n in doc.descendants().filter(|n| n.is_element()) {
         let xacro = n
             .tag_name()
@@ -377,6 +383,23 @@ mod tests {
         assert!(s.contains("r\u{e9}"));
         let err = decode(b"<robot name=\"r\xE9\"/>".to_vec(), "f").unwrap_err();
         assert!(err.to_string().starts_with("f:1:15:"), "{err}");
+    }
+
+    /// xacro is refused whether written plainly or through a character reference (the byte
+    /// search that skips the element scan must not miss it).
+    #[test]
+    fn xacro_is_refused_also_through_references() {
+        let refused = |t: &str| {
+            let doc = roxmltree::Document::parse_with_options(t, options()).unwrap();
+            refuse_xacro(&doc, "f").is_err()
+        };
+        assert!(refused(r#"<robot><link name="${a}"/></robot>"#));
+        assert!(refused(r#"<robot><link name="&#36;{a}"/></robot>"#));
+        assert!(refused(
+            r#"<robot xmlns:x="http://www.ros.org/wiki/&#120;acro"><x:macro name="m"/></robot>"#
+        ));
+        assert!(!refused(r#"<robot><link name="a"/></robot>"#));
+        assert!(!refused(r#"<robot><link name="a&amp;b"/></robot>"#));
     }
 
     #[test]

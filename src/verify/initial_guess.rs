@@ -63,7 +63,9 @@ fn sparse_dof(model: &Model, start: State, cons: Constraints) -> Result<usize> {
         cons.on_branches(start.branches.clone()),
         Backend::Sparse,
     );
-    sys.residual(&start.q);
+    // `Φ` with the Jacobian (the same values to the last bit): at an assembled start the
+    // guard and the count below use these triplets as they are.
+    sys.triplets(&start.q);
     let state = if sys.dimensionless_residual() <= Options::default().constraint_tolerance {
         start
     } else {
@@ -73,8 +75,13 @@ fn sparse_dof(model: &Model, start: State, cons: Constraints) -> Result<usize> {
         state
     };
     // The rows evaluated for the guard at `state` are the partition's and the rank count's.
-    crate::solver::finite::guard_system(&mut sys, &state, "the assembled initial guess")?;
-    if super::potential_energy(model, &state).is_none() {
+    // The guard's energy is the one that must be defined there (one evaluation for both).
+    let energy = crate::solver::finite::guard_system_energy(
+        &mut sys,
+        &state,
+        "the assembled initial guess",
+    )?;
+    if energy.is_none() {
         return Err(
             crate::forces::undefined_term(model, &state.branches, &state.q).unwrap_or(
                 Error::SingularPartition {

@@ -112,6 +112,11 @@ pub(super) fn free_columns(
     let nb = n / 7;
     let mut rows = Rows::new(m, n, entries, row_scale, scale)?;
     let mut row = Vec::with_capacity(14);
+    // Every row expanded once, kept row after row (`expanded[at[r]..at[r + 1]]`): the passes
+    // below and each body's copies read it instead of expanding again.
+    let mut expanded: Vec<(usize, f64)> = Vec::with_capacity(entries.len());
+    let mut at = Vec::with_capacity(m + 1);
+    at.push(0);
     // Each row's largest entry; the rows touching each body (ascending, each once, counted
     // then filled); the body of the rows lying on one body alone.
     let mut rmax = vec![0.0f64; m];
@@ -120,6 +125,8 @@ pub(super) fn free_columns(
     let mut reach = vec![[0.0f64; 2]; m];
     for r in 0..m {
         rows.expand(r, &mut row);
+        expanded.extend_from_slice(&row);
+        at.push(expanded.len());
         rmax[r] = row_max(&row);
         let mut last = usize::MAX;
         for &(c, _) in &row {
@@ -152,9 +159,8 @@ pub(super) fn free_columns(
     let mut body_rows = vec![usize::MAX; body_start[nb]];
     let mut body_fill = body_start.clone();
     for r in 0..m {
-        rows.expand(r, &mut row);
         let mut last = usize::MAX;
-        for &(c, _) in &row {
+        for &(c, _) in &expanded[at[r]..at[r + 1]] {
             if c / 7 != last {
                 last = c / 7;
                 body_rows[body_fill[last]] = r;
@@ -181,7 +187,9 @@ pub(super) fn free_columns(
             local.rows.resize_with(k, Vec::new);
         }
         for (slot, &r) in local.cands.iter().enumerate() {
-            rows.expand(r, &mut local.rows[slot]);
+            let copy = &mut local.rows[slot];
+            copy.clear();
+            copy.extend_from_slice(&expanded[at[r]..at[r + 1]]);
         }
         let in_b = |c: usize| c / 7 == b;
         all.clear();

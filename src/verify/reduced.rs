@@ -13,7 +13,6 @@
 
 use crate::constraints::Constraints;
 use crate::error::{Error, Result};
-use crate::forces::potential;
 use crate::model::{JointId, Model};
 use crate::solver::partition::Partition;
 use crate::solver::system::{coordinate_scale, Backend, Eval, System};
@@ -58,9 +57,9 @@ pub(super) fn reduced<'a>(
         Constraints::new(model, locks).on_branches(state.branches.clone()),
         backend,
     );
-    crate::solver::finite::guard_system(&mut sys, state, "the given pose")?;
-    let mut g = DVector::zeros(q.len());
-    potential(model, &state.branches, q, &mut g, None).ok_or_else(|| {
+    // The guard's gradient is `∇V` (one evaluation for both).
+    let guarded = crate::solver::finite::guard_system_energy(&mut sys, state, "the given pose")?;
+    let (_, g) = guarded.ok_or_else(|| {
         crate::forces::undefined_term(model, &state.branches, q).unwrap_or(
             Error::SingularPartition {
                 at: "the given pose".into(),

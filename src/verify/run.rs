@@ -12,11 +12,9 @@ use crate::model::{JointId, Model};
 use crate::solver::system::{Backend, Scaling};
 use crate::state::State;
 
-/// The scalar coordinates of the tree joints: `(joint, dof, value)` and their gradients.
-pub(super) fn tree_coordinates(
-    model: &Model,
-    state: &State,
-) -> Vec<(JointId, usize, crate::jet::Scalar)> {
+/// The scalar coordinates of the tree joints: `(joint, dof, value)` (values alone: bit for
+/// bit those of the coordinates' jets).
+pub(super) fn tree_coordinates(model: &Model, state: &State) -> Vec<(JointId, usize, f64)> {
     let mut coords = Vec::new();
     for (i, j) in model.joints.iter().enumerate() {
         if !j.tree || j.merged {
@@ -24,9 +22,12 @@ pub(super) fn tree_coordinates(
         }
         let pair = pair_of(&j.bodies, &state.q, false);
         for dof in 0..j.kind.scalar_coordinates() {
-            if let Some(s) =
-                crate::kinematics::coordinate(j, &pair, dof, state.branches.get(JointId(i), dof))
-            {
+            if let Some(s) = crate::kinematics::coordinate_value(
+                j,
+                &pair,
+                dof,
+                state.branches.get(JointId(i), dof),
+            ) {
                 coords.push((JointId(i), dof, s));
             }
         }
@@ -75,7 +76,7 @@ pub(super) fn verify_on(
     let mut contact = unilateral::UnilateralCheck::default();
     let list = unilateral::touching(model, state, uni, tol.gap, &mut contact);
     let coords = tree_coordinates(model, state);
-    let values: Vec<_> = coords.iter().map(|c| (c.0, c.1, c.2.v)).collect();
+    let values = coords.as_slice();
     let (phi, scaled, energy, projected_gradient, force_scale, closure, held, stability) =
         if let Some(r) = reduced {
             let closure = closures(model, &r.sys.problem.cons, &r.phi, tol.constraint);
@@ -101,7 +102,7 @@ pub(super) fn verify_on(
                         crate::solver::stability_of(&mut sys, &state.q, &part, &eval, eigenvalues)
                     })
                 });
-                let held = held::held(model, state, &list, &values, forces_backend, tau, free)?;
+                let held = held::held(model, state, &list, values, forces_backend, tau, free)?;
                 let passed = passes(scaled, &held, force_scale, tol);
                 // A panic there is re-raised here, as if the verdict had been computed on
                 // this thread.
@@ -130,7 +131,7 @@ pub(super) fn verify_on(
             let projected_gradient = (p.null.transpose() * &p.grad_s).amax();
             let force_scale = p.grad_s.amax();
             let tau = tol.force + tol.relative * force_scale;
-            let held = held::held(model, state, &list, &values, forces_backend, tau, None)?;
+            let held = held::held(model, state, &list, values, forces_backend, tau, None)?;
             (
                 p.phi,
                 scaled,

@@ -123,10 +123,7 @@ fn held_from_the_balance_checks_system_is_held_from_its_own() {
             let locks = crate::solver::lock_values(&model);
             let backend = crate::solver::system::Backend::Sparse;
             let r = super::reduced::reduced(&model, &state, &locks, backend).unwrap();
-            let values: Vec<_> = super::run::tree_coordinates(&model, &state)
-                .iter()
-                .map(|c| (c.0, c.1, c.2.v))
-                .collect();
+            let values = super::run::tree_coordinates(&model, &state);
             let tau = 1e-9 * r.force_scale.max(1.0);
             let own = super::held::held(&model, &state, &[], &values, backend, tau, None).unwrap();
             let free = super::held::free_of(&r.sys, &r.part, &r.eval);

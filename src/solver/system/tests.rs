@@ -122,7 +122,7 @@ fn constraint_jacobian_and_weighted_hessian_match_finite_differences() {
                         "{}: Φ_q[{},{i}] ({}) {} vs {fd}",
                         model.name,
                         r,
-                        sys.problem.cons.row_name(r),
+                        sys.problem.cons.row_name(&model, r),
                         j[(r, i)]
                     )
                 });

@@ -5,7 +5,7 @@
 use super::kkt_matrix::KktMatrix;
 use super::Backend;
 use super::{Eval, System};
-use crate::jet::HessianSink;
+use crate::jet::{HessianSink, LMat, NL};
 use crate::model::BodyId;
 use crate::solver::partition::Partition;
 use crate::solver::sparse::kkt::{Factored, Kkt};
@@ -96,7 +96,9 @@ impl System<'_> {
             in_part[r] = true;
         }
         let entries = &self.work.jac.entries;
-        let mut pending: Option<([Option<BodyId>; 2], crate::jet::LMat)> = None;
+        // The pending body pair and its accumulated `Σ ρ g gᵀ` (column-major, as `LMat`).
+        let mut pending: Option<[Option<BodyId>; 2]> = None;
+        let mut acc = [0.0f64; NL * NL];
         let mut k = 0;
         while k < entries.len() {
             let row = entries[k].0;
@@ -131,43 +133,41 @@ impl System<'_> {
                 }
                 continue;
             }
-            let mut g = crate::jet::LVec::zeros();
+            let mut g = [0.0f64; NL];
             for e in group {
                 let side = usize::from(bodies[0].map(|x| x.0) != Some(e.1 / 7));
                 g[7 * side + e.1 % 7] += e.2;
             }
-            let same = pending.as_ref().is_some_and(|(b, _)| {
+            let same = pending.as_ref().is_some_and(|b| {
                 b.iter()
                     .map(|x| x.map(|y| y.0))
                     .eq(bodies.iter().map(|x| x.map(|y| y.0)))
             });
             if !same {
-                if let Some((b, acc)) = pending.take() {
-                    self.work.hess.add_block(&b, &acc, 1.0);
+                if let Some(b) = pending.take() {
+                    self.work
+                        .hess
+                        .add_block(&b, &LMat::from_column_slice(&acc), 1.0);
                 }
-                pending = Some((bodies, crate::jet::LMat::zeros()));
+                pending = Some(bodies);
+                acc = [0.0; NL * NL];
             }
-            if let Some((_, acc)) = pending.as_mut() {
-                // `acc += g gᵀ ρ` in place, entry by entry in the same order of operations
-                // (no 14 × 14 temporaries), over the row's nonzero entries only (listed once).
-                let mut nz = [0usize; crate::jet::NL];
-                let mut count = 0;
-                for (i, &gi) in g.iter().enumerate() {
-                    if gi != 0.0 {
-                        nz[count] = i;
-                        count += 1;
-                    }
-                }
-                let nz = &nz[..count];
-                for &j in nz {
-                    for &i in nz {
-                        acc[(i, j)] += g[i] * g[j] * rho;
+            // `acc += g gᵀ ρ` in place, entry by entry in the same order of operations
+            // (`(g_i g_j) ρ`), over the columns of the row's nonzero entries: a zero `g_i`
+            // adds a signed zero, which changes no sum.
+            for (j, &gj) in g.iter().enumerate() {
+                if gj != 0.0 {
+                    let col = &mut acc[NL * j..NL * j + NL];
+                    for (a, &gi) in col.iter_mut().zip(&g) {
+                        *a += gi * gj * rho;
                     }
                 }
             }
         }
-        if let Some((b, acc)) = pending.take() {
-            self.work.hess.add_block(&b, &acc, 1.0);
+        if let Some(b) = pending.take() {
+            self.work
+                .hess
+                .add_block(&b, &LMat::from_column_slice(&acc), 1.0);
         }
     }
 

@@ -15,8 +15,10 @@ pub(crate) struct Workspace {
     pub(crate) phi: DVector<f64>,
     /// Triplets of `Φ_q`.
     pub(crate) jac: Triplets,
-    /// The configuration of the last triplets (`jac` and `phi`); empty when `phi` is newer.
+    /// The configuration of the last triplets (`jac` and `phi`), valid while `jac_fresh`
+    /// (false once `phi` is newer; the buffer is kept).
     pub(crate) jac_at: DVector<f64>,
+    pub(crate) jac_fresh: bool,
     /// The symbolic split of `Φ_q` under the last partition (sparse path).
     pub(crate) split: Option<Split>,
     /// The KKT system of the last assembly (sparse path; tree backend: tree-structured where
@@ -38,6 +40,7 @@ impl Workspace {
             phi: DVector::zeros(rows),
             jac: Triplets::default(),
             jac_at: DVector::zeros(0),
+            jac_fresh: false,
             split: None,
             kkt: None,
             tree_split: None,

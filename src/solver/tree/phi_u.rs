@@ -80,6 +80,10 @@ impl TreeSplit {
         n: usize,
         entries: &[(usize, usize, f64)],
     ) -> Option<Self> {
+        // Positions and triplet numbers are held as `u32`.
+        if u32::try_from(entries.len().max(m).max(n)).is_err() {
+            return None;
+        }
         let order = part.rows.len();
         let mut row_pos = vec![u32::MAX; m];
         for (k, &r) in part.rows.iter().enumerate() {
@@ -157,7 +161,7 @@ impl TreeSplit {
             let q = col_pos[e.1];
             if q == u32::MAX {
                 if ind_pos[e.1] != u32::MAX {
-                    pending_v.push(t);
+                    pending_v.push(t as u32);
                     v_at.push((p, ind_pos[e.1]));
                 }
                 continue;
@@ -165,7 +169,7 @@ impl TreeSplit {
             let (p, q) = (p as usize, q as usize);
             let (np, nq) = (node_of[p], node_of[q]);
             if np == u32::MAX || nq == u32::MAX {
-                border_at.push((t, border.add(p, q) as u32));
+                border_at.push((t as u32, border.add(p, q) as u32));
             } else if np == nq {
                 let i = np as usize;
                 let (a, b) = (p - span[i].0, q - span[i].0);
@@ -173,7 +177,7 @@ impl TreeSplit {
                 slots[t] = (diag_at[i] + a * d + b) as u32;
             } else {
                 count[np as usize + 1] += 1;
-                pending.push((t, p, q));
+                pending.push((t as u32, p as u32, q as u32));
             }
         }
         for i in 0..nodes {
@@ -182,6 +186,7 @@ impl TreeSplit {
         let off_at = count.clone();
         let mut off = vec![(0u32, 0u32); pending.len()];
         for &(t, p, q) in &pending {
+            let (t, p, q) = (t as usize, p as usize, q as usize);
             let i = node_of[p] as usize;
             let at = count[i];
             count[i] += 1;
@@ -193,10 +198,10 @@ impl TreeSplit {
         let v0 = border0 + border.len();
         let len = v0 + v_at.len() + 1;
         for (t, k) in border_at {
-            slots[t] = (border0 + k as usize) as u32;
+            slots[t as usize] = (border0 + k as usize) as u32;
         }
         for (k, t) in pending_v.into_iter().enumerate() {
-            slots[t] = (v0 + k) as u32;
+            slots[t as usize] = (v0 + k) as u32;
         }
         // The triplets no block holds go to the spare last slot.
         let spare = u32::try_from(len - 1).ok()?;

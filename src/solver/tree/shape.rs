@@ -94,21 +94,21 @@ impl Shape {
             }
         }
         let nodes = members.len();
-        // Node couplings: every pair of unknowns with a value.
-        let mut pairs: Vec<(u32, u32)> = Vec::new();
-        for &(a, b) in &hess.keys {
-            pairs.push((body_node[a], body_node[b]));
-        }
-        for e in entries {
-            if row_pos[e.0] != u32::MAX {
-                pairs.push((owner[n + row_pos[e.0] as usize], body_node[e.1 / 7]));
-            }
-        }
+        // Node couplings: every pair of unknowns with a value (listed straight into `later`,
+        // in the same order, without a list of all pairs first).
         let mut later: Vec<Vec<u32>> = vec![Vec::new(); nodes];
-        for &(a, b) in &pairs {
+        let mut couple = |a: u32, b: u32| {
             if a != u32::MAX && b != u32::MAX && a != b {
                 let (lo, hi) = (a.min(b), a.max(b));
                 later[lo as usize].push(hi);
+            }
+        };
+        for &(a, b) in &hess.keys {
+            couple(body_node[a], body_node[b]);
+        }
+        for e in entries {
+            if row_pos[e.0] != u32::MAX {
+                couple(owner[n + row_pos[e.0] as usize], body_node[e.1 / 7]);
             }
         }
         let mut in_border = vec![false; nodes];

@@ -2,6 +2,7 @@
 //! they were taken at, the sparse split of `Φ_q` into `Φ_u` and `Φ_v`, the KKT system and the
 //! block-sparse Hessian of the Lagrangian `W = V_qq − Σ μ_k Φ_k,qq`.
 
+use super::augment::AugmentPlan;
 use super::kkt_matrix::KktMatrix;
 use crate::constraints::Triplets;
 use crate::solver::sparse::factor::Split;
@@ -31,6 +32,8 @@ pub(crate) struct Workspace {
     pub(crate) tree_kkt_refused: Option<(usize, usize)>,
     /// `W` in body blocks (sparse path).
     pub(crate) hess: BlockHessian,
+    /// The rows of the augmentation of `W` under the last partition (module `augment`).
+    pub(crate) augment: Option<AugmentPlan>,
 }
 
 impl Workspace {
@@ -47,6 +50,7 @@ impl Workspace {
             tree_refused: None,
             tree_kkt_refused: None,
             hess: BlockHessian::default(),
+            augment: None,
         }
     }
 }

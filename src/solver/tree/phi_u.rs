@@ -339,10 +339,13 @@ impl TreeLu {
         if s.border.is_empty() {
             self.tree_solve(x, transpose);
         } else {
-            s.border
-                .solve(&self.vals[s.border0..s.v0], &self.border_piv, x, transpose, |y, t| {
-                    self.tree_solve(y, t)
-                });
+            s.border.solve(
+                &self.vals[s.border0..s.v0],
+                &self.border_piv,
+                x,
+                transpose,
+                |y, t| self.tree_solve(y, t),
+            );
         }
         x.iter().all(|v| v.is_finite())
     }

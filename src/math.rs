@@ -34,7 +34,30 @@ pub fn rotation(p: &Vector4<f64>) -> Matrix3<f64> {
 }
 
 /// `B(p, a) = ∂(A(p) a)/∂p`, a 3 × 4 matrix linear in `p`.
+///
+/// Entry by entry, with the sums in the order of nalgebra's products
+/// `2 (e0 I + ẽ) a` and `2 (e aᵀ − (e0 I + ẽ) ã)` (the same values; no temporaries).
 pub fn b_matrix(p: &Vector4<f64>, a: &Vector3<f64>) -> Matrix3x4<f64> {
+    let (e0, e) = (p[0], [p[1], p[2], p[3]]);
+    // m = e0 I + ẽ and ã, row-major.
+    let m = [[e0, -e[2], e[1]], [e[2], e0, -e[0]], [-e[1], e[0], e0]];
+    let s = [[0.0, -a.z, a.y], [a.z, 0.0, -a.x], [-a.y, a.x, 0.0]];
+    let a = [a.x, a.y, a.z];
+    let mut b = Matrix3x4::zeros();
+    for i in 0..3 {
+        let m2 = [2.0 * m[i][0], 2.0 * m[i][1], 2.0 * m[i][2]];
+        b[(i, 0)] = m2[0] * a[0] + m2[1] * a[1] + m2[2] * a[2];
+        for j in 0..3 {
+            let ms = m[i][0] * s[0][j] + m[i][1] * s[1][j] + m[i][2] * s[2][j];
+            b[(i, j + 1)] = 2.0 * (e[i] * a[j] - ms);
+        }
+    }
+    b
+}
+
+/// The former `b_matrix` through nalgebra's products (the reference of the tests).
+#[cfg(test)]
+fn b_matrix_products(p: &Vector4<f64>, a: &Vector3<f64>) -> Matrix3x4<f64> {
     let e0 = p[0];
     let e = Vector3::new(p[1], p[2], p[3]);
     let m = Matrix3::identity() * e0 + skew(&e);
@@ -94,6 +117,25 @@ pub fn wrap_angle(a: f64) -> f64 {
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    #[test]
+    fn b_matrix_entrywise_equals_the_products_exactly() {
+        let mut state = 7u64;
+        let mut rnd = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 11) as f64 / (1u64 << 53) as f64) * 4.0 - 2.0
+        };
+        for _ in 0..20_000 {
+            let p = Vector4::new(rnd(), rnd(), rnd(), rnd());
+            let a = Vector3::new(rnd(), rnd(), rnd());
+            let (x, y) = (b_matrix(&p, &a), b_matrix_products(&p, &a));
+            for k in 0..12 {
+                assert!(x[k] == y[k], "{p} {a}: {} != {}", x[k], y[k]);
+            }
+        }
+    }
 
     fn arb_p() -> impl Strategy<Value = Vector4<f64>> {
         (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64)

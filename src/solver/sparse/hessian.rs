@@ -38,6 +38,28 @@ impl BlockHessian {
         }
     }
 
+    /// [`BlockHessian::scatter_scaled`] for a matrix in which every slot holds at most one
+    /// block entry (the tree KKT matrix): the scaled values are stored, not added, so that
+    /// the slots need no zeroing first. Same values as adding them to zero.
+    pub(crate) fn scatter_scaled_store(
+        &self,
+        slots: &[[u32; 49]],
+        scale: &[f64],
+        values: &mut [f64],
+    ) {
+        for ((&(a, b), blk), slots) in self.keys.iter().zip(&self.values).zip(slots) {
+            let (sa, sb) = (&scale[7 * a..7 * a + 7], &scale[7 * b..7 * b + 7]);
+            for i in 0..7 {
+                for j in 0..7 {
+                    let slot = slots[7 * i + j];
+                    if slot != u32::MAX {
+                        values[slot as usize] = blk[7 * i + j] * sa[i] * sb[j];
+                    }
+                }
+            }
+        }
+    }
+
     /// Sets every block to zero, keeping the structure.
     pub(crate) fn clear(&mut self) {
         self.values.iter_mut().for_each(|b| *b = [0.0; 49]);

@@ -92,6 +92,9 @@ struct Elimination {
     dependent: Vec<usize>,
     pivot_rows: Vec<usize>,
     redundant: Vec<usize>,
+    /// Scratch of [`Elimination::pivot`]: the position of each column in the row being
+    /// updated (`u32::MAX`: absent), reset after each row.
+    pos: Vec<u32>,
 }
 
 impl Elimination {
@@ -119,17 +122,26 @@ impl Elimination {
             };
             let f = self.rows[i][k].1 / a_rc;
             self.rows[i].swap_remove(k);
+            // A row's columns are distinct: the position map finds the entry a search would.
+            let (row, pos) = (&mut self.rows[i], &mut self.pos);
+            for (j, e) in row.iter().enumerate() {
+                pos[e.0] = j as u32;
+            }
             for &(col, v) in &pivot_row {
                 if col == c {
                     continue;
                 }
-                match self.rows[i].iter_mut().find(|e| e.0 == col) {
-                    Some(e) => e.1 -= f * v,
-                    None => {
-                        self.rows[i].push((col, -f * v));
+                match pos[col] {
+                    u32::MAX => {
+                        pos[col] = row.len() as u32;
+                        row.push((col, -f * v));
                         self.body_rows[col / 7].push(i);
                     }
+                    j => row[j as usize].1 -= f * v,
                 }
+            }
+            for e in row.iter() {
+                pos[e.0] = u32::MAX;
             }
             if self.row_max(i) <= self.tol {
                 self.active[i] = false;
@@ -247,7 +259,10 @@ pub(crate) fn partition(
     let mut body_rows = vec![Vec::new(); nb];
     for (r, row) in rows.iter().enumerate() {
         for &(c, _) in row {
-            body_rows[c / 7].push(r);
+            // Once per run of a row's entries on one body (readers sort and deduplicate).
+            if body_rows[c / 7].last() != Some(&r) {
+                body_rows[c / 7].push(r);
+            }
         }
     }
     let tol = (RANK_TOLERANCE * amax).max(f64::MIN_POSITIVE);
@@ -260,6 +275,7 @@ pub(crate) fn partition(
         tol,
         dependent: Vec::new(),
         pivot_rows: Vec::new(),
+        pos: vec![u32::MAX; n],
     };
     for r in 0..m {
         if el.active[r] && el.row_max(r) <= tol {

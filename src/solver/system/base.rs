@@ -28,7 +28,7 @@ impl<'a> System<'a> {
 
     /// `Φ(q)` (invalidates the triplets' `Φ`).
     pub(crate) fn residual(&mut self, q: &DVector<f64>) -> &DVector<f64> {
-        self.work.jac_at = DVector::zeros(0);
+        self.work.jac_fresh = false;
         self.problem
             .cons
             .evaluate(self.problem.model, q, &mut self.work.phi, None);
@@ -48,13 +48,19 @@ impl<'a> System<'a> {
     /// `Φ(q)` and the triplets of `Φ_q(q)` into the scratch (kept if they are at `q`).
     pub(crate) fn triplets(&mut self, q: &DVector<f64>) {
         let work = &mut self.work;
-        if work.jac_at.len() == q.len() && work.jac_at == *q {
+        if work.jac_fresh && work.jac_at.len() == q.len() && work.jac_at == *q {
             return;
         }
         self.problem
             .cons
             .evaluate(self.problem.model, q, &mut work.phi, Some(&mut work.jac));
-        work.jac_at.clone_from(q);
+        // In place (no allocation) when the length is the same.
+        if work.jac_at.len() == q.len() {
+            work.jac_at.copy_from(q);
+        } else {
+            work.jac_at = q.clone();
+        }
+        work.jac_fresh = true;
     }
 
     /// Dense `Φ_q(q)` (and `Φ(q)` into the scratch).

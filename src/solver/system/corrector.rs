@@ -59,7 +59,14 @@ impl System<'_> {
         let mut last = f64::INFINITY;
         let (mut newton, mut stalls) = (false, 0);
         for it in 0..=max_iterations {
-            self.residual(q);
+            // Before a Newton step `Φ` comes with the Jacobian the step needs (the same values
+            // to the last bit as `Φ` alone, module `jet::closed`); where the corrector ends
+            // here, the evaluation at the point that follows finds the triplets in place.
+            if chord.is_none() {
+                self.triplets(q);
+            } else {
+                self.residual(q);
+            }
             let res = self
                 .problem
                 .scaling

@@ -5,8 +5,6 @@
 use super::kkt_matrix::KktMatrix;
 use super::Backend;
 use super::{Eval, System};
-use crate::jet::HessianSink;
-use crate::model::BodyId;
 use crate::solver::partition::Partition;
 use crate::solver::sparse::kkt::{Factored, Kkt};
 use crate::solver::tree::kkt::TreeKkt;
@@ -75,100 +73,6 @@ impl System<'_> {
             &self.work.hess,
         );
         true
-    }
-
-    /// Adds `Φ_qᵀ D R D Φ_q` over the independent rows to the block Hessian (see
-    /// [`System::factor_kkt`]).
-    fn augment(&mut self, part: &Partition) {
-        let n = self.problem.model.coordinate_count();
-        let mut wdiag = vec![0.0f64; n];
-        for (&(a, b), blk) in self.work.hess.keys.iter().zip(&self.work.hess.values) {
-            if a == b {
-                for i in 0..7 {
-                    wdiag[7 * a + i] =
-                        blk[8 * i].abs() * self.problem.scaling.columns[7 * a + i].powi(2);
-                }
-            }
-        }
-        let floor = 1e-6 * wdiag.iter().fold(0.0f64, |x, &y| x.max(y)) + 1e-12;
-        let mut in_part = vec![false; self.problem.cons.len()];
-        for &r in &part.rows {
-            in_part[r] = true;
-        }
-        let entries = &self.work.jac.entries;
-        let mut pending: Option<([Option<BodyId>; 2], crate::jet::LMat)> = None;
-        let mut k = 0;
-        while k < entries.len() {
-            let row = entries[k].0;
-            let mut end = k;
-            while end < entries.len() && entries[end].0 == row {
-                end += 1;
-            }
-            let group = &entries[k..end];
-            k = end;
-            if !in_part[row] {
-                continue;
-            }
-            let rho = group.iter().fold(floor, |a, e| a.max(wdiag[e.1]))
-                * self.problem.scaling.rows[row].powi(2);
-            let mut bodies: [Option<BodyId>; 2] = [None, None];
-            let mut local = true;
-            for e in group {
-                let b = e.1 / 7;
-                if bodies.iter().any(|x| x.map(|y| y.0) == Some(b)) {
-                    continue;
-                }
-                match bodies.iter().position(|x| x.is_none()) {
-                    Some(slot) => bodies[slot] = Some(BodyId(b)),
-                    None => local = false,
-                }
-            }
-            if !local {
-                for a in group {
-                    for b in group {
-                        self.work.hess.add_entry(a.1, b.1, rho * a.2 * b.2);
-                    }
-                }
-                continue;
-            }
-            let mut g = crate::jet::LVec::zeros();
-            for e in group {
-                let side = usize::from(bodies[0].map(|x| x.0) != Some(e.1 / 7));
-                g[7 * side + e.1 % 7] += e.2;
-            }
-            let same = pending.as_ref().is_some_and(|(b, _)| {
-                b.iter()
-                    .map(|x| x.map(|y| y.0))
-                    .eq(bodies.iter().map(|x| x.map(|y| y.0)))
-            });
-            if !same {
-                if let Some((b, acc)) = pending.take() {
-                    self.work.hess.add_block(&b, &acc, 1.0);
-                }
-                pending = Some((bodies, crate::jet::LMat::zeros()));
-            }
-            if let Some((_, acc)) = pending.as_mut() {
-                // `acc += g gᵀ ρ` in place, entry by entry in the same order of operations
-                // (no 14 × 14 temporaries), over the row's nonzero entries only (listed once).
-                let mut nz = [0usize; crate::jet::NL];
-                let mut count = 0;
-                for (i, &gi) in g.iter().enumerate() {
-                    if gi != 0.0 {
-                        nz[count] = i;
-                        count += 1;
-                    }
-                }
-                let nz = &nz[..count];
-                for &j in nz {
-                    for &i in nz {
-                        acc[(i, j)] += g[i] * g[j] * rho;
-                    }
-                }
-            }
-        }
-        if let Some((b, acc)) = pending.take() {
-            self.work.hess.add_block(&b, &acc, 1.0);
-        }
     }
 
     /// Replaces the KKT factors by LU (see [`Kkt::fall_back_to_lu`]).

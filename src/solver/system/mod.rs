@@ -16,6 +16,7 @@
 //! [`Workspace`] (scratch, reused) and a [`Backend`] (dense or sparse, chosen once). The
 //! factors of `Φ_u` are module `factors`.
 
+mod augment;
 mod backend;
 mod base;
 mod corrector;

@@ -2,6 +2,7 @@
 //! they were taken at, the sparse split of `Φ_q` into `Φ_u` and `Φ_v`, the KKT system and the
 //! block-sparse Hessian of the Lagrangian `W = V_qq − Σ μ_k Φ_k,qq`.
 
+use super::augment::AugmentPlan;
 use super::kkt_matrix::KktMatrix;
 use crate::constraints::Triplets;
 use crate::solver::sparse::factor::Split;
@@ -15,8 +16,10 @@ pub(crate) struct Workspace {
     pub(crate) phi: DVector<f64>,
     /// Triplets of `Φ_q`.
     pub(crate) jac: Triplets,
-    /// The configuration of the last triplets (`jac` and `phi`); empty when `phi` is newer.
+    /// The configuration of the last triplets (`jac` and `phi`), valid while `jac_fresh`
+    /// (false once `phi` is newer; the buffer is kept).
     pub(crate) jac_at: DVector<f64>,
+    pub(crate) jac_fresh: bool,
     /// The symbolic split of `Φ_q` under the last partition (sparse path).
     pub(crate) split: Option<Split>,
     /// The KKT system of the last assembly (sparse path; tree backend: tree-structured where
@@ -29,6 +32,8 @@ pub(crate) struct Workspace {
     pub(crate) tree_kkt_refused: Option<(usize, usize)>,
     /// `W` in body blocks (sparse path).
     pub(crate) hess: BlockHessian,
+    /// The rows of the augmentation of `W` under the last partition (module `augment`).
+    pub(crate) augment: Option<AugmentPlan>,
 }
 
 impl Workspace {
@@ -38,12 +43,14 @@ impl Workspace {
             phi: DVector::zeros(rows),
             jac: Triplets::default(),
             jac_at: DVector::zeros(0),
+            jac_fresh: false,
             split: None,
             kkt: None,
             tree_split: None,
             tree_refused: None,
             tree_kkt_refused: None,
             hess: BlockHessian::default(),
+            augment: None,
         }
     }
 }

@@ -109,14 +109,28 @@ impl TreeKkt {
         scale: &[f64],
         hess: &BlockHessian,
     ) {
-        self.values.iter_mut().for_each(|v| *v = 0.0);
+        // Every slot holds one pair of unknowns (module `shape`): a `W` entry takes the value of
+        // one Hessian block entry, stored; a Jacobian entry the sum of its triplets, zeroed
+        // first. The slots of neither (the zero blocks of the rows) stay zero from allocation,
+        // and the diagonal is zeroed for a coordinate without a block (a shift left there).
         self.shifts.clear();
         let s = &self.shape;
-        hess.scatter_scaled(&s.block_slots, scale, &mut self.values);
+        let values = &mut self.values;
+        for &slot in &s.diag_slots {
+            values[slot as usize] = 0.0;
+        }
+        for slots in &s.jac_slots {
+            for &slot in slots {
+                if slot != SKIP {
+                    values[slot as usize] = 0.0;
+                }
+            }
+        }
+        hess.scatter_scaled_store(&s.block_slots, scale, values);
         for (e, slots) in entries.iter().zip(&s.jac_slots) {
             for &slot in slots {
                 if slot != SKIP {
-                    self.values[slot as usize] += e.2 * row_scale[e.0] * scale[e.1];
+                    values[slot as usize] += e.2 * row_scale[e.0] * scale[e.1];
                 }
             }
         }

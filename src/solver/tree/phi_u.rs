@@ -39,16 +39,14 @@ pub(crate) struct Shape {
     off: Vec<(u32, u32)>,
     off_at: Vec<usize>,
     border: Border,
-}
-
-/// Where a Jacobian triplet goes.
-#[derive(Clone, Copy)]
-enum Slot {
-    None,
-    Diag(u32),
-    Off(u32),
-    Border(u32),
-    PhiV(u32),
+    /// `(row position, independent position)` of the `Φ_v` entries.
+    v_at: Vec<(u32, u32)>,
+    /// The factor buffers' layout: the diagonal blocks, the off-diagonal entries, the border,
+    /// the `Φ_v` entries, then one slot that takes the triplets no block holds.
+    off0: usize,
+    border0: usize,
+    v0: usize,
+    len: usize,
 }
 
 /// The split of the Jacobian's triplets under one partition into the blocks of `Φ_u` and the
@@ -57,21 +55,19 @@ pub(crate) struct TreeSplit {
     id: usize,
     triplets: usize,
     shape: Arc<Shape>,
-    slots: Vec<Slot>,
-    /// `(row position, independent position)` of the `Φ_v` entries.
-    v_at: Vec<(usize, usize)>,
+    /// Where each Jacobian triplet goes in the factor buffer (the last slot: nowhere).
+    slots: Vec<u32>,
     pool: Vec<Arc<TreeLu>>,
 }
 
 /// The factors of `Φ_u` and the values of `Φ_v` at one configuration.
 pub(crate) struct TreeLu {
     shape: Arc<Shape>,
-    diag: Vec<f64>,
+    /// The diagonal blocks (factored in place), the off-diagonal entries, the border, the
+    /// `Φ_v` entries and the spare slot, laid out as [`Shape`] says.
+    vals: Vec<f64>,
     piv: Vec<u16>,
-    off: Vec<f64>,
-    border: Vec<f64>,
     border_piv: Vec<u16>,
-    phi_v: Vec<(usize, usize, f64)>,
     ok: bool,
 }
 
@@ -84,6 +80,10 @@ impl TreeSplit {
         n: usize,
         entries: &[(usize, usize, f64)],
     ) -> Option<Self> {
+        // Positions and triplet numbers are held as `u32`.
+        if u32::try_from(entries.len().max(m).max(n)).is_err() {
+            return None;
+        }
         let order = part.rows.len();
         let mut row_pos = vec![u32::MAX; m];
         for (k, &r) in part.rows.iter().enumerate() {
@@ -147,9 +147,12 @@ impl TreeSplit {
         // Off-diagonal entries of T, grouped by row node (counting sort).
         let mut count = vec![0usize; nodes + 1];
         let mut border = Border::new(&border_positions, order);
-        let mut slots = vec![Slot::None; entries.len()];
+        // Slots by kind first (diagonal, off-diagonal, border, `Φ_v`), offset once all are known.
+        let (diag_len, mut border_at) = (diag_at[nodes], Vec::new());
+        let mut slots = vec![u32::MAX; entries.len()];
         let mut v_at = Vec::new();
         let mut pending = Vec::new();
+        let mut pending_v = Vec::new();
         for (t, e) in entries.iter().enumerate() {
             let p = row_pos[e.0];
             if p == u32::MAX {
@@ -158,23 +161,23 @@ impl TreeSplit {
             let q = col_pos[e.1];
             if q == u32::MAX {
                 if ind_pos[e.1] != u32::MAX {
-                    slots[t] = Slot::PhiV(v_at.len() as u32);
-                    v_at.push((p as usize, ind_pos[e.1] as usize));
+                    pending_v.push(t as u32);
+                    v_at.push((p, ind_pos[e.1]));
                 }
                 continue;
             }
             let (p, q) = (p as usize, q as usize);
             let (np, nq) = (node_of[p], node_of[q]);
             if np == u32::MAX || nq == u32::MAX {
-                slots[t] = Slot::Border(border.add(p, q) as u32);
+                border_at.push((t as u32, border.add(p, q) as u32));
             } else if np == nq {
                 let i = np as usize;
                 let (a, b) = (p - span[i].0, q - span[i].0);
                 let d = span[i].1 - span[i].0;
-                slots[t] = Slot::Diag((diag_at[i] + a * d + b) as u32);
+                slots[t] = (diag_at[i] + a * d + b) as u32;
             } else {
                 count[np as usize + 1] += 1;
-                pending.push((t, p, q));
+                pending.push((t as u32, p as u32, q as u32));
             }
         }
         for i in 0..nodes {
@@ -183,11 +186,29 @@ impl TreeSplit {
         let off_at = count.clone();
         let mut off = vec![(0u32, 0u32); pending.len()];
         for &(t, p, q) in &pending {
+            let (t, p, q) = (t as usize, p as usize, q as usize);
             let i = node_of[p] as usize;
             let at = count[i];
             count[i] += 1;
             off[at] = (p as u32, q as u32);
-            slots[t] = Slot::Off(at as u32);
+            slots[t] = (diag_len + at) as u32;
+        }
+        let off0 = diag_len;
+        let border0 = off0 + off.len();
+        let v0 = border0 + border.len();
+        let len = v0 + v_at.len() + 1;
+        for (t, k) in border_at {
+            slots[t as usize] = (border0 + k as usize) as u32;
+        }
+        for (k, t) in pending_v.into_iter().enumerate() {
+            slots[t as usize] = (v0 + k) as u32;
+        }
+        // The triplets no block holds go to the spare last slot.
+        let spare = u32::try_from(len - 1).ok()?;
+        for s in &mut slots {
+            if *s == u32::MAX {
+                *s = spare;
+            }
         }
         Some(TreeSplit {
             id: part.id,
@@ -199,9 +220,13 @@ impl TreeSplit {
                 off,
                 off_at,
                 border,
+                v_at,
+                off0,
+                border0,
+                v0,
+                len,
             }),
             slots,
-            v_at,
             pool: Vec::new(),
         })
     }
@@ -220,28 +245,19 @@ impl TreeSplit {
             Some(k) => self.pool.swap_remove(k),
             None => Arc::new(TreeLu {
                 shape: shape.clone(),
-                diag: vec![0.0; *shape.diag_at.last().unwrap_or(&0)],
+                vals: vec![0.0; shape.len],
                 piv: vec![0; shape.order],
-                off: vec![0.0; shape.off.len()],
-                border: vec![0.0; shape.border.len()],
                 border_piv: vec![0; shape.border.size()],
-                phi_v: self.v_at.iter().map(|&(r, c)| (r, c, 0.0)).collect(),
                 ok: false,
             }),
         };
         if let Some(f) = Arc::get_mut(&mut lu) {
-            f.diag.iter_mut().for_each(|v| *v = 0.0);
-            f.off.iter_mut().for_each(|v| *v = 0.0);
-            f.border.iter_mut().for_each(|v| *v = 0.0);
-            f.phi_v.iter_mut().for_each(|v| v.2 = 0.0);
-            for (slot, e) in self.slots.iter().zip(entries) {
-                match *slot {
-                    Slot::None => {}
-                    Slot::Diag(s) => f.diag[s as usize] += e.2,
-                    Slot::Off(s) => f.off[s as usize] += e.2,
-                    Slot::Border(s) => f.border[s as usize] += e.2,
-                    Slot::PhiV(s) => f.phi_v[s as usize].2 += e.2,
-                }
+            // One pass, no branch: every triplet adds into its slot (in the triplets' order,
+            // so the sums are those of a block-by-block scatter).
+            f.vals.iter_mut().for_each(|v| *v = 0.0);
+            let vals = &mut f.vals[..];
+            for (&slot, e) in self.slots.iter().zip(entries) {
+                vals[slot as usize] += e.2;
             }
             f.ok = f.factor_blocks();
         }
@@ -263,7 +279,7 @@ impl TreeLu {
         for i in 0..shape.span.len() {
             let (a, b) = shape.span[i];
             let d = b - a;
-            let blk = &mut self.diag[shape.diag_at[i]..shape.diag_at[i + 1]];
+            let blk = &mut self.vals[shape.diag_at[i]..shape.diag_at[i + 1]];
             if !dense::lu(blk, d, &mut self.piv[a..b]) {
                 return false;
             }
@@ -271,15 +287,15 @@ impl TreeLu {
         if shape.border.is_empty() {
             return true;
         }
-        let (mut border, mut piv) = (
-            std::mem::take(&mut self.border),
-            std::mem::take(&mut self.border_piv),
-        );
+        let range = shape.border0..shape.v0;
+        let mut border = self.vals[range.clone()].to_vec();
+        let mut piv = std::mem::take(&mut self.border_piv);
         let ok = shape
             .border
             .factor(&mut border, &mut piv, |x, t| self.tree_solve(x, t), false)
             .is_some();
-        (self.border, self.border_piv) = (border, piv);
+        self.vals[range].copy_from_slice(&border);
+        self.border_piv = piv;
         ok
     }
 
@@ -287,24 +303,26 @@ impl TreeLu {
     fn tree_solve(&self, x: &mut [f64], transpose: bool) {
         let s = &*self.shape;
         let nodes = s.span.len();
+        let (diag, rest) = self.vals.split_at(s.off0);
+        let off = &rest[..s.border0 - s.off0];
         if !transpose {
             for i in (0..nodes).rev() {
                 for k in s.off_at[i]..s.off_at[i + 1] {
                     let (p, q) = s.off[k];
-                    x[p as usize] -= self.off[k] * x[q as usize];
+                    x[p as usize] -= off[k] * x[q as usize];
                 }
                 let (a, b) = s.span[i];
-                let blk = &self.diag[s.diag_at[i]..s.diag_at[i + 1]];
+                let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];
                 dense::lu_solve(blk, &self.piv[a..b], b - a, &mut x[a..b], 1);
             }
         } else {
             for i in 0..nodes {
                 let (a, b) = s.span[i];
-                let blk = &self.diag[s.diag_at[i]..s.diag_at[i + 1]];
+                let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];
                 dense::lu_solve_transpose(blk, &self.piv[a..b], b - a, &mut x[a..b]);
                 for k in s.off_at[i]..s.off_at[i + 1] {
                     let (p, q) = s.off[k];
-                    x[q as usize] -= self.off[k] * x[p as usize];
+                    x[q as usize] -= off[k] * x[p as usize];
                 }
             }
         }
@@ -321,10 +339,13 @@ impl TreeLu {
         if s.border.is_empty() {
             self.tree_solve(x, transpose);
         } else {
-            s.border
-                .solve(&self.border, &self.border_piv, x, transpose, |y, t| {
-                    self.tree_solve(y, t)
-                });
+            s.border.solve(
+                &self.vals[s.border0..s.v0],
+                &self.border_piv,
+                x,
+                transpose,
+                |y, t| self.tree_solve(y, t),
+            );
         }
         x.iter().all(|v| v.is_finite())
     }
@@ -347,11 +368,21 @@ impl TreeLu {
 
     /// `Φ_v x` (length: independent rows).
     pub(crate) fn phi_v_mul(&self, x: &[f64], r: usize) -> Vec<f64> {
-        crate::solver::sparse::factor::triplets_mul(&self.phi_v, x, r)
+        let s = &*self.shape;
+        let mut y = vec![0.0; r];
+        for (&(i, j), v) in s.v_at.iter().zip(&self.vals[s.v0..]) {
+            y[i as usize] += v * x[j as usize];
+        }
+        y
     }
 
     /// `Φ_vᵀ y` (length: degrees of freedom).
     pub(crate) fn phi_v_tr_mul(&self, y: &[f64], dof: usize) -> Vec<f64> {
-        crate::solver::sparse::factor::triplets_tr_mul(&self.phi_v, y, dof)
+        let s = &*self.shape;
+        let mut x = vec![0.0; dof];
+        for (&(i, j), v) in s.v_at.iter().zip(&self.vals[s.v0..]) {
+            x[j as usize] += v * y[i as usize];
+        }
+        x
     }
 }

@@ -94,21 +94,21 @@ impl Shape {
             }
         }
         let nodes = members.len();
-        // Node couplings: every pair of unknowns with a value.
-        let mut pairs: Vec<(u32, u32)> = Vec::new();
-        for &(a, b) in &hess.keys {
-            pairs.push((body_node[a], body_node[b]));
-        }
-        for e in entries {
-            if row_pos[e.0] != u32::MAX {
-                pairs.push((owner[n + row_pos[e.0] as usize], body_node[e.1 / 7]));
-            }
-        }
+        // Node couplings: every pair of unknowns with a value (listed straight into `later`,
+        // in the same order, without a list of all pairs first).
         let mut later: Vec<Vec<u32>> = vec![Vec::new(); nodes];
-        for &(a, b) in &pairs {
+        let mut couple = |a: u32, b: u32| {
             if a != u32::MAX && b != u32::MAX && a != b {
                 let (lo, hi) = (a.min(b), a.max(b));
                 later[lo as usize].push(hi);
+            }
+        };
+        for &(a, b) in &hess.keys {
+            couple(body_node[a], body_node[b]);
+        }
+        for e in entries {
+            if row_pos[e.0] != u32::MAX {
+                couple(owner[n + row_pos[e.0] as usize], body_node[e.1 / 7]);
             }
         }
         let mut in_border = vec![false; nodes];
@@ -220,16 +220,9 @@ impl Shape {
         }
         let mut border = Border::new(&(tree_len..dim).collect::<Vec<_>>(), dim);
         let mut border_slot: HashMap<(usize, usize), u32> = HashMap::new();
-        let mut locate = |u1: usize, u2: usize| -> Option<u32> {
-            let (t1, t2) = (tpos[u1], tpos[u2]);
-            if t1 >= tree_len || t2 >= tree_len {
-                let next = border_slot.len() as u32;
-                let s = *border_slot.entry((t1, t2)).or_insert(next);
-                if s == next {
-                    border.add(t1, t2);
-                }
-                return Some(flat as u32 + s);
-            }
+        // The slot of the tree-space pair `(t1, t2)`, both in the tree: its node's diagonal
+        // block, its coupling to the parent, `SKIP` for the mirror of a coupling, or `None`.
+        let tree_slot = |t1: usize, t2: usize| -> Option<u32> {
             let (a, b) = (node_of[t1] as usize, node_of[t2] as usize);
             let (l1, l2) = (t1 - at[a], t2 - at[b]);
             if a == b {
@@ -242,12 +235,46 @@ impl Shape {
                 None
             }
         };
+        let mut locate = |u1: usize, u2: usize| -> Option<u32> {
+            let (t1, t2) = (tpos[u1], tpos[u2]);
+            if t1 >= tree_len || t2 >= tree_len {
+                let next = border_slot.len() as u32;
+                let s = *border_slot.entry((t1, t2)).or_insert(next);
+                if s == next {
+                    border.add(t1, t2);
+                }
+                return Some(flat as u32 + s);
+            }
+            tree_slot(t1, t2)
+        };
         let mut block_slots = Vec::with_capacity(hess.keys.len());
         for &(a, b) in &hess.keys {
             let mut s = [SKIP; 49];
-            for i in 0..7 {
-                for j in 0..7 {
-                    s[7 * i + j] = locate(7 * a + i, 7 * b + j)?;
+            // A body's 7 coordinates lead its node, in order (or all lie in the border): a
+            // block between two tree nodes is one dense run of slots, or all mirrors.
+            let (ta, tb) = (tpos[7 * a], tpos[7 * b]);
+            if ta < tree_len && tb < tree_len {
+                let (na, nb) = (node_of[ta] as usize, node_of[tb] as usize);
+                let (start, stride) = if na == nb {
+                    (diag_at[na] + (ta - at[na]) * d[na] + (tb - at[nb]), d[na])
+                } else if par[na] == nb as u32 {
+                    (coup_at[na] + (ta - at[na]) * w[na] + (tb - at[nb]), w[na])
+                } else if par[nb] == na as u32 {
+                    block_slots.push(s);
+                    continue;
+                } else {
+                    return None;
+                };
+                for i in 0..7 {
+                    for j in 0..7 {
+                        s[7 * i + j] = (start + i * stride + j) as u32;
+                    }
+                }
+            } else {
+                for i in 0..7 {
+                    for j in 0..7 {
+                        s[7 * i + j] = locate(7 * a + i, 7 * b + j)?;
+                    }
                 }
             }
             block_slots.push(s);
@@ -258,7 +285,12 @@ impl Shape {
                 u32::MAX => [SKIP, SKIP],
                 k => {
                     let r = n + k as usize;
-                    [locate(r, e.1)?, locate(e.1, r)?]
+                    let (t1, t2) = (tpos[r], tpos[e.1]);
+                    if t1 < tree_len && t2 < tree_len {
+                        [tree_slot(t1, t2)?, tree_slot(t2, t1)?]
+                    } else {
+                        [locate(r, e.1)?, locate(e.1, r)?]
+                    }
                 }
             });
         }

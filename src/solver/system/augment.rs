@@ -1,0 +1,240 @@
+//! The augmentation of the KKT system's `W` block: `W += Φ_qᵀ D R D Φ_q` over the independent
+//! rows (module `kkt`), with `R_k = max(ρ₀, max_{c ∈ row k} D_c² |W_cc|) d_k²` and
+//! `ρ₀ = 10⁻⁶ max_c D_c² |W_cc| + 10⁻¹²`.
+//!
+//! A row on one or two bodies adds `ρ g gᵀ` to their `14 × 14` pair block (`g` the row's
+//! entries in the pair's local order); consecutive rows on the same pair are summed before
+//! they reach the block Hessian. A row on more bodies adds entry by entry. Which entries form
+//! a row, its bodies and each entry's local index depend on the partition and the triplets'
+//! pattern only: they are listed once per partition ([`AugmentPlan`]), and each assembly
+//! runs over the values.
+
+use super::System;
+use crate::jet::{HessianSink, LMat, NL};
+use crate::model::BodyId;
+use crate::solver::partition::Partition;
+
+/// One independent row's run of triplets.
+struct Group {
+    start: usize,
+    end: usize,
+    row: usize,
+    /// The row's bodies in order of first appearance; `None` for a row on more than two.
+    bodies: Option<[Option<BodyId>; 2]>,
+}
+
+/// The rows of the augmentation under one partition and one triplet pattern.
+pub(crate) struct AugmentPlan {
+    id: usize,
+    triplets: usize,
+    groups: Vec<Group>,
+    /// Each triplet's index in its pair's local order (`7 side + c mod 7`).
+    local: Vec<u8>,
+}
+
+impl AugmentPlan {
+    fn new(part: &Partition, m: usize, entries: &[(usize, usize, f64)]) -> Self {
+        let mut in_part = vec![false; m];
+        for &r in &part.rows {
+            in_part[r] = true;
+        }
+        let mut groups = Vec::with_capacity(part.rows.len());
+        let mut local = vec![0u8; entries.len()];
+        let mut k = 0;
+        while k < entries.len() {
+            let row = entries[k].0;
+            let mut end = k;
+            while end < entries.len() && entries[end].0 == row {
+                end += 1;
+            }
+            let (start, group) = (k, &entries[k..end]);
+            k = end;
+            if !in_part[row] {
+                continue;
+            }
+            let mut bodies: [Option<BodyId>; 2] = [None, None];
+            let mut on_two = true;
+            for e in group {
+                let b = e.1 / 7;
+                if bodies.iter().any(|x| x.map(|y| y.0) == Some(b)) {
+                    continue;
+                }
+                match bodies.iter().position(|x| x.is_none()) {
+                    Some(slot) => bodies[slot] = Some(BodyId(b)),
+                    None => on_two = false,
+                }
+            }
+            if on_two {
+                for (t, e) in group.iter().enumerate() {
+                    let side = usize::from(bodies[0].map(|x| x.0) != Some(e.1 / 7));
+                    local[start + t] = (7 * side + e.1 % 7) as u8;
+                }
+            }
+            groups.push(Group {
+                start,
+                end,
+                row,
+                bodies: on_two.then_some(bodies),
+            });
+        }
+        AugmentPlan {
+            id: part.id,
+            triplets: entries.len(),
+            groups,
+            local,
+        }
+    }
+
+    fn fits(&self, part: &Partition, triplets: usize) -> bool {
+        self.id == part.id && self.triplets == triplets
+    }
+}
+
+impl System<'_> {
+    /// Adds `Φ_qᵀ D R D Φ_q` over the independent rows to the block Hessian (module docs).
+    pub(super) fn augment(&mut self, part: &Partition) {
+        let n = self.problem.model.coordinate_count();
+        let m = self.problem.cons.len();
+        let work = &mut self.work;
+        let entries = &work.jac.entries;
+        let plan = match work.augment.take() {
+            Some(p) if p.fits(part, entries.len()) => p,
+            _ => AugmentPlan::new(part, m, entries),
+        };
+        let columns = &self.problem.scaling.columns;
+        let mut wdiag = vec![0.0f64; n];
+        for (&(a, b), blk) in work.hess.keys.iter().zip(&work.hess.values) {
+            if a == b {
+                for i in 0..7 {
+                    wdiag[7 * a + i] = blk[8 * i].abs() * columns[7 * a + i].powi(2);
+                }
+            }
+        }
+        let floor = 1e-6 * wdiag.iter().fold(0.0f64, |x, &y| x.max(y)) + 1e-12;
+        // The pending body pair and its accumulated `Σ ρ g gᵀ` (column-major, as `LMat`).
+        let mut pending: Option<[Option<BodyId>; 2]> = None;
+        let mut acc = [0.0f64; NL * NL];
+        for g in &plan.groups {
+            let range = g.start..g.end;
+            let group = &entries[range.clone()];
+            let rho = group.iter().fold(floor, |a, e| a.max(wdiag[e.1]))
+                * self.problem.scaling.rows[g.row].powi(2);
+            let Some(bodies) = g.bodies else {
+                for a in group {
+                    for b in group {
+                        work.hess.add_entry(a.1, b.1, rho * a.2 * b.2);
+                    }
+                }
+                continue;
+            };
+            let mut gv = [0.0f64; NL];
+            for (e, &i) in group.iter().zip(&plan.local[range]) {
+                gv[i as usize] += e.2;
+            }
+            if pending != Some(bodies) {
+                if let Some(b) = pending.take() {
+                    work.hess.add_block(&b, &LMat::from_column_slice(&acc), 1.0);
+                }
+                pending = Some(bodies);
+                acc = [0.0; NL * NL];
+            }
+            add_outer(&mut acc, &gv, rho);
+        }
+        if let Some(b) = pending.take() {
+            work.hess.add_block(&b, &LMat::from_column_slice(&acc), 1.0);
+        }
+        work.augment = Some(plan);
+    }
+}
+
+/// `acc += g gᵀ ρ` (column-major `NL × NL`), entry by entry as `(g_i g_j) ρ`, over the columns
+/// of `g`'s nonzero entries: a zero `g_i` adds a signed zero, which changes no sum.
+fn add_outer(acc: &mut [f64; NL * NL], g: &[f64; NL], rho: f64) {
+    for (j, &gj) in g.iter().enumerate() {
+        if gj != 0.0 {
+            let col = &mut acc[NL * j..NL * j + NL];
+            for (a, &gi) in col.iter_mut().zip(g) {
+                *a += gi * gj * rho;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::constraints::Constraints;
+    use crate::solver::sparse::hessian::BlockHessian;
+    use crate::solver::system::{Backend, System};
+    use crate::urdf::{load_str, ImportOptions};
+    use nalgebra::{DMatrix, DVector};
+
+    fn dense(h: &BlockHessian, n: usize) -> DMatrix<f64> {
+        let mut d = DMatrix::zeros(n, n);
+        for c in 0..n {
+            let mut e = vec![0.0; n];
+            e[c] = 1.0;
+            let mut y = vec![0.0; n];
+            h.mul_add(&e, &mut y);
+            d.set_column(c, &DVector::from_vec(y));
+        }
+        d
+    }
+
+    /// The augmentation adds `Σ_k R_k ∇Φ_k ∇Φ_kᵀ` over the independent rows, with `R_k` as the
+    /// module says, computed here densely from the triplets; and a second assembly under the
+    /// same partition (the plan reused) adds exactly what a fresh plan adds.
+    #[test]
+    fn augmentation_adds_the_weighted_gram_matrix_of_the_independent_rows() {
+        let texts = [
+            crate::generate::chain(7, false),
+            include_str!("../../../robots/four_bar_spatial.urdf").to_string(),
+            crate::generate::ladder(2),
+        ];
+        for text in &texts {
+            let model = load_str(text, "m.urdf", &ImportOptions::default())
+                .expect("model loads")
+                .model;
+            let n = model.coordinate_count();
+            let q = crate::solver::initial_state(&model).q;
+            let mut sys = System::new(&model, Constraints::new(&model, &[]), Backend::Tree);
+            let part = sys.partition(&q);
+            let eval = sys.evaluate(&q, &part).expect("evaluates");
+            sys.lagrangian_blocks(&q, &part, &eval);
+            let before = dense(&sys.work.hess, n);
+            sys.augment(&part);
+            let after = dense(&sys.work.hess, n);
+            // Reference: ρ_k from W's scaled diagonal, the row's gradient from the triplets.
+            let cols = &sys.problem.scaling.columns;
+            let wdiag: Vec<f64> = (0..n)
+                .map(|c| before[(c, c)].abs() * cols[c].powi(2))
+                .collect();
+            let floor = 1e-6 * wdiag.iter().fold(0.0f64, |a, &b| a.max(b)) + 1e-12;
+            let mut expected = before.clone();
+            for &r in &part.rows {
+                let mut g = DVector::<f64>::zeros(n);
+                let mut reach = floor;
+                for e in sys.work.jac.entries.iter().filter(|e| e.0 == r) {
+                    g[e.1] += e.2;
+                    reach = reach.max(wdiag[e.1]);
+                }
+                let rho = reach * sys.problem.scaling.rows[r].powi(2);
+                expected += &g * g.transpose() * rho;
+            }
+            let scale = after.amax().max(1.0);
+            assert!(
+                (&after - &expected).amax() <= 1e-12 * scale,
+                "{}",
+                (&after - &expected).amax()
+            );
+            // Again with the plan in place, and with a fresh one.
+            sys.lagrangian_blocks(&q, &part, &eval);
+            sys.augment(&part);
+            let reused = dense(&sys.work.hess, n);
+            sys.work.augment = None;
+            sys.lagrangian_blocks(&q, &part, &eval);
+            sys.augment(&part);
+            assert_eq!(reused, dense(&sys.work.hess, n));
+            assert_eq!(reused, after);
+        }
+    }
+}

@@ -38,6 +38,7 @@ from restpose._errors import (
 from restpose._native import Model, ModelBuilder, Result, __version__, load, load_string
 from restpose._records import (
     ActiveLimit,
+    BuriedBody,
     CheckReport,
     Contact,
     Diagnostics,
@@ -65,6 +66,7 @@ __all__ = [
     "Contact",
     "ActiveLimit",
     "LimitViolation",
+    "BuriedBody",
     "Iterate",
     "Diagnostics",
     "Imbalance",

@@ -8,6 +8,7 @@ import numpy.typing as npt
 
 from restpose._records import (
     ActiveLimit,
+    BuriedBody,
     CheckReport,
     Contact,
     Diagnostics,
@@ -150,6 +151,8 @@ class Result:
     def active_limits(self) -> List[ActiveLimit]: ...
     @property
     def limit_violations(self) -> List[LimitViolation]: ...
+    @property
+    def buried_bodies(self) -> List[BuriedBody]: ...
     @property
     def redundant_constraints(self) -> List[str]: ...
     @property

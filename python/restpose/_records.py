@@ -17,6 +17,7 @@ __all__ = [
     "Contact",
     "ActiveLimit",
     "LimitViolation",
+    "BuriedBody",
     "Iterate",
     "Diagnostics",
     "Imbalance",
@@ -137,6 +138,15 @@ class LimitViolation(Record):
     limits: np.ndarray
 
 
+class BuriedBody(Record):
+    """A body without contact points whose centre of mass lies inside a ground: ``body``,
+    ``ground``, ``depth`` [m] below the ground plane."""
+
+    body: str
+    ground: str
+    depth: float
+
+
 class Iterate(Record):
     """One minimizer iteration: ``iteration``, ``potential_energy`` [J], ``gradient_norm``."""
 
@@ -254,6 +264,7 @@ _SECTIONS = {
     "contacts": Contact,
     "active_limits": ActiveLimit,
     "limit_violations": LimitViolation,
+    "buried_bodies": BuriedBody,
     "history": Iterate,
     "diagnostics": Diagnostics,
 }

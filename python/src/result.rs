@@ -271,6 +271,13 @@ impl Result {
         section(py, "limit_violations", &self.result.limit_violations)
     }
 
+    /// Bodies without contact points whose centre of mass lies inside a ground, deepest first
+    /// (``restpose.BuriedBody`` list: ``body``, ``ground``, ``depth`` [m]; empty when none).
+    #[getter]
+    fn buried_bodies<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        section(py, "buried_bodies", &self.result.buried_bodies)
+    }
+
     /// Constraint rows dropped as redundant.
     #[getter]
     fn redundant_constraints(&self) -> Vec<String> {

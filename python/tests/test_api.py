@@ -201,6 +201,23 @@ def test_floating_base_on_the_ground(robots):
     assert all(c.gap > -1e-6 for c in result.contacts)
 
 
+def test_buried_bodies_name_bodies_resting_inside_a_ground():
+    # The arm without collision geometry under a ground at z = 1: its point mass at
+    # (cos θ, 0, −sin θ) rests 1 + sin θ inside it (docs/contact.md).
+    shelf = ARM.replace("</robot>", '<mech:ground name="shelf" xyz="0 0 1"/></robot>')
+    result = restpose.load_string(shelf).solve()
+    assert result.converged
+    theta = result.joint("j")[0]
+    [b] = result.buried_bodies
+    assert isinstance(b, restpose.BuriedBody)
+    assert (b.body, b.ground) == ("arm", "shelf")
+    assert b.depth == pytest.approx(1.0 + math.sin(theta), abs=1e-12)
+    assert json.loads(result.to_json())["buried_bodies"] == [b.to_dict()]
+    # none: an empty list here, the field absent from the JSON
+    free = restpose.load_string(ARM).solve()
+    assert free.buried_bodies == [] and "buried_bodies" not in json.loads(free.to_json())
+
+
 def test_builder_pendulum_matches_the_closed_form():
     b = restpose.ModelBuilder("pendulum")
     b.add_rigid_body("arm", mass=1.0, com=(0.5, 0, 0), inertia=np.eye(3) * 1e-3)

@@ -104,27 +104,24 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
     if !a.quiet && a.stdout_outputs().is_empty() {
         print::analysis(&result);
     }
-    if !a.quiet && result.converged {
-        let mut buried = super::buried::buried(model, &state);
-        buried.sort_by(|x, y| y.depth.total_cmp(&x.depth));
-        if !buried.is_empty() {
-            let worst: Vec<String> = buried
-                .iter()
-                .take(3)
-                .map(|b| format!("`{}` {:.4} m inside `{}`", b.body, b.depth, b.ground))
-                .collect();
-            let more = if buried.len() > 3 { ", …" } else { "" };
-            let count = match buried.len() {
-                1 => "1 body without contact points rests with its".to_string(),
-                n => format!("{n} bodies without contact points rest with their"),
-            };
-            super::print::note!(
-                "warning: {count} centre of mass inside a ground ({}{more}): only links with \
-                 contact points touch the grounds; give them collision geometry or hold the \
-                 joints (--servo all=K)",
-                worst.join(", ")
-            );
-        }
+    if !a.quiet && result.converged && !result.buried_bodies.is_empty() {
+        let buried = &result.buried_bodies;
+        let worst: Vec<String> = buried
+            .iter()
+            .take(3)
+            .map(|b| format!("`{}` {:.4} m inside `{}`", b.body, b.depth, b.ground))
+            .collect();
+        let more = if buried.len() > 3 { ", …" } else { "" };
+        let count = match buried.len() {
+            1 => "1 body without contact points rests with its".to_string(),
+            n => format!("{n} bodies without contact points rest with their"),
+        };
+        super::print::note!(
+            "warning: {count} centre of mass inside a ground ({}{more}): only links with \
+             contact points touch the grounds; give them collision geometry or hold the \
+             joints (--servo all=K)",
+            worst.join(", ")
+        );
     }
     if let Some(why) = &rejected {
         super::print::note!(

@@ -4,7 +4,6 @@
 
 pub(crate) mod analyze;
 pub(crate) mod args;
-pub(crate) mod buried;
 pub(crate) mod check;
 pub(crate) mod confirm;
 pub(crate) mod exit;

@@ -173,6 +173,11 @@ pub struct AnalysisResult {
     /// Position servos with their holding torques (absent without `--servo`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub servos: Vec<ServoResult>,
+    /// Bodies without contact points whose centre of mass lies inside a ground, deepest
+    /// first: `{body, ground, depth}` (absent when there are none; module
+    /// [`super::buried`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub buried_bodies: Vec<super::buried::BuriedBody>,
 }
 
 impl AnalysisResult {
@@ -270,6 +275,7 @@ impl AnalysisResult {
             coordinates: report.sizes.coordinates,
             constraints: report.sizes.constraint_rows,
             servos: servo_results(model, state),
+            buried_bodies: super::buried::buried_bodies(model, state),
         }
     }
 

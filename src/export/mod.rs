@@ -1,7 +1,8 @@
 //! Result writers: the result JSON ([`json`]), ROS joint states ([`joint_states`]), the pose
 //! in other tools' terms ([`configuration`]: MuJoCo's `qpos`, Pinocchio's `q`; [`mujoco`]: a
-//! MuJoCo keyframe; [`srdf`]: a MoveIt named state), and atomic file output. The URDF write-back is [`crate::urdf::with_initial_pose`].
+//! MuJoCo keyframe; [`srdf`]: a MoveIt named state), the bodies resting inside a ground ([`buried`]), and atomic file output. The URDF write-back is [`crate::urdf::with_initial_pose`].
 
+pub mod buried;
 pub mod configuration;
 pub mod joint_states;
 pub mod json;

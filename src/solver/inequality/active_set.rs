@@ -224,7 +224,8 @@ pub(crate) fn solve(
             max_iterations: options.max_iterations.saturating_sub(iterations),
             ..options.clone()
         };
-        let release = super::release::Release::new(model, &active, &released_before, threshold);
+        let release = super::release::Release::new(model, &active, &released_before, threshold)
+            .holding_patch_neighbours(&active);
         let round = crate::solver::solve_round(
             model,
             crate::State { q, branches },

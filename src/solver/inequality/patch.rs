@@ -15,7 +15,8 @@
 //! of a pivot on the same ground push along the normal only (no friction of their own), so the
 //! multiplier of the pivot's gap is the rate of lifting it about its neighbours, and a pivot
 //! that pulls hands its role to the touching neighbour nearest to it, anchored where that one
-//! touches: the polygon rolls from vertex to vertex as a real foot rolls. Points farther apart
+//! touches: the polygon rolls from vertex to vertex as a real foot rolls (a neighbour leaves
+//! only at a stationary point, not early: module `release`). Points farther apart
 //! (a box's corners) each stick where they touched, as before.
 
 use crate::constraints::unilateral::{Active, Unilateral};
@@ -44,7 +45,7 @@ fn patch_radius(model: &Model, point: usize) -> f64 {
 
 /// Whether contact `point` on `ground` lies within the patch of a sticking pivot among
 /// `active` (same body, same link, same ground).
-fn near_pivot(model: &Model, active: &[Active], point: usize, ground: usize) -> bool {
+pub(crate) fn near_pivot(model: &Model, active: &[Active], point: usize, ground: usize) -> bool {
     let c = &model.contact_points[point];
     let delta = patch_radius(model, point);
     active.iter().any(|a| match (a.anchor, a.row) {

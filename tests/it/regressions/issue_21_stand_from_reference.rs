@@ -214,7 +214,7 @@ fn an_unactuated_robot_that_finds_no_rest_is_told_to_add_servos() {
     let meshes = std::path::Path::new(path).parent().unwrap().join("meshes");
     std::os::unix::fs::symlink(meshes, dir.path().join("meshes")).unwrap();
     let file = dir.path().join("solo12_limp.urdf");
-    std::fs::write(&file, text).unwrap();
+    std::fs::write(&file, &text).unwrap();
     let run = |extra: &[&str]| {
         std::process::Command::new(env!("CARGO_BIN_EXE_restpose"))
             .args(["analyze", "-q", "--floating-base", "--friction", "stick"])
@@ -233,8 +233,16 @@ fn an_unactuated_robot_that_finds_no_rest_is_told_to_add_servos() {
     );
     // Without the iteration limit the limp robot converges, upside down through the floor;
     // analyze warns that bodies without contact points rest inside the ground, deepest first.
+    let json = dir.path().join("limp.json");
     let upside_down = std::process::Command::new(env!("CARGO_BIN_EXE_restpose"))
-        .args(["analyze", "--floating-base", "--friction", "stick"])
+        .args([
+            "analyze",
+            "--floating-base",
+            "--friction",
+            "stick",
+            "--json",
+        ])
+        .arg(&json)
         .arg(&file)
         .output()
         .unwrap();
@@ -245,6 +253,49 @@ fn an_unactuated_robot_that_finds_no_rest_is_told_to_add_servos() {
             && err.contains("inside `floor`"),
         "{err}"
     );
+    // The result JSON lists all nine, deepest first, the deepest three as the warning prints
+    // them; each a body without contact points (not a foot, the only links with collision
+    // geometry here), 0.2-0.35 m below the floor.
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let buried = v["buried_bodies"].as_array().expect("buried_bodies");
+    assert_eq!(buried.len(), 9, "{buried:?}");
+    let depths: Vec<f64> = buried
+        .iter()
+        .map(|b| b["depth"].as_f64().unwrap())
+        .collect();
+    assert!(depths.windows(2).all(|w| w[0] >= w[1]), "{depths:?}");
+    assert!(
+        depths.iter().all(|&d| (0.2..0.35).contains(&d)),
+        "{depths:?}"
+    );
+    for b in buried {
+        assert_eq!(b["ground"], "floor");
+        let body = b["body"].as_str().unwrap();
+        assert!(!body.contains("LOWER_LEG"), "{body} carries a foot");
+    }
+    // The trunk's centre of mass is its link origin: its depth is the floor's height minus
+    // the link's, read from the file and the result's link frames.
+    let floor_z: f64 = text
+        .split(r#"<mech:ground name="floor" xyz="0 0 "#)
+        .nth(1)
+        .and_then(|t| t.split('"').next())
+        .and_then(|z| z.parse().ok())
+        .expect("the floor's height");
+    let trunk = buried.iter().find(|b| b["body"] == "base_link").unwrap();
+    let z = v["links"]["base_link"]["position"][2].as_f64().unwrap();
+    assert!(
+        (trunk["depth"].as_f64().unwrap() - (floor_z - z)).abs() < 1e-9,
+        "{trunk}"
+    );
+    for b in &buried[..3] {
+        let shown = format!(
+            "`{}` {:.4} m inside `floor`",
+            b["body"].as_str().unwrap(),
+            b["depth"].as_f64().unwrap()
+        );
+        assert!(err.contains(&shown), "{shown} not in: {err}");
+    }
     let held = run(&["--servo", "all=50"]);
     let err = String::from_utf8_lossy(&held.stderr);
     assert_eq!(held.status.code(), Some(0), "{err}");
@@ -257,11 +308,16 @@ fn an_unactuated_robot_that_finds_no_rest_is_told_to_add_servos() {
             "stick",
             "--servo",
             "all=50",
+            "--json",
         ])
+        .arg(&json)
         .arg(&file)
         .output()
         .unwrap();
     let err = String::from_utf8_lossy(&standing.stderr);
     assert_eq!(standing.status.code(), Some(0), "{err}");
     assert!(!err.contains("inside a ground"), "{err}");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert!(v.get("buried_bodies").is_none(), "{}", v["buried_bodies"]);
 }

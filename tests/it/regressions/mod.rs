@@ -3,6 +3,7 @@
 mod issue_12_assembly_names_the_joint;
 mod issue_12_sparse_verify_angle_branch;
 mod issue_13_floating_base_start;
+mod issue_21_bolt_rolls_over;
 mod issue_21_chain_on_its_stops;
 mod issue_21_falls_found_at_once;
 mod issue_21_free_arm_converges_directly;

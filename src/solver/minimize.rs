@@ -206,15 +206,6 @@ pub(crate) fn minimize(
         let d = reduced_step(sys, &mut s, eig.as_ref(), negative_curvature, options);
         let step = cap_step(sys, &s.part, &s.eval, &s.q, d, options);
         let slope = s.eval.grad_v.dot(&step.d);
-        if std::env::var("RP_TRACE").is_ok() {
-            eprintln!(
-                " it {} capped={} E={:.9} g={:.2e}",
-                s.iteration,
-                step.capped,
-                s.eval.energy.total,
-                s.eval.grad_v.amax()
-            );
-        }
         let failures_before = s.diag.corrector_failures;
         // From the step length the corrector last managed (with second-pass choices in the
         // partition; from 1 otherwise).

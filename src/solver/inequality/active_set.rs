@@ -247,30 +247,6 @@ pub(crate) fn solve(
             std::mem::take(&mut report.iterates),
         );
         let cycling = changes - initial >= options.max_iterations;
-        if std::env::var("RP_TRACE").is_ok() {
-            let name = |u: &Unilateral| match u {
-                Unilateral::Limit { joint, bound, .. } => {
-                    format!("{}:{}", model.joints[joint.0].name, bound.name())
-                }
-                _ => "contact".into(),
-            };
-            eprintln!(
-                "round {rounds} it={} E={:.9} term={:?} blocked={:?} released={:?}",
-                report.iterations,
-                report.energy.total,
-                report.termination,
-                round.blocked.as_ref().map(|b| b
-                    .iter()
-                    .filter(|&&k| !guard.is_roll_limit(k))
-                    .map(|&k| name(&guard.inactive[k]))
-                    .collect::<Vec<_>>()),
-                round
-                    .released
-                    .iter()
-                    .map(|&i| name(&active[i].row))
-                    .collect::<Vec<_>>(),
-            );
-        }
         if !round.released.is_empty() && !cycling {
             // Rows pulling hard before the round was stationary (module `release`), or rows
             // carried past an obstacle's edge by a stalled round (module `stall`: its line
@@ -341,47 +317,12 @@ pub(crate) fn solve(
                 .copied()
                 .filter(|&i| !released_before.contains(&active[i].row))
                 .collect();
-            if fresh.is_empty() && std::env::var("RP_STAT_ALL").is_ok() {
-                let n: usize = std::env::var("RP_STAT_ALL").unwrap().parse().unwrap();
-                let few: Vec<usize> = gone
-                    .iter()
-                    .copied()
-                    .filter(|&i| {
-                        released_before
-                            .iter()
-                            .filter(|&&r| r == active[i].row)
-                            .count()
-                            <= n
-                    })
-                    .collect();
-                if few.is_empty() {
-                    gone.truncate(1);
-                } else {
-                    gone = few;
-                }
-            } else if fresh.is_empty() {
+            if fresh.is_empty() {
                 gone.truncate(1);
             } else {
                 gone = fresh;
             }
             if !gone.is_empty() {
-                if std::env::var("RP_TRACE").is_ok() {
-                    eprintln!(
-                        "   stationary release {:?} of {} pulling",
-                        gone.iter()
-                            .map(|&i| format!(
-                                "{:?} {:.3e}",
-                                active[i].row,
-                                scaled_force(
-                                    model,
-                                    &round.multipliers[i].0,
-                                    &round.multipliers[i].1
-                                )
-                            ))
-                            .collect::<Vec<_>>(),
-                        super::release::all_to_release(model, &round.multipliers, threshold).len()
-                    );
-                }
                 gone.sort_unstable();
                 changes += super::release::leave(
                     (model, options, &state.q),

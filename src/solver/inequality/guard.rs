@@ -23,7 +23,7 @@ use nalgebra::{DVector, Vector3};
 pub(crate) struct Guard<'m> {
     model: &'m Model,
     pub(crate) inactive: Vec<Unilateral>,
-    pub(super) tol: f64,
+    tol: f64,
     /// For contacts with an obstacle: its tangent plane `(o, n)` at the round's start. A step
     /// is guarded against that plane (a finite obstacle could otherwise be stepped through).
     planes: Vec<Option<(Vector3<f64>, Vector3<f64>)>>,
@@ -97,7 +97,7 @@ impl<'m> Guard<'m> {
 
     /// Dimensionless gap of inequality `k` (against an obstacle: to its plane of `planes`; a
     /// roll limit's margin after the inactive ones).
-    pub(super) fn gap(&self, k: usize, q: &DVector<f64>, branches: &Branches) -> f64 {
+    fn gap(&self, k: usize, q: &DVector<f64>, branches: &Branches) -> f64 {
         self.gap_sharing(k, q, branches, &mut None)
     }
 
@@ -174,41 +174,6 @@ impl<'m> Guard<'m> {
             self.gap_sharing(k, to, b, &mut at_to)
                 < self.gap_sharing(k, from, b, &mut at_from) - self.tol
         })
-    }
-
-    /// TRACE
-    pub(crate) fn count_violated(&self, sys: &System, q: &DVector<f64>) -> usize {
-        let b = &sys.problem.cons.branches;
-        (0..self.len())
-            .filter(|&k| self.gap(k, q, b) < -self.tol)
-            .count()
-    }
-
-    /// TRACE
-    pub(crate) fn describe_cut(
-        &self,
-        sys: &System,
-        q0: &DVector<f64>,
-        qb: &DVector<f64>,
-        qt: &DVector<f64>,
-    ) -> String {
-        let b = &sys.problem.cons.branches;
-        let mut out = String::new();
-        for k in 0..self.len() {
-            let g1 = self.gap(k, qt, b);
-            if g1 < -self.tol {
-                let g0 = self.gap(k, q0, b);
-                let gb = self.gap(k, qb, b);
-                let name = match self.inactive.get(k) {
-                    Some(Unilateral::Limit { joint, bound, .. }) => {
-                        format!("{}:{}", self.model.joints[joint.0].name, bound.name())
-                    }
-                    _ => "c".into(),
-                };
-                out += &format!(" [{name} f={:.3}]", (g0 - gb) / (g0 - g1));
-            }
-        }
-        out
     }
 
     /// Whether `q` violates one of the inequalities by more than the tolerance.

@@ -78,39 +78,12 @@ pub(crate) fn line_search(
             continue;
         }
         if let Some(guard) = guard.filter(|g| g.violated(sys, &qt)) {
-            if std::env::var("RP_AFTER").is_err() {
-                if let Some(t) = crate::solver::inequality::bend::held_trial(
-                    sys,
-                    line,
-                    alpha,
-                    guard,
-                    options,
-                    diag,
-                    f64::INFINITY,
-                ) {
-                    return Some(t);
-                }
-            }
             // Cut the step where the first inequality reaches its boundary.
             if let Some((qb, k)) = guard.boundary(sys, q, dq, alpha, Some(&qt), part, options, eval)
             {
-                if std::env::var("RP_TRACE").is_ok() {
-                    eprintln!(
-                        "  cut: alpha={alpha:.3e} crossed={} {}",
-                        guard.count_violated(sys, &qt),
-                        guard.describe_cut(sys, q, &qb, &qt)
-                    );
-                }
                 if let Some(eb) = sys.evaluate(&qb, part) {
                     diag.function_evaluations += 1;
                     if eb.merit <= f + roundoff_of(eval, &eb) {
-                        if std::env::var("RP_AFTER").is_ok() {
-                            if let Some(t) = crate::solver::inequality::bend::held_trial(
-                                sys, line, alpha, guard, options, diag, eb.merit,
-                            ) {
-                                return Some(t);
-                            }
-                        }
                         return Some(Trial {
                             q: qb,
                             eval: eb,

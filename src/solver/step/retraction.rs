@@ -38,8 +38,6 @@ pub(crate) struct Retraction {
     /// `(body, tree parent)`, every body once, a parent before its children (`None`: the
     /// world, for a body that no tree joint moves or one jointed to the world).
     order: Vec<(usize, Option<usize>)>,
-    /// The tree joint that moves each body relative to its tree parent.
-    via: Vec<Option<usize>>,
 }
 
 /// The rigid displacement `y ↦ A(r) y + t` of the world that a body has undergone.
@@ -52,18 +50,11 @@ impl Retraction {
         let mut parent: Vec<Option<usize>> = vec![None; n];
         let mut children: Vec<Vec<usize>> = vec![Vec::new(); n];
         let mut moved = vec![false; n];
-        let mut via = vec![None; n];
-        for (i, j) in model
-            .joints
-            .iter()
-            .enumerate()
-            .filter(|(_, j)| j.tree && !j.merged)
-        {
+        for j in model.joints.iter().filter(|j| j.tree && !j.merged) {
             let Some(c) = j.bodies[1] else { continue };
             if std::mem::replace(&mut moved[c.0], true) {
                 continue;
             }
-            via[c.0] = Some(i);
             parent[c.0] = j.bodies[0].map(|b| b.0);
             if let Some(p) = j.bodies[0] {
                 children[p.0].push(c.0);
@@ -81,44 +72,11 @@ impl Retraction {
         }
         // Not reached from a root (a cycle of tree edges cannot be built): its own twist.
         order.extend((0..n).filter(|&b| !seen[b]).map(|b| (b, None)));
-        Retraction { order, via }
-    }
-
-    /// The body that tree joint `joint` moves along the path (`None` for a loop-closing joint).
-    pub(crate) fn body_of(&self, joint: usize) -> Option<usize> {
-        self.via.iter().position(|&j| j == Some(joint))
+        Retraction { order }
     }
 
     /// The point at `alpha` along the tangent `dq` from `q` (module docs).
     pub(crate) fn point(&self, q: &DVector<f64>, dq: &DVector<f64>, alpha: f64) -> DVector<f64> {
-        self.bent_point(q, dq, alpha, &[])
-    }
-
-    /// [`Retraction::point`] with the relative motion of each body `b` of `caps` (`(b, α_b)`)
-    /// stopped at `min(α, α_b)`: its tree joint goes from `θ` to `θ + min(α, α_b) θ̇` (the
-    /// path held at a joint stop, module `inequality::bend`); its children move on.
-    pub(crate) fn bent_point(
-        &self,
-        q: &DVector<f64>,
-        dq: &DVector<f64>,
-        alpha: f64,
-        caps: &[(usize, f64)],
-    ) -> DVector<f64> {
-        self.point_with(q, dq, |b| {
-            caps.iter()
-                .filter(|c| c.0 == b)
-                .fold(alpha, |a, c| a.min(c.1))
-        })
-    }
-
-    /// The point where each body `b` has moved relative to its tree parent by the fraction
-    /// `alpha_of(b)` of its relative twist.
-    pub(crate) fn point_with(
-        &self,
-        q: &DVector<f64>,
-        dq: &DVector<f64>,
-        alpha_of: impl Fn(usize) -> f64,
-    ) -> DVector<f64> {
         let mut out = q.clone();
         let identity: Displacement = (Vector4::new(1.0, 0.0, 0.0, 0.0), Vector3::zeros());
         let mut moved = vec![identity; q.len() / 7];
@@ -136,8 +94,7 @@ impl Retraction {
                 }
                 None => (angular_velocity(q, dq, b), position(dq, b), identity),
             };
-            let ab = alpha_of(b);
-            let (re, shift) = screw(&(wr * ab), &(w * ab));
+            let (re, shift) = screw(&(wr * alpha), &(w * alpha));
             // E_b(y) = x_b + A(r_e)(y − x_b) + shift, M_b = M_a ∘ E_b.
             let te = xb - rotation(&re) * xb + shift;
             let rb = compose(&ra, &re);

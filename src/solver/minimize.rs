@@ -8,8 +8,8 @@
 //!    negative one.
 //! 3. **Reduced step** ([`reduced_step`]): Newton `d = −Ĥ⁻¹ ∇f` with the exact reduced
 //!    Hessian taken along the search path (`Ĥ + C`, module `step::path_hessian`), its
-//!    eigenvalues replaced by their magnitudes, floored, plus a step along its directions of
-//!    negative curvature (dense, module `step::newton`), or the KKT direction
+//!    eigenvalues replaced by their magnitudes, floored (dense, module `step::newton`), or the
+//!    KKT direction
 //!    (sparse); BFGS / DFP `d = −B ∇f` (module `step::quasi_newton`); steepest descent when `d` is
 //!    not a descent direction.
 //! 4. **Step cap** (module `step::step_cap`): the tangent step `δq = Z d` limited on the motion of the
@@ -368,10 +368,7 @@ fn reduced_step(
         match (eig, options.method) {
             (Some(e), Method::Newton) if e.exact => {
                 // The Hessian along the search path (module `step::path_hessian`).
-                let path = along_path(sys, &s.q, &s.part, &s.eval, e);
-                let (d, negative) = newton_step(&path, g, options.max_step);
-                s.diag.negative_curvature_steps += usize::from(negative);
-                d
+                newton_step(&along_path(sys, &s.q, &s.part, &s.eval, e), g)
             }
             (_, Method::Newton) => {
                 super::step::kkt_direction::kkt_direction(sys, &s.q, &s.part, &s.eval)

@@ -6,8 +6,10 @@
 //!    10⁻¹³ Σ|V_k|)` and, unless `allow_unstable` is set, no negative eigenvalue of the reduced
 //!    Hessian; at a saddle or maximum the search leaves along the eigenvector of the most
 //!    negative one.
-//! 3. **Reduced step** ([`reduced_step`]): Newton `d = −Ĥ⁻¹ ∇f` with the eigenvalues of the
-//!    exact reduced Hessian replaced by their magnitudes, floored (dense), or the KKT direction
+//! 3. **Reduced step** ([`reduced_step`]): Newton `d = −Ĥ⁻¹ ∇f` with the exact reduced
+//!    Hessian taken along the search path (`Ĥ + C`, module `step::path_hessian`), its
+//!    eigenvalues replaced by their magnitudes, floored (dense, module `step::newton`), or the
+//!    KKT direction
 //!    (sparse); BFGS / DFP `d = −B ∇f` (module `step::quasi_newton`); steepest descent when `d` is
 //!    not a descent direction.
 //! 4. **Step cap** (module `step::step_cap`): the tangent step `δq = Z d` limited on the motion of the
@@ -43,6 +45,8 @@ use super::report::{Diagnostics, Iterate, Termination};
 use super::stability::at_rest::for_minimizer;
 use super::stability::spectrum::Spectrum;
 use super::step::line_search::{line_search, Line, Trial};
+use super::step::newton::newton_step;
+use super::step::path_hessian::along_path;
 use super::step::quasi_newton::QuasiNewton;
 use super::step::retraction::independent_change;
 use super::step::step_cap::{cap_step, Step};
@@ -86,11 +90,6 @@ const GRADIENT_FLOOR: f64 = 1e-13;
 /// spread with it and its floor swallows the physical curvatures (a UR5 swinging down from
 /// horizontal stalled at ‖∇f‖ = 10⁻² for 200 iterations).
 const PIVOT_DRIFT: f64 = 0.85;
-
-/// The dense Newton step's floor on the eigenvalue magnitudes, a fraction of the largest. At
-/// 10⁻⁸ it cut the steps along near-neutral directions (iCub's hip yaws, 1.2·10⁻¹⁰ of the
-/// largest) 80-fold and the solve crawled at the rate `1 − λ/floor`.
-const EIGENVALUE_FLOOR: f64 = 1e-12;
 
 /// Up to this many degrees of freedom the sparse path too steps by the exact reduced Hessian's
 /// eigen-decomposition, not the shifted KKT system (whose shift cut Tiago's steps 200-fold).
@@ -368,13 +367,8 @@ fn reduced_step(
     } else {
         match (eig, options.method) {
             (Some(e), Method::Newton) if e.exact => {
-                let floor = EIGENVALUE_FLOOR * e.values.amax().max(1e-12);
-                let mut d = DVector::zeros(dof);
-                for i in 0..dof {
-                    let v = e.vectors.column(i);
-                    d -= v * (v.dot(g) / e.values[i].abs().max(floor));
-                }
-                d
+                // The Hessian along the search path (module `step::path_hessian`).
+                newton_step(&along_path(sys, &s.q, &s.part, &s.eval, e), g)
             }
             (_, Method::Newton) => {
                 super::step::kkt_direction::kkt_direction(sys, &s.q, &s.part, &s.eval)

@@ -195,7 +195,6 @@ fn tractor_trailer_converges_from_near_and_far_starts() {
         [("fifth_wheel_pitch", 0, 0.0017)],
         [("fifth_wheel_pitch", 0, 0.054)],
         [("tractor_trunnion_left", 0, 0.0154)],
-        [("tractor_trunnion_left", 0, -0.46)],
         [("front_leaf_left_eye", 0, 0.429)],
         [("trailer_trunnion_left", 0, 0.46)],
     ] {
@@ -207,6 +206,21 @@ fn tractor_trailer_converges_from_near_and_far_starts() {
             r.iterations
         );
     }
+    // From the left tractor trunnion at −0.46 rad the Newton step along the search path
+    // (`step::path_hessian`) comes in 12 iterations to another stable equilibrium, 3,253 J
+    // lower (the step in the partition's coordinates reached the rest above in 9): a verified
+    // minimum below that rest.
+    let start = [("tractor_trunnion_left", 0, -0.46)];
+    let (far, s, r) = solve_with_initial("tractor_trailer", &start);
+    assert!(r.converged(), "{:?}", r.termination);
+    assert!(r.iterations <= 15, "{} iterations", r.iterations);
+    let rest_energy = solve_with_initial("tractor_trailer", &[]).2.energy.total;
+    assert!(r.energy.total <= rest_energy + 1e-6 * rest_energy.abs());
+    assert_eq!(
+        r.stability.as_ref().unwrap().verdict,
+        restpose::solver::Verdict::Stable
+    );
+    crate::common::assert_verified_minimum(&far, &s);
 }
 
 /// Stewart platform under a payload: 13 bodies, 6 degrees of freedom, back to the same pose

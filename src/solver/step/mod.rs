@@ -3,6 +3,9 @@
 //!
 //! - `kkt_direction`: the Newton direction of the sparse path from the KKT system
 //!   `[W Φ_qᵀ; Φ_q 0] [δq; λ] = [−S(V_qᵀ − Φ_qᵀ μ); 0]`.
+//! - `newton`: the dense Newton step from the eigen-decomposition of the Hessian along the
+//!   search path.
+//! - `path_hessian`: that Hessian, `Ĥ + C`, `C` the search path's curvature times `∇f`.
 //! - `quasi_newton`: the BFGS / DFP inverse-Hessian approximation `B ≈ Ĥ⁻¹`.
 //! - `step_cap`: the step limit, every body's Euler parameters moving by at most `max_step`.
 //! - `line_search`: the backtracking line search along a reduced step `d` (`δq = Z d`).
@@ -11,6 +14,8 @@
 
 pub(super) mod kkt_direction;
 pub(super) mod line_search;
+pub(super) mod newton;
+pub(super) mod path_hessian;
 pub(super) mod quasi_newton;
 pub(super) mod retraction;
 pub(super) mod step_cap;

@@ -75,6 +75,15 @@ impl Retraction {
         Retraction { order }
     }
 
+    /// Every body's tree parent (`None`: the world, or no tree joint moves it).
+    pub(crate) fn parents(&self) -> Vec<Option<usize>> {
+        let mut parents = vec![None; self.order.len()];
+        for &(b, a) in &self.order {
+            parents[b] = a;
+        }
+        parents
+    }
+
     /// The point at `alpha` along the tangent `dq` from `q` (module docs).
     pub(crate) fn point(&self, q: &DVector<f64>, dq: &DVector<f64>, alpha: f64) -> DVector<f64> {
         let mut out = q.clone();
@@ -131,7 +140,7 @@ fn position(q: &DVector<f64>, b: usize) -> Vector3<f64> {
 
 /// The world angular velocity of body `b` for the tangent `dq` at `q`:
 /// `ω = 2 (e0 ė − ė0 e + e × ė) / (pᵀp)`.
-fn angular_velocity(q: &DVector<f64>, dq: &DVector<f64>, b: usize) -> Vector3<f64> {
+pub(crate) fn angular_velocity(q: &DVector<f64>, dq: &DVector<f64>, b: usize) -> Vector3<f64> {
     let i = 7 * b;
     let (e0, de0) = (q[i + 3], dq[i + 3]);
     let e = Vector3::new(q[i + 4], q[i + 5], q[i + 6]);

@@ -43,16 +43,8 @@
 //!
 //! Both apply to a row once per solve: a row released before (early or at a stationary point)
 //! that a later step pushes back into its bound is re-added by the guard, and then leaves only
-//! alone, as in the classic method; so the set cannot zigzag between several rows leaving
-//! together and coming back. A joint stop re-added once may still leave early, alone: the
-//! most pulling of those pulling hard (same test), and only when no fresh row leaves; after
-//! its second release it leaves only at a stationary point. Without this, each stop re-added
-//! on the way down cost a round solved to `10⁻⁸` before the one release it was waiting for:
-//! on the hanging iCub (example-robot-data) a round of 97 iterations crawled along a
-//! near-neutral direction (`‖∂V/∂v‖∞` between 10⁻⁸ and 10⁻⁵ J) while the re-added `r_elbow`
-//! stop pulled with 0.092 N m; with the rule iCub takes 68 iterations instead of 155 and iCub
-//! reduced 51 instead of 65, every rest energy of the hanging corpus unchanged
-//! (docs/method.md, "The search path").
+//! alone, the most negative at a stationary point, as in the classic method; so the set cannot
+//! zigzag between several rows leaving together and coming back.
 //!
 //! ## References
 //! - B. A. Murtagh, M. A. Saunders, "Large-scale linearly constrained optimization",
@@ -74,18 +66,12 @@ use nalgebra::DVector;
 /// `‖∂V/∂v‖∞ / η`.
 pub(crate) const SUBSPACE_TOLERANCE: f64 = 0.5;
 
-/// A joint stop released this many times may leave early once more (alone, module docs).
-const EARLY_AGAIN: usize = 1;
-
 /// The early-release test of one round, and its stall test (module `stall`).
 pub(crate) struct Release<'m> {
     model: &'m Model,
     /// Per active inequality (in the order of the round's active list): whether it may leave
     /// before the round is stationary.
     eligible: Vec<bool>,
-    /// Per active inequality: a joint stop released [`EARLY_AGAIN`] times, which may leave
-    /// early alone when no eligible row does.
-    again: Vec<bool>,
     /// Per active inequality: a contact on a body that joints connect to the world (its rate
     /// is taken per unit of motion, module docs).
     held_chain: Vec<bool>,
@@ -110,13 +96,6 @@ impl<'m> Release<'m> {
             eligible: active
                 .iter()
                 .map(|a| !released_before.contains(&a.row))
-                .collect(),
-            again: active
-                .iter()
-                .map(|a| {
-                    matches!(a.row, Unilateral::Limit { .. })
-                        && released_before.iter().filter(|&&r| r == a.row).count() == EARLY_AGAIN
-                })
                 .collect(),
             held_chain: active
                 .iter()
@@ -164,10 +143,9 @@ impl<'m> Release<'m> {
 
     /// The active inequalities (indices into the round's active list) to release now, or
     /// `None` to go on with the round: those eligible whose multiplier pulls beyond the
-    /// tolerance by an energy rate above `‖∂V/∂v‖∞ / η`; where there are none, the one
-    /// pulling hardest so among the stops that may leave again (module docs).
+    /// tolerance by an energy rate above `‖∂V/∂v‖∞ / η`.
     pub(crate) fn early(&self, sys: &System, part: &Partition, eval: &Eval) -> Option<Vec<usize>> {
-        if !self.eligible.iter().chain(&self.again).any(|&e| e) {
+        if !self.eligible.iter().any(|&e| e) {
             return None;
         }
         let gnorm = eval.grad_v.amax();
@@ -176,8 +154,6 @@ impl<'m> Release<'m> {
             position[row] = k;
         }
         let mut out = Vec::new();
-        // The stop that may leave again pulling hardest: its index and energy rate.
-        let mut alone: Option<(usize, f64)> = None;
         let unilateral = sys
             .problem
             .cons
@@ -189,24 +165,11 @@ impl<'m> Release<'m> {
             });
         for (i, (a, first)) in unilateral.enumerate() {
             let k = position[first];
-            if k == usize::MAX {
+            if !self.eligible.get(i).copied().unwrap_or(false) || k == usize::MAX {
                 continue;
             }
             let scaled = super::active_set::scaled_force(self.model, a, &[eval.mu[k]]);
             let pulls_hard = |rate: f64| -rate * SUBSPACE_TOLERANCE > gnorm;
-            if self.again.get(i).copied().unwrap_or(false) {
-                let rate = scaled * self.model.length_scale;
-                if scaled < -self.threshold
-                    && pulls_hard(rate)
-                    && alone.is_none_or(|(_, r)| rate < r)
-                {
-                    alone = Some((i, rate));
-                }
-                continue;
-            }
-            if !self.eligible.get(i).copied().unwrap_or(false) {
-                continue;
-            }
             if scaled >= -self.threshold || !pulls_hard(scaled * self.model.length_scale) {
                 continue;
             }
@@ -217,9 +180,6 @@ impl<'m> Release<'m> {
                 continue;
             }
             out.push(i);
-        }
-        if out.is_empty() {
-            out.extend(alone.map(|(i, _)| i));
         }
         (!out.is_empty()).then_some(out)
     }
@@ -276,96 +236,4 @@ pub(super) fn leave(
     super::patch::promote(model, options, active, &removed, q);
     super::rolling::record_touches(model, active, q, touched);
     gone.len()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::constraints::unilateral::{self, Bound};
-    use crate::constraints::Constraints;
-    use crate::solver::inequality::active_set::{activate, dimensionless, force_scale};
-    use crate::solver::options::Options;
-    use crate::solver::system::Backend;
-    use crate::urdf::{load_str, ImportOptions};
-
-    /// Two links (the second light) on hinges, started horizontal on the lower stop (0 rad) of the
-    /// first joint, which gravity turns towards positive angles: the stop pulls (`λ < 0`)
-    /// far beyond the reduced gradient. It leaves early with several others when never
-    /// released before, alone when released once before (module docs), and not before the
-    /// round is stationary when released twice.
-    #[test]
-    fn a_stop_released_once_may_leave_early_once_more() {
-        let text = r#"<robot name="two">
-  <link name="world"/>
-  <link name="a"><inertial><origin xyz="0.1 0 0"/><mass value="1"/><inertia ixx="1e-3" ixy="0" ixz="0" iyy="4e-3" iyz="0" izz="4e-3"/></inertial></link>
-  <link name="b"><inertial><origin xyz="0.1 0 0"/><mass value="0.01"/><inertia ixx="1e-3" ixy="0" ixz="0" iyy="4e-3" iyz="0" izz="4e-3"/></inertial></link>
-  <joint name="j0" type="revolute"><parent link="world"/><child link="a"/><axis xyz="0 1 0"/><limit lower="0" upper="1.5" effort="10" velocity="1"/></joint>
-  <joint name="j1" type="continuous"><parent link="a"/><child link="b"/><origin xyz="0.2 0 0"/><axis xyz="0 1 0"/></joint>
-</robot>"#;
-        let model = load_str(text, "two.urdf", &ImportOptions::default())
-            .unwrap()
-            .model;
-        let options = Options::default();
-        let tol = options.gap_tolerance;
-        let start = crate::State::initial(&model);
-        let mut branches = start.branches.clone();
-        let q = crate::solver::assemble::assemble(&model, start.q, &mut branches, &[], &options)
-            .unwrap();
-        let touching: Vec<Unilateral> = active_set_rows(&model, &options, &q, &branches, tol);
-        assert_eq!(touching.len(), 1);
-        assert!(matches!(
-            touching[0],
-            Unilateral::Limit {
-                bound: Bound::Lower,
-                ..
-            }
-        ));
-        let active: Vec<Active> = touching
-            .iter()
-            .map(|&u| activate(&model, &options, u, &q))
-            .collect();
-        let cons = Constraints::new(&model, &[])
-            .with_active(&model, &active)
-            .on_branches(branches);
-        let mut sys = System::new(&model, cons, Backend::of(&model, &options));
-        let part = sys.partition(&q);
-        let eval = sys.evaluate(&q, &part).unwrap();
-        let threshold = options.force_tolerance * force_scale(&model);
-        let early = |before: &[Unilateral]| {
-            Release::new(&model, &active, before, threshold).early(&sys, &part, &eval)
-        };
-        let row = touching[0];
-        assert_eq!(early(&[]), Some(vec![0]));
-        assert_eq!(early(&[row]), Some(vec![0]));
-        assert_eq!(early(&[row, row]), None);
-
-        // Independently: the stop's torque pulls, by more than the reduced gradient / η.
-        let full = crate::solver::inequality::active_set::active_multipliers(&sys.problem.cons, &{
-            let mut m = DVector::zeros(sys.problem.cons.len());
-            for (k, &r) in part.rows.iter().enumerate() {
-                m[r] = eval.mu[k];
-            }
-            m
-        });
-        let torque = full[0].1[0];
-        assert!(torque < -threshold * model.length_scale, "{torque}");
-        assert!(-torque * SUBSPACE_TOLERANCE > eval.grad_v.amax());
-    }
-
-    /// The inequalities within `tol` of their boundary at `q`.
-    fn active_set_rows(
-        model: &Model,
-        options: &Options,
-        q: &DVector<f64>,
-        branches: &crate::kinematics::Branches,
-        tol: f64,
-    ) -> Vec<Unilateral> {
-        crate::solver::inequality::active_set::inequalities(model, options)
-            .into_iter()
-            .filter(|u| {
-                unilateral::gap(model, u, q, branches)
-                    .is_some_and(|g| dimensionless(model, u, g) <= tol)
-            })
-            .collect()
-    }
 }

@@ -110,13 +110,16 @@ impl InputArgs {
             inertia_density: self.inertia_from_geometry,
             ..Default::default()
         };
-        if self.base_xyz.is_some() || self.base_rpy.is_some() {
-            let t = self.base_xyz.clone().unwrap_or_else(|| vec![0.0; 3]);
-            let r = self.base_rpy.clone().unwrap_or_else(|| vec![0.0; 3]);
+        let r = self.base_rpy.clone().unwrap_or_else(|| vec![0.0; 3]);
+        let rotation = nalgebra::UnitQuaternion::from_euler_angles(r[0], r[1], r[2]);
+        if let Some(t) = &self.base_xyz {
             opts.base_pose = Some(nalgebra::Isometry3::from_parts(
                 nalgebra::Translation3::new(t[0], t[1], t[2]),
-                nalgebra::UnitQuaternion::from_euler_angles(r[0], r[1], r[2]),
+                rotation,
             ));
+        } else if self.base_rpy.is_some() {
+            // The orientation given, the position found by the ground start.
+            opts.base_orientation = Some(rotation);
         }
         if let Some(g) = &self.gravity {
             opts.gravity = nalgebra::Vector3::new(g[0], g[1], g[2]);

@@ -68,8 +68,8 @@ pub(crate) struct InputArgs {
     pub(crate) base_rpy: Option<Vec<f64>>,
     /// Hold joints like position servos: `all=K` (every revolute, continuous and prismatic
     /// joint that is not locked or a mimic) or `JOINT=K[@REF]`, a joint spring of stiffness K
-    /// [N m/rad or N/m] about REF (default: the reference pose, else the initial value);
-    /// later ones override earlier ones (repeatable).
+    /// [N m/rad or N/m] about REF (default: the reference pose, else the initial value); a
+    /// JOINT's REF is also its start; later ones override earlier ones (repeatable).
     #[arg(long, value_name = "JOINT=K[@REF]")]
     pub(crate) servo: Vec<String>,
     /// The servos' reference pose: a joint_states YAML (what --write-joint-states writes) or

@@ -463,10 +463,11 @@ pub(super) fn read(
             value: *value,
         });
     }
-    // The reference pose (an SRDF state, a pose file) is also the start: a robot held about
-    // its standing state starts standing. It overrides `mech:initial`, `--initial` overrides
-    // it; joints the model lacks or with several coordinates are skipped (as by the servos).
-    for (name, value) in &options.servo_reference {
+    // The reference pose (an SRDF state, a pose file, a servo's own reference) is also the
+    // start: a robot held about its standing state starts standing. It overrides
+    // `mech:initial`, `--initial` overrides it; joints the model lacks or with several
+    // coordinates are skipped (as by the servos).
+    for (name, value) in &super::servo::starts(options) {
         let Some(id) = b.model.joint_id(name) else {
             continue;
         };

@@ -95,7 +95,12 @@ pub(crate) fn import_options(
     if base_xyz.is_some() || base_rpy.is_some() {
         finite(&base_xyz.unwrap_or_default(), "base_xyz")?;
         finite(&base_rpy.unwrap_or_default(), "base_rpy")?;
-        opts.base_pose = Some(origin(base_xyz, base_rpy));
+        if base_xyz.is_some() {
+            opts.base_pose = Some(origin(base_xyz, base_rpy));
+        } else {
+            // The orientation given, the position found by the ground start (as the CLI).
+            opts.base_orientation = Some(origin(None, base_rpy).rotation);
+        }
     }
     let mut packages: Vec<_> = packages.unwrap_or_default().into_iter().collect();
     packages.sort();

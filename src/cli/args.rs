@@ -68,8 +68,8 @@ pub(crate) struct InputArgs {
     pub(crate) base_rpy: Option<Vec<f64>>,
     /// Hold joints like position servos: `all=K` (every revolute, continuous and prismatic
     /// joint that is not locked or a mimic) or `JOINT=K[@REF]`, a joint spring of stiffness K
-    /// [N m/rad or N/m] about REF (default: the reference pose, else the initial value);
-    /// later ones override earlier ones (repeatable).
+    /// [N m/rad or N/m] about REF (default: the reference pose, else the initial value); a
+    /// JOINT's REF is also its start; later ones override earlier ones (repeatable).
     #[arg(long, value_name = "JOINT=K[@REF]")]
     pub(crate) servo: Vec<String>,
     /// The servos' reference pose: a joint_states YAML (what --write-joint-states writes) or
@@ -110,13 +110,16 @@ impl InputArgs {
             inertia_density: self.inertia_from_geometry,
             ..Default::default()
         };
-        if self.base_xyz.is_some() || self.base_rpy.is_some() {
-            let t = self.base_xyz.clone().unwrap_or_else(|| vec![0.0; 3]);
-            let r = self.base_rpy.clone().unwrap_or_else(|| vec![0.0; 3]);
+        let r = self.base_rpy.clone().unwrap_or_else(|| vec![0.0; 3]);
+        let rotation = nalgebra::UnitQuaternion::from_euler_angles(r[0], r[1], r[2]);
+        if let Some(t) = &self.base_xyz {
             opts.base_pose = Some(nalgebra::Isometry3::from_parts(
                 nalgebra::Translation3::new(t[0], t[1], t[2]),
-                nalgebra::UnitQuaternion::from_euler_angles(r[0], r[1], r[2]),
+                rotation,
             ));
+        } else if self.base_rpy.is_some() {
+            // The orientation given, the position found by the ground start.
+            opts.base_orientation = Some(rotation);
         }
         if let Some(g) = &self.gravity {
             opts.gravity = nalgebra::Vector3::new(g[0], g[1], g[2]);

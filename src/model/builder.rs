@@ -72,6 +72,7 @@ impl ModelBuilder {
                 contact_points: Shared::default(),
                 length_scale: 1.0,
                 base_pose: None,
+                base_on_ground: false,
                 joint_names: Default::default(),
             },
             inertials: Vec::new(),

@@ -160,6 +160,19 @@ impl ModelBuilder {
     /// then extend to the whole tree.
     pub fn set_base_pose(&mut self, pose: nalgebra::Isometry3<f64>) {
         self.model.base_pose = Some(pose);
+        self.model.base_on_ground = false;
+    }
+
+    /// Sets the start orientation of the floating root link and leaves its position to the
+    /// ground start: with grounds and contact points, the floating bodies are raised along
+    /// gravity, so turned, until their lowest contact point touches a ground; without, the
+    /// root link starts at the world origin.
+    pub fn set_base_orientation(&mut self, rotation: nalgebra::UnitQuaternion<f64>) {
+        self.model.base_pose = Some(nalgebra::Isometry3::from_parts(
+            nalgebra::Translation3::identity(),
+            rotation,
+        ));
+        self.model.base_on_ground = true;
     }
 
     /// Makes the collision shapes of the world-fixed link with index `link` obstacles

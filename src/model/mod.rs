@@ -79,6 +79,9 @@ pub struct Model {
     /// Start pose of the root link in the world when the base floats (`mech:base`; `None`:
     /// the identity).
     pub(crate) base_pose: Option<nalgebra::Isometry3<f64>>,
+    /// Only the orientation of `base_pose` was given (`--base-rpy` alone): with grounds, the
+    /// ground start finds its position (`solver::assemble::grounded_start`).
+    pub(crate) base_on_ground: bool,
     /// Joint ids by name (the first joint of a name wins), built by the builder.
     pub(crate) joint_names: std::sync::Arc<crate::names::NameMap<String, JointId>>,
 }
@@ -251,6 +254,7 @@ impl Model {
     pub fn with_base_pose(&self, pose: nalgebra::Isometry3<f64>) -> Model {
         let mut m = self.clone();
         m.base_pose = Some(pose);
+        m.base_on_ground = false;
         m
     }
 

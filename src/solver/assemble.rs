@@ -91,12 +91,14 @@ fn newton(
 }
 
 /// The start of a floating mechanism placed on the grounds: with grounds, contact points and
-/// no base pose given (`mech:base`, `--base-xyz`), every group of bodies that no joint holds
-/// to the world is translated against gravity (along +z without gravity), as it is (upright
-/// when the base starts at the identity), until its lowest contact point touches the grounds
+/// no base position given (`mech:base`, `--base-xyz`; `--base-rpy` alone gives only the
+/// orientation), every group of bodies that no joint holds to the world is translated against
+/// gravity (along +z without gravity), as it is (upright when the base starts at the
+/// identity, turned as `--base-rpy` says), until its lowest contact point touches the grounds
 /// that face that way: `t = max_{c,g} −g_gap(c) / (n_g·û)`. It then settles from there.
 pub(crate) fn grounded_start(model: &Model, mut start: crate::State) -> crate::State {
-    if model.base_pose.is_some() || model.grounds.is_empty() || model.contact_points.is_empty() {
+    let placed = model.base_pose.is_some() && !model.base_on_ground;
+    if placed || model.grounds.is_empty() || model.contact_points.is_empty() {
         return start;
     }
     let up = if model.gravity.norm() > 0.0 {

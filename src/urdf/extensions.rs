@@ -413,12 +413,16 @@ pub(super) fn read(
     if !b.gravity_set {
         b.model.set_gravity(options.gravity);
     }
-    if let Some(pose) = options.base_pose {
+    if options.base_pose.is_some() || options.base_orientation.is_some() {
         if !super::base::has_floating_root(b.model.partial()) {
             let robot = src.doc.root_element();
             return Err(src.error(robot, super::base::NO_FLOATING_ROOT));
         }
-        b.model.set_base_pose(pose);
+        match (options.base_pose, options.base_orientation) {
+            (Some(pose), _) => b.model.set_base_pose(pose),
+            (None, Some(r)) => b.model.set_base_orientation(r),
+            (None, None) => {}
+        }
     }
     let default = Ground::default();
     if options.ground
@@ -459,10 +463,11 @@ pub(super) fn read(
             value: *value,
         });
     }
-    // The reference pose (an SRDF state, a pose file) is also the start: a robot held about
-    // its standing state starts standing. It overrides `mech:initial`, `--initial` overrides
-    // it; joints the model lacks or with several coordinates are skipped (as by the servos).
-    for (name, value) in &options.servo_reference {
+    // The reference pose (an SRDF state, a pose file, a servo's own reference) is also the
+    // start: a robot held about its standing state starts standing. It overrides
+    // `mech:initial`, `--initial` overrides it; joints the model lacks or with several
+    // coordinates are skipped (as by the servos).
+    for (name, value) in &super::servo::starts(options) {
         let Some(id) = b.model.joint_id(name) else {
             continue;
         };

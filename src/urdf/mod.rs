@@ -54,6 +54,10 @@ pub struct ImportOptions {
     pub ground: bool,
     /// Start pose of the root link in the world when the base floats; overrides `mech:base`.
     pub base_pose: Option<nalgebra::Isometry3<f64>>,
+    /// Start orientation of the root link when the base floats and `base_pose` is not given
+    /// (`--base-rpy` alone); overrides `mech:base`. Its position is found by the ground start
+    /// (the lowest contact point on the ground; without grounds, the world origin).
+    pub base_orientation: Option<nalgebra::UnitQuaternion<f64>>,
     /// Position servos (`--servo`), applied in order after the file's own elements.
     pub servos: Vec<ServoRequest>,
     /// Reference pose of the servos `(joint, value)` (`--servo-reference`, an SRDF
@@ -76,6 +80,7 @@ impl Default for ImportOptions {
             inertia_density: None,
             ground: false,
             base_pose: None,
+            base_orientation: None,
             servos: Vec::new(),
             servo_reference: Vec::new(),
             xacro_args: Vec::new(),

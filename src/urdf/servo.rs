@@ -24,6 +24,21 @@ pub struct ServoRequest {
     pub reference: Option<f64>,
 }
 
+/// Where the servos' references make the start `(joint, value)`: the reference pose
+/// (`ImportOptions::servo_reference`), then the reference given with a named joint's servo
+/// (`--servo JOINT=K@REF`; a later one wins). A robot held about a crouch starts crouched, as
+/// one held about an SRDF state starts in it.
+pub(super) fn starts(options: &ImportOptions) -> Vec<(String, f64)> {
+    let mut out = options.servo_reference.clone();
+    for r in &options.servos {
+        if let (Some(joint), Some(value)) = (&r.joint, r.reference) {
+            out.retain(|(n, _)| n != joint);
+            out.push((joint.clone(), value));
+        }
+    }
+    out
+}
+
 /// Adds the servos of `options` to the model being built (later requests replace earlier ones
 /// on the same joint, so `all=K` followed by `JOINT=K2` gives JOINT the stiffness K2).
 pub(super) fn add(b: &mut Builder, options: &ImportOptions) -> Result<()> {

@@ -97,6 +97,40 @@ fn the_reference_comes_from_the_request_then_the_reference_pose_then_the_initial
     assert_eq!(twice.servos()[0].stiffness, 7.0);
 }
 
+/// Regression (pybullet_data's Spirit 40, Vision 60, Spirit 40 newer held about a crouch by
+/// `--servo JOINT=K@REF`): a servo's own reference was not the start, as the reference pose of
+/// `--servo-reference` / `--srdf-state` is, so the robots started from the file's zero pose
+/// (legs flat, every contact sticking) and ended with errors, cycling, or lying clamped at
+/// 4,774 J; started crouched they stand in 3-4 iterations. The bar starts at its servo's
+/// reference, which overrides the reference pose; `--initial` overrides both.
+#[test]
+fn a_servo_reference_is_also_the_start() {
+    let own = |r: f64| ServoRequest {
+        joint: Some("pivot".into()),
+        stiffness: 100.0,
+        reference: Some(r),
+    };
+    let start = |m: &restpose::Model| restpose::State::initial(m).joint(m, "pivot").unwrap()[0];
+    assert_eq!(start(&bar(vec![own(-0.5)], Vec::new())), -0.5);
+    assert_eq!(
+        start(&bar(vec![own(-0.5)], vec![("pivot".into(), 0.25)])),
+        -0.5
+    );
+    let options = ImportOptions {
+        servos: vec![own(-0.5)],
+        initial: vec![("pivot".into(), 0, 0.1)],
+        ..Default::default()
+    };
+    let m = load_str(BAR, "bar.urdf", &options).unwrap().model;
+    assert!((start(&m) - 0.1).abs() < 1e-15);
+    // `all=K@REF` sets the references, not the start.
+    let all = ServoRequest {
+        joint: None,
+        ..own(-0.5)
+    };
+    assert_eq!(start(&bar(vec![all], Vec::new())), 0.0);
+}
+
 #[test]
 fn an_unknown_servo_joint_is_named_with_a_suggestion() {
     let options = ImportOptions {

@@ -45,8 +45,7 @@ pub(crate) fn reanchor(
         let rot = body_rotation(c.body, q);
         // Rolling from the first touch by the rotation vector ψ moves the touching point by
         // ρ ψ × n along the ground.
-        let psi = nalgebra::Rotation3::from_matrix_unchecked(rot * first.rotation.transpose())
-            .scaled_axis();
+        let psi = crate::math::rotation_vector(&(rot * first.rotation.transpose()));
         let anchor = unilateral::Anchor {
             world: first.world + psi.cross(&n) * c.radius,
             body: c.point - rot.transpose() * n * c.radius,
@@ -148,5 +147,68 @@ impl RollLimit {
         let (_, n) = unilateral::surface(model, self.ground, &x);
         let touching = c.point - body_rotation(c.body, q).transpose() * n * c.radius;
         (ROLL_LIMIT * c.radius - (touching - self.anchored).norm()) / model.length_scale
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::Friction;
+    use crate::urdf::{load_str, ImportOptions};
+
+    /// A sticking ball (ρ = 0.02 m) whose body turned by 1e-9 rad since it first touched, its
+    /// Euler parameters 1e-12 off the unit sphere (the normalization row holds to the
+    /// constraint tolerance, not exactly): rolling moves its touching point by ρ · 1e-9 m, far
+    /// below the gap tolerance, so it is not re-anchored, and a turn of 0.01 rad is (by
+    /// `ρ ψ × n` within 1e-15 m). The rotation vector was read as `acos` of the trace, a turn
+    /// of ~2e-6 rad, which moved the anchor 4e-8 m: on the Spirit 40 lying on its legs the
+    /// toes' redundant tangential rows then contradicted the thighs' by 9.5e-9 m ("inconsistent
+    /// over-constrained model").
+    #[test]
+    fn a_ball_that_did_not_roll_keeps_its_anchor() {
+        let text = r#"<robot name="ball" xmlns:mech="urn:urdf-mech:1">
+  <link name="ball"><inertial><mass value="1"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial>
+    <collision><geometry><sphere radius="0.02"/></geometry></collision></link>
+  <mech:ground xyz="0 0 -0.02"/>
+</robot>"#;
+        let options = ImportOptions {
+            floating_base: true,
+            ..Default::default()
+        };
+        let model = load_str(text, "ball.urdf", &options).unwrap().model;
+        let opts = Options {
+            friction: Friction::Stick,
+            ..Default::default()
+        };
+        let q0 = crate::State::initial(&model).q;
+        let u = super::super::active_set::inequalities(&model, &opts)[0];
+        let mut active = vec![super::super::active_set::activate(&model, &opts, u, &q0)];
+        let first = active[0].anchor.unwrap();
+        let mut touched = Vec::new();
+        record_touches(&model, &active, &q0, &mut touched);
+        let turned = |angle: f64, scale: f64| {
+            let turn = crate::math::euler_parameters(&nalgebra::UnitQuaternion::from_scaled_axis(
+                Vector3::y() * angle,
+            ));
+            let p = crate::math::compose(&turn, &q0.fixed_rows::<4>(3).into_owned()) * scale;
+            let mut q = q0.clone();
+            q.fixed_rows_mut::<4>(3).copy_from(&p);
+            q
+        };
+        for scale in [1.0 + 1e-12, 1.0 - 1e-12] {
+            let q = turned(1e-9, scale);
+            assert!(
+                !reanchor(&model, &opts, &mut active, &touched, &q),
+                "{scale}"
+            );
+            assert_eq!(active[0].anchor.unwrap(), first);
+        }
+        let q = turned(0.01, 1.0 + 1e-12);
+        assert!(reanchor(&model, &opts, &mut active, &touched, &q));
+        let moved = active[0].anchor.unwrap().world - first.world;
+        assert!(
+            (moved - Vector3::x() * 0.02 * 0.01).norm() < 1e-15,
+            "{moved}"
+        );
     }
 }

@@ -13,6 +13,15 @@ use restpose::Options;
 /// The Solo-12 of `robots/solo12/` with its ground moved from z = −0.2389 m (where the feet
 /// touch with the base at the origin) to `z`.
 fn solo_over(z: f64, base: Option<nalgebra::Isometry3<f64>>) -> restpose::Result<restpose::Model> {
+    solo_turned(z, base, None)
+}
+
+/// As [`solo_over`], with only the base's orientation given (`--base-rpy` alone).
+fn solo_turned(
+    z: f64,
+    base: Option<nalgebra::Isometry3<f64>>,
+    orientation: Option<nalgebra::UnitQuaternion<f64>>,
+) -> restpose::Result<restpose::Model> {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/robots/solo12/solo12_ground.urdf"
@@ -30,6 +39,7 @@ fn solo_over(z: f64, base: Option<nalgebra::Isometry3<f64>>) -> restpose::Result
     let options = ImportOptions {
         floating_base: true,
         base_pose: base,
+        base_orientation: orientation,
         ..Default::default()
     };
     let loaded = load_file(&file, &options);
@@ -89,4 +99,60 @@ fn a_base_placed_inside_the_ground_names_base_xyz() {
             assert!(r.converged(), "{:?}", r.termination);
         }
     }
+}
+
+/// Regression (pybullet_data's laikago, a y-up file stood with `--base-rpy 1.5708 0 3.1416`):
+/// the ground start was skipped when only the base's orientation was given, so the robot started
+/// at the world origin with its feet 0.48 m inside the floor ("cannot assemble"). Now the
+/// orientation given, the height is found: the Solo-12 turned by a yaw of 0.7 rad stands as the
+/// unturned reference does, 0.7389 m higher (energy `+ m g Δz`), its yaw kept; turned upside
+/// down (a roll of π) it starts with its lowest contact point (now on its back) on the floor
+/// 0.5 m up: the lift follows the turned geometry.
+#[test]
+fn with_only_the_base_orientation_the_height_is_found() {
+    let reference = solo_over(-0.238946146991093, Some(nalgebra::Isometry3::identity())).unwrap();
+    let (s0, r0) = restpose::solve(&reference, &Options::default()).unwrap();
+    assert!(r0.converged(), "{:?}", r0.termination);
+    let lift = 0.5 + 0.238946146991093;
+    let yaw = nalgebra::UnitQuaternion::from_euler_angles(0.0, 0.0, 0.7);
+    let model = solo_turned(0.5, None, Some(yaw)).unwrap();
+    assert!(model.base_pose().is_some());
+    let (state, report) = restpose::solve(&model, &Options::default()).unwrap();
+    assert!(report.converged(), "{:?}", report.termination);
+    assert_eq!(report.contacts.len(), 4);
+    let weight: f64 = model.bodies().iter().map(|b| b.gravity_mass).sum::<f64>() * 9.81;
+    assert!(
+        (report.energy.total - r0.energy.total - weight * lift).abs() < 1e-6,
+        "V = {} vs {} + m g {lift}",
+        report.energy.total,
+        r0.energy.total
+    );
+    let base = state.link_pose(&model, "base_link").unwrap();
+    let base0 = s0.link_pose(&reference, "base_link").unwrap();
+    assert!((base.translation.z - base0.translation.z - lift).abs() < 1e-6);
+    // The yaw given is kept: on the frictionless floor yaw is neutral, and the settling path
+    // turns both robots by less than 1e-3 rad (the reference by 4.4e-5, this one by −5.3e-4).
+    let (_, _, turned) = base.rotation.euler_angles();
+    let (_, _, own) = base0.rotation.euler_angles();
+    assert!(
+        (turned - 0.7).abs() < 1e-3 && own.abs() < 1e-3,
+        "yaw {turned}, {own}"
+    );
+    // Upside down: the start touches the floor with the highest point of the upright robot.
+    let flipped = nalgebra::UnitQuaternion::from_euler_angles(std::f64::consts::PI, 0.0, 0.0);
+    let model = solo_turned(0.5, None, Some(flipped)).unwrap();
+    let start = restpose::solve(
+        &model,
+        &Options {
+            max_iterations: 0,
+            ..Default::default()
+        },
+    );
+    let (state, _) = start.unwrap();
+    let lowest = model
+        .contact_points()
+        .iter()
+        .map(|c| (state.body_pose(c.body) * nalgebra::Point3::from(c.point)).z - c.radius)
+        .fold(f64::INFINITY, f64::min);
+    assert!((lowest - 0.5).abs() < 1e-9, "lowest contact at {lowest}");
 }

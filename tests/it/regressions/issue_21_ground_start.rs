@@ -110,14 +110,18 @@ fn a_base_placed_inside_the_ground_names_base_xyz() {
 /// 0.5 m up: the lift follows the turned geometry.
 #[test]
 fn with_only_the_base_orientation_the_height_is_found() {
+    let sticking = Options {
+        friction: restpose::model::Friction::Stick,
+        ..Options::default()
+    };
     let reference = solo_over(-0.238946146991093, Some(nalgebra::Isometry3::identity())).unwrap();
-    let (s0, r0) = restpose::solve(&reference, &Options::default()).unwrap();
+    let (s0, r0) = restpose::solve(&reference, &sticking).unwrap();
     assert!(r0.converged(), "{:?}", r0.termination);
     let lift = 0.5 + 0.238946146991093;
     let yaw = nalgebra::UnitQuaternion::from_euler_angles(0.0, 0.0, 0.7);
     let model = solo_turned(0.5, None, Some(yaw)).unwrap();
     assert!(model.base_pose().is_some());
-    let (state, report) = restpose::solve(&model, &Options::default()).unwrap();
+    let (state, report) = restpose::solve(&model, &sticking).unwrap();
     assert!(report.converged(), "{:?}", report.termination);
     assert_eq!(report.contacts.len(), 4);
     let weight: f64 = model.bodies().iter().map(|b| b.gravity_mass).sum::<f64>() * 9.81;
@@ -130,8 +134,8 @@ fn with_only_the_base_orientation_the_height_is_found() {
     let base = state.link_pose(&model, "base_link").unwrap();
     let base0 = s0.link_pose(&reference, "base_link").unwrap();
     assert!((base.translation.z - base0.translation.z - lift).abs() < 1e-6);
-    // The yaw given is kept: on the frictionless floor yaw is neutral, and the settling path
-    // turns both robots by less than 1e-3 rad (the reference by 4.4e-5, this one by −5.3e-4).
+    // The yaw given is kept: the feet stick (on a frictionless floor yaw is neutral, and where
+    // a search leaves a neutral coordinate is not the ground start's to say).
     let (_, _, turned) = base.rotation.euler_angles();
     let (_, _, own) = base0.rotation.euler_angles();
     assert!(

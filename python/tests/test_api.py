@@ -294,7 +294,7 @@ def test_verify_a_pose_file_like_the_command_line(robots, tmp_path):
 
 def test_solves_release_the_gil():
     text = subprocess.run(
-        ["restpose", "generate", "chain", "--size", "400"],
+        ["restpose", "generate", "chain", "--size", "2000"],
         check=True,
         capture_output=True,
         text=True,

@@ -126,6 +126,8 @@ pub(crate) fn stability_touching(
     backend: Backend,
     eigenvalues: bool,
 ) -> Option<Stability> {
+    let (held, weak) = both_stops_held(strong, weak);
+    let (strong, weak) = (held.as_slice(), weak.as_slice());
     if weak.is_empty() {
         return crate::solver::stability_on(model, state, strong, backend, eigenvalues);
     }
@@ -184,6 +186,36 @@ pub(crate) fn stability_touching(
         s.tolerance = tol;
         s
     })
+}
+
+/// A joint whose two stops both touch without a force (a `[l, l]` range: urdfdom's reading of
+/// a `<limit>` without bounds, as on pybullet_data's minitaur knees) is held both ways:
+/// `a · d ≥ 0` and `−a · d ≥ 0` leave `a · d = 0`, which one of its stops held as a row says
+/// exactly; a weak stop whose other stop carries a force adds nothing (`a · d = 0` already).
+/// Returns the strong list with those rows and the weak ones left. Without this, the eight
+/// knees' sixteen weak stops exceed [`MAX_WEAK`] and the verdict fell back to the tangent space
+/// of the strong rows alone, where the knees were free: "neutral" with six zero eigenvalues.
+fn both_stops_held(strong: &[Active], weak: &[Active]) -> (Vec<Active>, Vec<Active>) {
+    let stop = |a: &Active| match a.row {
+        unilateral::Unilateral::Limit { joint, bound, .. } => Some((joint, bound)),
+        unilateral::Unilateral::Contact { .. } => None,
+    };
+    let mut held = strong.to_vec();
+    let mut left = Vec::with_capacity(weak.len());
+    for w in weak {
+        if let Some((joint, bound)) = stop(w) {
+            let opposite = |a: &Active| stop(a).is_some_and(|(j, b)| j == joint && b != bound);
+            if held.iter().any(opposite) {
+                continue;
+            }
+            if weak.iter().any(opposite) {
+                held.push(*w);
+                continue;
+            }
+        }
+        left.push(*w);
+    }
+    (held, left)
 }
 
 #[cfg(test)]

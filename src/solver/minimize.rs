@@ -46,7 +46,7 @@ use super::stability::at_rest::for_minimizer;
 use super::stability::spectrum::Spectrum;
 use super::step::line_search::{line_search, Line, Trial};
 use super::step::newton::newton_step;
-use super::step::path_hessian::along_path;
+use super::step::path_hessian::{along_path, path_keeps_rows};
 use super::step::quasi_newton::QuasiNewton;
 use super::step::retraction::independent_change;
 use super::step::step_cap::{cap_step, Step};
@@ -366,10 +366,11 @@ fn reduced_step(
         nc * scale
     } else {
         match (eig, options.method) {
-            (Some(e), Method::Newton) if e.exact => {
+            (Some(e), Method::Newton) if e.exact && path_keeps_rows(sys) => {
                 // The Hessian along the search path (module `step::path_hessian`).
                 newton_step(&along_path(sys, &s.q, &s.part, &s.eval, e), g)
             }
+            (Some(e), Method::Newton) if e.exact => newton_step(e, g),
             (_, Method::Newton) => {
                 super::step::kkt_direction::kkt_direction(sys, &s.q, &s.part, &s.eval)
             }

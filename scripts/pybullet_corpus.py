@@ -346,12 +346,7 @@ def main():
                 print(f"{head} Pinocchio: {e}  FAIL")
                 continue
             row.update(fk=fk, energy=de, residual=res, scale=scale)
-            if fk > 1e-9:
-                bad.append(f"forward kinematics differ by {fk:.1e} m")
-            if de > 1e-9 * scale:
-                bad.append(f"gravity energy differs by {de:.1e} J")
-            if converged and res > 1e-6 * scale:
-                bad.append(f"g(q) − τ held = {res:.1e} (scale {scale:.1e})")
+            bad += pc.disagreements(fk, de, res, scale, converged)
             if bad:
                 failures.append(f"{name}: " + "; ".join(bad))
             row["agree"] = not bad

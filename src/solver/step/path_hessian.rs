@@ -179,25 +179,7 @@ mod tests {
     use crate::state::State;
     use crate::urdf::{load_str, ImportOptions};
 
-    const ARM: &str = r#"<robot name="arm">
-  <link name="base"/>
-  <link name="a"><inertial><origin xyz="0.1 0 0.2"/><mass value="1"/>
-    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
-  <link name="b"><inertial><origin xyz="0 0.1 -0.1"/><mass value="1"/>
-    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
-  <link name="c"><inertial><origin xyz="0.2 0 0"/><mass value="1"/>
-    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
-  <link name="d"><inertial><origin xyz="0 0 -0.3"/><mass value="1"/>
-    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
-  <joint name="pan" type="revolute"><parent link="base"/><child link="a"/>
-    <origin xyz="0 0 0.1"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
-  <joint name="slide" type="prismatic"><parent link="a"/><child link="b"/>
-    <origin xyz="0.1 0 0.3" rpy="0.3 0 0"/><axis xyz="1 0 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
-  <joint name="roll" type="continuous"><parent link="b"/><child link="c"/>
-    <origin xyz="0 0.2 0" rpy="0 0.4 0.1"/><axis xyz="1 1 0"/></joint>
-  <joint name="lift" type="revolute"><parent link="c"/><child link="d"/>
-    <origin xyz="0.4 0 0"/><axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
-</robot>"#;
+    use crate::solver::step::retraction::tests::ARM;
 
     /// `C` equals the central second differences of `∇fᵀ v̂` along the search path, on a
     /// fixed and a floating base, away from equilibrium.

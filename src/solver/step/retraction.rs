@@ -177,4 +177,4 @@ fn screw(phi: &Vector3<f64>, u: &Vector3<f64>) -> (Vector4<f64>, Vector3<f64>) {
 
 #[cfg(test)]
 #[path = "retraction_tests.rs"]
-mod tests;
+pub(crate) mod tests;

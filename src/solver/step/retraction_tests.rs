@@ -8,7 +8,9 @@ use crate::state::State;
 use crate::urdf::{load_str, ImportOptions};
 use nalgebra::DVector;
 
-const ARM: &str = r#"<robot name="arm">
+/// An arm with a prismatic, a continuous, a branch and a fixed joint (also the path Hessian's
+/// test model, module `path_hessian`).
+pub(crate) const ARM: &str = r#"<robot name="arm">
   <link name="base"/>
   <link name="a"><inertial><origin xyz="0.1 0 0.2"/><mass value="1"/>
     <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>

@@ -16,7 +16,7 @@ use restpose::{Options, Termination};
 
 /// `robots/ur5_class.urdf` without its springs and initial values: the bare arm, starting
 /// straight out (q = 0) and hanging freely under gravity.
-fn bare_ur5() -> restpose::Model {
+pub(super) fn bare_ur5() -> restpose::Model {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/robots/ur5_class.urdf");
     let text: String = std::fs::read_to_string(path)
         .unwrap()

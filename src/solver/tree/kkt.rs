@@ -18,7 +18,7 @@
 //! path's. Values, factors and scratch are allocated once per structure.
 
 use super::dense;
-use super::shape::{Shape, SKIP};
+use super::shape::{Shape, FIRST, SKIP};
 use crate::solver::partition::Partition;
 use crate::solver::sparse::hessian::BlockHessian;
 use crate::solver::sparse::kkt::Factored;
@@ -110,27 +110,28 @@ impl TreeKkt {
         hess: &BlockHessian,
     ) {
         // Every slot holds one pair of unknowns (module `shape`): a `W` entry takes the value of
-        // one Hessian block entry, stored; a Jacobian entry the sum of its triplets, zeroed
-        // first. The slots of neither (the zero blocks of the rows) stay zero from allocation,
-        // and the diagonal is zeroed for a coordinate without a block (a shift left there).
+        // one Hessian block entry, stored; a Jacobian entry the sum of its triplets, the first
+        // stored (as `0 + v`: the same value as zeroing and adding, signed zeros included) and
+        // the others added, in triplet order. The slots of neither (the zero blocks of the
+        // rows) stay zero from allocation, and the diagonal of a coordinate without a block is
+        // zeroed (a shift left there).
         self.shifts.clear();
         let s = &self.shape;
         let values = &mut self.values;
-        for &slot in &s.diag_slots {
+        for &slot in &s.bare_diag {
             values[slot as usize] = 0.0;
-        }
-        for slots in &s.jac_slots {
-            for &slot in slots {
-                if slot != SKIP {
-                    values[slot as usize] = 0.0;
-                }
-            }
         }
         hess.scatter_scaled_store(&s.block_slots, scale, values);
         for (e, slots) in entries.iter().zip(&s.jac_slots) {
+            let v = e.2 * row_scale[e.0] * scale[e.1];
             for &slot in slots {
                 if slot != SKIP {
-                    values[slot as usize] += e.2 * row_scale[e.0] * scale[e.1];
+                    let at = &mut values[(slot & !FIRST) as usize];
+                    if slot & FIRST != 0 {
+                        *at = 0.0 + v;
+                    } else {
+                        *at += v;
+                    }
                 }
             }
         }

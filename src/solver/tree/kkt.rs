@@ -271,7 +271,7 @@ impl TreeKkt {
         let mut bpiv = std::mem::take(&mut self.border_piv);
         let got = s
             .border
-            .factor(&mut border, &mut bpiv, |x, _| self.tree_solve(x, lu), !lu);
+            .factor(&mut border, &mut bpiv, |x, lo, _| self.tree_solve_from(x, lu, lo), !lu);
         self.border = border;
         self.border_piv = bpiv;
         match got? {
@@ -283,9 +283,17 @@ impl TreeKkt {
 
     /// `x ← T⁻¹ x` over the tree part (tree-space order; the border untouched).
     fn tree_solve(&self, x: &mut [f64], lu: bool) {
+        self.tree_solve_from(x, lu, 0);
+    }
+
+    /// [`TreeKkt::tree_solve`] for an `x` that is zero before the tree-space position `lo`:
+    /// the forward pass starts at the node holding `lo` (the nodes before it, leaves whose
+    /// right side is zero, would pass zeros on; the backward pass fills every node).
+    fn tree_solve_from(&self, x: &mut [f64], lu: bool, lo: usize) {
         let s = &self.shape;
         let nodes = s.at.len();
-        for i in 0..nodes {
+        let first = s.at.partition_point(|&a| a <= lo).saturating_sub(1);
+        for i in first..nodes {
             let (at, d, w) = (s.at[i], s.d[i], s.w[i]);
             let blk = &self.factors[s.diag_at[i]..s.diag_at[i] + d * d];
             let (head, tail) = x.split_at_mut(at + d);

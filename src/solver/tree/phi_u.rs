@@ -19,6 +19,7 @@
 
 use super::border::Border;
 use super::dense;
+use super::shape::FIRST;
 use crate::solver::partition::Partition;
 use std::sync::Arc;
 
@@ -55,8 +56,10 @@ pub(crate) struct TreeSplit {
     id: usize,
     triplets: usize,
     shape: Arc<Shape>,
-    /// Where each Jacobian triplet goes in the factor buffer (the last slot: nowhere).
+    /// Where each Jacobian triplet goes in the factor buffer (the last slot: nowhere), with
+    /// [`FIRST`] on the first triplet of each slot; the slots no triplet reaches.
     slots: Vec<u32>,
+    unreached: Vec<u32>,
     pool: Vec<Arc<TreeLu>>,
 }
 
@@ -205,11 +208,23 @@ impl TreeSplit {
         }
         // The triplets no block holds go to the spare last slot.
         let spare = u32::try_from(len - 1).ok()?;
+        if len >= FIRST as usize {
+            return None;
+        }
         for s in &mut slots {
             if *s == u32::MAX {
                 *s = spare;
             }
         }
+        // Each slot's first triplet stores, the others add; the slots no triplet reaches are
+        // zeroed (the factors of the last point are in place).
+        let mut reached = vec![false; len];
+        for s in &mut slots {
+            if !std::mem::replace(&mut reached[*s as usize], true) {
+                *s |= FIRST;
+            }
+        }
+        let unreached = (0..len as u32).filter(|&k| !reached[k as usize]).collect();
         Some(TreeSplit {
             id: part.id,
             triplets: entries.len(),
@@ -227,6 +242,7 @@ impl TreeSplit {
                 len,
             }),
             slots,
+            unreached,
             pool: Vec::new(),
         })
     }
@@ -252,12 +268,20 @@ impl TreeSplit {
             }),
         };
         if let Some(f) = Arc::get_mut(&mut lu) {
-            // One pass, no branch: every triplet adds into its slot (in the triplets' order,
-            // so the sums are those of a block-by-block scatter).
-            f.vals.iter_mut().for_each(|v| *v = 0.0);
+            // One pass: every triplet adds into its slot in the triplets' order (so the sums
+            // are those of a block-by-block scatter), the first one of a slot stores `0 + v`
+            // (the value of adding it to zero); the slots no triplet reaches are zeroed.
             let vals = &mut f.vals[..];
+            for &k in &self.unreached {
+                vals[k as usize] = 0.0;
+            }
             for (&slot, e) in self.slots.iter().zip(entries) {
-                vals[slot as usize] += e.2;
+                let at = &mut vals[(slot & !FIRST) as usize];
+                if slot & FIRST != 0 {
+                    *at = 0.0 + e.2;
+                } else {
+                    *at += e.2;
+                }
             }
             f.ok = f.factor_blocks();
         }
@@ -292,7 +316,7 @@ impl TreeLu {
         let mut piv = std::mem::take(&mut self.border_piv);
         let ok = shape
             .border
-            .factor(&mut border, &mut piv, |x, t| self.tree_solve(x, t), false)
+            .factor(&mut border, &mut piv, |x, _, hi| self.tree_solve_to(x, hi), false)
             .is_some();
         self.vals[range].copy_from_slice(&border);
         self.border_piv = piv;
@@ -303,9 +327,37 @@ impl TreeLu {
     fn tree_solve(&self, x: &mut [f64], transpose: bool) {
         let s = &*self.shape;
         let nodes = s.span.len();
+        if !transpose {
+            self.solve_nodes(x, nodes);
+            return;
+        }
         let (diag, rest) = self.vals.split_at(s.off0);
         let off = &rest[..s.border0 - s.off0];
-        if !transpose {
+        for i in 0..nodes {
+            let (a, b) = s.span[i];
+            let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];
+            dense::lu_solve_transpose(blk, &self.piv[a..b], b - a, &mut x[a..b]);
+            for k in s.off_at[i]..s.off_at[i + 1] {
+                let (p, q) = s.off[k];
+                x[q as usize] -= off[k] * x[p as usize];
+            }
+        }
+    }
+
+    /// `T x = r` for an `r` that is zero after the position `hi`: the nodes after the one
+    /// holding `hi` have a zero right side and only later nodes' entries (last node first),
+    /// so their part of `x` is zero and the solve starts at that node.
+    fn tree_solve_to(&self, x: &mut [f64], hi: usize) {
+        let s = &*self.shape;
+        self.solve_nodes(x, s.span.partition_point(|&(a, _)| a <= hi));
+    }
+
+    /// `T x = r` over the first `nodes` nodes, last first.
+    fn solve_nodes(&self, x: &mut [f64], nodes: usize) {
+        let s = &*self.shape;
+        let (diag, rest) = self.vals.split_at(s.off0);
+        let off = &rest[..s.border0 - s.off0];
+        {
             for i in (0..nodes).rev() {
                 for k in s.off_at[i]..s.off_at[i + 1] {
                     let (p, q) = s.off[k];
@@ -314,16 +366,6 @@ impl TreeLu {
                 let (a, b) = s.span[i];
                 let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];
                 dense::lu_solve(blk, &self.piv[a..b], b - a, &mut x[a..b], 1);
-            }
-        } else {
-            for i in 0..nodes {
-                let (a, b) = s.span[i];
-                let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];
-                dense::lu_solve_transpose(blk, &self.piv[a..b], b - a, &mut x[a..b]);
-                for k in s.off_at[i]..s.off_at[i + 1] {
-                    let (p, q) = s.off[k];
-                    x[q as usize] -= off[k] * x[p as usize];
-                }
             }
         }
     }

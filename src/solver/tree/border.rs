@@ -10,6 +10,9 @@
 //! ```
 //!
 //! and for the transposed system `Sᵀ` with `Tᵀ`: two tree solves per solve, `k` to form `S`.
+//! A column of `C` reaches one or two bodies (a loop or contact row): its solve `T⁻¹ c` is
+//! zero outside the nodes it can reach from there, and the caller's block solve starts at the
+//! column's first (or last) tree entry instead of the end of the tree.
 
 use super::dense;
 

@@ -16,6 +16,12 @@
 //! `y_i = K_i⁻¹ r_i`, `r_p −= C_iᵀ y_i` from the leaves and `x_i = y_i − X_i x_p` back from
 //! the root, then the border (module `border`), then iterative refinement like the sparse
 //! path's. Values, factors and scratch are allocated once per structure.
+//!
+//! Assembly writes every slot once per Newton step without clearing the values first: a `W`
+//! entry stores its (scaled) Hessian block entry, a Jacobian entry stores its first triplet
+//! `0 + d_r J_rc s_c` and adds the others in triplet order (the first of each slot flagged
+//! once per structure, module `shape`), and only the diagonal slots that no Hessian block
+//! writes are zeroed: the same sums, in the same order, as zeroing and adding.
 
 use super::dense;
 use super::shape::{Shape, FIRST, SKIP};
@@ -269,9 +275,12 @@ impl TreeKkt {
         self.border.copy_from_slice(&self.values[s.flat_len..]);
         let mut border = std::mem::take(&mut self.border);
         let mut bpiv = std::mem::take(&mut self.border_piv);
-        let got = s
-            .border
-            .factor(&mut border, &mut bpiv, |x, lo, _| self.tree_solve_from(x, lu, lo), !lu);
+        let got = s.border.factor(
+            &mut border,
+            &mut bpiv,
+            |x, lo, _| self.tree_solve_from(x, lu, lo),
+            !lu,
+        );
         self.border = border;
         self.border_piv = bpiv;
         match got? {

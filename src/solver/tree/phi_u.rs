@@ -15,7 +15,9 @@
 //! with one LU with partial pivoting per diagonal block (`≤ 7 × 7`) and no fill. Nodes with an
 //! entry before their own (the rows closing a loop, pivoted last) form a **border** `B`; with
 //! `T` the rest, `Φ_u = [T C; R D]` is solved through the dense Schur complement
-//! `S = D − R T⁻¹ C` (module `border`).
+//! `S = D − R T⁻¹ C` (module `border`). The values are refilled from the triplets in one
+//! pass per factorization: each slot's first triplet stores, later ones add (in triplet
+//! order), and the slots no triplet reaches are zeroed (the last factors are in place).
 
 use super::border::Border;
 use super::dense;
@@ -316,7 +318,12 @@ impl TreeLu {
         let mut piv = std::mem::take(&mut self.border_piv);
         let ok = shape
             .border
-            .factor(&mut border, &mut piv, |x, _, hi| self.tree_solve_to(x, hi), false)
+            .factor(
+                &mut border,
+                &mut piv,
+                |x, _, hi| self.tree_solve_to(x, hi),
+                false,
+            )
             .is_some();
         self.vals[range].copy_from_slice(&border);
         self.border_piv = piv;

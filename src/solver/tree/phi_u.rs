@@ -15,13 +15,10 @@
 //! with one LU with partial pivoting per diagonal block (`≤ 7 × 7`) and no fill. Nodes with an
 //! entry before their own (the rows closing a loop, pivoted last) form a **border** `B`; with
 //! `T` the rest, `Φ_u = [T C; R D]` is solved through the dense Schur complement
-//! `S = D − R T⁻¹ C` (module `border`). The values are refilled from the triplets in one
-//! pass per factorization: each slot's first triplet stores, later ones add (in triplet
-//! order), and the slots no triplet reaches are zeroed (the last factors are in place).
+//! `S = D − R T⁻¹ C` (module `border`).
 
 use super::border::Border;
 use super::dense;
-use super::shape::FIRST;
 use crate::solver::partition::Partition;
 use std::sync::Arc;
 
@@ -58,10 +55,8 @@ pub(crate) struct TreeSplit {
     id: usize,
     triplets: usize,
     shape: Arc<Shape>,
-    /// Where each Jacobian triplet goes in the factor buffer (the last slot: nowhere), with
-    /// [`FIRST`] on the first triplet of each slot; the slots no triplet reaches.
+    /// Where each Jacobian triplet goes in the factor buffer (the last slot: nowhere).
     slots: Vec<u32>,
-    unreached: Vec<u32>,
     pool: Vec<Arc<TreeLu>>,
 }
 
@@ -210,23 +205,11 @@ impl TreeSplit {
         }
         // The triplets no block holds go to the spare last slot.
         let spare = u32::try_from(len - 1).ok()?;
-        if len >= FIRST as usize {
-            return None;
-        }
         for s in &mut slots {
             if *s == u32::MAX {
                 *s = spare;
             }
         }
-        // Each slot's first triplet stores, the others add; the slots no triplet reaches are
-        // zeroed (the factors of the last point are in place).
-        let mut reached = vec![false; len];
-        for s in &mut slots {
-            if !std::mem::replace(&mut reached[*s as usize], true) {
-                *s |= FIRST;
-            }
-        }
-        let unreached = (0..len as u32).filter(|&k| !reached[k as usize]).collect();
         Some(TreeSplit {
             id: part.id,
             triplets: entries.len(),
@@ -244,7 +227,6 @@ impl TreeSplit {
                 len,
             }),
             slots,
-            unreached,
             pool: Vec::new(),
         })
     }
@@ -270,20 +252,12 @@ impl TreeSplit {
             }),
         };
         if let Some(f) = Arc::get_mut(&mut lu) {
-            // One pass: every triplet adds into its slot in the triplets' order (so the sums
-            // are those of a block-by-block scatter), the first one of a slot stores `0 + v`
-            // (the value of adding it to zero); the slots no triplet reaches are zeroed.
+            // One pass, no branch: every triplet adds into its slot (in the triplets' order,
+            // so the sums are those of a block-by-block scatter).
+            f.vals.iter_mut().for_each(|v| *v = 0.0);
             let vals = &mut f.vals[..];
-            for &k in &self.unreached {
-                vals[k as usize] = 0.0;
-            }
             for (&slot, e) in self.slots.iter().zip(entries) {
-                let at = &mut vals[(slot & !FIRST) as usize];
-                if slot & FIRST != 0 {
-                    *at = 0.0 + e.2;
-                } else {
-                    *at += e.2;
-                }
+                vals[slot as usize] += e.2;
             }
             f.ok = f.factor_blocks();
         }
@@ -364,16 +338,14 @@ impl TreeLu {
         let s = &*self.shape;
         let (diag, rest) = self.vals.split_at(s.off0);
         let off = &rest[..s.border0 - s.off0];
-        {
-            for i in (0..nodes).rev() {
-                for k in s.off_at[i]..s.off_at[i + 1] {
-                    let (p, q) = s.off[k];
-                    x[p as usize] -= off[k] * x[q as usize];
-                }
-                let (a, b) = s.span[i];
-                let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];
-                dense::lu_solve(blk, &self.piv[a..b], b - a, &mut x[a..b], 1);
+        for i in (0..nodes).rev() {
+            for k in s.off_at[i]..s.off_at[i + 1] {
+                let (p, q) = s.off[k];
+                x[p as usize] -= off[k] * x[q as usize];
             }
+            let (a, b) = s.span[i];
+            let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];
+            dense::lu_solve(blk, &self.piv[a..b], b - a, &mut x[a..b], 1);
         }
     }
 

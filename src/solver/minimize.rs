@@ -52,6 +52,7 @@ use super::step::retraction::independent_change;
 use super::step::step_cap::{cap_step, Step};
 use super::system::{Backend, Eval, System};
 use super::unbounded::LinearDescent;
+use super::valley::{Valley, STALL};
 use nalgebra::DVector;
 
 /// Outcome of the minimization.
@@ -122,6 +123,9 @@ struct Search {
     /// Consecutive full capped steps along which the gradient did not change.
     linear_steps: usize,
     descent: LinearDescent,
+    /// A step stalled where the reduced Hessian has a valley's spectral gap: the line search
+    /// brings its trial points back to the floor from then on (module `valley`).
+    in_valley: bool,
 }
 
 /// What the convergence test found.
@@ -167,6 +171,7 @@ pub(crate) fn minimize(
         just_repartitioned: false,
         linear_steps: 0,
         descent: LinearDescent::default(),
+        in_valley: false,
     };
     let mut termination = Termination::MaxIterations;
     let mut eigen = None;
@@ -213,12 +218,20 @@ pub(crate) fn minimize(
         } else {
             s.reach
         };
+        // In a curved valley, from the first stalled step on (module `valley`).
+        let stalled = s.history.len() >= 2
+            && s.history[s.history.len() - 1].gradient_norm
+                > STALL * s.history[s.history.len() - 2].gradient_norm;
+        let valley = eig.as_ref().and_then(Valley::of);
+        s.in_valley |= stalled && valley.is_some();
+        let valley = valley.filter(|_| s.in_valley);
         let line = Line {
             q: &s.q,
             part: &s.part,
             eval: &s.eval,
             dq: &step.dq,
             slope,
+            valley: valley.as_ref(),
         };
         let trial = line_search(sys, &line, alpha, guard, options, &mut s.diag);
         match trial {

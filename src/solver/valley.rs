@@ -1,0 +1,167 @@
+//! Curved valleys: a trial point of the line search brought back to the valley floor along
+//! the stiff eigenvectors of the reduced Hessian before it is judged.
+//!
+//! Where the reduced Hessian has a few near-neutral directions (a hanging leg whose centre of
+//! mass lies almost on its hip-yaw axis: curvature `ε″ ≈ 10⁻⁹ N m/rad`) well apart from the
+//! rest, the energy near the floor of the valley reads `V ≈ ½ k (θ − a(ψ))² + ε(ψ)`, `ψ` the
+//! soft coordinate, `θ` the stiff ones. Off the floor the soft curvature is
+//! `ε″ − (∂V/∂θ) a″`: a stiff gradient of 10⁻⁶ already hides `ε″`, the Newton step along `ψ`
+//! is a few per cent of the way, and the straight step leaves the curved floor by `½ a″ Δψ²`,
+//! which brings the stiff gradient back. The iteration crawls (iCub reduced hanging: 36
+//! iterations in one active-set round, the hip yaw moving 0.4 rad by 0.01 rad a step, the energy
+//! changing below its rounding).
+//!
+//! The remedy is the second-order correction of constrained optimization applied to the
+//! valley: at a trial point `v̂ + α d` with reduced gradient `g`, the stiff Newton step
+//!
+//! `δ = −Σ_{i stiff} w_i (w_iᵀ g) / λ_i`
+//!
+//! (`λ_i, w_i` the eigenpairs of the reduced Hessian at `v̂`, the stiff ones those above a
+//! spectral gap of [`GAP`]) moves the trial point back to the floor, and the line search judges
+//! the corrected point (kept only where it lowers the merit). The next iterate then sits on the
+//! floor, its soft curvature is `ε″` itself and the Newton step along `ψ` goes the whole way.
+//! It is used only where the iteration has stalled: the gradient fell by less than
+//! [`STALL`] over the last step and the spectrum has the gap.
+//!
+//! ## References
+//! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §15.6
+//!   (second-order correction), §3.4.
+//! - H. H. Rosenbrock, An automatic method for finding the greatest or least value of a
+//!   function, *Computer Journal* 3 (1960) 175–184 (the curved valley).
+
+use super::options::Options;
+use super::partition::Partition;
+use super::report::Diagnostics;
+use super::stability::spectrum::Spectrum;
+use super::system::{Eval, System};
+use nalgebra::{DMatrix, DVector};
+
+/// The ratio between the smallest stiff and the largest soft eigenvalue magnitude that
+/// separates a valley's floor from its walls.
+pub(crate) const GAP: f64 = 1e3;
+
+/// A step after which the reduced gradient is above this fraction of what it was has stalled
+/// (a Newton step in its quadratic range cuts it by far more).
+pub(crate) const STALL: f64 = 0.1;
+
+/// A valley's soft curvature is resolved above this fraction of the largest eigenvalue (the
+/// dense Newton step's floor, module `step::newton`).
+pub(crate) const RESOLVED: f64 = 1e-12;
+
+/// The stiff eigenpairs of the reduced Hessian at the start of a line search.
+pub(crate) struct Valley {
+    vectors: DMatrix<f64>,
+    values: DVector<f64>,
+}
+
+impl Valley {
+    /// The valley of the spectrum `e`, where it has a gap of [`GAP`] between its soft
+    /// eigenvalues (at most half of them) and its stiff ones, every eigenvalue positive and
+    /// above [`RESOLVED`] of the largest.
+    pub(crate) fn of(e: &Spectrum) -> Option<Valley> {
+        let n = e.values.len();
+        if !e.exact || n < 2 {
+            return None;
+        }
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by(|&a, &b| e.values[a].abs().total_cmp(&e.values[b].abs()));
+        // The widest gap among the lower half of the magnitudes.
+        let (mut split, mut ratio) = (0, 0.0);
+        for k in 0..n / 2 {
+            let r = e.values[order[k + 1]].abs() / e.values[order[k]].abs().max(1e-300);
+            if r > ratio {
+                (split, ratio) = (k + 1, r);
+            }
+        }
+        // A soft eigenvalue at rounding level is a neutral direction (a wrist whose axis
+        // passes through its load), not a valley floor: every rest along it is as good.
+        let resolved = RESOLVED * e.values.amax();
+        if ratio < GAP || order.iter().any(|&i| e.values[i] <= resolved) {
+            return None;
+        }
+        let stiff = &order[split..];
+        Some(Valley {
+            vectors: e.vectors.select_columns(stiff),
+            values: DVector::from_iterator(stiff.len(), stiff.iter().map(|&i| e.values[i])),
+        })
+    }
+
+    /// The stiff Newton step at the reduced gradient `g` (module docs).
+    fn step(&self, g: &DVector<f64>) -> DVector<f64> {
+        let c = self.vectors.tr_mul(g).component_div(&self.values);
+        -(&self.vectors * c)
+    }
+
+    /// The trial point `(q, eval)` moved to the valley floor by one stiff Newton step, when
+    /// that lowers the merit; unchanged otherwise.
+    pub(crate) fn correct(
+        &self,
+        sys: &mut System,
+        part: &Partition,
+        options: &Options,
+        diag: &mut Diagnostics,
+        (q, eval): (DVector<f64>, Eval),
+    ) -> (DVector<f64>, Eval) {
+        let d = self.step(&eval.grad_v);
+        let dq = sys.tangent_step(part, &eval, &d);
+        let mut qc = sys.problem.retraction.point(&q, &dq, 1.0);
+        if sys
+            .correct_from(
+                &mut qc,
+                part,
+                options.constraint_tolerance,
+                options.max_corrector_iterations,
+                Some(&eval.factors),
+            )
+            .is_err()
+        {
+            diag.corrector_failures += 1;
+            return (q, eval);
+        }
+        let Some(ec) = sys.evaluate(&qc, part) else {
+            return (q, eval);
+        };
+        diag.function_evaluations += 1;
+        if ec.merit <= eval.merit && ec.grad_v.amax() < eval.grad_v.amax() {
+            (qc, ec)
+        } else {
+            (q, eval)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spectrum(values: &[f64]) -> Spectrum {
+        let n = values.len();
+        Spectrum {
+            values: DVector::from_row_slice(values),
+            vectors: DMatrix::identity(n, n),
+            largest: values.iter().fold(0.0f64, |m, v| m.max(v.abs())),
+            exact: true,
+            negative_by_inertia: None,
+        }
+    }
+
+    #[test]
+    fn a_gap_of_a_thousand_separates_the_floor_from_the_walls() {
+        let v = Valley::of(&spectrum(&[2.0, 1e-7, 0.02, 70.0])).expect("a valley");
+        // The stiff step leaves the soft component alone and is Newton's on the others.
+        let g = DVector::from_row_slice(&[4.0, 1.0, 0.02, 7.0]);
+        let d = v.step(&g);
+        assert_eq!(d[1], 0.0);
+        assert!(
+            (d[0] + 2.0).abs() < 1e-15 && (d[2] + 1.0).abs() < 1e-15 && (d[3] + 0.1).abs() < 1e-15
+        );
+    }
+
+    #[test]
+    fn no_valley_without_a_gap_with_negative_curvature_or_a_neutral_direction() {
+        assert!(Valley::of(&spectrum(&[1.0, 1e-2, 3.0])).is_none());
+        assert!(Valley::of(&spectrum(&[-1.0, 1e-7, 3.0])).is_none());
+        assert!(Valley::of(&spectrum(&[-1e-7, 1.0, 3.0])).is_none());
+        assert!(Valley::of(&spectrum(&[1e-17, 1.0, 3.0])).is_none());
+    }
+}

@@ -17,11 +17,19 @@
 //! `δ = −Σ_{i stiff} w_i (w_iᵀ g) / λ_i`
 //!
 //! (`λ_i, w_i` the eigenpairs of the reduced Hessian at `v̂`, the stiff ones those above a
-//! spectral gap of [`GAP`]) moves the trial point back to the floor, and the line search judges
+//! spectral gap of [`GAP`]; up to [`CORRECTIONS`] times) moves the trial point back to the floor, and the line search judges
 //! the corrected point (kept only where it lowers the merit). The next iterate then sits on the
 //! floor, its soft curvature is `ε″` itself and the Newton step along `ψ` goes the whole way.
+//! Along the floor the energy may change by less than its rounding: a trial point whose merit
+//! is equal to rounding is then accepted when its gradient along the soft eigenvectors is
+//! smaller ([`Valley::closer`]).
 //! It is used only where the iteration has stalled: the gradient fell by less than
-//! [`STALL`] over the last step and the spectrum has the gap.
+//! [`STALL`] over the last step and the spectrum has the gap; from then on in the round.
+//!
+//! In such a valley the gradient test alone does not place the soft coordinate (a curvature of
+//! 10⁻⁹ N m/rad and a tolerance of 10⁻⁸ J leave it free over radians), so a point that passes
+//! it is taken as the rest only when the Newton step along the soft eigenvectors is below
+//! [`SETTLED`] ([`Watch::unsettled`]).
 //!
 //! ## References
 //! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §15.6
@@ -31,7 +39,7 @@
 
 use super::options::Options;
 use super::partition::Partition;
-use super::report::Diagnostics;
+use super::report::{Diagnostics, Iterate};
 use super::stability::spectrum::Spectrum;
 use super::system::{Eval, System};
 use nalgebra::{DMatrix, DVector};
@@ -48,10 +56,68 @@ pub(crate) const STALL: f64 = 0.1;
 /// dense Newton step's floor, module `step::newton`).
 pub(crate) const RESOLVED: f64 = 1e-12;
 
-/// The stiff eigenpairs of the reduced Hessian at the start of a line search.
+/// A point that passed the gradient test in a valley is settled when the Newton step along
+/// the soft eigenvectors moves no scaled coordinate by more than this (rad, or lengths `L`).
+pub(crate) const SETTLED: f64 = 1e-3;
+
+/// Iterations a round takes past the gradient test to settle the soft coordinates.
+pub(crate) const MAX_SETTLING: usize = 3;
+
+/// Stiff Newton steps that bring a trial point back to the floor at most (the stiff Hessian is
+/// that of the start of the line search: the steps converge linearly).
+pub(crate) const CORRECTIONS: usize = 3;
+
+/// The stiff eigenpairs of the reduced Hessian at the start of a line search, and the soft
+/// ones.
 pub(crate) struct Valley {
     vectors: DMatrix<f64>,
     values: DVector<f64>,
+    soft: Vec<(DVector<f64>, f64)>,
+}
+
+/// The valley watch of one minimization (one active-set round).
+#[derive(Default)]
+pub(crate) struct Watch {
+    /// A step has stalled where the spectrum has a valley's gap.
+    on: bool,
+    /// Iterations taken past the gradient test to settle the soft coordinates.
+    settling: usize,
+}
+
+impl Watch {
+    /// The valley of the spectrum `e` for this step, once a step of the round (`history`,
+    /// its iterates so far) has stalled where the spectrum has the gap.
+    pub(crate) fn step(&mut self, e: Option<&Spectrum>, history: &[Iterate]) -> Option<Valley> {
+        let stalled = match history {
+            [.., a, b] => b.gradient_norm > STALL * a.gradient_norm,
+            _ => false,
+        };
+        let valley = e.and_then(Valley::of);
+        self.on |= stalled && valley.is_some();
+        valley.filter(|_| self.on)
+    }
+
+    /// Whether a point that passed the gradient test is still far from the lowest point of
+    /// its valley: with a soft curvature of 10⁻⁹ N m/rad a gradient tolerance of 10⁻⁸ J
+    /// leaves the soft coordinate free over radians. So the round goes on (at most
+    /// [`MAX_SETTLING`] times) while the Newton step along the soft eigenvectors moves a scaled
+    /// coordinate by more than [`SETTLED`] and their gradient is above ten times the rounding
+    /// floor `floor` of the gradient.
+    pub(crate) fn unsettled(&mut self, e: &Spectrum, g: &DVector<f64>, floor: f64) -> bool {
+        let Some(valley) = Valley::of(e).filter(|_| self.on && self.settling < MAX_SETTLING) else {
+            return false;
+        };
+        let mut d = DVector::zeros(g.len());
+        for (w, l) in &valley.soft {
+            let c = w.dot(g);
+            if c.abs() > 10.0 * floor {
+                d += w * (c / l);
+            }
+        }
+        let far = d.amax() > SETTLED;
+        self.settling += usize::from(far);
+        far
+    }
 }
 
 impl Valley {
@@ -83,6 +149,10 @@ impl Valley {
         Some(Valley {
             vectors: e.vectors.select_columns(stiff),
             values: DVector::from_iterator(stiff.len(), stiff.iter().map(|&i| e.values[i])),
+            soft: order[..split]
+                .iter()
+                .map(|&i| (e.vectors.column(i).into_owned(), e.values[i]))
+                .collect(),
         })
     }
 
@@ -92,41 +162,51 @@ impl Valley {
         -(&self.vectors * c)
     }
 
-    /// The trial point `(q, eval)` moved to the valley floor by one stiff Newton step, when
-    /// that lowers the merit; unchanged otherwise.
+    /// Whether the gradient along the floor (on the soft eigenvectors) is smaller at `g1` than
+    /// at `g0`: the line search's test where the energy along the floor changes below its
+    /// rounding (module docs).
+    pub(crate) fn closer(&self, g0: &DVector<f64>, g1: &DVector<f64>) -> bool {
+        let along = |g: &DVector<f64>| self.soft.iter().map(|(w, _)| w.dot(g).powi(2)).sum::<f64>();
+        along(g1) < along(g0)
+    }
+
+    /// The trial point `(q, eval)` moved to the valley floor by up to [`CORRECTIONS`] stiff
+    /// Newton steps, each kept while it lowers both the merit and the gradient.
     pub(crate) fn correct(
         &self,
         sys: &mut System,
         part: &Partition,
         options: &Options,
         diag: &mut Diagnostics,
-        (q, eval): (DVector<f64>, Eval),
+        (mut q, mut eval): (DVector<f64>, Eval),
     ) -> (DVector<f64>, Eval) {
-        let d = self.step(&eval.grad_v);
-        let dq = sys.tangent_step(part, &eval, &d);
-        let mut qc = sys.problem.retraction.point(&q, &dq, 1.0);
-        if sys
-            .correct_from(
-                &mut qc,
-                part,
-                options.constraint_tolerance,
-                options.max_corrector_iterations,
-                Some(&eval.factors),
-            )
-            .is_err()
-        {
-            diag.corrector_failures += 1;
-            return (q, eval);
+        for _ in 0..CORRECTIONS {
+            let d = self.step(&eval.grad_v);
+            let dq = sys.tangent_step(part, &eval, &d);
+            let mut qc = sys.problem.retraction.point(&q, &dq, 1.0);
+            if sys
+                .correct_from(
+                    &mut qc,
+                    part,
+                    options.constraint_tolerance,
+                    options.max_corrector_iterations,
+                    Some(&eval.factors),
+                )
+                .is_err()
+            {
+                diag.corrector_failures += 1;
+                break;
+            }
+            let Some(ec) = sys.evaluate(&qc, part) else {
+                break;
+            };
+            diag.function_evaluations += 1;
+            if ec.merit > eval.merit || ec.grad_v.amax() >= eval.grad_v.amax() {
+                break;
+            }
+            (q, eval) = (qc, ec);
         }
-        let Some(ec) = sys.evaluate(&qc, part) else {
-            return (q, eval);
-        };
-        diag.function_evaluations += 1;
-        if ec.merit <= eval.merit && ec.grad_v.amax() < eval.grad_v.amax() {
-            (qc, ec)
-        } else {
-            (q, eval)
-        }
+        (q, eval)
     }
 }
 

@@ -114,7 +114,13 @@ pub(crate) fn line_search(
         // Rounding error of V: relative to the size of its terms, not of their sum.
         let roundoff = 1e-12 * eval.energy.magnitude.max(et.energy.magnitude) + f64::MIN_POSITIVE;
         let armijo = ft <= f + 1e-4 * alpha * slope;
-        let flat = (ft - f).abs() <= roundoff && et.grad_v.amax() < 0.5 * gnorm;
+        // (In a curved valley, flat with the gradient along the floor smaller: module
+        // `valley`.)
+        let flat = (ft - f).abs() <= roundoff
+            && (et.grad_v.amax() < 0.5 * gnorm
+                || line
+                    .valley
+                    .is_some_and(|v| v.closer(&eval.grad_v, &et.grad_v)));
         if ft.is_finite() && (armijo || flat) {
             return Some(Trial {
                 q: qt,

@@ -6,7 +6,8 @@
 //! Newton step along the yaw went a few per cent of the way, and the straight step left the
 //! floor again: 80 and 168 iterations on main (603a9e6), 200 without converging at 10⁻⁸. The
 //! line search now brings its trial points back to the floor along the stiff eigenvectors
-//! once a step has stalled there (module `solver::valley`).
+//! once a step has stalled there, and the round ends only where the Newton step along the
+//! floor is short (module `solver::valley`).
 
 use restpose::state::State;
 use restpose::{Options, Termination};
@@ -49,12 +50,12 @@ fn a_leg_in_a_curved_valley_converges_in_few_iterations() {
         load_steps: 1,
         ..Default::default()
     };
-    for (k, main) in [(1e-6, 80), (1e-7, 168)] {
+    for (k, main) in [(1e-6, 80), (1e-7, 168), (1e-8, 200)] {
         let model = leg(k);
         let (state, report) = restpose::solve(&model, &direct).unwrap();
         assert_eq!(report.termination, Termination::Converged, "k = {k}");
         assert!(
-            report.iterations <= 15,
+            report.iterations <= 10,
             "k = {k}: {} iterations (main: {main})",
             report.iterations
         );
@@ -67,7 +68,9 @@ fn a_leg_in_a_curved_valley_converges_in_few_iterations() {
         );
 
         // Independently: the rest hangs the centre of mass straight below the hip,
-        // V = −m g |c| with the spring at rest (ψ = 0 to within the gradient tolerance / k).
+        // V = −m g |c| with the spring at rest, ψ = 0: the gradient test alone would leave ψ
+        // anywhere within 10⁻⁸ J / k (1 rad at k = 10⁻⁸); the Newton step along the valley
+        // placed it.
         let values: restpose::state::JointValues = state.joint_values(&model).into_iter().collect();
         let energy = |joint: &str, delta: f64| {
             let mut v = values.clone();
@@ -83,7 +86,7 @@ fn a_leg_in_a_curved_valley_converges_in_few_iterations() {
         );
         assert!((report.energy.total - v0).abs() < 1e-12);
         let psi = values["hip_yaw"][0];
-        assert!(psi.abs() < 1e-8 / k, "k = {k}: ψ = {psi}");
+        assert!(psi.abs() < 1e-2, "k = {k}: ψ = {psi}");
         // Joint-space central differences: stationary, and a minimum along each joint.
         let h = 1e-4;
         for joint in ["hip_pitch", "hip_roll", "hip_yaw"] {

@@ -17,14 +17,14 @@
 //! `δ = −Σ_{i stiff} w_i (w_iᵀ g) / λ_i`
 //!
 //! (`λ_i, w_i` the eigenpairs of the reduced Hessian at `v̂`, the stiff ones those above a
-//! spectral gap of [`GAP`]; up to [`CORRECTIONS`] times) moves the trial point back to the floor, and the line search judges
-//! the corrected point (kept only where it lowers the merit). The next iterate then sits on the
-//! floor, its soft curvature is `ε″` itself and the Newton step along `ψ` goes the whole way.
-//! Along the floor the energy may change by less than its rounding: a trial point whose merit
-//! is equal to rounding is then accepted when its gradient along the soft eigenvectors is
-//! smaller ([`Valley::closer`]).
-//! It is used only where the iteration has stalled: the gradient fell by less than
-//! [`STALL`] over the last step and the spectrum has the gap; from then on in the round.
+//! spectral gap of [`GAP`]; up to [`CORRECTIONS`] times, each kept where it lowers the merit
+//! and the gradient) moves the trial point back to the floor, and the line search judges the
+//! corrected point. The next iterate then sits on the floor, its soft curvature is `ε″` itself
+//! and the Newton step along `ψ` goes the whole way. Along the floor the energy may change by
+//! less than its rounding: a trial point whose merit is equal to rounding is then accepted when
+//! its gradient along the soft eigenvectors is smaller ([`Valley::closer`]). All this only
+//! where the iteration has stalled (the gradient fell by less than [`STALL`] over the last step)
+//! and the spectrum has the gap; from then on in the round.
 //!
 //! In such a valley the gradient test alone does not place the soft coordinate (a curvature of
 //! 10⁻⁹ N m/rad and a tolerance of 10⁻⁸ J leave it free over radians), so a point that passes
@@ -235,6 +235,33 @@ mod tests {
         assert!(
             (d[0] + 2.0).abs() < 1e-15 && (d[2] + 1.0).abs() < 1e-15 && (d[3] + 0.1).abs() < 1e-15
         );
+    }
+
+    #[test]
+    fn the_floor_gradient_decides_and_a_long_soft_step_is_not_a_rest() {
+        let e = spectrum(&[1e-9, 1.0]);
+        let v = Valley::of(&e).expect("a valley");
+        let g0 = DVector::from_row_slice(&[6e-10, 1e-3]);
+        // Smaller along the floor, larger on the wall: closer to the floor's lowest point.
+        assert!(v.closer(&g0, &DVector::from_row_slice(&[1e-10, 1e-2])));
+        assert!(!v.closer(&g0, &DVector::from_row_slice(&[-7e-10, 0.0])));
+        // 6·10⁻¹⁰ J below the gradient tolerance, but the Newton step along the floor is
+        // 0.6 rad: not settled, once the round is in the valley, and at most MAX_SETTLING times.
+        let g = DVector::from_row_slice(&[6e-10, 0.0]);
+        let mut watch = Watch::default();
+        assert!(!watch.unsettled(&e, &g, 1e-12));
+        watch.on = true;
+        for _ in 0..MAX_SETTLING {
+            assert!(watch.unsettled(&e, &g, 1e-12));
+        }
+        assert!(!watch.unsettled(&e, &g, 1e-12));
+        // Settled: a step of 10⁻⁴; or a soft gradient at the rounding floor.
+        let mut watch = Watch {
+            on: true,
+            settling: 0,
+        };
+        assert!(!watch.unsettled(&e, &DVector::from_row_slice(&[1e-13, 0.0]), 1e-12));
+        assert!(!watch.unsettled(&e, &DVector::from_row_slice(&[6e-10, 0.0]), 1e-10));
     }
 
     #[test]

@@ -132,9 +132,11 @@ pub(crate) fn joint_spectrum(
     let t = DMatrix::from_fn(rows.len(), dof, |r, c| {
         rows[r].iter().map(|&(g, x)| x * z[(g, c)]).sum()
     });
-    // An orthonormal basis of T's range, then the rows with the most independent motion.
-    let svd = super::eigen::svd(t.clone(), true, false)?;
-    let u = svd.u.as_ref()?;
+    // Every coordinate selectable and as many as the degrees of freedom (a tree of scalar
+    // joints): all are chosen (the rows of an orthogonal `U` stay of norm 1 through the
+    // Gram–Schmidt steps), and only the rank is needed from the decomposition.
+    let all = rows.len() == dof && selectable.iter().all(|&s| s);
+    let svd = super::eigen::svd(t.clone(), !all, false)?;
     let top = svd.singular_values.max();
     let rank = svd
         .singular_values
@@ -144,34 +146,41 @@ pub(crate) fn joint_spectrum(
     if rank < dof || top <= 0.0 {
         return None;
     }
-    let cols: Vec<usize> = (0..svd.singular_values.len())
-        .filter(|&k| svd.singular_values[k] > 1e-9 * top)
-        .collect();
-    let mut basis = DMatrix::from_fn(rows.len(), dof, |r, c| u[(r, cols[c])]);
-    let mut chosen = Vec::with_capacity(dof);
-    for _ in 0..dof {
-        let (best, norm) = (0..rows.len())
-            .filter(|&r| selectable[r] && !chosen.contains(&r))
-            .map(|r| (r, basis.row(r).norm()))
-            .fold((usize::MAX, 0.0), |a, b| {
-                if b.1 > a.1 * (1.0 + 1e-9) {
-                    b
-                } else {
-                    a
-                }
-            });
-        if best == usize::MAX || norm <= 1e-9 {
-            return None;
+    let chosen: Vec<usize> = if all {
+        (0..dof).collect()
+    } else {
+        // An orthonormal basis of T's range, then the rows with the most independent motion.
+        let u = svd.u.as_ref()?;
+        let cols: Vec<usize> = (0..svd.singular_values.len())
+            .filter(|&k| svd.singular_values[k] > 1e-9 * top)
+            .collect();
+        let mut basis = DMatrix::from_fn(rows.len(), dof, |r, c| u[(r, cols[c])]);
+        let mut chosen = Vec::with_capacity(dof);
+        for _ in 0..dof {
+            let (best, norm) = (0..rows.len())
+                .filter(|&r| selectable[r] && !chosen.contains(&r))
+                .map(|r| (r, basis.row(r).norm()))
+                .fold((usize::MAX, 0.0), |a, b| {
+                    if b.1 > a.1 * (1.0 + 1e-9) {
+                        b
+                    } else {
+                        a
+                    }
+                });
+            if best == usize::MAX || norm <= 1e-9 {
+                return None;
+            }
+            chosen.push(best);
+            let pivot = basis.row(best).transpose() / norm;
+            for r in 0..rows.len() {
+                let d = basis.row(r).dot(&pivot.transpose());
+                let mut row = basis.row_mut(r);
+                row -= pivot.transpose() * d;
+            }
         }
-        chosen.push(best);
-        let pivot = basis.row(best).transpose() / norm;
-        for r in 0..rows.len() {
-            let d = basis.row(r).dot(&pivot.transpose());
-            let mut row = basis.row_mut(r);
-            row -= pivot.transpose() * d;
-        }
-    }
-    chosen.sort_unstable();
+        chosen.sort_unstable();
+        chosen
+    };
     let t_i = DMatrix::from_fn(dof, dof, |r, c| t[(chosen[r], c)]);
     let m = t_i.try_inverse()?;
     let h_theta = m.transpose() * h * &m;

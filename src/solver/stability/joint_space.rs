@@ -111,18 +111,27 @@ fn chart(model: &Model, q: &DVector<f64>) -> Vec<(String, Vec<Row>, bool)> {
 
 /// The reduced Hessian `h` (scaled independent coordinates of `part`) in joint coordinates:
 /// its eigenvalues (ascending) and the mode shape of each of the lowest `shown`, by joint in
-/// file order. `None` where the joint coordinates do not span the feasible motions.
+/// file order (`basis`: the null-space basis `Z` at `q` if at hand). `None` where the joint
+/// coordinates do not span the feasible motions.
 #[allow(clippy::type_complexity)]
 pub(crate) fn joint_spectrum(
     sys: &System,
     q: &DVector<f64>,
     part: &Partition,
     eval: &Eval,
+    basis: Option<&DMatrix<f64>>,
     h: &DMatrix<f64>,
     shown: usize,
 ) -> Option<(Vec<f64>, Vec<Vec<(String, Vec<f64>)>>)> {
     let dof = part.independent.len();
-    let z = sys.null_basis(part, eval);
+    let solved;
+    let z = match basis {
+        Some(z) => z,
+        None => {
+            solved = sys.null_basis(part, eval);
+            &solved
+        }
+    };
     let chart = chart(sys.problem.model, q);
     let rows: Vec<&Row> = chart.iter().flat_map(|(_, r, _)| r).collect();
     let selectable: Vec<bool> = chart

@@ -36,7 +36,11 @@ use crate::solver::system::{Eval, System};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3, Vector4};
 use std::collections::BTreeMap;
 
-/// `C` of the module docs at `q` (`dof × dof`, symmetric).
+/// The per-edge sums `(G_l, M_l, s_l, R_l)` of [`path_curvature`].
+type EdgeSums = (Vector3<f64>, Matrix3<f64>, f64, Vector4<f64>);
+
+/// `C` of the module docs at `q` (`dof × dof`, symmetric), with the null-space basis `Z` at
+/// `q` if it is at hand (else it is solved for).
 ///
 /// The sum over the bodies `b` carrying independent coordinates and the edges `l` above them
 /// is gathered per edge: with `r_b = y_b − x_l`, the gradient weights `w_b` on `b`'s origin
@@ -52,6 +56,7 @@ pub(crate) fn path_curvature(
     q: &DVector<f64>,
     part: &Partition,
     eval: &Eval,
+    basis: Option<&DMatrix<f64>>,
 ) -> DMatrix<f64> {
     let dof = part.independent.len();
     let columns = &sys.problem.scaling.columns;
@@ -61,7 +66,14 @@ pub(crate) fn path_curvature(
     // column i of `omega[l]` and `vel[l]`.
     let mut omega = vec![nalgebra::Matrix3xX::<f64>::zeros(dof); bodies];
     let mut vel = vec![nalgebra::Matrix3xX::<f64>::zeros(dof); bodies];
-    let z = sys.null_basis(part, eval);
+    let solved;
+    let z = match basis {
+        Some(z) => z,
+        None => {
+            solved = sys.null_basis(part, eval);
+            &solved
+        }
+    };
     for i in 0..dof {
         let dq = z.column(i).into_owned();
         for b in 0..bodies {
@@ -76,8 +88,7 @@ pub(crate) fn path_curvature(
         weights.entry(c / 7).or_insert([0.0; 7])[c % 7] += eval.grad_v[k] / columns[c];
     }
     // Per edge l: (G_l, M_l, s_l, R_l) over the weighted bodies below it (module docs).
-    let mut sums: BTreeMap<usize, (Vector3<f64>, Matrix3<f64>, f64, Vector4<f64>)> =
-        BTreeMap::new();
+    let mut sums: BTreeMap<usize, EdgeSums> = BTreeMap::new();
     for (&b, w) in &weights {
         let y = position(q, b);
         let p = Vector4::new(q[7 * b + 3], q[7 * b + 4], q[7 * b + 5], q[7 * b + 6]);
@@ -218,7 +229,7 @@ pub(crate) fn along_path(
     e: &Spectrum,
 ) -> Spectrum {
     let mut h = &e.vectors * DMatrix::from_diagonal(&e.values) * e.vectors.transpose();
-    h += path_curvature(sys, q, part, eval);
+    h += path_curvature(sys, q, part, eval, e.basis.as_ref());
     let h = (&h + h.transpose()) * 0.5;
     let (values, vectors) = symmetric_eigen(&h);
     Spectrum {
@@ -227,6 +238,7 @@ pub(crate) fn along_path(
         vectors,
         exact: true,
         negative_by_inertia: None,
+        basis: None,
     }
 }
 
@@ -259,7 +271,7 @@ mod tests {
             let part = sys.partition(&q);
             let eval = sys.evaluate(&q, &part).unwrap();
             assert!(eval.grad_v.amax() > 0.1, "away from equilibrium");
-            let c = path_curvature(sys, &q, &part, &eval);
+            let c = path_curvature(sys, &q, &part, &eval, None);
             let dof = part.independent.len();
             let columns = &sys.problem.scaling.columns;
             let h = 1e-4;
@@ -304,7 +316,7 @@ mod tests {
             let sys = &mut System::new(&model, Constraints::new(&model, &[]), backend);
             let part = sys.partition(&q);
             let eval = sys.evaluate(&q, &part).unwrap();
-            let c = path_curvature(sys, &q, &part, &eval);
+            let c = path_curvature(sys, &q, &part, &eval, None);
             let dof = part.independent.len();
             let columns = &sys.problem.scaling.columns;
             let parents = sys.problem.retraction.parents();

@@ -53,6 +53,7 @@ mod tests {
             vectors,
             exact: true,
             negative_by_inertia: None,
+            basis: None,
         }
     }
 

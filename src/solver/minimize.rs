@@ -46,7 +46,8 @@ use super::stability::at_rest::for_minimizer;
 use super::stability::spectrum::Spectrum;
 use super::step::line_search::{line_search, Line, Trial};
 use super::step::newton::newton_step;
-use super::step::path_hessian::{along_path, path_keeps_rows};
+use super::step::escape::escape_step;
+use super::step::path_hessian::path_keeps_rows;
 use super::step::quasi_newton::QuasiNewton;
 use super::step::retraction::independent_change;
 use super::step::step_cap::{cap_step, Step};
@@ -202,7 +203,7 @@ pub(crate) fn minimize(
         if s.iteration >= options.max_iterations {
             break;
         }
-        let d = reduced_step(sys, &mut s, eig.as_ref(), negative_curvature, options);
+        let d = reduced_step(sys, &mut s, eig.as_ref(), negative_curvature, guard, options);
         let step = cap_step(sys, &s.part, &s.eval, &s.q, d, options);
         let slope = s.eval.grad_v.dot(&step.d);
         let failures_before = s.diag.corrector_failures;
@@ -355,29 +356,38 @@ fn reduced_step(
     s: &mut Search,
     eig: Option<&Spectrum>,
     negative_curvature: Option<DVector<f64>>,
+    guard: Option<&Guard>,
     options: &Options,
 ) -> DVector<f64> {
     let dof = s.part.independent.len();
     let g = &s.eval.grad_v;
-    let d = if let Some(nc) = negative_curvature {
-        s.diag.negative_curvature_steps += 1;
-        let sign = if nc.dot(g) > 0.0 { -1.0 } else { 1.0 };
-        let scale = sign * options.max_step / nc.amax().max(1e-300);
-        nc * scale
-    } else {
-        match (eig, options.method) {
-            (Some(e), Method::Newton) if e.exact && path_keeps_rows(sys) => {
-                // The Hessian along the search path (module `step::path_hessian`).
-                newton_step(&along_path(sys, &s.q, &s.part, &s.eval, e), g)
-            }
-            (Some(e), Method::Newton) if e.exact => newton_step(e, g),
+    // Where the path keeps every row, the Newton step along it, escaping maxima and saddles
+    // along every direction of negative curvature (module `step::escape`).
+    let along = eig
+        .filter(|e| e.exact && options.method == Method::Newton && path_keeps_rows(sys))
+        .map(|e| escape_step(sys, &s.q, &s.part, &s.eval, e, guard, options));
+    let escaped = matches!(along, Some((_, true)));
+    let saddle = negative_curvature.is_some();
+    let d = match (along, negative_curvature) {
+        (Some((d, _)), nc) if escaped || nc.is_none() => d,
+        (_, Some(nc)) => {
+            let sign = if nc.dot(g) > 0.0 { -1.0 } else { 1.0 };
+            let scale = sign * options.max_step / nc.amax().max(1e-300);
+            nc * scale
+        }
+        _ => match (eig, options.method) {
+            (Some(e), Method::Newton) if e.exact => newton_step(e, g, None).0,
             (_, Method::Newton) => {
                 super::step::kkt_direction::kkt_direction(sys, &s.q, &s.part, &s.eval)
             }
             _ => -(&s.qn.binv * g),
-        }
+        },
     };
-    if d.dot(g) > 0.0 {
+    if escaped || saddle {
+        s.diag.negative_curvature_steps += 1;
+    }
+    // An escape may climb a slope at rounding level to fall to the side with room.
+    if d.dot(g) > 0.0 && !escaped {
         s.qn = QuasiNewton::new(dof, options.method);
         return -g.clone();
     }

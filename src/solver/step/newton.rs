@@ -28,15 +28,45 @@ use nalgebra::DVector;
 /// largest) 80-fold and the solve crawled at the rate `1 − λ/floor`.
 const EIGENVALUE_FLOOR: f64 = 1e-12;
 
-/// The Newton step at the reduced gradient `g` (module docs).
-pub(crate) fn newton_step(e: &Spectrum, g: &DVector<f64>) -> DVector<f64> {
+/// The escape is taken where the magnitude step is shorter than this fraction of the saddle
+/// step `c`: near a stationary point.
+const NEAR_STATIONARY: f64 = 0.1;
+
+/// The Newton step at the reduced gradient `g` (module docs). With `escape = Some(c)` and a
+/// magnitude step shorter than `c` (`‖s‖∞ < c`, near a stationary point), every direction of
+/// negative curvature `v_i` along which `s` moves by less than `c / ‖v_i‖∞` is stepped along
+/// by that length instead, downhill (`−sign(v_iᵀ∇f)`, `+1` where the slope is 0). Returns the
+/// step and the escaped directions with their signed lengths `(i, t_i)`.
+pub(crate) fn newton_step(
+    e: &Spectrum,
+    g: &DVector<f64>,
+    escape: Option<f64>,
+) -> (DVector<f64>, Vec<(usize, f64)>) {
     let floor = EIGENVALUE_FLOOR * e.values.amax().max(1e-12);
-    let mut d = DVector::zeros(g.len());
-    for i in 0..g.len() {
-        let v = e.vectors.column(i);
-        d -= v * (v.dot(g) / e.values[i].abs().max(floor));
+    let n = g.len();
+    let slopes: Vec<f64> = (0..n).map(|i| e.vectors.column(i).dot(g)).collect();
+    let mut t: Vec<f64> = (0..n)
+        .map(|i| -slopes[i] / e.values[i].abs().max(floor))
+        .collect();
+    let step = |t: &[f64]| {
+        let mut d = DVector::zeros(n);
+        for (i, ti) in t.iter().enumerate() {
+            d += e.vectors.column(i) * *ti;
+        }
+        d
+    };
+    let mut escaped = Vec::new();
+    if let Some(c) = escape.filter(|&c| step(&t).amax() < NEAR_STATIONARY * c) {
+        let tol = e.tolerance();
+        for i in (0..n).filter(|&i| e.values[i] < -tol) {
+            let length = c / e.vectors.column(i).amax().max(1e-300);
+            if t[i].abs() < length {
+                t[i] = if slopes[i] > 0.0 { -length } else { length };
+                escaped.push((i, t[i]));
+            }
+        }
     }
-    d
+    (step(&t), escaped)
 }
 
 #[cfg(test)]
@@ -60,7 +90,7 @@ mod tests {
     fn positive_definite_hessian_gives_the_newton_step() {
         let h = DMatrix::from_row_slice(2, 2, &[4.0, 1.0, 1.0, 3.0]);
         let g = DVector::from_vec(vec![1.0, -2.0]);
-        let d = newton_step(&spectrum(&h), &g);
+        let (d, _) = newton_step(&spectrum(&h), &g, None);
         // H d = −g.
         assert!((&h * &d + &g).amax() < 1e-14, "{d}");
     }
@@ -70,7 +100,7 @@ mod tests {
         // f = −½ x² + y²: the step along x is −g_x/|λ| (downhill, away from the maximum).
         let h = DMatrix::from_row_slice(2, 2, &[-1.0, 0.0, 0.0, 2.0]);
         let g = DVector::from_vec(vec![-1e-3, 1.0]);
-        let d = newton_step(&spectrum(&h), &g);
+        let (d, _) = newton_step(&spectrum(&h), &g, None);
         assert!(
             (d[0] - 1e-3).abs() < 1e-15 && (d[1] + 0.5).abs() < 1e-15,
             "{d}"
@@ -82,7 +112,7 @@ mod tests {
     fn near_neutral_directions_are_floored_at_1e_12_of_the_largest() {
         let h = DMatrix::from_diagonal(&DVector::from_vec(vec![1e-20, 1.0]));
         let g = DVector::from_vec(vec![1e-9, 0.0]);
-        let d = newton_step(&spectrum(&h), &g);
+        let (d, _) = newton_step(&spectrum(&h), &g, None);
         assert!((d[0] + 1e-9 / 1e-12).abs() < 1e-9, "{d}");
     }
 }

@@ -1,0 +1,51 @@
+//! The dense Newton step along the search path with the escape from maxima and saddles
+//! (module `newton`): where the path keeps every row (module `path_hessian`), `Ĥ + C` is the
+//! energy's Hessian in the joint coordinates, and near a stationary point (`‖s‖∞ < max_step`)
+//! every direction of negative curvature `v_i` is stepped along by at least
+//! `t_i = max_step / ‖v_i‖∞`.
+//!
+//! Each escaped direction goes downhill (`−sign(v_iᵀ∇f)`) unless its trial point
+//! `R(q, ±t_i v_i)` (the capped step alone, along the path) crosses an inactive stop or
+//! contact of the round's guard and the other sign's does not: on a maximum the slope is at
+//! rounding level and says nothing, while a finger pointing up with 0.2 rad before its back
+//! stop and 1.6 rad before its front one has a side to fall to (the Allegro hands of
+//! example-robot-data rest 0.06 and 0.12 J lower that way).
+
+use crate::solver::inequality::active_set::Guard;
+use crate::solver::options::Options;
+use crate::solver::partition::Partition;
+use crate::solver::stability::spectrum::Spectrum;
+use crate::solver::step::newton::newton_step;
+use crate::solver::step::path_hessian::along_path;
+use crate::solver::step::step_cap::cap_step;
+use crate::solver::system::{Eval, System};
+use nalgebra::DVector;
+
+/// The Newton step `d` along the path at `q`, `e` the exact spectrum of `Ĥ` there (module
+/// docs), and whether it escaped along a direction of negative curvature.
+pub(crate) fn escape_step(
+    sys: &mut System,
+    q: &DVector<f64>,
+    part: &Partition,
+    eval: &Eval,
+    e: &Spectrum,
+    guard: Option<&Guard>,
+    options: &Options,
+) -> (DVector<f64>, bool) {
+    let e = &along_path(sys, q, part, eval, e);
+    let (mut d, escaped) = newton_step(e, &eval.grad_v, Some(options.max_step));
+    if let Some(guard) = guard {
+        for &(i, t) in &escaped {
+            let v = e.vectors.column(i).into_owned();
+            let crosses = |sys: &mut System, t: f64| {
+                let step = cap_step(sys, part, eval, q, &v * t, options);
+                let trial = sys.problem.retraction.point(q, &step.dq, 1.0);
+                guard.violated(sys, &trial)
+            };
+            if crosses(sys, t) && !crosses(sys, -t) {
+                d -= v * (2.0 * t);
+            }
+        }
+    }
+    (d, !escaped.is_empty())
+}

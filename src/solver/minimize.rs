@@ -5,13 +5,13 @@
 //! 2. **Convergence test** ([`convergence_test`]): `‖∇f‖∞ ≤ max(gradient_tolerance,
 //!    10⁻¹³ Σ|V_k|)` and, unless `allow_unstable` is set, no negative eigenvalue of the reduced
 //!    Hessian; at a saddle or maximum the search leaves along the eigenvector of the most
-//!    negative one.
-//! 3. **Reduced step** ([`reduced_step`]): Newton `d = −Ĥ⁻¹ ∇f` with the exact reduced
-//!    Hessian taken along the search path (`Ĥ + C`, module `step::path_hessian`), its
-//!    eigenvalues replaced by their magnitudes, floored (dense, module `step::newton`), or the
-//!    KKT direction
-//!    (sparse); BFGS / DFP `d = −B ∇f` (module `step::quasi_newton`); steepest descent when `d` is
-//!    not a descent direction.
+//!    negative one (along every negative one where the path keeps every row, as in stage 3).
+//! 3. **Reduced step** ([`reduced_step`]): Newton `d = −Ĥ⁻¹ ∇f` with the exact reduced Hessian
+//!    along the search path (`Ĥ + C`, module `step::path_hessian`), its eigenvalues replaced by
+//!    their magnitudes, floored (dense, module `step::newton`), near a maximum or saddle at
+//!    least a saddle step along every direction of negative curvature (module `step::escape`),
+//!    or the KKT direction (sparse); BFGS / DFP `d = −B ∇f` (module `step::quasi_newton`);
+//!    steepest descent when `d` is not a descent direction (an escape excepted).
 //! 4. **Step cap** (module `step::step_cap`): the tangent step `δq = Z d` limited on the motion of the
 //!    whole mechanism (every body's Euler parameters by `max_step`, its origin by
 //!    `10 max_step ℓ`, `ℓ` the larger of the length scale and the mechanism's extent).
@@ -44,9 +44,9 @@ use super::partition::Partition;
 use super::report::{Diagnostics, Iterate, Termination};
 use super::stability::at_rest::for_minimizer;
 use super::stability::spectrum::Spectrum;
+use super::step::escape::escape_step;
 use super::step::line_search::{line_search, Line, Trial};
 use super::step::newton::newton_step;
-use super::step::escape::escape_step;
 use super::step::path_hessian::path_keeps_rows;
 use super::step::quasi_newton::QuasiNewton;
 use super::step::retraction::independent_change;
@@ -203,7 +203,14 @@ pub(crate) fn minimize(
         if s.iteration >= options.max_iterations {
             break;
         }
-        let d = reduced_step(sys, &mut s, eig.as_ref(), negative_curvature, guard, options);
+        let d = reduced_step(
+            sys,
+            &mut s,
+            eig.as_ref(),
+            negative_curvature,
+            guard,
+            options,
+        );
         let step = cap_step(sys, &s.part, &s.eval, &s.q, d, options);
         let slope = s.eval.grad_v.dot(&step.d);
         let failures_before = s.diag.corrector_failures;
@@ -348,9 +355,9 @@ fn convergence_test(
     (eig, test)
 }
 
-/// Stage 3: the reduced step `d` (module docs): along the negative-curvature direction at a
-/// saddle, else Newton or quasi-Newton; steepest descent (and a reset quasi-Newton matrix)
-/// when that is not a descent direction.
+/// Stage 3: the reduced step `d` (module docs): the escaping Newton step along the path, else
+/// along the negative-curvature direction at a saddle, else Newton or quasi-Newton; steepest
+/// descent (and a reset quasi-Newton matrix) when that is not a descent direction.
 fn reduced_step(
     sys: &mut System,
     s: &mut Search,
@@ -361,13 +368,14 @@ fn reduced_step(
 ) -> DVector<f64> {
     let dof = s.part.independent.len();
     let g = &s.eval.grad_v;
-    // Where the path keeps every row, the Newton step along it, escaping maxima and saddles
-    // along every direction of negative curvature (module `step::escape`).
+    // Where the path keeps every row, the Newton step along it (module `step::escape`).
     let along = eig
         .filter(|e| e.exact && options.method == Method::Newton && path_keeps_rows(sys))
         .map(|e| escape_step(sys, &s.q, &s.part, &s.eval, e, guard, options));
-    let escaped = matches!(along, Some((_, true)));
-    let saddle = negative_curvature.is_some();
+    let (escaped, saddle) = (
+        matches!(along, Some((_, true))),
+        negative_curvature.is_some(),
+    );
     let d = match (along, negative_curvature) {
         (Some((d, _)), nc) if escaped || nc.is_none() => d,
         (_, Some(nc)) => {
@@ -383,10 +391,7 @@ fn reduced_step(
             _ => -(&s.qn.binv * g),
         },
     };
-    if escaped || saddle {
-        s.diag.negative_curvature_steps += 1;
-    }
-    // An escape may climb a slope at rounding level to fall to the side with room.
+    s.diag.negative_curvature_steps += usize::from(escaped || saddle);
     if d.dot(g) > 0.0 && !escaped {
         s.qn = QuasiNewton::new(dof, options.method);
         return -g.clone();

@@ -11,6 +11,7 @@
 //! stop and 1.6 rad before its front one has a side to fall to (the Allegro hands of
 //! example-robot-data rest 0.06 and 0.12 J lower that way).
 
+use crate::forces::potential;
 use crate::solver::inequality::active_set::Guard;
 use crate::solver::options::Options;
 use crate::solver::partition::Partition;
@@ -33,19 +34,29 @@ pub(crate) fn escape_step(
     options: &Options,
 ) -> (DVector<f64>, bool) {
     let e = &along_path(sys, q, part, eval, e);
-    let (mut d, escaped) = newton_step(e, &eval.grad_v, Some(options.max_step));
-    if let Some(guard) = guard {
-        for &(i, t) in &escaped {
-            let v = e.vectors.column(i).into_owned();
-            let crosses = |sys: &mut System, t: f64| {
-                let step = cap_step(sys, part, eval, q, &v * t, options);
-                let trial = sys.problem.retraction.point(q, &step.dq, 1.0);
-                guard.violated(sys, &trial)
-            };
-            if crosses(sys, t) && !crosses(sys, -t) {
-                d -= v * (2.0 * t);
+    let (mut d, candidates) = newton_step(e, &eval.grad_v, Some(options.max_step));
+    let mut escaped = false;
+    for &(i, t, newton) in &candidates {
+        let v = e.vectors.column(i).into_owned();
+        let (lambda, slope) = (e.values[i], v.dot(&eval.grad_v));
+        // The energy along the path falls by at least half the model's decrease, and no
+        // inactive inequality is crossed.
+        let falls = |sys: &mut System, t: f64| {
+            let step = cap_step(sys, part, eval, q, &v * t, options);
+            let trial = sys.problem.retraction.point(q, &step.dq, 1.0);
+            if guard.is_some_and(|g| g.violated(sys, &trial)) {
+                return false;
             }
-        }
+            let s = step.d.dot(&v);
+            let model = slope * s + 0.5 * lambda * s * s;
+            let mut grad = DVector::zeros(q.len());
+            let m = sys.problem.model;
+            potential(m, &sys.problem.cons.branches, &trial, &mut grad, None)
+                .is_some_and(|v| v.total - eval.energy.total <= 0.5 * model)
+        };
+        let chosen = [t, -t].into_iter().find(|&t| falls(sys, t));
+        d += &v * (chosen.unwrap_or(newton) - t);
+        escaped |= chosen.is_some();
     }
-    (d, !escaped.is_empty())
+    (d, escaped)
 }

@@ -36,12 +36,13 @@ const NEAR_STATIONARY: f64 = 0.1;
 /// magnitude step shorter than `c` (`‖s‖∞ < c`, near a stationary point), every direction of
 /// negative curvature `v_i` along which `s` moves by less than `c / ‖v_i‖∞` is stepped along
 /// by that length instead, downhill (`−sign(v_iᵀ∇f)`, `+1` where the slope is 0). Returns the
-/// step and the escaped directions with their signed lengths `(i, t_i)`.
+/// step and the escaped directions `(i, t_i, s_i)`: the escape's signed length and the
+/// magnitude step's.
 pub(crate) fn newton_step(
     e: &Spectrum,
     g: &DVector<f64>,
     escape: Option<f64>,
-) -> (DVector<f64>, Vec<(usize, f64)>) {
+) -> (DVector<f64>, Vec<(usize, f64, f64)>) {
     let floor = EIGENVALUE_FLOOR * e.values.amax().max(1e-12);
     let n = g.len();
     let slopes: Vec<f64> = (0..n).map(|i| e.vectors.column(i).dot(g)).collect();
@@ -61,8 +62,9 @@ pub(crate) fn newton_step(
         for i in (0..n).filter(|&i| e.values[i] < -tol) {
             let length = c / e.vectors.column(i).amax().max(1e-300);
             if t[i].abs() < length {
+                let newton = t[i];
                 t[i] = if slopes[i] > 0.0 { -length } else { length };
-                escaped.push((i, t[i]));
+                escaped.push((i, t[i], newton));
             }
         }
     }
@@ -114,5 +116,42 @@ mod tests {
         let g = DVector::from_vec(vec![1e-9, 0.0]);
         let (d, _) = newton_step(&spectrum(&h), &g, None);
         assert!((d[0] + 1e-9 / 1e-12).abs() < 1e-9, "{d}");
+    }
+
+    #[test]
+    fn near_a_maximum_every_negative_direction_is_left_by_a_saddle_step() {
+        // f = −½ x² − 2 y² + z² near its top in x and y (‖s‖∞ = 2·10⁻⁸ < 0.1 c).
+        let h = DMatrix::from_diagonal(&DVector::from_vec(vec![-1.0, -4.0, 1.0]));
+        let g = DVector::from_vec(vec![-2e-8, 0.0, 1e-9]);
+        let (d, escaped) = newton_step(&spectrum(&h), &g, Some(0.3));
+        // Downhill along x (−sign g_x), +1 along y where the slope is 0, Newton along z.
+        assert!(
+            (d[0] - 0.3).abs() < 1e-15 && (d[1].abs() - 0.3).abs() < 1e-15,
+            "{d}"
+        );
+        assert!((d[2] + 1e-9).abs() < 1e-20, "{d}");
+        assert_eq!(escaped.len(), 2);
+        for (i, t, newton) in escaped {
+            assert!((d[i] - t).abs() < 1e-15);
+            assert!(newton.abs() < 1e-7, "the magnitude step was {newton}");
+        }
+    }
+
+    #[test]
+    fn away_from_stationary_points_the_step_is_the_magnitude_step() {
+        // ‖s‖∞ = 0.5 ≥ 0.1 c: no escape, the step along x stays −g_x/|λ| however short.
+        let h = DMatrix::from_diagonal(&DVector::from_vec(vec![-1.0, 2.0]));
+        let g = DVector::from_vec(vec![-1e-6, 1.0]);
+        let (d, escaped) = newton_step(&spectrum(&h), &g, Some(0.3));
+        assert!(escaped.is_empty());
+        assert!(
+            (d[0] - 1e-6).abs() < 1e-18 && (d[1] + 0.5).abs() < 1e-15,
+            "{d}"
+        );
+        // Curvature within the spectrum's tolerance is not negative.
+        let h = DMatrix::from_diagonal(&DVector::from_vec(vec![-1e-12, 1.0]));
+        let g = DVector::from_vec(vec![1e-9, 1e-9]);
+        let (_, escaped) = newton_step(&spectrum(&h), &g, Some(0.3));
+        assert!(escaped.is_empty());
     }
 }

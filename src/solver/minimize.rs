@@ -44,10 +44,8 @@ use super::partition::Partition;
 use super::report::{Diagnostics, Iterate, Termination};
 use super::stability::at_rest::for_minimizer;
 use super::stability::spectrum::Spectrum;
-use super::step::escape::escape_step;
+use super::step::direction::direction;
 use super::step::line_search::{line_search, Line, Trial};
-use super::step::newton::newton_step;
-use super::step::path_hessian::path_keeps_rows;
 use super::step::quasi_newton::QuasiNewton;
 use super::step::retraction::independent_change;
 use super::step::step_cap::{cap_step, Step};
@@ -368,29 +366,16 @@ fn reduced_step(
 ) -> DVector<f64> {
     let dof = s.part.independent.len();
     let g = &s.eval.grad_v;
-    // Where the path keeps every row, the Newton step along it (module `step::escape`).
-    let along = eig
-        .filter(|e| e.exact && options.method == Method::Newton && path_keeps_rows(sys))
-        .map(|e| escape_step(sys, &s.q, &s.part, &s.eval, e, guard, options));
-    let (escaped, saddle) = (
-        matches!(along, Some((_, true))),
-        negative_curvature.is_some(),
+    let (d, escaped) = direction(
+        sys,
+        (&s.q, &s.part, &s.eval),
+        eig,
+        negative_curvature.as_ref(),
+        &s.qn.binv,
+        guard,
+        options,
     );
-    let d = match (along, negative_curvature) {
-        (Some((d, _)), nc) if escaped || nc.is_none() => d,
-        (_, Some(nc)) => {
-            let sign = if nc.dot(g) > 0.0 { -1.0 } else { 1.0 };
-            let scale = sign * options.max_step / nc.amax().max(1e-300);
-            nc * scale
-        }
-        _ => match (eig, options.method) {
-            (Some(e), Method::Newton) if e.exact => newton_step(e, g, None).0,
-            (_, Method::Newton) => {
-                super::step::kkt_direction::kkt_direction(sys, &s.q, &s.part, &s.eval)
-            }
-            _ => -(&s.qn.binv * g),
-        },
-    };
+    let saddle = negative_curvature.is_some();
     s.diag.negative_curvature_steps += usize::from(escaped || saddle);
     if d.dot(g) > 0.0 && !escaped {
         s.qn = QuasiNewton::new(dof, options.method);

@@ -7,13 +7,23 @@
 //! a descent direction whatever the inertia.
 //!
 //! Along a direction of curvature `λ < 0` it moves by `−(vᵀ∇f)/|λ|`, which near a maximum or
-//! a saddle (`vᵀ∇f ≈ λ x`) is the step `x → 2x`: from the upright start of example-robot-data's
-//! double pendulum the distance doubles per iteration (38 iterations, 16 of them doubling,
-//! then 16 more from a saddle). Adding a saddle-sized step along the directions of negative
-//! curvature (Moré & Sorensen's descent pair) takes it to 10, and was tried and not adopted
-//! (docs/method.md, "The Newton step along the path"): the longer early steps send falls to
-//! other equilibria (a far tractor start, a limp Solo-12) and an unbalanced ball on the
-//! ground was reported unbounded.
+//! a saddle (`vᵀ∇f ≈ λ x`) is the step `x → 2x`: from a start with every leg straight up
+//! (pybullet_data's minitaurs, ‖∇f‖ = 10⁻⁸) the distance doubled per iteration, and the legs
+//! fell one after another, 27 iterations each (57–151 iterations).
+//!
+//! The escape (module `escape`, where the path keeps every row): near a stationary point,
+//! `‖d‖∞ < 0.1 c` (`c = max_step`), each direction of curvature `λ_i < −τ` (`τ` the
+//! spectrum's tolerance) along which `d` moves by less than `c_i = c / ‖v_i‖∞` gets the length
+//! `t_i = −sign(v_iᵀ∇f) c_i` (`+c_i` where the slope is 0) instead of its magnitude step:
+//!
+//! `d = −Σ_{i ∉ E} v_i (v_iᵀ∇f) / max(|λ_i|, ε λ_max) + Σ_{i ∈ E} t_i v_i`,
+//!
+//! all at once, each direction scaled like the step that leaves a saddle (Moré & Sorensen's
+//! direction of negative curvature, taken per eigen-direction instead of as one combined
+//! vector). Module `escape` keeps a direction in `E` only where the energy along the path
+//! falls as the curvature says. Away from stationary points (`‖d‖∞ ≥ 0.1 c`) the step is the
+//! magnitude step: a combined step `s + n` taken there as well (tried in session 22) sent
+//! falls to other equilibria (Panda +0.18 J; docs/method.md).
 //!
 //! ## References
 //! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §3.4.
@@ -29,11 +39,14 @@ use nalgebra::DVector;
 const EIGENVALUE_FLOOR: f64 = 1e-12;
 
 /// The escape is taken where the magnitude step is shorter than this fraction of the saddle
-/// step `c`: near a stationary point.
+/// step `c`: near a stationary point. At 1 (escaping in the middle of falls too, without the
+/// energy test of module `escape`), G1 and the classical simple humanoid of
+/// example-robot-data ended `max_iterations`; with no such bound iCub took 59 → 120
+/// iterations.
 const NEAR_STATIONARY: f64 = 0.1;
 
 /// The Newton step at the reduced gradient `g` (module docs). With `escape = Some(c)` and a
-/// magnitude step shorter than `c` (`‖s‖∞ < c`, near a stationary point), every direction of
+/// magnitude step shorter than `0.1 c` (near a stationary point), every direction of
 /// negative curvature `v_i` along which `s` moves by less than `c / ‖v_i‖∞` is stepped along
 /// by that length instead, downhill (`−sign(v_iᵀ∇f)`, `+1` where the slope is 0). Returns the
 /// step and the escaped directions `(i, t_i, s_i)`: the escape's signed length and the

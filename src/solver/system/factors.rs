@@ -83,29 +83,29 @@ impl Factors {
         }
     }
 
-    /// The smallest pivot of `U` over the largest (dense; `None` for the sparse factors): a
-    /// cheap measure of how well the dependent coordinates are determined by the independent
-    /// rows at this configuration.
+    /// The smallest pivot of `U` over the largest (dense; the tree factors: over their
+    /// diagonal blocks and border; `None` for the sparse factors): a cheap measure of how well
+    /// the dependent coordinates are determined by the independent rows at this configuration.
     pub(crate) fn pivot_ratio(&self) -> Option<f64> {
         match self {
             Factors::Dense { lu, .. } => {
                 let d = lu.u().diagonal().abs();
                 Some(if d.is_empty() { 1.0 } else { d.min() / d.max() })
             }
-            Factors::Sparse(_) | Factors::Tree(_) => None,
+            Factors::Tree(f) => f.pivot_ratio(),
+            Factors::Sparse(_) => None,
         }
     }
 
-    /// Whether `Φ_u` has become ill-conditioned (dense: a pivot of `U` below `1e-8` of the
-    /// largest; the sparse factors do not tell, and the minimizer re-partitions when the
-    /// corrector or the line search fails instead).
+    /// Whether `Φ_u` has become ill-conditioned (dense and tree: a pivot below `1e-8` of the
+    /// largest, [`Factors::pivot_ratio`]; the sparse factors do not tell, and the minimizer
+    /// re-partitions when the corrector or the line search fails instead).
     pub(crate) fn ill_conditioned(&self) -> bool {
         match self {
-            Factors::Dense { lu, .. } => {
-                let d = lu.u().diagonal().abs();
-                !d.is_empty() && d.min() < 1e-8 * d.max()
+            Factors::Dense { .. } | Factors::Tree(_) => {
+                self.pivot_ratio().is_some_and(|r| r < 1e-8)
             }
-            Factors::Sparse(_) | Factors::Tree(_) => false,
+            Factors::Sparse(_) => false,
         }
     }
 }

@@ -56,6 +56,16 @@ impl Border {
         self.positions.len()
     }
 
+    /// The smallest and largest magnitude of the pivots of `S` in the factored `values`
+    /// ([`Border::factor`]).
+    pub(crate) fn pivot_range(&self, values: &[f64]) -> (f64, f64) {
+        let (k, s) = (self.size(), &values[self.entries.len()..]);
+        (0..k).fold((f64::INFINITY, 0.0), |(lo, hi), b| {
+            let v = s[b * k + b].abs();
+            (lo.min(v), hi.max(v))
+        })
+    }
+
     /// Length of the values: the entries, then `S` (`k × k`, row-major).
     pub(crate) fn len(&self) -> usize {
         self.entries.len() + self.positions.len().pow(2)

@@ -371,6 +371,31 @@ impl TreeLu {
         x.iter().all(|v| v.is_finite())
     }
 
+    /// The smallest pivot of the diagonal blocks' `U` (and of the border's `S`) over the
+    /// largest: how well the dependent coordinates are determined by the independent rows (an
+    /// Euler parameter taken as independent near its turning point folds the chart and makes
+    /// its body's block nearly singular); `None` if the factors failed.
+    pub(crate) fn pivot_ratio(&self) -> Option<f64> {
+        if !self.ok {
+            return None;
+        }
+        let s = &*self.shape;
+        let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+        for i in 0..s.span.len() {
+            let d = s.span[i].1 - s.span[i].0;
+            let blk = &self.vals[s.diag_at[i]..s.diag_at[i + 1]];
+            for k in 0..d {
+                let v = blk[k * d + k].abs();
+                (lo, hi) = (lo.min(v), hi.max(v));
+            }
+        }
+        if !s.border.is_empty() {
+            let (a, b) = s.border.pivot_range(&self.vals[s.border0..s.v0]);
+            (lo, hi) = (lo.min(a), hi.max(b));
+        }
+        Some(if hi > 0.0 { lo / hi } else { 1.0 })
+    }
+
     /// Pivots in the border (0 on a tree).
     #[cfg(test)]
     pub(crate) fn border_size(&self) -> usize {

@@ -85,9 +85,9 @@ pub(crate) struct Outcome {
 /// default 1e-8 J only for models whose energy terms add up to more than 10⁵ J.
 const GRADIENT_FLOOR: f64 = 1e-13;
 
-/// A dense partition whose smallest-to-largest pivot ratio of `Φ_u` has fallen below this
-/// fraction of its value where the partition was made is checked against a fresh one: as the
-/// mechanism moves, the dependent coordinates chosen at the start lose their hold (an Euler
+/// A dense or tree partition whose smallest-to-largest pivot ratio of `Φ_u` has fallen below
+/// this fraction of its value where the partition was made is checked against a fresh one: as
+/// the mechanism moves, the dependent coordinates chosen at the start lose their hold (an Euler
 /// parameter near a turning point), `H = −Φ_u⁻¹ Φ_v` grows, the reduced Hessian's eigenvalues
 /// spread with it and its floor swallows the physical curvatures (a UR5 swinging down from
 /// horizontal stalled at ‖∇f‖ = 10⁻² for 200 iterations).
@@ -444,8 +444,8 @@ fn accept_step(
         || (0..q.len()).any(|i| i % 7 < 3 && q[i].abs() > 1e6 * sys.problem.model.length_scale)
 }
 
-/// Stage 7: re-partitions when `Φ_u` has become ill-conditioned, or (a dense partition) when
-/// its pivots have drifted and a fresh full pivoting differs, or (a sparse partition with
+/// Stage 7: re-partitions when `Φ_u` has become ill-conditioned, or (a dense or tree partition)
+/// when its pivots have drifted and a fresh full pivoting differs, or (a sparse partition with
 /// second-pass choices) when the partition at `q` makes other ones. (Not on any change: where
 /// a carried row ends in the final full pivoting among nearly equal levers would flip from
 /// step to step.) `None` when the evaluation at `q` fails.

@@ -28,7 +28,9 @@
 //!    shrinking towards an obstacle's edge end the round, module `inequality::stall`).
 //! 7. **Refresh the partition** ([`refresh_partition`], paper step (b)): anew when `Φ_u` is
 //!    ill-conditioned, when its pivots have drifted ([`PIVOT_DRIFT`]) and a fresh full
-//!    pivoting differs, or when a sparse partition's second-pass choices change. When the
+//!    pivoting differs, when a sparse partition's second-pass choices change, or when a sparse
+//!    or tree partition needed a failed correction on the accepted step and a fresh one
+//!    differs (a folded chart). When the
 //!    line search finds no step, the coordinates are re-partitioned once at the current
 //!    point; a second failure ends the minimization.
 //!
@@ -251,7 +253,8 @@ pub(crate) fn minimize(
                     termination = Termination::LineSearchFailed;
                     break;
                 }
-                refresh_partition(sys, &mut s)?;
+                let corrector_failed = s.diag.corrector_failures > failures_before;
+                refresh_partition(sys, &mut s, corrector_failed)?;
             }
             None if !s.just_repartitioned => {
                 repartition(sys, &mut s)?;
@@ -434,10 +437,15 @@ fn accept_step(
 
 /// Stage 7: re-partitions when `Φ_u` has become ill-conditioned, or (a dense partition) when
 /// its pivots have drifted and a fresh full pivoting differs, or (a sparse partition with
-/// second-pass choices) when the partition at `q` makes other ones. (Not on any change: where
-/// a carried row ends in the final full pivoting among nearly equal levers would flip from
-/// step to step.) `None` when the evaluation at `q` fails.
-fn refresh_partition(sys: &mut System, s: &mut Search) -> Option<()> {
+/// second-pass choices) when the partition at `q` makes other ones, or (a sparse or tree
+/// partition, whose factors have no pivots to watch) when the accepted step needed a failed
+/// correction and a fresh partition differs: an independent coordinate at its extremum (a
+/// motor body's Euler parameter as the motor turns to π) folds the chart, `Φ_u` turns singular
+/// and every search halves to nothing without failing outright (a minitaur with its knee loops
+/// closed: 80 iterations at one energy). (Not on any change: where a carried row ends in the
+/// final full pivoting among nearly equal levers would flip from step to step.) `None` when the
+/// evaluation at `q` fails.
+fn refresh_partition(sys: &mut System, s: &mut Search, corrector_failed: bool) -> Option<()> {
     let drifted = match (s.eval.factors.pivot_ratio(), s.pivot_reference) {
         (Some(now), Some(reference)) => now < PIVOT_DRIFT * reference,
         _ => false,
@@ -455,6 +463,11 @@ fn refresh_partition(sys: &mut System, s: &mut Search) -> Option<()> {
     } else if !s.part.second_pass.is_empty() {
         let fresh = sys.partition(&s.q);
         if fresh.second_pass != s.part.second_pass {
+            adopt(sys, s, fresh)?;
+        }
+    } else if corrector_failed && sys.backend != Backend::Dense {
+        let fresh = sys.partition(&s.q);
+        if !same_split(&fresh, &s.part) {
             adopt(sys, s, fresh)?;
         }
     }

@@ -28,11 +28,9 @@
 //!    shrinking towards an obstacle's edge end the round, module `inequality::stall`).
 //! 7. **Refresh the partition** ([`refresh_partition`], paper step (b)): anew when `Φ_u` is
 //!    ill-conditioned, when its pivots have drifted ([`PIVOT_DRIFT`]) and a fresh full
-//!    pivoting differs, when a sparse partition's second-pass choices change, or when a sparse
-//!    or tree partition needed a failed correction on the accepted step and a fresh one
-//!    differs (a folded chart). When the
-//!    line search finds no step, the coordinates are re-partitioned once at the current
-//!    point; a second failure ends the minimization.
+//!    pivoting differs, when a sparse partition's second-pass choices change or (sparse, tree)
+//!    a fresh one differs after a failed correction. When the line search finds no step, the
+//!    coordinates are re-partitioned once at the current point; a second failure ends it.
 //!
 //! ## References
 //! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §3.1, §3.4, §6.1.
@@ -437,14 +435,11 @@ fn accept_step(
 
 /// Stage 7: re-partitions when `Φ_u` has become ill-conditioned, or (a dense partition) when
 /// its pivots have drifted and a fresh full pivoting differs, or (a sparse partition with
-/// second-pass choices) when the partition at `q` makes other ones, or (a sparse or tree
-/// partition, whose factors have no pivots to watch) when the accepted step needed a failed
-/// correction and a fresh partition differs: an independent coordinate at its extremum (a
-/// motor body's Euler parameter as the motor turns to π) folds the chart, `Φ_u` turns singular
-/// and every search halves to nothing without failing outright (a minitaur with its knee loops
-/// closed: 80 iterations at one energy). (Not on any change: where a carried row ends in the
-/// final full pivoting among nearly equal levers would flip from step to step.) `None` when the
-/// evaluation at `q` fails.
+/// second-pass choices) when the partition at `q` makes other ones, or (sparse or tree factors,
+/// which have no pivots to watch) when a fresh one differs after a step that needed a failed
+/// correction (a folded chart: docs/method.md, "Re-partition"). (Not on any change: where a
+/// carried row ends in the final full pivoting among nearly equal levers would flip from step
+/// to step.) `None` when the evaluation at `q` fails.
 fn refresh_partition(sys: &mut System, s: &mut Search, corrector_failed: bool) -> Option<()> {
     let drifted = match (s.eval.factors.pivot_ratio(), s.pivot_reference) {
         (Some(now), Some(reference)) => now < PIVOT_DRIFT * reference,
@@ -460,14 +455,12 @@ fn refresh_partition(sys: &mut System, s: &mut Search, corrector_failed: bool) -
             adopt(sys, s, fresh)?;
         }
         s.pivot_reference = s.eval.factors.pivot_ratio();
-    } else if !s.part.second_pass.is_empty() {
+    } else if !s.part.second_pass.is_empty() || (corrector_failed && sys.backend != Backend::Dense)
+    {
         let fresh = sys.partition(&s.q);
-        if fresh.second_pass != s.part.second_pass {
-            adopt(sys, s, fresh)?;
-        }
-    } else if corrector_failed && sys.backend != Backend::Dense {
-        let fresh = sys.partition(&s.q);
-        if !same_split(&fresh, &s.part) {
+        if fresh.second_pass != s.part.second_pass
+            || (s.part.second_pass.is_empty() && !same_split(&fresh, &s.part))
+        {
             adopt(sys, s, fresh)?;
         }
     }

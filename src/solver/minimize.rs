@@ -22,7 +22,9 @@
 //!    sparse partition from the reach the corrector last managed ([`Search::reach`]). With a
 //!    guard, a step that would violate an inactive inequality is cut where the first one
 //!    reaches its boundary, and the minimization stops there (`Outcome::blocked`: the
-//!    inequality update is the caller's, folder `inequality`).
+//!    inequality update is the caller's, folder `inequality`). In a curved valley the trial
+//!    points are brought back to its floor first, and the test of stage 2 also asks the
+//!    Newton step along the valley to be short (module `valley`).
 //! 6. **Accept** ([`accept_step`]): quasi-Newton update, and the unbounded test (a linear
 //!    descent that goes on, module `unbounded`); with inequalities, the stall test (steps
 //!    shrinking towards an obstacle's edge end the round, module `inequality::stall`).
@@ -52,6 +54,7 @@ use super::step::retraction::independent_change;
 use super::step::step_cap::{cap_step, Step};
 use super::system::{Backend, Eval, System};
 use super::unbounded::LinearDescent;
+use super::valley::Watch;
 use nalgebra::DVector;
 
 /// Outcome of the minimization.
@@ -122,6 +125,8 @@ struct Search {
     /// Consecutive full capped steps along which the gradient did not change.
     linear_steps: usize,
     descent: LinearDescent,
+    /// Curved valleys (module `valley`).
+    valley: Watch,
 }
 
 /// What the convergence test found.
@@ -167,6 +172,7 @@ pub(crate) fn minimize(
         just_repartitioned: false,
         linear_steps: 0,
         descent: LinearDescent::default(),
+        valley: Watch::default(),
     };
     let mut termination = Termination::MaxIterations;
     let mut eigen = None;
@@ -188,7 +194,7 @@ pub(crate) fn minimize(
                 break;
             }
         }
-        let (eig, test) = convergence_test(sys, &s, gtol, options);
+        let (eig, test) = convergence_test(sys, &mut s, gtol, options);
         let negative_curvature = match test {
             Test::Converged(e, v) => {
                 eigen = e;
@@ -213,12 +219,15 @@ pub(crate) fn minimize(
         } else {
             s.reach
         };
+        // In a curved valley, from the first stalled step on (module `valley`).
+        let valley = s.valley.step(eig.as_ref(), &s.history);
         let line = Line {
             q: &s.q,
             part: &s.part,
             eval: &s.eval,
             dq: &step.dq,
             slope,
+            valley: valley.as_ref(),
         };
         let trial = line_search(sys, &line, alpha, guard, options, &mut s.diag);
         match trial {
@@ -310,7 +319,7 @@ fn record(s: &mut Search, options: &Options, report: bool) {
 /// Hessian's spectrum when it was needed (for the test, or for a dense Newton step).
 fn convergence_test(
     sys: &mut System,
-    s: &Search,
+    s: &mut Search,
     gtol: f64,
     options: &Options,
 ) -> (Option<Spectrum>, Test) {
@@ -336,11 +345,14 @@ fn convergence_test(
     if gnorm > gtol {
         return (eig, Test::Continue);
     }
+    let rounding = GRADIENT_FLOOR * s.eval.energy.magnitude;
     let test = match &eig {
         Some(e) if !options.allow_unstable => match e.lowest() {
             Some((imin, lmin)) if lmin < -e.tolerance() => {
                 Test::Saddle(e.vectors.column(imin).into_owned())
             }
+            // Not yet at the lowest point of a curved valley (module `valley`).
+            _ if s.valley.unsettled(e, &s.eval.grad_v, rounding) => Test::Continue,
             _ => Test::Converged(Some(e.clone()), None),
         },
         _ => Test::Converged(eig.clone(), verdict),
@@ -451,7 +463,7 @@ fn refresh_partition(sys: &mut System, s: &mut Search, corrector_failed: bool) -
         // The dependent coordinates chosen at the start of this partition are losing their
         // hold: a fresh full pivoting at `q`, adopted if it differs.
         let fresh = sys.partition(&s.q);
-        if !same_split(&fresh, &s.part) {
+        if !fresh.same_split(&s.part) {
             adopt(sys, s, fresh)?;
         }
         s.pivot_reference = s.eval.factors.pivot_ratio();
@@ -487,14 +499,4 @@ fn adopt(sys: &mut System, s: &mut Search, fresh: Partition) -> Option<()> {
     s.part = fresh;
     s.qn = QuasiNewton::new(s.part.independent.len(), s.method);
     Some(())
-}
-
-/// Whether two partitions choose the same dependent coordinates and rows (in any order).
-fn same_split(a: &Partition, b: &Partition) -> bool {
-    let sorted = |x: &[usize]| {
-        let mut x = x.to_vec();
-        x.sort_unstable();
-        x
-    };
-    sorted(&a.dependent) == sorted(&b.dependent) && sorted(&a.rows) == sorted(&b.rows)
 }

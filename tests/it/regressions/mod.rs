@@ -5,6 +5,7 @@ mod issue_12_sparse_verify_angle_branch;
 mod issue_13_floating_base_start;
 mod issue_21_bolt_rolls_over;
 mod issue_21_chain_on_its_stops;
+mod issue_21_curved_valley;
 mod issue_21_falls_found_at_once;
 mod issue_21_free_arm_converges_directly;
 mod issue_21_ground_start;

@@ -445,13 +445,11 @@ fn accept_step(
         || (0..q.len()).any(|i| i % 7 < 3 && q[i].abs() > 1e6 * sys.problem.model.length_scale)
 }
 
-/// Stage 7: re-partitions when `Φ_u` has become ill-conditioned, or (a dense partition) when
-/// its pivots have drifted and a fresh full pivoting differs, or (a sparse partition with
-/// second-pass choices) when the partition at `q` makes other ones, or (sparse or tree factors,
-/// which have no pivots to watch) when a fresh one differs after a step that needed a failed
-/// correction (a folded chart: docs/method.md, "Re-partition"). (Not on any change: where a
-/// carried row ends in the final full pivoting among nearly equal levers would flip from step
-/// to step.) `None` when the evaluation at `q` fails.
+/// Stage 7: re-partitions when `Φ_u` is ill-conditioned, or (dense) when its pivots drifted and
+/// a fresh full pivoting differs, or (sparse, second-pass choices) when the partition at `q`
+/// makes other ones, or (sparse or tree factors) when a fresh one differs after a step that
+/// needed a failed correction (a folded chart: docs/method.md, "Re-partition"). Not on any
+/// change (nearly equal levers would flip from step to step). `None` if evaluating `q` fails.
 fn refresh_partition(sys: &mut System, s: &mut Search, corrector_failed: bool) -> Option<()> {
     let drifted = match (s.eval.factors.pivot_ratio(), s.pivot_reference) {
         (Some(now), Some(reference)) => now < PIVOT_DRIFT * reference,
@@ -471,7 +469,7 @@ fn refresh_partition(sys: &mut System, s: &mut Search, corrector_failed: bool) -
     {
         let fresh = sys.partition(&s.q);
         if fresh.second_pass != s.part.second_pass
-            || (s.part.second_pass.is_empty() && !same_split(&fresh, &s.part))
+            || (s.part.second_pass.is_empty() && !fresh.same_split(&s.part))
         {
             adopt(sys, s, fresh)?;
         }

@@ -114,11 +114,14 @@ fn the_sparse_path_leaves_a_folded_chart() {
     crate::common::assert_verified_minimum(&model, &state);
     // Both upper legs hang straight down (motor angle π; the lower legs' centres of mass lie
     // on the knee axes, so the knees are free): the energy is that of the dense path's rest.
+    // The knees' near-neutral mode (eigenvalue ~1e-9 N m/rad) carries the motors with it by
+    // up to ~1e-5 rad where the search stops along it (knee ±0.20 rad: 1.0e-5 rad; ±0.49 rad:
+    // 3.9e-6 rad), at the same energy to 1e-11 J; a leg not hanging down is off by radians.
     for motor in ["motor_R_joint", "motor_L_joint"] {
         let a = state.joint(&model, motor).unwrap()[0];
         let off = (a - std::f64::consts::PI).rem_euclid(std::f64::consts::TAU);
         let off = off.min(std::f64::consts::TAU - off);
-        assert!(off < 1e-6, "{motor} at {a} rad, not hanging down");
+        assert!(off < 1e-4, "{motor} at {a} rad, not hanging down");
     }
     let (_, _, dense) = solve(LinearAlgebra::Dense);
     assert!(dense.converged());

@@ -5,13 +5,13 @@
 //! 2. **Convergence test** ([`convergence_test`]): `‖∇f‖∞ ≤ max(gradient_tolerance,
 //!    10⁻¹³ Σ|V_k|)` and, unless `allow_unstable` is set, no negative eigenvalue of the reduced
 //!    Hessian; at a saddle or maximum the search leaves along the eigenvector of the most
-//!    negative one.
-//! 3. **Reduced step** ([`reduced_step`]): Newton `d = −Ĥ⁻¹ ∇f` with the exact reduced
-//!    Hessian taken along the search path (`Ĥ + C`, module `step::path_hessian`), its
-//!    eigenvalues replaced by their magnitudes, floored (dense, module `step::newton`), or the
-//!    KKT direction
-//!    (sparse); BFGS / DFP `d = −B ∇f` (module `step::quasi_newton`); steepest descent when `d` is
-//!    not a descent direction.
+//!    negative one (along every negative one where the path keeps every row, as in stage 3).
+//! 3. **Reduced step** ([`reduced_step`]): Newton `d = −Ĥ⁻¹ ∇f` with the exact reduced Hessian
+//!    along the search path (`Ĥ + C`, module `step::path_hessian`), its eigenvalues replaced by
+//!    their magnitudes, floored (dense, module `step::newton`), near a maximum or saddle at
+//!    least a saddle step along every direction of negative curvature (module `step::escape`),
+//!    or the KKT direction (sparse); BFGS / DFP `d = −B ∇f` (module `step::quasi_newton`);
+//!    steepest descent when `d` is not a descent direction (an escape excepted).
 //! 4. **Step cap** (module `step::step_cap`): the tangent step `δq = Z d` limited on the motion of the
 //!    whole mechanism (every body's Euler parameters by `max_step`, its origin by
 //!    `10 max_step ℓ`, `ℓ` the larger of the length scale and the mechanism's extent).
@@ -46,9 +46,8 @@ use super::partition::Partition;
 use super::report::{Diagnostics, Iterate, Termination};
 use super::stability::at_rest::for_minimizer;
 use super::stability::spectrum::Spectrum;
+use super::step::direction::direction;
 use super::step::line_search::{line_search, Line, Trial};
-use super::step::newton::newton_step;
-use super::step::path_hessian::{along_path, path_keeps_rows};
 use super::step::quasi_newton::QuasiNewton;
 use super::step::retraction::independent_change;
 use super::step::step_cap::{cap_step, Step};
@@ -208,7 +207,14 @@ pub(crate) fn minimize(
         if s.iteration >= options.max_iterations {
             break;
         }
-        let d = reduced_step(sys, &mut s, eig.as_ref(), negative_curvature, options);
+        let d = reduced_step(
+            sys,
+            &mut s,
+            eig.as_ref(),
+            negative_curvature,
+            guard,
+            options,
+        );
         let step = cap_step(sys, &s.part, &s.eval, &s.q, d, options);
         let slope = s.eval.grad_v.dot(&step.d);
         let failures_before = s.diag.corrector_failures;
@@ -360,37 +366,31 @@ fn convergence_test(
     (eig, test)
 }
 
-/// Stage 3: the reduced step `d` (module docs): along the negative-curvature direction at a
-/// saddle, else Newton or quasi-Newton; steepest descent (and a reset quasi-Newton matrix)
-/// when that is not a descent direction.
+/// Stage 3: the reduced step `d` (module docs): the escaping Newton step along the path, else
+/// along the negative-curvature direction at a saddle, else Newton or quasi-Newton; steepest
+/// descent (and a reset quasi-Newton matrix) when that is not a descent direction.
 fn reduced_step(
     sys: &mut System,
     s: &mut Search,
     eig: Option<&Spectrum>,
     negative_curvature: Option<DVector<f64>>,
+    guard: Option<&Guard>,
     options: &Options,
 ) -> DVector<f64> {
     let dof = s.part.independent.len();
     let g = &s.eval.grad_v;
-    let d = if let Some(nc) = negative_curvature {
-        s.diag.negative_curvature_steps += 1;
-        let sign = if nc.dot(g) > 0.0 { -1.0 } else { 1.0 };
-        let scale = sign * options.max_step / nc.amax().max(1e-300);
-        nc * scale
-    } else {
-        match (eig, options.method) {
-            (Some(e), Method::Newton) if e.exact && path_keeps_rows(sys) => {
-                // The Hessian along the search path (module `step::path_hessian`).
-                newton_step(&along_path(sys, &s.q, &s.part, &s.eval, e), g)
-            }
-            (Some(e), Method::Newton) if e.exact => newton_step(e, g),
-            (_, Method::Newton) => {
-                super::step::kkt_direction::kkt_direction(sys, &s.q, &s.part, &s.eval)
-            }
-            _ => -(&s.qn.binv * g),
-        }
-    };
-    if d.dot(g) > 0.0 {
+    let (d, escaped) = direction(
+        sys,
+        (&s.q, &s.part, &s.eval),
+        eig,
+        negative_curvature.as_ref(),
+        &s.qn.binv,
+        guard,
+        options,
+    );
+    let saddle = negative_curvature.is_some();
+    s.diag.negative_curvature_steps += usize::from(escaped || saddle);
+    if d.dot(g) > 0.0 && !escaped {
         s.qn = QuasiNewton::new(dof, options.method);
         return -g.clone();
     }

@@ -222,6 +222,7 @@ mod tests {
             largest: values.iter().fold(0.0f64, |m, v| m.max(v.abs())),
             exact: true,
             negative_by_inertia: None,
+            basis: None,
         }
     }
 

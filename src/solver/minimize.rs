@@ -30,9 +30,9 @@
 //!    shrinking towards an obstacle's edge end the round, module `inequality::stall`).
 //! 7. **Refresh the partition** ([`refresh_partition`], paper step (b)): anew when `Φ_u` is
 //!    ill-conditioned, when its pivots have drifted ([`PIVOT_DRIFT`]) and a fresh full
-//!    pivoting differs, or when a sparse partition's second-pass choices change. When the
-//!    line search finds no step, the coordinates are re-partitioned once at the current
-//!    point; a second failure ends the minimization.
+//!    pivoting differs, when a sparse partition's second-pass choices change or (sparse, tree)
+//!    a fresh one differs after a failed correction. When the line search finds no step, the
+//!    coordinates are re-partitioned once at the current point; a second failure ends it.
 //!
 //! ## References
 //! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §3.1, §3.4, §6.1.
@@ -266,7 +266,8 @@ pub(crate) fn minimize(
                     termination = Termination::LineSearchFailed;
                     break;
                 }
-                refresh_partition(sys, &mut s)?;
+                let corrector_failed = s.diag.corrector_failures > failures_before;
+                refresh_partition(sys, &mut s, corrector_failed)?;
             }
             None if !s.just_repartitioned => {
                 repartition(sys, &mut s)?;
@@ -444,12 +445,12 @@ fn accept_step(
         || (0..q.len()).any(|i| i % 7 < 3 && q[i].abs() > 1e6 * sys.problem.model.length_scale)
 }
 
-/// Stage 7: re-partitions when `Φ_u` has become ill-conditioned, or (a dense or tree partition)
-/// when its pivots have drifted and a fresh full pivoting differs, or (a sparse partition with
-/// second-pass choices) when the partition at `q` makes other ones. (Not on any change: where
-/// a carried row ends in the final full pivoting among nearly equal levers would flip from
-/// step to step.) `None` when the evaluation at `q` fails.
-fn refresh_partition(sys: &mut System, s: &mut Search) -> Option<()> {
+/// Stage 7: re-partitions when `Φ_u` is ill-conditioned, or (dense, tree) when its pivots drifted
+/// and a fresh full pivoting differs, or (sparse, second-pass choices) when the partition at `q`
+/// makes other ones, or (sparse or tree factors) when a fresh one differs after a step that
+/// needed a failed correction (a folded chart: docs/method.md, "Re-partition"). Not on any
+/// change (nearly equal levers would flip from step to step). `None` if evaluating `q` fails.
+fn refresh_partition(sys: &mut System, s: &mut Search, corrector_failed: bool) -> Option<()> {
     let drifted = match (s.eval.factors.pivot_ratio(), s.pivot_reference) {
         (Some(now), Some(reference)) => now < PIVOT_DRIFT * reference,
         _ => false,
@@ -464,9 +465,12 @@ fn refresh_partition(sys: &mut System, s: &mut Search) -> Option<()> {
             adopt(sys, s, fresh)?;
         }
         s.pivot_reference = s.eval.factors.pivot_ratio();
-    } else if !s.part.second_pass.is_empty() {
+    } else if !s.part.second_pass.is_empty() || (corrector_failed && sys.backend != Backend::Dense)
+    {
         let fresh = sys.partition(&s.q);
-        if fresh.second_pass != s.part.second_pass {
+        if fresh.second_pass != s.part.second_pass
+            || (s.part.second_pass.is_empty() && !fresh.same_split(&s.part))
+        {
             adopt(sys, s, fresh)?;
         }
     }

@@ -164,6 +164,17 @@ fn small_tree(model: &Model) -> bool {
         && model.mimics.is_empty()
 }
 
+/// Whether the tree factors of `model` report their pivot ratio to the minimizer's drift test
+/// (module `minimize`): at the dense size, where they take the place of the dense factors and
+/// keep their watch (an Euler parameter taken as independent folds its chart where a leg has
+/// turned by π: the hanging minitaurs stalled at `max_iterations` without it). Above it they
+/// re-partition like the sparse factors (on a fold, after a failed correction): the watch is
+/// not measured there (ropes and long chains, whose every body turns, might re-partition at
+/// every step).
+pub(crate) fn tree_watches_pivots(model: &Model) -> bool {
+    model.coordinate_count() <= SPARSE_FROM_COORDINATES
+}
+
 /// Whether `model` has no closed loop (every joint a tree joint or merged).
 fn open(model: &Model) -> bool {
     model.joints.iter().all(|j| j.tree || j.merged)

@@ -83,8 +83,8 @@ impl Factors {
         }
     }
 
-    /// The smallest pivot of `U` over the largest (dense; the tree factors: over their
-    /// diagonal blocks and border; `None` for the sparse factors): a cheap measure of how well
+    /// The smallest pivot of `U` over the largest (dense; the tree factors of a small model:
+    /// over their diagonal blocks and border; `None` otherwise): a cheap measure of how well
     /// the dependent coordinates are determined by the independent rows at this configuration.
     pub(crate) fn pivot_ratio(&self) -> Option<f64> {
         match self {
@@ -97,9 +97,9 @@ impl Factors {
         }
     }
 
-    /// Whether `Φ_u` has become ill-conditioned (dense and tree: a pivot below `1e-8` of the
-    /// largest, [`Factors::pivot_ratio`]; the sparse factors do not tell, and the minimizer
-    /// re-partitions when the corrector or the line search fails instead).
+    /// Whether `Φ_u` has become ill-conditioned (a pivot below `1e-8` of the largest,
+    /// [`Factors::pivot_ratio`]; where that is `None`, the minimizer re-partitions when the
+    /// corrector or the line search fails instead).
     pub(crate) fn ill_conditioned(&self) -> bool {
         match self {
             Factors::Dense { .. } | Factors::Tree(_) => {
@@ -141,7 +141,8 @@ impl System<'_> {
                 }
             }
             if let Some(split) = work.tree_split.as_mut() {
-                return Some(Factors::Tree(split.factor(entries)));
+                let watch = super::backend::tree_watches_pivots(self.problem.model);
+                return Some(Factors::Tree(split.factor(entries, watch)));
             }
         }
         if self.backend != Backend::Dense {

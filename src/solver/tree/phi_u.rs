@@ -69,6 +69,8 @@ pub(crate) struct TreeLu {
     piv: Vec<u16>,
     border_piv: Vec<u16>,
     ok: bool,
+    /// Whether [`TreeLu::pivot_ratio`] reports (module `system::backend`).
+    watch: bool,
 }
 
 impl TreeSplit {
@@ -237,8 +239,9 @@ impl TreeSplit {
     }
 
     /// Refills the blocks from `entries` and factors them, in a buffer of the pool that no
-    /// evaluation holds any more (a new one if all are held).
-    pub(crate) fn factor(&mut self, entries: &[(usize, usize, f64)]) -> Arc<TreeLu> {
+    /// evaluation holds any more (a new one if all are held); with `watch`, the factors report
+    /// their pivot ratio.
+    pub(crate) fn factor(&mut self, entries: &[(usize, usize, f64)], watch: bool) -> Arc<TreeLu> {
         let shape = &self.shape;
         let free = self.pool.iter().position(|f| Arc::strong_count(f) == 1);
         let mut lu = match free {
@@ -249,6 +252,7 @@ impl TreeSplit {
                 piv: vec![0; shape.order],
                 border_piv: vec![0; shape.border.size()],
                 ok: false,
+                watch,
             }),
         };
         if let Some(f) = Arc::get_mut(&mut lu) {
@@ -260,6 +264,7 @@ impl TreeSplit {
                 vals[slot as usize] += e.2;
             }
             f.ok = f.factor_blocks();
+            f.watch = watch;
         }
         self.pool.push(lu.clone());
         // Keep at most a few buffers (the current point, trial points of a line search).
@@ -374,9 +379,9 @@ impl TreeLu {
     /// The smallest pivot of the diagonal blocks' `U` (and of the border's `S`) over the
     /// largest: how well the dependent coordinates are determined by the independent rows (an
     /// Euler parameter taken as independent near its turning point folds the chart and makes
-    /// its body's block nearly singular); `None` if the factors failed.
+    /// its body's block nearly singular); `None` if the factors failed or do not watch.
     pub(crate) fn pivot_ratio(&self) -> Option<f64> {
-        if !self.ok {
+        if !self.ok || !self.watch {
             return None;
         }
         let s = &*self.shape;

@@ -2,7 +2,7 @@
 //! families (plain harness, no criterion: the sizes span four decades and each large size is
 //! solved once, in its own process so that its peak memory can be read).
 //!
-//! `cargo bench --bench chain -- [--dense | --sparse] [--family chain|ladder|rope|robots] [N …]`
+//! `cargo bench --bench chain -- [--dense | --sparse | --tree] [--family chain|ladder|rope|robots] [N …]`
 //!
 //! - `chain N`: `restpose generate chain --size N` (N bodies);
 //! - `ladder N`: `restpose generate ladder --size N` (N closed loops, 3N bodies);
@@ -12,7 +12,8 @@
 //! - `robots`: the tractor-trailer and the 7-axis arm of `robots/`.
 //!
 //! Each row is measured in a child process (this executable again, with
-//! `RESTPOSE_BENCH_CHILD=family:N:algebra`): best of 3 solves (1 above 2,000 bodies) with the
+//! `RESTPOSE_BENCH_CHILD=family:N:algebra`): best of 3 solves (1 above 2,000 bodies;
+//! `RESTPOSE_BENCH_RUNS` overrides) with the
 //! default options (Newton, gradient tolerance 1e-8), then the process's peak resident memory
 //! (`VmHWM`). Solves are checked: converged, ‖Φ‖∞ below 1e-9, and (chains and ladders, after
 //! the timing) the energy and its joint-space gradient against the family's energy written
@@ -169,11 +170,15 @@ fn child(spec: &str) {
         linear_algebra: match algebra {
             "dense" => LinearAlgebra::Dense,
             "sparse" => LinearAlgebra::Sparse,
+            "tree" => LinearAlgebra::Tree,
             _ => LinearAlgebra::Auto,
         },
         ..Default::default()
     };
-    let runs = if model.bodies().len() > 2000 { 1 } else { 3 };
+    let runs = std::env::var("RESTPOSE_BENCH_RUNS")
+        .ok()
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(if model.bodies().len() > 2000 { 1 } else { 3 });
     let mut best = f64::INFINITY;
     let mut report = None;
     for _ in 0..runs {
@@ -216,6 +221,8 @@ fn main() {
         "dense"
     } else if args.iter().any(|a| a == "--sparse") {
         "sparse"
+    } else if args.iter().any(|a| a == "--tree") {
+        "tree"
     } else {
         "auto"
     };

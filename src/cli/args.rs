@@ -289,7 +289,9 @@ pub(crate) struct AnalyzeArgs {
     #[arg(long, value_enum, default_value_t = Method::from(Options::default().method))]
     pub(crate) method: Method,
     /// Linear algebra: dense matrices (small models), sparse (partition body by body, faer
-    /// sparse LU, Newton steps from the sparse KKT system), or auto: sparse above 40 bodies.
+    /// sparse LU, Newton steps from the sparse KKT system), tree (the sparse partition factored
+    /// along the kinematic tree), or auto: tree or sparse above 40 bodies, tree below for
+    /// open models without stops or contacts, dense otherwise.
     #[arg(long, value_enum, default_value_t = LinearAlgebra::from(Options::default().linear_algebra))]
     pub(crate) linear_algebra: LinearAlgebra,
     /// Ramp gravity, loads and efforts in N steps (0: automatic, 8 steps only if the direct

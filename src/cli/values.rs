@@ -50,7 +50,8 @@ mirror! {
 mirror! {
     /// Linear algebra of the solver (`restpose::LinearAlgebra`).
     LinearAlgebra = LibLinearAlgebra {
-        /// Dense up to 40 bodies (280 coordinates); above, tree without closed loops, sparse
+        /// Up to 40 bodies (280 coordinates): tree from 3 bodies without closed loops, stops,
+        /// contacts, locks or mimics, dense otherwise; above: tree without closed loops, sparse
         /// with them (default).
         Auto,
         /// Dense matrices: full-pivoting partition, dense LU, exact reduced Hessian. `O(N³)`.

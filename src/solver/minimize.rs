@@ -5,13 +5,13 @@
 //! 2. **Convergence test** ([`convergence_test`]): `‖∇f‖∞ ≤ max(gradient_tolerance,
 //!    10⁻¹³ Σ|V_k|)` and, unless `allow_unstable` is set, no negative eigenvalue of the reduced
 //!    Hessian; at a saddle or maximum the search leaves along the eigenvector of the most
-//!    negative one.
-//! 3. **Reduced step** ([`reduced_step`]): Newton `d = −Ĥ⁻¹ ∇f` with the exact reduced
-//!    Hessian taken along the search path (`Ĥ + C`, module `step::path_hessian`), its
-//!    eigenvalues replaced by their magnitudes, floored (dense, module `step::newton`), or the
-//!    KKT direction
-//!    (sparse); BFGS / DFP `d = −B ∇f` (module `step::quasi_newton`); steepest descent when `d` is
-//!    not a descent direction.
+//!    negative one (along every negative one where the path keeps every row, as in stage 3).
+//! 3. **Reduced step** ([`reduced_step`]): Newton `d = −Ĥ⁻¹ ∇f` with the exact reduced Hessian
+//!    along the search path (`Ĥ + C`, module `step::path_hessian`), its eigenvalues replaced by
+//!    their magnitudes, floored (dense, module `step::newton`), near a maximum or saddle at
+//!    least a saddle step along every direction of negative curvature (module `step::escape`),
+//!    or the KKT direction (sparse); BFGS / DFP `d = −B ∇f` (module `step::quasi_newton`);
+//!    steepest descent when `d` is not a descent direction (an escape excepted).
 //! 4. **Step cap** (module `step::step_cap`): the tangent step `δq = Z d` limited on the motion of the
 //!    whole mechanism (every body's Euler parameters by `max_step`, its origin by
 //!    `10 max_step ℓ`, `ℓ` the larger of the length scale and the mechanism's extent).
@@ -22,7 +22,9 @@
 //!    sparse partition from the reach the corrector last managed ([`Search::reach`]). With a
 //!    guard, a step that would violate an inactive inequality is cut where the first one
 //!    reaches its boundary, and the minimization stops there (`Outcome::blocked`: the
-//!    inequality update is the caller's, folder `inequality`).
+//!    inequality update is the caller's, folder `inequality`). In a curved valley the trial
+//!    points are brought back to its floor first, and the test of stage 2 also asks the
+//!    Newton step along the valley to be short (module `valley`).
 //! 6. **Accept** ([`accept_step`]): quasi-Newton update, and the unbounded test (a linear
 //!    descent that goes on, module `unbounded`); with inequalities, the stall test (steps
 //!    shrinking towards an obstacle's edge end the round, module `inequality::stall`).
@@ -44,14 +46,14 @@ use super::partition::Partition;
 use super::report::{Diagnostics, Iterate, Termination};
 use super::stability::at_rest::for_minimizer;
 use super::stability::spectrum::Spectrum;
+use super::step::direction::direction;
 use super::step::line_search::{line_search, Line, Trial};
-use super::step::newton::newton_step;
-use super::step::path_hessian::{along_path, path_keeps_rows};
 use super::step::quasi_newton::QuasiNewton;
 use super::step::retraction::independent_change;
 use super::step::step_cap::{cap_step, Step};
 use super::system::{Backend, Eval, System};
 use super::unbounded::LinearDescent;
+use super::valley::Watch;
 use nalgebra::DVector;
 
 /// Outcome of the minimization.
@@ -122,6 +124,8 @@ struct Search {
     /// Consecutive full capped steps along which the gradient did not change.
     linear_steps: usize,
     descent: LinearDescent,
+    /// Curved valleys (module `valley`).
+    valley: Watch,
 }
 
 /// What the convergence test found.
@@ -167,6 +171,7 @@ pub(crate) fn minimize(
         just_repartitioned: false,
         linear_steps: 0,
         descent: LinearDescent::default(),
+        valley: Watch::default(),
     };
     let mut termination = Termination::MaxIterations;
     let mut eigen = None;
@@ -188,7 +193,7 @@ pub(crate) fn minimize(
                 break;
             }
         }
-        let (eig, test) = convergence_test(sys, &s, gtol, options);
+        let (eig, test) = convergence_test(sys, &mut s, gtol, options);
         let negative_curvature = match test {
             Test::Converged(e, v) => {
                 eigen = e;
@@ -202,7 +207,14 @@ pub(crate) fn minimize(
         if s.iteration >= options.max_iterations {
             break;
         }
-        let d = reduced_step(sys, &mut s, eig.as_ref(), negative_curvature, options);
+        let d = reduced_step(
+            sys,
+            &mut s,
+            eig.as_ref(),
+            negative_curvature,
+            guard,
+            options,
+        );
         let step = cap_step(sys, &s.part, &s.eval, &s.q, d, options);
         let slope = s.eval.grad_v.dot(&step.d);
         let failures_before = s.diag.corrector_failures;
@@ -213,12 +225,15 @@ pub(crate) fn minimize(
         } else {
             s.reach
         };
+        // In a curved valley, from the first stalled step on (module `valley`).
+        let valley = s.valley.step(eig.as_ref(), &s.history);
         let line = Line {
             q: &s.q,
             part: &s.part,
             eval: &s.eval,
             dq: &step.dq,
             slope,
+            valley: valley.as_ref(),
         };
         let trial = line_search(sys, &line, alpha, guard, options, &mut s.diag);
         match trial {
@@ -309,7 +324,7 @@ fn record(s: &mut Search, options: &Options, report: bool) {
 /// Hessian's spectrum when it was needed (for the test, or for a dense Newton step).
 fn convergence_test(
     sys: &mut System,
-    s: &Search,
+    s: &mut Search,
     gtol: f64,
     options: &Options,
 ) -> (Option<Spectrum>, Test) {
@@ -335,11 +350,14 @@ fn convergence_test(
     if gnorm > gtol {
         return (eig, Test::Continue);
     }
+    let rounding = GRADIENT_FLOOR * s.eval.energy.magnitude;
     let test = match &eig {
         Some(e) if !options.allow_unstable => match e.lowest() {
             Some((imin, lmin)) if lmin < -e.tolerance() => {
                 Test::Saddle(e.vectors.column(imin).into_owned())
             }
+            // Not yet at the lowest point of a curved valley (module `valley`).
+            _ if s.valley.unsettled(e, &s.eval.grad_v, rounding) => Test::Continue,
             _ => Test::Converged(Some(e.clone()), None),
         },
         _ => Test::Converged(eig.clone(), verdict),
@@ -347,37 +365,31 @@ fn convergence_test(
     (eig, test)
 }
 
-/// Stage 3: the reduced step `d` (module docs): along the negative-curvature direction at a
-/// saddle, else Newton or quasi-Newton; steepest descent (and a reset quasi-Newton matrix)
-/// when that is not a descent direction.
+/// Stage 3: the reduced step `d` (module docs): the escaping Newton step along the path, else
+/// along the negative-curvature direction at a saddle, else Newton or quasi-Newton; steepest
+/// descent (and a reset quasi-Newton matrix) when that is not a descent direction.
 fn reduced_step(
     sys: &mut System,
     s: &mut Search,
     eig: Option<&Spectrum>,
     negative_curvature: Option<DVector<f64>>,
+    guard: Option<&Guard>,
     options: &Options,
 ) -> DVector<f64> {
     let dof = s.part.independent.len();
     let g = &s.eval.grad_v;
-    let d = if let Some(nc) = negative_curvature {
-        s.diag.negative_curvature_steps += 1;
-        let sign = if nc.dot(g) > 0.0 { -1.0 } else { 1.0 };
-        let scale = sign * options.max_step / nc.amax().max(1e-300);
-        nc * scale
-    } else {
-        match (eig, options.method) {
-            (Some(e), Method::Newton) if e.exact && path_keeps_rows(sys) => {
-                // The Hessian along the search path (module `step::path_hessian`).
-                newton_step(&along_path(sys, &s.q, &s.part, &s.eval, e), g)
-            }
-            (Some(e), Method::Newton) if e.exact => newton_step(e, g),
-            (_, Method::Newton) => {
-                super::step::kkt_direction::kkt_direction(sys, &s.q, &s.part, &s.eval)
-            }
-            _ => -(&s.qn.binv * g),
-        }
-    };
-    if d.dot(g) > 0.0 {
+    let (d, escaped) = direction(
+        sys,
+        (&s.q, &s.part, &s.eval),
+        eig,
+        negative_curvature.as_ref(),
+        &s.qn.binv,
+        guard,
+        options,
+    );
+    let saddle = negative_curvature.is_some();
+    s.diag.negative_curvature_steps += usize::from(escaped || saddle);
+    if d.dot(g) > 0.0 && !escaped {
         s.qn = QuasiNewton::new(dof, options.method);
         return -g.clone();
     }
@@ -448,7 +460,7 @@ fn refresh_partition(sys: &mut System, s: &mut Search) -> Option<()> {
         // The dependent coordinates chosen at the start of this partition are losing their
         // hold: a fresh full pivoting at `q`, adopted if it differs.
         let fresh = sys.partition(&s.q);
-        if !same_split(&fresh, &s.part) {
+        if !fresh.same_split(&s.part) {
             adopt(sys, s, fresh)?;
         }
         s.pivot_reference = s.eval.factors.pivot_ratio();
@@ -481,14 +493,4 @@ fn adopt(sys: &mut System, s: &mut Search, fresh: Partition) -> Option<()> {
     s.part = fresh;
     s.qn = QuasiNewton::new(s.part.independent.len(), s.method);
     Some(())
-}
-
-/// Whether two partitions choose the same dependent coordinates and rows (in any order).
-fn same_split(a: &Partition, b: &Partition) -> bool {
-    let sorted = |x: &[usize]| {
-        let mut x = x.to_vec();
-        x.sort_unstable();
-        x
-    };
-    sorted(&a.dependent) == sorted(&b.dependent) && sorted(&a.rows) == sorted(&b.rows)
 }

@@ -38,6 +38,7 @@ mod step;
 pub(crate) mod system;
 pub(crate) mod tree;
 mod unbounded;
+pub(crate) mod valley;
 
 pub use mode_animation::mode_animation;
 pub use options::{ContactPolicy, Limits, LinearAlgebra, Method, Options, Progress, ProgressFn};

@@ -18,7 +18,8 @@ pub enum Method {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum LinearAlgebra {
-    /// Dense up to 40 bodies (280 coordinates); above, tree without closed loops, sparse
+    /// Up to 40 bodies (280 coordinates): tree from 3 bodies without closed loops, stops,
+    /// contacts, locks or mimics, dense otherwise; above: tree without closed loops, sparse
     /// with them (default).
     #[default]
     Auto,

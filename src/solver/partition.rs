@@ -155,6 +155,19 @@ fn search(a: &DMatrix<f64>, col_max: &[f64], k: usize) -> (usize, usize, f64) {
     best
 }
 
+impl Partition {
+    /// Whether two partitions choose the same dependent coordinates and rows (in any order).
+    pub(crate) fn same_split(&self, other: &Partition) -> bool {
+        let sorted = |x: &[usize]| {
+            let mut x = x.to_vec();
+            x.sort_unstable();
+            x
+        };
+        sorted(&self.dependent) == sorted(&other.dependent)
+            && sorted(&self.rows) == sorted(&other.rows)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

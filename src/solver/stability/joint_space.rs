@@ -111,18 +111,27 @@ fn chart(model: &Model, q: &DVector<f64>) -> Vec<(String, Vec<Row>, bool)> {
 
 /// The reduced Hessian `h` (scaled independent coordinates of `part`) in joint coordinates:
 /// its eigenvalues (ascending) and the mode shape of each of the lowest `shown`, by joint in
-/// file order. `None` where the joint coordinates do not span the feasible motions.
+/// file order (`basis`: the null-space basis `Z` at `q` if at hand). `None` where the joint
+/// coordinates do not span the feasible motions.
 #[allow(clippy::type_complexity)]
 pub(crate) fn joint_spectrum(
     sys: &System,
     q: &DVector<f64>,
     part: &Partition,
     eval: &Eval,
+    basis: Option<&DMatrix<f64>>,
     h: &DMatrix<f64>,
     shown: usize,
 ) -> Option<(Vec<f64>, Vec<Vec<(String, Vec<f64>)>>)> {
     let dof = part.independent.len();
-    let z = sys.null_basis(part, eval);
+    let solved;
+    let z = match basis {
+        Some(z) => z,
+        None => {
+            solved = sys.null_basis(part, eval);
+            &solved
+        }
+    };
     let chart = chart(sys.problem.model, q);
     let rows: Vec<&Row> = chart.iter().flat_map(|(_, r, _)| r).collect();
     let selectable: Vec<bool> = chart
@@ -132,9 +141,11 @@ pub(crate) fn joint_spectrum(
     let t = DMatrix::from_fn(rows.len(), dof, |r, c| {
         rows[r].iter().map(|&(g, x)| x * z[(g, c)]).sum()
     });
-    // An orthonormal basis of T's range, then the rows with the most independent motion.
-    let svd = super::eigen::svd(t.clone(), true, false)?;
-    let u = svd.u.as_ref()?;
+    // Every coordinate selectable and as many as the degrees of freedom (a tree of scalar
+    // joints): all are chosen (the rows of an orthogonal `U` stay of norm 1 through the
+    // Gram–Schmidt steps), and only the rank is needed from the decomposition.
+    let all = rows.len() == dof && selectable.iter().all(|&s| s);
+    let svd = super::eigen::svd(t.clone(), !all, false)?;
     let top = svd.singular_values.max();
     let rank = svd
         .singular_values
@@ -144,34 +155,41 @@ pub(crate) fn joint_spectrum(
     if rank < dof || top <= 0.0 {
         return None;
     }
-    let cols: Vec<usize> = (0..svd.singular_values.len())
-        .filter(|&k| svd.singular_values[k] > 1e-9 * top)
-        .collect();
-    let mut basis = DMatrix::from_fn(rows.len(), dof, |r, c| u[(r, cols[c])]);
-    let mut chosen = Vec::with_capacity(dof);
-    for _ in 0..dof {
-        let (best, norm) = (0..rows.len())
-            .filter(|&r| selectable[r] && !chosen.contains(&r))
-            .map(|r| (r, basis.row(r).norm()))
-            .fold((usize::MAX, 0.0), |a, b| {
-                if b.1 > a.1 * (1.0 + 1e-9) {
-                    b
-                } else {
-                    a
-                }
-            });
-        if best == usize::MAX || norm <= 1e-9 {
-            return None;
+    let chosen: Vec<usize> = if all {
+        (0..dof).collect()
+    } else {
+        // An orthonormal basis of T's range, then the rows with the most independent motion.
+        let u = svd.u.as_ref()?;
+        let cols: Vec<usize> = (0..svd.singular_values.len())
+            .filter(|&k| svd.singular_values[k] > 1e-9 * top)
+            .collect();
+        let mut basis = DMatrix::from_fn(rows.len(), dof, |r, c| u[(r, cols[c])]);
+        let mut chosen = Vec::with_capacity(dof);
+        for _ in 0..dof {
+            let (best, norm) = (0..rows.len())
+                .filter(|&r| selectable[r] && !chosen.contains(&r))
+                .map(|r| (r, basis.row(r).norm()))
+                .fold((usize::MAX, 0.0), |a, b| {
+                    if b.1 > a.1 * (1.0 + 1e-9) {
+                        b
+                    } else {
+                        a
+                    }
+                });
+            if best == usize::MAX || norm <= 1e-9 {
+                return None;
+            }
+            chosen.push(best);
+            let pivot = basis.row(best).transpose() / norm;
+            for r in 0..rows.len() {
+                let d = basis.row(r).dot(&pivot.transpose());
+                let mut row = basis.row_mut(r);
+                row -= pivot.transpose() * d;
+            }
         }
-        chosen.push(best);
-        let pivot = basis.row(best).transpose() / norm;
-        for r in 0..rows.len() {
-            let d = basis.row(r).dot(&pivot.transpose());
-            let mut row = basis.row_mut(r);
-            row -= pivot.transpose() * d;
-        }
-    }
-    chosen.sort_unstable();
+        chosen.sort_unstable();
+        chosen
+    };
     let t_i = DMatrix::from_fn(dof, dof, |r, c| t[(chosen[r], c)]);
     let m = t_i.try_inverse()?;
     let h_theta = m.transpose() * h * &m;

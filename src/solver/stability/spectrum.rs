@@ -43,6 +43,9 @@ pub(crate) struct Spectrum {
     /// of the KKT matrix (negative pivots minus rows), when the Lanczos path had one: a
     /// certificate that does not depend on Lanczos finding the negative end.
     pub(crate) negative_by_inertia: Option<usize>,
+    /// The null-space basis `Z` the exact reduced Hessian was formed with, where it was kept
+    /// (`System::reduced_hessian_and_basis`).
+    pub(crate) basis: Option<DMatrix<f64>>,
 }
 
 impl Spectrum {
@@ -79,7 +82,8 @@ pub(crate) fn spectrum(
 ) -> Spectrum {
     let dof = part.independent.len();
     if exact(sys.backend, dof) {
-        let (values, vectors) = symmetric_eigen(&sys.reduced_hessian(q, part, eval));
+        let (h, basis) = sys.reduced_hessian_and_basis(q, part, eval);
+        let (values, vectors) = symmetric_eigen(&h);
         let largest = values.amax();
         return Spectrum {
             values,
@@ -87,6 +91,7 @@ pub(crate) fn spectrum(
             largest,
             exact: true,
             negative_by_inertia: None,
+            basis,
         };
     }
     lanczos(sys, q, part, eval).unwrap_or_else(|| Spectrum {
@@ -96,6 +101,7 @@ pub(crate) fn spectrum(
         largest: 1.0,
         exact: false,
         negative_by_inertia: None,
+        basis: None,
     })
 }
 
@@ -153,6 +159,7 @@ fn lanczos(sys: &mut System, q: &DVector<f64>, part: &Partition, eval: &Eval) ->
         vectors,
         exact: false,
         negative_by_inertia,
+        basis: None,
     })
 }
 

@@ -45,7 +45,9 @@ pub(crate) fn from_spectrum(
     // In joint coordinates where the whole spectrum is known (module `joint_space`).
     if spectrum.exact && shown > 0 {
         let h = vecs * nalgebra::DMatrix::from_diagonal(vals) * vecs.transpose();
-        if let Some((values, modes)) = joint_space::joint_spectrum(sys, q, part, eval, &h, shown) {
+        if let Some((values, modes)) =
+            joint_space::joint_spectrum(sys, q, part, eval, spectrum.basis.as_ref(), &h, shown)
+        {
             return Stability {
                 verdict,
                 tolerance: tol,

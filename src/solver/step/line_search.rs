@@ -35,6 +35,9 @@ pub(crate) struct Line<'a> {
     pub(crate) eval: &'a Eval,
     pub(crate) dq: &'a DVector<f64>,
     pub(crate) slope: f64,
+    /// Where the iteration crawls along a curved valley, the trial points are brought back
+    /// to its floor before they are judged (module `valley`).
+    pub(crate) valley: Option<&'a crate::solver::valley::Valley>,
 }
 
 /// A point the line search accepted.
@@ -103,11 +106,21 @@ pub(crate) fn line_search(
             continue;
         };
         diag.function_evaluations += 1;
+        let (qt, et) = match line.valley {
+            Some(v) => v.correct(sys, part, options, diag, (qt, et)),
+            None => (qt, et),
+        };
         let ft = et.merit;
         // Rounding error of V: relative to the size of its terms, not of their sum.
         let roundoff = 1e-12 * eval.energy.magnitude.max(et.energy.magnitude) + f64::MIN_POSITIVE;
         let armijo = ft <= f + 1e-4 * alpha * slope;
-        let flat = (ft - f).abs() <= roundoff && et.grad_v.amax() < 0.5 * gnorm;
+        // (In a curved valley, flat with the gradient along the floor smaller: module
+        // `valley`.)
+        let flat = (ft - f).abs() <= roundoff
+            && (et.grad_v.amax() < 0.5 * gnorm
+                || line
+                    .valley
+                    .is_some_and(|v| v.closer(&eval.grad_v, &et.grad_v)));
         if ft.is_finite() && (armijo || flat) {
             return Some(Trial {
                 q: qt,

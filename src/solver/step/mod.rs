@@ -3,6 +3,9 @@
 //!
 //! - `kkt_direction`: the Newton direction of the sparse path from the KKT system
 //!   `[W Φ_qᵀ; Φ_q 0] [δq; λ] = [−S(V_qᵀ − Φ_qᵀ μ); 0]`.
+//! - `direction`: the choice of the reduced step among the ones below.
+//! - `escape`: the dense Newton step along the path, leaving maxima and saddles along every
+//!   direction of negative curvature.
 //! - `newton`: the dense Newton step from the eigen-decomposition of the Hessian along the
 //!   search path.
 //! - `path_hessian`: that Hessian, `Ĥ + C`, `C` the search path's curvature times `∇f`.
@@ -12,6 +15,8 @@
 //! - `retraction`: the search path of the line search, `δq` followed as rigid motions along
 //!   the spanning tree (`θ(α) = θ + α θ̇` on every tree joint).
 
+pub(super) mod direction;
+pub(super) mod escape;
 pub(super) mod kkt_direction;
 pub(super) mod line_search;
 pub(super) mod newton;

@@ -7,13 +7,23 @@
 //! a descent direction whatever the inertia.
 //!
 //! Along a direction of curvature `λ < 0` it moves by `−(vᵀ∇f)/|λ|`, which near a maximum or
-//! a saddle (`vᵀ∇f ≈ λ x`) is the step `x → 2x`: from the upright start of example-robot-data's
-//! double pendulum the distance doubles per iteration (38 iterations, 16 of them doubling,
-//! then 16 more from a saddle). Adding a saddle-sized step along the directions of negative
-//! curvature (Moré & Sorensen's descent pair) takes it to 10, and was tried and not adopted
-//! (docs/method.md, "The Newton step along the path"): the longer early steps send falls to
-//! other equilibria (a far tractor start, a limp Solo-12) and an unbalanced ball on the
-//! ground was reported unbounded.
+//! a saddle (`vᵀ∇f ≈ λ x`) is the step `x → 2x`: from a start with every leg straight up
+//! (pybullet_data's minitaurs, ‖∇f‖ = 10⁻⁸) the distance doubled per iteration, and the legs
+//! fell one after another, 27 iterations each (57–151 iterations).
+//!
+//! The escape (module `escape`, where the path keeps every row): near a stationary point,
+//! `‖d‖∞ < 0.1 c` (`c = max_step`), each direction of curvature `λ_i < −τ` (`τ` the
+//! spectrum's tolerance) along which `d` moves by less than `c_i = c / ‖v_i‖∞` gets the length
+//! `t_i = −sign(v_iᵀ∇f) c_i` (`+c_i` where the slope is 0) instead of its magnitude step:
+//!
+//! `d = −Σ_{i ∉ E} v_i (v_iᵀ∇f) / max(|λ_i|, ε λ_max) + Σ_{i ∈ E} t_i v_i`,
+//!
+//! all at once, each direction scaled like the step that leaves a saddle (Moré & Sorensen's
+//! direction of negative curvature, taken per eigen-direction instead of as one combined
+//! vector). Module `escape` keeps a direction in `E` only where the energy along the path
+//! falls as the curvature says. Away from stationary points (`‖d‖∞ ≥ 0.1 c`) the step is the
+//! magnitude step: a combined step `s + n` taken there as well (tried in session 22) sent
+//! falls to other equilibria (Panda +0.18 J; docs/method.md).
 //!
 //! ## References
 //! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §3.4.
@@ -28,15 +38,50 @@ use nalgebra::DVector;
 /// largest) 80-fold and the solve crawled at the rate `1 − λ/floor`.
 const EIGENVALUE_FLOOR: f64 = 1e-12;
 
-/// The Newton step at the reduced gradient `g` (module docs).
-pub(crate) fn newton_step(e: &Spectrum, g: &DVector<f64>) -> DVector<f64> {
+/// The escape is taken where the magnitude step is shorter than this fraction of the saddle
+/// step `c`: near a stationary point. At 1 (escaping in the middle of falls too, without the
+/// energy test of module `escape`), G1 and the classical simple humanoid of
+/// example-robot-data ended `max_iterations`; with no such bound iCub took 59 → 120
+/// iterations.
+const NEAR_STATIONARY: f64 = 0.1;
+
+/// The Newton step at the reduced gradient `g` (module docs). With `escape = Some(c)` and a
+/// magnitude step shorter than `0.1 c` (near a stationary point), every direction of
+/// negative curvature `v_i` along which `s` moves by less than `c / ‖v_i‖∞` is stepped along
+/// by that length instead, downhill (`−sign(v_iᵀ∇f)`, `+1` where the slope is 0). Returns the
+/// step and the escaped directions `(i, t_i, s_i)`: the escape's signed length and the
+/// magnitude step's.
+pub(crate) fn newton_step(
+    e: &Spectrum,
+    g: &DVector<f64>,
+    escape: Option<f64>,
+) -> (DVector<f64>, Vec<(usize, f64, f64)>) {
     let floor = EIGENVALUE_FLOOR * e.values.amax().max(1e-12);
-    let mut d = DVector::zeros(g.len());
-    for i in 0..g.len() {
-        let v = e.vectors.column(i);
-        d -= v * (v.dot(g) / e.values[i].abs().max(floor));
+    let n = g.len();
+    let slopes: Vec<f64> = (0..n).map(|i| e.vectors.column(i).dot(g)).collect();
+    let mut t: Vec<f64> = (0..n)
+        .map(|i| -slopes[i] / e.values[i].abs().max(floor))
+        .collect();
+    let step = |t: &[f64]| {
+        let mut d = DVector::zeros(n);
+        for (i, ti) in t.iter().enumerate() {
+            d += e.vectors.column(i) * *ti;
+        }
+        d
+    };
+    let mut escaped = Vec::new();
+    if let Some(c) = escape.filter(|&c| step(&t).amax() < NEAR_STATIONARY * c) {
+        let tol = e.tolerance();
+        for i in (0..n).filter(|&i| e.values[i] < -tol) {
+            let length = c / e.vectors.column(i).amax().max(1e-300);
+            if t[i].abs() < length {
+                let newton = t[i];
+                t[i] = if slopes[i] > 0.0 { -length } else { length };
+                escaped.push((i, t[i], newton));
+            }
+        }
     }
-    d
+    (step(&t), escaped)
 }
 
 #[cfg(test)]
@@ -53,6 +98,7 @@ mod tests {
             vectors,
             exact: true,
             negative_by_inertia: None,
+            basis: None,
         }
     }
 
@@ -60,7 +106,7 @@ mod tests {
     fn positive_definite_hessian_gives_the_newton_step() {
         let h = DMatrix::from_row_slice(2, 2, &[4.0, 1.0, 1.0, 3.0]);
         let g = DVector::from_vec(vec![1.0, -2.0]);
-        let d = newton_step(&spectrum(&h), &g);
+        let (d, _) = newton_step(&spectrum(&h), &g, None);
         // H d = −g.
         assert!((&h * &d + &g).amax() < 1e-14, "{d}");
     }
@@ -70,7 +116,7 @@ mod tests {
         // f = −½ x² + y²: the step along x is −g_x/|λ| (downhill, away from the maximum).
         let h = DMatrix::from_row_slice(2, 2, &[-1.0, 0.0, 0.0, 2.0]);
         let g = DVector::from_vec(vec![-1e-3, 1.0]);
-        let d = newton_step(&spectrum(&h), &g);
+        let (d, _) = newton_step(&spectrum(&h), &g, None);
         assert!(
             (d[0] - 1e-3).abs() < 1e-15 && (d[1] + 0.5).abs() < 1e-15,
             "{d}"
@@ -82,7 +128,44 @@ mod tests {
     fn near_neutral_directions_are_floored_at_1e_12_of_the_largest() {
         let h = DMatrix::from_diagonal(&DVector::from_vec(vec![1e-20, 1.0]));
         let g = DVector::from_vec(vec![1e-9, 0.0]);
-        let d = newton_step(&spectrum(&h), &g);
+        let (d, _) = newton_step(&spectrum(&h), &g, None);
         assert!((d[0] + 1e-9 / 1e-12).abs() < 1e-9, "{d}");
+    }
+
+    #[test]
+    fn near_a_maximum_every_negative_direction_is_left_by_a_saddle_step() {
+        // f = −½ x² − 2 y² + z² near its top in x and y (‖s‖∞ = 2·10⁻⁸ < 0.1 c).
+        let h = DMatrix::from_diagonal(&DVector::from_vec(vec![-1.0, -4.0, 1.0]));
+        let g = DVector::from_vec(vec![-2e-8, 0.0, 1e-9]);
+        let (d, escaped) = newton_step(&spectrum(&h), &g, Some(0.3));
+        // Downhill along x (−sign g_x), +1 along y where the slope is 0, Newton along z.
+        assert!(
+            (d[0] - 0.3).abs() < 1e-15 && (d[1].abs() - 0.3).abs() < 1e-15,
+            "{d}"
+        );
+        assert!((d[2] + 1e-9).abs() < 1e-20, "{d}");
+        assert_eq!(escaped.len(), 2);
+        for (i, t, newton) in escaped {
+            assert!((d[i] - t).abs() < 1e-15);
+            assert!(newton.abs() < 1e-7, "the magnitude step was {newton}");
+        }
+    }
+
+    #[test]
+    fn away_from_stationary_points_the_step_is_the_magnitude_step() {
+        // ‖s‖∞ = 0.5 ≥ 0.1 c: no escape, the step along x stays −g_x/|λ| however short.
+        let h = DMatrix::from_diagonal(&DVector::from_vec(vec![-1.0, 2.0]));
+        let g = DVector::from_vec(vec![-1e-6, 1.0]);
+        let (d, escaped) = newton_step(&spectrum(&h), &g, Some(0.3));
+        assert!(escaped.is_empty());
+        assert!(
+            (d[0] - 1e-6).abs() < 1e-18 && (d[1] + 0.5).abs() < 1e-15,
+            "{d}"
+        );
+        // Curvature within the spectrum's tolerance is not negative.
+        let h = DMatrix::from_diagonal(&DVector::from_vec(vec![-1e-12, 1.0]));
+        let g = DVector::from_vec(vec![1e-9, 1e-9]);
+        let (_, escaped) = newton_step(&spectrum(&h), &g, Some(0.3));
+        assert!(escaped.is_empty());
     }
 }

@@ -33,36 +33,62 @@ use crate::solver::stability::eigen::symmetric_eigen;
 use crate::solver::stability::spectrum::Spectrum;
 use crate::solver::step::retraction::angular_velocity;
 use crate::solver::system::{Eval, System};
-use nalgebra::{DMatrix, DVector, Vector3, Vector4};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3, Vector4};
 use std::collections::BTreeMap;
 
-/// `C` of the module docs at `q` (`dof × dof`, symmetric).
+/// The per-edge sums `(G_l, M_l, s_l, R_l)` of [`path_curvature`].
+type EdgeSums = (Vector3<f64>, Matrix3<f64>, f64, Vector4<f64>);
+
+/// `C` of the module docs at `q` (`dof × dof`, symmetric), with the null-space basis `Z` at
+/// `q` if it is at hand (else it is solved for).
+///
+/// The sum over the bodies `b` carrying independent coordinates and the edges `l` above them
+/// is gathered per edge: with `r_b = y_b − x_l`, the gradient weights `w_b` on `b`'s origin
+/// and `ρ_b` on its Euler parameters, summed over the bodies below `l` (`G_l = Σ w_b`,
+/// `M_l = Σ w_b r_bᵀ`, `s_l = Σ w_b · r_b`, `R_l = Σ ρ_b`),
+///
+/// `C_ij = Σ_l a_iᵀ K_l (ω_j, w_j)`,   `K_l = [M_lᵀ − (s_l + ¼ R_l0) I − ¼ [R_lv]×,  −[G_l]×]`
+///
+/// (`w·(a × (ω × r)) = (w·ω)(a·r) − (w·r)(a·ω)`), `O(bodies · dof²)` instead of a `dof × dof`
+/// sum per body and edge.
 pub(crate) fn path_curvature(
     sys: &System,
     q: &DVector<f64>,
     part: &Partition,
     eval: &Eval,
+    basis: Option<&DMatrix<f64>>,
 ) -> DMatrix<f64> {
     let dof = part.independent.len();
     let columns = &sys.problem.scaling.columns;
     let parents = sys.problem.retraction.parents();
-    // Each edge's relative twist (ω_l, w_l at the child's origin) per unit step along e_i.
-    let twists: Vec<Vec<(Vector3<f64>, Vector3<f64>)>> = (0..dof)
-        .map(|i| {
-            let mut e = DVector::zeros(dof);
-            e[i] = 1.0;
-            let dq = sys.tangent_step(part, eval, &e);
-            (0..parents.len())
-                .map(|b| relative_twist(q, &dq, b, parents[b]))
-                .collect()
-        })
-        .collect();
+    let bodies = parents.len();
+    // Each edge's relative twist (ω_l, w_l at the child's origin) per unit step along e_i:
+    // column i of `omega[l]` and `vel[l]`.
+    let mut omega = vec![nalgebra::Matrix3xX::<f64>::zeros(dof); bodies];
+    let mut vel = vec![nalgebra::Matrix3xX::<f64>::zeros(dof); bodies];
+    let solved;
+    let z = match basis {
+        Some(z) => z,
+        None => {
+            solved = sys.null_basis(part, eval);
+            &solved
+        }
+    };
+    for i in 0..dof {
+        let dq = z.column(i).into_owned();
+        for b in 0..bodies {
+            let (w, v) = relative_twist(q, &dq, b, parents[b]);
+            omega[b].set_column(i, &w);
+            vel[b].set_column(i, &v);
+        }
+    }
     // The gradient's weight on each coordinate of the bodies with independent coordinates.
     let mut weights: BTreeMap<usize, [f64; 7]> = BTreeMap::new();
     for (k, &c) in part.independent.iter().enumerate() {
         weights.entry(c / 7).or_insert([0.0; 7])[c % 7] += eval.grad_v[k] / columns[c];
     }
-    let mut m = DMatrix::zeros(dof, dof);
+    // Per edge l: (G_l, M_l, s_l, R_l) over the weighted bodies below it (module docs).
+    let mut sums: BTreeMap<usize, EdgeSums> = BTreeMap::new();
     for (&b, w) in &weights {
         let y = position(q, b);
         let p = Vector4::new(q[7 * b + 3], q[7 * b + 4], q[7 * b + 5], q[7 * b + 6]);
@@ -74,29 +100,73 @@ pub(crate) fn path_curvature(
             (0..4).map(|r| w[3 + r] * ep[r]).sum::<f64>()
         });
         let wy = Vector3::new(w[0], w[1], w[2]);
-        let mut chain = vec![b];
-        while let Some(a) = parents[*chain.last().unwrap_or(&b)] {
-            chain.push(a);
-        }
-        let mut before = vec![Vector3::zeros(); dof];
-        for &l in chain.iter().rev() {
-            let xl = position(q, l);
-            let a: Vec<Vector3<f64>> = (0..dof).map(|i| twists[i][l].0 + 2.0 * before[i]).collect();
-            for j in 0..dof {
-                let (omega, wl) = twists[j][l];
-                let xi = omega.cross(&(y - xl)) + wl;
-                for (i, ai) in a.iter().enumerate() {
-                    let c = ai.cross(&omega);
-                    let pq = Vector4::new(-ai.dot(&omega), c.x, c.y, c.z);
-                    m[(i, j)] += wy.dot(&ai.cross(&xi)) + 0.25 * pq.dot(&rho);
-                }
-            }
-            for (i, bi) in before.iter_mut().enumerate() {
-                *bi += twists[i][l].0;
-            }
+        let mut l = Some(b);
+        while let Some(at) = l {
+            let r = y - position(q, at);
+            let e = sums.entry(at).or_insert((
+                Vector3::zeros(),
+                Matrix3::zeros(),
+                0.0,
+                Vector4::zeros(),
+            ));
+            e.0 += wy;
+            e.1 += wy * r.transpose();
+            e.2 += wy.dot(&r);
+            e.3 += rho;
+            l = parents[at];
         }
     }
+    // a_i = ω_i + 2 Σ_{k above l} ω_k, the sum taken from the root down.
+    let mut above: Vec<Option<nalgebra::Matrix3xX<f64>>> = vec![None; bodies];
+    let mut m = DMatrix::zeros(dof, dof);
+    for (&l, (g, mm, s, r)) in &sums {
+        let before = sum_above(l, &parents, &omega, &mut above, dof);
+        let a = &omega[l] + 2.0 * &before;
+        let rv = Vector3::new(r[1], r[2], r[3]);
+        let k_omega =
+            mm.transpose() - Matrix3::identity() * (s + 0.25 * r[0]) - 0.25 * rv.cross_matrix();
+        let k_vel = -g.cross_matrix();
+        let kt = k_omega * &omega[l] + k_vel * &vel[l];
+        m.gemm_tr(1.0, &a, &kt, 1.0);
+    }
     (&m + m.transpose()) * 0.5
+}
+
+/// `Σ ω_k` over the edges `k` above `l` (nearer the root), summed from the root down and kept
+/// per body in `memo`.
+fn sum_above(
+    l: usize,
+    parents: &[Option<usize>],
+    omega: &[nalgebra::Matrix3xX<f64>],
+    memo: &mut [Option<nalgebra::Matrix3xX<f64>>],
+    dof: usize,
+) -> nalgebra::Matrix3xX<f64> {
+    let Some(a) = parents[l] else {
+        return nalgebra::Matrix3xX::zeros(dof);
+    };
+    if let Some(s) = &memo[a] {
+        return s.clone();
+    }
+    // The chain above `l`, root first, then the running sums down to `a`.
+    let mut chain = vec![a];
+    while let Some(p) = parents[*chain.last().unwrap_or(&a)] {
+        if memo[p].is_some() {
+            break;
+        }
+        chain.push(p);
+    }
+    let top = *chain.last().unwrap_or(&a);
+    let mut run = match parents[top] {
+        Some(p) => memo[p]
+            .clone()
+            .unwrap_or_else(|| nalgebra::Matrix3xX::zeros(dof)),
+        None => nalgebra::Matrix3xX::zeros(dof),
+    };
+    for &k in chain.iter().rev() {
+        run += &omega[k];
+        memo[k] = Some(run.clone());
+    }
+    run
 }
 
 /// The relative twist of body `b`'s tree edge for the tangent `dq` (module `retraction`):
@@ -159,7 +229,7 @@ pub(crate) fn along_path(
     e: &Spectrum,
 ) -> Spectrum {
     let mut h = &e.vectors * DMatrix::from_diagonal(&e.values) * e.vectors.transpose();
-    h += path_curvature(sys, q, part, eval);
+    h += path_curvature(sys, q, part, eval, e.basis.as_ref());
     let h = (&h + h.transpose()) * 0.5;
     let (values, vectors) = symmetric_eigen(&h);
     Spectrum {
@@ -168,6 +238,7 @@ pub(crate) fn along_path(
         vectors,
         exact: true,
         negative_by_inertia: None,
+        basis: None,
     }
 }
 
@@ -200,7 +271,7 @@ mod tests {
             let part = sys.partition(&q);
             let eval = sys.evaluate(&q, &part).unwrap();
             assert!(eval.grad_v.amax() > 0.1, "away from equilibrium");
-            let c = path_curvature(sys, &q, &part, &eval);
+            let c = path_curvature(sys, &q, &part, &eval, None);
             let dof = part.independent.len();
             let columns = &sys.problem.scaling.columns;
             let h = 1e-4;
@@ -225,6 +296,80 @@ mod tests {
                 );
             }
             assert!(c.amax() > 1e-3, "the path is curved in v̂");
+        }
+    }
+
+    /// The per-edge sums give the direct sum over bodies and edges of the module docs
+    /// (`C_ij = Σ_b Σ_l wy_b·(a_i × ξ_j(y_b)) + ¼ (a_i ⊗ ω_j)·ρ_b`, written out here) to
+    /// rounding, on a branched tree on the dense and the tree path.
+    #[test]
+    fn per_edge_sums_equal_the_direct_sum() {
+        let model = load_str(ARM, "arm.urdf", &ImportOptions::default())
+            .unwrap()
+            .model;
+        let values = [("pan", 0.4), ("slide", 0.1), ("roll", -0.7), ("lift", 1.1)]
+            .iter()
+            .map(|(n, v)| (n.to_string(), vec![*v]))
+            .collect();
+        let q = State::from_joint_values(&model, &values).q;
+        for backend in [Backend::Dense, Backend::Tree] {
+            let sys = &mut System::new(&model, Constraints::new(&model, &[]), backend);
+            let part = sys.partition(&q);
+            let eval = sys.evaluate(&q, &part).unwrap();
+            let c = path_curvature(sys, &q, &part, &eval, None);
+            let dof = part.independent.len();
+            let columns = &sys.problem.scaling.columns;
+            let parents = sys.problem.retraction.parents();
+            let twists: Vec<Vec<(Vector3<f64>, Vector3<f64>)>> = (0..dof)
+                .map(|i| {
+                    let mut e = DVector::zeros(dof);
+                    e[i] = 1.0;
+                    let dq = sys.tangent_step(&part, &eval, &e);
+                    (0..parents.len())
+                        .map(|b| relative_twist(&q, &dq, b, parents[b]))
+                        .collect()
+                })
+                .collect();
+            let mut direct = DMatrix::<f64>::zeros(dof, dof);
+            for (k, &col) in part.independent.iter().enumerate() {
+                let b = col / 7;
+                let mut w = [0.0; 7];
+                w[col % 7] = eval.grad_v[k] / columns[col];
+                let y = position(&q, b);
+                let p = Vector4::new(q[7 * b + 3], q[7 * b + 4], q[7 * b + 5], q[7 * b + 6]);
+                let wy = Vector3::new(w[0], w[1], w[2]);
+                let wp = Vector4::new(w[3], w[4], w[5], w[6]);
+                let mut chain = vec![b];
+                while let Some(a) = parents[*chain.last().unwrap_or(&b)] {
+                    chain.push(a);
+                }
+                let mut before = vec![Vector3::<f64>::zeros(); dof];
+                for &l in chain.iter().rev() {
+                    let xl = position(&q, l);
+                    for i in 0..dof {
+                        let a = twists[i][l].0 + 2.0 * before[i];
+                        for j in 0..dof {
+                            let (omega, vl) = twists[j][l];
+                            let xi = omega.cross(&(y - xl)) + vl;
+                            let ao = a.cross(&omega);
+                            let pq = Vector4::new(-a.dot(&omega), ao.x, ao.y, ao.z);
+                            // wᵀ ¼ (pq ⊗ p), the second derivative of p written out.
+                            direct[(i, j)] +=
+                                wy.dot(&a.cross(&xi)) + 0.25 * wp.dot(&compose(&pq, &p));
+                        }
+                    }
+                    for (i, bi) in before.iter_mut().enumerate() {
+                        *bi += twists[i][l].0;
+                    }
+                }
+            }
+            let direct = (&direct + direct.transpose()) * 0.5;
+            let scale = direct.amax();
+            assert!(scale > 1e-3);
+            assert!(
+                (&c - &direct).amax() <= 1e-12 * scale,
+                "{backend:?}: {c} against {direct}"
+            );
         }
     }
 }

@@ -14,12 +14,21 @@ use crate::solver::partition::{partition, Partition};
 use crate::solver::LinearAlgebra;
 
 /// Models with more coordinates than this (40 bodies) use the sparse path when the choice is
-/// automatic. The sparse path is as fast or faster from 5 bodies up (BENCHMARKS.md), but the
-/// dense path stays the default for small models: its Newton steps use the exact eigenvalues
-/// of the reduced Hessian (negative curvature handled mode by mode), and its full-pivoting
-/// partition picks the assembly branch the robot tests are written against (from a far start
-/// the tractor-trailer reaches a different, lower-energy branch on the sparse path).
+/// automatic. Below, the dense path stays the default for every model that has closed loops,
+/// joint stops, contacts, locks or mimics: its full-pivoting partition picks the assembly
+/// branch the robot tests are written against (from a far start the tractor-trailer reaches a
+/// different, lower-energy branch on the sparse path), and its partition is checked for drift
+/// as the mechanism moves.
 const SPARSE_FROM_COORDINATES: usize = 7 * 40;
+
+/// Small models without closed loops, stops, contacts, locks or mimics take the tree factors
+/// from this many bodies on (automatic choice): they cost the same as the dense path at 1 – 2
+/// bodies and less from 3 (chain 3: 0.073 against 0.084 ms; chain 5: 0.13 / 0.18; chain 20:
+/// 1.4 / 3.4; chain 40: 10 / 61; BENCHMARKS.md). Up to 64 degrees of freedom the minimizer
+/// steps on both by the same exact eigen-decomposition of the Hessian along the search path
+/// (module `step::path_hessian`), so the Newton steps are the same up to the partition's
+/// choice of independent coordinates.
+const TREE_FROM_BODIES: usize = 3;
 
 /// The linear algebra of a system.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -43,7 +52,9 @@ impl Backend {
     /// of 3.7e-8 (tolerance 1e-8) where the sparse ones converge in 17 iterations; until that
     /// is understood, models with stops keep the sparse factors unless `--linear-algebra tree`
     /// asks for the tree. Contacts are rows on their body like a joint's (tested against the
-    /// sparse factors: a rope on the ground, Solo-12 standing).
+    /// sparse factors: a rope on the ground, Solo-12 standing). Below, the tree factors for a
+    /// model of [`TREE_FROM_BODIES`] or more bodies without closed loops, stops, contacts,
+    /// locks or mimics, and the dense path otherwise.
     pub(crate) fn choose(model: &Model, choice: LinearAlgebra) -> Self {
         match choice {
             LinearAlgebra::Auto if model.coordinate_count() > SPARSE_FROM_COORDINATES => {
@@ -53,6 +64,7 @@ impl Backend {
                     Backend::Sparse
                 }
             }
+            LinearAlgebra::Auto if small_tree(model) => Backend::Tree,
             LinearAlgebra::Auto | LinearAlgebra::Dense => Backend::Dense,
             LinearAlgebra::Sparse => Backend::Sparse,
             LinearAlgebra::Tree => Backend::Tree,
@@ -95,8 +107,12 @@ impl Backend {
 
     /// The automatic backend of `verify` at a pose: [`Backend::choose`], but the tree factors
     /// for every mechanism without closed loops above the dense size, stops or not (they
-    /// factor the same sparse partition, and give the same efforts and forces to rounding).
+    /// factor the same sparse partition, and give the same efforts and forces to rounding),
+    /// and the dense path for every model up to that size.
     pub(crate) fn for_verify(model: &Model) -> Self {
+        if model.coordinate_count() <= SPARSE_FROM_COORDINATES {
+            return Backend::Dense;
+        }
         match Self::choose(model, LinearAlgebra::Auto) {
             Backend::Sparse if open(model) => Backend::Tree,
             chosen => chosen,
@@ -135,6 +151,19 @@ impl Backend {
     }
 }
 
+/// Whether `model` is small and takes the tree factors ([`TREE_FROM_BODIES`]): open, at least
+/// that many bodies, and no stop, contact, lock or mimic.
+fn small_tree(model: &Model) -> bool {
+    model.bodies.len() >= TREE_FROM_BODIES
+        && open(model)
+        && model.joints.iter().all(|j| j.limits.is_none())
+        && model.grounds.is_empty()
+        && model.obstacles.is_empty()
+        && model.contact_points.is_empty()
+        && model.locks.is_empty()
+        && model.mimics.is_empty()
+}
+
 /// Whether `model` has no closed loop (every joint a tree joint or merged).
 fn open(model: &Model) -> bool {
     model.joints.iter().all(|j| j.tree || j.merged)
@@ -151,8 +180,9 @@ mod tests {
             .model
     }
 
-    /// The automatic choice: the tree factors for a long open chain, the sparse ones once the
-    /// same chain has stops, dense when small.
+    /// The automatic choice: the tree factors for an open chain without stops, long or from 3
+    /// bodies; the sparse ones once a long chain has stops, dense once a short one has them or
+    /// below 3 bodies (and for `verify` up to 40 bodies).
     #[test]
     fn automatic_choice_keeps_the_tree_factors_to_open_chains_without_stops() {
         let free = crate::generate::chain(60, false);
@@ -174,6 +204,22 @@ mod tests {
         let small = crate::generate::chain(10, false);
         assert_eq!(
             Backend::choose(&model(&small), LinearAlgebra::Auto),
+            Backend::Tree
+        );
+        assert_eq!(Backend::for_verify(&model(&small)), Backend::Dense);
+        let small_limited = small
+            .replace("type=\"continuous\"", "type=\"revolute\"")
+            .replace(
+                "<axis ",
+                "<limit lower=\"-3\" upper=\"3\" effort=\"1\" velocity=\"1\"/><axis ",
+            );
+        assert_eq!(
+            Backend::choose(&model(&small_limited), LinearAlgebra::Auto),
+            Backend::Dense
+        );
+        let tiny = crate::generate::chain(1, false);
+        assert_eq!(
+            Backend::choose(&model(&tiny), LinearAlgebra::Auto),
             Backend::Dense
         );
     }

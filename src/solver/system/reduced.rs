@@ -8,6 +8,10 @@ use crate::jet::HessianSink;
 use crate::solver::partition::Partition;
 use nalgebra::{DMatrix, DVector};
 
+/// The largest null-space basis (`coordinates × dof` entries, 8 MB) that
+/// [`System::reduced_hessian_and_basis`] keeps.
+pub(crate) const KEPT_BASIS_ENTRIES: usize = 1 << 20;
+
 /// Quantities at a feasible configuration under a partition.
 #[derive(Clone)]
 pub(crate) struct Eval {
@@ -202,22 +206,45 @@ impl System<'_> {
         part: &Partition,
         eval: &Eval,
     ) -> DMatrix<f64> {
-        let hr = if self.backend != Backend::Dense {
+        self.reduced_hessian_and_basis(q, part, eval).0
+    }
+
+    /// [`System::reduced_hessian`] and the null-space basis `Z` it was formed with (the
+    /// columns of [`System::null_basis`], bit for bit), kept where `Z` has at most
+    /// [`KEPT_BASIS_ENTRIES`] entries (the minimizer's path curvature and the joint-space
+    /// spectrum use it again at the same point instead of solving for it anew).
+    pub(crate) fn reduced_hessian_and_basis(
+        &mut self,
+        q: &DVector<f64>,
+        part: &Partition,
+        eval: &Eval,
+    ) -> (DMatrix<f64>, Option<DMatrix<f64>>) {
+        let n = self.problem.model.coordinate_count();
+        let dof = part.independent.len();
+        let keep = n * dof <= KEPT_BASIS_ENTRIES;
+        let (hr, basis) = if self.backend != Backend::Dense {
             self.lagrangian_blocks(q, part, eval);
-            let dof = part.independent.len();
             let mut hr = DMatrix::zeros(dof, dof);
+            let mut basis = keep.then(|| DMatrix::zeros(n, dof));
             for b in 0..dof {
                 let mut e = DVector::zeros(dof);
                 e[b] = 1.0;
-                hr.set_column(b, &self.reduced_apply(part, eval, &e));
+                // `reduced_apply`, keeping `Z e_b`.
+                let zx = self.tangent_step(part, eval, &e);
+                let mut wzx = DVector::zeros(zx.len());
+                self.work.hess.mul_add(zx.as_slice(), wzx.as_mut_slice());
+                hr.set_column(b, &self.tangent_transpose(part, eval, &wzx));
+                if let Some(z) = basis.as_mut() {
+                    z.set_column(b, &zx);
+                }
             }
-            hr
+            (hr, basis)
         } else {
             let z = self.null_basis(part, eval);
             let w = self.lagrangian_hessian(q, part, eval);
-            z.transpose() * w * &z
+            (z.transpose() * w * &z, keep.then_some(z))
         };
-        (&hr + hr.transpose()) * 0.5
+        ((&hr + hr.transpose()) * 0.5, basis)
     }
 
     /// `Zᵀ W Z x` with the `W` of the last block assembly (sparse path).

@@ -10,6 +10,9 @@
 //! ```
 //!
 //! and for the transposed system `Sᵀ` with `Tᵀ`: two tree solves per solve, `k` to form `S`.
+//! A column of `C` reaches one or two bodies (a loop or contact row): its solve `T⁻¹ c` is
+//! zero outside the nodes it can reach from there, and the caller's block solve starts at the
+//! column's first (or last) tree entry instead of the end of the tree.
 
 use super::dense;
 
@@ -58,16 +61,17 @@ impl Border {
         self.entries.len() + self.positions.len().pow(2)
     }
 
-    /// Forms `S = D − R T⁻¹ C` from the entry values at the front of `values` (`solve(x, t)`:
-    /// `x ← T⁻¹ x`, or `T⁻ᵀ x` when `t`) and factors it (LU with partial pivoting); `None` if
-    /// singular. With `inertia` (a symmetric matrix), also the number of negative eigenvalues
+    /// Forms `S = D − R T⁻¹ C` from the entry values at the front of `values` (`solve(x, lo,
+    /// hi)`: `x ← T⁻¹ x` where `x` is zero outside the positions `lo ..= hi`, so that the
+    /// caller's block solve may skip the nodes whose part of the result is zero) and factors
+    /// it (LU with partial pivoting); `None` if singular. With `inertia` (a symmetric matrix), also the number of negative eigenvalues
     /// of `S` (LDLᵀ without pivoting of its symmetric part; `None` on a zero pivot): the
     /// border's share of the matrix's inertia (Haynsworth).
     pub(crate) fn factor(
         &self,
         values: &mut [f64],
         piv: &mut [u16],
-        solve: impl Fn(&mut [f64], bool),
+        solve: impl Fn(&mut [f64], usize, usize),
         inertia: bool,
     ) -> Option<Option<usize>> {
         let k = self.size();
@@ -77,16 +81,24 @@ impl Border {
         let mut col = vec![0.0; self.index.len()];
         for (b, &pb) in self.positions.iter().enumerate() {
             col.iter_mut().for_each(|v| *v = 0.0);
+            // The column's tree entries lie in `lo ..= hi` (a contact or a loop row reaches
+            // one or two bodies): the solve starts or ends there.
+            let (mut lo, mut hi) = (usize::MAX, 0);
             for (e, &(p, q)) in self.entries.iter().enumerate() {
                 let (p, q) = (p as usize, q as usize);
                 if q == pb {
                     match self.index[p] {
-                        u32::MAX => col[p] += vals[e],
+                        u32::MAX => {
+                            col[p] += vals[e];
+                            (lo, hi) = (lo.min(p), hi.max(p));
+                        }
                         a => s[a as usize * k + b] += vals[e],
                     }
                 }
             }
-            solve(&mut col, false);
+            if lo <= hi {
+                solve(&mut col, lo, hi);
+            }
             for (e, &(p, q)) in self.entries.iter().enumerate() {
                 let (a, q) = (self.index[p as usize], q as usize);
                 if a != u32::MAX && self.index[q] == u32::MAX {

@@ -16,9 +16,15 @@
 //! `y_i = K_i⁻¹ r_i`, `r_p −= C_iᵀ y_i` from the leaves and `x_i = y_i − X_i x_p` back from
 //! the root, then the border (module `border`), then iterative refinement like the sparse
 //! path's. Values, factors and scratch are allocated once per structure.
+//!
+//! Assembly writes every slot once per Newton step without clearing the values first: a `W`
+//! entry stores its (scaled) Hessian block entry, a Jacobian entry stores its first triplet
+//! `0 + d_r J_rc s_c` and adds the others in triplet order (the first of each slot flagged
+//! once per structure, module `shape`), and only the diagonal slots that no Hessian block
+//! writes are zeroed: the same sums, in the same order, as zeroing and adding.
 
 use super::dense;
-use super::shape::{Shape, SKIP};
+use super::shape::{Shape, FIRST, SKIP};
 use crate::solver::partition::Partition;
 use crate::solver::sparse::hessian::BlockHessian;
 use crate::solver::sparse::kkt::Factored;
@@ -110,27 +116,28 @@ impl TreeKkt {
         hess: &BlockHessian,
     ) {
         // Every slot holds one pair of unknowns (module `shape`): a `W` entry takes the value of
-        // one Hessian block entry, stored; a Jacobian entry the sum of its triplets, zeroed
-        // first. The slots of neither (the zero blocks of the rows) stay zero from allocation,
-        // and the diagonal is zeroed for a coordinate without a block (a shift left there).
+        // one Hessian block entry, stored; a Jacobian entry the sum of its triplets, the first
+        // stored (as `0 + v`: the same value as zeroing and adding, signed zeros included) and
+        // the others added, in triplet order. The slots of neither (the zero blocks of the
+        // rows) stay zero from allocation, and the diagonal of a coordinate without a block is
+        // zeroed (a shift left there).
         self.shifts.clear();
         let s = &self.shape;
         let values = &mut self.values;
-        for &slot in &s.diag_slots {
+        for &slot in &s.bare_diag {
             values[slot as usize] = 0.0;
-        }
-        for slots in &s.jac_slots {
-            for &slot in slots {
-                if slot != SKIP {
-                    values[slot as usize] = 0.0;
-                }
-            }
         }
         hess.scatter_scaled_store(&s.block_slots, scale, values);
         for (e, slots) in entries.iter().zip(&s.jac_slots) {
+            let v = e.2 * row_scale[e.0] * scale[e.1];
             for &slot in slots {
                 if slot != SKIP {
-                    values[slot as usize] += e.2 * row_scale[e.0] * scale[e.1];
+                    let at = &mut values[(slot & !FIRST) as usize];
+                    if slot & FIRST != 0 {
+                        *at = 0.0 + v;
+                    } else {
+                        *at += v;
+                    }
                 }
             }
         }
@@ -268,9 +275,12 @@ impl TreeKkt {
         self.border.copy_from_slice(&self.values[s.flat_len..]);
         let mut border = std::mem::take(&mut self.border);
         let mut bpiv = std::mem::take(&mut self.border_piv);
-        let got = s
-            .border
-            .factor(&mut border, &mut bpiv, |x, _| self.tree_solve(x, lu), !lu);
+        let got = s.border.factor(
+            &mut border,
+            &mut bpiv,
+            |x, lo, _| self.tree_solve_from(x, lu, lo),
+            !lu,
+        );
         self.border = border;
         self.border_piv = bpiv;
         match got? {
@@ -282,9 +292,17 @@ impl TreeKkt {
 
     /// `x ← T⁻¹ x` over the tree part (tree-space order; the border untouched).
     fn tree_solve(&self, x: &mut [f64], lu: bool) {
+        self.tree_solve_from(x, lu, 0);
+    }
+
+    /// [`TreeKkt::tree_solve`] for an `x` that is zero before the tree-space position `lo`:
+    /// the forward pass starts at the node holding `lo` (the nodes before it, leaves whose
+    /// right side is zero, would pass zeros on; the backward pass fills every node).
+    fn tree_solve_from(&self, x: &mut [f64], lu: bool, lo: usize) {
         let s = &self.shape;
         let nodes = s.at.len();
-        for i in 0..nodes {
+        let first = s.at.partition_point(|&a| a <= lo).saturating_sub(1);
+        for i in first..nodes {
             let (at, d, w) = (s.at[i], s.d[i], s.w[i]);
             let blk = &self.factors[s.diag_at[i]..s.diag_at[i] + d * d];
             let (head, tail) = x.split_at_mut(at + d);

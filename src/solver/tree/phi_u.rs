@@ -292,7 +292,12 @@ impl TreeLu {
         let mut piv = std::mem::take(&mut self.border_piv);
         let ok = shape
             .border
-            .factor(&mut border, &mut piv, |x, t| self.tree_solve(x, t), false)
+            .factor(
+                &mut border,
+                &mut piv,
+                |x, _, hi| self.tree_solve_to(x, hi),
+                false,
+            )
             .is_some();
         self.vals[range].copy_from_slice(&border);
         self.border_piv = piv;
@@ -303,28 +308,44 @@ impl TreeLu {
     fn tree_solve(&self, x: &mut [f64], transpose: bool) {
         let s = &*self.shape;
         let nodes = s.span.len();
+        if !transpose {
+            self.solve_nodes(x, nodes);
+            return;
+        }
         let (diag, rest) = self.vals.split_at(s.off0);
         let off = &rest[..s.border0 - s.off0];
-        if !transpose {
-            for i in (0..nodes).rev() {
-                for k in s.off_at[i]..s.off_at[i + 1] {
-                    let (p, q) = s.off[k];
-                    x[p as usize] -= off[k] * x[q as usize];
-                }
-                let (a, b) = s.span[i];
-                let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];
-                dense::lu_solve(blk, &self.piv[a..b], b - a, &mut x[a..b], 1);
+        for i in 0..nodes {
+            let (a, b) = s.span[i];
+            let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];
+            dense::lu_solve_transpose(blk, &self.piv[a..b], b - a, &mut x[a..b]);
+            for k in s.off_at[i]..s.off_at[i + 1] {
+                let (p, q) = s.off[k];
+                x[q as usize] -= off[k] * x[p as usize];
             }
-        } else {
-            for i in 0..nodes {
-                let (a, b) = s.span[i];
-                let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];
-                dense::lu_solve_transpose(blk, &self.piv[a..b], b - a, &mut x[a..b]);
-                for k in s.off_at[i]..s.off_at[i + 1] {
-                    let (p, q) = s.off[k];
-                    x[q as usize] -= off[k] * x[p as usize];
-                }
+        }
+    }
+
+    /// `T x = r` for an `r` that is zero after the position `hi`: the nodes after the one
+    /// holding `hi` have a zero right side and only later nodes' entries (last node first),
+    /// so their part of `x` is zero and the solve starts at that node.
+    fn tree_solve_to(&self, x: &mut [f64], hi: usize) {
+        let s = &*self.shape;
+        self.solve_nodes(x, s.span.partition_point(|&(a, _)| a <= hi));
+    }
+
+    /// `T x = r` over the first `nodes` nodes, last first.
+    fn solve_nodes(&self, x: &mut [f64], nodes: usize) {
+        let s = &*self.shape;
+        let (diag, rest) = self.vals.split_at(s.off0);
+        let off = &rest[..s.border0 - s.off0];
+        for i in (0..nodes).rev() {
+            for k in s.off_at[i]..s.off_at[i + 1] {
+                let (p, q) = s.off[k];
+                x[p as usize] -= off[k] * x[q as usize];
             }
+            let (a, b) = s.span[i];
+            let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];
+            dense::lu_solve(blk, &self.piv[a..b], b - a, &mut x[a..b], 1);
         }
     }
 

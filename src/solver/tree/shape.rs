@@ -23,6 +23,10 @@ pub(crate) const MAX_BORDER: usize = 96;
 /// mirror of a coupling entry, which the block elimination reads from its transpose).
 pub(crate) const SKIP: u32 = u32::MAX;
 
+/// The flag of a Jacobian slot that the triplet is the first to reach (the assembly stores
+/// `0 + v` there and adds the later triplets' values: no zeroing pass). Slots stay below it.
+pub(crate) const FIRST: u32 = 1 << 31;
+
 /// The structure of the tree KKT matrix.
 pub(crate) struct Shape {
     /// Coordinates `n` and rows.
@@ -44,10 +48,14 @@ pub(crate) struct Shape {
     pub(crate) tree_len: usize,
     pub(crate) border: Border,
     /// Slots of each Hessian block's entries and of each Jacobian triplet (`(row, column)` and
-    /// its mirror), and of each coordinate's diagonal.
+    /// its mirror; [`FIRST`] set on the first triplet to reach a slot), and of each
+    /// coordinate's diagonal.
     pub(crate) block_slots: Vec<[u32; 49]>,
     pub(crate) jac_slots: Vec<[u32; 2]>,
     pub(crate) diag_slots: Vec<u32>,
+    /// The diagonal slots that no Hessian block writes (zeroed by each assembly: a shift of
+    /// the last factorization may be left there).
+    pub(crate) bare_diag: Vec<u32>,
 }
 
 impl Shape {
@@ -295,6 +303,27 @@ impl Shape {
             });
         }
         let diag_slots = (0..n).map(|c| locate(c, c)).collect::<Option<Vec<_>>>()?;
+        let total = flat + border_slot.len();
+        if total >= FIRST as usize {
+            return None;
+        }
+        // Flag each slot's first triplet; list the diagonal slots no block reaches.
+        let mut reached = vec![false; total];
+        for slots in &mut jac_slots {
+            for slot in slots.iter_mut().filter(|s| **s != SKIP) {
+                if !std::mem::replace(&mut reached[*slot as usize], true) {
+                    *slot |= FIRST;
+                }
+            }
+        }
+        for s in block_slots.iter().flatten().filter(|&&s| s != SKIP) {
+            reached[*s as usize] = true;
+        }
+        let bare_diag = diag_slots
+            .iter()
+            .copied()
+            .filter(|&s| !reached[s as usize])
+            .collect();
         Some(Shape {
             n,
             rows,
@@ -311,6 +340,7 @@ impl Shape {
             block_slots,
             jac_slots,
             diag_slots,
+            bare_diag,
         })
     }
 }

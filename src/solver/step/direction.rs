@@ -1,0 +1,54 @@
+//! The reduced step of one iteration (stage 3 of module `minimize`), by the first that
+//! applies:
+//!
+//! 1. where the path keeps every row (module `path_hessian`) and the Hessian is exact, the
+//!    Newton step along the path, escaping maxima and saddles along every direction of
+//!    negative curvature (module `escape`);
+//! 2. at a stationary saddle, `max_step` along the eigenvector of the most negative
+//!    eigenvalue, downhill;
+//! 3. the Newton step with the eigenvalue magnitudes (dense, module `newton`), the KKT
+//!    direction (sparse, module `kkt_direction`), or `−B ∇f` (module `quasi_newton`).
+
+use crate::solver::inequality::active_set::Guard;
+use crate::solver::options::{Method, Options};
+use crate::solver::partition::Partition;
+use crate::solver::stability::spectrum::Spectrum;
+use crate::solver::step::escape::escape_step;
+use crate::solver::step::kkt_direction::kkt_direction;
+use crate::solver::step::newton::newton_step;
+use crate::solver::step::path_hessian::path_keeps_rows;
+use crate::solver::system::{Eval, System};
+use nalgebra::{DMatrix, DVector};
+
+/// The reduced step at `(q, part, eval)` (module docs), `eig` the reduced Hessian's spectrum
+/// when computed, `negative_curvature` the saddle's direction when the point is stationary,
+/// `binv` the quasi-Newton inverse Hessian; and whether it escaped along negative curvature.
+pub(crate) fn direction(
+    sys: &mut System,
+    (q, part, eval): (&DVector<f64>, &Partition, &Eval),
+    eig: Option<&Spectrum>,
+    negative_curvature: Option<&DVector<f64>>,
+    binv: &DMatrix<f64>,
+    guard: Option<&Guard>,
+    options: &Options,
+) -> (DVector<f64>, bool) {
+    let g = &eval.grad_v;
+    let along = eig
+        .filter(|e| e.exact && options.method == Method::Newton && path_keeps_rows(sys))
+        .map(|e| escape_step(sys, q, part, eval, e, guard, options));
+    match (along, negative_curvature) {
+        (Some((d, escaped)), nc) if escaped || nc.is_none() => (d, escaped),
+        (_, Some(nc)) => {
+            let sign = if nc.dot(g) > 0.0 { -1.0 } else { 1.0 };
+            (
+                nc * (sign * options.max_step / nc.amax().max(1e-300)),
+                false,
+            )
+        }
+        _ => match (eig, options.method) {
+            (Some(e), Method::Newton) if e.exact => (newton_step(e, g, None).0, false),
+            (_, Method::Newton) => (kkt_direction(sys, q, part, eval), false),
+            _ => (-(binv * g), false),
+        },
+    }
+}

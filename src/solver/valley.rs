@@ -1,0 +1,275 @@
+//! Curved valleys: a trial point of the line search brought back to the valley floor along
+//! the stiff eigenvectors of the reduced Hessian before it is judged.
+//!
+//! Where the reduced Hessian has a few near-neutral directions (a hanging leg whose centre of
+//! mass lies almost on its hip-yaw axis: curvature `ε″ ≈ 10⁻⁹ N m/rad`) well apart from the
+//! rest, the energy near the floor of the valley reads `V ≈ ½ k (θ − a(ψ))² + ε(ψ)`, `ψ` the
+//! soft coordinate, `θ` the stiff ones. Off the floor the soft curvature is
+//! `ε″ − (∂V/∂θ) a″`: a stiff gradient of 10⁻⁶ already hides `ε″`, the Newton step along `ψ`
+//! is a few per cent of the way, and the straight step leaves the curved floor by `½ a″ Δψ²`,
+//! which brings the stiff gradient back. The iteration crawls (iCub reduced hanging: 36
+//! iterations in one active-set round, the hip yaw moving 0.4 rad by 0.01 rad a step, the energy
+//! changing below its rounding).
+//!
+//! The remedy is the second-order correction of constrained optimization applied to the
+//! valley: at a trial point `v̂ + α d` with reduced gradient `g`, the stiff Newton step
+//!
+//! `δ = −Σ_{i stiff} w_i (w_iᵀ g) / λ_i`
+//!
+//! (`λ_i, w_i` the eigenpairs of the reduced Hessian at `v̂`, the stiff ones those above a
+//! spectral gap of [`GAP`]; up to [`CORRECTIONS`] times, each kept where it lowers the merit
+//! and the gradient) moves the trial point back to the floor, and the line search judges the
+//! corrected point. The next iterate then sits on the floor, its soft curvature is `ε″` itself
+//! and the Newton step along `ψ` goes the whole way. Along the floor the energy may change by
+//! less than its rounding: a trial point whose merit is equal to rounding is then accepted when
+//! its gradient along the soft eigenvectors is smaller ([`Valley::closer`]). All this only
+//! where the iteration has stalled (the gradient fell by less than [`STALL`] over the last step)
+//! and the spectrum has the gap; from then on in the round.
+//!
+//! In such a valley the gradient test alone does not place the soft coordinate (a curvature of
+//! 10⁻⁹ N m/rad and a tolerance of 10⁻⁸ J leave it free over radians), so a point that passes
+//! it is taken as the rest only when the Newton step along the soft eigenvectors is below
+//! [`SETTLED`] ([`Watch::unsettled`]).
+//!
+//! ## References
+//! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §15.6
+//!   (second-order correction), §3.4.
+//! - H. H. Rosenbrock, An automatic method for finding the greatest or least value of a
+//!   function, *Computer Journal* 3 (1960) 175–184 (the curved valley).
+
+use super::options::Options;
+use super::partition::Partition;
+use super::report::{Diagnostics, Iterate};
+use super::stability::spectrum::Spectrum;
+use super::system::{Eval, System};
+use nalgebra::{DMatrix, DVector};
+
+/// The ratio between the smallest stiff and the largest soft eigenvalue magnitude that
+/// separates a valley's floor from its walls.
+pub(crate) const GAP: f64 = 1e3;
+
+/// A step after which the reduced gradient is above this fraction of what it was has stalled
+/// (a Newton step in its quadratic range cuts it by far more).
+pub(crate) const STALL: f64 = 0.1;
+
+/// A valley's soft curvature is resolved above this fraction of the largest eigenvalue (the
+/// dense Newton step's floor, module `step::newton`).
+pub(crate) const RESOLVED: f64 = 1e-12;
+
+/// A point that passed the gradient test in a valley is settled when the Newton step along
+/// the soft eigenvectors moves no scaled coordinate by more than this (rad, or lengths `L`).
+pub(crate) const SETTLED: f64 = 1e-3;
+
+/// Iterations a round takes past the gradient test to settle the soft coordinates.
+pub(crate) const MAX_SETTLING: usize = 3;
+
+/// Stiff Newton steps that bring a trial point back to the floor at most (the stiff Hessian is
+/// that of the start of the line search: the steps converge linearly).
+pub(crate) const CORRECTIONS: usize = 3;
+
+/// The stiff eigenpairs of the reduced Hessian at the start of a line search, and the soft
+/// ones.
+pub(crate) struct Valley {
+    vectors: DMatrix<f64>,
+    values: DVector<f64>,
+    soft: Vec<(DVector<f64>, f64)>,
+}
+
+/// The valley watch of one minimization (one active-set round).
+#[derive(Default)]
+pub(crate) struct Watch {
+    /// A step has stalled where the spectrum has a valley's gap.
+    on: bool,
+    /// Iterations taken past the gradient test to settle the soft coordinates.
+    settling: usize,
+}
+
+impl Watch {
+    /// The valley of the spectrum `e` for this step, once a step of the round (`history`,
+    /// its iterates so far) has stalled where the spectrum has the gap.
+    pub(crate) fn step(&mut self, e: Option<&Spectrum>, history: &[Iterate]) -> Option<Valley> {
+        let stalled = match history {
+            [.., a, b] => b.gradient_norm > STALL * a.gradient_norm,
+            _ => false,
+        };
+        let valley = e.and_then(Valley::of);
+        self.on |= stalled && valley.is_some();
+        valley.filter(|_| self.on)
+    }
+
+    /// Whether a point that passed the gradient test is still far from the lowest point of
+    /// its valley: with a soft curvature of 10⁻⁹ N m/rad a gradient tolerance of 10⁻⁸ J
+    /// leaves the soft coordinate free over radians. So the round goes on (at most
+    /// [`MAX_SETTLING`] times) while the Newton step along the soft eigenvectors moves a scaled
+    /// coordinate by more than [`SETTLED`] and their gradient is above ten times the rounding
+    /// floor `floor` of the gradient.
+    pub(crate) fn unsettled(&mut self, e: &Spectrum, g: &DVector<f64>, floor: f64) -> bool {
+        let Some(valley) = Valley::of(e).filter(|_| self.on && self.settling < MAX_SETTLING) else {
+            return false;
+        };
+        let mut d = DVector::zeros(g.len());
+        for (w, l) in &valley.soft {
+            let c = w.dot(g);
+            if c.abs() > 10.0 * floor {
+                d += w * (c / l);
+            }
+        }
+        let far = d.amax() > SETTLED;
+        self.settling += usize::from(far);
+        far
+    }
+}
+
+impl Valley {
+    /// The valley of the spectrum `e`, where it has a gap of [`GAP`] between its soft
+    /// eigenvalues (at most half of them) and its stiff ones, every eigenvalue positive and
+    /// above [`RESOLVED`] of the largest.
+    pub(crate) fn of(e: &Spectrum) -> Option<Valley> {
+        let n = e.values.len();
+        if !e.exact || n < 2 {
+            return None;
+        }
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by(|&a, &b| e.values[a].abs().total_cmp(&e.values[b].abs()));
+        // The widest gap among the lower half of the magnitudes.
+        let (mut split, mut ratio) = (0, 0.0);
+        for k in 0..n / 2 {
+            let r = e.values[order[k + 1]].abs() / e.values[order[k]].abs().max(1e-300);
+            if r > ratio {
+                (split, ratio) = (k + 1, r);
+            }
+        }
+        // A soft eigenvalue at rounding level is a neutral direction (a wrist whose axis
+        // passes through its load), not a valley floor: every rest along it is as good.
+        let resolved = RESOLVED * e.values.amax();
+        if ratio < GAP || order.iter().any(|&i| e.values[i] <= resolved) {
+            return None;
+        }
+        let stiff = &order[split..];
+        Some(Valley {
+            vectors: e.vectors.select_columns(stiff),
+            values: DVector::from_iterator(stiff.len(), stiff.iter().map(|&i| e.values[i])),
+            soft: order[..split]
+                .iter()
+                .map(|&i| (e.vectors.column(i).into_owned(), e.values[i]))
+                .collect(),
+        })
+    }
+
+    /// The stiff Newton step at the reduced gradient `g` (module docs).
+    fn step(&self, g: &DVector<f64>) -> DVector<f64> {
+        let c = self.vectors.tr_mul(g).component_div(&self.values);
+        -(&self.vectors * c)
+    }
+
+    /// Whether the gradient along the floor (on the soft eigenvectors) is smaller at `g1` than
+    /// at `g0`: the line search's test where the energy along the floor changes below its
+    /// rounding (module docs).
+    pub(crate) fn closer(&self, g0: &DVector<f64>, g1: &DVector<f64>) -> bool {
+        let along = |g: &DVector<f64>| self.soft.iter().map(|(w, _)| w.dot(g).powi(2)).sum::<f64>();
+        along(g1) < along(g0)
+    }
+
+    /// The trial point `(q, eval)` moved to the valley floor by up to [`CORRECTIONS`] stiff
+    /// Newton steps, each kept while it lowers both the merit and the gradient.
+    pub(crate) fn correct(
+        &self,
+        sys: &mut System,
+        part: &Partition,
+        options: &Options,
+        diag: &mut Diagnostics,
+        (mut q, mut eval): (DVector<f64>, Eval),
+    ) -> (DVector<f64>, Eval) {
+        for _ in 0..CORRECTIONS {
+            let d = self.step(&eval.grad_v);
+            let dq = sys.tangent_step(part, &eval, &d);
+            let mut qc = sys.problem.retraction.point(&q, &dq, 1.0);
+            if sys
+                .correct_from(
+                    &mut qc,
+                    part,
+                    options.constraint_tolerance,
+                    options.max_corrector_iterations,
+                    Some(&eval.factors),
+                )
+                .is_err()
+            {
+                diag.corrector_failures += 1;
+                break;
+            }
+            let Some(ec) = sys.evaluate(&qc, part) else {
+                break;
+            };
+            diag.function_evaluations += 1;
+            if ec.merit > eval.merit || ec.grad_v.amax() >= eval.grad_v.amax() {
+                break;
+            }
+            (q, eval) = (qc, ec);
+        }
+        (q, eval)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spectrum(values: &[f64]) -> Spectrum {
+        let n = values.len();
+        Spectrum {
+            values: DVector::from_row_slice(values),
+            vectors: DMatrix::identity(n, n),
+            largest: values.iter().fold(0.0f64, |m, v| m.max(v.abs())),
+            exact: true,
+            negative_by_inertia: None,
+            basis: None,
+        }
+    }
+
+    #[test]
+    fn a_gap_of_a_thousand_separates_the_floor_from_the_walls() {
+        let v = Valley::of(&spectrum(&[2.0, 1e-7, 0.02, 70.0])).expect("a valley");
+        // The stiff step leaves the soft component alone and is Newton's on the others.
+        let g = DVector::from_row_slice(&[4.0, 1.0, 0.02, 7.0]);
+        let d = v.step(&g);
+        assert_eq!(d[1], 0.0);
+        assert!(
+            (d[0] + 2.0).abs() < 1e-15 && (d[2] + 1.0).abs() < 1e-15 && (d[3] + 0.1).abs() < 1e-15
+        );
+    }
+
+    #[test]
+    fn the_floor_gradient_decides_and_a_long_soft_step_is_not_a_rest() {
+        let e = spectrum(&[1e-9, 1.0]);
+        let v = Valley::of(&e).expect("a valley");
+        let g0 = DVector::from_row_slice(&[6e-10, 1e-3]);
+        // Smaller along the floor, larger on the wall: closer to the floor's lowest point.
+        assert!(v.closer(&g0, &DVector::from_row_slice(&[1e-10, 1e-2])));
+        assert!(!v.closer(&g0, &DVector::from_row_slice(&[-7e-10, 0.0])));
+        // 6·10⁻¹⁰ J below the gradient tolerance, but the Newton step along the floor is
+        // 0.6 rad: not settled, once the round is in the valley, and at most MAX_SETTLING times.
+        let g = DVector::from_row_slice(&[6e-10, 0.0]);
+        let mut watch = Watch::default();
+        assert!(!watch.unsettled(&e, &g, 1e-12));
+        watch.on = true;
+        for _ in 0..MAX_SETTLING {
+            assert!(watch.unsettled(&e, &g, 1e-12));
+        }
+        assert!(!watch.unsettled(&e, &g, 1e-12));
+        // Settled: a step of 10⁻⁴; or a soft gradient at the rounding floor.
+        let mut watch = Watch {
+            on: true,
+            settling: 0,
+        };
+        assert!(!watch.unsettled(&e, &DVector::from_row_slice(&[1e-13, 0.0]), 1e-12));
+        assert!(!watch.unsettled(&e, &DVector::from_row_slice(&[6e-10, 0.0]), 1e-10));
+    }
+
+    #[test]
+    fn no_valley_without_a_gap_with_negative_curvature_or_a_neutral_direction() {
+        assert!(Valley::of(&spectrum(&[1.0, 1e-2, 3.0])).is_none());
+        assert!(Valley::of(&spectrum(&[-1.0, 1e-7, 3.0])).is_none());
+        assert!(Valley::of(&spectrum(&[-1e-7, 1.0, 3.0])).is_none());
+        assert!(Valley::of(&spectrum(&[1e-17, 1.0, 3.0])).is_none());
+    }
+}

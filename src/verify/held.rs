@@ -98,7 +98,7 @@ pub(super) fn held(
     coords: &[(JointId, usize, f64)],
     backend: Backend,
     tau: f64,
-    free: Option<Multipliers>,
+    free: Free,
 ) -> Result<Held> {
     let locks = crate::solver::lock_values(model);
     let mut all = locks.clone();
@@ -121,7 +121,20 @@ pub(super) fn held(
     // and these are the forces (the least-norm ones among those needing none).
     // Nothing touching: the caller may have these multipliers already ([`free_of`]).
     let free = match free {
-        Some(m) if list.is_empty() => (m, Vec::new(), Vec::new()),
+        Free::Given(m) if list.is_empty() => (m, Vec::new(), Vec::new()),
+        Free::Skip if list.is_empty() => {
+            // The locked solve is what the two stages give without a touching row (both the
+            // balanced and the unbalanced case solve it; the balanced one adds a zero).
+            let r = solve_once(model, state, &[], &[], &all, locks.len(), backend, None)?;
+            return Ok(Held {
+                efforts: row_of.iter().map(|&k| r.locks[k]).collect(),
+                locked,
+                unassigned: r.unassigned,
+                forces: Vec::new(),
+                pulling: Vec::new(),
+                friction: None,
+            });
+        }
         _ => with_rounds(list, tau, |on| {
             solve_once(model, state, list, on, &locks, locks.len(), backend, None)
         })?,
@@ -202,6 +215,17 @@ fn with_rounds(
             on[i] = false;
         }
     }
+}
+
+/// The first solve of [`held`] (the model's rows and the touching ones, no joint locked).
+pub(super) enum Free {
+    /// Nothing touches and these are its multipliers ([`free_of`]).
+    Given(Multipliers),
+    /// To be solved.
+    Solve,
+    /// Not needed where nothing touches: the efforts, forces and unassigned force are the
+    /// locked solve's (as they are after the first solve; solved where something touches).
+    Skip,
 }
 
 /// One solve's multipliers: per lock of `all`, per inequality of `list`, and the unassigned
@@ -376,7 +400,7 @@ fn solve_once(
             }
         }
         let at = |rows: &[usize]| DVector::from_iterator(rows.len(), rows.iter().map(|&r| mu[r]));
-        let z = lexicographic(&k_free, &at(&free), &k_touch, &at(&touch));
+        let z = super::lexicographic::lexicographic(&k_free, &at(&free), &k_touch, &at(&touch));
         mu += &k_all * z;
         directions = Some((k_touch, k_all));
     }
@@ -427,55 +451,4 @@ fn solve_once(
         resolved,
         chosen,
     })
-}
-
-/// `z` minimizing `‖a + A z‖₂`, then among those minimizers `‖b + B z‖₂` (then `‖z‖₂`).
-fn lexicographic(
-    a_mat: &DMatrix<f64>,
-    a: &DVector<f64>,
-    b_mat: &DMatrix<f64>,
-    b: &DVector<f64>,
-) -> DVector<f64> {
-    let d = a_mat.ncols();
-    // Stage 1: z₁ = −A⁺ a, and a basis N of the null space of A.
-    let (z1, null) = if a_mat.nrows() == 0 {
-        (DVector::zeros(d), DMatrix::identity(d, d))
-    } else {
-        let Some(svd) = crate::solver::eigen::svd(a_mat.clone(), true, true) else {
-            return DVector::from_element(d, f64::NAN);
-        };
-        let top = svd.singular_values.max();
-        let eps = 1e-10 * top.max(1e-300);
-        let z1 = svd.solve(&(-a), eps).unwrap_or_else(|_| DVector::zeros(d));
-        // Rows of Vᵀ beyond the rank span the null space (all of them when d > rows).
-        let v_t = svd.v_t.clone().unwrap_or_else(|| DMatrix::zeros(0, d));
-        let rank = svd.singular_values.iter().filter(|&&s| s > eps).count();
-        let full = DMatrix::<f64>::identity(d, d);
-        // Complete the basis: N = I − V_r V_rᵀ, orthonormalized by its own SVD.
-        let v_r = v_t.rows(0, rank).transpose();
-        let proj = &full - &v_r * v_r.transpose();
-        let Some(psvd) = crate::solver::eigen::svd(proj, true, false) else {
-            return DVector::from_element(d, f64::NAN);
-        };
-        let u = psvd.u.unwrap_or_else(|| DMatrix::zeros(d, 0));
-        let cols: Vec<usize> = (0..psvd.singular_values.len())
-            .filter(|&k| psvd.singular_values[k] > 0.5)
-            .collect();
-        let null = DMatrix::from_fn(d, cols.len(), |r, c| u[(r, cols[c])]);
-        (z1, null)
-    };
-    if null.ncols() == 0 || b_mat.nrows() == 0 {
-        return z1;
-    }
-    // Stage 2: y minimizing ‖b + B z₁ + B N y‖.
-    let bn = b_mat * &null;
-    let rhs = -(b + b_mat * &z1);
-    let Some(svd) = crate::solver::eigen::svd(bn, true, true) else {
-        return DVector::from_element(null.ncols(), f64::NAN) * 0.0 + z1;
-    };
-    let eps = 1e-10 * svd.singular_values.max().max(1e-300);
-    let y = svd
-        .solve(&rhs, eps)
-        .unwrap_or_else(|_| DVector::zeros(null.ncols()));
-    z1 + null * y
 }

@@ -35,6 +35,7 @@ mod dense;
 mod friction;
 mod held;
 mod initial_guess;
+mod lexicographic;
 mod pose;
 mod rank;
 mod reduced;
@@ -136,7 +137,8 @@ pub struct Verification {
     pub max_imbalance: Option<Imbalance>,
     /// Generalized force no scalar joint coordinate carries (spherical, floating joints) \[J\].
     pub unassigned: f64,
-    /// `‖Nᵀ S ∇V‖∞` \[J\].
+    /// `‖Nᵀ S ∇V‖∞` \[J\] (NaN where not computed: [`Eigenvalues::Skip`] on the sparse
+    /// path).
     pub projected_gradient: f64,
     /// Potential energy \[J\].
     pub potential_energy: f64,
@@ -182,7 +184,7 @@ pub fn balance(model: &Model, state: &State) -> Result<Balance> {
         // The finiteness guard inside, on the rows it evaluates anyway.
         let r = {
             let locks = crate::solver::lock_values(model);
-            reduced::reduced(model, state, &locks, auto_backend(model))?
+            reduced::reduced(model, state, &locks, auto_backend(model), true)?
         };
         return Ok(Balance {
             constraint_residual: r.phi.amax(),
@@ -280,7 +282,9 @@ pub enum Eigenvalues {
     /// sparse path, the low end found by Lanczos, as `analyze` reports them).
     Always,
     /// No stability verdict (`stability` is `None`): the balance checks only, as `analyze`
-    /// runs them on its own answer.
+    /// runs them on its own answer. On the sparse path the model's rows are then not
+    /// partitioned at all (the pass reads the residual and the forces of module `held`, which
+    /// partition their own system): `projected_gradient` is NaN there (not computed).
     Skip,
 }
 

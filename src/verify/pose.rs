@@ -196,7 +196,7 @@ pub fn pose_state_with_bodies(
     values: &JointValues,
     bodies: &[(crate::model::BodyId, nalgebra::Isometry3<f64>)],
 ) -> Result<(State, Vec<String>)> {
-    let mut all = crate::solver::initial_values(model);
+    let initial = crate::solver::initial_values(model);
     // `joint_id` looks names up in the model's map: a pose names every joint.
     for (name, v) in values {
         let id = model
@@ -213,8 +213,18 @@ pub fn pose_state_with_bodies(
                 got: v.len(),
             });
         }
-        all.insert(name.clone(), v.clone());
     }
+    // The given values over the initial ones: the given map itself where it names every
+    // joint with an initial value (a result JSON names them all), without copying it.
+    let all = if initial.keys().all(|k| values.contains_key(k)) {
+        std::borrow::Cow::Borrowed(values)
+    } else {
+        let mut all = initial;
+        for (name, v) in values {
+            all.insert(name.clone(), v.clone());
+        }
+        std::borrow::Cow::Owned(all)
+    };
     let missing = model
         .joints
         .iter()

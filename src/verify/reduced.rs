@@ -9,7 +9,10 @@
 //!   projection `Nᵀ S ∇V` of the dense path vanishes; its size differs by the conditioning of `Z`.
 //! - the efforts and forces that hold the pose: module `held` (on both paths).
 //!
-//! The partition and evaluation are kept for the stability verdict.
+//! The partition and evaluation are kept for the stability verdict. Where neither the
+//! projected gradient nor the verdict is asked (`analyze`'s self-check, which judges the pose
+//! by its residual and the forces of module `held`), the rows and the energy are evaluated
+//! without a partition.
 
 use crate::constraints::Constraints;
 use crate::error::{Error, Result};
@@ -25,22 +28,22 @@ pub(super) struct Reduced<'a> {
     pub(super) phi: DVector<f64>,
     /// Potential energy \[J\].
     pub(super) energy: f64,
-    /// `‖Zᵀ ∇V‖∞` \[J\] (0 without degrees of freedom).
+    /// `‖Zᵀ ∇V‖∞` \[J\] (0 without degrees of freedom; NaN where not partitioned).
     pub(super) reduced_gradient: f64,
     /// `‖S ∇V‖∞` \[J\]: the largest generalized force, the scale of the relative tolerance.
     pub(super) force_scale: f64,
     /// Number of independent coordinates.
     pub(super) dof: usize,
-    /// The system (rows included), its partition and evaluation at the configuration: what
-    /// the stability verdict needs too.
+    /// The system (rows included), its partition and evaluation at the configuration (where
+    /// partitioned): what the stability verdict needs too.
     pub(super) sys: System<'a>,
-    pub(super) part: Partition,
-    pub(super) eval: Eval,
+    pub(super) solved: Option<(Partition, Eval)>,
 }
 
 /// Partitions and evaluates the rows of `model` plus its `locks` at `q` on the sparse path
 /// (the sparse partition, factored by `backend`: the sparse or the tree factors), after the finiteness guard on those rows (`solver::finite`; they are evaluated once for
-/// both).
+/// both). Without `partition`, the rows and the energy only (no partition, factors or
+/// reduced gradient: `solved` is `None`, `reduced_gradient` NaN, `dof` 0).
 ///
 /// # Errors
 /// The guard's [`Error::NonFiniteConstraint`] or [`Error::NonFiniteEnergy`]; an undefined
@@ -50,6 +53,7 @@ pub(super) fn reduced<'a>(
     state: &State,
     locks: &[(JointId, usize, f64)],
     backend: Backend,
+    partition: bool,
 ) -> Result<Reduced<'a>> {
     let q = &state.q;
     let mut sys = System::new(
@@ -59,7 +63,7 @@ pub(super) fn reduced<'a>(
     );
     // The guard's gradient is `∇V` (one evaluation for both).
     let guarded = crate::solver::finite::guard_system_energy(&mut sys, state, "the given pose")?;
-    let (_, g) = guarded.ok_or_else(|| {
+    let (guard_energy, g) = guarded.ok_or_else(|| {
         crate::forces::undefined_term(model, &state.branches, q).unwrap_or(
             Error::SingularPartition {
                 at: "the given pose".into(),
@@ -72,6 +76,17 @@ pub(super) fn reduced<'a>(
         .iter()
         .zip(&scale)
         .fold(0.0f64, |a, (x, s)| a.max((x * s).abs()));
+    if !partition {
+        return Ok(Reduced {
+            phi: sys.phi().clone(),
+            energy: guard_energy,
+            reduced_gradient: f64::NAN,
+            force_scale,
+            dof: 0,
+            sys,
+            solved: None,
+        });
+    }
     let part = sys.partition(q);
     let eval = sys
         .evaluate(q, &part)
@@ -86,7 +101,6 @@ pub(super) fn reduced<'a>(
         force_scale,
         dof: part.independent.len(),
         sys,
-        part,
-        eval,
+        solved: Some((part, eval)),
     })
 }

@@ -58,7 +58,9 @@ pub(super) fn verify_on(
     // balance check's system (evaluated once for both, module `reduced`).
     let reduced = if sparse {
         let locks = crate::solver::lock_values(model);
-        Some(reduced::reduced(model, state, &locks, backend)?)
+        // Without the verdict (`analyze`'s self-check) no partition of the model's rows:
+        // its only other use is the projected gradient, which the pass does not read.
+        Some(reduced::reduced(model, state, &locks, backend, !skip)?)
     } else {
         crate::solver::finite::guard(model, state, "the given pose")?;
         None
@@ -87,21 +89,31 @@ pub(super) fn verify_on(
                 reduced_gradient,
                 force_scale,
                 mut sys,
-                part,
-                eval,
+                solved,
                 ..
             } = r;
             let assembled = scaled <= tol.constraint;
             let tau = tol.force + tol.relative * force_scale;
             // Without a stop or contact touching, the forces' first solve is this system's
-            // (`held::free_of`), and the verdict is judged on this partition.
-            let free = list.is_empty().then(|| held::free_of(&sys, &part, &eval));
+            // (`held::free_of`), and the verdict is judged on this partition; unpartitioned
+            // (no verdict asked), the forces come from the locked solve alone.
+            let free = match &solved {
+                Some((part, eval)) if list.is_empty() => {
+                    held::Free::Given(held::free_of(&sys, part, eval))
+                }
+                None => held::Free::Skip,
+                Some(_) => held::Free::Solve,
+            };
             let (held, stability) = std::thread::scope(|s| {
-                let verdict = (assembled && list.is_empty() && !skip).then(|| {
-                    s.spawn(|| {
-                        crate::solver::stability_of(&mut sys, &state.q, &part, &eval, eigenvalues)
-                    })
-                });
+                let verdict = solved
+                    .as_ref()
+                    .filter(|_| assembled && list.is_empty() && !skip)
+                    .map(|(part, eval)| {
+                        let sys = &mut sys;
+                        s.spawn(move || {
+                            crate::solver::stability_of(sys, &state.q, part, eval, eigenvalues)
+                        })
+                    });
                 let held = held::held(model, state, &list, values, forces_backend, tau, free)?;
                 let passed = passes(scaled, &held, force_scale, tol);
                 // A panic there is re-raised here, as if the verdict had been computed on
@@ -131,7 +143,15 @@ pub(super) fn verify_on(
             let projected_gradient = (p.null.transpose() * &p.grad_s).amax();
             let force_scale = p.grad_s.amax();
             let tau = tol.force + tol.relative * force_scale;
-            let held = held::held(model, state, &list, values, forces_backend, tau, None)?;
+            let held = held::held(
+                model,
+                state,
+                &list,
+                values,
+                forces_backend,
+                tau,
+                held::Free::Solve,
+            )?;
             (
                 p.phi,
                 scaled,

@@ -95,6 +95,8 @@ struct Elimination {
     /// Scratch of [`Elimination::pivot`]: the position of each column in the row being
     /// updated (`u32::MAX`: absent), reset after each row.
     pos: Vec<u32>,
+    /// `row_max(r)` of every row, kept current as the rows change (in [`Elimination::pivot`]).
+    rmax: Vec<f64>,
 }
 
 impl Elimination {
@@ -143,7 +145,8 @@ impl Elimination {
             for e in row.iter() {
                 pos[e.0] = u32::MAX;
             }
-            if self.row_max(i) <= self.tol {
+            self.rmax[i] = self.row_max(i);
+            if self.rmax[i] <= self.tol {
                 self.active[i] = false;
                 self.redundant.push(i);
             }
@@ -167,7 +170,7 @@ impl Elimination {
             if !self.active[r] {
                 continue;
             }
-            let rmax = self.row_max(r);
+            let rmax = self.rmax[r];
             entries.clear();
             entries.extend(
                 self.rows[r]
@@ -191,6 +194,45 @@ impl Elimination {
 }
 
 impl Elimination {
+    /// Row `r`'s entries on the free columns of body `b`, by column offset `c − 7 b`, and the
+    /// mask of the offsets present (a row's columns are distinct): the entries a filter and
+    /// a sort by column would list, in that order.
+    fn on_body(&self, r: usize, b: usize) -> ([f64; 7], u8) {
+        let (mut vals, mut mask) = ([0.0; 7], 0u8);
+        for &(c, v) in &self.rows[r] {
+            let k = c.wrapping_sub(7 * b);
+            if k < 7 && self.free[c] {
+                vals[k] = v;
+                mask |= 1 << k;
+            }
+        }
+        (vals, mask)
+    }
+
+    /// [`Elimination::best_pivot`] in the free columns of body `b` (same test, same order).
+    fn best_pivot_at(&self, cands: &[usize], threshold: f64, b: usize) -> Option<(usize, usize)> {
+        let mut best: Option<(usize, usize, f64)> = None;
+        for &r in cands {
+            if !self.active[r] {
+                continue;
+            }
+            let rmax = self.rmax[r];
+            let (vals, mask) = self.on_body(r, b);
+            for k in (0..7).filter(|k| mask & (1 << k) != 0) {
+                let a = vals[k].abs();
+                if a > self.tol
+                    && a >= threshold * rmax
+                    && best.is_none_or(|x| a > x.2 * (1.0 + 1e-9))
+                {
+                    best = Some((r, 7 * b + k, a));
+                }
+            }
+        }
+        best.map(|(r, c, _)| (r, c))
+    }
+}
+
+impl Elimination {
     /// The second pass's pivot at body `b` among the rows `cands` that started on one body:
     /// the entry on a free column of `b` largest relative to the row's `reach` on its own body
     /// in columns of the same kind (translations, Euler parameters), if at least `OWN_THRESHOLD`
@@ -206,13 +248,9 @@ impl Elimination {
             if !self.active[r] {
                 continue;
             }
-            let mut entries: Vec<(usize, f64)> = self.rows[r]
-                .iter()
-                .copied()
-                .filter(|&(c, _)| self.free[c] && c / 7 == b)
-                .collect();
-            entries.sort_unstable_by_key(|e| e.0);
-            for (c, v) in entries {
+            let (vals, mask) = self.on_body(r, b);
+            for k in (0..7).filter(|k| mask & (1 << k) != 0) {
+                let (c, v) = (7 * b + k, vals[k]);
                 let reference = reach[r][usize::from(c % 7 >= 3)];
                 let ratio = v.abs() / reference.max(f64::MIN_POSITIVE);
                 if v.abs() > self.tol
@@ -276,9 +314,11 @@ pub(crate) fn partition(
         dependent: Vec::new(),
         pivot_rows: Vec::new(),
         pos: vec![u32::MAX; n],
+        rmax: Vec::new(),
     };
+    el.rmax = (0..m).map(|r| el.row_max(r)).collect();
     for r in 0..m {
-        if el.active[r] && el.row_max(r) <= tol {
+        if el.active[r] && el.rmax[r] <= tol {
             el.active[r] = false;
             el.redundant.push(r);
         }
@@ -309,7 +349,7 @@ pub(crate) fn partition(
             cands.extend_from_slice(&el.body_rows[b]);
             cands.sort_unstable();
             cands.dedup();
-            match el.best_pivot(&cands, THRESHOLD, |c| c / 7 == b, &mut entries) {
+            match el.best_pivot_at(&cands, THRESHOLD, b) {
                 Some((r, c)) => el.pivot(r, c),
                 None => break,
             }

@@ -11,8 +11,8 @@
 //!
 //! Here two legs stand straight up on continuous joints whose axes are horizontal (`z` of a
 //! frame turned by π/2 about `x`, like the minitaurs' motors), one of two links: main b17dd2c
-//! converged at the minimum's energy only after three iterations with ‖∂V/∂v‖∞ ≈ 3 J and called
-//! the rest neutral.
+//! (and 101d79d) reached the minimum's energy with ‖∂V/∂v‖∞ ≈ 3 J, converged only two
+//! iterations later and called the rest neutral.
 
 use restpose::urdf::{load_str, ImportOptions};
 use restpose::{Options, Termination};

@@ -92,6 +92,9 @@ impl Watch {
             [.., a, b] => b.gradient_norm > STALL * a.gradient_norm,
             _ => false,
         };
+        if !(self.on || stalled) {
+            return None;
+        }
         let valley = e.and_then(Valley::of);
         self.on |= stalled && valley.is_some();
         valley.filter(|_| self.on)

@@ -37,6 +37,22 @@ pub(crate) fn solve(model: &Model) -> (State, Report) {
     (s, r)
 }
 
+/// Solves by the direct solve (`load_steps: 1`, no load ramp), the way issue 21 counts
+/// iterations; the caller checks the termination.
+pub(crate) fn solve_direct(model: &Model) -> (State, Report) {
+    let direct = Options {
+        load_steps: 1,
+        ..Default::default()
+    };
+    restpose::solve(model, &direct).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The distance between two angles on the circle, in `[0, π]` (rad).
+pub(crate) fn angle_distance(a: f64, b: f64) -> f64 {
+    let off = (a - b).rem_euclid(std::f64::consts::TAU);
+    off.min(std::f64::consts::TAU - off)
+}
+
 /// Independent equilibrium checks: constraints hold, the projected gradient vanishes, and no
 /// small feasible perturbation (random joint displacements, then re-assembly) lowers the
 /// energy.

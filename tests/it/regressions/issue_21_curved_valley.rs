@@ -10,7 +10,7 @@
 //! floor is short (module `solver::valley`).
 
 use restpose::state::State;
-use restpose::{Options, Termination};
+use restpose::Termination;
 
 fn leg(k: f64) -> restpose::Model {
     let inertial = |m: f64, xyz: &str, i: &str| {
@@ -46,13 +46,9 @@ fn leg(k: f64) -> restpose::Model {
 
 #[test]
 fn a_leg_in_a_curved_valley_converges_in_few_iterations() {
-    let direct = Options {
-        load_steps: 1,
-        ..Default::default()
-    };
     for (k, main) in [(1e-6, 80), (1e-7, 168), (1e-8, 200)] {
         let model = leg(k);
-        let (state, report) = restpose::solve(&model, &direct).unwrap();
+        let (state, report) = crate::common::solve_direct(&model);
         assert_eq!(report.termination, Termination::Converged, "k = {k}");
         assert!(
             report.iterations <= 10,

@@ -32,11 +32,7 @@ pub(super) fn bare_ur5() -> restpose::Model {
 #[test]
 fn the_bare_ur5_hangs_by_the_direct_solve_in_few_iterations() {
     let model = bare_ur5();
-    let direct = Options {
-        load_steps: 1,
-        ..Default::default()
-    };
-    let (state, report) = restpose::solve(&model, &direct).unwrap();
+    let (state, report) = crate::common::solve_direct(&model);
     assert_eq!(report.termination, Termination::Converged);
     assert!(
         report.iterations <= 30,

@@ -13,8 +13,7 @@
 //! stops at −2.5 and 0.3 rad. Main 603a9e6 took 64 iterations and rested the last leg on its
 //! near stop (0.3 rad, 1.21 J higher); the escape falls toward the side with room.
 
-use restpose::urdf::{load_str, ImportOptions};
-use restpose::{Options, Termination};
+use restpose::Termination;
 
 const LEGS_UP: &str = r#"<?xml version="1.0"?>
 <robot name="legs_up">
@@ -62,14 +61,8 @@ const LEGS_UP: &str = r#"<?xml version="1.0"?>
 
 #[test]
 fn legs_straight_up_fall_at_once_to_the_lowest_rest() {
-    let model = load_str(LEGS_UP, "legs_up.urdf", &ImportOptions::default())
-        .unwrap()
-        .model;
-    let direct = Options {
-        load_steps: 1,
-        ..Default::default()
-    };
-    let (state, report) = restpose::solve(&model, &direct).unwrap();
+    let model = crate::common::model_from(LEGS_UP);
+    let (state, report) = crate::common::solve_direct(&model);
     assert_eq!(report.termination, Termination::Converged);
     assert!(
         report.iterations <= 15,

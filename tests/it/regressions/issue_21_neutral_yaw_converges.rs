@@ -10,7 +10,7 @@
 //! every joint turns from `θ` to `θ + α θ̇`, and the yaw is reached in a few Newton steps.
 
 use restpose::state::State;
-use restpose::{Options, Termination};
+use restpose::Termination;
 
 fn so101() -> restpose::Model {
     crate::common::robot("so101/so101")
@@ -19,11 +19,7 @@ fn so101() -> restpose::Model {
 #[test]
 fn so101_hangs_by_the_direct_solve_in_few_iterations() {
     let model = so101();
-    let direct = Options {
-        load_steps: 1,
-        ..Default::default()
-    };
-    let (state, report) = restpose::solve(&model, &direct).unwrap();
+    let (state, report) = crate::common::solve_direct(&model);
     assert_eq!(report.termination, Termination::Converged);
     assert!(
         report.iterations <= 25,

@@ -8,18 +8,14 @@
 //! the gradient norm). The step now uses `Ĥ + C`, `dᵀC d = ∇fᵀ c(d)` the path's curvature
 //! (`step::path_hessian`): 4 iterations here, iCub 59.
 
-use restpose::{Options, Termination};
+use restpose::Termination;
 
 /// The same solve as `issue_21_free_arm_converges_directly`, which checks its rest pose
 /// (verified minimum, the 8-step ramp's energy); here the count of Newton steps.
 #[test]
 fn the_bare_ur5_falls_in_four_newton_steps() {
     let model = super::issue_21_free_arm_converges_directly::bare_ur5();
-    let direct = Options {
-        load_steps: 1,
-        ..Default::default()
-    };
-    let (_, report) = restpose::solve(&model, &direct).unwrap();
+    let (_, report) = crate::common::solve_direct(&model);
     assert_eq!(report.termination, Termination::Converged);
     assert!(
         report.iterations <= 5,

@@ -119,8 +119,7 @@ fn the_sparse_path_leaves_a_folded_chart() {
     // 3.9e-6 rad), at the same energy to 1e-11 J; a leg not hanging down is off by radians.
     for motor in ["motor_R_joint", "motor_L_joint"] {
         let a = state.joint(&model, motor).unwrap()[0];
-        let off = (a - std::f64::consts::PI).rem_euclid(std::f64::consts::TAU);
-        let off = off.min(std::f64::consts::TAU - off);
+        let off = crate::common::angle_distance(a, std::f64::consts::PI);
         assert!(off < 1e-4, "{motor} at {a} rad, not hanging down");
     }
     let (_, _, dense) = solve(LinearAlgebra::Dense);

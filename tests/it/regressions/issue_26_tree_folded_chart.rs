@@ -14,8 +14,7 @@
 //! (and 101d79d) reached the minimum's energy with ‖∂V/∂v‖∞ ≈ 3 J, converged only two
 //! iterations later and called the rest neutral.
 
-use restpose::urdf::{load_str, ImportOptions};
-use restpose::{Options, Termination};
+use restpose::Termination;
 
 const TURNED_LEGS: &str = r#"<?xml version="1.0"?>
 <robot name="turned_legs">
@@ -44,14 +43,8 @@ const TURNED_LEGS: &str = r#"<?xml version="1.0"?>
 
 #[test]
 fn legs_turning_by_pi_on_the_tree_factors_leave_the_folded_chart() {
-    let model = load_str(TURNED_LEGS, "turned_legs.urdf", &ImportOptions::default())
-        .unwrap()
-        .model;
-    let direct = Options {
-        load_steps: 1,
-        ..Default::default()
-    };
-    let (state, report) = restpose::solve(&model, &direct).unwrap();
+    let model = crate::common::model_from(TURNED_LEGS);
+    let (state, report) = crate::common::solve_direct(&model);
     // The automatic choice for this small open model.
     assert_eq!(report.diagnostics.linear_algebra, "tree");
     assert_eq!(report.termination, Termination::Converged);
@@ -74,9 +67,7 @@ fn legs_turning_by_pi_on_the_tree_factors_leave_the_folded_chart() {
         ("knee_a", 0.0),
     ] {
         let a = state.joint(&model, joint).unwrap()[0];
-        let tau = 2.0 * std::f64::consts::PI;
-        let off = (a - turn).rem_euclid(tau);
-        let off = off.min(tau - off);
+        let off = crate::common::angle_distance(a, turn);
         assert!(off < 1e-6, "{joint} at {a} rad");
     }
     let d = &report.diagnostics;

@@ -95,15 +95,31 @@ impl<'e> Rows<'e> {
 }
 
 /// The elimination at one body: copies of its rows (`slot[i]` is row `cands[i]`).
+/// Copies of the active ones only: the others are never read.
 struct Local {
     cands: Vec<usize>,
     rows: Vec<Vec<(usize, f64)>>,
-    /// Scratch: one row's entries in the body's free columns.
-    entries: Vec<(usize, f64)>,
+    /// `row_max` of each copy, kept current as the copies change (in [`pivot`]).
+    rmax: Vec<f64>,
 }
 
 fn row_max(row: &[(usize, f64)]) -> f64 {
     row.iter().fold(0.0, |a, &(_, v)| a.max(v.abs()))
+}
+
+/// A row's entries on the free columns of body `b`, by column offset `c − 7 b`, and the mask
+/// of the offsets present (a row's columns are distinct): the entries a filter and a sort by
+/// column would list, in that order.
+fn on_body(row: &[(usize, f64)], free: &[bool], b: usize) -> ([f64; 7], u8) {
+    let (mut vals, mut mask) = ([0.0; 7], 0u8);
+    for &(c, v) in row {
+        let k = c.wrapping_sub(7 * b);
+        if k < 7 && free[c] {
+            vals[k] = v;
+            mask |= 1 << k;
+        }
+    }
+    (vals, mask)
 }
 
 /// The number of free columns `n − rank` the sparse partition leaves for the `m × n` Jacobian
@@ -236,7 +252,7 @@ fn eliminate(
     let mut local = Local {
         cands: Vec::new(),
         rows: Vec::new(),
-        entries: Vec::with_capacity(14),
+        rmax: Vec::new(),
     };
     let (mut all, mut own) = (Vec::new(), Vec::new());
     for b in elimination_order(model) {
@@ -248,18 +264,21 @@ fn eliminate(
         let k = local.cands.len();
         if local.rows.len() < k {
             local.rows.resize_with(k, Vec::new);
+            local.rmax.resize(k, 0.0);
         }
         for (slot, &r) in local.cands.iter().enumerate() {
             let copy = &mut local.rows[slot];
             copy.clear();
-            copy.extend_from_slice(&expanded[at[r]..at[r + 1]]);
+            if active[r] {
+                copy.extend_from_slice(&expanded[at[r]..at[r + 1]]);
+                local.rmax[slot] = rmax[r];
+            }
         }
-        let in_b = |c: usize| c / 7 == b;
         all.clear();
         all.extend(0..k);
         let mut taken = 0;
         while taken < 7 {
-            match best_pivot(&mut local, &all, &active, &free, tol, in_b) {
+            match best_pivot(&local, &all, &active, &free, tol, b) {
                 Some((slot, c)) => {
                     pivots.order.push((local.cands[slot], c));
                     pivot(&mut local, slot, c, &mut active, &mut free, tol);
@@ -271,7 +290,7 @@ fn eliminate(
         own.clear();
         own.extend((0..k).filter(|&s| own_of[local.cands[s]] == b));
         while taken < 7 {
-            match best_own_pivot(&mut local, &own, &active, &free, tol, b, &reach) {
+            match best_own_pivot(&local, &own, &active, &free, tol, b, &reach) {
                 Some((slot, c)) => {
                     pivots.order.push((local.cands[slot], c));
                     pivots.second.push((local.cands[slot], b, true));
@@ -291,32 +310,28 @@ fn eliminate(
     Some(pivots)
 }
 
-/// The partition's pivot choice among the rows at `slots` (ascending) in the free columns
-/// `cols`: the largest `|a_rc| > tol` with `|a_rc| ≥ THRESHOLD · max_k |a_rk|`, a later one
+/// The partition's pivot choice among the rows at `slots` (ascending) in the free columns of
+/// body `b`: the largest `|a_rc| > tol` with `|a_rc| ≥ THRESHOLD · max_k |a_rk|`, a later one
 /// only if larger by a relative `1e-9`.
 fn best_pivot(
-    local: &mut Local,
+    local: &Local,
     slots: &[usize],
     active: &[bool],
     free: &[bool],
     tol: f64,
-    cols: impl Fn(usize) -> bool,
+    b: usize,
 ) -> Option<(usize, usize)> {
     let mut best: Option<(usize, usize, f64)> = None;
-    let entries = &mut local.entries;
     for &s in slots {
         if !active[local.cands[s]] {
             continue;
         }
-        let row = &local.rows[s];
-        let rmax = row_max(row);
-        entries.clear();
-        entries.extend(row.iter().copied().filter(|&(c, _)| free[c] && cols(c)));
-        entries.sort_unstable_by_key(|e| e.0);
-        for &(c, v) in entries.iter() {
-            let a = v.abs();
-            if a > tol && a >= THRESHOLD * rmax && best.is_none_or(|b| a > b.2 * (1.0 + 1e-9)) {
-                best = Some((s, c, a));
+        let rmax = local.rmax[s];
+        let (vals, mask) = on_body(&local.rows[s], free, b);
+        for k in (0..7).filter(|k| mask & (1 << k) != 0) {
+            let a = vals[k].abs();
+            if a > tol && a >= THRESHOLD * rmax && best.is_none_or(|x| a > x.2 * (1.0 + 1e-9)) {
+                best = Some((s, 7 * b + k, a));
             }
         }
     }
@@ -328,7 +343,7 @@ fn best_pivot(
 /// `reach` there (same kind of column), if at least `OWN_THRESHOLD` of it; a later one only
 /// if larger by a relative `1e-9`.
 fn best_own_pivot(
-    local: &mut Local,
+    local: &Local,
     slots: &[usize],
     active: &[bool],
     free: &[bool],
@@ -337,21 +352,14 @@ fn best_own_pivot(
     reach: &[[f64; 2]],
 ) -> Option<(usize, usize)> {
     let mut best: Option<(usize, usize, f64)> = None;
-    let entries = &mut local.entries;
     for &s in slots {
         let r = local.cands[s];
         if !active[r] {
             continue;
         }
-        entries.clear();
-        entries.extend(
-            local.rows[s]
-                .iter()
-                .copied()
-                .filter(|&(c, _)| free[c] && c / 7 == b),
-        );
-        entries.sort_unstable_by_key(|e| e.0);
-        for &(c, v) in entries.iter() {
+        let (vals, mask) = on_body(&local.rows[s], free, b);
+        for k in (0..7).filter(|k| mask & (1 << k) != 0) {
+            let (c, v) = (7 * b + k, vals[k]);
             let ratio = v.abs() / reach[r][usize::from(c % 7 >= 3)].max(f64::MIN_POSITIVE);
             if v.abs() > tol
                 && ratio >= OWN_THRESHOLD
@@ -396,7 +404,8 @@ fn pivot(
                 None => row.push((col, -f * v)),
             }
         }
-        if row_max(row) <= tol {
+        local.rmax[s] = row_max(row);
+        if local.rmax[s] <= tol {
             active[local.cands[s]] = false;
         }
     }

@@ -101,6 +101,9 @@ struct Local {
     rows: Vec<Vec<(usize, f64)>>,
     /// `row_max` of each copy, kept current as the copies change (in [`pivot`]).
     rmax: Vec<f64>,
+    /// [`on_body`] of each copy at the body, kept current as the copies change and the
+    /// body's columns are taken (in [`pivot`]).
+    on_b: Vec<([f64; 7], u8)>,
 }
 
 fn row_max(row: &[(usize, f64)]) -> f64 {
@@ -253,6 +256,7 @@ fn eliminate(
         cands: Vec::new(),
         rows: Vec::new(),
         rmax: Vec::new(),
+        on_b: Vec::new(),
     };
     let (mut all, mut own) = (Vec::new(), Vec::new());
     for b in elimination_order(model) {
@@ -265,6 +269,7 @@ fn eliminate(
         if local.rows.len() < k {
             local.rows.resize_with(k, Vec::new);
             local.rmax.resize(k, 0.0);
+            local.on_b.resize(k, ([0.0; 7], 0));
         }
         for (slot, &r) in local.cands.iter().enumerate() {
             let copy = &mut local.rows[slot];
@@ -272,16 +277,17 @@ fn eliminate(
             if active[r] {
                 copy.extend_from_slice(&expanded[at[r]..at[r + 1]]);
                 local.rmax[slot] = rmax[r];
+                local.on_b[slot] = on_body(copy, &free, b);
             }
         }
         all.clear();
         all.extend(0..k);
         let mut taken = 0;
         while taken < 7 {
-            match best_pivot(&local, &all, &active, &free, tol, b) {
+            match best_pivot(&local, &all, &active, tol, b) {
                 Some((slot, c)) => {
                     pivots.order.push((local.cands[slot], c));
-                    pivot(&mut local, slot, c, &mut active, &mut free, tol);
+                    pivot(&mut local, slot, c, &mut active, &mut free, tol, b);
                 }
                 None => break,
             }
@@ -290,11 +296,11 @@ fn eliminate(
         own.clear();
         own.extend((0..k).filter(|&s| own_of[local.cands[s]] == b));
         while taken < 7 {
-            match best_own_pivot(&local, &own, &active, &free, tol, b, &reach) {
+            match best_own_pivot(&local, &own, &active, tol, b, &reach) {
                 Some((slot, c)) => {
                     pivots.order.push((local.cands[slot], c));
                     pivots.second.push((local.cands[slot], b, true));
-                    pivot(&mut local, slot, c, &mut active, &mut free, tol);
+                    pivot(&mut local, slot, c, &mut active, &mut free, tol, b);
                 }
                 None => break,
             }
@@ -317,7 +323,6 @@ fn best_pivot(
     local: &Local,
     slots: &[usize],
     active: &[bool],
-    free: &[bool],
     tol: f64,
     b: usize,
 ) -> Option<(usize, usize)> {
@@ -327,7 +332,7 @@ fn best_pivot(
             continue;
         }
         let rmax = local.rmax[s];
-        let (vals, mask) = on_body(&local.rows[s], free, b);
+        let (vals, mask) = local.on_b[s];
         for k in (0..7).filter(|k| mask & (1 << k) != 0) {
             let a = vals[k].abs();
             if a > tol && a >= THRESHOLD * rmax && best.is_none_or(|x| a > x.2 * (1.0 + 1e-9)) {
@@ -346,7 +351,6 @@ fn best_own_pivot(
     local: &Local,
     slots: &[usize],
     active: &[bool],
-    free: &[bool],
     tol: f64,
     b: usize,
     reach: &[[f64; 2]],
@@ -357,7 +361,7 @@ fn best_own_pivot(
         if !active[r] {
             continue;
         }
-        let (vals, mask) = on_body(&local.rows[s], free, b);
+        let (vals, mask) = local.on_b[s];
         for k in (0..7).filter(|k| mask & (1 << k) != 0) {
             let (c, v) = (7 * b + k, vals[k]);
             let ratio = v.abs() / reach[r][usize::from(c % 7 >= 3)].max(f64::MIN_POSITIVE);
@@ -380,9 +384,18 @@ fn pivot(
     active: &mut [bool],
     free: &mut [bool],
     tol: f64,
+    b: usize,
 ) {
     active[local.cands[slot]] = false;
     free[c] = false;
+    // Column `c` is no longer free: gone from every row's entries on the body (those of the
+    // rows changed below are gathered again).
+    let k = c.wrapping_sub(7 * b);
+    if k < 7 {
+        for e in &mut local.on_b {
+            e.1 &= !(1u8 << k);
+        }
+    }
     let pivot_row = std::mem::take(&mut local.rows[slot]);
     let a_rc = pivot_row.iter().find(|e| e.0 == c).map_or(0.0, |e| e.1);
     for s in 0..local.cands.len() {
@@ -405,6 +418,7 @@ fn pivot(
             }
         }
         local.rmax[s] = row_max(row);
+        local.on_b[s] = on_body(row, free, b);
         if local.rmax[s] <= tol {
             active[local.cands[s]] = false;
         }

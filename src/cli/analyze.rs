@@ -55,6 +55,13 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
                  --initial JOINT=VALUE for the joints"
             )
         }
+        restpose::Error::Assembly { ref remedy, .. } if remedy.contains("nearly dependent") => {
+            anyhow::anyhow!(
+                "{e}; on the command line: without --initial the servos' references \
+                 (--servo JOINT=K@REF, --srdf-state) are the start; --friction none for \
+                 sliding contacts"
+            )
+        }
         e => e.into(),
     })?;
     report.diagnostics.timings.import = import;

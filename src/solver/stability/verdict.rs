@@ -173,10 +173,11 @@ pub(crate) fn stability_on(
 /// The verdict with the system of the model's rows already partitioned and evaluated at
 /// `q` (what `verify` has made for its balance check); `None` with no degree of freedom.
 ///
-/// Where the eigenvalues would come from Lanczos (sparse path, more than
-/// `spectrum::EXACT_UP_TO` degrees of freedom) and `eigenvalues` is false, the verdict comes
+/// Where the eigenvalues are not listed by default (sparse or tree path, more than
+/// `spectrum::LISTED_UP_TO` degrees of freedom) and `eigenvalues` is false, the verdict comes
 /// from the inertia of the shifted KKT matrix alone (module `stability::inertia`), without
-/// eigenvalues or mode shapes; Lanczos only if that inertia cannot be trusted.
+/// eigenvalues or mode shapes; the spectrum (exact up to `spectrum::EXACT_UP_TO`, Lanczos
+/// above) only if that inertia cannot be trusted.
 pub(crate) fn stability_of(
     sys: &mut System,
     q: &nalgebra::DVector<f64>,
@@ -187,8 +188,7 @@ pub(crate) fn stability_of(
     if part.independent.is_empty() {
         return None;
     }
-    let lanczos = !spectrum::exact(sys.backend, part.independent.len());
-    if lanczos && !eigenvalues {
+    if !spectrum::listed(sys.backend, part.independent.len()) && !eigenvalues {
         if let Some((verdict, tolerance)) = inertia::inertia_verdict(sys, q, part, eval) {
             return Some(Stability {
                 verdict,

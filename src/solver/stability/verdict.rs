@@ -130,7 +130,21 @@ pub(crate) fn stability_verdict(
     backend: Backend,
     eigenvalues: bool,
 ) -> Option<Stability> {
-    super::cone::stability_touching(model, state, strong, weak, backend, eigenvalues)
+    super::cone::stability_touching(model, state, strong, weak, backend, eigenvalues, None)
+}
+
+/// [`stability_verdict`] at the end of an active-set round that held every one of `strong`
+/// and `weak` as a row and judged its tangent space (`all_held`, if it has a verdict): that
+/// verdict's eigenvalues and modes are reported, not computed again.
+pub(crate) fn stability_verdict_after_round(
+    model: &Model,
+    state: &State,
+    (strong, weak): (&[Active], &[Active]),
+    backend: Backend,
+    eigenvalues: bool,
+    all_held: Option<Stability>,
+) -> Option<Stability> {
+    super::cone::stability_touching(model, state, strong, weak, backend, eigenvalues, all_held)
 }
 
 /// The verdict on the tangent space of the equality rows and the inequalities `active` (every

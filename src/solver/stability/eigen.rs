@@ -49,7 +49,8 @@ pub(crate) fn symmetric_eigen(a: &DMatrix<f64>) -> (DVector<f64>, DMatrix<f64>) 
                 vals[i] = v.dot(&av);
                 for r in 0..n {
                     let x = (av[r] - v[r] * vals[i]).abs();
-                    if !(x <= 1e-9 * scale) {
+                    // A NaN residual fails too.
+                    if x.is_nan() || x > 1e-9 * scale {
                         return None;
                     }
                 }

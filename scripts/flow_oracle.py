@@ -10,8 +10,9 @@ where they push back:
 
 where `W` is the damping metric. Two are integrated and reported:
   - `identity`: uniform viscous damping at every joint (W = I; rad and m weighted alike);
-  - `mass`: damping proportional to the mass matrix (W = M(x), Rayleigh damping: the
-    overdamped limit of the dynamics M ẍ + c M ẋ = −∇V, independent of the coordinates).
+  - `mass`: damping proportional to the mass matrix (W = M(x) + 1e-4 max diag(M) I, Rayleigh
+    damping: the overdamped limit of the dynamics M ẍ + c M ẋ = −∇V; regularized because M
+    is singular on some robots).
 They are different flows and may reach different rests: both are printed.
 
 Integration: projected linearly implicit Euler (the time-stepping of a constrained gradient
@@ -74,7 +75,7 @@ class Robot:
         root = ET.fromstring(open(urdf, "rb").read().lstrip())
         mimic = {}
         types = {}
-        for j in root.iter("joint"):
+        for j in root.findall("joint"):  # not the <joint> of a <transmission>
             types[j.get("name")] = j.get("type")
             e = j.find("mimic")
             if e is not None:
@@ -168,7 +169,7 @@ def qp(W, c, lo, hi, max_iter=200):
     condition holds. Returns p and the held coordinates."""
     n = W.shape[0]
     p = np.zeros(n)
-    scale = max(np.max(np.abs(np.linalg.solve(W, c)), initial=0.0), 1e-300)
+    scale = np.max(np.abs(np.clip(np.linalg.solve(W, c), lo, hi)), initial=0.0)
 
     def f(x):
         return 0.5 * x @ W @ x + c @ x
@@ -187,11 +188,11 @@ def qp(W, c, lo, hi, max_iter=200):
             if f(pn) <= f0 + 1e-4 * grad @ (pn - p) or t < 1e-12:
                 break
             t *= 0.5
-        done = np.max(np.abs(pn - p), initial=0.0) <= 1e-13 * scale
+        done = np.max(np.abs(pn - p), initial=0.0) <= 1e-14 * np.max(np.abs(pn), initial=0.0)
         p = pn
         if done:
             return p, held
-    raise RuntimeError("projected Newton QP did not converge")
+    return p, held  # feasible and lower than p = 0: a step all the same
 
 
 def positive_part(K, Wm):
@@ -203,7 +204,7 @@ def positive_part(K, Wm):
     return (B * np.maximum(lam, 0.0)) @ B.T
 
 
-def flow(robot, metric, delta, max_steps=200000):
+def flow(robot, metric, delta, max_steps=30000):
     """Integrate the projected flow to rest: (q, energy, active stops, steps, note)."""
     m = robot.model
     q = robot.q.copy()
@@ -213,7 +214,10 @@ def flow(robot, metric, delta, max_steps=200000):
     steps = 0
     while steps < max_steps:
         g, K, M = robot.derivatives(q)
-        Wm = np.eye(robot.nx) if metric == "identity" else M
+        # (M can be singular: iCub's neck yaw and roll meet without a mass between them and its
+        # M has an eigenvalue of 3.5e-18; regularized by 1e-4 of the largest diagonal entry)
+        Wm = (np.eye(robot.nx) if metric == "identity"
+              else M + 1e-4 * np.max(np.diag(M), initial=1.0) * np.eye(robot.nx))
         lo, hi = robot.box(q)
         # At rest: the projected gradient (the flow's velocity in the identity metric) vanishes.
         pg = np.where(((lo >= 0) & (g > 0)) | ((hi <= 0) & (g < 0)), 0.0, g)
@@ -240,8 +244,49 @@ def flow(robot, metric, delta, max_steps=200000):
         steps += 1
         q, V = qn, Vn
         if over < 0.5:
-            h *= 2.0
+            h = min(2.0 * h, 1e15)
     return q, V, active(robot, q), steps, "max_steps"
+
+
+def projected_newton(robot, max_step, max_iter=500):
+    """A step policy measured against the flow: projected Newton (Bertsekas 1982) in joint
+    coordinates. Every joint within ε of a stop that the gradient pushes into is held, the
+    Newton step is taken in the others (eigenvalues by magnitude, floored at 1e-12 of the
+    largest, as restpose's dense step), scaled as a whole to at most `max_step` in every joint,
+    and the energy is searched along the projection arc x(t) = P(x + t d) (Armijo, halving):
+    every stop the step reaches is met in the same iteration. Returns as `flow`."""
+    m = robot.model
+    q = robot.q.copy()
+    V = robot.energy(q)
+    for it in range(max_iter):
+        g, K, _ = robot.derivatives(q)
+        lo, hi = robot.box(q)
+        pg = np.where(((lo >= 0) & (g > 0)) | ((hi <= 0) & (g < 0)), 0.0, g)
+        if np.max(np.abs(pg), initial=0.0) < GRADIENT_TOL:
+            return q, V, active(robot, q), it, "rest"
+        eps = min(1e-3, np.max(np.abs(np.clip(-g, lo, hi)), initial=0.0))
+        held = ((lo >= -eps) & (g > 0)) | ((hi <= eps) & (g < 0))
+        F = ~held
+        d = np.zeros(robot.nx)
+        if F.any():
+            lam, U = np.linalg.eigh(K[np.ix_(F, F)])
+            big = np.max(np.abs(lam), initial=0.0)
+            d[F] = -U @ ((U.T @ g[F]) / np.maximum(np.abs(lam), 1e-12 * big + 1e-300))
+        long = np.max(np.abs(d), initial=0.0)
+        if long > max_step:
+            d *= max_step / long
+        t = 1.0
+        while True:
+            x = np.clip(t * d, lo, hi)
+            qn = pin.integrate(m, q, robot.T @ x)
+            Vn = robot.energy(qn)
+            if Vn <= V + 1e-4 * (g @ x) + 1e-13 * (1 + abs(V)):
+                break
+            t *= 0.5
+            if t < 1e-20:
+                return q, V, active(robot, q), it, "line search failed"
+        q, V = qn, Vn
+    return q, V, active(robot, q), max_iter, "max_iterations"
 
 
 def active(robot, q, tol=1e-9):
@@ -273,6 +318,8 @@ def main():
     ap.add_argument("--start", help="restpose binary whose assembled start (--max-iterations 0) "
                     "the flows start from (default: the first --restpose; else 0 clamped)")
     ap.add_argument("--json")
+    ap.add_argument("--policy", type=float, action="append", default=[],
+                    help="also run the projected Newton policy with this step limit [rad]")
     ap.add_argument("robots", nargs="*")
     a = ap.parse_args()
     metrics = ["identity", "mass"] if a.metric == "both" else [a.metric]
@@ -295,9 +342,16 @@ def main():
             robot.q = q0
         row = {"robot": rel, "start_energy": robot.energy(robot.q), "flows": {}, "restpose": {}}
         for metric in metrics:
-            q, V, act, steps, note = flow(robot, metric, a.delta)
+            try:
+                q, V, act, steps, note = flow(robot, metric, a.delta)
+            except (np.linalg.LinAlgError, RuntimeError) as e:
+                q, V, act, steps, note = robot.q, float("nan"), [], 0, f"error: {e}"
             row["flows"][metric] = {"energy": V, "active": act, "steps": steps, "end": note,
                                     "q": q.tolist()}
+        for lim in a.policy:
+            q, V, act, steps, note = projected_newton(robot, lim)
+            row["flows"][f"pn{lim:g}"] = {"energy": V, "active": act, "steps": steps,
+                                          "end": note, "q": q.tolist()}
         for b in a.restpose:
             r = restpose(b, f)
             row["restpose"][b] = (None if r is None else {
@@ -309,6 +363,35 @@ def main():
         print(report(row), flush=True)
     if a.json:
         json.dump(rows, open(a.json, "w"), indent=1)
+    print(summary(rows))
+
+
+def summary(rows):
+    """Per solver (restpose binaries, policies): iterations in all, robots in ≤ 30, robots at
+    the rest of each flow (energy within 1e-6 J)."""
+    solvers = {}
+    for row in rows:
+        for b, r in row["restpose"].items():
+            if r is not None:
+                solvers.setdefault(os.path.basename(b), []).append(
+                    (row, r["energy"], r["iterations"], r["termination"] == "converged"))
+        for name, fl in row["flows"].items():
+            if name.startswith("pn"):
+                solvers.setdefault(name, []).append(
+                    (row, fl["energy"], fl["steps"], fl["end"] == "rest"))
+    metrics = [m for m in ("identity", "mass") if rows and m in rows[0]["flows"]]
+    out = []
+    for name, xs in solvers.items():
+        its = [x[2] for x in xs if x[3]]
+        line = (f"{name:20s} {len(xs)} robots, {len(its)} converged, {sum(its)} iterations, "
+                f"{sum(1 for i in its if i <= 30)} in <= 30")
+        for m in metrics:
+            done = [x for x in xs if x[0]["flows"][m]["end"] == "rest"]
+            same = sum(1 for x in done if abs(x[1] - x[0]["flows"][m]["energy"]) <= 1e-6)
+            low = sum(1 for x in done if x[1] < x[0]["flows"][m]["energy"] - 1e-6)
+            line += f"; {m} flow: {same}/{len(done)} at its rest, {low} lower"
+        out.append(line)
+    return "\n".join(out)
 
 
 def report(row):
@@ -321,7 +404,8 @@ def report(row):
             parts.append(f"{os.path.basename(b)}: error")
             continue
         match = ",".join(m for m, fl in row["flows"].items()
-                         if abs(fl["energy"] - r["energy"]) <= 1e-6) or "none"
+                         if abs(fl["energy"] - r["energy"]) <= 1e-6
+                         and m in ("identity", "mass")) or "none"
         parts.append(f"{os.path.basename(b)}: {r['termination']} it={r['iterations']} "
                      f"V={r['energy']:.10f} match={match}")
     return "\n    ".join(parts)

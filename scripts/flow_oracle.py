@@ -272,6 +272,9 @@ def projected_newton(robot, max_step, max_iter=500):
             lam, U = np.linalg.eigh(K[np.ix_(F, F)])
             big = np.max(np.abs(lam), initial=0.0)
             d[F] = -U @ ((U.T @ g[F]) / np.maximum(np.abs(lam), 1e-12 * big + 1e-300))
+        # A held joint within ε of its stop goes onto it (Bertsekas' projection of its
+        # gradient step; left where it is, it never reaches the stop and the search stalls).
+        d[held] = np.where(g[held] > 0, lo[held], hi[held])
         long = np.max(np.abs(d), initial=0.0)
         if long > max_step:
             d *= max_step / long
@@ -312,7 +315,7 @@ def restpose(binary, urdf, extra=()):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--metric", default="both", choices=["identity", "mass", "both"])
+    ap.add_argument("--metric", default="both", choices=["identity", "mass", "both", "none"])
     ap.add_argument("--delta", type=float, default=0.01)
     ap.add_argument("--restpose", action="append", default=[])
     ap.add_argument("--start", help="restpose binary whose assembled start (--max-iterations 0) "
@@ -322,7 +325,7 @@ def main():
                     help="also run the projected Newton policy with this step limit [rad]")
     ap.add_argument("robots", nargs="*")
     a = ap.parse_args()
-    metrics = ["identity", "mass"] if a.metric == "both" else [a.metric]
+    metrics = {"both": ["identity", "mass"], "none": []}.get(a.metric, [a.metric])
     rows = []
     for f in sorted(glob.glob(f"{ERD}/**/*.urdf", recursive=True)):
         rel = os.path.relpath(f, ERD)
@@ -386,7 +389,7 @@ def summary(rows):
         line = (f"{name:20s} {len(xs)} robots, {len(its)} converged, {sum(its)} iterations, "
                 f"{sum(1 for i in its if i <= 30)} in <= 30")
         for m in metrics:
-            done = [x for x in xs if x[0]["flows"][m]["end"] == "rest"]
+            done = [x for x in xs if m in x[0]["flows"] and x[0]["flows"][m]["end"] == "rest"]
             same = sum(1 for x in done if abs(x[1] - x[0]["flows"][m]["energy"]) <= 1e-6)
             low = sum(1 for x in done if x[1] < x[0]["flows"][m]["energy"] - 1e-6)
             line += f"; {m} flow: {same}/{len(done)} at its rest, {low} lower"

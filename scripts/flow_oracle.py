@@ -6,7 +6,7 @@ A robot released from its start and damped so heavily that inertia plays no part
 gradient flow of its gravity energy `V(x)` in the joint coordinates `x`, its stops holding it
 where they push back:
 
-    W ẋ = −∇V(x) + Aᵀλ,   λ ≥ 0,  λ ⟂ (A x − b)   (the stops A x ≥ b),
+    W ẋ = −∇V(x) + λ,   λ_i ≥ 0 pushing back only where joint i is on its stop,
 
 where `W` is the damping metric. Two are integrated and reported:
   - `identity`: uniform viscous damping at every joint (W = I; rad and m weighted alike);
@@ -16,15 +16,17 @@ where `W` is the damping metric. Two are integrated and reported:
 They are different flows and may reach different rests: both are printed.
 
 Integration: projected linearly implicit Euler (the time-stepping of a constrained gradient
-flow): each step solves the quadratic program
+flow): each step solves the box-constrained quadratic program (the stops are bounds on the
+joint coordinates; a mimic joint's stop bounds its master)
 
-    min_Δ  ½ Δᵀ (W/h + K) Δ + ∇Vᵀ Δ   subject to  A (x + Δ) ≥ b,
+    min_Δ  ½ Δᵀ (W/h + K₊) Δ + ∇Vᵀ Δ   subject to  lo ≤ x + Δ ≤ hi,
 
-`K = ∂²V/∂x²` (Pinocchio's `computeGeneralizedGravityDerivatives`; its negative curvature in
-the metric W is taken explicitly: set to 0 in the matrix), by projected Newton iterations; h is chosen so that no joint moves by more than `--delta` (rad; a tenth of it in m for
-prismatic joints) per step and the energy never rises. Stiff directions then follow their slow
-manifold (the implicit step) and the path is resolved to `delta` everywhere; as the flow comes
-to rest h grows without bound and the step becomes the projected Newton step, which converges.
+by projected Newton iterations; `K₊` is `K = ∂²V/∂x²` (Pinocchio's
+`computeGeneralizedGravityDerivatives`) with its negative curvature in the metric W set to 0
+(taken explicitly). h is chosen so that no joint moves by more than `--delta` (rad; a tenth of
+it in m for prismatic joints) per step and the energy never rises. Stiff directions then follow
+their slow manifold (the implicit step) and the path is resolved to `delta` everywhere; as the
+flow comes to rest h grows and the step becomes the projected Newton step, which converges.
 The rest is reported where the projected gradient (the velocity of the identity flow: ∇V less
 its components pushing into the stops) is below 1e-9 in every joint.
 
@@ -37,12 +39,16 @@ stops on that combination (as in restpose). Stops: every revolute and prismatic 
 `<limit>` (Pinocchio's lower/upper position limits, as urdfdom reads them).
 
 Usage:
-  python scripts/flow_oracle.py [--metric identity|mass|both] [--delta 0.01]
-      [--restpose BIN ...] [ROBOT ...]
+  python scripts/flow_oracle.py [--metric identity|mass|both|none] [--delta 0.01]
+      [--restpose BIN ...] [--start BIN] [--policy LIMIT ...] [--json FILE] [ROBOT ...]
 ROBOT: URDF file names without `.urdf` (default: every hanging robot of the corpus). With
 `--restpose`, each binary solves the same robot (`analyze --load-steps 1`) and its energy is
-compared with the flows' (`match` when equal to 1e-6 J). Environment: ERD_ROBOTS (the corpus's
-robots folder). Runs with the venv of scripts/peers_venv.sh (pin 4.1.0).
+compared with the flows' (`match` when equal to 1e-6 J). `--policy LIMIT` also runs the
+projected Newton prototype (function `projected_newton`) with that step limit [rad]. A summary
+per solver ends the output (iterations, robots in ≤ 30, robots at each flow's rest).
+Environment: ERD_ROBOTS (the corpus's robots folder). Runs with the venv of
+scripts/peers_venv.sh (pin 4.1.0): the whole corpus with both flows and two binaries takes about
+10 minutes on a loaded 2-core machine (docs/method.md, "Which rest").
 """
 
 import argparse
@@ -127,9 +133,6 @@ class Robot:
                 val = q[iq]
                 x_shift[col[iv]] = min(max(val, lo), hi) - val
         self.q = pin.integrate(m, q, T @ x_shift)
-
-    def values(self, q):
-        return np.array([q[s[1]] for s in self.stops])
 
     def box(self, q):
         """The stops as bounds on the step Δx: a stop on joint value v = k x_j + offset bounds

@@ -341,6 +341,31 @@ pub(crate) trait HessianSink {
     fn add_block(&mut self, bodies: &[Option<crate::model::BodyId>; 2], h: &LMat, c: f64);
     /// Adds `v` at the global position `(i, j)`.
     fn add_entry(&mut self, i: usize, j: usize, v: f64);
+    /// Adds `c h` for a local Hessian `h` that is zero outside the Euler parameters of the
+    /// pair, given by its [`EULER`] rows and columns `hp` (a revolute angle, a weighted point:
+    /// `A(p)` is quadratic in `p` and the rest linear). By default the full local Hessian.
+    fn add_euler_block(
+        &mut self,
+        bodies: &[Option<crate::model::BodyId>; 2],
+        hp: &SMatrix<f64, 8, 8>,
+        c: f64,
+    ) {
+        self.add_block(bodies, &euler_to_local(hp), c);
+    }
+}
+
+/// The Euler-parameter coordinates of a body pair (local indices).
+pub(crate) const EULER: [usize; 8] = [3, 4, 5, 6, 10, 11, 12, 13];
+
+/// The local Hessian whose [`EULER`] rows and columns are `hp` (zero elsewhere).
+pub(crate) fn euler_to_local(hp: &SMatrix<f64, 8, 8>) -> LMat {
+    let mut h = LMat::zeros();
+    for (a, &i) in EULER.iter().enumerate() {
+        for (b, &j) in EULER.iter().enumerate() {
+            h[(i, j)] = hp[(a, b)];
+        }
+    }
+    h
 }
 
 impl HessianSink for nalgebra::DMatrix<f64> {

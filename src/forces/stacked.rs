@@ -12,20 +12,21 @@
 //! only, so its Hessian is formed over those 8 coordinates of the pair (not 14), and no term
 //! allocates.
 
-use crate::jet::closed::{dot_gradient, dot_hessian, linear_gradient, linear_hessian};
+use crate::jet::closed::{dot_gradient, dot_hessian, linear_gradient, linear_hessian_euler};
 use crate::jet::closed::{Lin, Rotations};
 use crate::jet::{global_index, HessianSink, LMat, LVec, Pair, NL};
 use crate::model::{BodyId, Joint};
 use nalgebra::{DVector, SMatrix, Vector3};
 
 /// The Euler-parameter coordinates of a body pair (local indices).
-const P: [usize; 8] = [3, 4, 5, 6, 10, 11, 12, 13];
+const P: [usize; 8] = crate::jet::EULER;
 
-/// `c ∇f` into `grad` and `c ∇²f` into `hess` (as [`crate::jet::scatter`]).
+/// `c ∇f` into `grad` and `c ∇²f` into `hess` (as [`crate::jet::scatter`]), for an `f` whose
+/// Hessian is zero outside the Euler parameters (`hp` over [`P`]).
 fn scatter(
     bodies: &[Option<BodyId>; 2],
     g: &LVec,
-    h: &LMat,
+    hp: &SMatrix<f64, 8, 8>,
     c: f64,
     grad: &mut DVector<f64>,
     hess: &mut dyn HessianSink,
@@ -35,7 +36,7 @@ fn scatter(
             grad[gi] += c * g[i];
         }
     }
-    hess.add_block(bodies, h, c);
+    hess.add_euler_block(bodies, hp, c);
 }
 
 /// `wᵀ (r_k + A(p_k) s)` of side `k` with its gradient into `grad` and Hessian into `hess`
@@ -53,8 +54,8 @@ pub(crate) fn weighted_point(
     let p = Lin::point(pair, &rot, 0, s);
     let mut g = LVec::zeros();
     linear_gradient(&p, w, &mut g);
-    let mut h = LMat::zeros();
-    linear_hessian(&p, w, &mut h);
+    let mut h = SMatrix::<f64, 8, 8>::zeros();
+    linear_hessian_euler(&p, w, &mut h);
     scatter(bodies, &g, &h, 1.0, grad, hess);
     w.dot(&p.v)
 }
@@ -117,22 +118,18 @@ pub(crate) fn scatter_angle(
     grad: &mut DVector<f64>,
     hess: &mut dyn HessianSink,
 ) {
-    let mut h = LMat::zeros();
+    let mut h = SMatrix::<f64, 8, 8>::zeros();
     let g = match law {
         Some((du, ddu)) => {
             for (a, &i) in P.iter().enumerate() {
                 for (b, &j) in P.iter().enumerate() {
-                    h[(i, j)] = theta.g[i] * theta.g[j] * ddu + theta.h[(a, b)] * du;
+                    h[(a, b)] = theta.g[i] * theta.g[j] * ddu + theta.h[(a, b)] * du;
                 }
             }
             theta.g * du
         }
         None => {
-            for (a, &i) in P.iter().enumerate() {
-                for (b, &j) in P.iter().enumerate() {
-                    h[(i, j)] = theta.h[(a, b)];
-                }
-            }
+            h = theta.h;
             theta.g
         }
     };

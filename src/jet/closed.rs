@@ -23,7 +23,7 @@ use super::{LMat, LVec, Pair, Scalar};
 use crate::joint::{Row, V};
 use crate::math::{b_matrix, rotation};
 use crate::model::Joint;
-use nalgebra::{Matrix3, Matrix3x4, Matrix4, Vector3};
+use nalgebra::{Matrix3, Matrix3x4, Matrix4, SMatrix, Vector3};
 
 /// `Σ_k t_k r_k + A(p_k) s_k` with `B_k = B(p_k, s_k)`; `on[k]` whether side `k` enters.
 #[derive(Clone, Copy, Debug)]
@@ -166,6 +166,22 @@ pub(crate) fn linear_hessian(a: &Lin, w: &Vector3<f64>, h: &mut LMat) {
             for i in 0..4 {
                 for j in 0..4 {
                     h[(o + i, o + j)] += m[(i, j)];
+                }
+            }
+        }
+    }
+}
+
+/// [`linear_hessian`] into the Euler-parameter rows and columns of the pair
+/// ([`crate::jet::EULER`]): the same entries, the same arithmetic.
+pub(crate) fn linear_hessian_euler(a: &Lin, w: &Vector3<f64>, hp: &mut SMatrix<f64, 8, 8>) {
+    for k in 0..2 {
+        if a.on[k] {
+            let m = quadratic_form(&a.s[k], w) * 2.0;
+            let o = 4 * k;
+            for i in 0..4 {
+                for j in 0..4 {
+                    hp[(o + i, o + j)] += m[(i, j)];
                 }
             }
         }

@@ -321,9 +321,10 @@ pub(crate) fn pair_of(
     let mut p = [Vector4::new(1.0, 0.0, 0.0, 0.0); 2];
     for k in 0..2 {
         if let Some(b) = bodies[k] {
-            let i = 7 * b.0;
-            r[k] = Vector3::new(q[i], q[i + 1], q[i + 2]);
-            p[k] = Vector4::new(q[i + 3], q[i + 4], q[i + 5], q[i + 6]);
+            // One bounds check for the body's 7 coordinates (not two per entry).
+            let x = &q.as_slice()[7 * b.0..7 * b.0 + 7];
+            r[k] = Vector3::new(x[0], x[1], x[2]);
+            p[k] = Vector4::new(x[3], x[4], x[5], x[6]);
         }
     }
     Pair { r, p, hess }

@@ -12,9 +12,9 @@
 //! only, so its Hessian is formed over those 8 coordinates of the pair (not 14), and no term
 //! allocates.
 
-use crate::jet::closed::{dot_gradient, dot_hessian, linear_gradient, linear_hessian_euler};
+use crate::jet::closed::{dot_gradient, dot_hessian_euler, linear_gradient, linear_hessian_euler};
 use crate::jet::closed::{Lin, Rotations};
-use crate::jet::{global_index, HessianSink, LMat, LVec, Pair, NL};
+use crate::jet::{global_index, HessianSink, LVec, Pair, NL};
 use crate::model::{BodyId, Joint};
 use nalgebra::{DVector, SMatrix, Vector3};
 
@@ -75,13 +75,15 @@ pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair) -> Angle {
         Lin::vector(pair, &rot, k, &r.matrix().column(i).into_owned())
     };
     let (x0, y0, x1) = (axis(0, 0), axis(0, 1), axis(1, 0));
-    let dot = |a: &Lin, b: &Lin, h: &mut LMat| {
+    // The Hessians of the two dot products over the Euler parameters only (directions: zero
+    // elsewhere).
+    let dot = |a: &Lin, b: &Lin, h: &mut SMatrix<f64, 8, 8>| {
         let mut g = LVec::zeros();
         dot_gradient(a, b, 1.0, &mut g);
-        dot_hessian(a, b, 1.0, h);
+        dot_hessian_euler(a, b, 1.0, h);
         (a.v.dot(&b.v), g)
     };
-    let (mut hs, mut hc) = (LMat::zeros(), LMat::zeros());
+    let (mut hs, mut hc) = (SMatrix::<f64, 8, 8>::zeros(), SMatrix::<f64, 8, 8>::zeros());
     let (s, gs) = dot(&y0, &x1, &mut hs);
     let (c, gc) = dot(&x0, &x1, &mut hc);
     // `Pair::atan2`, over the Euler parameters.
@@ -91,7 +93,7 @@ pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair) -> Angle {
     let mut m = SMatrix::<f64, 8, 8>::zeros();
     for (a, &i) in P.iter().enumerate() {
         for (b, &j) in P.iter().enumerate() {
-            let x = gs[i] * gc[j] - gc[i] * gs[j] + hs[(i, j)] * c - hc[(i, j)] * s;
+            let x = gs[i] * gc[j] - gc[i] * gs[j] + hs[(a, b)] * c - hc[(a, b)] * s;
             m[(a, b)] = x / rho - n[i] * drho[j] / rho;
         }
     }

@@ -242,6 +242,43 @@ pub(crate) fn dot_hessian(a: &Lin, b: &Lin, c: f64, h: &mut LMat) {
     linear_hessian(b, &(a.v * c), h);
 }
 
+/// [`dot_hessian`] into the Euler-parameter rows and columns of the pair
+/// ([`crate::jet::EULER`]), for two directions (`t = 0` on both sides: no `r` terms, so the
+/// full Hessian is zero elsewhere): the same entries, added in the same order.
+pub(crate) fn dot_hessian_euler(a: &Lin, b: &Lin, c: f64, h: &mut SMatrix<f64, 8, 8>) {
+    if a.t != [0.0; 2] || b.t != [0.0; 2] {
+        // Not two directions: the full Hessian, restricted.
+        let mut full = LMat::zeros();
+        dot_hessian(a, b, c, &mut full);
+        for (x, &i) in super::EULER.iter().enumerate() {
+            for (y, &j) in super::EULER.iter().enumerate() {
+                h[(x, y)] += full[(i, j)];
+            }
+        }
+        return;
+    }
+    for k in 0..2 {
+        if !a.on[k] {
+            continue;
+        }
+        for l in 0..2 {
+            if !b.on[l] {
+                continue;
+            }
+            let (ok, ol) = (4 * k, 4 * l);
+            let pp = a.b[k].tr_mul(&b.b[l]) * c;
+            for i in 0..4 {
+                for j in 0..4 {
+                    h[(ok + i, ol + j)] += pp[(i, j)];
+                    h[(ol + j, ok + i)] += pp[(i, j)];
+                }
+            }
+        }
+    }
+    linear_hessian_euler(a, &(b.v * c), h);
+    linear_hessian_euler(b, &(a.v * c), h);
+}
+
 /// The joint frames of both sides as far as a joint's rows need them: origin difference
 /// `d = o₁ − o₀` and axes (`None` where not needed).
 pub(crate) struct Frames {

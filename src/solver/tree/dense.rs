@@ -54,14 +54,14 @@ fn ldlt_with(a: &mut [f64], d: usize, v: &mut [f64]) -> Option<usize> {
 
 /// `x ← A⁻¹ x` for the factors of [`ldlt`]; `x` is `d × w` row-major (`w` right sides).
 pub(crate) fn ldlt_solve(f: &[f64], d: usize, x: &mut [f64], w: usize) {
-    // Constant sizes of a chain's blocks, so that the loops are unrolled and each row of `x`
-    // is updated in registers.
+    // Constant sizes of a chain's blocks, so that the loops are unrolled; with 7 right sides
+    // (the couplings `X_i`) each row of `x` is updated in registers.
     match (d, w) {
-        (13, 1) => ldlt_solve_rows::<1>(f, 13, x),
+        (13, 1) => ldlt_solve_impl(f, 13, x, 1),
         (13, 7) => ldlt_solve_rows::<7>(f, 13, x),
-        (14, 1) => ldlt_solve_rows::<1>(f, 14, x),
+        (14, 1) => ldlt_solve_impl(f, 14, x, 1),
         (14, 7) => ldlt_solve_rows::<7>(f, 14, x),
-        (8, 1) => ldlt_solve_rows::<1>(f, 8, x),
+        (8, 1) => ldlt_solve_impl(f, 8, x, 1),
         (8, 7) => ldlt_solve_rows::<7>(f, 8, x),
         _ => ldlt_solve_impl(f, d, x, w),
     }

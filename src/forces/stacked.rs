@@ -14,7 +14,7 @@
 
 use crate::jet::closed::{dot_gradient, dot_hessian_euler, linear_gradient, linear_hessian_euler};
 use crate::jet::closed::{Lin, Rotations};
-use crate::jet::{global_index, HessianSink, LVec, Pair, NL};
+use crate::jet::{HessianSink, LVec, Pair};
 use crate::model::{BodyId, Joint};
 use nalgebra::{DVector, SMatrix, Vector3};
 
@@ -31,9 +31,14 @@ fn scatter(
     grad: &mut DVector<f64>,
     hess: &mut dyn HessianSink,
 ) {
-    for i in 0..NL {
-        if let Some(gi) = global_index(bodies, i) {
-            grad[gi] += c * g[i];
+    // Each side's 7 entries as one slice (one bounds check, not one per entry).
+    let grad = grad.as_mut_slice();
+    for (k, body) in bodies.iter().enumerate() {
+        if let Some(b) = body {
+            let out = &mut grad[7 * b.0..7 * b.0 + 7];
+            for (i, o) in out.iter_mut().enumerate() {
+                *o += c * g[7 * k + i];
+            }
         }
     }
     hess.add_euler_block(bodies, hp, c);

@@ -214,17 +214,23 @@ impl TreeKkt {
                 let r = s.diag_at[i]..s.diag_at[i] + d * d;
                 factors[r.clone()].copy_from_slice(&values[r]);
             }
-            for a in 0..d {
-                let row = &values[s.diag_at[i] + a * d..s.diag_at[i] + a * d + d];
-                sums[at + a] += row.iter().map(|v| v.abs()).sum::<f64>();
+            let blk = &values[s.diag_at[i]..s.diag_at[i] + d * d];
+            let own = &mut sums[at..at + d];
+            for (a, row) in own.iter_mut().zip(blk.chunks_exact(d.max(1))) {
+                *a += row.iter().map(|v| v.abs()).sum::<f64>();
             }
-            if s.parent[i] != u32::MAX {
+            if s.parent[i] != u32::MAX && w > 0 {
+                // The same additions in the same order, on slices (the parent's unknowns come
+                // after the node's own in tree-space order).
                 let pa = s.at[s.parent[i] as usize];
-                for a in 0..d {
-                    for b in 0..w {
-                        let v = values[s.coup_at[i] + a * w + b].abs();
-                        sums[at + a] += v;
-                        sums[pa + b] += v;
+                let (head, tail) = sums.split_at_mut(pa);
+                let (own, up) = (&mut head[at..at + d], &mut tail[..w]);
+                let c = &values[s.coup_at[i]..s.coup_at[i] + d * w];
+                for (sa, crow) in own.iter_mut().zip(c.chunks_exact(w)) {
+                    for (sb, &x) in up.iter_mut().zip(crow) {
+                        let v = x.abs();
+                        *sa += v;
+                        *sb += v;
                     }
                 }
             }

@@ -323,9 +323,9 @@ impl TreeLu {
             let (a, b) = s.span[i];
             let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];
             dense::lu_solve_transpose(blk, &self.piv[a..b], b - a, &mut x[a..b]);
-            for k in s.off_at[i]..s.off_at[i + 1] {
-                let (p, q) = s.off[k];
-                x[q as usize] -= off[k] * x[p as usize];
+            let r = s.off_at[i]..s.off_at[i + 1];
+            for (&(p, q), &v) in s.off[r.clone()].iter().zip(&off[r]) {
+                x[q as usize] -= v * x[p as usize];
             }
         }
     }
@@ -344,9 +344,9 @@ impl TreeLu {
         let (diag, rest) = self.vals.split_at(s.off0);
         let off = &rest[..s.border0 - s.off0];
         for i in (0..nodes).rev() {
-            for k in s.off_at[i]..s.off_at[i + 1] {
-                let (p, q) = s.off[k];
-                x[p as usize] -= off[k] * x[q as usize];
+            let r = s.off_at[i]..s.off_at[i + 1];
+            for (&(p, q), &v) in s.off[r.clone()].iter().zip(&off[r]) {
+                x[p as usize] -= v * x[q as usize];
             }
             let (a, b) = s.span[i];
             let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];

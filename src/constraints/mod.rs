@@ -237,8 +237,10 @@ impl Constraints {
                         for (k, &v) in values.iter().take(k.unwrap_or(0)).enumerate() {
                             visit(block.first + k, Term::Value(v));
                         }
-                    } else if let Some(rows) = unilateral::rows(model, a, &pair, &self.branches) {
-                        for (k, s) in rows.iter().enumerate() {
+                    } else if unilateral::rows_into(model, a, &pair, &self.branches, &mut buf)
+                        .is_some()
+                    {
+                        for (k, s) in buf.iter().enumerate() {
                             visit(block.first + k, Term::Jet(&bodies, s, 1.0));
                         }
                     }

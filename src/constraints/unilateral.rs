@@ -190,6 +190,19 @@ pub(crate) fn rows(
     pair: &Pair,
     branches: &Branches,
 ) -> Option<Vec<Scalar>> {
+    let mut out = Vec::with_capacity(a.row_count());
+    rows_into(model, a, pair, branches, &mut out).map(|()| out)
+}
+
+/// [`rows`] into the buffer `out` (cleared first; no allocation once it has room for 3).
+pub(crate) fn rows_into(
+    model: &Model,
+    a: &Active,
+    pair: &Pair,
+    branches: &Branches,
+    out: &mut Vec<Scalar>,
+) -> Option<()> {
+    out.clear();
     match a.row {
         Unilateral::Limit {
             joint,
@@ -198,10 +211,11 @@ pub(crate) fn rows(
         } => {
             let j = &model.joints[joint.0];
             let theta = coordinate(j, pair, 0, branches.get(joint, 0))?;
-            Some(vec![match bound {
+            out.push(match bound {
                 Bound::Lower => theta.minus(value),
                 Bound::Upper => theta.minus(value).scale(-1.0),
-            }])
+            });
+            Some(())
         }
         Unilateral::Contact { point, ground } => {
             let c = &model.contact_points[point];
@@ -224,7 +238,7 @@ pub(crate) fn rows(
                     **h += x.j.transpose() * k * x.j;
                 }
             }
-            let mut out = vec![gap];
+            out.push(gap);
             if let Some(anchor) = a.anchor {
                 let d = pair
                     .point(0, &anchor.body)
@@ -233,7 +247,7 @@ pub(crate) fn rows(
                     out.push(pair.dot(&d, &pair.vector(1, &t)));
                 }
             }
-            Some(out)
+            Some(())
         }
     }
 }

@@ -217,6 +217,11 @@ impl Elimination {
                 continue;
             }
             let rmax = self.rmax[r];
+            // No entry of the row exceeds `rmax`: a row whose `rmax` cannot beat the best so
+            // far is not read (the same choice as reading it).
+            if best.is_some_and(|x| rmax <= x.2 * (1.0 + 1e-9)) {
+                continue;
+            }
             let (vals, mask) = self.on_body(r, b);
             for k in (0..7).filter(|k| mask & (1 << k) != 0) {
                 let a = vals[k].abs();

@@ -274,7 +274,8 @@ pub(crate) fn values(
             let theta = crate::kinematics::coordinate_value(j, pair, 0, branches.get(joint, 0))?;
             out[0] = match bound {
                 Bound::Lower => theta - value,
-                Bound::Upper => (theta - value) * -1.0,
+                // `Scalar::scale(-1.0)`: the product by −1 is the negation, exactly.
+                Bound::Upper => -(theta - value),
             };
             Some(1)
         }

@@ -55,6 +55,24 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
                  --initial JOINT=VALUE for the joints"
             )
         }
+        restpose::Error::Assembly { ref remedy, .. } if remedy.contains("nearly dependent") => {
+            anyhow::anyhow!(
+                "{e}; on the command line: without --initial the servos' references \
+                 (--servo JOINT=K@REF, --srdf-state) are the start; --friction none for \
+                 sliding contacts"
+            )
+        }
+        restpose::Error::Inconsistent { ref row, .. }
+            if row.contains(".contact[") && (row.ends_with(".t1") || row.ends_with(".t2")) =>
+        {
+            anyhow::anyhow!(
+                "{e}; it is a sticking contact's tangential row, redundant with other sticking \
+                 points of the same links, each held where it touched: their anchors disagree \
+                 (nearly dependent sticking rows, a leg lying on the ground); on the command \
+                 line: without --initial the servos' references (--servo JOINT=K@REF, \
+                 --srdf-state) are the start; --friction none for sliding contacts"
+            )
+        }
         e => e.into(),
     })?;
     report.diagnostics.timings.import = import;

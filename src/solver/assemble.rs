@@ -4,6 +4,15 @@
 //! dependent coordinates), halving the step until `‖Φ‖∞` decreases. Joints with an initial
 //! value are held by temporary lock rows, so that the loop closes around them (choosing the
 //! assembly branch); if that fails, the assembly is retried without them.
+//!
+//! The projection at the start of each active-set round (`project`) closes the new rows to the
+//! constraint tolerance over the partition's independent rows, the redundant ones to
+//! `REDUNDANT_FLOOR`. Sticking contacts whose tangential rows are nearly dependent (Vision 60
+//! of pybullet_data started flat, its legs on the ground: a pivot of `Φ_u` at `10⁻⁸` of the
+//! largest) can hold a row as redundant to `4.5·10⁻⁹` and then, when a contact joins, count it
+//! independent: the damped Newton step through that pivot cannot close it. The error then says
+//! so and names the remedies (start standing, or frictionless contacts) rather than the base's
+//! start pose.
 
 use super::options::Options;
 use super::system::residual::REDUNDANT_FLOOR;
@@ -212,27 +221,46 @@ pub(crate) fn project(
             let worst = worst_joint_row(&mut sys, &q0);
             let row = sys.problem.cons.row_name(model, worst);
             // The blocks are in row order: the row is the last block starting at or before it.
-            let unilateral = sys
+            let block = sys
                 .problem
                 .cons
                 .blocks
                 .iter()
                 .rev()
-                .find(|b| b.first <= worst)
+                .find(|b| b.first <= worst);
+            let unilateral = block
                 .is_some_and(|b| matches!(b.kind, crate::constraints::BlockKind::Unilateral(_)));
-            let remedy = if unilateral {
+            // A sticking contact's tangential row off by no more than the redundant rows'
+            // floor: rows nearly dependent on others (module docs).
+            let tangential = block.is_some_and(|b| {
+                matches!(b.kind, crate::constraints::BlockKind::Unilateral(a) if a.anchor.is_some())
+                    && worst > b.first
+            });
+            let scaled = sys.problem.scaling.row_residual(sys.phi(), worst);
+            let remedy = if tangential && scaled <= REDUNDANT_FLOOR {
+                format!(
+                    "the sticking contacts' tangential rows are nearly dependent here (several \
+                     points of the same links touch the ground and stick, as a leg lying on it), \
+                     and a residual of {scaled:.1e} of the characteristic length cannot be closed through them: start the \
+                     robot standing above the ground (no `mech:initial` folding its legs onto \
+                     it; with servos, their reference pose as the start), or let the contacts \
+                     slide (`friction=\"none\"`)"
+                )
+            } else if unilateral {
                 "a contact or stop starts too far inside its bound to be pushed out together with \
                  the joints: start the floating base above the ground (`mech:base`), or the \
                  joints inside their limits (`mech:initial`)"
+                    .into()
             } else {
                 "check the loop geometry or give `mech:initial` values near an assembled pose"
+                    .into()
             };
             Err(Error::Assembly {
                 site: model.row_site(&row).map(Box::new),
                 residual: sys.phi()[worst].abs(),
                 row,
                 iterations,
-                remedy: remedy.into(),
+                remedy,
             })
         }
     }

@@ -209,17 +209,19 @@ fn check_depth(text: &str, file: &str) -> Result<()> {
             depth = depth.saturating_sub(1);
             skip_to(i, ">")
         } else {
-            // A start tag: skip quoted values, then see whether it closes itself.
+            // A start tag: skip quoted values (a byte search for the closing quote; `k + 1`
+            // follows an ASCII quote, so it is a character boundary), then see whether it
+            // closes itself.
             let mut k = i + 1;
-            let mut quote: Option<u8> = None;
             while k < b.len() {
-                match (quote, b[k]) {
-                    (None, b'"' | b'\'') => quote = Some(b[k]),
-                    (Some(q), c) if c == q => quote = None,
-                    (None, b'>') => break,
-                    _ => {}
+                match b[k] {
+                    q @ (b'"' | b'\'') => match text[k + 1..].find(q as char) {
+                        Some(e) => k += e + 2,
+                        None => k = b.len(),
+                    },
+                    b'>' => break,
+                    _ => k += 1,
                 }
-                k += 1;
             }
             if k < b.len() && b[k - 1] != b'/' {
                 depth += 1;

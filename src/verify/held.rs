@@ -56,7 +56,7 @@ use crate::state::State;
 use nalgebra::{DMatrix, DVector};
 
 /// Scale of the lock and touching rows in the pivot choice: a model row is preferred.
-const PREFERENCE: f64 = 1e-3;
+pub(super) const PREFERENCE: f64 = 1e-3;
 
 /// Largest number of dependent rows whose multipliers are made least-norm.
 const MAX_DEPENDENT: usize = 200;
@@ -311,7 +311,7 @@ fn solve_once(
         at: "the given pose".into(),
         rows,
     };
-    let part = sys.partition(&state.q);
+    let part = super::rank::partition(&mut sys, &state.q);
     let mut eval = sys
         .evaluate(&state.q, &part)
         .ok_or_else(|| singular(part.rows.len()))?;

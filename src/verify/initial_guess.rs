@@ -93,8 +93,7 @@ fn sparse_dof(model: &Model, start: State, cons: Constraints) -> Result<usize> {
     }
     // Closed loops and mimics couple bodies beyond a joint's two: their elimination has fill
     // between bodies, where the fill-free route would give up; the partition counts them.
-    let coupled = model.joints.iter().any(|j| !j.tree && !j.merged) || !model.mimics.is_empty();
-    let fast = if coupled {
+    let fast = if super::coupled(model) {
         None
     } else {
         let jac = &sys.work.jac;

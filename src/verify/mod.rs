@@ -155,6 +155,12 @@ pub struct Verification {
     pub unilateral: UnilateralCheck,
 }
 
+/// Whether closed loops or mimics couple bodies beyond a joint's two: their elimination has
+/// fill between bodies, where the fill-free route of module `rank` would give up.
+fn coupled(model: &Model) -> bool {
+    model.joints.iter().any(|j| !j.tree && !j.merged) || !model.mimics.is_empty()
+}
+
 /// Whether `model` is verified on the sparse path (module `reduced`).
 fn sparse_path(model: &Model) -> bool {
     auto_backend(model) != Backend::Dense

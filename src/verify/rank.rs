@@ -1,6 +1,8 @@
-//! `check`'s degrees of freedom `n − rank(D Φ_q S)` without the general sparse partition when
-//! the elimination has no fill between bodies (trees): the same pivots, the same arithmetic,
-//! on a few rows at a time.
+//! The solver's sparse partition of `D Φ_q S` without the general sparse elimination when it
+//! has no fill between bodies (trees): the same pivots, the same arithmetic, on a few rows at
+//! a time. `check` counts its free columns (`n − rank`); `verify` takes the partition itself
+//! ([`partition`]: the same `Partition` to the last index, so the factors and every number
+//! computed from them are the same to the bit).
 //!
 //! The solver's sparse partition (`solver::sparse::partition`) eliminates the bodies in its
 //! order (deepest first); at body `b` it pivots up to seven times on the largest threshold-
@@ -15,12 +17,18 @@
 //! same pivots are chosen, in the same order, with the same floating-point operations on every
 //! entry), and gives up (`None`) at the first body where a row touching it stays active (a
 //! loop's rows, which carry fill to other bodies): the caller then runs the full partition.
-//! The number of free columns left, `n − pivots`, is the partition's `independent.len()`; a
-//! test checks both agree on every model of the test set.
+//! Every row then ends a pivot row or redundant: the pivots in their order are the partition's
+//! dependent columns and independent rows, the other rows its redundant ones, the columns left
+//! free its independent coordinates, the second pass's pivots its `second_pass` list. Tests
+//! check that the partitions agree on every model of the test set, with and without a lock on
+//! every joint coordinate (`verify`'s locked system).
 
 use crate::model::Model;
 use crate::solver::partition::RANK_TOLERANCE;
+use crate::solver::partition::{next_id, Partition};
 use crate::solver::sparse::partition::{elimination_order, OWN_THRESHOLD, THRESHOLD};
+use crate::solver::system::{Backend, System};
+use nalgebra::DVector;
 
 /// The rows of a Jacobian whose triplets are grouped by row: row `r` is
 /// `entries[start[r]..start[r + 1]]`, expanded on demand with its scales.
@@ -87,15 +95,34 @@ impl<'e> Rows<'e> {
 }
 
 /// The elimination at one body: copies of its rows (`slot[i]` is row `cands[i]`).
+/// Copies of the active ones only: the others are never read.
 struct Local {
     cands: Vec<usize>,
     rows: Vec<Vec<(usize, f64)>>,
-    /// Scratch: one row's entries in the body's free columns.
-    entries: Vec<(usize, f64)>,
+    /// `row_max` of each copy, kept current as the copies change (in [`pivot`]).
+    rmax: Vec<f64>,
+    /// [`on_body`] of each copy at the body, kept current as the copies change and the
+    /// body's columns are taken (in [`pivot`]).
+    on_b: Vec<([f64; 7], u8)>,
 }
 
 fn row_max(row: &[(usize, f64)]) -> f64 {
     row.iter().fold(0.0, |a, &(_, v)| a.max(v.abs()))
+}
+
+/// A row's entries on the free columns of body `b`, by column offset `c − 7 b`, and the mask
+/// of the offsets present (a row's columns are distinct): the entries a filter and a sort by
+/// column would list, in that order.
+fn on_body(row: &[(usize, f64)], free: &[bool], b: usize) -> ([f64; 7], u8) {
+    let (mut vals, mut mask) = ([0.0; 7], 0u8);
+    for &(c, v) in row {
+        let k = c.wrapping_sub(7 * b);
+        if k < 7 && free[c] {
+            vals[k] = v;
+            mask |= 1 << k;
+        }
+    }
+    (vals, mask)
 }
 
 /// The number of free columns `n − rank` the sparse partition leaves for the `m × n` Jacobian
@@ -109,6 +136,58 @@ pub(super) fn free_columns(
     row_scale: &[f64],
     scale: &[f64],
 ) -> Option<usize> {
+    eliminate(model, m, n, entries, row_scale, scale).map(|p| n - p.order.len())
+}
+
+/// The pivots of the fill-free elimination: `(row, column)` in pivot order, and the second
+/// pass's `(row, body, true)`.
+struct Pivots {
+    order: Vec<(usize, usize)>,
+    second: Vec<(usize, usize, bool)>,
+}
+
+/// The sparse partition of the rows of `sys` at `q` (`sys.partition(q)`, the same
+/// `Partition` but for its id), by the fill-free elimination where the model has neither
+/// closed loops nor mimics and the elimination answers; by the solver's partition otherwise.
+pub(super) fn partition(sys: &mut System, q: &DVector<f64>) -> Partition {
+    let model = sys.problem.model;
+    if sys.backend == Backend::Dense || super::coupled(model) {
+        return sys.partition(q);
+    }
+    sys.triplets(q);
+    let (jac, s) = (&sys.work.jac, &sys.problem.scaling);
+    let (m, n) = (jac.rows, jac.cols);
+    let Some(p) = eliminate(model, m, n, &jac.entries, &s.rows, &s.columns) else {
+        return sys.partition(q);
+    };
+    let mut pivot_row = vec![false; m];
+    let mut free = vec![true; n];
+    for &(r, c) in &p.order {
+        pivot_row[r] = true;
+        free[c] = false;
+    }
+    let mut second_pass = p.second;
+    second_pass.sort_unstable();
+    Partition {
+        id: next_id(),
+        dependent: p.order.iter().map(|e| e.1).collect(),
+        independent: (0..n).filter(|&c| free[c]).collect(),
+        rows: p.order.iter().map(|e| e.0).collect(),
+        redundant: (0..m).filter(|&r| !pivot_row[r]).collect(),
+        second_pass,
+    }
+}
+
+/// The fill-free elimination ([`free_columns`]): its pivots, or `None` if it has fill between
+/// bodies.
+fn eliminate(
+    model: &Model,
+    m: usize,
+    n: usize,
+    entries: &[(usize, usize, f64)],
+    row_scale: &[f64],
+    scale: &[f64],
+) -> Option<Pivots> {
     let nb = n / 7;
     let mut rows = Rows::new(m, n, entries, row_scale, scale)?;
     let mut row = Vec::with_capacity(14);
@@ -169,11 +248,15 @@ pub(super) fn free_columns(
         }
     }
     let mut free = vec![true; n];
-    let mut pivots = 0usize;
+    let mut pivots = Pivots {
+        order: Vec::with_capacity(n),
+        second: Vec::new(),
+    };
     let mut local = Local {
         cands: Vec::new(),
         rows: Vec::new(),
-        entries: Vec::with_capacity(14),
+        rmax: Vec::new(),
+        on_b: Vec::new(),
     };
     let (mut all, mut own) = (Vec::new(), Vec::new());
     for b in elimination_order(model) {
@@ -185,32 +268,42 @@ pub(super) fn free_columns(
         let k = local.cands.len();
         if local.rows.len() < k {
             local.rows.resize_with(k, Vec::new);
+            local.rmax.resize(k, 0.0);
+            local.on_b.resize(k, ([0.0; 7], 0));
         }
         for (slot, &r) in local.cands.iter().enumerate() {
             let copy = &mut local.rows[slot];
             copy.clear();
-            copy.extend_from_slice(&expanded[at[r]..at[r + 1]]);
+            if active[r] {
+                copy.extend_from_slice(&expanded[at[r]..at[r + 1]]);
+                local.rmax[slot] = rmax[r];
+                local.on_b[slot] = on_body(copy, &free, b);
+            }
         }
-        let in_b = |c: usize| c / 7 == b;
         all.clear();
         all.extend(0..k);
         let mut taken = 0;
         while taken < 7 {
-            match best_pivot(&mut local, &all, &active, &free, tol, in_b) {
-                Some((slot, c)) => pivot(&mut local, slot, c, &mut active, &mut free, tol),
+            match best_pivot(&local, &all, &active, tol, b) {
+                Some((slot, c)) => {
+                    pivots.order.push((local.cands[slot], c));
+                    pivot(&mut local, slot, c, &mut active, &mut free, tol, b);
+                }
                 None => break,
             }
-            pivots += 1;
             taken += 1;
         }
         own.clear();
         own.extend((0..k).filter(|&s| own_of[local.cands[s]] == b));
         while taken < 7 {
-            match best_own_pivot(&mut local, &own, &active, &free, tol, b, &reach) {
-                Some((slot, c)) => pivot(&mut local, slot, c, &mut active, &mut free, tol),
+            match best_own_pivot(&local, &own, &active, tol, b, &reach) {
+                Some((slot, c)) => {
+                    pivots.order.push((local.cands[slot], c));
+                    pivots.second.push((local.cands[slot], b, true));
+                    pivot(&mut local, slot, c, &mut active, &mut free, tol, b);
+                }
                 None => break,
             }
-            pivots += 1;
             taken += 1;
         }
         if local.cands.iter().any(|&r| active[r]) {
@@ -220,35 +313,30 @@ pub(super) fn free_columns(
     if active.iter().any(|&a| a) {
         return None;
     }
-    Some(n - pivots)
+    Some(pivots)
 }
 
-/// The partition's pivot choice among the rows at `slots` (ascending) in the free columns
-/// `cols`: the largest `|a_rc| > tol` with `|a_rc| ≥ THRESHOLD · max_k |a_rk|`, a later one
+/// The partition's pivot choice among the rows at `slots` (ascending) in the free columns of
+/// body `b`: the largest `|a_rc| > tol` with `|a_rc| ≥ THRESHOLD · max_k |a_rk|`, a later one
 /// only if larger by a relative `1e-9`.
 fn best_pivot(
-    local: &mut Local,
+    local: &Local,
     slots: &[usize],
     active: &[bool],
-    free: &[bool],
     tol: f64,
-    cols: impl Fn(usize) -> bool,
+    b: usize,
 ) -> Option<(usize, usize)> {
     let mut best: Option<(usize, usize, f64)> = None;
-    let entries = &mut local.entries;
     for &s in slots {
         if !active[local.cands[s]] {
             continue;
         }
-        let row = &local.rows[s];
-        let rmax = row_max(row);
-        entries.clear();
-        entries.extend(row.iter().copied().filter(|&(c, _)| free[c] && cols(c)));
-        entries.sort_unstable_by_key(|e| e.0);
-        for &(c, v) in entries.iter() {
-            let a = v.abs();
-            if a > tol && a >= THRESHOLD * rmax && best.is_none_or(|b| a > b.2 * (1.0 + 1e-9)) {
-                best = Some((s, c, a));
+        let rmax = local.rmax[s];
+        let (vals, mask) = local.on_b[s];
+        for k in (0..7).filter(|k| mask & (1 << k) != 0) {
+            let a = vals[k].abs();
+            if a > tol && a >= THRESHOLD * rmax && best.is_none_or(|x| a > x.2 * (1.0 + 1e-9)) {
+                best = Some((s, 7 * b + k, a));
             }
         }
     }
@@ -260,30 +348,22 @@ fn best_pivot(
 /// `reach` there (same kind of column), if at least `OWN_THRESHOLD` of it; a later one only
 /// if larger by a relative `1e-9`.
 fn best_own_pivot(
-    local: &mut Local,
+    local: &Local,
     slots: &[usize],
     active: &[bool],
-    free: &[bool],
     tol: f64,
     b: usize,
     reach: &[[f64; 2]],
 ) -> Option<(usize, usize)> {
     let mut best: Option<(usize, usize, f64)> = None;
-    let entries = &mut local.entries;
     for &s in slots {
         let r = local.cands[s];
         if !active[r] {
             continue;
         }
-        entries.clear();
-        entries.extend(
-            local.rows[s]
-                .iter()
-                .copied()
-                .filter(|&(c, _)| free[c] && c / 7 == b),
-        );
-        entries.sort_unstable_by_key(|e| e.0);
-        for &(c, v) in entries.iter() {
+        let (vals, mask) = local.on_b[s];
+        for k in (0..7).filter(|k| mask & (1 << k) != 0) {
+            let (c, v) = (7 * b + k, vals[k]);
             let ratio = v.abs() / reach[r][usize::from(c % 7 >= 3)].max(f64::MIN_POSITIVE);
             if v.abs() > tol
                 && ratio >= OWN_THRESHOLD
@@ -304,9 +384,18 @@ fn pivot(
     active: &mut [bool],
     free: &mut [bool],
     tol: f64,
+    b: usize,
 ) {
     active[local.cands[slot]] = false;
     free[c] = false;
+    // Column `c` is no longer free: gone from every row's entries on the body (those of the
+    // rows changed below are gathered again).
+    let k = c.wrapping_sub(7 * b);
+    if k < 7 {
+        for e in &mut local.on_b {
+            e.1 &= !(1u8 << k);
+        }
+    }
     let pivot_row = std::mem::take(&mut local.rows[slot]);
     let a_rc = pivot_row.iter().find(|e| e.0 == c).map_or(0.0, |e| e.1);
     for s in 0..local.cands.len() {
@@ -328,7 +417,9 @@ fn pivot(
                 None => row.push((col, -f * v)),
             }
         }
-        if row_max(row) <= tol {
+        local.rmax[s] = row_max(row);
+        local.on_b[s] = on_body(row, free, b);
+        if local.rmax[s] <= tol {
             active[local.cands[s]] = false;
         }
     }
@@ -336,99 +427,5 @@ fn pivot(
 }
 
 #[cfg(test)]
-mod tests {
-    use crate::constraints::Constraints;
-    use crate::solver::system::{Backend, System};
-    use crate::urdf::{load_str, ImportOptions};
-
-    /// `(free columns of this module, of the sparse partition)` at the assembled initial guess.
-    fn both(text: &str, options: &ImportOptions) -> (Option<usize>, usize) {
-        let model = load_str(text, "m.urdf", options).unwrap().model;
-        let locks = crate::solver::lock_values(&model);
-        let mut branches = Default::default();
-        let q0 = crate::solver::initial_state(&model).q;
-        let q = crate::solver::assemble_only(&model, q0, &mut branches, &locks).unwrap();
-        let cons = Constraints::new(&model, &locks).on_branches(branches);
-        let mut sys = System::new(&model, cons, Backend::Sparse);
-        let mut phi = nalgebra::DVector::zeros(sys.problem.cons.len());
-        let mut jac = crate::constraints::Triplets::default();
-        sys.problem
-            .cons
-            .evaluate(&model, &q, &mut phi, Some(&mut jac));
-        let s = &sys.problem.scaling;
-        let fast = super::free_columns(
-            &model,
-            jac.rows,
-            jac.cols,
-            &jac.entries,
-            &s.rows,
-            &s.columns,
-        );
-        (fast, sys.partition(&q).independent.len())
-    }
-
-    /// Same count as the partition wherever the fill-free route answers; it answers on every
-    /// tree and gives up on closed loops.
-    #[test]
-    fn same_free_columns_as_the_sparse_partition() {
-        let trees = [
-            include_str!("../../robots/pendulum.urdf").to_string(),
-            include_str!("../../robots/chain20.urdf").to_string(),
-            include_str!("../../robots/panda_class.urdf").to_string(),
-            include_str!("../../robots/ur5_class.urdf").to_string(),
-            include_str!("../../robots/quadruped_leg.urdf").to_string(),
-            include_str!("../../robots/gazebo_transmission.urdf").to_string(),
-            include_str!("../../robots/solo12/solo12_ground.urdf").to_string(),
-            crate::generate::chain(9, false),
-            crate::generate::chain(120, false),
-            crate::generate::chain(120, true),
-            crate::generate::chain(2000, false),
-            crate::generate::rope(12),
-        ];
-        let loops = [
-            include_str!("../../robots/slider_crank.urdf").to_string(),
-            include_str!("../../robots/four_bar_spatial.urdf").to_string(),
-            include_str!("../../robots/stewart_platform.urdf").to_string(),
-            include_str!("../../robots/drake_closed_chain.urdf").to_string(),
-            include_str!("../../robots/tractor_trailer.urdf").to_string(),
-            crate::generate::ladder(5),
-        ];
-        let plain = ImportOptions::default();
-        let floating = ImportOptions {
-            floating_base: true,
-            ..Default::default()
-        };
-        for (k, t) in trees.iter().enumerate() {
-            for o in [&plain, &floating] {
-                let (fast, partition) = both(t, o);
-                assert_eq!(fast, Some(partition), "tree {k}");
-            }
-        }
-        for (k, t) in loops.iter().enumerate() {
-            let (fast, partition) = both(t, &plain);
-            assert!(fast.is_none_or(|f| f == partition), "loop {k}");
-        }
-    }
-
-    /// Lock rows (on the joint's own body) and a redundant lock: the same count as the
-    /// partition, the redundant row found as there.
-    #[test]
-    fn locks_and_a_redundant_lock() {
-        let chain = crate::generate::chain(60, false);
-        let lock = |joint: &str| (joint.to_string(), 0, None);
-        let one = ImportOptions {
-            locks: vec![lock("joint0"), lock("joint30")],
-            ..Default::default()
-        };
-        let (fast, partition) = both(&chain, &one);
-        assert_eq!(fast, Some(partition));
-        assert_eq!(partition, 58);
-        let twice = ImportOptions {
-            locks: vec![lock("joint7"), lock("joint7")],
-            ..Default::default()
-        };
-        let (fast, partition) = both(&chain, &twice);
-        assert_eq!(partition, 59);
-        assert_eq!(fast, Some(partition));
-    }
-}
+#[path = "rank_tests.rs"]
+mod tests;

@@ -87,7 +87,7 @@ pub(super) fn reduced<'a>(
             solved: None,
         });
     }
-    let part = sys.partition(q);
+    let part = super::rank::partition(&mut sys, q);
     let eval = sys
         .evaluate(q, &part)
         .ok_or_else(|| Error::SingularPartition {

@@ -200,6 +200,8 @@ pub(crate) fn solve(
     let mut let_go: Vec<Unilateral> = Vec::new();
     // The inequalities the last step met (module `guard`: some may be false hits).
     let mut hits: Vec<Unilateral> = Vec::new();
+    // A row that leaves again alone and comes straight back (module `release`).
+    let mut returns = super::release::Returns::default();
     loop {
         let mut branches = state.branches.clone();
         let q = super::guard::project_past_false_hits(
@@ -247,7 +249,17 @@ pub(crate) fn solve(
             std::mem::take(&mut report.history),
             std::mem::take(&mut report.iterates),
         );
-        let cycling = changes - initial >= options.max_iterations;
+        let energy = history.last().map_or(0.0, |h| h.potential_energy);
+        let met: Vec<Unilateral> = round
+            .blocked
+            .iter()
+            .flatten()
+            .filter(|&&k| !guard.is_roll_limit(k))
+            .map(|&k| guard.inactive[k])
+            .collect();
+        let returned =
+            !met.is_empty() && returns.met(&met, energy, force_scale(model) * model.length_scale);
+        let cycling = changes - initial >= options.max_iterations || returned;
         if !round.released.is_empty() && !cycling {
             // Rows pulling hard before the round was stationary (module `release`), or rows
             // carried past an obstacle's edge by a stalled round (module `stall`: its line
@@ -320,6 +332,9 @@ pub(crate) fn solve(
                 .collect();
             if fresh.is_empty() {
                 gone.truncate(1);
+                if let Some(&i) = gone.first() {
+                    returns.left(active[i].row, energy);
+                }
             } else {
                 gone = fresh;
             }

@@ -46,6 +46,16 @@
 //! alone, the most negative at a stationary point, as in the classic method; so the set cannot
 //! zigzag between several rows leaving together and coming back.
 //!
+//! A row that leaves again alone at a stationary point and that the next round's first step
+//! meets again at once, the energy falling by less than `RETURN_DECREASE · F L` (`F` the
+//! weight and loads, `L` the characteristic length), is a two-round cycle at a degenerate
+//! vertex of the active set: the A1 of example-robot-data falling on its legs without servos,
+//! sticking (`--friction stick`), released a thigh contact pulling −224 N at a stationary
+//! point, and the next round's Newton step (and steepest descent as well, tried) turned it back
+//! into the floor after 10⁻⁸ J, 101 times, until `max_iterations` changes of the set: 103
+//! iterations, 202 rounds. After [`RETURNS`] such returns in a row the search ends there as
+//! `active_set_cycling` (module `active_set`), with the message that names the remedy.
+//!
 //! ## References
 //! - B. A. Murtagh, M. A. Saunders, "Large-scale linearly constrained optimization",
 //!   *Mathematical Programming* 14 (1978) 41–72 (§4: the reduced-gradient tolerance before
@@ -65,6 +75,56 @@ use nalgebra::DVector;
 /// The subspace tolerance `η`: a round ends early when a pulling row's energy rate exceeds
 /// `‖∂V/∂v‖∞ / η`.
 pub(crate) const SUBSPACE_TOLERANCE: f64 = 0.5;
+
+/// Consecutive returns of a row that left again alone at a stationary point after which the
+/// search ends as cycling (module docs).
+pub(crate) const RETURNS: usize = 3;
+
+/// The largest energy decrease, in units of `F L`, over a release and return that counts as a
+/// return without progress (module docs).
+pub(crate) const RETURN_DECREASE: f64 = 1e-8;
+
+/// The returns of a row that left again alone at a stationary point (module docs).
+#[derive(Default)]
+pub(crate) struct Returns {
+    /// The row that left last, alone at a stationary point, and the energy there.
+    last: Option<(Unilateral, f64)>,
+    /// Whether the round after that release has not been met yet.
+    armed: bool,
+    /// Consecutive returns without progress.
+    count: usize,
+}
+
+impl Returns {
+    /// `row` left again, alone, at a stationary point at energy `energy`.
+    pub(crate) fn left(&mut self, row: Unilateral, energy: f64) {
+        if self.last.is_none_or(|(r, _)| r != row) {
+            self.count = 0;
+        }
+        self.last = Some((row, energy));
+        self.armed = true;
+    }
+
+    /// A step met the inequalities `hits` at energy `energy`; `scale` is `F L` \[J\]. Whether
+    /// the row that left last has come back [`RETURNS`] times in a row without progress.
+    pub(crate) fn met(&mut self, hits: &[Unilateral], energy: f64, scale: f64) -> bool {
+        match self.last {
+            Some((row, before))
+                if self.armed
+                    && hits.contains(&row)
+                    && before - energy <= RETURN_DECREASE * scale =>
+            {
+                self.count += 1;
+            }
+            _ => {
+                self.count = 0;
+                self.last = None;
+            }
+        }
+        self.armed = false;
+        self.count >= RETURNS
+    }
+}
 
 /// The early-release test of one round, and its stall test (module `stall`).
 pub(crate) struct Release<'m> {
@@ -236,4 +296,50 @@ pub(super) fn leave(
     super::patch::promote(model, options, active, &removed, q);
     super::rolling::record_touches(model, active, q, touched);
     gone.len()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_row_that_comes_straight_back_without_progress_is_a_cycle_at_the_third_return() {
+        let row = Unilateral::Contact {
+            point: 1,
+            ground: 0,
+        };
+        let other = Unilateral::Contact {
+            point: 2,
+            ground: 0,
+        };
+        let mut r = Returns::default();
+        for k in 1..=RETURNS {
+            r.left(row, 10.0);
+            assert_eq!(
+                r.met(&[other, row], 10.0 - 0.5e-8, 1.0),
+                k == RETURNS,
+                "{k}"
+            );
+        }
+        // With progress (the energy falls by more than 10⁻⁸ F L), never.
+        let mut r = Returns::default();
+        for _ in 0..2 * RETURNS {
+            r.left(row, 10.0);
+            assert!(!r.met(&[row], 10.0 - 2e-8, 1.0));
+        }
+        // Another row met in between, or a step that meets something before the release,
+        // starts the count again.
+        let mut r = Returns::default();
+        for k in 0..3 * RETURNS {
+            r.left(row, 10.0);
+            let hits = if k % RETURNS == 1 { [other] } else { [row] };
+            assert!(!r.met(&hits, 10.0, 1.0), "{k}");
+        }
+        let mut r = Returns::default();
+        r.left(row, 10.0);
+        assert!(!r.met(&[row], 10.0, 1.0));
+        assert!(!r.met(&[row], 10.0, 1.0));
+        r.left(row, 10.0);
+        assert!(!r.met(&[row], 10.0, 1.0));
+    }
 }

@@ -3,6 +3,7 @@
 mod issue_12_assembly_names_the_joint;
 mod issue_12_sparse_verify_angle_branch;
 mod issue_13_floating_base_start;
+mod issue_21_a1_falls_without_servos;
 mod issue_21_bolt_rolls_over;
 mod issue_21_chain_on_its_stops;
 mod issue_21_curved_valley;
@@ -17,6 +18,7 @@ mod issue_21_sparse_chart_fold;
 mod issue_21_stand_from_reference;
 mod issue_21_stops_leave_together;
 mod issue_21_verify_forces_and_stability;
+mod issue_21_vision60_flat;
 mod issue_22_off_the_ramp;
 mod issue_25_closed_pipe;
 mod issue_25_fuzz_smoke;

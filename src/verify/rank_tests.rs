@@ -1,0 +1,188 @@
+//! The fill-free elimination against the solver's sparse partition.
+
+use crate::constraints::Constraints;
+use crate::solver::system::{Backend, System};
+use crate::urdf::{load_str, ImportOptions};
+
+/// `(free columns of this module, of the sparse partition)` at the assembled initial guess.
+fn both(text: &str, options: &ImportOptions) -> (Option<usize>, usize) {
+    let model = load_str(text, "m.urdf", options).unwrap().model;
+    let locks = crate::solver::lock_values(&model);
+    let mut branches = Default::default();
+    let q0 = crate::solver::initial_state(&model).q;
+    let q = crate::solver::assemble_only(&model, q0, &mut branches, &locks).unwrap();
+    let cons = Constraints::new(&model, &locks).on_branches(branches);
+    let mut sys = System::new(&model, cons, Backend::Sparse);
+    let mut phi = nalgebra::DVector::zeros(sys.problem.cons.len());
+    let mut jac = crate::constraints::Triplets::default();
+    sys.problem
+        .cons
+        .evaluate(&model, &q, &mut phi, Some(&mut jac));
+    let s = &sys.problem.scaling;
+    let fast = super::free_columns(
+        &model,
+        jac.rows,
+        jac.cols,
+        &jac.entries,
+        &s.rows,
+        &s.columns,
+    );
+    (fast, sys.partition(&q).independent.len())
+}
+
+/// Trees (on which the fill-free route answers) and closed loops of the test set.
+fn models() -> (Vec<String>, Vec<String>) {
+    let trees = vec![
+        include_str!("../../robots/pendulum.urdf").to_string(),
+        include_str!("../../robots/chain20.urdf").to_string(),
+        include_str!("../../robots/panda_class.urdf").to_string(),
+        include_str!("../../robots/ur5_class.urdf").to_string(),
+        include_str!("../../robots/quadruped_leg.urdf").to_string(),
+        include_str!("../../robots/gazebo_transmission.urdf").to_string(),
+        include_str!("../../robots/solo12/solo12_ground.urdf").to_string(),
+        crate::generate::chain(9, false),
+        crate::generate::chain(120, false),
+        crate::generate::chain(120, true),
+        crate::generate::chain(2000, false),
+        crate::generate::rope(12),
+    ];
+    let loops = vec![
+        include_str!("../../robots/slider_crank.urdf").to_string(),
+        include_str!("../../robots/four_bar_spatial.urdf").to_string(),
+        include_str!("../../robots/stewart_platform.urdf").to_string(),
+        include_str!("../../robots/drake_closed_chain.urdf").to_string(),
+        include_str!("../../robots/tractor_trailer.urdf").to_string(),
+        crate::generate::ladder(5),
+    ];
+    (trees, loops)
+}
+
+/// Same count as the partition wherever the fill-free route answers; it answers on every
+/// tree and gives up on closed loops.
+#[test]
+fn same_free_columns_as_the_sparse_partition() {
+    let (trees, loops) = models();
+    let plain = ImportOptions::default();
+    let floating = ImportOptions {
+        floating_base: true,
+        ..Default::default()
+    };
+    for (k, t) in trees.iter().enumerate() {
+        for o in [&plain, &floating] {
+            let (fast, partition) = both(t, o);
+            assert_eq!(fast, Some(partition), "tree {k}");
+        }
+    }
+    for (k, t) in loops.iter().enumerate() {
+        let (fast, partition) = both(t, &plain);
+        assert!(fast.is_none_or(|f| f == partition), "loop {k}");
+    }
+}
+
+/// Lock rows (on the joint's own body) and a redundant lock: the same count as the
+/// partition, the redundant row found as there.
+#[test]
+fn locks_and_a_redundant_lock() {
+    let chain = crate::generate::chain(60, false);
+    let lock = |joint: &str| (joint.to_string(), 0, None);
+    let one = ImportOptions {
+        locks: vec![lock("joint0"), lock("joint30")],
+        ..Default::default()
+    };
+    let (fast, partition) = both(&chain, &one);
+    assert_eq!(fast, Some(partition));
+    assert_eq!(partition, 58);
+    let twice = ImportOptions {
+        locks: vec![lock("joint7"), lock("joint7")],
+        ..Default::default()
+    };
+    let (fast, partition) = both(&chain, &twice);
+    assert_eq!(partition, 59);
+    assert_eq!(fast, Some(partition));
+}
+
+/// The partition of `super::partition` against the solver's (`System::partition`) at the
+/// assembled initial guess of `text` and at a pose off it (each coordinate moved): all but
+/// the id equal. `locked`: with a lock on every joint coordinate scaled down as module `held`
+/// does (its locked system). Returns whether the fill-free route answered.
+fn same_partition(text: &str, options: &ImportOptions, locked: bool) -> bool {
+    let model = load_str(text, "m.urdf", options).unwrap().model;
+    let locks = crate::solver::lock_values(&model);
+    let mut branches = Default::default();
+    let q0 = crate::solver::initial_state(&model).q;
+    let q = crate::solver::assemble_only(&model, q0, &mut branches, &locks).unwrap();
+    let state = crate::state::State { q, branches };
+    let mut all = locks.clone();
+    if locked {
+        let coords = super::super::run::tree_coordinates(&model, &state);
+        all.extend(
+            coords
+                .into_iter()
+                .filter(|c| !locks.iter().any(|l| l.0 == c.0 && l.1 == c.1)),
+        );
+    }
+    let off = state
+        .q
+        .map_with_location(|i, _, x| x + 1e-3 * ((i % 5) as f64 - 2.0));
+    let mut answered = true;
+    for q in [&state.q, &off] {
+        let cons = Constraints::new(&model, &all).on_branches(state.branches.clone());
+        let lock_rows: Vec<usize> = cons
+            .blocks
+            .iter()
+            .filter(|b| matches!(b.kind, crate::constraints::BlockKind::Lock { .. }))
+            .map(|b| b.first)
+            .collect();
+        let mut sys = System::new(&model, cons, Backend::Sparse);
+        for &r in &lock_rows[locks.len()..] {
+            sys.problem.scaling.rows[r] *= super::super::held::PREFERENCE;
+        }
+        let fast = super::partition(&mut sys, q);
+        let jac = &sys.work.jac;
+        let s = &sys.problem.scaling;
+        answered &= super::free_columns(
+            &model,
+            jac.rows,
+            jac.cols,
+            &jac.entries,
+            &s.rows,
+            &s.columns,
+        )
+        .is_some();
+        let full = sys.partition(q);
+        assert_ne!(fast.id, full.id);
+        assert_eq!(fast.dependent, full.dependent);
+        assert_eq!(fast.independent, full.independent);
+        assert_eq!(fast.rows, full.rows);
+        assert_eq!(fast.redundant, full.redundant);
+        assert_eq!(fast.second_pass, full.second_pass);
+    }
+    answered
+}
+
+/// The same partition as the solver's on every model of the test set, with and without the
+/// locked system's rows; the fill-free route answers on every tree (and on the locked systems
+/// of all but one).
+#[test]
+fn same_partition_as_the_sparse_partition() {
+    let (trees, loops) = models();
+    let plain = ImportOptions::default();
+    let floating = ImportOptions {
+        floating_base: true,
+        ..Default::default()
+    };
+    for (k, t) in trees.iter().enumerate() {
+        for o in [&plain, &floating] {
+            assert!(same_partition(t, o, false), "tree {k}");
+            // Panda's locked system keeps a row active at a body: the solver's partition
+            // answers there (equal all the same).
+            let answered = same_partition(t, o, true);
+            assert!(answered || k == 2, "tree {k}, locked");
+        }
+    }
+    for t in &loops {
+        for locked in [false, true] {
+            same_partition(t, &plain, locked);
+        }
+    }
+}

@@ -226,8 +226,10 @@ pub(crate) struct VerifyArgs {
     #[arg(long, value_enum, default_value_t = LinearAlgebra::from(Options::default().linear_algebra))]
     pub(crate) linear_algebra: LinearAlgebra,
     /// Report the lowest eigenvalues and mode shapes of the stability verdict at any size.
-    /// Without it, above 200 degrees of freedom on the sparse path the verdict comes from the
-    /// inertia of the shifted KKT matrix alone (faster; `eigenvalues` and `modes` empty).
+    /// Without it, above 64 degrees of freedom on the tree and sparse paths the verdict comes
+    /// from the inertia of the shifted KKT matrix alone (faster; `eigenvalues` and `modes`
+    /// empty, `diagnostics.eigenvalues_by` "inertia"); up to 64, or on the dense path, they
+    /// are always listed.
     #[arg(long)]
     pub(crate) eigenvalues: bool,
     /// Print only errors and the verdict.
@@ -303,8 +305,10 @@ pub(crate) struct AnalyzeArgs {
     #[arg(long)]
     pub(crate) allow_unstable: bool,
     /// Report the lowest eigenvalues and mode shapes of the stability verdict at any size.
-    /// Without it, above 200 degrees of freedom on the sparse path the verdict comes from the
-    /// inertia of the shifted KKT matrix alone (faster; `eigenvalues` and `modes` empty).
+    /// Without it, above 64 degrees of freedom on the tree and sparse paths the verdict comes
+    /// from the inertia of the shifted KKT matrix alone (faster; `eigenvalues` and `modes`
+    /// empty, `diagnostics.eigenvalues_by` "inertia"); up to 64, or on the dense path, they
+    /// are always listed.
     #[arg(long)]
     pub(crate) eigenvalues: bool,
     #[command(flatten)]

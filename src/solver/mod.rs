@@ -47,7 +47,9 @@ pub use report::{
     Report, Sizes, Stability, Termination, Timings, Verdict,
 };
 pub(crate) use stability::eigen;
-pub(crate) use stability::verdict::{stability_of, stability_on, stability_verdict};
+pub(crate) use stability::verdict::{
+    stability_of, stability_on, stability_verdict, stability_verdict_after_round,
+};
 
 use crate::constraints::unilateral::Active;
 use crate::constraints::Constraints;

@@ -132,10 +132,11 @@ pub struct Options {
     /// maxima along the direction of negative curvature).
     pub allow_unstable: bool,
     /// Report the lowest eigenvalues and mode shapes of the stability verdict at any size
-    /// (default: false: above 200 degrees of freedom on the sparse path the verdict comes
-    /// from the inertia of the shifted KKT matrix alone, `eigenvalues` and `modes` empty and
-    /// `diagnostics.eigenvalues_by` `"inertia"`; below, they are exact and cheap and always
-    /// reported).
+    /// (default: false: above 64 degrees of freedom on the tree and sparse paths the verdict
+    /// comes from the inertia of the shifted KKT matrix alone, `eigenvalues` and `modes` empty
+    /// and `diagnostics.eigenvalues_by` `"inertia"`; up to 64, or on the dense path, they are
+    /// exact and cheap (the Newton steps decompose the reduced Hessian anyway) and always
+    /// reported; asked for, exact up to 200 and the low end by Lanczos above).
     pub eigenvalues: bool,
     /// Dense or sparse linear algebra (default: automatic by size).
     pub linear_algebra: LinearAlgebra,

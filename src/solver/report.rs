@@ -112,10 +112,10 @@ pub struct Stability {
     /// Smallest eigenvalues of the reduced Hessian in joint coordinates, ascending (at most 6):
     /// `d²V/dθ²` along the feasible motions \[N m/rad for rotations, N/m for slides\], the same
     /// from any start (module `solver::joint_space`; independent joint coordinates where loops
-    /// make some dependent). Above 200 degrees of freedom on the sparse path (Lanczos) they are
-    /// those of the scaled reduced Hessian \[J\] instead, and `verify` leaves them empty unless
-    /// asked for (`verify::Eigenvalues::Always`): its verdict then comes from the KKT inertia
-    /// alone. Empty when stops or contacts leave no feasible motion (verdict `stable`). The
+    /// make some dependent). Above 64 degrees of freedom on the tree and sparse paths they are
+    /// empty unless asked for ([`crate::Options::eigenvalues`], `verify::Eigenvalues::Always`):
+    /// the verdict then comes from the KKT inertia alone; asked for above 200 (Lanczos) they
+    /// are those of the scaled reduced Hessian \[J\] instead. Empty when stops or contacts leave no feasible motion (verdict `stable`). The
     /// verdict and `tolerance` are those of the scaled reduced Hessian, which has the same
     /// signs (Sylvester's law of inertia).
     pub eigenvalues: Vec<f64>,
@@ -206,8 +206,9 @@ pub struct Diagnostics {
     pub linear_algebra: String,
     /// How the stability eigenvalues were found: `"exact"` (the reduced Hessian decomposed),
     /// `"lanczos"` (its low end only, for many degrees of freedom), or `"inertia"` (none: the
-    /// verdict from the inertia of the shifted KKT matrix, many degrees of freedom without
-    /// [`Options::eigenvalues`](crate::Options::eigenvalues)); empty without a verdict.
+    /// verdict from the inertia of the shifted KKT matrix, above 64 degrees of freedom on the
+    /// tree and sparse paths without [`Options::eigenvalues`](crate::Options::eigenvalues));
+    /// empty without a verdict.
     pub eigenvalues_by: String,
     /// Wall time of each phase \[s\].
     pub timings: Timings,

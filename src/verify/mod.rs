@@ -279,13 +279,14 @@ pub fn verify_using(
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Eigenvalues {
     /// The lowest eigenvalues and their mode shapes where they are exact and cheap (the
-    /// reduced Hessian formed and decomposed: up to 200 degrees of freedom, or up to 40
-    /// bodies, where the stability uses dense linear algebra); above, the verdict alone, from
-    /// the inertia of the shifted KKT matrix (`stability.eigenvalues` and `modes` empty).
+    /// reduced Hessian formed and decomposed: up to 64 degrees of freedom on the tree and
+    /// sparse paths, or up to 40 bodies, where the stability uses dense linear algebra);
+    /// above, the verdict alone, from the inertia of the shifted KKT matrix
+    /// (`stability.eigenvalues` and `modes` empty), as `analyze` reports it.
     #[default]
     WhenCheap,
-    /// Always the lowest eigenvalues and mode shapes (above 200 degrees of freedom on the
-    /// sparse path, the low end found by Lanczos, as `analyze` reports them).
+    /// Always the lowest eigenvalues and mode shapes (exact up to 200 degrees of freedom; above
+    /// on the sparse path, the low end found by Lanczos, as `analyze` reports them).
     Always,
     /// No stability verdict (`stability` is `None`): the balance checks only, as `analyze`
     /// runs them on its own answer. On the sparse path the model's rows are then not

@@ -27,6 +27,7 @@ mod regressions;
 mod robots;
 mod servo;
 mod sparse;
+mod stability_listing;
 mod stand;
 mod stdout_outputs;
 mod verify;

@@ -395,13 +395,14 @@ pub(crate) fn solve(
         let judged = std::time::Instant::now();
         let (strong, weak) = split(model, &round.multipliers, threshold);
         if report.converged() && !weak.is_empty() {
-            report.stability = crate::solver::stability_verdict(
+            // The round held all of them as rows: its verdict's eigenvalues are reported.
+            report.stability = crate::solver::stability_verdict_after_round(
                 model,
                 &state,
-                &strong,
-                &weak,
+                (&strong, &weak),
                 Backend::of(model, options),
                 options.eigenvalues,
+                report.stability.take(),
             );
         }
         // Stops and contacts carrying a force that leave no feasible motion: a strict

@@ -1,25 +1,27 @@
 //! The curvature the minimizer needs at a point, and no more.
 //!
 //! The dense Newton direction uses the whole spectrum of `Ĥ`, and a small spectrum is exact
-//! and cheap (module `spectrum`): those are computed as before. At a stationary point with many
-//! degrees of freedom (Lanczos path) the minimizer only needs to know whether the point is a
-//! saddle or a maximum it must leave: the inertia of the shifted KKT matrix answers that
-//! (module `inertia`: `#{λ < −t}`, `t = 10⁻¹⁰ max(λ_max, 1)`) with one or two LDLᵀ
-//! factorizations, and Lanczos runs only where it says `unstable` (its eigenvector of the
-//! negative eigenvalue is the way out) or where it cannot be trusted. The verdict found on the
-//! way is the rest's stability verdict (module `verdict`) unless eigenvalues are asked for.
+//! and cheap (module `spectrum`): those are computed as before (the dense path, and up to
+//! `spectrum::LISTED_UP_TO` degrees of freedom on the sparse and tree paths, where the Newton
+//! step decomposes `Ĥ` anyway). Above, at a stationary point the minimizer only needs to know
+//! whether the point is a saddle or a maximum it must leave: the inertia of the shifted KKT
+//! matrix answers that (module `inertia`: `#{λ < −t}`, `t = 10⁻¹⁰ max(λ_max, 1)`) with one or
+//! two LDLᵀ factorizations, and the spectrum (exact up to `spectrum::EXACT_UP_TO`, Lanczos
+//! above) is computed only where it says `unstable` (its eigenvector of the negative
+//! eigenvalue is the way out) or where it cannot be trusted. The verdict found on the way is
+//! the rest's stability verdict (module `verdict`) unless eigenvalues are asked for.
 
 use super::inertia::inertia_verdict;
-use super::spectrum::{exact, spectrum, Spectrum};
+use super::spectrum::{listed, spectrum, Spectrum};
 use crate::solver::partition::Partition;
 use crate::solver::report::Verdict;
 use crate::solver::system::{Eval, System};
 use nalgebra::DVector;
 
-/// The spectrum the minimizer uses at `q` (dof > 0): exact where it is cheap; on the Lanczos
-/// path the inertia verdict first (stored in `verdict`), and the Lanczos spectrum only when
-/// that verdict is `unstable` and the minimizer is to leave (`allow_unstable` false), or
-/// when the inertia cannot be trusted.
+/// The spectrum the minimizer uses at `q` (dof > 0): exact where it is listed (dense path,
+/// few degrees of freedom); else the inertia verdict first (stored in `verdict`), and the
+/// spectrum only when that verdict is `unstable` and the minimizer is to leave
+/// (`allow_unstable` false), or when the inertia cannot be trusted.
 pub(crate) fn for_minimizer(
     sys: &mut System,
     q: &DVector<f64>,
@@ -29,7 +31,7 @@ pub(crate) fn for_minimizer(
     verdict: &mut Option<(Verdict, f64)>,
 ) -> Option<Spectrum> {
     *verdict = None;
-    if exact(sys.backend, part.independent.len()) {
+    if listed(sys.backend, part.independent.len()) {
         return Some(spectrum(sys, q, part, eval));
     }
     match inertia_verdict(sys, q, part, eval) {

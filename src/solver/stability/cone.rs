@@ -117,7 +117,10 @@ pub(crate) fn minimum(h: &DMatrix<f64>, weak: &[DMatrix<f64>], eig_tol: f64) -> 
 /// force and `weak` touch without one: the reported eigenvalues and modes are those of the
 /// tangent space of all of them (every touching row held), the verdict is the critical
 /// cone's. `None` where there is no degree of freedom even without the weak ones;
-/// `eigenvalues` as in `solver::stability_of`.
+/// `eigenvalues` as in `solver::stability_of`. `all_held`: the verdict on the tangent space of
+/// all of them if already at hand (the active-set round that ended at `state` held every one
+/// as a row, and judged it): its eigenvalues and modes are reported instead of judging that
+/// space again.
 pub(crate) fn stability_touching(
     model: &Model,
     state: &State,
@@ -125,11 +128,13 @@ pub(crate) fn stability_touching(
     weak: &[Active],
     backend: Backend,
     eigenvalues: bool,
+    all_held: Option<Stability>,
 ) -> Option<Stability> {
     let (held, weak) = both_stops_held(strong, weak);
     let (strong, weak) = (held.as_slice(), weak.as_slice());
     if weak.is_empty() {
-        return crate::solver::stability_on(model, state, strong, backend, eigenvalues);
+        return all_held
+            .or_else(|| crate::solver::stability_on(model, state, strong, backend, eigenvalues));
     }
     let all: Vec<Active> = strong.iter().chain(weak).copied().collect();
     let q = &state.q;
@@ -179,7 +184,8 @@ pub(crate) fn stability_touching(
     } else {
         Verdict::Stable
     };
-    let shown = crate::solver::stability_on(model, state, &all, backend, eigenvalues)
+    let shown = all_held
+        .or_else(|| crate::solver::stability_on(model, state, &all, backend, eigenvalues))
         .or_else(|| crate::solver::stability_on(model, state, strong, backend, eigenvalues));
     shown.map(|mut s| {
         s.verdict = verdict;

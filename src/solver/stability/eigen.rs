@@ -3,7 +3,7 @@
 //! nalgebra's `SymmetricEigen` can return an orthonormal `V` whose columns are paired with the
 //! wrong eigenvalues (dimforge/nalgebra#1109; seen here on a 21 × 21 `JᵀJ`). Every eigenvalue
 //! is therefore recomputed as the Rayleigh quotient `λ_i = v_iᵀ A v_i`, and the residual
-//! `‖A V − V Λ‖` is checked; if it is still large the cyclic Jacobi method, slower but
+//! `‖A V − V Λ‖` is checked (each `A v_i` formed once, for both); if it is still large the cyclic Jacobi method, slower but
 //! unconditionally convergent, is used instead. A matrix with non-finite entries gets NaN
 //! eigenvalues (the caller's tests then fail) rather than an endless iteration; the singular
 //! value decomposition is guarded the same way ([`svd`]: `None` rather than a panic or a hang).
@@ -36,22 +36,28 @@ pub(crate) fn symmetric_eigen(a: &DMatrix<f64>) -> (DVector<f64>, DMatrix<f64>) 
         return (DVector::from_element(n, f64::NAN), DMatrix::identity(n, n));
     }
     let scale = a.amax().max(f64::MIN_POSITIVE);
-    // Bounded iterations: nalgebra's `new` iterates without limit.
-    let (mut vals, mut vecs) =
-        match nalgebra::SymmetricEigen::try_new(a.clone(), f64::EPSILON, 10_000) {
-            Some(e) => {
-                let vecs = e.eigenvectors;
-                (
-                    DVector::from_fn(n, |i, _| vecs.column(i).dot(&(a * vecs.column(i)))),
-                    vecs,
-                )
+    // Bounded iterations: nalgebra's `new` iterates without limit. Each `A v_i` is formed once,
+    // for its Rayleigh quotient and its column of the residual `A V − V Λ`.
+    let guarded =
+        nalgebra::SymmetricEigen::try_new(a.clone(), f64::EPSILON, 10_000).and_then(|e| {
+            let vecs = e.eigenvectors;
+            let mut vals = DVector::zeros(n);
+            let mut av = DVector::zeros(n);
+            for i in 0..n {
+                a.mul_to(&vecs.column(i), &mut av);
+                let v = vecs.column(i);
+                vals[i] = v.dot(&av);
+                for r in 0..n {
+                    let x = (av[r] - v[r] * vals[i]).abs();
+                    // A NaN residual fails too.
+                    if x.is_nan() || x > 1e-9 * scale {
+                        return None;
+                    }
+                }
             }
-            None => jacobi(a),
-        };
-    let residual = (a * &vecs - &vecs * DMatrix::from_diagonal(&vals)).amax();
-    if residual.is_nan() || residual > 1e-9 * scale {
-        (vals, vecs) = jacobi(a);
-    }
+            Some((vals, vecs))
+        });
+    let (vals, vecs) = guarded.unwrap_or_else(|| jacobi(a));
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_by(|&i, &j| vals[i].total_cmp(&vals[j]));
     let sorted_vals = DVector::from_fn(n, |i, _| vals[order[i]]);

@@ -25,6 +25,14 @@ use nalgebra::{DMatrix, DVector};
 
 /// Up to this many degrees of freedom the reduced Hessian is formed and decomposed exactly.
 pub(crate) const EXACT_UP_TO: usize = 200;
+/// Up to this many degrees of freedom on the sparse and tree paths the stability verdict
+/// comes from the exact spectrum and the report lists the eigenvalues; above, from the
+/// inertia of the shifted KKT matrix unless eigenvalues are asked for ([`listed`]). It is
+/// the minimizer's `EXACT_NEWTON_DOF`: up to there every Newton step decomposes `Ĥ`, so at
+/// the rest the spectrum is at hand; above, the steps are KKT solves and forming `Ĥ` (`dof`
+/// tangent solves and their transposes, `O(dof · N)`) and decomposing it (`O(dof³)`) would
+/// cost more than the solve (chain 100: about two thirds of it).
+pub(crate) const LISTED_UP_TO: usize = 64;
 /// Lanczos steps at most.
 const STEPS: usize = 24;
 /// Eigenvalues reported (the smallest).
@@ -67,13 +75,20 @@ impl Spectrum {
     }
 }
 
-/// The spectrum at a feasible `q` (dof > 0).
 /// Whether the spectrum of `dof` degrees of freedom with `backend` is exact (the reduced
 /// Hessian formed and decomposed) rather than found by Lanczos.
 pub(crate) fn exact(backend: Backend, dof: usize) -> bool {
     backend == Backend::Dense || dof <= EXACT_UP_TO
 }
 
+/// Whether the stability verdict of `dof` degrees of freedom with `backend` lists its
+/// eigenvalues by default (the dense path, or at most [`LISTED_UP_TO`]); otherwise the verdict
+/// comes from the KKT inertia (module `inertia`) unless eigenvalues are asked for.
+pub(crate) fn listed(backend: Backend, dof: usize) -> bool {
+    backend == Backend::Dense || dof <= LISTED_UP_TO
+}
+
+/// The spectrum at a feasible `q` (dof > 0): exact where [`exact`], else by Lanczos.
 pub(crate) fn spectrum(
     sys: &mut System,
     q: &DVector<f64>,

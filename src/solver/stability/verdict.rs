@@ -130,7 +130,21 @@ pub(crate) fn stability_verdict(
     backend: Backend,
     eigenvalues: bool,
 ) -> Option<Stability> {
-    super::cone::stability_touching(model, state, strong, weak, backend, eigenvalues)
+    super::cone::stability_touching(model, state, strong, weak, backend, eigenvalues, None)
+}
+
+/// [`stability_verdict`] at the end of an active-set round that held every one of `strong`
+/// and `weak` as a row and judged its tangent space (`all_held`, if it has a verdict): that
+/// verdict's eigenvalues and modes are reported, not computed again.
+pub(crate) fn stability_verdict_after_round(
+    model: &Model,
+    state: &State,
+    (strong, weak): (&[Active], &[Active]),
+    backend: Backend,
+    eigenvalues: bool,
+    all_held: Option<Stability>,
+) -> Option<Stability> {
+    super::cone::stability_touching(model, state, strong, weak, backend, eigenvalues, all_held)
 }
 
 /// The verdict on the tangent space of the equality rows and the inequalities `active` (every
@@ -173,10 +187,11 @@ pub(crate) fn stability_on(
 /// The verdict with the system of the model's rows already partitioned and evaluated at
 /// `q` (what `verify` has made for its balance check); `None` with no degree of freedom.
 ///
-/// Where the eigenvalues would come from Lanczos (sparse path, more than
-/// `spectrum::EXACT_UP_TO` degrees of freedom) and `eigenvalues` is false, the verdict comes
+/// Where the eigenvalues are not listed by default (sparse or tree path, more than
+/// `spectrum::LISTED_UP_TO` degrees of freedom) and `eigenvalues` is false, the verdict comes
 /// from the inertia of the shifted KKT matrix alone (module `stability::inertia`), without
-/// eigenvalues or mode shapes; Lanczos only if that inertia cannot be trusted.
+/// eigenvalues or mode shapes; the spectrum (exact up to `spectrum::EXACT_UP_TO`, Lanczos
+/// above) only if that inertia cannot be trusted.
 pub(crate) fn stability_of(
     sys: &mut System,
     q: &nalgebra::DVector<f64>,
@@ -187,8 +202,7 @@ pub(crate) fn stability_of(
     if part.independent.is_empty() {
         return None;
     }
-    let lanczos = !spectrum::exact(sys.backend, part.independent.len());
-    if lanczos && !eigenvalues {
+    if !spectrum::listed(sys.backend, part.independent.len()) && !eigenvalues {
         if let Some((verdict, tolerance)) = inertia::inertia_verdict(sys, q, part, eval) {
             return Some(Stability {
                 verdict,

@@ -222,7 +222,23 @@ impl System<'_> {
         let n = self.problem.model.coordinate_count();
         let dof = part.independent.len();
         let keep = n * dof <= KEPT_BASIS_ENTRIES;
-        let (hr, basis) = if self.backend != Backend::Dense {
+        let (hr, basis) = if self.backend != Backend::Dense && keep {
+            // `Z` column by column through the factors, `W Z` through the blocks, then
+            // `Zᵀ (W Z)` as one product (no transposed solves).
+            self.lagrangian_blocks(q, part, eval);
+            let mut z = DMatrix::zeros(n, dof);
+            let mut wz = DMatrix::zeros(n, dof);
+            for b in 0..dof {
+                let mut e = DVector::zeros(dof);
+                e[b] = 1.0;
+                let zx = self.tangent_step(part, eval, &e);
+                self.work
+                    .hess
+                    .mul_add(zx.as_slice(), wz.column_mut(b).as_mut_slice());
+                z.set_column(b, &zx);
+            }
+            (z.tr_mul(&wz), Some(z))
+        } else if self.backend != Backend::Dense {
             self.lagrangian_blocks(q, part, eval);
             let mut hr = DMatrix::zeros(dof, dof);
             let mut basis = keep.then(|| DMatrix::zeros(n, dof));

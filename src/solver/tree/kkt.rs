@@ -284,7 +284,7 @@ impl TreeKkt {
         let got = s.border.factor(
             &mut border,
             &mut bpiv,
-            |x, lo, _| self.tree_solve_from(x, lu, lo),
+            |x, lo, _, need| self.tree_solve_from(x, lu, lo, need),
             !lu,
         );
         self.border = border;
@@ -298,13 +298,14 @@ impl TreeKkt {
 
     /// `x ← T⁻¹ x` over the tree part (tree-space order; the border untouched).
     fn tree_solve(&self, x: &mut [f64], lu: bool) {
-        self.tree_solve_from(x, lu, 0);
+        self.tree_solve_from(x, lu, 0, 0);
     }
 
     /// [`TreeKkt::tree_solve`] for an `x` that is zero before the tree-space position `lo`:
     /// the forward pass starts at the node holding `lo` (the nodes before it, leaves whose
-    /// right side is zero, would pass zeros on; the backward pass fills every node).
-    fn tree_solve_from(&self, x: &mut [f64], lu: bool, lo: usize) {
+    /// right side is zero, would pass zeros on); the backward pass (each node from its
+    /// parent) ends at the node holding `need`, below which `x` is not read.
+    fn tree_solve_from(&self, x: &mut [f64], lu: bool, lo: usize, need: usize) {
         let s = &self.shape;
         let nodes = s.at.len();
         let first = s.at.partition_point(|&a| a <= lo).saturating_sub(1);
@@ -327,7 +328,8 @@ impl TreeKkt {
             let c = &self.values[s.coup_at[i]..s.coup_at[i] + d * w];
             dense::sub_tr_mul(c, y, &mut tail[pa..pa + w], d, w);
         }
-        for i in (0..nodes).rev() {
+        let last = s.at.partition_point(|&a| a <= need).saturating_sub(1);
+        for i in (last..nodes).rev() {
             let p = s.parent[i];
             if p == u32::MAX {
                 continue;

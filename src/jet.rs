@@ -321,9 +321,10 @@ pub(crate) fn pair_of(
     let mut p = [Vector4::new(1.0, 0.0, 0.0, 0.0); 2];
     for k in 0..2 {
         if let Some(b) = bodies[k] {
-            let i = 7 * b.0;
-            r[k] = Vector3::new(q[i], q[i + 1], q[i + 2]);
-            p[k] = Vector4::new(q[i + 3], q[i + 4], q[i + 5], q[i + 6]);
+            // One bounds check for the body's 7 coordinates (not two per entry).
+            let x = &q.as_slice()[7 * b.0..7 * b.0 + 7];
+            r[k] = Vector3::new(x[0], x[1], x[2]);
+            p[k] = Vector4::new(x[3], x[4], x[5], x[6]);
         }
     }
     Pair { r, p, hess }
@@ -341,6 +342,31 @@ pub(crate) trait HessianSink {
     fn add_block(&mut self, bodies: &[Option<crate::model::BodyId>; 2], h: &LMat, c: f64);
     /// Adds `v` at the global position `(i, j)`.
     fn add_entry(&mut self, i: usize, j: usize, v: f64);
+    /// Adds `c h` for a local Hessian `h` that is zero outside the Euler parameters of the
+    /// pair, given by its [`EULER`] rows and columns `hp` (a revolute angle, a weighted point:
+    /// `A(p)` is quadratic in `p` and the rest linear). By default the full local Hessian.
+    fn add_euler_block(
+        &mut self,
+        bodies: &[Option<crate::model::BodyId>; 2],
+        hp: &SMatrix<f64, 8, 8>,
+        c: f64,
+    ) {
+        self.add_block(bodies, &euler_to_local(hp), c);
+    }
+}
+
+/// The Euler-parameter coordinates of a body pair (local indices).
+pub(crate) const EULER: [usize; 8] = [3, 4, 5, 6, 10, 11, 12, 13];
+
+/// The local Hessian whose [`EULER`] rows and columns are `hp` (zero elsewhere).
+pub(crate) fn euler_to_local(hp: &SMatrix<f64, 8, 8>) -> LMat {
+    let mut h = LMat::zeros();
+    for (a, &i) in EULER.iter().enumerate() {
+        for (b, &j) in EULER.iter().enumerate() {
+            h[(i, j)] = hp[(a, b)];
+        }
+    }
+    h
 }
 
 impl HessianSink for nalgebra::DMatrix<f64> {

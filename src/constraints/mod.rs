@@ -65,6 +65,8 @@ enum Term<'a> {
     /// The rows of a joint with closed-form derivatives ([`crate::jet::closed`]), from
     /// `row` on.
     Closed(&'a crate::model::Joint, &'a crate::jet::Pair),
+    /// A row's value alone (the rows of stops and contacts when only `Φ` is asked for).
+    Value(f64),
 }
 
 /// The full set of constraint rows of a model, with locks resolved to values.
@@ -196,9 +198,11 @@ impl Constraints {
         model: &Model,
         q: &DVector<f64>,
         hess: bool,
+        values_only: bool,
         mut visit: impl FnMut(usize, Term),
     ) {
         let mut buf = Vec::with_capacity(6);
+        let mut values = [0.0; 3];
         for block in &self.blocks {
             match &block.kind {
                 BlockKind::Joint(id) => {
@@ -228,8 +232,15 @@ impl Constraints {
                 BlockKind::Unilateral(a) => {
                     let bodies = unilateral::bodies(model, &a.row);
                     let pair = pair_of(&bodies, q, hess);
-                    if let Some(rows) = unilateral::rows(model, a, &pair, &self.branches) {
-                        for (k, s) in rows.iter().enumerate() {
+                    if values_only {
+                        let k = unilateral::values(model, a, &pair, &self.branches, &mut values);
+                        for (k, &v) in values.iter().take(k.unwrap_or(0)).enumerate() {
+                            visit(block.first + k, Term::Value(v));
+                        }
+                    } else if unilateral::rows_into(model, a, &pair, &self.branches, &mut buf)
+                        .is_some()
+                    {
+                        for (k, s) in buf.iter().enumerate() {
                             visit(block.first + k, Term::Jet(&bodies, s, 1.0));
                         }
                     }
@@ -291,8 +302,11 @@ impl Constraints {
                 }
             }
         }
-        self.for_each_row(model, q, false, |row, term| match term {
+        let values_only = jac.is_none();
+        self.for_each_row(model, q, false, values_only, |row, term| match term {
             Term::Jet(bodies, s, c) => push(phi, jac.as_deref_mut(), row, bodies, s, c),
+            // `push`'s `phi[row] += 1.0 · v`.
+            Term::Value(v) => phi[row] += 1.0 * v,
             Term::Closed(j, pair) if jac.is_none() => {
                 crate::jet::closed::values(j, pair, &mut closed_values);
                 for (k, v) in closed_values.iter().enumerate() {
@@ -333,7 +347,7 @@ impl Constraints {
                 h.add_block(&bodies, &acc, 1.0);
             }
         };
-        self.for_each_row(model, q, true, |row, term| match term {
+        self.for_each_row(model, q, true, false, |row, term| match term {
             Term::Jet(bodies, s, c) => {
                 if w[row] != 0.0 {
                     let same = pending.as_ref().is_some_and(|(b, _)| {
@@ -373,6 +387,7 @@ impl Constraints {
                     h.add_entry(i + k, i + k, 2.0 * w[row]);
                 }
             }
+            Term::Value(_) => {}
         });
         flush(&mut pending, h);
     }

@@ -15,7 +15,9 @@ use std::io::Write;
 use std::path::Path;
 
 /// Writes `bytes` to `path` atomically: a temporary file in the same folder, then a rename,
-/// so that a reader never sees a half-written file.
+/// so that a reader never sees a half-written file. A symbolic link is followed (its target
+/// is replaced, not the link). A path that is not a file (`/dev/null`, `/dev/stdout`, a
+/// named pipe) is written in place: a rename would replace the device or pipe itself.
 ///
 /// # Errors
 /// [`Error::Io`] if the folder is not writable.
@@ -23,6 +25,21 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let io = |cause| Error::Io {
         path: path.display().to_string(),
         cause,
+    };
+    let resolved;
+    let path = match (std::fs::metadata(path), std::fs::symlink_metadata(path)) {
+        (Ok(target), _) if !target.is_file() && !target.is_dir() => {
+            return std::fs::OpenOptions::new()
+                .write(true)
+                .open(path)
+                .and_then(|mut f| f.write_all(bytes))
+                .map_err(io);
+        }
+        (Ok(_), Ok(link)) if link.file_type().is_symlink() => {
+            resolved = std::fs::canonicalize(path).map_err(io)?;
+            resolved.as_path()
+        }
+        _ => path,
     };
     let dir = path
         .parent()
@@ -42,4 +59,44 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         let _ = std::fs::remove_file(&tmp);
         io(e)
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::write_atomic;
+
+    #[test]
+    fn a_device_is_written_in_place_and_a_link_through() {
+        let dir = std::env::temp_dir().join(format!("restpose-write-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // A named pipe stays the pipe and its reader gets the bytes (as `/dev/null` stays the
+        // device: a rename would have put a file in its place).
+        let fifo = dir.join("pipe.json");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        if made.is_ok_and(|s| s.success()) {
+            let reader = {
+                let fifo = fifo.clone();
+                std::thread::spawn(move || std::fs::read(fifo).unwrap())
+            };
+            write_atomic(&fifo, b"{}").unwrap();
+            let kind = std::fs::symlink_metadata(&fifo).unwrap().file_type();
+            assert!(!kind.is_file(), "the pipe was replaced by a file");
+            assert_eq!(reader.join().unwrap(), b"{}");
+        }
+        let file = dir.join("pose.json");
+        write_atomic(&file, b"one").unwrap();
+        assert_eq!(std::fs::read(&file).unwrap(), b"one");
+        #[cfg(unix)]
+        {
+            let link = dir.join("link.json");
+            std::os::unix::fs::symlink(&file, &link).unwrap();
+            write_atomic(&link, b"two").unwrap();
+            assert!(std::fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink());
+            assert_eq!(std::fs::read(&file).unwrap(), b"two");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

@@ -12,30 +12,36 @@
 //! only, so its Hessian is formed over those 8 coordinates of the pair (not 14), and no term
 //! allocates.
 
-use crate::jet::closed::{dot_gradient, dot_hessian, linear_gradient, linear_hessian};
+use crate::jet::closed::{dot_gradient, dot_hessian_euler, linear_gradient, linear_hessian_euler};
 use crate::jet::closed::{Lin, Rotations};
-use crate::jet::{global_index, HessianSink, LMat, LVec, Pair, NL};
+use crate::jet::{HessianSink, LVec, Pair};
 use crate::model::{BodyId, Joint};
 use nalgebra::{DVector, SMatrix, Vector3};
 
 /// The Euler-parameter coordinates of a body pair (local indices).
-const P: [usize; 8] = [3, 4, 5, 6, 10, 11, 12, 13];
+const P: [usize; 8] = crate::jet::EULER;
 
-/// `c ∇f` into `grad` and `c ∇²f` into `hess` (as [`crate::jet::scatter`]).
+/// `c ∇f` into `grad` and `c ∇²f` into `hess` (as [`crate::jet::scatter`]), for an `f` whose
+/// Hessian is zero outside the Euler parameters (`hp` over [`P`]).
 fn scatter(
     bodies: &[Option<BodyId>; 2],
     g: &LVec,
-    h: &LMat,
+    hp: &SMatrix<f64, 8, 8>,
     c: f64,
     grad: &mut DVector<f64>,
     hess: &mut dyn HessianSink,
 ) {
-    for i in 0..NL {
-        if let Some(gi) = global_index(bodies, i) {
-            grad[gi] += c * g[i];
+    // Each side's 7 entries as one slice (one bounds check, not one per entry).
+    let grad = grad.as_mut_slice();
+    for (k, body) in bodies.iter().enumerate() {
+        if let Some(b) = body {
+            let out = &mut grad[7 * b.0..7 * b.0 + 7];
+            for (i, o) in out.iter_mut().enumerate() {
+                *o += c * g[7 * k + i];
+            }
         }
     }
-    hess.add_block(bodies, h, c);
+    hess.add_euler_block(bodies, hp, c);
 }
 
 /// `wᵀ (r_k + A(p_k) s)` of side `k` with its gradient into `grad` and Hessian into `hess`
@@ -53,8 +59,8 @@ pub(crate) fn weighted_point(
     let p = Lin::point(pair, &rot, 0, s);
     let mut g = LVec::zeros();
     linear_gradient(&p, w, &mut g);
-    let mut h = LMat::zeros();
-    linear_hessian(&p, w, &mut h);
+    let mut h = SMatrix::<f64, 8, 8>::zeros();
+    linear_hessian_euler(&p, w, &mut h);
     scatter(bodies, &g, &h, 1.0, grad, hess);
     w.dot(&p.v)
 }
@@ -74,13 +80,15 @@ pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair) -> Angle {
         Lin::vector(pair, &rot, k, &r.matrix().column(i).into_owned())
     };
     let (x0, y0, x1) = (axis(0, 0), axis(0, 1), axis(1, 0));
-    let dot = |a: &Lin, b: &Lin, h: &mut LMat| {
+    // The Hessians of the two dot products over the Euler parameters only (directions: zero
+    // elsewhere).
+    let dot = |a: &Lin, b: &Lin, h: &mut SMatrix<f64, 8, 8>| {
         let mut g = LVec::zeros();
         dot_gradient(a, b, 1.0, &mut g);
-        dot_hessian(a, b, 1.0, h);
+        dot_hessian_euler(a, b, 1.0, h);
         (a.v.dot(&b.v), g)
     };
-    let (mut hs, mut hc) = (LMat::zeros(), LMat::zeros());
+    let (mut hs, mut hc) = (SMatrix::<f64, 8, 8>::zeros(), SMatrix::<f64, 8, 8>::zeros());
     let (s, gs) = dot(&y0, &x1, &mut hs);
     let (c, gc) = dot(&x0, &x1, &mut hc);
     // `Pair::atan2`, over the Euler parameters.
@@ -90,7 +98,7 @@ pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair) -> Angle {
     let mut m = SMatrix::<f64, 8, 8>::zeros();
     for (a, &i) in P.iter().enumerate() {
         for (b, &j) in P.iter().enumerate() {
-            let x = gs[i] * gc[j] - gc[i] * gs[j] + hs[(i, j)] * c - hc[(i, j)] * s;
+            let x = gs[i] * gc[j] - gc[i] * gs[j] + hs[(a, b)] * c - hc[(a, b)] * s;
             m[(a, b)] = x / rho - n[i] * drho[j] / rho;
         }
     }
@@ -117,22 +125,18 @@ pub(crate) fn scatter_angle(
     grad: &mut DVector<f64>,
     hess: &mut dyn HessianSink,
 ) {
-    let mut h = LMat::zeros();
+    let mut h = SMatrix::<f64, 8, 8>::zeros();
     let g = match law {
         Some((du, ddu)) => {
             for (a, &i) in P.iter().enumerate() {
                 for (b, &j) in P.iter().enumerate() {
-                    h[(i, j)] = theta.g[i] * theta.g[j] * ddu + theta.h[(a, b)] * du;
+                    h[(a, b)] = theta.g[i] * theta.g[j] * ddu + theta.h[(a, b)] * du;
                 }
             }
             theta.g * du
         }
         None => {
-            for (a, &i) in P.iter().enumerate() {
-                for (b, &j) in P.iter().enumerate() {
-                    h[(i, j)] = theta.h[(a, b)];
-                }
-            }
+            h = theta.h;
             theta.g
         }
     };

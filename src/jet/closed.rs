@@ -23,7 +23,7 @@ use super::{LMat, LVec, Pair, Scalar};
 use crate::joint::{Row, V};
 use crate::math::{b_matrix, rotation};
 use crate::model::Joint;
-use nalgebra::{Matrix3, Matrix3x4, Matrix4, Vector3};
+use nalgebra::{Matrix3, Matrix3x4, Matrix4, SMatrix, Vector3};
 
 /// `Σ_k t_k r_k + A(p_k) s_k` with `B_k = B(p_k, s_k)`; `on[k]` whether side `k` enters.
 #[derive(Clone, Copy, Debug)]
@@ -172,6 +172,22 @@ pub(crate) fn linear_hessian(a: &Lin, w: &Vector3<f64>, h: &mut LMat) {
     }
 }
 
+/// [`linear_hessian`] into the Euler-parameter rows and columns of the pair
+/// ([`crate::jet::EULER`]): the same entries, the same arithmetic.
+pub(crate) fn linear_hessian_euler(a: &Lin, w: &Vector3<f64>, hp: &mut SMatrix<f64, 8, 8>) {
+    for k in 0..2 {
+        if a.on[k] {
+            let m = quadratic_form(&a.s[k], w) * 2.0;
+            let o = 4 * k;
+            for i in 0..4 {
+                for j in 0..4 {
+                    hp[(o + i, o + j)] += m[(i, j)];
+                }
+            }
+        }
+    }
+}
+
 /// `c ∇²(aᵀb)` added into `h`.
 pub(crate) fn dot_hessian(a: &Lin, b: &Lin, c: f64, h: &mut LMat) {
     for k in 0..2 {
@@ -224,6 +240,43 @@ pub(crate) fn dot_hessian(a: &Lin, b: &Lin, c: f64, h: &mut LMat) {
     }
     linear_hessian(a, &(b.v * c), h);
     linear_hessian(b, &(a.v * c), h);
+}
+
+/// [`dot_hessian`] into the Euler-parameter rows and columns of the pair
+/// ([`crate::jet::EULER`]), for two directions (`t = 0` on both sides: no `r` terms, so the
+/// full Hessian is zero elsewhere): the same entries, added in the same order.
+pub(crate) fn dot_hessian_euler(a: &Lin, b: &Lin, c: f64, h: &mut SMatrix<f64, 8, 8>) {
+    if a.t != [0.0; 2] || b.t != [0.0; 2] {
+        // Not two directions: the full Hessian, restricted.
+        let mut full = LMat::zeros();
+        dot_hessian(a, b, c, &mut full);
+        for (x, &i) in super::EULER.iter().enumerate() {
+            for (y, &j) in super::EULER.iter().enumerate() {
+                h[(x, y)] += full[(i, j)];
+            }
+        }
+        return;
+    }
+    for k in 0..2 {
+        if !a.on[k] {
+            continue;
+        }
+        for l in 0..2 {
+            if !b.on[l] {
+                continue;
+            }
+            let (ok, ol) = (4 * k, 4 * l);
+            let pp = a.b[k].tr_mul(&b.b[l]) * c;
+            for i in 0..4 {
+                for j in 0..4 {
+                    h[(ok + i, ol + j)] += pp[(i, j)];
+                    h[(ol + j, ok + i)] += pp[(i, j)];
+                }
+            }
+        }
+    }
+    linear_hessian_euler(a, &(b.v * c), h);
+    linear_hessian_euler(b, &(a.v * c), h);
 }
 
 /// The joint frames of both sides as far as a joint's rows need them: origin difference

@@ -18,3 +18,5 @@ pub(crate) mod patch;
 pub(crate) mod release;
 pub(crate) mod rolling;
 pub(crate) mod stall;
+#[cfg(test)]
+mod values_tests;

@@ -7,6 +7,7 @@
 
 use crate::jet::{HessianSink, LMat};
 use crate::model::BodyId;
+use nalgebra::SMatrix;
 
 /// A symmetric matrix over `7 N` coordinates stored as dense 7 × 7 body blocks.
 #[derive(Clone, Debug, Default)]
@@ -116,6 +117,30 @@ impl HessianSink for BlockHessian {
     fn add_entry(&mut self, i: usize, j: usize, v: f64) {
         self.block(i / 7, j / 7)[7 * (i % 7) + j % 7] += v;
     }
+
+    /// The Euler-parameter entries only (4 × 4 of each 7 × 7 block), the blocks found in the
+    /// order of [`BlockHessian::add_block`]: the other entries would add `c · 0`, a signed
+    /// zero for a finite `c`, which changes no entry (a block entry starts at `+0` and sums
+    /// of finite terms are never `−0`), so the values are those of `add_block` to the last
+    /// bit. A `c` that is not finite takes the full block.
+    fn add_euler_block(&mut self, bodies: &[Option<BodyId>; 2], hp: &SMatrix<f64, 8, 8>, c: f64) {
+        if !c.is_finite() {
+            self.add_block(bodies, &crate::jet::euler_to_local(hp), c);
+            return;
+        }
+        for sa in 0..2 {
+            let Some(a) = bodies[sa] else { continue };
+            for sb in 0..2 {
+                let Some(b) = bodies[sb] else { continue };
+                let blk = self.block(a.0, b.0);
+                for i in 0..4 {
+                    for j in 0..4 {
+                        blk[7 * (3 + i) + 3 + j] += c * hp[(4 * sa + i, 4 * sb + j)];
+                    }
+                }
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -123,6 +148,42 @@ mod tests {
     use super::*;
     use crate::jet::NL;
     use nalgebra::DMatrix;
+
+    /// The Euler-parameter shortcut adds what the full block adds, bit for bit, on fresh and
+    /// on filled blocks (and takes the full block for a `c` that is not finite).
+    #[test]
+    fn euler_blocks_equal_full_blocks_bit_for_bit() {
+        let mut hp = SMatrix::<f64, 8, 8>::zeros();
+        for a in 0..8 {
+            for b in 0..8 {
+                hp[(a, b)] = ((a * 8 + b) as f64 * 0.37).sin() * if a == b { -1.0 } else { 1e-3 };
+            }
+        }
+        hp[(1, 2)] = -0.0;
+        let full = crate::jet::euler_to_local(&hp);
+        let mut filler = LMat::zeros();
+        for i in 0..NL {
+            for j in 0..NL {
+                filler[(i, j)] = ((i + 2 * j) as f64).cos();
+            }
+        }
+        for bodies in [[Some(BodyId(1)), Some(BodyId(0))], [Some(BodyId(2)), None]] {
+            for c in [1.0, -2.5, 1e-300, f64::INFINITY] {
+                let (mut x, mut y) = (BlockHessian::default(), BlockHessian::default());
+                x.add_block(&bodies, &full, c);
+                y.add_euler_block(&bodies, &hp, c);
+                x.add_block(&bodies, &filler, 0.5);
+                y.add_block(&bodies, &filler, 0.5);
+                x.add_block(&bodies, &full, c);
+                y.add_euler_block(&bodies, &hp, c);
+                assert_eq!(x.keys, y.keys);
+                for (p, q) in x.values.iter().zip(&y.values) {
+                    let same = p.iter().zip(q).all(|(u, v)| u.to_bits() == v.to_bits());
+                    assert!(same, "c = {c}");
+                }
+            }
+        }
+    }
 
     #[test]
     fn blocks_add_up_like_the_dense_matrix() {

@@ -217,6 +217,11 @@ impl Elimination {
                 continue;
             }
             let rmax = self.rmax[r];
+            // No entry of the row exceeds `rmax`: a row whose `rmax` cannot beat the best so
+            // far is not read (the same choice as reading it).
+            if best.is_some_and(|x| rmax <= x.2 * (1.0 + 1e-9)) {
+                continue;
+            }
             let (vals, mask) = self.on_body(r, b);
             for k in (0..7).filter(|k| mask & (1 << k) != 0) {
                 let a = vals[k].abs();
@@ -283,12 +288,32 @@ pub(crate) fn partition(
         count[r] += 1;
     }
     let mut rows: Vec<Vec<(usize, f64)>> = count.iter().map(|&k| Vec::with_capacity(k)).collect();
+    // Duplicates summed in the order they come, found through the position of each column in
+    // the row being filled (`pos`; the triplets come row by row, and a row met again later is
+    // mapped afresh): the sums a search of the row would make, without the search.
+    let mut pos = vec![u32::MAX; n];
+    let mut current = usize::MAX;
     for &(r, c, v) in entries {
         let a = v * row_scale[r] * scale[c];
-        match rows[r].iter_mut().find(|e| e.0 == c) {
-            Some(e) => e.1 += a,
-            None => rows[r].push((c, a)),
+        if r != current {
+            if let Some(row) = rows.get(current) {
+                row.iter().for_each(|e| pos[e.0] = u32::MAX);
+            }
+            current = r;
+            for (j, e) in rows[r].iter().enumerate() {
+                pos[e.0] = j as u32;
+            }
         }
+        match pos[c] {
+            u32::MAX => {
+                pos[c] = rows[r].len() as u32;
+                rows[r].push((c, a));
+            }
+            j => rows[r][j as usize].1 += a,
+        }
+    }
+    if let Some(row) = rows.get(current) {
+        row.iter().for_each(|e| pos[e.0] = u32::MAX);
     }
     for row in &mut rows {
         row.retain(|e| e.1 != 0.0);
@@ -313,7 +338,7 @@ pub(crate) fn partition(
         tol,
         dependent: Vec::new(),
         pivot_rows: Vec::new(),
-        pos: vec![u32::MAX; n],
+        pos,
         rmax: Vec::new(),
     };
     el.rmax = (0..m).map(|r| el.row_max(r)).collect();
@@ -344,11 +369,13 @@ pub(crate) fn partition(
     let (mut cands, mut entries) = (Vec::new(), Vec::new());
     for b in elimination_order(model) {
         let mut taken = 0;
+        // The rows on `b` once: a pivot at `b` leaves there the active ones among them
+        // (`Elimination::pivot`), which the search below skips when inactive.
+        cands.clear();
+        cands.extend_from_slice(&el.body_rows[b]);
+        cands.sort_unstable();
+        cands.dedup();
         while taken < 7 {
-            cands.clear();
-            cands.extend_from_slice(&el.body_rows[b]);
-            cands.sort_unstable();
-            cands.dedup();
             match el.best_pivot_at(&cands, THRESHOLD, b) {
                 Some((r, c)) => el.pivot(r, c),
                 None => break,

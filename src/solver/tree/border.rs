@@ -72,8 +72,10 @@ impl Border {
     }
 
     /// Forms `S = D − R T⁻¹ C` from the entry values at the front of `values` (`solve(x, lo,
-    /// hi)`: `x ← T⁻¹ x` where `x` is zero outside the positions `lo ..= hi`, so that the
-    /// caller's block solve may skip the nodes whose part of the result is zero) and factors
+    /// hi, need)`: `x ← T⁻¹ x` where `x` is zero outside the positions `lo ..= hi`, so that the
+    /// caller's block solve may skip the nodes whose part of the result is zero, and where only
+    /// the positions from `need` on are read: those `R` reaches, whose values the block solve
+    /// finishes before it reaches the nodes below, which it may leave undone) and factors
     /// it (LU with partial pivoting); `None` if singular. With `inertia` (a symmetric matrix), also the number of negative eigenvalues
     /// of `S` (LDLᵀ without pivoting of its symmetric part; `None` on a zero pivot): the
     /// border's share of the matrix's inertia (Haynsworth).
@@ -81,7 +83,7 @@ impl Border {
         &self,
         values: &mut [f64],
         piv: &mut [u16],
-        solve: impl Fn(&mut [f64], usize, usize),
+        solve: impl Fn(&mut [f64], usize, usize, usize),
         inertia: bool,
     ) -> Option<Option<usize>> {
         let k = self.size();
@@ -89,6 +91,16 @@ impl Border {
         let (vals, s) = values.split_at_mut(ne);
         s.iter_mut().for_each(|v| *v = 0.0);
         let mut col = vec![0.0; self.index.len()];
+        // The lowest tree position `R` reaches (a border row's entry in the tree): the solves
+        // below are read there and above only (none: `S = D`).
+        let need = self
+            .entries
+            .iter()
+            .filter(|&&(p, q)| {
+                self.index[p as usize] != u32::MAX && self.index[q as usize] == u32::MAX
+            })
+            .map(|&(_, q)| q as usize)
+            .min();
         for (b, &pb) in self.positions.iter().enumerate() {
             col.iter_mut().for_each(|v| *v = 0.0);
             // The column's tree entries lie in `lo ..= hi` (a contact or a loop row reaches
@@ -106,8 +118,8 @@ impl Border {
                     }
                 }
             }
-            if lo <= hi {
-                solve(&mut col, lo, hi);
+            if let Some(need) = need.filter(|_| lo <= hi) {
+                solve(&mut col, lo, hi, need);
             }
             for (e, &(p, q)) in self.entries.iter().enumerate() {
                 let (a, q) = (self.index[p as usize], q as usize);

@@ -214,17 +214,23 @@ impl TreeKkt {
                 let r = s.diag_at[i]..s.diag_at[i] + d * d;
                 factors[r.clone()].copy_from_slice(&values[r]);
             }
-            for a in 0..d {
-                let row = &values[s.diag_at[i] + a * d..s.diag_at[i] + a * d + d];
-                sums[at + a] += row.iter().map(|v| v.abs()).sum::<f64>();
+            let blk = &values[s.diag_at[i]..s.diag_at[i] + d * d];
+            let own = &mut sums[at..at + d];
+            for (a, row) in own.iter_mut().zip(blk.chunks_exact(d.max(1))) {
+                *a += row.iter().map(|v| v.abs()).sum::<f64>();
             }
-            if s.parent[i] != u32::MAX {
+            if s.parent[i] != u32::MAX && w > 0 {
+                // The same additions in the same order, on slices (the parent's unknowns come
+                // after the node's own in tree-space order).
                 let pa = s.at[s.parent[i] as usize];
-                for a in 0..d {
-                    for b in 0..w {
-                        let v = values[s.coup_at[i] + a * w + b].abs();
-                        sums[at + a] += v;
-                        sums[pa + b] += v;
+                let (head, tail) = sums.split_at_mut(pa);
+                let (own, up) = (&mut head[at..at + d], &mut tail[..w]);
+                let c = &values[s.coup_at[i]..s.coup_at[i] + d * w];
+                for (sa, crow) in own.iter_mut().zip(c.chunks_exact(w)) {
+                    for (sb, &x) in up.iter_mut().zip(crow) {
+                        let v = x.abs();
+                        *sa += v;
+                        *sb += v;
                     }
                 }
             }
@@ -278,7 +284,7 @@ impl TreeKkt {
         let got = s.border.factor(
             &mut border,
             &mut bpiv,
-            |x, lo, _| self.tree_solve_from(x, lu, lo),
+            |x, lo, _, need| self.tree_solve_from(x, lu, lo, need),
             !lu,
         );
         self.border = border;
@@ -292,13 +298,14 @@ impl TreeKkt {
 
     /// `x ← T⁻¹ x` over the tree part (tree-space order; the border untouched).
     fn tree_solve(&self, x: &mut [f64], lu: bool) {
-        self.tree_solve_from(x, lu, 0);
+        self.tree_solve_from(x, lu, 0, 0);
     }
 
     /// [`TreeKkt::tree_solve`] for an `x` that is zero before the tree-space position `lo`:
     /// the forward pass starts at the node holding `lo` (the nodes before it, leaves whose
-    /// right side is zero, would pass zeros on; the backward pass fills every node).
-    fn tree_solve_from(&self, x: &mut [f64], lu: bool, lo: usize) {
+    /// right side is zero, would pass zeros on); the backward pass (each node from its
+    /// parent) ends at the node holding `need`, below which `x` is not read.
+    fn tree_solve_from(&self, x: &mut [f64], lu: bool, lo: usize, need: usize) {
         let s = &self.shape;
         let nodes = s.at.len();
         let first = s.at.partition_point(|&a| a <= lo).saturating_sub(1);
@@ -321,7 +328,8 @@ impl TreeKkt {
             let c = &self.values[s.coup_at[i]..s.coup_at[i] + d * w];
             dense::sub_tr_mul(c, y, &mut tail[pa..pa + w], d, w);
         }
-        for i in (0..nodes).rev() {
+        let last = s.at.partition_point(|&a| a <= need).saturating_sub(1);
+        for i in (last..nodes).rev() {
             let p = s.parent[i];
             if p == u32::MAX {
                 continue;

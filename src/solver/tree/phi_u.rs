@@ -300,7 +300,7 @@ impl TreeLu {
             .factor(
                 &mut border,
                 &mut piv,
-                |x, _, hi| self.tree_solve_to(x, hi),
+                |x, _, hi, need| self.tree_solve_to(x, hi, need),
                 false,
             )
             .is_some();
@@ -314,7 +314,7 @@ impl TreeLu {
         let s = &*self.shape;
         let nodes = s.span.len();
         if !transpose {
-            self.solve_nodes(x, nodes);
+            self.solve_nodes(x, 0, nodes);
             return;
         }
         let (diag, rest) = self.vals.split_at(s.off0);
@@ -323,30 +323,33 @@ impl TreeLu {
             let (a, b) = s.span[i];
             let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];
             dense::lu_solve_transpose(blk, &self.piv[a..b], b - a, &mut x[a..b]);
-            for k in s.off_at[i]..s.off_at[i + 1] {
-                let (p, q) = s.off[k];
-                x[q as usize] -= off[k] * x[p as usize];
+            let r = s.off_at[i]..s.off_at[i + 1];
+            for (&(p, q), &v) in s.off[r.clone()].iter().zip(&off[r]) {
+                x[q as usize] -= v * x[p as usize];
             }
         }
     }
 
     /// `T x = r` for an `r` that is zero after the position `hi`: the nodes after the one
     /// holding `hi` have a zero right side and only later nodes' entries (last node first),
-    /// so their part of `x` is zero and the solve starts at that node.
-    fn tree_solve_to(&self, x: &mut [f64], hi: usize) {
+    /// so their part of `x` is zero and the solve starts at that node. Only the positions
+    /// from `need` on are solved for (a node's part needs only later nodes'): the solve ends
+    /// at the node holding `need`.
+    fn tree_solve_to(&self, x: &mut [f64], hi: usize, need: usize) {
         let s = &*self.shape;
-        self.solve_nodes(x, s.span.partition_point(|&(a, _)| a <= hi));
+        let first = s.span.partition_point(|&(_, b)| b <= need);
+        self.solve_nodes(x, first, s.span.partition_point(|&(a, _)| a <= hi));
     }
 
-    /// `T x = r` over the first `nodes` nodes, last first.
-    fn solve_nodes(&self, x: &mut [f64], nodes: usize) {
+    /// `T x = r` over the nodes `first .. nodes`, last first.
+    fn solve_nodes(&self, x: &mut [f64], first: usize, nodes: usize) {
         let s = &*self.shape;
         let (diag, rest) = self.vals.split_at(s.off0);
         let off = &rest[..s.border0 - s.off0];
-        for i in (0..nodes).rev() {
-            for k in s.off_at[i]..s.off_at[i + 1] {
-                let (p, q) = s.off[k];
-                x[p as usize] -= off[k] * x[q as usize];
+        for i in (first..nodes).rev() {
+            let r = s.off_at[i]..s.off_at[i + 1];
+            for (&(p, q), &v) in s.off[r.clone()].iter().zip(&off[r]) {
+                x[p as usize] -= v * x[q as usize];
             }
             let (a, b) = s.span[i];
             let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];

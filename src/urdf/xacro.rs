@@ -78,12 +78,11 @@ pub fn expand(
     // did not give: `xacro-rs` evaluates `<robot name="$(arg name)">` before it reads the
     // `<xacro:arg name="name" default="ur"/>` below it, which python xacro accepts.
     let text = std::fs::read_to_string(path).ok();
-    let mut args = args.to_vec();
-    for (name, default) in text
+    let doc = text
         .as_deref()
-        .map(literal_arg_defaults)
-        .unwrap_or_default()
-    {
+        .and_then(|t| roxmltree::Document::parse(t).ok());
+    let mut args = args.to_vec();
+    for (name, default) in doc.as_ref().map(literal_arg_defaults).unwrap_or_default() {
         if !args.iter().any(|(n, _)| *n == name) {
             args.push((name, default));
         }
@@ -102,8 +101,8 @@ pub fn expand(
     // byte (110,950 for Talos reduced's 111 kB: a third of its whole run). A file that
     // includes nothing and has no `$(…)` substitution or `load_yaml` (the only constructs
     // that read the file's folder or path) expands the same from its text, read at once.
-    match text.as_deref() {
-        Some(t) if self_contained(t) => processor.run_from_string(t),
+    match (text.as_deref(), &doc) {
+        (Some(t), Some(d)) if self_contained(d) => processor.run_from_string(t),
         _ => processor.run(path),
     }
     .map_err(|e| {
@@ -201,12 +200,9 @@ pub(crate) fn locate(e: Error, path: &Path) -> Error {
     }
 }
 
-/// Whether the xacro `text` expands without its path: no `include` element, and no `$(…)`
-/// or `load_yaml` in an attribute or a text (comments aside). `false` if it does not parse.
-fn self_contained(text: &str) -> bool {
-    let Ok(doc) = roxmltree::Document::parse(text) else {
-        return false;
-    };
+/// Whether the xacro document `doc` expands without its path: no `include` element, and no
+/// `$(…)` or `load_yaml` in an attribute or a text (comments aside).
+fn self_contained(doc: &roxmltree::Document) -> bool {
     let path_bound = |v: &str| v.contains("$(") || v.contains("load_yaml");
     doc.descendants().all(|n| {
         if n.is_element() {
@@ -217,12 +213,9 @@ fn self_contained(text: &str) -> bool {
     })
 }
 
-/// `(name, default)` of each `<xacro:arg>` child of the root of the xacro `text` whose
-/// default is literal (no `$(…)` or `${…}`).
-fn literal_arg_defaults(text: &str) -> Vec<(String, String)> {
-    let Ok(doc) = roxmltree::Document::parse(text) else {
-        return Vec::new();
-    };
+/// `(name, default)` of each `<xacro:arg>` child of the root of the xacro document `doc`
+/// whose default is literal (no `$(…)` or `${…}`).
+fn literal_arg_defaults(doc: &roxmltree::Document) -> Vec<(String, String)> {
     doc.root_element()
         .children()
         .filter(|n| {
@@ -239,7 +232,11 @@ fn literal_arg_defaults(text: &str) -> Vec<(String, String)> {
 
 #[cfg(test)]
 mod tests {
-    use super::self_contained;
+    /// [`super::self_contained`] of `text`; `false` if it does not parse (as `expand` then
+    /// expands from the path).
+    fn self_contained(text: &str) -> bool {
+        roxmltree::Document::parse(text).is_ok_and(|d| super::self_contained(&d))
+    }
 
     const NS: &str = r#"xmlns:xacro="http://www.ros.org/wiki/xacro""#;
 

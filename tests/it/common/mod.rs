@@ -10,6 +10,29 @@ use restpose::state::State;
 use restpose::urdf::{load_file, load_str, ImportOptions};
 use restpose::{Model, Options, Report};
 
+/// Runs `restpose analyze -q --json OUT ARGS…` in the folder `robots/DIR`: the exit code,
+/// standard error, and the result JSON (`Null` where none was written).
+pub(crate) fn analyze_in(dir: &str, args: &[String]) -> (Option<i32>, String, serde_json::Value) {
+    let tmp = tempfile::tempdir().unwrap();
+    let json = tmp.path().join("result.json");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_restpose"))
+        .current_dir(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("robots")
+                .join(dir),
+        )
+        .args(["analyze", "-q", "--json"])
+        .arg(&json)
+        .args(args)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    let v = std::fs::read_to_string(&json)
+        .map(|t| serde_json::from_str(&t).unwrap())
+        .unwrap_or(serde_json::Value::Null);
+    (out.status.code(), err, v)
+}
+
 /// Loads `robots/NAME.urdf`.
 pub(crate) fn robot(name: &str) -> Model {
     let path = format!("{}/robots/{name}.urdf", env!("CARGO_MANIFEST_DIR"));

@@ -8,25 +8,11 @@
 //! search there (module `inequality::release`), with the same message, in 9 iterations.
 //! Frictionless, the same fall has a rest (16 iterations, unchanged).
 
-use std::process::Command;
-
 fn analyze(friction: &str) -> (Option<i32>, String, serde_json::Value) {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/robots/a1");
-    let tmp = tempfile::tempdir().unwrap();
-    let json = tmp.path().join("a1.json");
-    let out = Command::new(env!("CARGO_BIN_EXE_restpose"))
-        .current_dir(dir)
-        .args(["analyze", "-q", "a1.urdf", "--load-steps", "1", "--json"])
-        .arg(&json)
-        .args(["--floating-base", "--ground", "--friction", friction])
-        .args(["--srdf", "a1.srdf", "--srdf-state", "standing"])
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    let v = std::fs::read_to_string(&json)
-        .map(|t| serde_json::from_str(&t).unwrap())
-        .unwrap_or(serde_json::Value::Null);
-    (out.status.code(), err, v)
+    let args = "a1.urdf --load-steps 1 --floating-base --ground --srdf a1.srdf --srdf-state standing --friction";
+    let mut args: Vec<String> = args.split(' ').map(String::from).collect();
+    args.push(friction.into());
+    crate::common::analyze_in("a1", &args)
 }
 
 #[test]

@@ -8,8 +8,6 @@
 //! sticking rows and the remedies, and both remedies work: started crouched (the servos'
 //! references as the start) it stands, and frictionless it rests flat.
 
-use std::process::Command;
-
 /// Hip π/4 and knee π/2 on joints "0".."7" (the crouch of scripts/pybullet_corpus.py), the
 /// abduction joints "8".."11" at 0, every servo 1000 N m/rad.
 fn crouch() -> Vec<String> {
@@ -32,30 +30,14 @@ fn flat() -> Vec<String> {
 }
 
 fn analyze(extra: &[String], friction: &str) -> (Option<i32>, String, serde_json::Value) {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/robots/vision60");
-    let tmp = tempfile::tempdir().unwrap();
-    let json = tmp.path().join("v60.json");
-    let out = Command::new(env!("CARGO_BIN_EXE_restpose"))
-        .current_dir(dir)
-        .args([
-            "analyze",
-            "-q",
-            "vision60.urdf",
-            "--load-steps",
-            "1",
-            "--json",
-        ])
-        .arg(&json)
-        .args(["--floating-base", "--ground", "--friction", friction])
-        .args(crouch())
-        .args(extra)
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    let v = std::fs::read_to_string(&json)
-        .map(|t| serde_json::from_str(&t).unwrap())
-        .unwrap_or(serde_json::Value::Null);
-    (out.status.code(), err, v)
+    let mut args: Vec<String> = "vision60.urdf --load-steps 1 --floating-base --ground --friction"
+        .split(' ')
+        .map(String::from)
+        .collect();
+    args.push(friction.into());
+    args.extend(crouch());
+    args.extend_from_slice(extra);
+    crate::common::analyze_in("vision60", &args)
 }
 
 #[test]

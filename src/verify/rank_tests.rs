@@ -57,16 +57,21 @@ fn models() -> (Vec<String>, Vec<String>) {
     (trees, loops)
 }
 
+/// The import options of the test set: a fixed base, then a floating one.
+fn bases() -> [ImportOptions; 2] {
+    let floating = ImportOptions {
+        floating_base: true,
+        ..Default::default()
+    };
+    [ImportOptions::default(), floating]
+}
+
 /// Same count as the partition wherever the fill-free route answers; it answers on every
 /// tree and gives up on closed loops.
 #[test]
 fn same_free_columns_as_the_sparse_partition() {
     let (trees, loops) = models();
-    let plain = ImportOptions::default();
-    let floating = ImportOptions {
-        floating_base: true,
-        ..Default::default()
-    };
+    let [plain, floating] = bases();
     for (k, t) in trees.iter().enumerate() {
         for o in [&plain, &floating] {
             let (fast, partition) = both(t, o);
@@ -166,11 +171,7 @@ fn same_partition(text: &str, options: &ImportOptions, locked: bool) -> bool {
 #[test]
 fn same_partition_as_the_sparse_partition() {
     let (trees, loops) = models();
-    let plain = ImportOptions::default();
-    let floating = ImportOptions {
-        floating_base: true,
-        ..Default::default()
-    };
+    let [plain, floating] = bases();
     for (k, t) in trees.iter().enumerate() {
         for o in [&plain, &floating] {
             assert!(same_partition(t, o, false), "tree {k}");

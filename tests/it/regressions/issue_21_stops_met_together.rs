@@ -89,7 +89,10 @@ fn solve_checked(search: StopSearch) -> (usize, usize) {
             .unwrap_or_else(|| panic!("{search:?}: knuckle{i} is not on its stop"));
         assert_eq!(limit.bound, "upper");
         let dv = torque(t, 0);
-        assert!(dv < -1.0, "{search:?}: knuckle{i}: the stop does not hold ({dv})");
+        assert!(
+            dv < -1.0,
+            "{search:?}: knuckle{i}: the stop does not hold ({dv})"
+        );
         assert_abs_diff_eq!(limit.effort, dv, epsilon = 1e-6 * dv.abs());
         let free = torque(t, 1);
         assert!(free.abs() <= 1e-6, "{search:?}: middle{i}: ∂V/∂θ = {free}");

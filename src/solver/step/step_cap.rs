@@ -5,9 +5,9 @@
 //! bounding box of the body origins.
 //!
 //! With the projected stop search (`StopSearch::Projected`, module `inequality::bend`) the
-//! rotations are limited in joint coordinates instead: every body's rotation relative to its
-//! tree parent, `|ω_b − ω_a|` (a revolute joint's `|θ̇|`), by `JOINT_STEP · max_step` rad
-//! (0.9 rad at the default `max_step`). Measured on the hanging corpus of example-robot-data
+//! rotations of a model with joint stops are limited in joint coordinates instead: every
+//! body's rotation relative to its tree parent, `|ω_b − ω_a|` (a revolute joint's `|θ̇|`), by
+//! `JOINT_STEP · max_step` rad (0.9 rad at the default `max_step`). Measured on the hanging corpus of example-robot-data
 //! (`--load-steps 1`): 0.3, 0.6, 0.9, 1.2 and 1.8 rad took 1,455, 994, 839, 857 and 993
 //! iterations, the per-body limit 922 (docs/method.md, "Meeting several stops in one step").
 
@@ -53,7 +53,7 @@ pub(crate) fn cap_step(
             rot = rot.max(x.abs());
         }
     }
-    if options.stop_search == StopSearch::Projected {
+    if options.stop_search == StopSearch::Projected && has_stops(sys, options) {
         // Per joint: `JOINT_STEP · max_step` rad (module docs).
         rot = sys.problem.retraction.joint_rotation(q, &dq) / JOINT_STEP;
     }
@@ -70,6 +70,18 @@ pub(crate) fn cap_step(
         capped,
         length: l,
     }
+}
+
+/// Whether the model has joint stops that the solve enforces (the projected stop search
+/// changes nothing on a model without them).
+fn has_stops(sys: &System, options: &Options) -> bool {
+    options.contact().enforces_limits()
+        && sys
+            .problem
+            .model
+            .joints
+            .iter()
+            .any(|j| !j.merged && j.kind.has_limits() && j.limits.is_some())
 }
 
 /// The diagonal of the bounding box of the body origins.

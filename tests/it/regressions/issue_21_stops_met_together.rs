@@ -26,8 +26,8 @@ fn stop(i: usize) -> f64 {
 }
 
 /// The hand: finger `i` has its knuckle limited to `[−3, stop(i)]`, its middle joint to
-/// `[−3, 3]`.
-fn hand() -> restpose::Model {
+/// `[−3, 3]`; with `limits` false every joint is continuous.
+fn hand(limits: bool) -> restpose::Model {
     let mut text = String::from("<robot name=\"hand\">\n  <link name=\"palm\"/>\n");
     let inertial = r#"<inertial><origin xyz="0.1 0 0"/><mass value="1"/>
     <inertia ixx="1e-3" ixy="0" ixz="0" iyy="4e-3" iyz="0" izz="4e-3"/></inertial>"#;
@@ -45,6 +45,9 @@ fn hand() -> restpose::Model {
             y = 0.1 * i as f64,
             upper = stop(i),
         );
+    }
+    if !limits {
+        text = text.replace("type=\"revolute\"", "type=\"continuous\"");
     }
     model_from(&(text + "</robot>"))
 }
@@ -66,7 +69,7 @@ fn torque(t: [f64; 2], k: usize) -> f64 {
 /// Solves the hand with `search`, checks the rest against the closed form and returns the
 /// iterations and active-set rounds it took.
 fn solve_checked(search: StopSearch) -> (usize, usize) {
-    let model = hand();
+    let model = hand(true);
     let options = Options {
         load_steps: 1,
         stop_search: search,
@@ -117,4 +120,30 @@ fn the_projected_search_meets_the_knuckle_stops_together() {
         iterations < cut_iterations,
         "projected: {iterations} iterations, cut {cut_iterations}"
     );
+}
+
+/// Without joint stops the projected search is the cut: the same iterates to the last bit.
+#[test]
+fn without_stops_the_projected_search_changes_nothing() {
+    let model = hand(false);
+    let run = |search| {
+        let options = Options {
+            load_steps: 1,
+            stop_search: search,
+            ..Default::default()
+        };
+        let (state, report) = restpose::solve(&model, &options).unwrap();
+        assert_eq!(report.termination, Termination::Converged, "{search:?}");
+        let history: Vec<(f64, f64)> = report
+            .history
+            .iter()
+            .map(|h| (h.potential_energy, h.gradient_norm))
+            .collect();
+        (state.q, history)
+    };
+    let (q_cut, h_cut) = run(StopSearch::Cut);
+    let (q, h) = run(StopSearch::Projected);
+    assert!(h_cut.len() > 2, "{h_cut:?}");
+    assert_eq!(h, h_cut);
+    assert_eq!(q, q_cut);
 }

@@ -269,10 +269,9 @@ impl System<'_> {
             let mut dvu = DVector::zeros(dof);
             for b in 0..dof {
                 self.tangent_column(part, eval, b, &mut dvu, z.column_mut(b).as_mut_slice());
-                self.work.hess.mul_add(
-                    z.column(b).as_slice(),
-                    wz.column_mut(b).as_mut_slice(),
-                );
+                self.work
+                    .hess
+                    .mul_add(z.column(b).as_slice(), wz.column_mut(b).as_mut_slice());
             }
             (z.tr_mul(&wz), Some(z))
         } else if self.backend != Backend::Dense {

@@ -115,7 +115,7 @@ impl System<'_> {
         let floor = 1e-6 * wdiag.iter().fold(0.0f64, |x, &y| x.max(y)) + 1e-12;
         // The pending body pair and its accumulated `Σ ρ g gᵀ` (column-major, as `LMat`).
         let mut pending: Option<[Option<BodyId>; 2]> = None;
-        let mut acc = LMat::zeros();
+        let mut acc = [0.0f64; NL * NL];
         for g in &plan.groups {
             let range = g.start..g.end;
             let group = &entries[range.clone()];
@@ -135,42 +135,30 @@ impl System<'_> {
             }
             if pending != Some(bodies) {
                 if let Some(b) = pending.take() {
-                    work.hess.add_block(&b, &acc, 1.0);
+                    work.hess.add_block(&b, &LMat::from_column_slice(&acc), 1.0);
                 }
                 pending = Some(bodies);
-                acc.fill(0.0);
+                acc = [0.0; NL * NL];
             }
             add_outer(&mut acc, &gv, rho);
         }
         if let Some(b) = pending.take() {
-            work.hess.add_block(&b, &acc, 1.0);
+            work.hess.add_block(&b, &LMat::from_column_slice(&acc), 1.0);
         }
         work.augment = Some(plan);
         work.wdiag = wdiag;
     }
 }
 
-/// `acc += g gᵀ ρ`, entry by entry as `(g_i g_j) ρ`, over the columns of `g`'s nonzero
-/// entries and, with `ρ` finite, over its nonzero rows: a zero `g_i` or `g_j` adds a signed
-/// zero, which changes no entry (they start at `+0`, and a sum of finite terms is never
-/// `−0`). A `ρ` that is not finite takes every row (`0 · ∞` is NaN).
-fn add_outer(acc: &mut LMat, g: &[f64; NL], rho: f64) {
-    let mut nz = [0usize; NL];
-    let mut k = 0;
-    for (i, &gi) in g.iter().enumerate() {
-        if gi != 0.0 || !rho.is_finite() {
-            nz[k] = i;
-            k += 1;
-        }
-    }
-    let nz = &nz[..k];
+/// `acc += g gᵀ ρ` (column-major `NL × NL`), entry by entry as `(g_i g_j) ρ`, over the columns
+/// of `g`'s nonzero entries: a zero `g_i` adds a signed zero, which changes no sum.
+fn add_outer(acc: &mut [f64; NL * NL], g: &[f64; NL], rho: f64) {
     for (j, &gj) in g.iter().enumerate() {
-        if gj == 0.0 {
-            continue;
-        }
-        let mut col = acc.column_mut(j);
-        for &i in nz {
-            col[i] += g[i] * gj * rho;
+        if gj != 0.0 {
+            let col = &mut acc[NL * j..NL * j + NL];
+            for (a, &gi) in col.iter_mut().zip(g) {
+                *a += gi * gj * rho;
+            }
         }
     }
 }

@@ -1,19 +1,16 @@
 //! Small dense kernels on row-major blocks (`a[i · d + j]`, `d ≤ 14` on the tree, any `d` for
 //! a border): symmetric `A = L D Lᵀ` without pivoting (its negative pivots count the negative
 //! eigenvalues: Sylvester's law of inertia) and `P A = L U` with partial pivoting, in place,
-//! with their solves. No allocation. The chain's constant sizes run on fixed-size arrays
-//! (module `fixed`: the same operations in the same order).
-
-use super::fixed;
+//! with their solves. No allocation.
 
 /// `A = L D Lᵀ` in place (`L` unit lower below the diagonal, `D` on it) of the symmetric `d × d`
 /// block `a` (both triangles given; the upper one is left as it was); the number of negative
 /// pivots, or `None` on a zero or non-finite pivot.
 pub(crate) fn ldlt(a: &mut [f64], d: usize) -> Option<usize> {
     match d {
-        13 => fixed::ldlt::<13>(a),
-        14 => fixed::ldlt::<14>(a),
-        8 => fixed::ldlt::<8>(a),
+        13 => ldlt_with(a, 13, &mut [0.0; 13]),
+        14 => ldlt_with(a, 14, &mut [0.0; 14]),
+        8 => ldlt_with(a, 8, &mut [0.0; 8]),
         _ => ldlt_any(a, d),
     }
 }
@@ -58,17 +55,57 @@ fn ldlt_with(a: &mut [f64], d: usize, v: &mut [f64]) -> Option<usize> {
 /// `x ← A⁻¹ x` for the factors of [`ldlt`]; `x` is `d × w` row-major (`w` right sides).
 pub(crate) fn ldlt_solve(f: &[f64], d: usize, x: &mut [f64], w: usize) {
     // Constant sizes of a chain's blocks, so that the loops are unrolled; with 7 right sides
-    // (the couplings `X_i`) each row of `x` is updated in registers (module `fixed`: each
-    // row taken into a local array, updated by the rows it depends on and stored once; every
-    // entry sees the same operations in the same order as in `ldlt_solve_impl`).
+    // (the couplings `X_i`) each row of `x` is updated in registers.
     match (d, w) {
-        (13, 1) => fixed::ldlt_solve::<13, 1>(f, x),
-        (13, 7) => fixed::ldlt_solve::<13, 7>(f, x),
-        (14, 1) => fixed::ldlt_solve::<14, 1>(f, x),
-        (14, 7) => fixed::ldlt_solve::<14, 7>(f, x),
-        (8, 1) => fixed::ldlt_solve::<8, 1>(f, x),
-        (8, 7) => fixed::ldlt_solve::<8, 7>(f, x),
+        (13, 1) => ldlt_solve_impl(f, 13, x, 1),
+        (13, 7) => ldlt_solve_rows::<7>(f, 13, x),
+        (14, 1) => ldlt_solve_impl(f, 14, x, 1),
+        (14, 7) => ldlt_solve_rows::<7>(f, 14, x),
+        (8, 1) => ldlt_solve_impl(f, 8, x, 1),
+        (8, 7) => ldlt_solve_rows::<7>(f, 8, x),
         _ => ldlt_solve_impl(f, d, x, w),
+    }
+}
+
+/// [`ldlt_solve`] for `W` right sides: each row of `x` is taken into a local array, updated
+/// by the rows it depends on and stored once. Every entry sees the same operations in the
+/// same order as in [`ldlt_solve_impl`] (the same results to the last bit).
+#[inline(always)]
+fn ldlt_solve_rows<const W: usize>(f: &[f64], d: usize, x: &mut [f64]) {
+    let (f, x) = (&f[..d * d], &mut x[..d * W]);
+    for i in 0..d {
+        let mut acc = [0.0; W];
+        acc.copy_from_slice(&x[i * W..i * W + W]);
+        for k in 0..i {
+            let l = f[i * d + k];
+            if l != 0.0 {
+                let xk = &x[k * W..k * W + W];
+                for c in 0..W {
+                    acc[c] -= l * xk[c];
+                }
+            }
+        }
+        x[i * W..i * W + W].copy_from_slice(&acc);
+    }
+    for i in (0..d).rev() {
+        let mut acc = [0.0; W];
+        acc.copy_from_slice(&x[i * W..i * W + W]);
+        // The diagonal scaling of row `i` (the middle pass of `ldlt_solve_impl`): no row
+        // reads row `i` between that pass and this point.
+        let p = 1.0 / f[i * d + i];
+        for a in acc.iter_mut() {
+            *a *= p;
+        }
+        for k in i + 1..d {
+            let l = f[k * d + i];
+            if l != 0.0 {
+                let xk = &x[k * W..k * W + W];
+                for c in 0..W {
+                    acc[c] -= l * xk[c];
+                }
+            }
+        }
+        x[i * W..i * W + W].copy_from_slice(&acc);
     }
 }
 
@@ -107,9 +144,9 @@ fn ldlt_solve_impl(f: &[f64], d: usize, x: &mut [f64], w: usize) {
 /// a zero or non-finite pivot.
 pub(crate) fn lu(a: &mut [f64], d: usize, piv: &mut [u16]) -> bool {
     match d {
-        6 => fixed::lu::<6>(a, piv),
-        7 => fixed::lu::<7>(a, piv),
-        13 => fixed::lu::<13>(a, piv),
+        6 => lu_impl(a, 6, piv),
+        7 => lu_impl(a, 7, piv),
+        13 => lu_impl(a, 13, piv),
         _ => lu_impl(a, d, piv),
     }
 }
@@ -153,9 +190,9 @@ fn lu_impl(a: &mut [f64], d: usize, piv: &mut [u16]) -> bool {
 /// `x ← A⁻¹ x` for the factors of [`lu`]; `x` is `d × w` row-major.
 pub(crate) fn lu_solve(f: &[f64], piv: &[u16], d: usize, x: &mut [f64], w: usize) {
     match (d, w) {
-        (6, 1) => fixed::lu_solve1::<6>(f, piv, x),
-        (7, 1) => fixed::lu_solve1::<7>(f, piv, x),
-        (13, 1) => fixed::lu_solve1::<13>(f, piv, x),
+        (6, 1) => lu_solve_impl(f, piv, 6, x, 1),
+        (7, 1) => lu_solve_impl(f, piv, 7, x, 1),
+        (13, 1) => lu_solve_impl(f, piv, 13, x, 1),
         (13, 7) => lu_solve_impl(f, piv, 13, x, 7),
         _ => lu_solve_impl(f, piv, d, x, w),
     }
@@ -201,8 +238,8 @@ fn lu_solve_impl(f: &[f64], piv: &[u16], d: usize, x: &mut [f64], w: usize) {
 /// `x ← A⁻ᵀ x` for the factors of [`lu`] (one right side): `Uᵀ y = x`, `Lᵀ z = y`, `x = Pᵀ z`.
 pub(crate) fn lu_solve_transpose(f: &[f64], piv: &[u16], d: usize, x: &mut [f64]) {
     match d {
-        6 => fixed::lu_solve_transpose::<6>(f, piv, x),
-        7 => fixed::lu_solve_transpose::<7>(f, piv, x),
+        6 => lu_solve_transpose_impl(f, piv, 6, x),
+        7 => lu_solve_transpose_impl(f, piv, 7, x),
         _ => lu_solve_transpose_impl(f, piv, d, x),
     }
 }
@@ -235,8 +272,8 @@ fn lu_solve_transpose_impl(f: &[f64], piv: &[u16], d: usize, x: &mut [f64]) {
 /// `out −= Cᵀ y` for a `d × w` row-major `C`.
 pub(crate) fn sub_tr_mul(c: &[f64], y: &[f64], out: &mut [f64], d: usize, w: usize) {
     match (d, w) {
-        (13, 7) => fixed::sub_tr_mul::<13, 7>(c, y, out),
-        (14, 7) => fixed::sub_tr_mul::<14, 7>(c, y, out),
+        (13, 7) => sub_tr_mul_impl(c, y, out, 13, 7),
+        (14, 7) => sub_tr_mul_impl(c, y, out, 14, 7),
         _ => sub_tr_mul_impl(c, y, out, d, w),
     }
 }
@@ -255,10 +292,9 @@ fn sub_tr_mul_impl(c: &[f64], y: &[f64], out: &mut [f64], d: usize, w: usize) {
 /// `x −= X y` for a `d × w` row-major `X`.
 pub(crate) fn sub_mul(xm: &[f64], y: &[f64], x: &mut [f64], d: usize, w: usize) {
     match (d, w) {
-        (13, 7) => fixed::sub_mul::<13, 7>(xm, y, x),
-        (14, 7) => fixed::sub_mul::<14, 7>(xm, y, x),
-        (13, 13) => fixed::sub_mul::<13, 13>(xm, y, x),
-        (14, 14) => fixed::sub_mul::<14, 14>(xm, y, x),
+        (13, 7) => sub_mul_impl(xm, y, x, 13, 7),
+        (14, 7) => sub_mul_impl(xm, y, x, 14, 7),
+        (13, 13) => sub_mul_impl(xm, y, x, 13, 13),
         _ => sub_mul_impl(xm, y, x, d, w),
     }
 }
@@ -279,10 +315,8 @@ fn sub_mul_impl(xm: &[f64], y: &[f64], x: &mut [f64], d: usize, w: usize) {
 /// row-major `C` and `X` (the Schur update of a parent's block).
 pub(crate) fn sub_tr_mul_block(c: &[f64], x: &[f64], p: &mut [f64], d: usize, w: usize, dp: usize) {
     match (d, w, dp) {
-        (13, 7, 13) => fixed::sub_tr_mul_block::<13, 7, 13>(c, x, p),
-        (14, 7, 14) => fixed::sub_tr_mul_block::<14, 7, 14>(c, x, p),
-        (13, 7, 14) => fixed::sub_tr_mul_block::<13, 7, 14>(c, x, p),
-        (14, 7, 13) => fixed::sub_tr_mul_block::<14, 7, 13>(c, x, p),
+        (13, 7, 13) => sub_tr_mul_block_impl(c, x, p, 13, 7, 13),
+        (14, 7, 14) => sub_tr_mul_block_impl(c, x, p, 14, 7, 14),
         _ => sub_tr_mul_block_impl(c, x, p, d, w, dp),
     }
 }
@@ -380,59 +414,6 @@ mod tests {
                 assert!((x[2 * i] - x0[i]).abs() < 1e-9);
                 assert!((x[2 * i + 1] - 2.0 * x0[i]).abs() < 1e-9);
                 assert!((t[i] - x0[i]).abs() < 1e-9);
-            }
-        }
-    }
-    /// The fixed-size kernels (module `fixed`) give the general loops' results bit for bit at
-    /// every constant size they serve, zeros in the factors included.
-    #[test]
-    fn fixed_size_kernels_equal_the_general_loops_bit_for_bit() {
-        let same = |p: &[f64], q: &[f64]| p.iter().zip(q).all(|(u, v)| u.to_bits() == v.to_bits());
-        for d in [6, 7, 8, 13, 14] {
-            let b = sample(d, 11 + d as u64);
-            let mut a = &b + b.transpose();
-            a[(d - 1, 0)] = 0.0;
-            a[(0, d - 1)] = 0.0;
-            let (mut f1, mut f2) = (row_major(&a), row_major(&a));
-            assert_eq!(ldlt(&mut f1, d), ldlt_any(&mut f2, d));
-            assert!(same(&f1, &f2), "ldlt {d}");
-            let m = row_major(&sample(d, 5 + d as u64));
-            let (mut l1, mut l2) = (m.clone(), m.clone());
-            let (mut p1, mut p2) = (vec![0u16; d], vec![0u16; d]);
-            assert_eq!(lu(&mut l1, d, &mut p1), lu_impl(&mut l2, d, &mut p2));
-            assert!(same(&l1, &l2) && p1 == p2, "lu {d}");
-            let x0: Vec<f64> = (0..d).map(|i| (i as f64 * 0.61).cos()).collect();
-            let (mut x1, mut x2) = (x0.clone(), x0.clone());
-            lu_solve(&l1, &p1, d, &mut x1, 1);
-            lu_solve_impl(&l1, &p1, d, &mut x2, 1);
-            assert!(same(&x1, &x2), "lu_solve {d}");
-            let (mut t1, mut t2) = (x0.clone(), x0.clone());
-            lu_solve_transpose(&l1, &p1, d, &mut t1);
-            lu_solve_transpose_impl(&l1, &p1, d, &mut t2);
-            assert!(same(&t1, &t2), "lu_solve_transpose {d}");
-            for w in [7, d] {
-                let c: Vec<f64> = (0..d * w).map(|i| (i as f64 * 0.29).sin()).collect();
-                let y: Vec<f64> = (0..d.max(w)).map(|i| (i as f64 * 0.43).cos()).collect();
-                let (mut o1, mut o2) = (y.clone(), y.clone());
-                sub_tr_mul(&c, &y, &mut o1, d, w);
-                sub_tr_mul_impl(&c, &y, &mut o2, d, w);
-                assert!(same(&o1, &o2), "sub_tr_mul {d} {w}");
-                let (mut o1, mut o2) = (y.clone(), y.clone());
-                sub_mul(&c, &y, &mut o1, d, w);
-                sub_mul_impl(&c, &y, &mut o2, d, w);
-                assert!(same(&o1, &o2), "sub_mul {d} {w}");
-                for dp in [13, 14] {
-                    if w > dp {
-                        continue;
-                    }
-                    let mut x = c.clone();
-                    x.reverse();
-                    let p0: Vec<f64> = (0..dp * dp).map(|i| (i as f64 * 0.17).sin()).collect();
-                    let (mut q1, mut q2) = (p0.clone(), p0.clone());
-                    sub_tr_mul_block(&c, &x, &mut q1, d, w, dp);
-                    sub_tr_mul_block_impl(&c, &x, &mut q2, d, w, dp);
-                    assert!(same(&q1, &q2), "sub_tr_mul_block {d} {w} {dp}");
-                }
             }
         }
     }

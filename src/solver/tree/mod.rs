@@ -5,7 +5,6 @@
 //! Schur complement.
 //!
 //! - `dense`: the block kernels (LDLᵀ without pivoting, LU with partial pivoting);
-//! - `fixed`: the same kernels at a chain's constant block sizes, on fixed-size arrays;
 //! - `phi_u`: `Φ_u` as a block upper triangular matrix (corrector, multipliers, tangent steps);
 //! - `shape`: the KKT matrix's nodes, parents, border and value slots, once per partition;
 //! - `kkt`: its block LDLᵀ (block LU as the fallback), solves and refinement;
@@ -16,7 +15,6 @@
 
 mod border;
 pub(crate) mod dense;
-mod fixed;
 pub(crate) mod kkt;
 pub(crate) mod phi_u;
 mod shape;

@@ -39,13 +39,14 @@ pub enum LinearAlgebra {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum StopSearch {
-    /// The step is cut where it first reaches a stop: one stop per iteration (default).
-    #[default]
+    /// The step is cut where it first reaches a stop: one stop per iteration.
     Cut,
     /// The projected search of bound-constrained Newton methods: each joint is held at a stop
     /// beyond the step length where it reaches it while the others move on, every stop the
     /// accepted step reaches joins the active set at once, and the step is limited in joint
-    /// coordinates (`3 max_step` rad per joint, module `step::step_cap`) instead of per body.
+    /// coordinates (`3 max_step` rad per joint, module `step::step_cap`) instead of per body
+    /// (default).
+    #[default]
     Projected,
 }
 
@@ -219,7 +220,7 @@ impl Default for Options {
             mu: ContactPolicy::default().mu,
             gap_tolerance: 1e-9,
             force_tolerance: 1e-9,
-            stop_search: StopSearch::Cut,
+            stop_search: StopSearch::Projected,
             progress: Progress::default(),
         }
     }

@@ -279,7 +279,14 @@ pub(crate) fn solve_round(
         mu[row] = out.eval.mu[k];
     }
     let mut chosen = None;
-    if !active.is_empty() && !out.part.redundant.is_empty() && out.released.is_empty() {
+    // The distribution among redundant stops and contacts, at a rest pose only: a round
+    // stopped by an inequality (blocked) or before it was stationary (released) is not one,
+    // and the active-set iteration goes on from it (as for the stability verdict above).
+    if !active.is_empty()
+        && !out.part.redundant.is_empty()
+        && out.released.is_empty()
+        && out.blocked.is_none()
+    {
         chosen = distribution::spread(
             model,
             &sys.problem.cons,

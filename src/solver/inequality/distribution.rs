@@ -180,8 +180,9 @@ fn null_space(
         for _ in 0..2 {
             for i in 0..j {
                 let c = y.column(i).dot(&y.column(j));
-                let prev = y.column(i).into_owned();
-                y.column_mut(j).axpy(-c, &prev, 1.0);
+                // Column `i` read in place (no copy per step; the same operations).
+                let (prev, mut col) = y.columns_range_pair_mut(i, j);
+                col.axpy(-c, &prev, 1.0);
             }
         }
         let n = y.column(j).norm();

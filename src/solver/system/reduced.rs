@@ -93,6 +93,44 @@ impl System<'_> {
         dq
     }
 
+    /// Column `b` of `Z` into `out` (zeroed, `n` long): [`System::tangent_step`] of the unit
+    /// step `e_b`, the same operations on the same numbers, without its allocations (`dvu`:
+    /// scratch of `dof` entries; the factors' solve in place in `out`'s rows of the dependent
+    /// coordinates' order, through a buffer of `rows` entries).
+    fn tangent_column(
+        &self,
+        part: &Partition,
+        eval: &Eval,
+        b: usize,
+        dvu: &mut DVector<f64>,
+        out: &mut [f64],
+    ) {
+        for (k, &c) in part.independent.iter().enumerate() {
+            dvu[k] = (if k == b { 1.0 } else { 0.0 }) * self.problem.scaling.columns[c];
+            out[c] = dvu[k];
+        }
+        if part.rows.is_empty() {
+            return;
+        }
+        let mut rhs = -eval.factors.phi_v_mul(dvu, part.rows.len());
+        let solved = match &eval.factors {
+            Factors::Sparse(f) => f.solve(rhs.as_mut_slice()),
+            Factors::Tree(f) => f.solve(rhs.as_mut_slice()),
+            Factors::Dense { .. } => match eval.factors.solve(&rhs) {
+                Some(du) => {
+                    rhs = du;
+                    true
+                }
+                None => false,
+            },
+        };
+        if solved {
+            for (k, &c) in part.dependent.iter().enumerate() {
+                out[c] = rhs[k];
+            }
+        }
+    }
+
     /// `Zᵀ y` for a covector `y` over all coordinates, in scaled independent coordinates:
     /// `S (y_v − Φ_vᵀ Φ_u⁻ᵀ y_u)`.
     pub(crate) fn tangent_transpose(
@@ -233,14 +271,12 @@ impl System<'_> {
             self.lagrangian_blocks(q, part, eval);
             let mut z = DMatrix::zeros(n, dof);
             let mut wz = DMatrix::zeros(n, dof);
+            let mut dvu = DVector::zeros(dof);
             for b in 0..dof {
-                let mut e = DVector::zeros(dof);
-                e[b] = 1.0;
-                let zx = self.tangent_step(part, eval, &e);
+                self.tangent_column(part, eval, b, &mut dvu, z.column_mut(b).as_mut_slice());
                 self.work
                     .hess
-                    .mul_add(zx.as_slice(), wz.column_mut(b).as_mut_slice());
-                z.set_column(b, &zx);
+                    .mul_add(z.column(b).as_slice(), wz.column_mut(b).as_mut_slice());
             }
             (z.tr_mul(&wz), Some(z))
         } else if self.backend != Backend::Dense {

@@ -225,7 +225,10 @@ impl System<'_> {
         if hess.keys.is_empty() {
             // A diagonal block per body and two per joint between bodies (the usual terms).
             let model = self.problem.model;
-            hess.reserve(model.bodies.len(), model.bodies.len() + 2 * model.joints.len());
+            hess.reserve(
+                model.bodies.len(),
+                model.bodies.len() + 2 * model.joints.len(),
+            );
         }
         let mut g = DVector::zeros(q.len());
         let _ = potential(

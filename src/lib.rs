@@ -45,5 +45,7 @@ pub mod view;
 
 pub use error::{Error, Result};
 pub use model::Model;
-pub use solver::{solve, solve_from, Limits, LinearAlgebra, Method, Options, Report, Termination};
+pub use solver::{
+    solve, solve_from, Limits, LinearAlgebra, Method, Options, Report, StopSearch, Termination,
+};
 pub use state::State;

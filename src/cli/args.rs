@@ -3,7 +3,7 @@
 //! `clap::ValueEnum` themselves (feature `cli`).
 
 use super::parse;
-use super::values::{Family, Friction, Limits, LinearAlgebra, Method};
+use super::values::{Family, Friction, Limits, LinearAlgebra, Method, StopSearch};
 use anyhow::{bail, Context};
 use clap::{Parser, Subcommand, ValueEnum};
 use restpose::solver::ContactPolicy;
@@ -301,6 +301,11 @@ pub(crate) struct AnalyzeArgs {
     #[arg(long, default_value_t = Options::default().load_steps, value_name = "N",
           value_parser = parse::load_steps)]
     pub(crate) load_steps: usize,
+    /// How a step that reaches joint stops is searched: cut where it reaches the first (one
+    /// stop per iteration), or projected (each joint held at a stop it reaches, the others
+    /// moving on; every stop reached joins at once). See docs/method.md, "The search path".
+    #[arg(long, value_enum, default_value_t = StopSearch::from(Options::default().stop_search))]
+    pub(crate) stop_search: StopSearch,
     /// Stop at an unstable stationary point instead of leaving it.
     #[arg(long)]
     pub(crate) allow_unstable: bool,
@@ -367,6 +372,7 @@ impl AnalyzeArgs {
             allow_unstable: self.allow_unstable,
             eigenvalues: self.eigenvalues,
             load_steps: self.load_steps,
+            stop_search: self.stop_search.into(),
             ..Default::default()
         }
         .with_contact(self.contact.policy())

@@ -5,7 +5,10 @@
 
 use restpose::generate::Family as LibFamily;
 use restpose::model::Friction as LibFriction;
-use restpose::{Limits as LibLimits, LinearAlgebra as LibLinearAlgebra, Method as LibMethod};
+use restpose::{
+    Limits as LibLimits, LinearAlgebra as LibLinearAlgebra, Method as LibMethod,
+    StopSearch as LibStopSearch,
+};
 
 /// A `ValueEnum` mirror of the library enum `$lib` with the same variants.
 macro_rules! mirror {
@@ -63,6 +66,18 @@ mirror! {
         /// kinematic tree (fixed-size blocks, no fill; loops as a small dense border). The sparse
         /// path where a partition does not fit a tree.
         Tree,
+    }
+}
+
+mirror! {
+    /// How a step that reaches joint stops is searched (`restpose::StopSearch`).
+    StopSearch = LibStopSearch {
+        /// Cut the step where it first reaches a stop: one stop per iteration (default).
+        Cut,
+        /// Hold each joint at a stop the step reaches while the others move on (the projected
+        /// search of bound-constrained Newton methods): every stop reached joins at once; the
+        /// step is limited per joint instead of per body.
+        Projected,
     }
 }
 

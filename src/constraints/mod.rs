@@ -298,9 +298,19 @@ impl Constraints {
         ) {
             phi[row] += c * s.v;
             if let Some(t) = jac {
+                // Zeros too: the sparsity pattern must not depend on `q`. A row on two bodies
+                // writes its 14 entries in one exact-size run (the same triplets, in the same
+                // order, as the loop below).
+                if let [Some(a), Some(b)] = bodies {
+                    let (a, b) = (7 * a.0, 7 * b.0);
+                    t.entries.extend((0..crate::jet::NL).map(|i| {
+                        let gi = if i < 7 { a + i } else { b + i - 7 };
+                        (row, gi, c * s.g[i])
+                    }));
+                    return;
+                }
                 for i in 0..crate::jet::NL {
                     if let Some(gi) = crate::jet::global_index(bodies, i) {
-                        // Zeros too: the sparsity pattern must not depend on `q`.
                         t.entries.push((row, gi, c * s.g[i]));
                     }
                 }

@@ -41,7 +41,9 @@ mod unbounded;
 pub(crate) mod valley;
 
 pub use mode_animation::mode_animation;
-pub use options::{ContactPolicy, Limits, LinearAlgebra, Method, Options, Progress, ProgressFn};
+pub use options::{
+    ContactPolicy, Limits, LinearAlgebra, Method, Options, Progress, ProgressFn, StopSearch,
+};
 pub use report::{
     ActiveLimit, Contact, ContactState, Diagnostics, FrictionVerdict, Iterate, Mode, Reaction,
     Report, Sizes, Stability, Termination, Timings, Verdict,

@@ -34,6 +34,21 @@ pub enum LinearAlgebra {
     Tree,
 }
 
+/// How a step that reaches inactive joint stops is searched (module
+/// `inequality::bend`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum StopSearch {
+    /// The step is cut where it first reaches a stop: one stop per iteration (default).
+    #[default]
+    Cut,
+    /// The projected search of bound-constrained Newton methods: each joint is held at a stop
+    /// beyond the step length where it reaches it while the others move on, every stop the
+    /// accepted step reaches joins the active set at once, and the step is limited in joint
+    /// coordinates (`3 max_step` rad per joint, module `step::step_cap`) instead of per body.
+    Projected,
+}
+
 /// Whether URDF joint limits hold the joints (part of a [`ContactPolicy`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -157,6 +172,8 @@ pub struct Options {
     /// Complementarity tolerance: a contact force or stop effort of the wrong sign smaller
     /// than this fraction of the largest applied force does not release it (default: 1e-9).
     pub force_tolerance: f64,
+    /// How a step that reaches inactive joint stops is searched (default: cut at the first).
+    pub stop_search: StopSearch,
     /// Called after every iteration (default: none).
     pub progress: Progress,
 }
@@ -202,6 +219,7 @@ impl Default for Options {
             mu: ContactPolicy::default().mu,
             gap_tolerance: 1e-9,
             force_tolerance: 1e-9,
+            stop_search: StopSearch::Cut,
             progress: Progress::default(),
         }
     }

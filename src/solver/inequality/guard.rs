@@ -23,7 +23,7 @@ use nalgebra::{DVector, Vector3};
 pub(crate) struct Guard<'m> {
     model: &'m Model,
     pub(crate) inactive: Vec<Unilateral>,
-    tol: f64,
+    pub(super) tol: f64,
     /// For contacts with an obstacle: its tangent plane `(o, n)` at the round's start. A step
     /// is guarded against that plane (a finite obstacle could otherwise be stepped through).
     planes: Vec<Option<(Vector3<f64>, Vector3<f64>)>>,
@@ -97,7 +97,7 @@ impl<'m> Guard<'m> {
 
     /// Dimensionless gap of inequality `k` (against an obstacle: to its plane of `planes`; a
     /// roll limit's margin after the inactive ones).
-    fn gap(&self, k: usize, q: &DVector<f64>, branches: &Branches) -> f64 {
+    pub(super) fn gap(&self, k: usize, q: &DVector<f64>, branches: &Branches) -> f64 {
         self.gap_sharing(k, q, branches, &mut None)
     }
 

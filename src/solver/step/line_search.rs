@@ -18,9 +18,11 @@
 //! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §3.1, §3.5.
 
 use crate::solver::inequality::active_set::Guard;
-use crate::solver::options::Options;
+use crate::solver::inequality::bend::Stop;
+use crate::solver::options::{Options, StopSearch};
 use crate::solver::partition::Partition;
 use crate::solver::report::Diagnostics;
+use crate::solver::step::retraction::independent_change;
 use crate::solver::system::{Eval, System};
 use nalgebra::DVector;
 
@@ -63,8 +65,19 @@ pub(crate) fn line_search(
     let (q, part, eval, dq, slope) = (line.q, line.part, line.eval, line.dq, line.slope);
     let f = eval.merit;
     let gnorm = eval.grad_v.amax();
+    // The inactive stops the path reaches, and where (module `inequality::bend`).
+    let stops = match (guard, options.stop_search) {
+        (Some(g), StopSearch::Projected) => g.stops(sys, q, dq),
+        _ => Vec::new(),
+    };
     for _ in 0..MAX_TRIALS {
-        let mut qt = sys.problem.retraction.point(q, dq, alpha);
+        let caps: Vec<Stop> = stops.iter().filter(|s| s.alpha < alpha).copied().collect();
+        let mut qt = if caps.is_empty() {
+            sys.problem.retraction.point(q, dq, alpha)
+        } else {
+            let bodies: Vec<(usize, f64)> = caps.iter().map(|s| (s.body, s.alpha)).collect();
+            sys.problem.retraction.bent_point(q, dq, alpha, &bodies)
+        };
         if sys
             .correct_from(
                 &mut qt,
@@ -113,7 +126,16 @@ pub(crate) fn line_search(
         let ft = et.merit;
         // Rounding error of V: relative to the size of its terms, not of their sum.
         let roundoff = 1e-12 * eval.energy.magnitude.max(et.energy.magnitude) + f64::MIN_POSITIVE;
-        let armijo = ft <= f + 1e-4 * alpha * slope;
+        // Along a bent path: Armijo on the change actually taken (the projected Armijo rule).
+        let armijo = if caps.is_empty() {
+            ft <= f + 1e-4 * alpha * slope
+        } else {
+            let columns = &sys.problem.scaling.columns;
+            let descent = eval
+                .grad_v
+                .dot(&independent_change(&part.independent, columns, q, &qt));
+            descent < 0.0 && ft <= f + 1e-4 * descent
+        };
         // (In a curved valley, flat with the gradient along the floor smaller: module
         // `valley`.)
         let flat = (ft - f).abs() <= roundoff
@@ -122,11 +144,12 @@ pub(crate) fn line_search(
                     .valley
                     .is_some_and(|v| v.closer(&eval.grad_v, &et.grad_v)));
         if ft.is_finite() && (armijo || flat) {
+            let reached = guard.map_or_else(Vec::new, |g| g.reached(sys, &caps, &qt));
             return Some(Trial {
                 q: qt,
                 eval: et,
                 alpha,
-                blocked: None,
+                blocked: (!reached.is_empty()).then_some(reached),
             });
         }
         // Quadratic interpolation of f along d, safeguarded.

@@ -38,6 +38,8 @@ pub(crate) struct Retraction {
     /// `(body, tree parent)`, every body once, a parent before its children (`None`: the
     /// world, for a body that no tree joint moves or one jointed to the world).
     order: Vec<(usize, Option<usize>)>,
+    /// The tree joint that moves each body relative to its tree parent.
+    via: Vec<Option<usize>>,
 }
 
 /// The rigid displacement `y ↦ A(r) y + t` of the world that a body has undergone.
@@ -50,11 +52,18 @@ impl Retraction {
         let mut parent: Vec<Option<usize>> = vec![None; n];
         let mut children: Vec<Vec<usize>> = vec![Vec::new(); n];
         let mut moved = vec![false; n];
-        for j in model.joints.iter().filter(|j| j.tree && !j.merged) {
+        let mut via = vec![None; n];
+        for (i, j) in model
+            .joints
+            .iter()
+            .enumerate()
+            .filter(|(_, j)| j.tree && !j.merged)
+        {
             let Some(c) = j.bodies[1] else { continue };
             if std::mem::replace(&mut moved[c.0], true) {
                 continue;
             }
+            via[c.0] = Some(i);
             parent[c.0] = j.bodies[0].map(|b| b.0);
             if let Some(p) = j.bodies[0] {
                 children[p.0].push(c.0);
@@ -72,7 +81,12 @@ impl Retraction {
         }
         // Not reached from a root (a cycle of tree edges cannot be built): its own twist.
         order.extend((0..n).filter(|&b| !seen[b]).map(|b| (b, None)));
-        Retraction { order }
+        Retraction { order, via }
+    }
+
+    /// The body that tree joint `joint` moves along the path (`None` for a loop-closing joint).
+    pub(crate) fn body_of(&self, joint: usize) -> Option<usize> {
+        self.via.iter().position(|&j| j == Some(joint))
     }
 
     /// Every body's tree parent (`None`: the world, or no tree joint moves it).
@@ -84,8 +98,36 @@ impl Retraction {
         parents
     }
 
+    /// The largest rotation rate of a body relative to its tree parent, `max_b |ω_b − ω_a|`
+    /// (for a revolute joint its rate `|θ̇|`): the step measured in joint coordinates.
+    pub(crate) fn joint_rotation(&self, q: &DVector<f64>, dq: &DVector<f64>) -> f64 {
+        self.order
+            .iter()
+            .map(|&(b, a)| {
+                let wb = angular_velocity(q, dq, b);
+                match a {
+                    Some(a) => (wb - angular_velocity(q, dq, a)).norm(),
+                    None => wb.norm(),
+                }
+            })
+            .fold(0.0, f64::max)
+    }
+
     /// The point at `alpha` along the tangent `dq` from `q` (module docs).
     pub(crate) fn point(&self, q: &DVector<f64>, dq: &DVector<f64>, alpha: f64) -> DVector<f64> {
+        self.bent_point(q, dq, alpha, &[])
+    }
+
+    /// [`Retraction::point`] with the relative motion of each body `b` of `caps` (`(b, α_b)`)
+    /// stopped at `min(α, α_b)`: its tree joint goes from `θ` to `θ + min(α, α_b) θ̇` (the
+    /// projected path of a joint stop, module `inequality::bend`); its children move on.
+    pub(crate) fn bent_point(
+        &self,
+        q: &DVector<f64>,
+        dq: &DVector<f64>,
+        alpha: f64,
+        caps: &[(usize, f64)],
+    ) -> DVector<f64> {
         let mut out = q.clone();
         let identity: Displacement = (Vector4::new(1.0, 0.0, 0.0, 0.0), Vector3::zeros());
         let mut moved = vec![identity; q.len() / 7];
@@ -103,7 +145,11 @@ impl Retraction {
                 }
                 None => (angular_velocity(q, dq, b), position(dq, b), identity),
             };
-            let (re, shift) = screw(&(wr * alpha), &(w * alpha));
+            let ab = caps
+                .iter()
+                .filter(|c| c.0 == b)
+                .fold(alpha, |a, c| a.min(c.1));
+            let (re, shift) = screw(&(wr * ab), &(w * ab));
             // E_b(y) = x_b + A(r_e)(y − x_b) + shift, M_b = M_a ∘ E_b.
             let te = xb - rotation(&re) * xb + shift;
             let rb = compose(&ra, &re);

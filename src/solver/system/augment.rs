@@ -102,7 +102,9 @@ impl System<'_> {
             _ => AugmentPlan::new(part, m, entries),
         };
         let columns = &self.problem.scaling.columns;
-        let mut wdiag = vec![0.0f64; n];
+        let mut wdiag = std::mem::take(&mut work.wdiag);
+        wdiag.clear();
+        wdiag.resize(n, 0.0);
         for (&(a, b), blk) in work.hess.keys.iter().zip(&work.hess.values) {
             if a == b {
                 for i in 0..7 {
@@ -144,6 +146,7 @@ impl System<'_> {
             work.hess.add_block(&b, &LMat::from_column_slice(&acc), 1.0);
         }
         work.augment = Some(plan);
+        work.wdiag = wdiag;
     }
 }
 

@@ -218,7 +218,8 @@ impl System<'_> {
         w
     }
 
-    /// `W` into the block-sparse scratch.
+    /// `W` into the block-sparse scratch (the gradient, which is not needed, and the weights
+    /// into scratch vectors reused from one assembly to the next).
     pub(super) fn lagrangian_blocks(&mut self, q: &DVector<f64>, part: &Partition, eval: &Eval) {
         let mut hess = std::mem::take(&mut self.work.hess);
         hess.clear();
@@ -230,7 +231,8 @@ impl System<'_> {
                 model.bodies.len() + 2 * model.joints.len(),
             );
         }
-        let mut g = DVector::zeros(q.len());
+        let mut g = std::mem::take(&mut self.work.grad);
+        refill(&mut g, q.len());
         let _ = potential(
             self.problem.model,
             &self.problem.cons.branches,
@@ -238,9 +240,16 @@ impl System<'_> {
             &mut g,
             Some(&mut hess as &mut dyn HessianSink),
         );
+        self.work.grad = g;
+        let mut weights = std::mem::take(&mut self.work.weights);
+        refill(&mut weights, self.problem.cons.len());
+        for (k, &row) in part.rows.iter().enumerate() {
+            weights[row] = -eval.mu[k];
+        }
         self.problem
             .cons
-            .add_hessian(self.problem.model, q, &self.weights(part, eval), &mut hess);
+            .add_hessian(self.problem.model, q, &weights, &mut hess);
+        self.work.weights = weights;
         self.work.hess = hess;
     }
 
@@ -318,5 +327,14 @@ impl System<'_> {
         let mut wzx = DVector::zeros(zx.len());
         self.work.hess.mul_add(zx.as_slice(), wzx.as_mut_slice());
         self.tangent_transpose(part, eval, &wzx)
+    }
+}
+
+/// `v` as `len` zeros, in place when it has that length already.
+fn refill(v: &mut DVector<f64>, len: usize) {
+    if v.len() == len {
+        v.fill(0.0);
+    } else {
+        *v = DVector::zeros(len);
     }
 }

@@ -34,6 +34,12 @@ pub(crate) struct Workspace {
     pub(crate) hess: BlockHessian,
     /// The rows of the augmentation of `W` under the last partition (module `augment`).
     pub(crate) augment: Option<AugmentPlan>,
+    /// Scratch of each assembly of `W` (module `reduced`, `augment`): the energy gradient
+    /// that comes with its Hessian, the multiplier weights over all rows, `W`'s scaled
+    /// diagonal.
+    pub(crate) grad: DVector<f64>,
+    pub(crate) weights: DVector<f64>,
+    pub(crate) wdiag: Vec<f64>,
 }
 
 impl Workspace {
@@ -51,6 +57,9 @@ impl Workspace {
             tree_kkt_refused: None,
             hess: BlockHessian::default(),
             augment: None,
+            grad: DVector::zeros(0),
+            weights: DVector::zeros(0),
+            wdiag: Vec::new(),
         }
     }
 }

@@ -13,6 +13,12 @@
 //! A column of `C` reaches one or two bodies (a loop or contact row): its solve `T⁻¹ c` is
 //! zero outside the nodes it can reach from there, and the caller's block solve starts at the
 //! column's first (or last) tree entry instead of the end of the tree.
+//!
+//! A ladder (a loop per rung) borders 7 pivots of `Φ_u` and 14 KKT unknowns per rung, above
+//! the limits of `phi_u` and `shape` from 10 rungs: it takes the sparse factors. Its `S` is
+//! banded (bandwidth 7 for `Φ_u`, about 23 for the KKT matrix, measured up to 100 rungs), but
+//! stored dense here and formed with solves that each run down to the lowest position any
+//! border row reaches, `O(k N)` (docs/benchmarks-history.md, session 25, h/ladder).
 
 use super::dense;
 

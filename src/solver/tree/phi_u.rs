@@ -19,6 +19,7 @@
 
 use super::border::Border;
 use super::dense;
+use super::shape::FIRST;
 use crate::solver::partition::Partition;
 use std::sync::Arc;
 
@@ -55,8 +56,11 @@ pub(crate) struct TreeSplit {
     id: usize,
     triplets: usize,
     shape: Arc<Shape>,
-    /// Where each Jacobian triplet goes in the factor buffer (the last slot: nowhere).
+    /// Where each Jacobian triplet goes in the factor buffer (the last slot: nowhere), with
+    /// [`FIRST`] set on the first triplet to reach its slot.
     slots: Vec<u32>,
+    /// The slots that no triplet reaches.
+    bare: Vec<u32>,
     pool: Vec<Arc<TreeLu>>,
 }
 
@@ -208,12 +212,24 @@ impl TreeSplit {
             slots[t as usize] = (v0 + k) as u32;
         }
         // The triplets no block holds go to the spare last slot.
-        let spare = u32::try_from(len - 1).ok()?;
+        let spare = u32::try_from(len - 1).ok().filter(|&s| s < FIRST)?;
         for s in &mut slots {
             if *s == u32::MAX {
                 *s = spare;
             }
         }
+        // The first triplet to reach a slot stores its value, the others add theirs; the
+        // slots no triplet reaches (zeros of the diagonal blocks, factored in place) are
+        // zeroed by each factorization: no pass over the whole buffer.
+        let mut reached = vec![false; len];
+        for s in &mut slots {
+            let at = *s as usize;
+            if !reached[at] {
+                reached[at] = true;
+                *s |= FIRST;
+            }
+        }
+        let bare = (0..len as u32).filter(|&k| !reached[k as usize]).collect();
         Some(TreeSplit {
             id: part.id,
             triplets: entries.len(),
@@ -231,6 +247,7 @@ impl TreeSplit {
                 len,
             }),
             slots,
+            bare,
             pool: Vec::new(),
         })
     }
@@ -258,12 +275,20 @@ impl TreeSplit {
             }),
         };
         if let Some(f) = Arc::get_mut(&mut lu) {
-            // One pass, no branch: every triplet adds into its slot (in the triplets' order,
-            // so the sums are those of a block-by-block scatter).
-            f.vals.iter_mut().for_each(|v| *v = 0.0);
+            // One pass: every triplet reaches its slot in the triplets' order, the first
+            // storing `0 + v` and the others adding (the sums of zeroing first and adding, so
+            // those of a block-by-block scatter); the slots no triplet reaches are zeroed.
             let vals = &mut f.vals[..];
+            for &at in &self.bare {
+                vals[at as usize] = 0.0;
+            }
             for (&slot, e) in self.slots.iter().zip(entries) {
-                vals[slot as usize] += e.2;
+                let at = &mut vals[(slot & !FIRST) as usize];
+                if slot & FIRST != 0 {
+                    *at = 0.0 + e.2;
+                } else {
+                    *at += e.2;
+                }
             }
             f.ok = f.factor_blocks();
             f.watch = watch;

@@ -186,3 +186,46 @@ fn tree_solves_match_the_sparse_ones() {
         );
     }
 }
+
+/// A factor buffer of `Φ_u` reused from the pool (the factors of another point in place)
+/// gives the multipliers and steps of a fresh buffer bit for bit: every slot is stored anew
+/// by its first triplet or zeroed (module `phi_u`), on trees, with locks and with a border.
+#[test]
+fn reused_phi_u_buffers_equal_fresh_ones_bit_for_bit() {
+    let bits = |a: &DVector<f64>, b: &DVector<f64>| {
+        a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+    };
+    for (name, model, locks) in cases() {
+        let q0 = crate::solver::initial_state(&model).q;
+        let q = crate::solver::assemble_only(&model, q0, &mut Default::default(), &[])
+            .expect("assembles");
+        let mut used = System::new(&model, Constraints::new(&model, &locks), Backend::Tree);
+        let part = used.partition(&q);
+        let mut q = q;
+        used.correct(&mut q, &part, 1e-12, 20)
+            .unwrap_or_else(|_| panic!("{name}: corrector"));
+        // Another point under the same partition, factored first and dropped: its buffer
+        // returns to the pool and takes the factors at `q`.
+        let e0 = used.evaluate(&q, &part).expect("evaluates");
+        let dv = DVector::from_fn(part.independent.len(), |i, _| (i as f64 + 0.5).sin());
+        let mut other = &q + used.tangent_step(&part, &e0, &dv) * 0.2;
+        used.correct(&mut other, &part, 1e-12, 20)
+            .unwrap_or_else(|_| panic!("{name}: corrector at the other point"));
+        drop(e0);
+        drop(
+            used.evaluate(&other, &part)
+                .expect("evaluates the other point"),
+        );
+        let reused = used.evaluate(&q, &part).expect("evaluates again");
+        let mut fresh_sys = System::new(&model, Constraints::new(&model, &locks), Backend::Tree);
+        let fresh = fresh_sys.evaluate(&q, &part).expect("evaluates fresh");
+        assert!(matches!(reused.factors, Factors::Tree(_)), "{name}");
+        assert!(bits(&reused.mu, &fresh.mu), "{name}: μ");
+        assert!(bits(&reused.grad_v, &fresh.grad_v), "{name}: ∇f");
+        let (zr, zf) = (
+            used.tangent_step(&part, &reused, &dv),
+            fresh_sys.tangent_step(&part, &fresh, &dv),
+        );
+        assert!(bits(&zr, &zf), "{name}: Z δv");
+    }
+}

@@ -17,6 +17,7 @@ mod issue_21_newton_along_the_path;
 mod issue_21_sparse_chart_fold;
 mod issue_21_stand_from_reference;
 mod issue_21_stops_leave_together;
+mod issue_21_stops_met_together;
 mod issue_21_verify_forces_and_stability;
 mod issue_21_vision60_flat;
 mod issue_22_off_the_ramp;

@@ -87,8 +87,12 @@ pub(crate) struct Constraints {
 impl Constraints {
     /// Builds the rows of `model` plus the locks `(joint, dof, value)`.
     pub(crate) fn new(model: &Model, locks: &[(JointId, usize, f64)]) -> Self {
-        let mut blocks = Vec::new();
-        let mut length_power = Vec::new();
+        // One block per joint, body and lock; about six rows per joint and one per body.
+        let mut blocks = Vec::with_capacity(
+            model.joints.len() + model.bodies.len() + locks.len() + model.mimics.len(),
+        );
+        let mut length_power =
+            Vec::with_capacity(6 * model.joints.len() + model.bodies.len() + locks.len());
         let mut len = 0;
         let mut push = |kind: BlockKind, count: usize, blocks: &mut Vec<Block>| {
             blocks.push(Block { kind, first: len });

@@ -47,6 +47,31 @@ pub(crate) fn guard_system_energy(
     Ok(Some((e.total, g)))
 }
 
+/// [`guard_system_energy`] where the rows of `sys` were evaluated without their derivatives
+/// (`System::residual` at `state.q`): `q`, `Φ(q)`, `V(q)` and `∇V(q)` finite.
+pub(crate) fn guard_values_energy(
+    sys: &System,
+    state: &State,
+    at: &str,
+) -> Result<Option<(f64, DVector<f64>)>> {
+    let model = sys.problem.model;
+    finite_coordinates(model, state, at)?;
+    finite_rows(
+        model,
+        &sys.problem.cons,
+        &sys.work.phi,
+        &Triplets::default(),
+        at,
+    )?;
+    let q = &state.q;
+    let mut g = DVector::zeros(q.len());
+    let Some(e) = crate::forces::potential(model, &state.branches, q, &mut g, None) else {
+        return Ok(None);
+    };
+    crate::forces::finite::check(model, &state.branches, q, e.total, &g, at)?;
+    Ok(Some((e.total, g)))
+}
+
 fn finite_coordinates(model: &Model, state: &State, at: &str) -> Result<()> {
     let q = &state.q;
     if q.iter().any(|x| !x.is_finite()) {

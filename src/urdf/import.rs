@@ -138,7 +138,7 @@ pub(super) fn import(
     }
 
     // Links and named frames.
-    let mut link_in = Vec::new();
+    let mut link_in = Vec::with_capacity(link_nodes.len());
     let mut link_index: NameMap<String, usize> = NameMap::default();
     link_index.reserve(link_nodes.len());
     for &n in &link_nodes {
@@ -171,7 +171,7 @@ pub(super) fn import(
     }
 
     // The joint graph, URDF and Drake joints first.
-    let mut edges: Vec<Edge> = Vec::new();
+    let mut edges: Vec<Edge> = Vec::with_capacity(joint_nodes.len() + loop_nodes.len());
     for &n in &joint_nodes {
         edges.push(edges::urdf_joint(&src, n, &frames, &mut warnings)?);
     }
@@ -301,7 +301,7 @@ pub(super) fn import(
     // Joints, in document order by kind of element.
     let mut auto_child = Vec::new();
     // URDF joints (for their <mimic>), by id.
-    let mut urdf_joints: Vec<(JointId, Node)> = Vec::new();
+    let mut urdf_joints: Vec<(JointId, Node)> = Vec::with_capacity(joint_nodes.len());
     for (k, e) in edges.into_iter().enumerate() {
         let place = |l: Option<usize>| {
             l.map_or((None, Isometry3::identity()), |l| {

@@ -7,6 +7,12 @@
 //! a count), computed by the same pivots body by body where the elimination has no fill
 //! between bodies (module `rank`: every tree), and on the dense path that of
 //! [`super::balance`].
+//!
+//! On a tree of joints whose rows are independent wherever they hold ([`tree_dof`]) the count
+//! needs no Jacobian: ordered leaves to root, `Φ_q` is block triangular, each body's block
+//! (its normalization and the rows of the joint to its parent, on its own 7 coordinates) has
+//! full row rank, so `rank Φ_q = m` and the degrees of freedom are `n − m`. There the rows
+//! are evaluated without their derivatives (for the assembly test and the guard).
 
 use super::{assemble, balance, sparse_path};
 use crate::constraints::Constraints;
@@ -58,11 +64,27 @@ pub fn check(model: &Model) -> ModelCheck {
 /// What the assembly reports, [`Error::ForceTableOutOfRange`] (or another undefined term) if
 /// the energy cannot be evaluated at the assembled guess.
 fn sparse_dof(model: &Model, start: State, cons: Constraints) -> Result<usize> {
+    let structural = tree_dof(model, &cons, start.q.len());
     let mut sys = System::new(
         model,
         cons.on_branches(start.branches.clone()),
         Backend::Sparse,
     );
+    if let Some(dof) = structural {
+        // `Φ` alone; the rest of this function where the start does not assemble.
+        sys.residual(&start.q);
+        if sys.dimensionless_residual() <= Options::default().constraint_tolerance {
+            let energy = crate::solver::finite::guard_values_energy(
+                &sys,
+                &start,
+                "the assembled initial guess",
+            )?;
+            return match energy {
+                Some(_) => Ok(dof),
+                None => Err(undefined(model, &start)),
+            };
+        }
+    }
     // `Φ` with the Jacobian (the same values to the last bit): at an assembled start the
     // guard and the count below use these triplets as they are.
     sys.triplets(&start.q);
@@ -82,14 +104,7 @@ fn sparse_dof(model: &Model, start: State, cons: Constraints) -> Result<usize> {
         "the assembled initial guess",
     )?;
     if energy.is_none() {
-        return Err(
-            crate::forces::undefined_term(model, &state.branches, &state.q).unwrap_or(
-                Error::SingularPartition {
-                    at: "the assembled initial guess".into(),
-                    rows: 0,
-                },
-            ),
-        );
+        return Err(undefined(model, &state));
     }
     // Closed loops and mimics couple bodies beyond a joint's two: their elimination has fill
     // between bodies, where the fill-free route would give up; the partition counts them.
@@ -111,4 +126,44 @@ fn sparse_dof(model: &Model, start: State, cons: Constraints) -> Result<usize> {
         Some(free) => free,
         None => sys.partition(&state.q).independent.len(),
     })
+}
+
+/// The error of an energy undefined at the assembled initial guess `state`.
+fn undefined(model: &Model, state: &State) -> Error {
+    crate::forces::undefined_term(model, &state.branches, &state.q).unwrap_or(
+        Error::SingularPartition {
+            at: "the assembled initial guess".into(),
+            rows: 0,
+        },
+    )
+}
+
+/// `n − m`, the degrees of freedom of the `n` coordinates under the rows `cons`, where every
+/// row is independent of the others wherever they hold: a tree (no closed loop, mimic or
+/// lock) of joints whose rows on the body they lead to have full row rank with its
+/// normalization at every configuration (revolute, continuous, prismatic, fixed, spherical,
+/// floating: a point and up to two axes held on a rigid frame). `None` otherwise (a distance
+/// of zero length, an axis that may become parallel to a line, a lock on a coordinate of a
+/// floating joint's rotation: rows that can be dependent), where the elimination counts.
+pub(super) fn tree_dof(model: &Model, cons: &Constraints, n: usize) -> Option<usize> {
+    use crate::model::JointKind as K;
+    let independent = model.joints.iter().all(|j| {
+        j.merged
+            || (j.bodies.iter().any(Option::is_some)
+                && matches!(
+                    j.kind,
+                    K::Revolute
+                        | K::Continuous
+                        | K::Prismatic
+                        | K::Fixed
+                        | K::Spherical
+                        | K::Floating
+                ))
+    });
+    let tree = !super::coupled(model) && crate::solver::lock_values(model).is_empty();
+    if independent && tree {
+        n.checked_sub(cons.len())
+    } else {
+        None
+    }
 }

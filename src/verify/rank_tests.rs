@@ -84,6 +84,44 @@ fn same_free_columns_as_the_sparse_partition() {
     }
 }
 
+/// The structural count of `check` (`n − m` on trees of joints with independent rows) is the
+/// partition's wherever it answers; it answers on the chains, the rope and the floating
+/// bases, not on closed loops or with a lock, and `check` reports it.
+#[test]
+fn structural_count_is_the_partition_count() {
+    let (trees, loops) = models();
+    let [plain, floating] = bases();
+    let structural = |t: &str, o: &ImportOptions| {
+        let model = load_str(t, "m.urdf", o).unwrap().model;
+        let cons = Constraints::new(&model, &crate::solver::lock_values(&model));
+        let n = crate::solver::initial_state(&model).q.len();
+        let dof = super::super::initial_guess::tree_dof(&model, &cons, n);
+        (dof, super::super::check(&model).dof)
+    };
+    let mut answered = 0;
+    for (k, t) in trees.iter().enumerate() {
+        for o in [&plain, &floating] {
+            let (dof, checked) = structural(t, o);
+            let (_, partition) = both(t, o);
+            assert!(dof.is_none_or(|d| d == partition), "tree {k}");
+            assert_eq!(checked, Some(partition), "tree {k}");
+            answered += usize::from(dof.is_some());
+        }
+    }
+    assert!(answered >= 16, "{answered}");
+    for k in [1, 7, 8, 9, 10, 11] {
+        assert!(structural(&trees[k], &plain).0.is_some(), "tree {k}");
+    }
+    for (k, t) in loops.iter().enumerate() {
+        assert_eq!(structural(t, &plain).0, None, "loop {k}");
+    }
+    let locked = ImportOptions {
+        locks: vec![("joint3".to_string(), 0, None)],
+        ..Default::default()
+    };
+    assert_eq!(structural(&trees[8], &locked).0, None);
+}
+
 /// Lock rows (on the joint's own body) and a redundant lock: the same count as the
 /// partition, the redundant row found as there.
 #[test]

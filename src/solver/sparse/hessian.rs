@@ -61,6 +61,14 @@ impl BlockHessian {
         }
     }
 
+    /// Room for `blocks` blocks over `bodies` row bodies before the first are added: a large
+    /// model's blocks without the regrowth copies (a hint; more still fit).
+    pub(crate) fn reserve(&mut self, bodies: usize, blocks: usize) {
+        self.index.reserve(bodies);
+        self.keys.reserve(blocks);
+        self.values.reserve(blocks);
+    }
+
     /// Sets every block to zero, keeping the structure.
     pub(crate) fn clear(&mut self) {
         self.values.iter_mut().for_each(|b| *b = [0.0; 49]);

@@ -223,6 +223,14 @@ impl System<'_> {
     pub(super) fn lagrangian_blocks(&mut self, q: &DVector<f64>, part: &Partition, eval: &Eval) {
         let mut hess = std::mem::take(&mut self.work.hess);
         hess.clear();
+        if hess.keys.is_empty() {
+            // A diagonal block per body and two per joint between bodies (the usual terms).
+            let model = self.problem.model;
+            hess.reserve(
+                model.bodies.len(),
+                model.bodies.len() + 2 * model.joints.len(),
+            );
+        }
         let mut g = std::mem::take(&mut self.work.grad);
         refill(&mut g, q.len());
         let _ = potential(

@@ -129,7 +129,7 @@ impl TreeSplit {
         }
         // Tree nodes: the runs not in the border (a run's positions are consecutive).
         let mut node_of = vec![u32::MAX; order];
-        let mut span: Vec<(usize, usize)> = Vec::new();
+        let mut span: Vec<(usize, usize)> = Vec::with_capacity(runs);
         let mut last_run = u32::MAX;
         for k in 0..order {
             if bordered[run_of[k] as usize] {
@@ -145,7 +145,8 @@ impl TreeSplit {
             node_of[k] = (span.len() - 1) as u32;
         }
         let nodes = span.len();
-        let mut diag_at = vec![0usize];
+        let mut diag_at = Vec::with_capacity(nodes + 1);
+        diag_at.push(0usize);
         for i in 0..nodes {
             let d = span[i].1 - span[i].0;
             diag_at.push(diag_at[i] + d * d);
@@ -156,9 +157,10 @@ impl TreeSplit {
         // Slots by kind first (diagonal, off-diagonal, border, `Φ_v`), offset once all are known.
         let (diag_len, mut border_at) = (diag_at[nodes], Vec::new());
         let mut slots = vec![u32::MAX; entries.len()];
-        let mut v_at = Vec::new();
-        let mut pending = Vec::new();
-        let mut pending_v = Vec::new();
+        // Sized for every triplet (untouched capacity costs no page): no regrowth copies.
+        let mut v_at = Vec::with_capacity(entries.len());
+        let mut pending = Vec::with_capacity(entries.len());
+        let mut pending_v = Vec::with_capacity(entries.len());
         for (t, e) in entries.iter().enumerate() {
             let p = row_pos[e.0];
             if p == u32::MAX {

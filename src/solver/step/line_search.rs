@@ -8,13 +8,7 @@
 //! leaves open (loops, contacts); if the corrector fails, the step is halved (step (f)). A corrected point is accepted when the Armijo condition
 //! `f(v̂ + α d) ≤ f + 10⁻⁴ α ∇fᵀ d` holds, or when `f` is flat to rounding and the gradient
 //! has halved; otherwise `α` shrinks by safeguarded quadratic interpolation (to between
-//! 0.1 and 0.5 of itself), but along a path bent at joint stops (module `inequality::bend`)
-//! not below the last stop that the rejected trial reached, `α_k`: the kink of the projected
-//! path, where the joint has just met its stop (Moré & Toraldo's search over the breakpoints
-//! of the projected path). The quadratic model of `f` along `d` does not hold across a kink;
-//! interpolating through it, iCub's near-neutral right hip yaw (example-robot-data, hanging)
-//! crawled to its stop in 0.09 rad steps, 5 iterations, where the trial at the kink takes it
-//! there in one (32 → 27 iterations, the same rest). Trial energies are compared through the Lagrangian `V − μᵀΦ`
+//! 0.1 and 0.5 of itself). Trial energies are compared through the Lagrangian `V − μᵀΦ`
 //! (`Eval::merit`), which removes the first-order effect of the corrector's remaining
 //! residual. With a guard, a trial point that violates an inactive inequality is replaced by
 //! the point where the first one reaches its boundary, accepted if it does not raise `f`
@@ -22,8 +16,6 @@
 //!
 //! ## References
 //! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §3.1, §3.5.
-//! - J. J. Moré, G. Toraldo, "Algorithms for bound constrained quadratic programming problems",
-//!   *Numer. Math.* 55 (1989) 377–400.
 
 use crate::solver::inequality::active_set::Guard;
 use crate::solver::inequality::bend::Stop;
@@ -79,9 +71,7 @@ pub(crate) fn line_search(
         _ => Vec::new(),
     };
     for _ in 0..MAX_TRIALS {
-        // The stops reached by `alpha` (at `alpha_k = alpha`, the last kink, the joint is on its
-        // stop: held there, and reported reached).
-        let caps: Vec<Stop> = stops.iter().filter(|s| s.alpha <= alpha).copied().collect();
+        let caps: Vec<Stop> = stops.iter().filter(|s| s.alpha < alpha).copied().collect();
         let mut qt = if caps.is_empty() {
             sys.problem.retraction.point(q, dq, alpha)
         } else {
@@ -162,16 +152,14 @@ pub(crate) fn line_search(
                 blocked: (!reached.is_empty()).then_some(reached),
             });
         }
-        // Quadratic interpolation of f along d, safeguarded; on a bent path not below its
-        // last kink (the stop reached last before `alpha`, module docs).
+        // Quadratic interpolation of f along d, safeguarded.
         let denom = 2.0 * (ft - f - slope * alpha);
         let next = if denom > 0.0 {
             -slope * alpha * alpha / denom
         } else {
             0.5 * alpha
         };
-        let kink = caps.iter().map(|s| s.alpha).fold(0.0, f64::max);
-        alpha = next.clamp(0.1 * alpha, 0.5 * alpha).max(kink);
+        alpha = next.clamp(0.1 * alpha, 0.5 * alpha);
         diag.step_halvings += 1;
     }
     None

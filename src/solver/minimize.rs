@@ -354,11 +354,11 @@ fn convergence_test(
     let rounding = GRADIENT_FLOOR * s.eval.energy.magnitude;
     let test = match &eig {
         Some(e) if !options.allow_unstable => match e.lowest() {
+            Some((_, lmin)) if e.unresolved(lmin, gnorm, rounding) => Test::Continue,
             Some((imin, lmin)) if lmin < -e.tolerance() => {
                 Test::Saddle(e.vectors.column(imin).into_owned())
             }
-            // Not yet at the lowest point of a curved valley (module `valley`).
-            _ if s.valley.unsettled(e, &s.eval.grad_v, rounding) => Test::Continue,
+            _ if s.valley.unsettled(e, &s.eval.grad_v, rounding) => Test::Continue, // valley floor
             _ => Test::Converged(Some(e.clone()), None),
         },
         _ => Test::Converged(eig.clone(), verdict),

@@ -65,6 +65,18 @@ impl Spectrum {
         1e-10 * self.largest.max(1.0)
     }
 
+    /// Whether a negative eigenvalue `lambda` beyond [`Spectrum::tolerance`] is still below the
+    /// reduced Hessian's error at a point stationary only to `gnorm = ‖∂V/∂v‖∞` (above the
+    /// gradient's rounding floor `rounding`): the multipliers' term `λ·Φ_qq` of `Ĥ` carries the
+    /// gradient's residual, an error of the order of `gnorm` in the eigenvalues (taken as
+    /// `10 gnorm`: the chart's second derivatives are of order one in the scaled coordinates).
+    /// Such a direction is not a saddle's yet: a Newton step that lowers the gradient comes
+    /// first. (A leg whose yaw axis is tilted 6·10⁻⁶ rad from vertical: −1.4·10⁻⁹ at `gnorm`
+    /// 7·10⁻⁹, +6.2·10⁻¹⁰ after one more step, the curvature its energy shows along the yaw.)
+    pub(crate) fn unresolved(&self, lambda: f64, gnorm: f64, rounding: f64) -> bool {
+        lambda < -self.tolerance() && lambda > -10.0 * gnorm && gnorm > rounding
+    }
+
     /// The smallest eigenvalue and its index.
     pub(crate) fn lowest(&self) -> Option<(usize, f64)> {
         self.values

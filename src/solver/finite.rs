@@ -20,7 +20,7 @@ pub(crate) fn guard(model: &Model, state: &State, at: &str) -> Result<()> {
     let mut jac = Triplets::default();
     cons.evaluate(model, &state.q, &mut phi, Some(&mut jac));
     finite_rows(model, &cons, &phi, &jac, at)?;
-    finite_energy(model, state, at)
+    finite_energy(model, state, at).map(|_| ())
 }
 
 /// [`guard`] with the rows of `sys` (the model's rows and locks on the state's branches, as
@@ -38,13 +38,7 @@ pub(crate) fn guard_system_energy(
     finite_coordinates(model, state, at)?;
     sys.triplets(&state.q);
     finite_rows(model, &sys.problem.cons, &sys.work.phi, &sys.work.jac, at)?;
-    let q = &state.q;
-    let mut g = DVector::zeros(q.len());
-    let Some(e) = crate::forces::potential(model, &state.branches, q, &mut g, None) else {
-        return Ok(None);
-    };
-    crate::forces::finite::check(model, &state.branches, q, e.total, &g, at)?;
-    Ok(Some((e.total, g)))
+    finite_energy(model, state, at)
 }
 
 /// [`guard_system_energy`] where the rows of `sys` were evaluated without their derivatives
@@ -63,13 +57,7 @@ pub(crate) fn guard_values_energy(
         &Triplets::default(),
         at,
     )?;
-    let q = &state.q;
-    let mut g = DVector::zeros(q.len());
-    let Some(e) = crate::forces::potential(model, &state.branches, q, &mut g, None) else {
-        return Ok(None);
-    };
-    crate::forces::finite::check(model, &state.branches, q, e.total, &g, at)?;
-    Ok(Some((e.total, g)))
+    finite_energy(model, state, at)
 }
 
 fn finite_coordinates(model: &Model, state: &State, at: &str) -> Result<()> {
@@ -102,12 +90,14 @@ fn finite_rows(
     Ok(())
 }
 
-fn finite_energy(model: &Model, state: &State, at: &str) -> Result<()> {
+/// `V(q)` and `∇V(q)` finite: what it evaluated (`None` where a force-table term is undefined
+/// at `state`: that error has its own message, raised by the caller's checks).
+fn finite_energy(model: &Model, state: &State, at: &str) -> Result<Option<(f64, DVector<f64>)>> {
     let q = &state.q;
     let mut g = DVector::zeros(q.len());
-    // An undefined force-table term has its own error, raised by the checks themselves.
     let Some(e) = crate::forces::potential(model, &state.branches, q, &mut g, None) else {
-        return Ok(());
+        return Ok(None);
     };
-    crate::forces::finite::check(model, &state.branches, q, e.total, &g, at)
+    crate::forces::finite::check(model, &state.branches, q, e.total, &g, at)?;
+    Ok(Some((e.total, g)))
 }

@@ -173,7 +173,7 @@ pub struct Options {
     /// Complementarity tolerance: a contact force or stop effort of the wrong sign smaller
     /// than this fraction of the largest applied force does not release it (default: 1e-9).
     pub force_tolerance: f64,
-    /// How a step that reaches inactive joint stops is searched (default: cut at the first).
+    /// How a step that reaches inactive joint stops is searched (default: the projected search).
     pub stop_search: StopSearch,
     /// Called after every iteration (default: none).
     pub progress: Progress,

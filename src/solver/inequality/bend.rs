@@ -1,5 +1,6 @@
 //! The projected (bent) search path of the joint stops, `Options::stop_search =
-//! StopSearch::Projected` (the default cuts the step at the first stop, module `guard`): along
+//! StopSearch::Projected` (the default; `StopSearch::Cut` cuts the step at the first stop,
+//! module `guard`): along
 //! the retraction (module `step::retraction`) a tree joint's coordinate moves linearly, `θ(α) = θ + α θ̇`, so an inactive
 //! stop `g(θ) ≥ 0` is reached at `α_k = −g(θ)/ġ` (`ġ < 0`). The trial point at `α` holds each
 //! such joint at its stop beyond `α_k`,
@@ -21,8 +22,8 @@
 //! the active rows whose multipliers push (module `release` lets the pulling ones leave
 //! before a round is stationary), the Newton step is the reduced one with those rows held
 //! (with the valley and escape steps of modules `valley` and `step::escape`), and the step is
-//! limited per joint (module `step::step_cap`). Why it is not the default: docs/method.md,
-//! "Meeting several stops in one step".
+//! limited per joint (module `step::step_cap`). Why it is the default, measured against the
+//! quasi-static release: docs/method.md, "Meeting several stops in one step".
 //!
 //! ## References
 //! - D. P. Bertsekas, "Projected Newton methods for optimization problems with simple

@@ -38,8 +38,9 @@ pub(crate) struct Retraction {
     /// `(body, tree parent)`, every body once, a parent before its children (`None`: the
     /// world, for a body that no tree joint moves or one jointed to the world).
     order: Vec<(usize, Option<usize>)>,
-    /// The tree joint that moves each body relative to its tree parent.
-    via: Vec<Option<usize>>,
+    /// The body each joint moves relative to its tree parent (`None`: a loop-closing or merged
+    /// joint, or a second tree joint onto a body already moved), indexed by joint.
+    moves: Vec<Option<usize>>,
 }
 
 /// The rigid displacement `y ↦ A(r) y + t` of the world that a body has undergone.
@@ -52,7 +53,7 @@ impl Retraction {
         let mut parent: Vec<Option<usize>> = vec![None; n];
         let mut children: Vec<Vec<usize>> = vec![Vec::new(); n];
         let mut moved = vec![false; n];
-        let mut via = vec![None; n];
+        let mut moves = vec![None; model.joints.len()];
         for (i, j) in model
             .joints
             .iter()
@@ -63,7 +64,7 @@ impl Retraction {
             if std::mem::replace(&mut moved[c.0], true) {
                 continue;
             }
-            via[c.0] = Some(i);
+            moves[i] = Some(c.0);
             parent[c.0] = j.bodies[0].map(|b| b.0);
             if let Some(p) = j.bodies[0] {
                 children[p.0].push(c.0);
@@ -81,12 +82,12 @@ impl Retraction {
         }
         // Not reached from a root (a cycle of tree edges cannot be built): its own twist.
         order.extend((0..n).filter(|&b| !seen[b]).map(|b| (b, None)));
-        Retraction { order, via }
+        Retraction { order, moves }
     }
 
     /// The body that tree joint `joint` moves along the path (`None` for a loop-closing joint).
     pub(crate) fn body_of(&self, joint: usize) -> Option<usize> {
-        self.via.iter().position(|&j| j == Some(joint))
+        self.moves.get(joint).copied().flatten()
     }
 
     /// Every body's tree parent (`None`: the world, or no tree joint moves it).

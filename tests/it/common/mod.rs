@@ -33,6 +33,16 @@ pub(crate) fn analyze_in(dir: &str, args: &[String]) -> (Option<i32>, String, se
     (out.status.code(), err, v)
 }
 
+/// The potential energy of `model` at the joint values of `state` with joint `joint`'s first
+/// coordinate moved by `delta` (the others held), by forward kinematics from the joint values:
+/// an independent probe of a rest in joint coordinates.
+pub(crate) fn energy_moved(model: &Model, state: &State, joint: &str, delta: f64) -> f64 {
+    let mut v: restpose::state::JointValues = state.joint_values(model).into_iter().collect();
+    v.get_mut(joint)
+        .unwrap_or_else(|| panic!("no joint `{joint}`"))[0] += delta;
+    restpose::verify::potential_energy(model, &State::from_joint_values(model, &v)).unwrap()
+}
+
 /// Loads `robots/NAME.urdf`.
 pub(crate) fn robot(name: &str) -> Model {
     let path = format!("{}/robots/{name}.urdf", env!("CARGO_MANIFEST_DIR"));

@@ -9,7 +9,6 @@
 //! once a step has stalled there, and the round ends only where the Newton step along the
 //! floor is short (module `solver::valley`).
 
-use restpose::state::State;
 use restpose::Termination;
 
 fn leg(k: f64) -> restpose::Model {
@@ -68,12 +67,8 @@ fn a_leg_in_a_curved_valley_converges_in_few_iterations() {
         // anywhere within 10⁻⁸ J / k (1 rad at k = 10⁻⁸); the Newton step along the valley
         // placed it.
         let values: restpose::state::JointValues = state.joint_values(&model).into_iter().collect();
-        let energy = |joint: &str, delta: f64| {
-            let mut v = values.clone();
-            v.get_mut(joint).unwrap()[0] += delta;
-            restpose::verify::potential_energy(&model, &State::from_joint_values(&model, &v))
-                .unwrap()
-        };
+        let energy =
+            |joint: &str, delta: f64| crate::common::energy_moved(&model, &state, joint, delta);
         let v0 = energy("hip_yaw", 0.0);
         let closed = -2.0 * model.gravity().norm() * (0.03f64.powi(2) + 0.3f64.powi(2)).sqrt();
         assert!(

@@ -9,7 +9,6 @@
 //! points now move the bodies rigidly along the spanning tree (module `solver::retraction`):
 //! every joint turns from `θ` to `θ + α θ̇`, and the yaw is reached in a few Newton steps.
 
-use restpose::state::State;
 use restpose::Termination;
 
 fn so101() -> restpose::Model {
@@ -38,12 +37,8 @@ fn so101_hangs_by_the_direct_solve_in_few_iterations() {
 
     // Independent check in joint space: central differences of the energy over each joint
     // coordinate, the others held, by forward kinematics from the rest's joint values.
-    let values: restpose::state::JointValues = state.joint_values(&model).into_iter().collect();
-    let energy = |joint: &str, delta: f64| {
-        let mut v = values.clone();
-        v.get_mut(joint).unwrap()[0] += delta;
-        restpose::verify::potential_energy(&model, &State::from_joint_values(&model, &v)).unwrap()
-    };
+    let energy =
+        |joint: &str, delta: f64| crate::common::energy_moved(&model, &state, joint, delta);
     let v0 = report.energy.total;
     assert!((energy("shoulder_pan", 0.0) - v0).abs() < 1e-12);
     let h = 1e-4;

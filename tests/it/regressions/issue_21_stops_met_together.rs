@@ -66,16 +66,20 @@ fn torque(t: [f64; 2], k: usize) -> f64 {
     (energy(plus) - energy(minus)) / (2.0 * h)
 }
 
+/// The direct solve (no load ramp) with `search`.
+fn direct(search: StopSearch) -> Options {
+    Options {
+        load_steps: 1,
+        stop_search: search,
+        ..Default::default()
+    }
+}
+
 /// Solves the hand with `search`, checks the rest against the closed form and returns the
 /// iterations and active-set rounds it took.
 fn solve_checked(search: StopSearch) -> (usize, usize) {
     let model = hand(true);
-    let options = Options {
-        load_steps: 1,
-        stop_search: search,
-        ..Default::default()
-    };
-    let (state, report) = restpose::solve(&model, &options).unwrap();
+    let (state, report) = restpose::solve(&model, &direct(search)).unwrap();
     assert_eq!(report.termination, Termination::Converged, "{search:?}");
     let mut total = 0.0;
     for i in 0..FINGERS {
@@ -127,12 +131,7 @@ fn the_projected_search_meets_the_knuckle_stops_together() {
 fn without_stops_the_projected_search_changes_nothing() {
     let model = hand(false);
     let run = |search| {
-        let options = Options {
-            load_steps: 1,
-            stop_search: search,
-            ..Default::default()
-        };
-        let (state, report) = restpose::solve(&model, &options).unwrap();
+        let (state, report) = restpose::solve(&model, &direct(search)).unwrap();
         assert_eq!(report.termination, Termination::Converged, "{search:?}");
         let history: Vec<(f64, f64)> = report
             .history

@@ -8,7 +8,6 @@
 //! of this kind). A negative eigenvalue within the Hessian's error at the current gradient
 //! now asks for a Newton step first (`Spectrum::unresolved`), after which it is resolved.
 
-use restpose::state::State;
 use restpose::Termination;
 
 fn leg(tilt: f64, lower: f64, knee: f64, off: f64, start: [(&str, f64); 4]) -> restpose::Model {
@@ -114,12 +113,8 @@ fn a_nearly_vertical_yaw_does_not_stall_at_its_rest() {
         // raises the energy), the pitch and ankle are balanced and at a minimum, and the yaw's
         // energy rises both ways over ±0.3 rad (the tilt's cosine, about 10⁻¹¹ J there).
         let values: restpose::state::JointValues = state.joint_values(&model).into_iter().collect();
-        let energy = |joint: &str, delta: f64| {
-            let mut v = values.clone();
-            v.get_mut(joint).unwrap()[0] += delta;
-            restpose::verify::potential_energy(&model, &State::from_joint_values(&model, &v))
-                .unwrap()
-        };
+        let energy =
+            |joint: &str, delta: f64| crate::common::energy_moved(&model, &state, joint, delta);
         let v0 = energy("hip_yaw", 0.0);
         assert!((report.energy.total - v0).abs() < 1e-12);
         assert!(

@@ -6,6 +6,7 @@ use super::{Backend, Factors, System};
 use crate::forces::{potential, Energy};
 use crate::jet::HessianSink;
 use crate::solver::partition::Partition;
+use crate::solver::sparse::hessian::BlockHessian;
 use nalgebra::{DMatrix, DVector};
 
 /// The largest null-space basis (`coordinates × dof` entries, 8 MB) that
@@ -128,6 +129,46 @@ impl System<'_> {
             for (k, &c) in part.dependent.iter().enumerate() {
                 out[c] = rhs[k];
             }
+        }
+    }
+
+    /// `Z` into the `n × dof` zeros `z`: the columns of [`System::tangent_column`] bit for
+    /// bit, on the tree factors all in one pass (`Φ_v S` scattered once, one solve with `dof`
+    /// right sides: [`TreeLu::solve_columns`]), otherwise one by one.
+    ///
+    /// [`TreeLu::solve_columns`]: crate::solver::tree::phi_u::TreeLu::solve_columns
+    fn tangent_columns(&self, part: &Partition, eval: &Eval, z: &mut DMatrix<f64>) {
+        let dof = part.independent.len();
+        let r = part.rows.len();
+        if let (Factors::Tree(f), true) = (&eval.factors, r > 0) {
+            // `dvu` of `tangent_column`: `1 · s_b` at `b`.
+            let scale: Vec<f64> = part
+                .independent
+                .iter()
+                .map(|&c| 1.0 * self.problem.scaling.columns[c])
+                .collect();
+            // `−Φ_v dvu` for every `b` (row-major `rows × dof`), negated as that of one column.
+            let mut x = vec![0.0; r * dof];
+            f.add_phi_v_scaled(&scale, &mut x, dof);
+            for v in x.iter_mut() {
+                *v = -*v;
+            }
+            if f.solve_columns(&mut x, dof) {
+                for (b, &c) in part.independent.iter().enumerate() {
+                    z[(c, b)] = scale[b];
+                }
+                for (k, &c) in part.dependent.iter().enumerate() {
+                    for (b, &v) in x[k * dof..(k + 1) * dof].iter().enumerate() {
+                        z[(c, b)] = v;
+                    }
+                }
+                return;
+            }
+            z.fill(0.0);
+        }
+        let mut dvu = DVector::zeros(dof);
+        for b in 0..dof {
+            self.tangent_column(part, eval, b, &mut dvu, z.column_mut(b).as_mut_slice());
         }
     }
 
@@ -283,13 +324,8 @@ impl System<'_> {
             self.lagrangian_blocks(q, part, eval);
             let mut z = DMatrix::zeros(n, dof);
             let mut wz = DMatrix::zeros(n, dof);
-            let mut dvu = DVector::zeros(dof);
-            for b in 0..dof {
-                self.tangent_column(part, eval, b, &mut dvu, z.column_mut(b).as_mut_slice());
-                self.work
-                    .hess
-                    .mul_add(z.column(b).as_slice(), wz.column_mut(b).as_mut_slice());
-            }
+            self.tangent_columns(part, eval, &mut z);
+            mul_add_columns(&self.work.hess, &z, &mut wz);
             (z.tr_mul(&wz), Some(z))
         } else if self.backend != Backend::Dense {
             self.lagrangian_blocks(q, part, eval);
@@ -327,6 +363,26 @@ impl System<'_> {
         let mut wzx = DVector::zeros(zx.len());
         self.work.hess.mul_add(zx.as_slice(), wzx.as_mut_slice());
         self.tangent_transpose(part, eval, &wzx)
+    }
+}
+
+/// `W Z` added into `wz` for every column of `z` (both `n × dof`), block by block: each
+/// column receives the sums of [`BlockHessian::mul_add`] in the same order (the same results
+/// to the last bit), each block read once for all columns.
+fn mul_add_columns(hess: &BlockHessian, z: &DMatrix<f64>, wz: &mut DMatrix<f64>) {
+    let n = z.nrows();
+    let (zs, ws) = (z.as_slice(), wz.as_mut_slice());
+    for (&(a, b), blk) in hess.keys.iter().zip(&hess.values) {
+        for (x, y) in zs.chunks_exact(n).zip(ws.chunks_exact_mut(n)) {
+            let (x, y) = (&x[7 * b..7 * b + 7], &mut y[7 * a..7 * a + 7]);
+            for i in 0..7 {
+                let mut s = 0.0;
+                for j in 0..7 {
+                    s += blk[7 * i + j] * x[j];
+                }
+                y[i] += s;
+            }
+        }
     }
 }
 

@@ -2,11 +2,11 @@
 //! reduced gradient `∂V/∂v = V_v − Φ_vᵀ μ` (eq. 37), the tangent map `Z = [H; I] S` with
 //! `H = −Φ_u⁻¹ Φ_v`, and the reduced Hessian `Zᵀ W Z`, `W = V_qq − Σ_k μ_k Φ_k,qq`.
 
+use super::basis_products::{mul_add_columns, tr_mul, Pattern};
 use super::{Backend, Factors, System};
 use crate::forces::{potential, Energy};
 use crate::jet::HessianSink;
 use crate::solver::partition::Partition;
-use crate::solver::sparse::hessian::BlockHessian;
 use nalgebra::{DMatrix, DVector};
 
 /// The largest null-space basis (`coordinates × dof` entries, 8 MB) that
@@ -325,8 +325,9 @@ impl System<'_> {
             let mut z = DMatrix::zeros(n, dof);
             let mut wz = DMatrix::zeros(n, dof);
             self.tangent_columns(part, eval, &mut z);
-            mul_add_columns(&self.work.hess, &z, &mut wz);
-            (z.tr_mul(&wz), Some(z))
+            let pattern = Pattern::of(&z);
+            mul_add_columns(&self.work.hess, &z, &pattern, &mut wz);
+            (tr_mul(&z, &wz, &pattern), Some(z))
         } else if self.backend != Backend::Dense {
             self.lagrangian_blocks(q, part, eval);
             let mut hr = DMatrix::zeros(dof, dof);
@@ -363,26 +364,6 @@ impl System<'_> {
         let mut wzx = DVector::zeros(zx.len());
         self.work.hess.mul_add(zx.as_slice(), wzx.as_mut_slice());
         self.tangent_transpose(part, eval, &wzx)
-    }
-}
-
-/// `W Z` added into `wz` for every column of `z` (both `n × dof`), block by block: each
-/// column receives the sums of [`BlockHessian::mul_add`] in the same order (the same results
-/// to the last bit), each block read once for all columns.
-fn mul_add_columns(hess: &BlockHessian, z: &DMatrix<f64>, wz: &mut DMatrix<f64>) {
-    let n = z.nrows();
-    let (zs, ws) = (z.as_slice(), wz.as_mut_slice());
-    for (&(a, b), blk) in hess.keys.iter().zip(&hess.values) {
-        for (x, y) in zs.chunks_exact(n).zip(ws.chunks_exact_mut(n)) {
-            let (x, y) = (&x[7 * b..7 * b + 7], &mut y[7 * a..7 * a + 7]);
-            for i in 0..7 {
-                let mut s = 0.0;
-                for j in 0..7 {
-                    s += blk[7 * i + j] * x[j];
-                }
-                y[i] += s;
-            }
-        }
     }
 }
 

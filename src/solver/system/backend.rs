@@ -76,28 +76,18 @@ impl Backend {
         Self::choose(model, options.linear_algebra)
     }
 
-    /// The backend of one round of a solve with `options` whose active inequalities are
-    /// `active`: [`Backend::of`], but with the automatic choice the tree factors also for a
-    /// mechanism without closed loops whose joint stops are all inactive in this round (a
-    /// chain whose limits are never reached: the stops are then only the guard's, outside the
-    /// linear algebra). A round with a stop active keeps the sparse factors (see
-    /// [`Backend::choose`]).
-    pub(crate) fn of_round(
-        model: &Model,
-        options: &crate::solver::Options,
-        active: &[crate::constraints::unilateral::Active],
-    ) -> Self {
+    /// The backend of one round of a solve with `options`: [`Backend::of`], but with the
+    /// automatic choice the tree factors for every mechanism without closed loops, its joint
+    /// stops active in the round or not (a stop's row is on its joint's child body, like the
+    /// joint's own rows). The sparse factors cost Romeo hanging onto its finger stops 1.26×
+    /// the CPU of its solve with `--limits ignore` (faer's numeric LU, its symbolic analysis
+    /// at each round's partition and its solves: all of the difference); the tree factors
+    /// 1.06× (BENCHMARKS.md). The stall [`Backend::choose`] recalls is gone since the
+    /// projected stop search: `--linear-algebra tree` ends Romeo's 14 iterations at the
+    /// sparse factors' rest.
+    pub(crate) fn of_round(model: &Model, options: &crate::solver::Options) -> Self {
         let chosen = Self::of(model, options);
-        let stop = active.iter().any(|a| {
-            matches!(
-                a.row,
-                crate::constraints::unilateral::Unilateral::Limit { .. }
-            )
-        });
-        if options.linear_algebra == LinearAlgebra::Auto
-            && chosen == Backend::Sparse
-            && !stop
-            && open(model)
+        if options.linear_algebra == LinearAlgebra::Auto && chosen == Backend::Sparse && open(model)
         {
             Backend::Tree
         } else {

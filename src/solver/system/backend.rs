@@ -47,11 +47,11 @@ impl Backend {
     /// [`SPARSE_FROM_COORDINATES`] the tree factors for a mechanism without closed loops or
     /// joint stops (its partitions fit a tree: `O(N)` with fixed-size blocks, faster than the
     /// general sparse factors on chains and ropes, BENCHMARKS.md), the sparse ones otherwise:
-    /// a ladder's thousand loops would not fit a small border, and with stops (Romeo hanging
-    /// onto its finger stops) the tree factors' last Newton steps stall at a reduced gradient
-    /// of 3.7e-8 (tolerance 1e-8) where the sparse ones converge in 17 iterations; until that
-    /// is understood, models with stops keep the sparse factors unless `--linear-algebra tree`
-    /// asks for the tree. Contacts are rows on their body like a joint's (tested against the
+    /// a ladder's thousand loops would not fit a small border. A mechanism without closed
+    /// loops but with stops is given the sparse factors here and the tree ones by each round
+    /// of its solve ([`Backend::of_round`]; before the projected stop search, the tree
+    /// factors' last Newton steps stalled on Romeo's finger stops at a reduced gradient of
+    /// 3.7e-8, tolerance 1e-8). Contacts are rows on their body like a joint's (tested against the
     /// sparse factors: a rope on the ground, Solo-12 standing). Below, the tree factors for a
     /// model of [`TREE_FROM_BODIES`] or more bodies without closed loops, stops, contacts,
     /// locks or mimics, and the dense path otherwise.

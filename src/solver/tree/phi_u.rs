@@ -467,10 +467,8 @@ impl TreeLu {
         x
     }
 
-    /// `B += Φ_v diag(scale)` for the row-major `order × w` block `b` of zeros (`w` = degrees
-    /// of freedom): column `j` is [`TreeLu::phi_v_mul`] of `scale[j] e_j`, summed in the same
-    /// order (the terms of the other columns are zeros, which change no partial sum: a sum
-    /// from `+0` of finite terms is never `−0`).
+    /// `B += Φ_v diag(scale)` into the row-major `order × w` zeros `b`: column `j` is
+    /// [`TreeLu::phi_v_mul`] of `scale[j] e_j` to the bit (the others' terms add zeros).
     pub(crate) fn add_phi_v_scaled(&self, scale: &[f64], b: &mut [f64], w: usize) {
         let s = &*self.shape;
         for (&(i, j), v) in s.v_at.iter().zip(&self.vals[s.v0..]) {
@@ -478,27 +476,20 @@ impl TreeLu {
         }
     }
 
-    /// `Φ_u X = B` in place for the `w` right sides of the row-major `order × w` block `x`:
-    /// each column sees the operations of [`TreeLu::solve`] in the same order (the same
-    /// results to the last bit), in one pass over the factors. `false` if `Φ_u` is singular,
-    /// it has a border, or an entry is not finite (then solve the columns one by one).
+    /// `Φ_u X = B` in place for the `w` columns of the row-major `order × w` `x` in one pass,
+    /// each column [`TreeLu::solve`]'s operations in its order; `false` on a singular `Φ_u`,
+    /// a border or a non-finite entry (then solve column by column).
     pub(crate) fn solve_columns(&self, x: &mut [f64], w: usize) -> bool {
         let s = &*self.shape;
-        if x.is_empty() {
-            return true;
-        }
         if !self.ok || !s.border.is_empty() || x.len() != s.order * w {
-            return false;
+            return x.is_empty();
         }
-        let (diag, rest) = self.vals.split_at(s.off0);
-        let off = &rest[..s.border0 - s.off0];
+        let (diag, off) = self.vals[..s.border0].split_at(s.off0);
         for i in (0..s.span.len()).rev() {
             let r = s.off_at[i]..s.off_at[i + 1];
             for (&(p, q), &v) in s.off[r.clone()].iter().zip(&off[r]) {
                 let (p, q) = (p as usize * w, q as usize * w);
-                for c in 0..w {
-                    x[p + c] -= v * x[q + c];
-                }
+                (0..w).for_each(|c| x[p + c] -= v * x[q + c]);
             }
             let (a, b) = s.span[i];
             let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];

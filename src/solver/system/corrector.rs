@@ -5,8 +5,9 @@
 //! than after `max_iterations` refactorizations. A point whose rows are all within their
 //! rounding floor (module `residual`) is taken as it is: the search path along the tree
 //! lands a chain's trial points there, and chasing the chord's target `10⁻³` of the
-//! tolerance below it cost two chord steps and a Newton step at every trial point. The residual is `‖D Φ‖∞` (module
-//! `residual`): over the independent rows while iterating, over every row at the end.
+//! tolerance below it cost two chord steps and a Newton step at every trial point. The
+//! residual is `‖D Φ‖∞` (module `residual`): over the independent rows while iterating, over
+//! every row at the end.
 
 use super::residual::REDUNDANT_FLOOR;
 use super::{Factors, System};
@@ -79,10 +80,8 @@ impl System<'_> {
             }
             // Chord steps converge linearly: they go on to 10⁻³ of the tolerance, so that the
             // result is as tight as a Newton step would leave it (a stalled chord step
-            // switches to Newton).
-            // Where every row is within its rounding floor, no step can be resolved from
-            // rounding: the point is as tight as a Newton step would leave it (module
-            // `residual`).
+            // switches to Newton), or to the rounding floor of every row where that lies above
+            // (no step can be resolved below it: module `residual`).
             let target = if chord.is_some() { 1e-3 * tol } else { tol };
             let floor = res <= tol && res > target && self.at_rounding_floor(q, part);
             if res <= target || floor || (res <= tol && it == max_iterations) {

@@ -14,7 +14,6 @@ mod import;
 mod limits;
 mod links;
 mod mimic;
-mod node_room;
 mod schema;
 mod servo;
 mod text;
@@ -131,14 +130,7 @@ pub fn load_file(path: impl AsRef<Path>, options: &ImportOptions) -> Result<Load
         }
         return Ok(loaded);
     }
-    // Room in the parser's node table (module `node_room`); an error is the file's own.
-    let mut text = text;
-    let len = node_room::make_room(&mut text);
-    let file = path.display().to_string();
-    match import::import(&text, &file, dir.clone(), options) {
-        Err(_) if len < text.len() => import::import(&text[..len], &file, dir, options),
-        loaded => loaded,
-    }
+    import::import(&text, &path.display().to_string(), dir, options)
 }
 
 /// The text of the URDF file at `path`: a xacro file (feature `xacro`) is expanded with the

@@ -116,11 +116,7 @@ pub fn read_file(path: &std::path::Path) -> Result<String> {
             element: String::new(),
         });
     }
-    // Spare capacity for the parser's node room (module `node_room`): appended in place
-    // (capacity never written costs no page).
-    let mut bytes = Vec::with_capacity(usize::try_from(len).unwrap_or(0) / 4 * 5 + 64);
-    std::io::Read::read_to_end(&mut std::fs::File::open(path).map_err(io)?, &mut bytes)
-        .map_err(io)?;
+    let bytes = std::fs::read(path).map_err(io)?;
     decode(bytes, &path.display().to_string())
 }
 

@@ -37,8 +37,9 @@
 //! - J. J. Moré, D. C. Sorensen, On the use of directions of negative curvature in a modified
 //!   Newton method, *Mathematical Programming* 16 (1979) 1–20.
 
+use crate::solver::stability::blocks::blocks;
 use crate::solver::stability::spectrum::Spectrum;
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 
 /// The dense Newton step's floor on the eigenvalue magnitudes, a fraction of the largest. At
 /// 10⁻⁸ it cut the steps along near-neutral directions (iCub's hip yaws, 1.2·10⁻¹⁰ of the
@@ -89,7 +90,7 @@ pub(crate) fn newton_step(
     // Near a stationary point: the whole step (as before), or a decoupled block (a finger, a
     // leg: eigenvectors on one block, module `stability::blocks`) whose own step is short and
     // whose slopes are rounding while the others move (`BLOCK_AT_REST`).
-    let group = groups(&e.vectors);
+    let group = groups(e);
     let whole = escape.is_some_and(|c| step(&t).amax() < NEAR_STATIONARY * c);
     let gmax = g.amax();
     // Per group (indexed by its root): its share of the step and whether its slopes vanish.
@@ -119,36 +120,24 @@ pub(crate) fn newton_step(
     (step(&t), escaped)
 }
 
-/// The group of each eigenvector (column of `v`): eigenvectors whose supports (nonzero
-/// entries) overlap, transitively, share a group.
-fn groups(v: &nalgebra::DMatrix<f64>) -> Vec<usize> {
-    let (n, m) = v.shape();
-    let mut owner = vec![usize::MAX; n];
-    let mut root: Vec<usize> = (0..m).collect();
-    fn find(root: &mut [usize], mut i: usize) -> usize {
-        while root[i] != i {
-            root[i] = root[root[i]];
-            i = root[i];
-        }
-        i
-    }
-    for k in 0..m {
-        for r in (0..n).filter(|&r| v[(r, k)] != 0.0) {
-            if owner[r] == usize::MAX {
-                owner[r] = k;
-            } else {
-                let (a, b) = (find(&mut root, owner[r]), find(&mut root, k));
-                root[a.max(b)] = a.min(b);
-            }
+/// The decoupled block (module `stability::blocks`) of each eigenpair of `e`: that of its
+/// largest entry (an eigenvector of `stability::blocks::block_symmetric_eigen` is zero outside
+/// its block), the blocks those of `V Λ Vᵀ`.
+fn groups(e: &Spectrum) -> Vec<usize> {
+    let n = e.values.len();
+    let h = &e.vectors * DMatrix::from_diagonal(&e.values) * e.vectors.transpose();
+    let mut block = vec![0; n];
+    for (b, members) in blocks(&h).iter().enumerate() {
+        for &r in members {
+            block[r] = b;
         }
     }
-    (0..m).map(|k| find(&mut root, k)).collect()
+    (0..n).map(|i| block[e.vectors.column(i).iamax()]).collect()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::DMatrix;
 
     /// The exact spectrum of a symmetric matrix, ascending, as the minimizer gets it.
     fn spectrum(h: &DMatrix<f64>) -> Spectrum {

@@ -5,7 +5,8 @@
 //! 2. **Convergence test** ([`convergence_test`]): `‖∇f‖∞ ≤ max(gradient_tolerance,
 //!    10⁻¹³ Σ|V_k|)` and, unless `allow_unstable` is set, no negative eigenvalue of the reduced
 //!    Hessian; at a saddle or maximum the search leaves along the eigenvector of the most
-//!    negative one (along every negative one where the path keeps every row, as in stage 3).
+//!    negative one (along every negative one where the path keeps every row, as in stage 3);
+//!    one within the Hessian's error first asks for the settling step (module `step::newton`).
 //! 3. **Reduced step** ([`reduced_step`]): Newton `d = −Ĥ⁻¹ ∇f` with the exact reduced Hessian
 //!    along the search path (`Ĥ + C`, module `step::path_hessian`), its eigenvalues replaced by
 //!    their magnitudes, floored (dense, module `step::newton`), near a maximum or saddle at
@@ -48,6 +49,7 @@ use super::stability::at_rest::for_minimizer;
 use super::stability::spectrum::Spectrum;
 use super::step::direction::direction;
 use super::step::line_search::{line_search, Line, Trial};
+use super::step::newton::Settle;
 use super::step::quasi_newton::QuasiNewton;
 use super::step::retraction::independent_change;
 use super::step::step_cap::{cap_step, Step};
@@ -60,8 +62,7 @@ use nalgebra::DVector;
 pub(crate) struct Outcome {
     pub(crate) q: DVector<f64>,
     pub(crate) part: Partition,
-    /// Reduced-Hessian eigenvalues and eigenvectors at `q`, when the convergence test
-    /// computed them.
+    /// The reduced Hessian's spectrum at `q`, where the convergence test computed it.
     pub(crate) eigen: Option<Spectrum>,
     /// The inertia verdict and tolerance at `q` where the convergence test took it instead of
     /// the Lanczos spectrum (module `stability::at_rest`).
@@ -72,17 +73,14 @@ pub(crate) struct Outcome {
     pub(crate) termination: Termination,
     pub(crate) history: Vec<Iterate>,
     pub(crate) diagnostics: Diagnostics,
-    /// The inactive inequalities (indices into the guard's list) that stopped the last step: `q`
-    /// is on its boundary.
+    /// The inactive inequalities (the guard's indices) that stopped the last step, `q` on one.
     pub(crate) blocked: Option<Vec<usize>>,
-    /// The active inequalities (indices into the round's active list) to release: the round
-    /// ended before it was stationary (module `inequality::release`).
+    /// The active inequalities (the round's indices) to release (module `inequality::release`).
     pub(crate) released: Vec<usize>,
 }
 
-/// Relative rounding floor of the reduced gradient: the convergence test uses
-/// `max(gradient_tolerance, 1e-13 · Σ|V_k|)`, `V_k` the individual energy terms. It exceeds the
-/// default 1e-8 J only for models whose energy terms add up to more than 10⁵ J.
+/// Relative rounding floor of the reduced gradient: `max(gradient_tolerance, 1e-13 Σ|V_k|)`,
+/// `V_k` the energy's terms; above the default 1e-8 J only where they add up to over 10⁵ J.
 const GRADIENT_FLOOR: f64 = 1e-13;
 
 /// A dense or tree partition whose smallest-to-largest pivot ratio of `Φ_u` has fallen below
@@ -126,12 +124,13 @@ struct Search {
     descent: LinearDescent,
     /// Curved valleys (module `valley`).
     valley: Watch,
+    /// The settling step at a curvature within the Hessian's error (module `step::newton`).
+    settle: Settle,
 }
 
 /// What the convergence test found.
 enum Test {
-    /// Stationary and (unless `allow_unstable`) no negative curvature: the spectrum, if
-    /// computed, or else the inertia verdict and tolerance, if that was taken.
+    /// Stationary, no negative curvature (unless allowed): the spectrum or inertia verdict.
     Converged(Option<Spectrum>, Option<(super::report::Verdict, f64)>),
     /// Stationary at a saddle or maximum: the eigenvector of the most negative eigenvalue.
     Saddle(DVector<f64>),
@@ -140,8 +139,7 @@ enum Test {
 }
 
 /// Minimizes from `q`; with a `guard`, a step that would violate one of its inequalities is
-/// cut where the first one reaches its boundary, and the minimization stops there
-/// (`Outcome::blocked`).
+/// cut where the first one reaches its boundary, and it stops there (`Outcome::blocked`).
 pub(crate) fn minimize(
     sys: &mut System,
     q: DVector<f64>,
@@ -172,6 +170,7 @@ pub(crate) fn minimize(
         linear_steps: 0,
         descent: LinearDescent::default(),
         valley: Watch::default(),
+        settle: Settle::default(),
     };
     let mut termination = Termination::MaxIterations;
     let mut eigen = None;
@@ -321,8 +320,7 @@ fn record(s: &mut Search, options: &Options, report: bool) {
     }
 }
 
-/// Stage 2: the convergence test at the current point (module docs), with the reduced
-/// Hessian's spectrum when it was needed (for the test, or for a dense Newton step).
+/// Stage 2: the convergence test (module docs), with the spectrum where it was needed.
 fn convergence_test(
     sys: &mut System,
     s: &mut Search,
@@ -354,7 +352,10 @@ fn convergence_test(
     let rounding = GRADIENT_FLOOR * s.eval.energy.magnitude;
     let test = match &eig {
         Some(e) if !options.allow_unstable => match e.lowest() {
-            Some((_, lmin)) if e.unresolved(lmin, gnorm, rounding) => Test::Continue,
+            Some((_, lmin)) if e.unresolved(lmin, gnorm, rounding) => {
+                s.settle.ask(gnorm);
+                Test::Continue
+            }
             Some((imin, lmin)) if lmin < -e.tolerance() => {
                 Test::Saddle(e.vectors.column(imin).into_owned())
             }
@@ -366,9 +367,8 @@ fn convergence_test(
     (eig, test)
 }
 
-/// Stage 3: the reduced step `d` (module docs): the escaping Newton step along the path, else
-/// along the negative-curvature direction at a saddle, else Newton or quasi-Newton; steepest
-/// descent (and a reset quasi-Newton matrix) when that is not a descent direction.
+/// Stage 3: the reduced step `d` (module docs, module `step::direction`); steepest descent
+/// (and a reset quasi-Newton matrix) when that is not a descent direction.
 fn reduced_step(
     sys: &mut System,
     s: &mut Search,
@@ -378,12 +378,14 @@ fn reduced_step(
     options: &Options,
 ) -> DVector<f64> {
     let dof = s.part.independent.len();
+    let settle = s.settle.take(s.eval.grad_v.amax());
     let g = &s.eval.grad_v;
     let (d, escaped) = direction(
         sys,
         (&s.q, &s.part, &s.eval),
         eig,
         negative_curvature.as_ref(),
+        settle,
         &s.qn.binv,
         guard,
         options,
@@ -477,8 +479,7 @@ fn refresh_partition(sys: &mut System, s: &mut Search, corrector_failed: bool) -
     Some(())
 }
 
-/// A fresh partition at `q` (paper step (b)), its evaluation, and a reset quasi-Newton
-/// approximation. `None` when the evaluation fails.
+/// A fresh partition at `q` (paper step (b)), evaluated, with a reset quasi-Newton matrix.
 fn repartition(sys: &mut System, s: &mut Search) -> Option<()> {
     let part = sys.partition(&s.q);
     s.diag.repartitions += 1;
@@ -489,8 +490,7 @@ fn repartition(sys: &mut System, s: &mut Search) -> Option<()> {
     Some(())
 }
 
-/// Replaces the partition by `fresh`, evaluated at `q`, with a reset quasi-Newton
-/// approximation. `None` when the evaluation fails.
+/// Replaces the partition by `fresh`, evaluated at `q`, with a reset quasi-Newton matrix.
 fn adopt(sys: &mut System, s: &mut Search, fresh: Partition) -> Option<()> {
     s.diag.repartitions += 1;
     s.eval = sys.evaluate(&s.q, &fresh)?;

@@ -72,10 +72,16 @@ impl Spectrum {
     /// gradient's residual, an error of the order of `gnorm` in the eigenvalues (taken as
     /// `10 gnorm`: the chart's second derivatives are of order one in the scaled coordinates).
     /// Such a direction is not a saddle's yet: a Newton step that lowers the gradient comes
-    /// first. (A leg whose yaw axis is tilted 6·10⁻⁶ rad from vertical: −1.4·10⁻⁹ at `gnorm`
+    /// first (the settling step, module `step::newton`). (A leg whose yaw axis is tilted 6·10⁻⁶ rad from vertical: −1.4·10⁻⁹ at `gnorm`
     /// 7·10⁻⁹, +6.2·10⁻¹⁰ after one more step, the curvature its energy shows along the yaw.)
     pub(crate) fn unresolved(&self, lambda: f64, gnorm: f64, rounding: f64) -> bool {
-        lambda < -self.tolerance() && lambda > -10.0 * gnorm && gnorm > rounding
+        lambda < -self.tolerance() && lambda > -Self::error(gnorm) && gnorm > rounding
+    }
+
+    /// The error of the reduced Hessian's eigenvalues at a point stationary only to
+    /// `gnorm = ‖∂V/∂v‖∞`: `10 gnorm` ([`Spectrum::unresolved`]).
+    pub(crate) fn error(gnorm: f64) -> f64 {
+        10.0 * gnorm
     }
 
     /// The smallest eigenvalue and its index.

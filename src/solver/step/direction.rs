@@ -1,6 +1,9 @@
 //! The reduced step of one iteration (stage 3 of module `minimize`), by the first that
 //! applies:
 //!
+//! 0. where the convergence test asked for it (a lowest eigenvalue within the Hessian's error
+//!    at a gradient below the tolerance) and the Hessian is exact, the settling step: Newton
+//!    along the resolved curvatures only (module `newton`);
 //! 1. where the path keeps every row (module `path_hessian`) and the Hessian is exact, the
 //!    Newton step along the path, escaping maxima and saddles along every direction of
 //!    negative curvature (module `escape`);
@@ -15,24 +18,29 @@ use crate::solver::partition::Partition;
 use crate::solver::stability::spectrum::Spectrum;
 use crate::solver::step::escape::escape_step;
 use crate::solver::step::kkt_direction::kkt_direction;
-use crate::solver::step::newton::newton_step;
+use crate::solver::step::newton::{newton_step, settling_step};
 use crate::solver::step::path_hessian::path_keeps_rows;
 use crate::solver::system::{Eval, System};
 use nalgebra::{DMatrix, DVector};
 
 /// The reduced step at `(q, part, eval)` (module docs), `eig` the reduced Hessian's spectrum
 /// when computed, `negative_curvature` the saddle's direction when the point is stationary,
+/// `settle` the Hessian's error where the convergence test asked for the settling step,
 /// `binv` the quasi-Newton inverse Hessian; and whether it escaped along negative curvature.
 pub(crate) fn direction(
     sys: &mut System,
     (q, part, eval): (&DVector<f64>, &Partition, &Eval),
     eig: Option<&Spectrum>,
     negative_curvature: Option<&DVector<f64>>,
+    settle: Option<f64>,
     binv: &DMatrix<f64>,
     guard: Option<&Guard>,
     options: &Options,
 ) -> (DVector<f64>, bool) {
     let g = &eval.grad_v;
+    if let (Some(band), Some(e)) = (settle, eig.filter(|e| e.exact)) {
+        return (settling_step(e, g, band), false);
+    }
     let along = eig
         .filter(|e| e.exact && options.method == Method::Newton && path_keeps_rows(sys))
         .map(|e| escape_step(sys, q, part, eval, e, guard, options));

@@ -120,6 +120,60 @@ pub(crate) fn newton_step(
     (step(&t), escaped)
 }
 
+/// The settling step where the convergence test finds the lowest eigenvalue within the
+/// Hessian's error at a gradient below the tolerance (`Spectrum::unresolved`): the Newton step
+/// along the resolved curvatures only, `d = −Σ_{λ_i > b} v_i (v_iᵀ∇f) / λ_i`, `b` that error
+/// (`Spectrum::error`), and none along the others, whose magnitude steps `v_iᵀ∇f / |λ_i|`
+/// are noise over noise. A leg hanging from a yaw tilted 1.3·10⁻⁷ rad (yaw curvature
+/// 2·10⁻¹³ N m/rad) sat at `‖∇f‖∞` = 6·10⁻⁹ with `λ_min` = −1.2·10⁻⁸: the magnitude step moved
+/// 0.05 along the yaw, brought the gradient back to 6·10⁻⁹, and no later step changed the
+/// energy beyond rounding (`max_iterations`); the settling step lowers it to 2.6·10⁻¹³, where
+/// the yaw's eigenvalue is resolved (neutral). Taken again only where the last settling step
+/// halved the gradient (else the iteration goes on as before).
+#[derive(Debug)]
+pub(crate) struct Settle {
+    /// The error `b` below which curvatures are left alone, where this iteration settles.
+    band: Option<f64>,
+    /// The gradient where the last step, if a settling one, started (else infinite).
+    from: f64,
+}
+
+impl Default for Settle {
+    fn default() -> Self {
+        Settle {
+            band: None,
+            from: f64::INFINITY,
+        }
+    }
+}
+
+impl Settle {
+    /// The convergence test found the lowest eigenvalue within the Hessian's error at the
+    /// gradient `gnorm`: settle, unless the last settling step failed to halve the gradient.
+    pub(crate) fn ask(&mut self, gnorm: f64) {
+        self.band = (gnorm <= 0.5 * self.from).then_some(Spectrum::error(gnorm));
+    }
+
+    /// The band of this iteration's settling step, if it settles (then recorded as taken from
+    /// `gnorm`), for the step at the gradient `gnorm`; clears the request.
+    pub(crate) fn take(&mut self, gnorm: f64) -> Option<f64> {
+        let band = self.band.take();
+        self.from = band.map_or(f64::INFINITY, |_| gnorm);
+        band
+    }
+}
+
+/// The settling step at `g` ([`Settle`]): Newton along the eigen-directions of `e` whose
+/// curvature is above `band`.
+pub(crate) fn settling_step(e: &Spectrum, g: &DVector<f64>, band: f64) -> DVector<f64> {
+    let mut d = DVector::zeros(g.len());
+    for (i, &l) in e.values.iter().enumerate().filter(|&(_, &l)| l > band) {
+        let v = e.vectors.column(i);
+        d -= v * (v.dot(g) / l);
+    }
+    d
+}
+
 /// The decoupled block (module `stability::blocks`) of each eigenpair of `e`: that of its
 /// largest entry (an eigenvector of `stability::blocks::block_symmetric_eigen` is zero outside
 /// its block), the blocks those of `V Λ Vᵀ`.
@@ -221,6 +275,42 @@ mod tests {
         h[(1, 0)] = 0.1;
         let (_, escaped) = newton_step(&spectrum(&h), &g, Some(0.3));
         assert!(escaped.is_empty(), "{escaped:?}");
+    }
+
+    #[test]
+    fn the_settling_step_leaves_curvatures_within_the_error_alone() {
+        // f = −10⁻⁸ x²/2 + y² + 2 z²/2 (x unresolved at ‖g‖ = 6·10⁻⁹, band 6·10⁻⁸): Newton
+        // along y and z, nothing along x.
+        let h = DMatrix::from_diagonal(&DVector::from_vec(vec![-1e-8, 2.0, 4.0]));
+        let g = DVector::from_vec(vec![6e-9, -2e-9, 4e-9]);
+        let d = settling_step(&spectrum(&h), &g, Spectrum::error(g.amax()));
+        assert_eq!(d[0], 0.0);
+        assert!(
+            (d[1] - 1e-9).abs() < 1e-24 && (d[2] + 1e-9).abs() < 1e-24,
+            "{d}"
+        );
+        // A positive curvature within the band is left alone too.
+        let h = DMatrix::from_diagonal(&DVector::from_vec(vec![3e-8, 2.0]));
+        let d = settling_step(&spectrum(&h), &g.rows(0, 2).into_owned(), 6e-8);
+        assert_eq!(d[0], 0.0);
+    }
+
+    #[test]
+    fn settling_is_asked_again_only_after_the_gradient_halved() {
+        let mut settle = Settle::default();
+        settle.ask(6e-9);
+        assert_eq!(settle.take(6e-9), Some(6e-8));
+        // No request: no settling step, and the record is cleared.
+        assert_eq!(settle.take(6e-9), None);
+        settle.ask(6e-9);
+        assert_eq!(settle.take(6e-9), Some(6e-8));
+        // The gradient did not halve: the next step is an ordinary one, then settling again.
+        settle.ask(4e-9);
+        assert_eq!(settle.take(4e-9), None);
+        settle.ask(4e-9);
+        assert_eq!(settle.take(4e-9), Some(4e-8));
+        settle.ask(1e-9);
+        assert!(settle.take(1e-9).is_some());
     }
 
     #[test]

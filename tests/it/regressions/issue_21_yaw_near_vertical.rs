@@ -10,7 +10,13 @@
 
 use restpose::Termination;
 
-fn leg(tilt: f64, lower: f64, knee: f64, off: f64, start: [(&str, f64); 4]) -> restpose::Model {
+pub(super) fn leg(
+    tilt: f64,
+    lower: f64,
+    knee: f64,
+    off: f64,
+    start: [(&str, f64); 4],
+) -> restpose::Model {
     let inertial = |m: f64, xyz: &str, i: &str| {
         format!(
             r#"<inertial><mass value="{m}"/><origin xyz="{xyz}"/><inertia {i} ixy="0" ixz="0" iyz="0"/></inertial>"#

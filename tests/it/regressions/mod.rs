@@ -22,6 +22,7 @@ mod issue_21_stops_met_together;
 mod issue_21_verify_forces_and_stability;
 mod issue_21_vision60_flat;
 mod issue_21_yaw_near_vertical;
+mod issue_21_yaw_within_the_hessian_error;
 mod issue_22_off_the_ramp;
 mod issue_25_closed_pipe;
 mod issue_25_fuzz_smoke;

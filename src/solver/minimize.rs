@@ -17,7 +17,9 @@
 //!    `10 max_step ℓ`, `ℓ` the larger of the length scale and the mechanism's extent).
 //! 5. **Line search and corrector** (module `step::line_search`): backtracking until the Armijo
 //!    condition holds along the search path (module `step::retraction`: every tree joint turns from
-//!    `θ` to `θ + α θ̇`), each trial brought back onto `Φ = 0` by the corrector and halved
+//!    `θ` to `θ + α θ̇`), each trial brought back onto `Φ = 0` by the corrector (after a
+//!    second-order correction with the KKT factors of the step, module `step::second_order`,
+//!    where the path leaves rows open) and halved
 //!    when the corrector fails (paper step (f)), from `α = 1`, or with second-pass choices in a
 //!    sparse partition from the reach the corrector last managed ([`Search::reach`]). With a
 //!    guard, a step that would violate an inactive inequality is cut where the first one
@@ -207,7 +209,7 @@ pub(crate) fn minimize(
         if s.iteration >= options.max_iterations {
             break;
         }
-        let d = reduced_step(
+        let (d, kkt) = reduced_step(
             sys,
             &mut s,
             eig.as_ref(),
@@ -234,6 +236,7 @@ pub(crate) fn minimize(
             dq: &step.dq,
             slope,
             valley: valley.as_ref(),
+            second_order: kkt,
         };
         let trial = line_search(sys, &line, alpha, guard, options, &mut s.diag);
         match trial {
@@ -376,10 +379,10 @@ fn reduced_step(
     negative_curvature: Option<DVector<f64>>,
     guard: Option<&Guard>,
     options: &Options,
-) -> DVector<f64> {
+) -> (DVector<f64>, bool) {
     let dof = s.part.independent.len();
     let g = &s.eval.grad_v;
-    let (d, escaped) = direction(
+    let (d, escaped, kkt) = direction(
         sys,
         (&s.q, &s.part, &s.eval),
         eig,
@@ -392,9 +395,9 @@ fn reduced_step(
     s.diag.negative_curvature_steps += usize::from(escaped || saddle);
     if d.dot(g) > 0.0 && !escaped {
         s.qn = QuasiNewton::new(dof, options.method);
-        return -g.clone();
+        return (-g.clone(), kkt);
     }
-    d
+    (d, kkt)
 }
 
 /// Stage 6: moves to the accepted trial point: the line search's next start, the quasi-Newton

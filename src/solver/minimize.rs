@@ -15,18 +15,15 @@
 //! 4. **Step cap** (module `step::step_cap`): the tangent step `δq = Z d` limited on the motion of the
 //!    whole mechanism (every body's Euler parameters by `max_step`, its origin by
 //!    `10 max_step ℓ`, `ℓ` the larger of the length scale and the mechanism's extent).
-//! 5. **Line search and corrector** (module `step::line_search`): backtracking until the Armijo
-//!    condition holds along the search path (module `step::retraction`: every tree joint turns from
-//!    `θ` to `θ + α θ̇`), each trial brought back onto `Φ = 0` by the corrector (after a
-//!    second-order correction with the KKT factors of the step, module `step::second_order`,
-//!    where the path leaves rows open) and halved
-//!    when the corrector fails (paper step (f)), from `α = 1`, or with second-pass choices in a
-//!    sparse partition from the reach the corrector last managed ([`Search::reach`]). With a
-//!    guard, a step that would violate an inactive inequality is cut where the first one
-//!    reaches its boundary, and the minimization stops there (`Outcome::blocked`: the
-//!    inequality update is the caller's, folder `inequality`). In a curved valley the trial
-//!    points are brought back to its floor first, and the test of stage 2 also asks the
-//!    Newton step along the valley to be short (module `valley`).
+//! 5. **Line search and corrector** (module `step::line_search`): backtracking until Armijo
+//!    holds along the search path (module `step::retraction`: tree joints turn from `θ` to
+//!    `θ + α θ̇`), each trial corrected to second order where the path leaves rows open (module
+//!    `step::second_order`), brought back onto `Φ = 0` by the corrector and halved when it fails
+//!    (paper step (f)), from `α = 1` or, with second-pass choices in a sparse partition, the
+//!    corrector's last reach ([`Search::reach`]). With a guard, a step that would violate an
+//!    inactive inequality is cut where the first one reaches its boundary and the minimization
+//!    stops there (`Outcome::blocked`: the caller updates the inequalities). In a curved valley
+//!    trial points go to its floor first and stage 2 asks a short step along it (`valley`).
 //! 6. **Accept** ([`accept_step`]): quasi-Newton update, and the unbounded test (a linear
 //!    descent that goes on, module `unbounded`); with inequalities, the stall test (steps
 //!    shrinking towards an obstacle's edge end the round, module `inequality::stall`).
@@ -370,8 +367,8 @@ fn convergence_test(
 }
 
 /// Stage 3: the reduced step `d` (module docs): the escaping Newton step along the path, else
-/// along the negative-curvature direction at a saddle, else Newton or quasi-Newton; steepest
-/// descent (and a reset quasi-Newton matrix) when that is not a descent direction.
+/// along a saddle's negative curvature, else Newton or quasi-Newton; steepest descent (and a
+/// reset quasi-Newton matrix) when not downhill; and whether `sys` keeps its KKT factors.
 fn reduced_step(
     sys: &mut System,
     s: &mut Search,

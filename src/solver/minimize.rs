@@ -336,6 +336,7 @@ fn convergence_test(
     // On the Lanczos path the inertia verdict, and the spectrum only to leave a saddle
     // (module `stability::at_rest`).
     let mut verdict = None;
+    let judging = std::time::Instant::now();
     let eig = (dof > 0 && (dense_newton || gnorm <= gtol))
         .then(|| {
             for_minimizer(
@@ -363,6 +364,11 @@ fn convergence_test(
         },
         _ => Test::Converged(eig.clone(), verdict),
     };
+    // The curvature at the rest is its stability verdict: its time is `timings.stability`,
+    // not the iterations' (where the point is left, it was the next step's).
+    if matches!(test, Test::Converged(..)) {
+        s.diag.timings.stability += judging.elapsed().as_secs_f64();
+    }
     (eig, test)
 }
 

@@ -303,7 +303,8 @@ pub(crate) fn solve_round(
     let multipliers = active_set::active_multipliers(&sys.problem.cons, &mu);
     let blocked = out.blocked;
     let released = out.released;
-    diagnostics.timings.stability = stability_started.elapsed().as_secs_f64();
+    // After the minimizer's verdict at the rest (`minimize::convergence_test`).
+    diagnostics.timings.stability += stability_started.elapsed().as_secs_f64();
     let mut history = out.history;
     for h in &mut history {
         h.load_step = 1;

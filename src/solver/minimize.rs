@@ -65,7 +65,7 @@ pub(crate) struct Outcome {
     pub(crate) eigen: Option<Spectrum>,
     /// The inertia verdict and tolerance at `q` where the convergence test took it instead of
     /// the Lanczos spectrum (module `stability::at_rest`).
-    pub(crate) inertia: Option<(super::report::Verdict, f64)>,
+    pub(crate) inertia: Option<super::stability::inertia::ByInertia>,
     /// The accepted iterates, when `Options::record_iterates` is set.
     pub(crate) iterates: Vec<DVector<f64>>,
     pub(crate) eval: Eval,
@@ -132,7 +132,10 @@ struct Search {
 enum Test {
     /// Stationary and (unless `allow_unstable`) no negative curvature: the spectrum, if
     /// computed, or else the inertia verdict and tolerance, if that was taken.
-    Converged(Option<Spectrum>, Option<(super::report::Verdict, f64)>),
+    Converged(
+        Option<Spectrum>,
+        Option<super::stability::inertia::ByInertia>,
+    ),
     /// Stationary at a saddle or maximum: the eigenvector of the most negative eigenvalue.
     Saddle(DVector<f64>),
     /// Not stationary.

@@ -355,7 +355,7 @@ mod tests {
             let part = sys.partition(&q);
             let eval = sys.evaluate(&q, &part).unwrap();
             let exact = symmetric_eigen(&sys.reduced_hessian(&q, &part, &eval)).0;
-            let lz = lanczos(&mut sys, &q, &part, &eval).unwrap();
+            let lz = lanczos(&mut sys, &q, &part, &eval, None).unwrap();
             let lo = lz.values[0];
             // Each Ritz value is an eigenvalue; without a flip the lowest is the lowest.
             for &l in lz.values.iter() {

@@ -70,13 +70,15 @@ impl System<'_> {
         }
         self.triplets(q);
         let (triplets, blocks) = (self.work.jac.entries.len(), self.work.hess.keys.len());
+        // Only a tree structure that fits (a sparse one stays in place for the general path).
+        let fits =
+            matches!(&self.work.kkt, Some(KktMatrix::Tree(t)) if t.fits(part, triplets, blocks));
+        if !fits {
+            return false;
+        }
         let Some(KktMatrix::Tree(mut tree)) = self.work.kkt.take() else {
             return false;
         };
-        if !tree.fits(part, triplets, blocks) {
-            self.work.kkt = Some(KktMatrix::Tree(tree));
-            return false;
-        }
         let (model, n) = (self.problem.model, q.len());
         let mut g = std::mem::take(&mut self.work.grad);
         if g.len() == n {

@@ -121,3 +121,18 @@ fn fused_blocks_equal_the_general_assembly_bit_for_bit() {
     }
     assert!(fused_cases >= 6, "{fused_cases} models on the tree path");
 }
+
+/// Where the tree structure does not fit (a ladder's border above its limit: the general
+/// sparse KKT matrix), the fused pass declines and leaves that matrix in place.
+#[test]
+fn fused_pass_leaves_a_sparse_kkt_matrix_in_place() {
+    let model = from_text(&crate::generate::ladder(40));
+    let mut sys = System::new(&model, Constraints::new(&model, &[]), Backend::Tree);
+    let q = crate::solver::initial_state(&model).q;
+    let part = sys.partition(&q);
+    let eval = sys.evaluate(&q, &part).expect("evaluates");
+    assert!(sys.assemble_kkt(&q, &part, &eval));
+    assert!(matches!(sys.work.kkt, Some(KktMatrix::Sparse(_))));
+    assert!(!sys.assemble_fused(&q, &part, &eval));
+    assert!(matches!(sys.work.kkt, Some(KktMatrix::Sparse(_))));
+}

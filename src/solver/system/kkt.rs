@@ -92,7 +92,7 @@ impl System<'_> {
         for (k, &row) in part.rows.iter().enumerate() {
             weights[row] = -eval.mu[k];
         }
-        let mut sink = tree.fused_begin();
+        let mut sink = tree.fused_begin(&self.work.hess.keys);
         let _ = potential(
             model,
             &self.problem.cons.branches,

@@ -26,7 +26,7 @@ use nalgebra::SMatrix;
 
 /// Where one Hessian block's entries go in the flat values.
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum Run {
+pub(crate) enum Run {
     /// The mirror of a coupling: not stored.
     Skip,
     /// Entry `(i, j)` at `start + i stride + j`.
@@ -35,19 +35,19 @@ enum Run {
     Scattered,
 }
 
-/// The Hessian blocks of a structure by body pair, and where each goes.
+/// The Hessian blocks of a structure by body pair, built at its first fused assembly.
 pub(crate) struct BlockMap {
     /// Row body `a`'s blocks: `first[a] .. first[a + 1]` into `cols` and `blocks`.
     first: Vec<u32>,
     cols: Vec<u32>,
     blocks: Vec<u32>,
-    runs: Vec<Run>,
+    /// `(row body, column body)` of each block.
+    keys: Vec<(usize, usize)>,
 }
 
 impl BlockMap {
-    /// The map of the blocks `keys` (`(row body, column body)`) over `bodies` bodies whose
-    /// entries go to `slots` (module `shape`: [`SKIP`] for a mirror).
-    pub(crate) fn new(bodies: usize, keys: &[(usize, usize)], slots: &[[u32; 49]]) -> Self {
+    /// The map of the blocks `keys` (`(row body, column body)`) over `bodies` bodies.
+    pub(crate) fn new(bodies: usize, keys: &[(usize, usize)]) -> Self {
         let mut count = vec![0u32; bodies + 1];
         for &(a, _) in keys {
             count[a + 1] += 1;
@@ -64,12 +64,11 @@ impl BlockMap {
             cols[at] = b as u32;
             blocks[at] = k as u32;
         }
-        let runs = slots.iter().map(run_of).collect();
         BlockMap {
             first,
             cols,
             blocks,
-            runs,
+            keys: keys.to_vec(),
         }
     }
 
@@ -81,26 +80,10 @@ impl BlockMap {
     }
 }
 
-/// A block's slots as a dense run where they are one.
-fn run_of(s: &[u32; 49]) -> Run {
-    if s.iter().all(|&x| x == SKIP) {
-        return Run::Skip;
-    }
-    if s[0] == SKIP || s[7] == SKIP || s[7] < s[0] {
-        return Run::Scattered;
-    }
-    let (start, stride) = (s[0] as usize, (s[7] - s[0]) as usize);
-    let dense = (0..7).all(|i| (0..7).all(|j| s[7 * i + j] as usize == start + i * stride + j));
-    if dense {
-        Run::Dense { start, stride }
-    } else {
-        Run::Scattered
-    }
-}
-
 /// The Hessian sink of the fused assembly: adds each term into the tree's values (unscaled).
 pub(crate) struct FusedSink<'a> {
     map: &'a BlockMap,
+    runs: &'a [Run],
     slots: &'a [[u32; 49]],
     values: &'a mut [f64],
     /// A term reached a body pair the structure does not hold.
@@ -123,7 +106,7 @@ impl FusedSink<'_> {
         cols: std::ops::Range<usize>,
         f: impl Fn(usize, usize) -> f64,
     ) {
-        match self.map.runs[k] {
+        match self.runs[k] {
             Run::Skip => {}
             Run::Dense { start, stride } => {
                 for i in rows {
@@ -190,15 +173,20 @@ impl HessianSink for FusedSink<'_> {
 
 impl TreeKkt {
     /// Starts a fused assembly: the `W` slots zeroed (the Jacobian's are stored by
-    /// [`TreeKkt::fused_finish`]) and the sink that adds the terms into them.
-    pub(crate) fn fused_begin(&mut self) -> FusedSink<'_> {
+    /// [`TreeKkt::fused_finish`]) and the sink that adds the terms into them. `keys` are the
+    /// block Hessian's (its first blocks are this structure's: [`TreeKkt::fits`]).
+    pub(crate) fn fused_begin(&mut self, keys: &[(usize, usize)]) -> FusedSink<'_> {
+        if self.map.is_none() {
+            let blocks = self.shape.block_slots.len();
+            self.map = Some(BlockMap::new(self.shape.n / 7, &keys[..blocks]));
+        }
         self.shifts.clear();
         let s = &self.shape;
         let values = &mut self.values;
         for &slot in &s.bare_diag {
             values[slot as usize] = 0.0;
         }
-        for (run, slots) in self.map.runs.iter().zip(&s.block_slots) {
+        for (run, slots) in s.block_runs.iter().zip(&s.block_slots) {
             match *run {
                 Run::Skip => {}
                 Run::Dense { start, stride } => {
@@ -216,10 +204,12 @@ impl TreeKkt {
         self.fused_sink()
     }
 
-    /// The sink of a fused assembly in progress (more terms: the augmentation).
+    /// The sink of a fused assembly in progress (more terms: the augmentation); before
+    /// [`TreeKkt::fused_begin`] an empty map, on which every term is `missing`.
     pub(crate) fn fused_sink(&mut self) -> FusedSink<'_> {
         FusedSink {
-            map: &self.map,
+            map: self.map.get_or_insert_with(|| BlockMap::new(0, &[])),
+            runs: &self.shape.block_runs,
             slots: &self.shape.block_slots,
             values: &mut self.values,
             missing: false,
@@ -241,7 +231,8 @@ impl TreeKkt {
     ) {
         let s = &self.shape;
         let values = &mut self.values;
-        for ((run, slots), &(a, b)) in self.map.runs.iter().zip(&s.block_slots).zip(&self.keys) {
+        let keys = self.map.as_ref().map_or(&[][..], |m| &m.keys[..]);
+        for ((run, slots), &(a, b)) in s.block_runs.iter().zip(&s.block_slots).zip(keys) {
             let (sa, sb) = (&scale[7 * a..7 * a + 7], &scale[7 * b..7 * b + 7]);
             match *run {
                 Run::Skip => {}

@@ -35,9 +35,8 @@ use std::cell::RefCell;
 /// The tree KKT matrix under one partition: its structure, values and factors.
 pub(crate) struct TreeKkt {
     pub(super) shape: Shape,
-    /// The Hessian blocks by body pair (module `fused`) and their `(row, column)` bodies.
-    pub(super) map: BlockMap,
-    pub(super) keys: Vec<(usize, usize)>,
+    /// The Hessian blocks by body pair (module `fused`; built at the first fused assembly).
+    pub(super) map: Option<BlockMap>,
     id: usize,
     triplets: usize,
     blocks: usize,
@@ -83,8 +82,7 @@ impl TreeKkt {
         let total = shape.flat_len + shape.border.len();
         let dim = shape.n + shape.rows;
         Some(TreeKkt {
-            map: BlockMap::new(n / 7, &hess.keys, &shape.block_slots),
-            keys: hess.keys.clone(),
+            map: None,
             id: part.id,
             triplets: entries.len(),
             blocks: hess.keys.len(),

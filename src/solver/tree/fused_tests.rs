@@ -21,8 +21,11 @@ fn robot(name: &str) -> Model {
         .model
 }
 
+/// Joint locks `(joint, coordinate, value)`.
+type Locks = Vec<(JointId, usize, f64)>;
+
 /// `(name, model, locks)`.
-fn cases() -> Vec<(&'static str, Model, Vec<(JointId, usize, f64)>)> {
+fn cases() -> Vec<(&'static str, Model, Locks)> {
     vec![
         (
             "chain",

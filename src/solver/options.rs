@@ -44,8 +44,9 @@ pub enum StopSearch {
     /// The projected search of bound-constrained Newton methods: each joint is held at a stop
     /// beyond the step length where it reaches it while the others move on, every stop the
     /// accepted step reaches joins the active set at once, and the step is limited in joint
-    /// coordinates (`3 max_step` rad per joint, module `step::step_cap`) instead of per body
-    /// (default).
+    /// coordinates (`3 max_step` rad per joint, module `step::step_cap`) instead of per body;
+    /// frictionless contacts the step pushes into a ground are held on it likewise (module
+    /// `inequality::hold`) (default).
     #[default]
     Projected,
 }

@@ -3,10 +3,10 @@
 //!
 //! The active inequalities `A` join `Φ` as rows `g_k(q) = 0`, and the equality-constrained
 //! problem is solved as any other (partition, reduced Newton, corrector). Then:
-//! - a step that would make an inactive `g_k` negative is cut (bisection or regula falsi on the
-//!   step length through the corrector, module `guard`) where the first one reaches
-//!   `|g_k| ≤ tol`; every inequality within `tol` of its boundary there joins `A`, and the
-//!   partition is recomputed;
+//! - a step that would make an inactive `g_k` negative is cut (module `guard`) where the first
+//!   one reaches `|g_k| ≤ tol`, or (projected search) holds the stops (module `bend`) and the
+//!   frictionless contacts (module `hold`) it reaches on their boundaries and goes on; every
+//!   inequality at its boundary there joins `A`, and the partition is recomputed;
 //! - at a stationary point, the multipliers `λ_k` of the active rows (`V_qᵀ = Φ_qᵀ μ`) are the
 //!   stops' efforts and the contacts' normal forces; those below `−force_tolerance · F` (`F`
 //!   the weight and loads of the mechanism) leave `A`: all of them the first time, later only
@@ -18,7 +18,6 @@
 //!   (complementarity `g_k λ_k = 0` holds by construction: active rows have `g = 0`, inactive
 //!   ones `λ = 0`), or after `max_iterations` changes of `A` after the start (reported as
 //!   cycling).
-//!
 //! - a sticking sphere that has rolled at a stationary point is re-anchored where it touches
 //!   and the round solved again (module `rolling`); where no rest exists this way (a ball on a
 //!   sloping plane rolls down) it gives up after `MAX_ROLLS` re-anchorings (`unbounded`).
@@ -220,7 +219,8 @@ pub(crate) fn solve(
             .copied()
             .collect();
         let guard = Guard::new(model, options, inactive, &active, tol, &q)
-            .with_true_gaps(&std::mem::take(&mut let_go));
+            .with_true_gaps(&std::mem::take(&mut let_go))
+            .holding(&active, locks, options);
         // `max_iterations` bounds the iterations of all rounds together.
         let budget = Options {
             max_iterations: options.max_iterations.saturating_sub(iterations),

@@ -21,7 +21,7 @@ use nalgebra::{DVector, Vector3};
 
 /// The inactive inequalities that a step must not violate.
 pub(crate) struct Guard<'m> {
-    model: &'m Model,
+    pub(super) model: &'m Model,
     pub(crate) inactive: Vec<Unilateral>,
     pub(super) tol: f64,
     /// For contacts with an obstacle: its tangent plane `(o, n)` at the round's start. A step
@@ -32,6 +32,9 @@ pub(crate) struct Guard<'m> {
     /// Whether the boundary may be searched by regula falsi: no guarded inequality is a
     /// sticking contact (anchored where it lands) and there is no roll limit.
     falsi: bool,
+    /// The round's active rows and locks, where frictionless contacts are held on their
+    /// grounds along a step (module `hold`).
+    pub(super) held: Option<super::hold::Held>,
 }
 
 impl<'m> Guard<'m> {
@@ -68,7 +71,27 @@ impl<'m> Guard<'m> {
             planes,
             falsi: !sticking && rolls.is_empty(),
             rolls,
+            held: None,
         }
+    }
+
+    /// With the projected search (`StopSearch::Projected`), the guard that holds frictionless
+    /// contacts on their grounds along a step (module `hold`), projecting with the round's
+    /// `active` rows and `locks`; unchanged where a guarded inequality is a sticking contact
+    /// or a roll limit.
+    pub(crate) fn holding(
+        mut self,
+        active: &[Active],
+        locks: &[(JointId, usize, f64)],
+        options: &Options,
+    ) -> Self {
+        if self.falsi && options.stop_search == crate::solver::options::StopSearch::Projected {
+            self.held = Some(super::hold::Held {
+                active: active.to_vec(),
+                locks: locks.to_vec(),
+            });
+        }
+        self
     }
 
     /// The guard with the contacts `rows` that let go of a floating body (module `let_go`)
@@ -86,7 +109,7 @@ impl<'m> Guard<'m> {
     }
 
     /// Number of guarded inequalities: the inactive ones, then the roll limits.
-    fn len(&self) -> usize {
+    pub(super) fn len(&self) -> usize {
         self.inactive.len() + self.rolls.len()
     }
 

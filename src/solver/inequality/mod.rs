@@ -4,6 +4,7 @@
 //! - `active_set`: the iteration (which inequality joins, which leaves, when it stops).
 //! - `guard`: where a step first reaches an inactive inequality's boundary.
 //! - `bend`: the search path projected onto the joint stops (several reached at once).
+//! - `hold`: frictionless contacts held on their grounds along a step (several met at once).
 //! - `release`: when active rows leave (early, before a round is stationary; several at once).
 //! - `let_go`: contacts that no longer hold a floating body when a round stalls.
 //! - `patch`: rounded hulls (mesh feet) rolling on one sticking pivot.
@@ -15,6 +16,7 @@ pub(crate) mod active_set;
 pub(crate) mod bend;
 pub(crate) mod distribution;
 pub(crate) mod guard;
+pub(crate) mod hold;
 pub(crate) mod let_go;
 pub(crate) mod patch;
 pub(crate) mod release;

@@ -12,7 +12,9 @@
 //! (`Eval::merit`), which removes the first-order effect of the corrector's remaining
 //! residual. With a guard, a trial point that violates an inactive inequality is replaced by
 //! the point where the first one reaches its boundary, accepted if it does not raise `f`
-//! beyond rounding.
+//! beyond rounding; with the projected search, first by its projection onto the frictionless
+//! contacts it pushes into a ground (module `inequality::hold`), accepted by Armijo's test on
+//! the change actually made.
 //!
 //! ## References
 //! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §3.1, §3.5.
@@ -94,6 +96,24 @@ pub(crate) fn line_search(
             continue;
         }
         if let Some(guard) = guard.filter(|g| g.violated(sys, &qt)) {
+            // Frictionless contacts held on their grounds (module `inequality::hold`).
+            if let Some((qh, k)) = guard.hold(sys, &qt, options) {
+                if let Some(eh) = sys.evaluate(&qh, part) {
+                    diag.function_evaluations += 1;
+                    let columns = &sys.problem.scaling.columns;
+                    let descent =
+                        eval.grad_v
+                            .dot(&independent_change(&part.independent, columns, q, &qh));
+                    if descent < 0.0 && eh.merit <= f + 1e-4 * descent {
+                        return Some(Trial {
+                            q: qh,
+                            eval: eh,
+                            alpha,
+                            blocked: Some(k),
+                        });
+                    }
+                }
+            }
             // Cut the step where the first inequality reaches its boundary.
             if let Some((qb, k)) = guard.boundary(sys, q, dq, alpha, Some(&qt), part, options, eval)
             {

@@ -13,7 +13,13 @@ pub(crate) fn run(a: &CheckArgs) -> anyhow::Result<u8> {
     let text = matches!(a.format, Format::Text) && !stdout_json;
     let check = restpose::verify::check(&loaded.model);
     let s = ModelSummary::of_model(&loaded).with_check(&check);
-    let mut listing = Vec::new();
+    // About 100 bytes a line, a line per body and joint: reserved once (capacity never
+    // written costs no page), not regrown by copies.
+    let mut listing = Vec::with_capacity(if text {
+        4096 + 128 * (s.bodies.len() + s.joints.len())
+    } else {
+        0
+    });
     if text {
         print::model_listing(&s, &mut listing);
     }

@@ -109,8 +109,10 @@ pub(super) fn import(
         ));
     }
     super::schema::check(&src, robot, &mut warnings)?;
-    let mut link_nodes = Vec::new();
-    let mut joint_nodes = Vec::new();
+    // Sized for every child element (no regrowth copies on large files).
+    let children = robot.children().filter(|c| c.is_element()).count();
+    let mut link_nodes = Vec::with_capacity(children);
+    let mut joint_nodes = Vec::with_capacity(children);
     let mut loop_nodes = Vec::new();
     let mut drake_nodes = Vec::new();
     let mut gazebo_nodes = Vec::new();

@@ -46,6 +46,7 @@
 //! partitions per round, `O(N)` on chains, trees and ladders, plus `O(d² m)` for `d`
 //! dependent rows among `m`.
 
+pub(super) use super::model_rows::ModelRows;
 use super::unilateral::Touching;
 use crate::constraints::{BlockKind, Constraints, Triplets};
 use crate::error::{Error, Result};
@@ -99,6 +100,7 @@ pub(super) fn held(
     backend: Backend,
     tau: f64,
     free: Free,
+    given: Option<ModelRows>,
 ) -> Result<Held> {
     let locks = crate::solver::lock_values(model);
     let mut all = locks.clone();
@@ -125,7 +127,17 @@ pub(super) fn held(
         Free::Skip if list.is_empty() => {
             // The locked solve is what the two stages give without a touching row (both the
             // balanced and the unbalanced case solve it; the balanced one adds a zero).
-            let r = solve_once(model, state, &[], &[], &all, locks.len(), backend, None)?;
+            let r = solve_once(
+                model,
+                state,
+                &[],
+                &[],
+                &all,
+                locks.len(),
+                backend,
+                None,
+                given,
+            )?;
             return Ok(Held {
                 efforts: row_of.iter().map(|&k| r.locks[k]).collect(),
                 locked,
@@ -136,14 +148,34 @@ pub(super) fn held(
             });
         }
         _ => with_rounds(list, tau, |on| {
-            solve_once(model, state, list, on, &locks, locks.len(), backend, None)
+            solve_once(
+                model,
+                state,
+                list,
+                on,
+                &locks,
+                locks.len(),
+                backend,
+                None,
+                None,
+            )
         })?,
     };
     let locked_solve = if free.0.unassigned <= tau {
         None
     } else {
         let (r, forces, _) = with_rounds(list, tau, |on| {
-            solve_once(model, state, list, on, &all, locks.len(), backend, None)
+            solve_once(
+                model,
+                state,
+                list,
+                on,
+                &all,
+                locks.len(),
+                backend,
+                None,
+                None,
+            )
         })?;
         // Too many dependent rows to choose among (a rope on the ground with its joints
         // locked): the forces of the solve without locks, the efforts balancing the rest.
@@ -167,6 +199,7 @@ pub(super) fn held(
                 locks.len(),
                 backend,
                 Some(&carried),
+                given,
             )?;
             (efforts, free.1)
         }
@@ -278,6 +311,7 @@ fn solve_once(
     model_locks: usize,
     backend: Backend,
     carried: Option<&DVector<f64>>,
+    given: Option<ModelRows>,
 ) -> Result<Multipliers> {
     let kept: Vec<usize> = (0..list.len()).filter(|&i| on[i]).collect();
     let active: Vec<_> = kept.iter().map(|&i| list[i].active).collect();
@@ -311,6 +345,10 @@ fn solve_once(
         at: "the given pose".into(),
         rows,
     };
+    // The model's rows from the balance check where they are this system's first ones.
+    if let Some(rows) = given {
+        rows.install(&mut sys, &state.q);
+    }
     let part = super::rank::partition(&mut sys, &state.q);
     let mut eval = sys
         .evaluate(&state.q, &part)

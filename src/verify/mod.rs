@@ -36,6 +36,7 @@ mod friction;
 mod held;
 mod initial_guess;
 mod lexicographic;
+mod model_rows;
 mod pose;
 mod rank;
 mod reduced;

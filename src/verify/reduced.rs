@@ -61,6 +61,20 @@ pub(super) fn reduced<'a>(
         Constraints::new(model, locks).on_branches(state.branches.clone()),
         backend,
     );
+    // Room in the triplets for a lock row on every joint coordinate: they become the first
+    // rows of the forces' locked system (module `model_rows`), which then grows them in
+    // place (capacity never written costs no page; `Constraints::evaluate` reserves only an
+    // empty list).
+    let coordinates: usize = model
+        .joints
+        .iter()
+        .filter(|j| j.tree && !j.merged)
+        .map(|j| j.kind.scalar_coordinates())
+        .sum();
+    sys.work
+        .jac
+        .entries
+        .reserve_exact(crate::jet::NL * (sys.problem.cons.len() + coordinates));
     // The guard's gradient is `∇V` (one evaluation for both).
     let guarded = crate::solver::finite::guard_system_energy(&mut sys, state, "the given pose")?;
     let (guard_energy, g) = guarded.ok_or_else(|| {

@@ -5,7 +5,6 @@
 use super::{
     closures, held, reduced, unilateral, Imbalance, Tolerances, Unilaterals, Verification,
 };
-use crate::error::Error;
 use crate::error::Result;
 use crate::jet::pair_of;
 use crate::model::{JointId, Model};
@@ -40,8 +39,9 @@ pub(super) fn tree_coordinates(model: &Model, state: &State) -> Vec<(JointId, us
 /// partition fits a tree, [`Backend::Tree`]).
 ///
 /// On the sparse path the stability verdict reuses the partition and evaluation of the
-/// balance check, and is computed on a second thread while the forces are (kept only when
-/// the pose passes); both only read the model and the state. `eigenvalues`: the lowest
+/// balance check and is computed before the forces (kept only when the pose passes), on the
+/// same thread: the balance check's memory then serves the forces' locked system, which
+/// starts from the balance check's evaluated rows (module `model_rows`). `eigenvalues`: the lowest
 /// eigenvalues also where only Lanczos finds them ([`super::Eigenvalues::Always`]).
 pub(super) fn verify_on(
     model: &Model,
@@ -104,28 +104,33 @@ pub(super) fn verify_on(
                 None => held::Free::Skip,
                 Some(_) => held::Free::Solve,
             };
-            let (held, stability) = std::thread::scope(|s| {
-                let verdict = solved
-                    .as_ref()
-                    .filter(|_| assembled && list.is_empty() && !skip)
-                    .map(|(part, eval)| {
-                        let sys = &mut sys;
-                        s.spawn(move || {
-                            crate::solver::stability_of(sys, &state.q, part, eval, eigenvalues)
-                        })
-                    });
-                let held = held::held(model, state, &list, values, forces_backend, tau, free)?;
-                let passed = passes(scaled, &held, force_scale, tol);
-                // A panic there is re-raised here, as if the verdict had been computed on
-                // this thread.
-                let stability = match verdict {
-                    Some(h) if passed => h
-                        .join()
-                        .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
-                    _ => None,
-                };
-                Ok::<_, Error>((held, stability))
-            })?;
+            // The verdict first, on this thread; then the balance check's memory (its
+            // factors, the KKT matrix and factors of the verdict) goes back before the forces'
+            // locked system is built, which reuses it (the two systems alive at once, on two
+            // threads, were most of `verify`'s fresh pages: each costs a page fault). The
+            // model's rows go to the locked system (module `model_rows`).
+            let stability = solved
+                .as_ref()
+                .filter(|_| assembled && list.is_empty() && !skip)
+                .and_then(|(part, eval)| {
+                    crate::solver::stability_of(&mut sys, &state.q, part, eval, eigenvalues)
+                });
+            sys.work.kkt = None;
+            drop(solved);
+            let given = held::ModelRows::take(&mut sys, &state.q, values.len());
+            drop(sys);
+            let held = held::held(
+                model,
+                state,
+                &list,
+                values,
+                forces_backend,
+                tau,
+                free,
+                given,
+            )?;
+            // The verdict of a pose that fails is not reported.
+            let stability = stability.filter(|_| passes(scaled, &held, force_scale, tol));
             (
                 phi,
                 scaled,
@@ -151,6 +156,7 @@ pub(super) fn verify_on(
                 forces_backend,
                 tau,
                 held::Free::Solve,
+                None,
             )?;
             (
                 p.phi,

@@ -109,33 +109,45 @@ fn sparse_and_dense_verdicts_agree_with_loops_and_spherical_joints() {
 
 /// Where nothing touches, the first solve of the forces that hold a pose is the balance
 /// check's own system: taken from it (`held::free_of`) the efforts, the unassigned force and
-/// the resolution are those `held` finds with its own partition, on a chain and a ladder (with
-/// redundant rows), at a rest and off it.
+/// the resolution are those `held` finds with its own partition, on a chain, a ladder (with
+/// redundant rows) and a chain with a lock of its own, at a rest and off it; and the locked
+/// system built on the balance check's evaluated rows (module `model_rows`) gives them too,
+/// to the bit.
 #[test]
 fn held_from_the_balance_checks_system_is_held_from_its_own() {
+    let locked = crate::generate::chain(30, false).replace(
+        "</robot>",
+        "<mech:lock joint=\"joint3\" value=\"0.2\"/></robot>",
+    );
     for text in [
         crate::generate::chain(30, false),
         crate::generate::ladder(5),
+        locked,
     ] {
         let model = load(&text);
         let (rest, _) = crate::solver::solve(&model, &Default::default()).unwrap();
         for state in [rest, bent(&model)] {
             let locks = crate::solver::lock_values(&model);
             let backend = crate::solver::system::Backend::Sparse;
-            let r = super::reduced::reduced(&model, &state, &locks, backend, true).unwrap();
+            let mut r = super::reduced::reduced(&model, &state, &locks, backend, true).unwrap();
             let values = super::run::tree_coordinates(&model, &state);
             let tau = 1e-9 * r.force_scale.max(1.0);
-            let held =
-                |free| super::held::held(&model, &state, &[], &values, backend, tau, free).unwrap();
-            let own = held(super::held::Free::Solve);
+            let held = |free, rows| {
+                super::held::held(&model, &state, &[], &values, backend, tau, free, rows).unwrap()
+            };
+            let own = held(super::held::Free::Solve, None);
             let (part, eval) = r.solved.as_ref().unwrap();
-            let given = held(super::held::Free::Given(super::held::free_of(
-                &r.sys, part, eval,
-            )));
+            let given = held(
+                super::held::Free::Given(super::held::free_of(&r.sys, part, eval)),
+                None,
+            );
             // Without the first solve (`analyze`'s self-check): the same numbers (a zero
             // added or not: `==` takes −0 for 0).
-            let skipped = held(super::held::Free::Skip);
-            for other in [&given, &skipped] {
+            let skipped = held(super::held::Free::Skip, None);
+            let rows = super::held::ModelRows::take(&mut r.sys, &state.q, values.len());
+            assert!(rows.is_some(), "{}: the balance check's rows", model.name);
+            let reused = held(super::held::Free::Skip, rows);
+            for other in [&given, &skipped, &reused] {
                 assert_eq!(own.efforts, other.efforts, "{}", model.name);
                 assert_eq!(own.unassigned, other.unassigned, "{}", model.name);
                 assert_eq!(own.locked, other.locked, "{}", model.name);

@@ -2,8 +2,12 @@
 //! rows, optionally starting with chord steps on the factors of a nearby point. It gives up
 //! at the second Newton step that does not decrease the residual (outside Newton's region of
 //! convergence, or no solution for this `v`: the line search then halves the step) rather
-//! than after `max_iterations` refactorizations. The residual is `‖D Φ‖∞` (module
-//! `residual`): over the independent rows while iterating, over every row at the end.
+//! than after `max_iterations` refactorizations. A point whose rows are all within their
+//! rounding floor (module `residual`) is taken as it is: the search path along the tree
+//! lands a chain's trial points there, and chasing the chord's target `10⁻³` of the
+//! tolerance below it cost two chord steps and a Newton step at every trial point. The
+//! residual is `‖D Φ‖∞` (module `residual`): over the independent rows while iterating, over
+//! every row at the end.
 
 use super::residual::REDUNDANT_FLOOR;
 use super::{Factors, System};
@@ -76,9 +80,11 @@ impl System<'_> {
             }
             // Chord steps converge linearly: they go on to 10⁻³ of the tolerance, so that the
             // result is as tight as a Newton step would leave it (a stalled chord step
-            // switches to Newton).
+            // switches to Newton), or to the rounding floor of every row where that lies above
+            // (no step can be resolved below it: module `residual`).
             let target = if chord.is_some() { 1e-3 * tol } else { tol };
-            if res <= target || (res <= tol && it == max_iterations) {
+            let floor = res <= tol && res > target && self.at_rounding_floor(q, part);
+            if res <= target || floor || (res <= tol && it == max_iterations) {
                 let all = self.dimensionless_residual();
                 return if all <= tol.max(REDUNDANT_FLOOR) {
                     Ok(it)
@@ -125,5 +131,13 @@ impl System<'_> {
             }
         }
         Err(CorrectorFailure)
+    }
+
+    /// Whether `Φ` of the last evaluation (at `q`) is within the rounding floor of every
+    /// independent row (module `residual`).
+    fn at_rounding_floor(&self, q: &DVector<f64>, part: &Partition) -> bool {
+        let scaling = &self.problem.scaling;
+        let m = scaling.extent(q);
+        scaling.at_rounding_floor(&self.problem.cons, &self.work.phi, &part.rows, m)
     }
 }

@@ -260,3 +260,81 @@ fn reduced_gradient_and_hessian_match_differences_through_the_corrector() {
         }
     }
 }
+
+/// `|D_i Φ_i| / (ε m^{k_i})` over the rows `rows`, with the extent `m` computed here from the
+/// body origins: how many units in the last place of its scale each row is off.
+fn worst_ulps(sys: &System, q: &DVector<f64>, rows: &[usize]) -> f64 {
+    let l = sys.problem.model.length_scale();
+    let m = (0..q.len())
+        .filter(|i| i % 7 < 3)
+        .fold(1.0f64, |m, i| m.max(q[i].abs() / l));
+    let phi = sys.phi().clone();
+    rows.iter()
+        .map(|&i| {
+            let k = sys.problem.cons.length_power(i);
+            (phi[i] * l.powi(-k)).abs() / (f64::EPSILON * m.powi(k))
+        })
+        .fold(0.0, f64::max)
+}
+
+/// The corrector takes a point whose rows are all within their rounding floor (8 ulps of the
+/// extent in `L^k`) as it is, although its residual is above the chord steps' target
+/// (`10⁻³` of the tolerance), and corrects a point above the floor (but within the
+/// tolerance) to the target or the floor.
+#[test]
+fn the_corrector_stops_at_the_rounding_floor_and_not_above_it() {
+    let model = load_str(
+        &crate::generate::chain(300, false),
+        "chain.urdf",
+        &ImportOptions::default(),
+    )
+    .unwrap()
+    .model;
+    let q0 = crate::solver::initial_state(&model).q;
+    let q = crate::solver::assemble_only(&model, q0, &mut Default::default(), &[]).unwrap();
+    let mut sys = System::new(
+        &model,
+        Constraints::new(&model, &[]),
+        Backend::choose(&model, crate::solver::LinearAlgebra::Auto),
+    );
+    let part = sys.partition(&q);
+    let e = sys.evaluate(&q, &part).unwrap();
+    let tol = 1e-10;
+    // A position coordinate of the last body, a dependent one.
+    let last = model.bodies.len() - 1;
+    let c = *part
+        .dependent
+        .iter()
+        .find(|&&c| c / 7 == last && c % 7 < 3)
+        .expect("a dependent position of the last body");
+    let l = model.length_scale();
+    let scaled = |sys: &mut System, q: &DVector<f64>| {
+        sys.residual(q);
+        sys.problem.scaling.residual_over(sys.phi(), &part.rows)
+    };
+    // 1.5 · 10⁻¹³ L off (about 5 ulps of the 60 m chain): above the target, within the floor.
+    let mut at_floor = q.clone();
+    at_floor[c] += 1.5e-13 * l;
+    let res = scaled(&mut sys, &at_floor);
+    let ulps = worst_ulps(&sys, &at_floor, &part.rows);
+    assert!(res > 1e-3 * tol && ulps <= 8.0, "res {res:e}, {ulps} ulps");
+    let before = at_floor.clone();
+    let its = sys
+        .correct_from(&mut at_floor, &part, tol, 25, Some(&e.factors))
+        .unwrap();
+    assert_eq!(its, 0);
+    assert_eq!(at_floor, before, "a point at the floor is not moved");
+    // 10⁻¹¹ L off: within the tolerance but far above the floor; corrected.
+    let mut above = q.clone();
+    above[c] += 1e-11 * l;
+    let res = scaled(&mut sys, &above);
+    assert!(res > 1e-12 && res <= tol, "res {res:e}");
+    let its = sys
+        .correct_from(&mut above, &part, tol, 25, Some(&e.factors))
+        .unwrap();
+    assert!(its >= 1);
+    let res = scaled(&mut sys, &above);
+    let ulps = worst_ulps(&sys, &above, &part.rows);
+    assert!(res <= 1e-3 * tol || ulps <= 8.0, "res {res:e}, {ulps} ulps");
+    assert!((above[c] - q[c]).abs() < 1e-12 * l, "corrected back");
+}

@@ -107,8 +107,7 @@ impl System<'_> {
         if complete {
             let columns = &self.problem.scaling.columns;
             let mut wdiag = std::mem::take(&mut self.work.wdiag);
-            wdiag.clear();
-            wdiag.extend((0..n).map(|c| tree.fused_diagonal(c).abs() * columns[c].powi(2)));
+            tree.fused_diagonal(columns, &mut wdiag);
             let mut sink = tree.fused_sink();
             self.augment_into(part, wdiag, &mut sink);
             let complete = !sink.missing;

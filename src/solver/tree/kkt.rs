@@ -37,6 +37,8 @@ pub(crate) struct TreeKkt {
     pub(super) shape: Shape,
     /// The Hessian blocks by body pair (module `fused`; built at the first fused assembly).
     pub(super) map: Option<BlockMap>,
+    /// The fused assembly's `7 × 7` blocks of `W` (unscaled; the kept blocks of `map`).
+    pub(super) w_blocks: Vec<[f64; 49]>,
     id: usize,
     triplets: usize,
     blocks: usize,
@@ -83,6 +85,7 @@ impl TreeKkt {
         let dim = shape.n + shape.rows;
         Some(TreeKkt {
             map: None,
+            w_blocks: Vec::new(),
             id: part.id,
             triplets: entries.len(),
             blocks: hess.keys.len(),

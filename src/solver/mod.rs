@@ -202,7 +202,7 @@ pub(crate) fn solve_round(
     let cons = Constraints::new(model, locks)
         .with_active(model, active)
         .on_branches(start.branches.clone());
-    let mut sys = System::new(model, cons, Backend::of_round(model, options, active));
+    let mut sys = System::new(model, cons, Backend::of_round(model, options));
     let part = sys.partition(&q);
     let dof0 = part.independent.len();
     if options.method != Method::Newton && dof0 > QUASI_NEWTON_DOF_LIMIT {

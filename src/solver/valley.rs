@@ -16,10 +16,14 @@
 //!
 //! `δ = −Σ_{i stiff} w_i (w_iᵀ g) / λ_i`
 //!
-//! (`λ_i, w_i` the eigenpairs of the reduced Hessian at `v̂`, the stiff ones those above a
-//! spectral gap of [`GAP`]; up to [`CORRECTIONS`] times, each kept where it lowers the merit
-//! and the gradient) moves the trial point back to the floor, and the line search judges the
-//! corrected point. The next iterate then sits on the floor, its soft curvature is `ε″` itself
+//! (`λ_i, w_i` the eigenpairs of the reduced Hessian at the point corrected, recomputed for
+//! each correction: the stiff directions turn with the soft coordinate; the stiff ones all but
+//! the valley's soft ones, those below a spectral gap of [`GAP`] at `v̂`; up to
+//! [`CORRECTIONS`] times, each kept where it lowers the merit and the gradient) moves the
+//! trial point back to the floor, and the line search judges the corrected point. With the
+//! eigenpairs of `v̂` instead (main until session 26), iCub's round along its right hip yaw
+//! crawled 8 iterations: the trial points 0.6 rad along the yaw stayed 10⁻⁹ … 10⁻⁸ J above
+//! the start, off the floor, and the search backtracked to a tenth. The next iterate then sits on the floor, its soft curvature is `ε″` itself
 //! and the Newton step along `ψ` goes the whole way. Along the floor the energy may change by
 //! less than its rounding: a trial point whose merit is equal to rounding is then accepted when
 //! its gradient along the soft eigenvectors is smaller ([`Valley::closer`]). All this only
@@ -40,6 +44,7 @@
 use super::options::Options;
 use super::partition::Partition;
 use super::report::{Diagnostics, Iterate};
+use super::stability::blocks::block_symmetric_eigen;
 use super::stability::spectrum::Spectrum;
 use super::system::{Eval, System};
 use nalgebra::{DMatrix, DVector};
@@ -63,15 +68,13 @@ pub(crate) const SETTLED: f64 = 1e-3;
 /// Iterations a round takes past the gradient test to settle the soft coordinates.
 pub(crate) const MAX_SETTLING: usize = 3;
 
-/// Stiff Newton steps that bring a trial point back to the floor at most (the stiff Hessian is
-/// that of the start of the line search: the steps converge linearly).
+/// Stiff Newton steps that bring a trial point back to the floor at most, each with the
+/// reduced Hessian at the point it starts from.
 pub(crate) const CORRECTIONS: usize = 3;
 
-/// The stiff eigenpairs of the reduced Hessian at the start of a line search, and the soft
-/// ones.
+/// The soft eigenpairs of the reduced Hessian at the start of a line search (the valley's
+/// floor).
 pub(crate) struct Valley {
-    vectors: DMatrix<f64>,
-    values: DVector<f64>,
     soft: Vec<(DVector<f64>, f64)>,
 }
 
@@ -148,10 +151,7 @@ impl Valley {
         if ratio < GAP || order.iter().any(|&i| e.values[i] <= resolved) {
             return None;
         }
-        let stiff = &order[split..];
         Some(Valley {
-            vectors: e.vectors.select_columns(stiff),
-            values: DVector::from_iterator(stiff.len(), stiff.iter().map(|&i| e.values[i])),
             soft: order[..split]
                 .iter()
                 .map(|&i| (e.vectors.column(i).into_owned(), e.values[i]))
@@ -159,10 +159,27 @@ impl Valley {
         })
     }
 
-    /// The stiff Newton step at the reduced gradient `g` (module docs).
-    fn step(&self, g: &DVector<f64>) -> DVector<f64> {
-        let c = self.vectors.tr_mul(g).component_div(&self.values);
-        -(&self.vectors * c)
+    /// The stiff Newton step at the reduced gradient `g` (module docs) with the eigenpairs
+    /// `(values, vectors)` of the reduced Hessian where `g` was taken: along all but the
+    /// valley's number of soft directions (the smallest magnitudes); `None` where one of
+    /// those stiff eigenvalues is not positive (no floor to go back to).
+    fn stiff_step(
+        &self,
+        values: &DVector<f64>,
+        vectors: &DMatrix<f64>,
+        g: &DVector<f64>,
+    ) -> Option<DVector<f64>> {
+        let mut order: Vec<usize> = (0..values.len()).collect();
+        order.sort_by(|&a, &b| values[a].abs().total_cmp(&values[b].abs()));
+        let mut d = DVector::zeros(g.len());
+        for &i in order.iter().skip(self.soft.len()) {
+            if values[i] <= 0.0 {
+                return None;
+            }
+            let w = vectors.column(i);
+            d -= w * (w.dot(g) / values[i]);
+        }
+        Some(d)
     }
 
     /// Whether the gradient along the floor (on the soft eigenvectors) is smaller at `g1` than
@@ -184,7 +201,13 @@ impl Valley {
         (mut q, mut eval): (DVector<f64>, Eval),
     ) -> (DVector<f64>, Eval) {
         for _ in 0..CORRECTIONS {
-            let d = self.step(&eval.grad_v);
+            // The stiff directions of the trial point itself: they turn with the soft
+            // coordinate (iCub's leg as its hip yaw turns 0.6 rad).
+            let h = sys.reduced_hessian(&q, part, &eval);
+            let (values, vectors) = block_symmetric_eigen(&h);
+            let Some(d) = self.stiff_step(&values, &vectors, &eval.grad_v) else {
+                break;
+            };
             let dq = sys.tangent_step(part, &eval, &d);
             let mut qc = sys.problem.retraction.point(&q, &dq, 1.0);
             if sys
@@ -234,11 +257,31 @@ mod tests {
         let v = Valley::of(&spectrum(&[2.0, 1e-7, 0.02, 70.0])).expect("a valley");
         // The stiff step leaves the soft component alone and is Newton's on the others.
         let g = DVector::from_row_slice(&[4.0, 1.0, 0.02, 7.0]);
-        let d = v.step(&g);
+        let e = spectrum(&[2.0, 1e-7, 0.02, 70.0]);
+        let d = v.stiff_step(&e.values, &e.vectors, &g).unwrap();
         assert_eq!(d[1], 0.0);
         assert!(
             (d[0] + 2.0).abs() < 1e-15 && (d[2] + 1.0).abs() < 1e-15 && (d[3] + 0.1).abs() < 1e-15
         );
+    }
+
+    #[test]
+    fn the_stiff_step_follows_the_directions_of_the_point_it_corrects() {
+        // The valley of the start: soft along e₀, stiff along e₁. At the trial point the
+        // floor has turned by 30°: the stiff step is Newton's along the turned direction
+        // (leaving the turned soft one alone), not along e₁.
+        let v = Valley::of(&spectrum(&[1e-9, 1.0])).expect("a valley");
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        let vectors = DMatrix::from_row_slice(2, 2, &[c, -s, s, c]);
+        let values = DVector::from_row_slice(&[2e-9, 4.0]);
+        let g = DVector::from_row_slice(&[0.3, 0.5]);
+        let d = v.stiff_step(&values, &vectors, &g).unwrap();
+        let (soft, stiff) = (vectors.column(0), vectors.column(1));
+        assert!(d.dot(&soft).abs() < 1e-15, "{d}");
+        assert!((d.dot(&stiff) + stiff.dot(&g) / 4.0).abs() < 1e-15, "{d}");
+        // No floor where a stiff eigenvalue is not positive.
+        let values = DVector::from_row_slice(&[2e-9, -4.0]);
+        assert!(v.stiff_step(&values, &vectors, &g).is_none());
     }
 
     #[test]

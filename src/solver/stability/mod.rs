@@ -15,6 +15,7 @@
 //!   `H_θ = T⁻ᵀ Ĥ T⁻¹` (physical units, independent of the partition).
 
 pub(crate) mod at_rest;
+pub(crate) mod blocks;
 pub(crate) mod cone;
 pub(crate) mod eigen;
 pub(crate) mod inertia;

@@ -17,6 +17,7 @@
 //! ## References
 //! - Y. Saad, *Numerical Methods for Large Eigenvalue Problems*, 2nd ed., SIAM (2011), §6.6.
 
+use super::blocks::block_symmetric_eigen;
 use super::eigen::symmetric_eigen;
 use crate::solver::partition::Partition;
 use crate::solver::sparse::kkt::Factored;
@@ -110,7 +111,7 @@ pub(crate) fn spectrum(
     let dof = part.independent.len();
     if exact(sys.backend, dof) {
         let (h, basis) = sys.reduced_hessian_and_basis(q, part, eval);
-        let (values, vectors) = symmetric_eigen(&h);
+        let (values, vectors) = block_symmetric_eigen(&h);
         let largest = values.amax();
         return Spectrum {
             values,

@@ -29,7 +29,7 @@
 
 use crate::math::compose;
 use crate::solver::partition::Partition;
-use crate::solver::stability::eigen::symmetric_eigen;
+use crate::solver::stability::blocks::block_symmetric_eigen;
 use crate::solver::stability::spectrum::Spectrum;
 use crate::solver::step::retraction::angular_velocity;
 use crate::solver::system::{Eval, System};
@@ -231,7 +231,8 @@ pub(crate) fn along_path(
     let mut h = &e.vectors * DMatrix::from_diagonal(&e.values) * e.vectors.transpose();
     h += path_curvature(sys, q, part, eval, e.basis.as_ref());
     let h = (&h + h.transpose()) * 0.5;
-    let (values, vectors) = symmetric_eigen(&h);
+    // Per decoupled block (fingers, legs): each eigenvector on one of them.
+    let (values, vectors) = block_symmetric_eigen(&h);
     Spectrum {
         largest: values.amax(),
         values,

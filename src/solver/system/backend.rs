@@ -47,11 +47,11 @@ impl Backend {
     /// [`SPARSE_FROM_COORDINATES`] the tree factors for a mechanism without closed loops or
     /// joint stops (its partitions fit a tree: `O(N)` with fixed-size blocks, faster than the
     /// general sparse factors on chains and ropes, BENCHMARKS.md), the sparse ones otherwise:
-    /// a ladder's thousand loops would not fit a small border, and with stops (Romeo hanging
-    /// onto its finger stops) the tree factors' last Newton steps stall at a reduced gradient
-    /// of 3.7e-8 (tolerance 1e-8) where the sparse ones converge in 17 iterations; until that
-    /// is understood, models with stops keep the sparse factors unless `--linear-algebra tree`
-    /// asks for the tree. Contacts are rows on their body like a joint's (tested against the
+    /// a ladder's thousand loops would not fit a small border. A mechanism without closed
+    /// loops but with stops is given the sparse factors here and the tree ones by each round
+    /// of its solve ([`Backend::of_round`]; before the projected stop search, the tree
+    /// factors' last Newton steps stalled on Romeo's finger stops at a reduced gradient of
+    /// 3.7e-8, tolerance 1e-8). Contacts are rows on their body like a joint's (tested against the
     /// sparse factors: a rope on the ground, Solo-12 standing). Below, the tree factors for a
     /// model of [`TREE_FROM_BODIES`] or more bodies without closed loops, stops, contacts,
     /// locks or mimics, and the dense path otherwise.
@@ -76,28 +76,18 @@ impl Backend {
         Self::choose(model, options.linear_algebra)
     }
 
-    /// The backend of one round of a solve with `options` whose active inequalities are
-    /// `active`: [`Backend::of`], but with the automatic choice the tree factors also for a
-    /// mechanism without closed loops whose joint stops are all inactive in this round (a
-    /// chain whose limits are never reached: the stops are then only the guard's, outside the
-    /// linear algebra). A round with a stop active keeps the sparse factors (see
-    /// [`Backend::choose`]).
-    pub(crate) fn of_round(
-        model: &Model,
-        options: &crate::solver::Options,
-        active: &[crate::constraints::unilateral::Active],
-    ) -> Self {
+    /// The backend of one round of a solve with `options`: [`Backend::of`], but with the
+    /// automatic choice the tree factors for every mechanism without closed loops, its joint
+    /// stops active in the round or not (a stop's row is on its joint's child body, like the
+    /// joint's own rows). The sparse factors cost Romeo hanging onto its finger stops 1.26×
+    /// the CPU of its solve with `--limits ignore` (faer's numeric LU, its symbolic analysis
+    /// at each round's partition and its solves: all of the difference); the tree factors
+    /// 1.06× (BENCHMARKS.md). The stall [`Backend::choose`] recalls is gone since the
+    /// projected stop search: `--linear-algebra tree` ends Romeo's 14 iterations at the
+    /// sparse factors' rest.
+    pub(crate) fn of_round(model: &Model, options: &crate::solver::Options) -> Self {
         let chosen = Self::of(model, options);
-        let stop = active.iter().any(|a| {
-            matches!(
-                a.row,
-                crate::constraints::unilateral::Unilateral::Limit { .. }
-            )
-        });
-        if options.linear_algebra == LinearAlgebra::Auto
-            && chosen == Backend::Sparse
-            && !stop
-            && open(model)
+        if options.linear_algebra == LinearAlgebra::Auto && chosen == Backend::Sparse && open(model)
         {
             Backend::Tree
         } else {

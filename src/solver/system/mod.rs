@@ -19,6 +19,7 @@
 mod augment;
 mod backend;
 mod base;
+mod basis_products;
 mod corrector;
 mod factors;
 mod kkt;

@@ -2,6 +2,7 @@
 //! reduced gradient `∂V/∂v = V_v − Φ_vᵀ μ` (eq. 37), the tangent map `Z = [H; I] S` with
 //! `H = −Φ_u⁻¹ Φ_v`, and the reduced Hessian `Zᵀ W Z`, `W = V_qq − Σ_k μ_k Φ_k,qq`.
 
+use super::basis_products::{mul_add_columns, tr_mul, Pattern};
 use super::{Backend, Factors, System};
 use crate::forces::{potential, Energy};
 use crate::jet::HessianSink;
@@ -128,6 +129,46 @@ impl System<'_> {
             for (k, &c) in part.dependent.iter().enumerate() {
                 out[c] = rhs[k];
             }
+        }
+    }
+
+    /// `Z` into the `n × dof` zeros `z`: the columns of [`System::tangent_column`] bit for
+    /// bit, on the tree factors all in one pass (`Φ_v S` scattered once, one solve with `dof`
+    /// right sides: [`TreeLu::solve_columns`]), otherwise one by one.
+    ///
+    /// [`TreeLu::solve_columns`]: crate::solver::tree::phi_u::TreeLu::solve_columns
+    fn tangent_columns(&self, part: &Partition, eval: &Eval, z: &mut DMatrix<f64>) {
+        let dof = part.independent.len();
+        let r = part.rows.len();
+        if let (Factors::Tree(f), true) = (&eval.factors, r > 0) {
+            // `dvu` of `tangent_column`: `1 · s_b` at `b`.
+            let scale: Vec<f64> = part
+                .independent
+                .iter()
+                .map(|&c| 1.0 * self.problem.scaling.columns[c])
+                .collect();
+            // `−Φ_v dvu` for every `b` (row-major `rows × dof`), negated as that of one column.
+            let mut x = vec![0.0; r * dof];
+            f.add_phi_v_scaled(&scale, &mut x, dof);
+            for v in x.iter_mut() {
+                *v = -*v;
+            }
+            if f.solve_columns(&mut x, dof) {
+                for (b, &c) in part.independent.iter().enumerate() {
+                    z[(c, b)] = scale[b];
+                }
+                for (k, &c) in part.dependent.iter().enumerate() {
+                    for (b, &v) in x[k * dof..(k + 1) * dof].iter().enumerate() {
+                        z[(c, b)] = v;
+                    }
+                }
+                return;
+            }
+            z.fill(0.0);
+        }
+        let mut dvu = DVector::zeros(dof);
+        for b in 0..dof {
+            self.tangent_column(part, eval, b, &mut dvu, z.column_mut(b).as_mut_slice());
         }
     }
 
@@ -283,14 +324,10 @@ impl System<'_> {
             self.lagrangian_blocks(q, part, eval);
             let mut z = DMatrix::zeros(n, dof);
             let mut wz = DMatrix::zeros(n, dof);
-            let mut dvu = DVector::zeros(dof);
-            for b in 0..dof {
-                self.tangent_column(part, eval, b, &mut dvu, z.column_mut(b).as_mut_slice());
-                self.work
-                    .hess
-                    .mul_add(z.column(b).as_slice(), wz.column_mut(b).as_mut_slice());
-            }
-            (z.tr_mul(&wz), Some(z))
+            self.tangent_columns(part, eval, &mut z);
+            let pattern = Pattern::of(&z);
+            mul_add_columns(&self.work.hess, &z, &pattern, &mut wz);
+            (tr_mul(&z, &wz, &pattern), Some(z))
         } else if self.backend != Backend::Dense {
             self.lagrangian_blocks(q, part, eval);
             let mut hr = DMatrix::zeros(dof, dof);

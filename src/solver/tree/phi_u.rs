@@ -466,4 +466,35 @@ impl TreeLu {
         }
         x
     }
+
+    /// `B += Φ_v diag(scale)` into the row-major `order × w` zeros `b`: column `j` is
+    /// [`TreeLu::phi_v_mul`] of `scale[j] e_j` to the bit (the others' terms add zeros).
+    pub(crate) fn add_phi_v_scaled(&self, scale: &[f64], b: &mut [f64], w: usize) {
+        let s = &*self.shape;
+        for (&(i, j), v) in s.v_at.iter().zip(&self.vals[s.v0..]) {
+            b[i as usize * w + j as usize] += v * scale[j as usize];
+        }
+    }
+
+    /// `Φ_u X = B` in place for the `w` columns of the row-major `order × w` `x` in one pass,
+    /// each column [`TreeLu::solve`]'s operations in its order; `false` on a singular `Φ_u`,
+    /// a border or a non-finite entry (then solve column by column).
+    pub(crate) fn solve_columns(&self, x: &mut [f64], w: usize) -> bool {
+        let s = &*self.shape;
+        if !self.ok || !s.border.is_empty() || x.len() != s.order * w {
+            return x.is_empty();
+        }
+        let (diag, off) = self.vals[..s.border0].split_at(s.off0);
+        for i in (0..s.span.len()).rev() {
+            let r = s.off_at[i]..s.off_at[i + 1];
+            for (&(p, q), &v) in s.off[r.clone()].iter().zip(&off[r]) {
+                let (p, q) = (p as usize * w, q as usize * w);
+                (0..w).for_each(|c| x[p + c] -= v * x[q + c]);
+            }
+            let (a, b) = s.span[i];
+            let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];
+            dense::lu_solve(blk, &self.piv[a..b], b - a, &mut x[a * w..b * w], w);
+        }
+        x.iter().all(|v| v.is_finite())
+    }
 }

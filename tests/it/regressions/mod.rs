@@ -8,6 +8,7 @@ mod issue_21_bolt_rolls_over;
 mod issue_21_chain_on_its_stops;
 mod issue_21_curved_valley;
 mod issue_21_falls_found_at_once;
+mod issue_21_fingers_fall_together;
 mod issue_21_free_arm_converges_directly;
 mod issue_21_ground_start;
 mod issue_21_knees_on_both_stops;

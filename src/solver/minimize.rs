@@ -44,8 +44,8 @@ use super::inequality::release::Release;
 use super::options::{Method, Options};
 use super::partition::Partition;
 use super::report::{Diagnostics, Iterate, Termination};
-use super::stability::at_rest::for_minimizer;
 use super::stability::spectrum::Spectrum;
+use super::stability::{at_rest::for_minimizer, inertia::ByInertia};
 use super::step::direction::direction;
 use super::step::line_search::{line_search, Line, Trial};
 use super::step::quasi_newton::QuasiNewton;
@@ -63,9 +63,8 @@ pub(crate) struct Outcome {
     /// Reduced-Hessian eigenvalues and eigenvectors at `q`, when the convergence test
     /// computed them.
     pub(crate) eigen: Option<Spectrum>,
-    /// The inertia verdict and tolerance at `q` where the convergence test took it instead of
-    /// the Lanczos spectrum (module `stability::at_rest`).
-    pub(crate) inertia: Option<(super::report::Verdict, f64)>,
+    /// The inertia verdict at `q`, where the convergence test took it (`stability::at_rest`).
+    pub(crate) inertia: Option<ByInertia>,
     /// The accepted iterates, when `Options::record_iterates` is set.
     pub(crate) iterates: Vec<DVector<f64>>,
     pub(crate) eval: Eval,
@@ -132,7 +131,7 @@ struct Search {
 enum Test {
     /// Stationary and (unless `allow_unstable`) no negative curvature: the spectrum, if
     /// computed, or else the inertia verdict and tolerance, if that was taken.
-    Converged(Option<Spectrum>, Option<(super::report::Verdict, f64)>),
+    Converged(Option<Spectrum>, Option<ByInertia>),
     /// Stationary at a saddle or maximum: the eigenvector of the most negative eigenvalue.
     Saddle(DVector<f64>),
     /// Not stationary.
@@ -193,11 +192,12 @@ pub(crate) fn minimize(
                 break;
             }
         }
+        let judging = std::time::Instant::now(); // the verdict at a rest: `timings.stability`
         let (eig, test) = convergence_test(sys, &mut s, gtol, options);
         let negative_curvature = match test {
             Test::Converged(e, v) => {
-                eigen = e;
-                inertia = v;
+                s.diag.timings.stability += judging.elapsed().as_secs_f64();
+                (eigen, inertia) = (e, v);
                 termination = Termination::Converged;
                 break;
             }

@@ -31,7 +31,7 @@ pub(crate) fn kkt_direction(
     }
     let mut delta = 0.0;
     for attempt in 0..12 {
-        let mut factored = sys.factor_kkt(q, part, eval, attempt == 0, delta);
+        let mut factored = sys.factor_step_kkt(q, part, eval, attempt == 0, delta);
         let mut dq = sys.kkt_solve(&b);
         if dq.is_none() && matches!(factored, Factored::Ldlt { .. }) {
             // LDLᵀ without pivoting was not accurate enough here: LU with partial pivoting.

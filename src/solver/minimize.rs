@@ -16,16 +16,15 @@
 //! 4. **Step cap** (module `step::step_cap`): the tangent step `δq = Z d` limited on the motion of the
 //!    whole mechanism (every body's Euler parameters by `max_step`, its origin by
 //!    `10 max_step ℓ`, `ℓ` the larger of the length scale and the mechanism's extent).
-//! 5. **Line search and corrector** (module `step::line_search`): backtracking until the Armijo
-//!    condition holds along the search path (module `step::retraction`: every tree joint turns from
-//!    `θ` to `θ + α θ̇`), each trial brought back onto `Φ = 0` by the corrector and halved
-//!    when the corrector fails (paper step (f)), from `α = 1`, or with second-pass choices in a
-//!    sparse partition from the reach the corrector last managed ([`Search::reach`]). With a
-//!    guard, a step that would violate an inactive inequality is cut where the first one
-//!    reaches its boundary, and the minimization stops there (`Outcome::blocked`: the
-//!    inequality update is the caller's, folder `inequality`). In a curved valley the trial
-//!    points are brought back to its floor first, and the test of stage 2 also asks the
-//!    Newton step along the valley to be short (module `valley`).
+//! 5. **Line search and corrector** (module `step::line_search`): backtracking until Armijo
+//!    holds along the search path (module `step::retraction`: tree joints turn from `θ` to
+//!    `θ + α θ̇`), each trial corrected to second order where the path leaves rows open (module
+//!    `step::second_order`), brought back onto `Φ = 0` by the corrector and halved when it fails
+//!    (paper step (f)), from `α = 1` or, with second-pass choices in a sparse partition, the
+//!    corrector's last reach ([`Search::reach`]). With a guard, a step that would violate an
+//!    inactive inequality is cut where the first one reaches its boundary and the minimization
+//!    stops there (`Outcome::blocked`: the caller updates the inequalities). In a curved valley
+//!    trial points go to its floor first and stage 2 asks a short step along it (`valley`).
 //! 6. **Accept** ([`accept_step`]): quasi-Newton update, and the unbounded test (a linear
 //!    descent that goes on, module `unbounded`); with inequalities, the stall test (steps
 //!    shrinking towards an obstacle's edge end the round, module `inequality::stall`).
@@ -45,8 +44,8 @@ use super::inequality::release::Release;
 use super::options::{Method, Options};
 use super::partition::Partition;
 use super::report::{Diagnostics, Iterate, Termination};
-use super::stability::at_rest::for_minimizer;
 use super::stability::spectrum::Spectrum;
+use super::stability::{at_rest::for_minimizer, inertia::ByInertia};
 use super::step::direction::direction;
 use super::step::line_search::{line_search, Line, Trial};
 use super::step::newton::Settle;
@@ -64,9 +63,8 @@ pub(crate) struct Outcome {
     pub(crate) part: Partition,
     /// The reduced Hessian's spectrum at `q`, where the convergence test computed it.
     pub(crate) eigen: Option<Spectrum>,
-    /// The inertia verdict and tolerance at `q` where the convergence test took it instead of
-    /// the Lanczos spectrum (module `stability::at_rest`).
-    pub(crate) inertia: Option<(super::report::Verdict, f64)>,
+    /// The inertia verdict at `q`, where the convergence test took it (`stability::at_rest`).
+    pub(crate) inertia: Option<ByInertia>,
     /// The accepted iterates, when `Options::record_iterates` is set.
     pub(crate) iterates: Vec<DVector<f64>>,
     pub(crate) eval: Eval,
@@ -131,7 +129,7 @@ struct Search {
 /// What the convergence test found.
 enum Test {
     /// Stationary, no negative curvature (unless allowed): the spectrum or inertia verdict.
-    Converged(Option<Spectrum>, Option<(super::report::Verdict, f64)>),
+    Converged(Option<Spectrum>, Option<ByInertia>),
     /// Stationary at a saddle or maximum: the eigenvector of the most negative eigenvalue.
     Saddle(DVector<f64>),
     /// Not stationary.
@@ -192,11 +190,12 @@ pub(crate) fn minimize(
                 break;
             }
         }
+        let judging = std::time::Instant::now(); // the verdict at a rest: `timings.stability`
         let (eig, test) = convergence_test(sys, &mut s, gtol, options);
         let negative_curvature = match test {
             Test::Converged(e, v) => {
-                eigen = e;
-                inertia = v;
+                s.diag.timings.stability += judging.elapsed().as_secs_f64();
+                (eigen, inertia) = (e, v);
                 termination = Termination::Converged;
                 break;
             }
@@ -206,7 +205,7 @@ pub(crate) fn minimize(
         if s.iteration >= options.max_iterations {
             break;
         }
-        let d = reduced_step(
+        let (d, kkt) = reduced_step(
             sys,
             &mut s,
             eig.as_ref(),
@@ -233,6 +232,7 @@ pub(crate) fn minimize(
             dq: &step.dq,
             slope,
             valley: valley.as_ref(),
+            second_order: kkt,
         };
         let trial = line_search(sys, &line, alpha, guard, options, &mut s.diag);
         match trial {
@@ -368,7 +368,7 @@ fn convergence_test(
 }
 
 /// Stage 3: the reduced step `d` (module docs, module `step::direction`); steepest descent
-/// (and a reset quasi-Newton matrix) when that is not a descent direction.
+/// (and a reset quasi-Newton matrix) when not downhill; and whether `sys` keeps its KKT factors.
 fn reduced_step(
     sys: &mut System,
     s: &mut Search,
@@ -376,11 +376,11 @@ fn reduced_step(
     negative_curvature: Option<DVector<f64>>,
     guard: Option<&Guard>,
     options: &Options,
-) -> DVector<f64> {
+) -> (DVector<f64>, bool) {
     let dof = s.part.independent.len();
     let settle = s.settle.take(s.eval.grad_v.amax());
     let g = &s.eval.grad_v;
-    let (d, escaped) = direction(
+    let (d, escaped, kkt) = direction(
         sys,
         (&s.q, &s.part, &s.eval),
         eig,
@@ -394,9 +394,9 @@ fn reduced_step(
     s.diag.negative_curvature_steps += usize::from(escaped || saddle);
     if d.dot(g) > 0.0 && !escaped {
         s.qn = QuasiNewton::new(dof, options.method);
-        return -g.clone();
+        return (-g.clone(), kkt);
     }
-    d
+    (d, kkt)
 }
 
 /// Stage 6: moves to the accepted trial point: the line search's next start, the quasi-Newton

@@ -258,21 +258,22 @@ pub(crate) fn solve_round(
     // A round stopped by an inequality is not a rest pose: the active-set iteration goes on
     // from it (and judges stability itself if it ends there).
     // Where the minimizer judged by the KKT inertia (many degrees of freedom), that verdict,
-    // unless eigenvalues are asked for (module `stability::at_rest`).
+    // unless eigenvalues are asked for (module `stability::at_rest`): then the spectrum, with
+    // that verdict's `λ_max` (the same power iteration at the same point).
     let stability = (dof > 0 && out.blocked.is_none() && out.released.is_empty()).then(|| {
-        if let (Some((verdict, tolerance)), false) = (out.inertia, options.eigenvalues) {
+        if let (Some(judged), false) = (out.inertia, options.eigenvalues) {
             diagnostics.eigenvalues_by = "inertia".into();
             return Stability {
-                verdict,
-                tolerance,
+                verdict: judged.verdict,
+                tolerance: judged.tolerance,
                 eigenvalues: Vec::new(),
                 modes: Vec::new(),
             };
         }
-        let eig = out
-            .eigen
-            .clone()
-            .unwrap_or_else(|| spectrum::spectrum(&mut sys, &out.q, &out.part, &out.eval));
+        let largest = out.inertia.map(|judged| judged.largest);
+        let eig = out.eigen.clone().unwrap_or_else(|| {
+            spectrum::spectrum_knowing(&mut sys, &out.q, &out.part, &out.eval, largest)
+        });
         diagnostics.eigenvalues_by = if eig.exact { "exact" } else { "lanczos" }.into();
         verdict::from_spectrum(&sys, &out.q, &out.part, &out.eval, &eig)
     });
@@ -303,7 +304,8 @@ pub(crate) fn solve_round(
     let multipliers = active_set::active_multipliers(&sys.problem.cons, &mu);
     let blocked = out.blocked;
     let released = out.released;
-    diagnostics.timings.stability = stability_started.elapsed().as_secs_f64();
+    // After the minimizer's verdict at the rest (`minimize::convergence_test`).
+    diagnostics.timings.stability += stability_started.elapsed().as_secs_f64();
     let mut history = out.history;
     for h in &mut history {
         h.load_step = 1;

@@ -225,7 +225,8 @@ pub struct Timings {
     pub assembly: f64,
     /// The minimizer's iterations, load stages included \[s\].
     pub iterations: f64,
-    /// Stability (eigenvalues or inertia) and reactions at the rest pose \[s\].
+    /// Stability (eigenvalues or inertia: the minimizer's verdict at its rest and the
+    /// active set's final one) and reactions at the rest pose \[s\].
     pub stability: f64,
     /// Building the result (joint values, link frames) \[s\].
     pub export: f64,

@@ -11,8 +11,8 @@
 //! eigenvalue is the way out) or where it cannot be trusted. The verdict found on the way is
 //! the rest's stability verdict (module `verdict`) unless eigenvalues are asked for.
 
-use super::inertia::inertia_verdict;
-use super::spectrum::{listed, spectrum, Spectrum};
+use super::inertia::{inertia_verdict, ByInertia};
+use super::spectrum::{listed, spectrum, spectrum_knowing, Spectrum};
 use crate::solver::partition::Partition;
 use crate::solver::report::Verdict;
 use crate::solver::system::{Eval, System};
@@ -21,14 +21,15 @@ use nalgebra::DVector;
 /// The spectrum the minimizer uses at `q` (dof > 0): exact where it is listed (dense path,
 /// few degrees of freedom); else the inertia verdict first (stored in `verdict`), and the
 /// spectrum only when that verdict is `unstable` and the minimizer is to leave
-/// (`allow_unstable` false), or when the inertia cannot be trusted.
+/// (`allow_unstable` false), or when the inertia cannot be trusted. The spectrum after an
+/// inertia verdict takes its `λ_max` (the same power iteration at the same point).
 pub(crate) fn for_minimizer(
     sys: &mut System,
     q: &DVector<f64>,
     part: &Partition,
     eval: &Eval,
     allow_unstable: bool,
-    verdict: &mut Option<(Verdict, f64)>,
+    verdict: &mut Option<ByInertia>,
 ) -> Option<Spectrum> {
     *verdict = None;
     if listed(sys.backend, part.independent.len()) {
@@ -37,7 +38,8 @@ pub(crate) fn for_minimizer(
     match inertia_verdict(sys, q, part, eval) {
         Some(found) => {
             *verdict = Some(found);
-            (found.0 == Verdict::Unstable && !allow_unstable).then(|| spectrum(sys, q, part, eval))
+            (found.verdict == Verdict::Unstable && !allow_unstable)
+                .then(|| spectrum_knowing(sys, q, part, eval, Some(found.largest)))
         }
         None => Some(spectrum(sys, q, part, eval)),
     }

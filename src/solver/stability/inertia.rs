@@ -42,32 +42,49 @@ use crate::solver::sparse::kkt::Factored;
 use crate::solver::system::{Eval, System};
 use nalgebra::DVector;
 
-/// The verdict and its tolerance from the KKT inertia at a feasible `q` of the sparse path;
-/// `None` when the shifted LDLᵀ cannot be trusted (module doc).
+/// A verdict by inertia: the verdict, its tolerance `t = 10⁻¹⁰ max(λ_max, 1)`, and the power
+/// iteration's `λ_max` it came from (the spectrum at the same point, if it is wanted after
+/// all, takes it instead of iterating again: `spectrum::spectrum_knowing`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct ByInertia {
+    pub(crate) verdict: Verdict,
+    pub(crate) tolerance: f64,
+    pub(crate) largest: f64,
+}
+
+/// The verdict from the KKT inertia at a feasible `q` of the sparse or tree path; `None`
+/// when the shifted LDLᵀ cannot be trusted (module doc).
 pub(crate) fn inertia_verdict(
     sys: &mut System,
     q: &DVector<f64>,
     part: &Partition,
     eval: &Eval,
-) -> Option<(Verdict, f64)> {
+) -> Option<ByInertia> {
     // Assembles `Ŵ` and the KKT matrix; only its shifted factorizations are needed (the
     // unshifted one is singular where the pose is neutral).
     if !sys.assemble_kkt(q, part, eval) {
         return None;
     }
-    let tol = 1e-10 * largest_eigenvalue(sys, part, eval).max(1.0);
+    let largest = largest_eigenvalue(sys, part, eval);
+    let tol = 1e-10 * largest.max(1.0);
     if !tol.is_finite() {
         return None;
     }
-    if eigenvalues_below(sys, part, tol)? == 0 {
-        return Some((Verdict::Stable, tol));
-    }
-    let verdict = if eigenvalues_below(sys, part, -tol)? > 0 {
-        Verdict::Unstable
-    } else {
-        Verdict::Neutral
+    let judged = |verdict| {
+        Some(ByInertia {
+            verdict,
+            tolerance: tol,
+            largest,
+        })
     };
-    Some((verdict, tol))
+    if eigenvalues_below(sys, part, tol)? == 0 {
+        return judged(Verdict::Stable);
+    }
+    if eigenvalues_below(sys, part, -tol)? > 0 {
+        judged(Verdict::Unstable)
+    } else {
+        judged(Verdict::Neutral)
+    }
 }
 
 /// The number of eigenvalues of the reduced Hessian below `sigma`, from the KKT matrix last

@@ -114,6 +114,18 @@ pub(crate) fn spectrum(
     part: &Partition,
     eval: &Eval,
 ) -> Spectrum {
+    spectrum_knowing(sys, q, part, eval, None)
+}
+
+/// [`spectrum`], with the power iteration's `λ_max` at this same point if already at hand
+/// (an inertia verdict's: `stability::inertia::ByInertia`), not iterated again.
+pub(crate) fn spectrum_knowing(
+    sys: &mut System,
+    q: &DVector<f64>,
+    part: &Partition,
+    eval: &Eval,
+    largest: Option<f64>,
+) -> Spectrum {
     let dof = part.independent.len();
     if exact(sys.backend, dof) {
         let (h, basis) = sys.reduced_hessian_and_basis(q, part, eval);
@@ -128,7 +140,7 @@ pub(crate) fn spectrum(
             basis,
         };
     }
-    lanczos(sys, q, part, eval).unwrap_or_else(|| Spectrum {
+    lanczos(sys, q, part, eval, largest).unwrap_or_else(|| Spectrum {
         // A singular reduced Hessian (the KKT matrix cannot be factored): neutral.
         values: DVector::zeros(1),
         vectors: DMatrix::zeros(dof, 1),
@@ -139,7 +151,13 @@ pub(crate) fn spectrum(
     })
 }
 
-fn lanczos(sys: &mut System, q: &DVector<f64>, part: &Partition, eval: &Eval) -> Option<Spectrum> {
+fn lanczos(
+    sys: &mut System,
+    q: &DVector<f64>,
+    part: &Partition,
+    eval: &Eval,
+    largest: Option<f64>,
+) -> Option<Spectrum> {
     let dof = part.independent.len();
     let n = q.len();
     let factored = sys.factor_kkt(q, part, eval, true, 0.0);
@@ -161,7 +179,7 @@ fn lanczos(sys: &mut System, q: &DVector<f64>, part: &Partition, eval: &Eval) ->
     };
     // The largest eigenvalue: power iteration on `Ĥ` (products through `Φ_u`'s factors and
     // `W`); the smallest: Lanczos through the KKT factors.
-    let largest = largest_eigenvalue(sys, part, eval);
+    let largest = largest.unwrap_or_else(|| largest_eigenvalue(sys, part, eval));
     let steps = lanczos_steps(sys, part, n, negative_by_inertia);
     let (alpha, beta, basis) = steps?;
     let k = alpha.len();
@@ -344,7 +362,7 @@ mod tests {
             let part = sys.partition(&q);
             let eval = sys.evaluate(&q, &part).unwrap();
             let exact = symmetric_eigen(&sys.reduced_hessian(&q, &part, &eval)).0;
-            let lz = lanczos(&mut sys, &q, &part, &eval).unwrap();
+            let lz = lanczos(&mut sys, &q, &part, &eval, None).unwrap();
             let lo = lz.values[0];
             // Each Ritz value is an eigenvalue; without a flip the lowest is the lowest.
             for &l in lz.values.iter() {

@@ -203,10 +203,10 @@ pub(crate) fn stability_of(
         return None;
     }
     if !spectrum::listed(sys.backend, part.independent.len()) && !eigenvalues {
-        if let Some((verdict, tolerance)) = inertia::inertia_verdict(sys, q, part, eval) {
+        if let Some(judged) = inertia::inertia_verdict(sys, q, part, eval) {
             return Some(Stability {
-                verdict,
-                tolerance,
+                verdict: judged.verdict,
+                tolerance: judged.tolerance,
                 eigenvalues: Vec::new(),
                 modes: Vec::new(),
             });

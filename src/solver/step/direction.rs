@@ -26,7 +26,8 @@ use nalgebra::{DMatrix, DVector};
 /// The reduced step at `(q, part, eval)` (module docs), `eig` the reduced Hessian's spectrum
 /// when computed, `negative_curvature` the saddle's direction when the point is stationary,
 /// `settle` the Hessian's error where the convergence test asked for the settling step,
-/// `binv` the quasi-Newton inverse Hessian; and whether it escaped along negative curvature.
+/// `binv` the quasi-Newton inverse Hessian; whether it escaped along negative curvature; and
+/// whether it is the KKT direction, whose factors then stay in `sys` (module `second_order`).
 pub(crate) fn direction(
     sys: &mut System,
     (q, part, eval): (&DVector<f64>, &Partition, &Eval),
@@ -36,27 +37,31 @@ pub(crate) fn direction(
     binv: &DMatrix<f64>,
     guard: Option<&Guard>,
     options: &Options,
-) -> (DVector<f64>, bool) {
+) -> (DVector<f64>, bool, bool) {
     let g = &eval.grad_v;
     if let (Some(band), Some(e)) = (settle, eig.filter(|e| e.exact)) {
-        return (settling_step(e, g, band), false);
+        return (settling_step(e, g, band), false, false);
     }
     let along = eig
         .filter(|e| e.exact && options.method == Method::Newton && path_keeps_rows(sys))
         .map(|e| escape_step(sys, q, part, eval, e, guard, options));
     match (along, negative_curvature) {
-        (Some((d, escaped)), nc) if escaped || nc.is_none() => (d, escaped),
+        (Some((d, escaped)), nc) if escaped || nc.is_none() => (d, escaped, false),
         (_, Some(nc)) => {
             let sign = if nc.dot(g) > 0.0 { -1.0 } else { 1.0 };
             (
                 nc * (sign * options.max_step / nc.amax().max(1e-300)),
                 false,
+                false,
             )
         }
         _ => match (eig, options.method) {
-            (Some(e), Method::Newton) if e.exact => (newton_step(e, g, None).0, false),
-            (_, Method::Newton) => (kkt_direction(sys, q, part, eval), false),
-            _ => (-(binv * g), false),
+            (Some(e), Method::Newton) if e.exact => (newton_step(e, g, None).0, false, false),
+            (_, Method::Newton) => {
+                let (d, kkt) = kkt_direction(sys, q, part, eval);
+                (d, false, kkt)
+            }
+            _ => (-(binv * g), false, false),
         },
     }
 }

@@ -11,13 +11,15 @@ use nalgebra::DVector;
 /// reduced Newton step if it is a descent direction, else the step with the `W` block shifted
 /// by `δ I`, `δ = 10⁻⁶ max|Ŵ_ii|` and growing a hundredfold until it is (a
 /// Levenberg–Marquardt-type modification of an indefinite reduced Hessian); the steepest
-/// descent direction if no shift works.
+/// descent direction if no shift works. Also returns whether the step came from KKT factors
+/// with a positive definite reduced Hessian (LDLᵀ with one negative pivot per row), which then
+/// stay in `sys` for the step's second-order correction (module `second_order`).
 pub(crate) fn kkt_direction(
     sys: &mut System,
     q: &DVector<f64>,
     part: &Partition,
     eval: &Eval,
-) -> DVector<f64> {
+) -> (DVector<f64>, bool) {
     let g = &eval.grad_v;
     // Right side `−S (V_qᵀ − Φ_qᵀ μ)`: zero on the dependent coordinates (`Φ_uᵀ μ = V_uᵀ`) and
     // `−∇f` on the independent ones. It has the same projection `Zᵀ b = −∇f` as `−S V_qᵀ`,
@@ -29,7 +31,7 @@ pub(crate) fn kkt_direction(
     }
     let mut delta = 0.0;
     for attempt in 0..12 {
-        let mut factored = sys.factor_kkt(q, part, eval, attempt == 0, delta);
+        let mut factored = sys.factor_step_kkt(q, part, eval, attempt == 0, delta);
         let mut dq = sys.kkt_solve(&b);
         if dq.is_none() && matches!(factored, Factored::Ldlt { .. }) {
             // LDLᵀ without pivoting was not accurate enough here: LU with partial pivoting.
@@ -46,7 +48,13 @@ pub(crate) fn kkt_direction(
                 part.independent.iter().map(|&c| dq[c]),
             );
             if d.dot(g) < -1e-12 * d.norm() * g.norm() {
-                return d;
+                // The factors are a metric for the second-order correction where the reduced
+                // Hessian they hold is positive definite (module `second_order`).
+                let definite = factored
+                    == Factored::Ldlt {
+                        negative: part.rows.len(),
+                    };
+                return (d, definite);
             }
         }
         delta = if delta == 0.0 {
@@ -55,5 +63,5 @@ pub(crate) fn kkt_direction(
             delta * 100.0
         };
     }
-    -g.clone()
+    (-g.clone(), false)
 }

@@ -5,7 +5,9 @@
 //! `retraction`: the bodies moved rigidly along the spanning tree, which turns every tree
 //! joint from `θ` to `θ + α θ̇`; the paper's path is the straight line `q + α δq`) and is brought
 //! back onto `Φ = 0` by the Newton corrector (paper step (e.1)), which closes what the path
-//! leaves open (loops, contacts); if the corrector fails, the step is halved (step (f)). A corrected point is accepted when the Armijo condition
+//! leaves open (loops, contacts), after the second-order correction of the trial point where the
+//! step came from the KKT factors (module `second_order`: those rows closed in all
+//! coordinates, to `O(α³)`); if the corrector fails, the step is halved (step (f)). A corrected point is accepted when the Armijo condition
 //! `f(v̂ + α d) ≤ f + 10⁻⁴ α ∇fᵀ d` holds, or when `f` is flat to rounding and the gradient
 //! has halved; otherwise `α` shrinks by safeguarded quadratic interpolation (to between
 //! 0.1 and 0.5 of itself). Trial energies are compared through the Lagrangian `V − μᵀΦ`
@@ -25,6 +27,7 @@ use crate::solver::options::{Options, StopSearch};
 use crate::solver::partition::Partition;
 use crate::solver::report::Diagnostics;
 use crate::solver::step::retraction::independent_change;
+use crate::solver::step::second_order::corrected_point;
 use crate::solver::system::{Eval, System};
 use nalgebra::DVector;
 
@@ -42,6 +45,10 @@ pub(crate) struct Line<'a> {
     /// Where the iteration crawls along a curved valley, the trial points are brought back
     /// to its floor before they are judged (module `valley`).
     pub(crate) valley: Option<&'a crate::solver::valley::Valley>,
+    /// The KKT factors of the step's direction at `q`, with a positive definite reduced
+    /// Hessian, are in `sys`: trial points get the second-order correction (module
+    /// `second_order`).
+    pub(crate) second_order: bool,
 }
 
 /// A point the line search accepted.
@@ -75,7 +82,12 @@ pub(crate) fn line_search(
     for _ in 0..MAX_TRIALS {
         let caps: Vec<Stop> = stops.iter().filter(|s| s.alpha < alpha).copied().collect();
         let mut qt = if caps.is_empty() {
-            sys.problem.retraction.point(q, dq, alpha)
+            let qt = sys.problem.retraction.point(q, dq, alpha);
+            let tolerance = options.constraint_tolerance;
+            line.second_order
+                .then(|| corrected_point(sys, part, (q, dq, alpha), &qt, tolerance))
+                .flatten()
+                .unwrap_or(qt)
         } else {
             let bodies: Vec<(usize, f64)> = caps.iter().map(|s| (s.body, s.alpha)).collect();
             sys.problem.retraction.bent_point(q, dq, alpha, &bodies)

@@ -14,6 +14,8 @@
 //! - `line_search`: the backtracking line search along a reduced step `d` (`δq = Z d`).
 //! - `retraction`: the search path of the line search, `δq` followed as rigid motions along
 //!   the spanning tree (`θ(α) = θ + α θ̇` on every tree joint).
+//! - `second_order`: the second-order correction of a trial point, the rows the path leaves
+//!   open closed in all coordinates with the KKT factors of the step.
 
 pub(super) mod direction;
 pub(super) mod escape;
@@ -23,4 +25,5 @@ pub(super) mod newton;
 pub(super) mod path_hessian;
 pub(super) mod quasi_newton;
 pub(super) mod retraction;
+pub(super) mod second_order;
 pub(super) mod step_cap;

@@ -94,6 +94,30 @@ impl System<'_> {
     /// Adds `Φ_qᵀ D R D Φ_q` over the independent rows to the block Hessian (module docs).
     pub(super) fn augment(&mut self, part: &Partition) {
         let n = self.problem.model.coordinate_count();
+        let columns = &self.problem.scaling.columns;
+        let mut wdiag = std::mem::take(&mut self.work.wdiag);
+        wdiag.clear();
+        wdiag.resize(n, 0.0);
+        for (&(a, b), blk) in self.work.hess.keys.iter().zip(&self.work.hess.values) {
+            if a == b {
+                for i in 0..7 {
+                    wdiag[7 * a + i] = blk[8 * i].abs() * columns[7 * a + i].powi(2);
+                }
+            }
+        }
+        let mut hess = std::mem::take(&mut self.work.hess);
+        self.augment_into(part, wdiag, &mut hess);
+        self.work.hess = hess;
+    }
+
+    /// Adds `Φ_qᵀ D R D Φ_q` into `sink`, given `W`'s scaled diagonal `D_c² |W_cc|` in
+    /// `wdiag` (the block Hessian's, or the fused assembly's: module `tree::fused`).
+    pub(super) fn augment_into(
+        &mut self,
+        part: &Partition,
+        wdiag: Vec<f64>,
+        sink: &mut dyn HessianSink,
+    ) {
         let m = self.problem.cons.len();
         let work = &mut self.work;
         let entries = &work.jac.entries;
@@ -101,17 +125,6 @@ impl System<'_> {
             Some(p) if p.fits(part, entries.len()) => p,
             _ => AugmentPlan::new(part, m, entries),
         };
-        let columns = &self.problem.scaling.columns;
-        let mut wdiag = std::mem::take(&mut work.wdiag);
-        wdiag.clear();
-        wdiag.resize(n, 0.0);
-        for (&(a, b), blk) in work.hess.keys.iter().zip(&work.hess.values) {
-            if a == b {
-                for i in 0..7 {
-                    wdiag[7 * a + i] = blk[8 * i].abs() * columns[7 * a + i].powi(2);
-                }
-            }
-        }
         let floor = 1e-6 * wdiag.iter().fold(0.0f64, |x, &y| x.max(y)) + 1e-12;
         // The pending body pair and its accumulated `Σ ρ g gᵀ` (column-major, as `LMat`).
         let mut pending: Option<[Option<BodyId>; 2]> = None;
@@ -124,7 +137,7 @@ impl System<'_> {
             let Some(bodies) = g.bodies else {
                 for a in group {
                     for b in group {
-                        work.hess.add_entry(a.1, b.1, rho * a.2 * b.2);
+                        sink.add_entry(a.1, b.1, rho * a.2 * b.2);
                     }
                 }
                 continue;
@@ -135,7 +148,7 @@ impl System<'_> {
             }
             if pending != Some(bodies) {
                 if let Some(b) = pending.take() {
-                    work.hess.add_block(&b, &LMat::from_column_slice(&acc), 1.0);
+                    sink.add_block(&b, &LMat::from_column_slice(&acc), 1.0);
                 }
                 pending = Some(bodies);
                 acc = [0.0; NL * NL];
@@ -143,7 +156,7 @@ impl System<'_> {
             add_outer(&mut acc, &gv, rho);
         }
         if let Some(b) = pending.take() {
-            work.hess.add_block(&b, &LMat::from_column_slice(&acc), 1.0);
+            sink.add_block(&b, &LMat::from_column_slice(&acc), 1.0);
         }
         work.augment = Some(plan);
         work.wdiag = wdiag;

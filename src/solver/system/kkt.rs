@@ -5,6 +5,7 @@
 use super::kkt_matrix::KktMatrix;
 use super::Backend;
 use super::{Eval, System};
+use crate::forces::potential;
 use crate::solver::partition::Partition;
 use crate::solver::sparse::kkt::{Factored, Kkt};
 use crate::solver::tree::kkt::TreeKkt;
@@ -34,6 +35,89 @@ impl System<'_> {
             .kkt
             .as_mut()
             .map_or(Factored::None, |k| k.factor(delta))
+    }
+
+    /// [`System::factor_kkt`] for a Newton step: the same matrix, assembled by the fused pass
+    /// where the tree structure fits (module `tree::fused`: no block Hessian, whose values
+    /// are left as they were; [`System::reduced_apply`] needs [`System::factor_kkt`]).
+    pub(crate) fn factor_step_kkt(
+        &mut self,
+        q: &DVector<f64>,
+        part: &Partition,
+        eval: &Eval,
+        fresh: bool,
+        delta: f64,
+    ) -> Factored {
+        if fresh && !self.assemble_fused(q, part, eval) && !self.assemble_kkt(q, part, eval) {
+            return Factored::None;
+        }
+        self.work
+            .kkt
+            .as_mut()
+            .map_or(Factored::None, |k| k.factor(delta))
+    }
+
+    /// The fused assembly of the tree KKT matrix at `q` (module `tree::fused`); false where
+    /// the structure in place does not fit (the caller assembles by the general path).
+    pub(crate) fn assemble_fused(
+        &mut self,
+        q: &DVector<f64>,
+        part: &Partition,
+        eval: &Eval,
+    ) -> bool {
+        if self.backend != Backend::Tree {
+            return false;
+        }
+        self.triplets(q);
+        let (triplets, blocks) = (self.work.jac.entries.len(), self.work.hess.keys.len());
+        // Only a tree structure that fits (a sparse one stays in place for the general path).
+        let fits =
+            matches!(&self.work.kkt, Some(KktMatrix::Tree(t)) if t.fits(part, triplets, blocks));
+        if !fits {
+            return false;
+        }
+        let Some(KktMatrix::Tree(mut tree)) = self.work.kkt.take() else {
+            return false;
+        };
+        let (model, n) = (self.problem.model, q.len());
+        let mut g = std::mem::take(&mut self.work.grad);
+        if g.len() == n {
+            g.fill(0.0);
+        } else {
+            g = DVector::zeros(n);
+        }
+        let mut weights = std::mem::take(&mut self.work.weights);
+        weights.fill(0.0);
+        weights.resize_vertically_mut(self.problem.cons.len(), 0.0);
+        for (k, &row) in part.rows.iter().enumerate() {
+            weights[row] = -eval.mu[k];
+        }
+        let mut sink = tree.fused_begin(&self.work.hess.keys);
+        let _ = potential(
+            model,
+            &self.problem.cons.branches,
+            q,
+            &mut g,
+            Some(&mut sink),
+        );
+        self.problem.cons.add_hessian(model, q, &weights, &mut sink);
+        let complete = !sink.missing;
+        self.work.grad = g;
+        self.work.weights = weights;
+        if complete {
+            let columns = &self.problem.scaling.columns;
+            let mut wdiag = std::mem::take(&mut self.work.wdiag);
+            tree.fused_diagonal(columns, &mut wdiag);
+            let mut sink = tree.fused_sink();
+            self.augment_into(part, wdiag, &mut sink);
+            let complete = !sink.missing;
+            let scaling = &self.problem.scaling;
+            tree.fused_finish(&self.work.jac.entries, &scaling.rows, &scaling.columns);
+            self.work.kkt = Some(KktMatrix::Tree(tree));
+            return complete;
+        }
+        self.work.kkt = Some(KktMatrix::Tree(tree));
+        false
     }
 
     /// Assembles `W` at `q` and the KKT matrix (as [`System::factor_kkt`]) without factoring

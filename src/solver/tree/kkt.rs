@@ -24,6 +24,7 @@
 //! writes are zeroed: the same sums, in the same order, as zeroing and adding.
 
 use super::dense;
+use super::fused::BlockMap;
 use super::shape::{Shape, FIRST, SKIP};
 use crate::solver::partition::Partition;
 use crate::solver::sparse::hessian::BlockHessian;
@@ -33,14 +34,18 @@ use std::cell::RefCell;
 
 /// The tree KKT matrix under one partition: its structure, values and factors.
 pub(crate) struct TreeKkt {
-    shape: Shape,
+    pub(super) shape: Shape,
+    /// The Hessian blocks by body pair (module `fused`; built at the first fused assembly).
+    pub(super) map: Option<BlockMap>,
+    /// The fused assembly's `7 × 7` blocks of `W` (unscaled; the kept blocks of `map`).
+    pub(super) w_blocks: Vec<[f64; 49]>,
     id: usize,
     triplets: usize,
     blocks: usize,
     /// Assembled values (shifted): the flat blocks, then the border entries.
-    values: Vec<f64>,
+    pub(super) values: Vec<f64>,
     /// The shifts `δ` and `−σ` now in `values`.
-    shifts: Shifts,
+    pub(super) shifts: Shifts,
     /// Factors: the flat blocks (`L D` or `L U` in place; `X_i` in the coupling slots), the
     /// border's values and `S`, the pivots of LU.
     factors: Vec<f64>,
@@ -79,6 +84,8 @@ impl TreeKkt {
         let total = shape.flat_len + shape.border.len();
         let dim = shape.n + shape.rows;
         Some(TreeKkt {
+            map: None,
+            w_blocks: Vec::new(),
             id: part.id,
             triplets: entries.len(),
             blocks: hess.keys.len(),
@@ -128,7 +135,18 @@ impl TreeKkt {
             values[slot as usize] = 0.0;
         }
         hess.scatter_scaled_store(&s.block_slots, scale, values);
-        for (e, slots) in entries.iter().zip(&s.jac_slots) {
+        self.store_jacobian(entries, row_scale, scale);
+    }
+
+    /// Stores the Jacobian's entries (scaled) at their slots (see [`TreeKkt::assemble`]).
+    pub(super) fn store_jacobian(
+        &mut self,
+        entries: &[(usize, usize, f64)],
+        row_scale: &[f64],
+        scale: &[f64],
+    ) {
+        let values = &mut self.values;
+        for (e, slots) in entries.iter().zip(&self.shape.jac_slots) {
             let v = e.2 * row_scale[e.0] * scale[e.1];
             for &slot in slots {
                 if slot != SKIP {

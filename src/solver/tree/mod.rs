@@ -7,6 +7,8 @@
 //! - `dense`: the block kernels (LDLᵀ without pivoting, LU with partial pivoting);
 //! - `phi_u`: `Φ_u` as a block upper triangular matrix (corrector, multipliers, tangent steps);
 //! - `shape`: the KKT matrix's nodes, parents, border and value slots, once per partition;
+//! - `fused`: the Newton step's assembly of `W`, its terms added into the tree's body-pair
+//!   blocks and stored into the 13 × 13 blocks in one pass;
 //! - `kkt`: its block LDLᵀ (block LU as the fallback), solves and refinement;
 //! - `border`: the dense Schur complement of the border.
 //!
@@ -15,6 +17,7 @@
 
 mod border;
 pub(crate) mod dense;
+pub(crate) mod fused;
 pub(crate) mod kkt;
 pub(crate) mod phi_u;
 mod shape;

@@ -11,6 +11,7 @@
 //! (module `border`), with the rows pivoted away from their body's run (loop rows).
 
 use super::border::Border;
+use super::fused::Run;
 use crate::solver::partition::Partition;
 use crate::solver::sparse::hessian::BlockHessian;
 use std::collections::HashMap;
@@ -51,6 +52,8 @@ pub(crate) struct Shape {
     /// its mirror; [`FIRST`] set on the first triplet to reach a slot), and of each
     /// coordinate's diagonal.
     pub(crate) block_slots: Vec<[u32; 49]>,
+    /// Each block's slots as a run (module `fused`).
+    pub(crate) block_runs: Vec<Run>,
     pub(crate) jac_slots: Vec<[u32; 2]>,
     pub(crate) diag_slots: Vec<u32>,
     /// The diagonal slots that no Hessian block writes (zeroed by each assembly: a shift of
@@ -256,6 +259,7 @@ impl Shape {
             tree_slot(t1, t2)
         };
         let mut block_slots = Vec::with_capacity(hess.keys.len());
+        let mut block_runs = Vec::with_capacity(hess.keys.len());
         for &(a, b) in &hess.keys {
             let mut s = [SKIP; 49];
             // A body's 7 coordinates lead its node, in order (or all lie in the border): a
@@ -269,6 +273,7 @@ impl Shape {
                     (coup_at[na] + (ta - at[na]) * w[na] + (tb - at[nb]), w[na])
                 } else if par[nb] == na as u32 {
                     block_slots.push(s);
+                    block_runs.push(Run::Skip);
                     continue;
                 } else {
                     return None;
@@ -278,12 +283,14 @@ impl Shape {
                         s[7 * i + j] = (start + i * stride + j) as u32;
                     }
                 }
+                block_runs.push(Run::Dense { start, stride });
             } else {
                 for i in 0..7 {
                     for j in 0..7 {
                         s[7 * i + j] = locate(7 * a + i, 7 * b + j)?;
                     }
                 }
+                block_runs.push(Run::Scattered);
             }
             block_slots.push(s);
         }
@@ -338,6 +345,7 @@ impl Shape {
             tree_len,
             border,
             block_slots,
+            block_runs,
             jac_slots,
             diag_slots,
             bare_diag,

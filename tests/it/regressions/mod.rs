@@ -31,5 +31,6 @@ mod issue_25_unbounded_numbers;
 mod issue_25_verify_agrees_with_analyze;
 mod issue_26_chain_with_unreached_limits;
 mod issue_26_contacts_met_together;
+mod issue_26_rope_full_steps;
 mod issue_26_rope_rounds;
 mod issue_26_tree_folded_chart;

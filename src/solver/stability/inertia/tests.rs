@@ -64,7 +64,11 @@ fn counts_and_verdicts_match_the_dense_eigendecomposition() {
         let eval = sys.evaluate(&q, &part).unwrap();
         let (exact, _) = symmetric_eigen(&sys.reduced_hessian(&q, &part, &eval));
         assert_eq!(exact.len(), n);
-        let (verdict, tol) = inertia_verdict(&mut sys, &q, &part, &eval).unwrap();
+        let ByInertia {
+            verdict,
+            tolerance: tol,
+            ..
+        } = inertia_verdict(&mut sys, &q, &part, &eval).unwrap();
         // The tolerance from power iteration: within a few per cent of the exact one.
         let exact_tol = 1e-10 * exact.amax().max(1.0);
         assert!(
@@ -119,7 +123,11 @@ fn neutral_without_gravity_or_springs() {
     let part = sys.partition(&q);
     let eval = sys.evaluate(&q, &part).unwrap();
     let (exact, _) = symmetric_eigen(&sys.reduced_hessian(&q, &part, &eval));
-    let (verdict, tol) = inertia_verdict(&mut sys, &q, &part, &eval).unwrap();
+    let ByInertia {
+        verdict,
+        tolerance: tol,
+        ..
+    } = inertia_verdict(&mut sys, &q, &part, &eval).unwrap();
     assert!(exact.amax() <= tol, "{exact}");
     assert_eq!(verdict, Verdict::Neutral);
     assert_eq!(by_eigenvalues(&exact, tol), Verdict::Neutral);
@@ -136,7 +144,11 @@ fn verdicts_match_lanczos_on_large_chains() {
         let mut sys = System::new(&model, Constraints::new(&model, &[]), Backend::Sparse);
         let part = sys.partition(&q);
         let eval = sys.evaluate(&q, &part).unwrap();
-        let (verdict, tol) = inertia_verdict(&mut sys, &q, &part, &eval).unwrap();
+        let ByInertia {
+            verdict,
+            tolerance: tol,
+            largest,
+        } = inertia_verdict(&mut sys, &q, &part, &eval).unwrap();
         let negative = eigenvalues_below(&mut sys, &part, 0.0);
         let spectrum = crate::solver::spectrum::spectrum(&mut sys, &q, &part, &eval);
         assert!(!spectrum.exact);
@@ -145,6 +157,14 @@ fn verdicts_match_lanczos_on_large_chains() {
             by_eigenvalues(&spectrum.values, spectrum.tolerance())
         );
         assert_eq!(tol, spectrum.tolerance(), "the same power iteration");
+        // The spectrum given the verdict's `λ_max` (not iterated again) is the same, bit for
+        // bit: what the minimizer and `--eigenvalues` take after an inertia verdict.
+        let knowing =
+            crate::solver::spectrum::spectrum_knowing(&mut sys, &q, &part, &eval, Some(largest));
+        assert_eq!(knowing.largest, spectrum.largest);
+        assert_eq!(knowing.values, spectrum.values);
+        assert_eq!(knowing.vectors, spectrum.vectors);
+        assert_eq!(knowing.negative_by_inertia, spectrum.negative_by_inertia);
         assert_eq!(verdict == Verdict::Unstable, flip);
         assert_eq!(negative, spectrum.negative_by_inertia);
         assert_eq!(negative.unwrap() > 0, flip);

@@ -31,6 +31,11 @@ impl System<'_> {
         if fresh && !self.assemble_kkt(q, part, eval) {
             return Factored::None;
         }
+        self.factor_assembled(delta)
+    }
+
+    /// Factors the KKT matrix in place with the shift `δ`.
+    fn factor_assembled(&mut self, delta: f64) -> Factored {
         self.work
             .kkt
             .as_mut()
@@ -51,10 +56,7 @@ impl System<'_> {
         if fresh && !self.assemble_fused(q, part, eval) && !self.assemble_kkt(q, part, eval) {
             return Factored::None;
         }
-        self.work
-            .kkt
-            .as_mut()
-            .map_or(Factored::None, |k| k.factor(delta))
+        self.factor_assembled(delta)
     }
 
     /// The fused assembly of the tree KKT matrix at `q` (module `tree::fused`); false where

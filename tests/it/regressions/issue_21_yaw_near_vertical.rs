@@ -131,25 +131,31 @@ fn a_nearly_vertical_yaw_does_not_stall_at_its_rest() {
             energy("knee", 1e-4) > v0 + 1e-6,
             "tilt {tilt}: the knee stop holds nothing"
         );
-        let h = 1e-4;
-        for joint in ["hip_pitch", "ankle"] {
-            let (up, down) = (energy(joint, h), energy(joint, -h));
-            let slope = (up - down) / (2.0 * h);
-            assert!(
-                slope.abs() < 1e-7,
-                "tilt {tilt}, {joint}: dV/dθ = {slope:e}"
-            );
-            assert!(
-                up >= v0 - 1e-12 && down >= v0 - 1e-12,
-                "tilt {tilt}, {joint}"
-            );
-        }
+        pitch_and_ankle_balanced(&energy, v0, tilt);
         let (up, down) = (energy("hip_yaw", 0.3), energy("hip_yaw", -0.3));
         assert!(
             up > v0 + 1e-12 && down > v0 + 1e-12,
             "tilt {tilt}: yaw ±0.3 rad gives {:e} / {:e} J against the rest",
             up - v0,
             down - v0
+        );
+    }
+}
+
+/// The hip pitch and the ankle balanced and at a minimum, by central differences of the
+/// energy (`energy(joint, δ)`: the energy with `joint` moved by `δ`; `v0` at the rest).
+pub(super) fn pitch_and_ankle_balanced(energy: &dyn Fn(&str, f64) -> f64, v0: f64, tilt: f64) {
+    let h = 1e-4;
+    for joint in ["hip_pitch", "ankle"] {
+        let (up, down) = (energy(joint, h), energy(joint, -h));
+        let slope = (up - down) / (2.0 * h);
+        assert!(
+            slope.abs() < 1e-7,
+            "tilt {tilt}, {joint}: dV/dθ = {slope:e}"
+        );
+        assert!(
+            up >= v0 - 1e-12 && down >= v0 - 1e-12,
+            "tilt {tilt}, {joint}"
         );
     }
 }

@@ -22,6 +22,9 @@
 //! trial says nothing about which to keep, and all leave as before. A single candidate leaves
 //! as before, without a trial. A stop kept this way does not leave before the next round is
 //! stationary (it is not eligible for the early release of module `release` in that round).
+//! No trial is computed where the next round would take no step: once the candidates are
+//! released, other rows pull hard and leave at its start (module `release`'s early test on
+//! the trial's multipliers); the release after it decides (only the evaluation is made).
 //!
 //! The round after a consistent trial starts with the stops released on the concave side of
 //! their fall; there the escape from negative curvature is taken at every iterate (the guard's
@@ -38,8 +41,6 @@
 //! ## References
 //! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §16.5
 //!   (a constraint leaves the working set when the step computed without it moves off it).
-//! - P. E. Gill, W. Murray, M. H. Wright, *Practical Optimization*, Academic Press (1981),
-//!   §5.2.4 (deleting several constraints at once).
 
 use crate::constraints::unilateral::{self, Active, Unilateral};
 use crate::constraints::Constraints;

@@ -12,6 +12,7 @@
 //! The root link is welded to the world (its frame is the world frame) unless a floating base
 //! is asked for.
 
+use super::dom::Node;
 use super::edges::{self, Declaration, Edge, FrameMap, Frames, DRAKE_NS};
 use super::extensions;
 use super::links::read_link;
@@ -25,7 +26,6 @@ use crate::model::{BodyId, Joint, JointId, JointKind, ModelBuilder};
 use crate::names::NameMap;
 use crate::state::State;
 use nalgebra::{Isometry3, Matrix3, UnitQuaternion, Vector3};
-use roxmltree::Node;
 
 /// The import context shared with the extension readers: the model builder and the names
 /// it resolves.

@@ -7,10 +7,14 @@
 //! `mech:loop_joint` closes a loop.
 
 mod base;
+mod dom;
+#[cfg(test)]
+mod dom_tests;
 mod edges;
 mod extensions;
 mod foreign;
 mod import;
+mod lean;
 mod limits;
 mod links;
 mod mimic;

@@ -86,6 +86,7 @@ pub(crate) struct Document<'i> {
 
 impl<'i> Document<'i> {
     /// The text of `s`.
+    #[inline]
     pub(super) fn str(&self, s: Str) -> &str {
         let (a, b) = (s.start as usize, (s.start + s.len) as usize);
         if s.owned {
@@ -93,6 +94,12 @@ impl<'i> Document<'i> {
         } else {
             &self.text[a..b]
         }
+    }
+
+    /// Whether `s` is `name`, lengths first.
+    #[inline]
+    fn is(&self, s: Str, name: &str) -> bool {
+        s.len as usize == name.len() && self.str(s) == name
     }
 
     /// The text the document was read from.
@@ -309,6 +316,13 @@ impl<'a, 'i> Node<'a, 'i> {
         }
     }
 
+    /// Whether the node is an element of local name `name` (any namespace).
+    #[inline]
+    pub(crate) fn is_named(&self, name: &str) -> bool {
+        let d = self.d();
+        d.kind == Kind::Element && self.doc.is(d.name, name)
+    }
+
     /// The attributes of an element.
     pub(crate) fn attributes(&self) -> impl Iterator<Item = Attribute<'a>> + 'a {
         let doc = self.doc;
@@ -328,7 +342,7 @@ impl<'a, 'i> Node<'a, 'i> {
         let (a, b) = self.d().attrs;
         doc.attrs[a as usize..b as usize]
             .iter()
-            .find(|x| x.ns.is_none() && doc.str(x.name) == name)
+            .find(|x| x.ns.is_none() && doc.is(x.name, name))
             .map(|x| doc.str(x.value))
     }
 

@@ -93,7 +93,7 @@ fn edge_cases_read_the_same_or_decline() {
         "<r/>",
         "<?xml version=\"1.0\"?>\n<r a='1' b = \"x>y\"/>",
         "<?xml version='1.0' encoding='UTF-8' standalone='yes' ?><r/>",
-        "<!-- c --><r>t<!--d-->u<e/> <f></f ></r><!--e-->\n",
+        "<!-- c --><r>t<!-- d -->u<e/> <f></f ></r><!--e-->\n",
         "<r xmlns:m='urn:a'><m:x m:a='1' a='2'/><y xmlns='urn:b'><z/></y></r>",
         "<r xmlns:m='urn:a'><x xmlns:m='urn:b' xmlns:n='urn:a'><m:y/></x></r>",
         "<r xmlns='urn:a' xmlns:m='urn:a'><x/></r>",
@@ -177,4 +177,16 @@ fn mutations_read_the_same_or_decline() {
         accepted > 1000 && declined > 1000,
         "{accepted} / {declined}"
     );
+}
+
+/// The lean reader declines where the importer's depth check refuses, and reads what it
+/// accepts.
+#[test]
+fn nesting_beyond_the_limit_is_declined() {
+    let deep = |n: usize| format!("{}{}", "<a>".repeat(n), "</a>".repeat(n));
+    let limit = super::text::MAX_DEPTH;
+    assert!(check(&deep(limit), "at the limit"));
+    assert!(super::lean::parse(&deep(limit + 1)).is_none());
+    let e = super::text::parse(&deep(limit + 1), "f", &mut Vec::new(), &mut None).unwrap_err();
+    assert!(e.to_string().contains("nested more than"), "{e}");
 }

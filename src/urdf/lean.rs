@@ -5,7 +5,8 @@
 //! character reference, DTD, CDATA section or processing instruction; names of ASCII letters,
 //! digits, `_`, `-`, `.` with at most one prefix; attribute values without `<`, tab or line
 //! break (which XML would rewrite). On anything else, well-formed or not, it declines
-//! (`None`) and the caller reads the text with `roxmltree`, which reads all of XML and
+//! (`None`), as for elements nested deeper than [`super::text::MAX_DEPTH`], and the caller
+//! reads the text with `roxmltree`, which reads all of XML and
 //! reports every error with its position: what this reader accepts, `roxmltree` accepts too,
 //! into the same document (compared node by node in the tests, `super::dom_tests`).
 
@@ -45,13 +46,23 @@ pub(super) fn parse(text: &str) -> Option<Document<'_>> {
     if b.len() > (u32::MAX / 2) as usize {
         return None;
     }
+    // Printable ASCII, tab and line feed, no `&`; the `<` and `=` counted for the tables'
+    // capacities (by blocks without an early exit, which the compiler vectorizes).
     let (mut lt, mut eq) = (0usize, 0usize);
-    for &c in b {
-        if !((0x20..0x7f).contains(&c) || c == b'\n' || c == b'\t') || c == b'&' {
+    for block in b.chunks(256) {
+        let mut bad = 0u8;
+        let (mut l, mut e) = (0u16, 0u16);
+        for &c in block {
+            let printable = c.wrapping_sub(0x20) < 0x5f && c != b'&';
+            bad |= u8::from(!(printable || c == b'\n' || c == b'\t'));
+            l += u16::from(c == b'<');
+            e += u16::from(c == b'=');
+        }
+        if bad != 0 {
             return None;
         }
-        lt += usize::from(c == b'<');
-        eq += usize::from(c == b'=');
+        lt += usize::from(l);
+        eq += usize::from(e);
     }
     let mut r = Reader {
         b,
@@ -440,6 +451,10 @@ impl<'i> Reader<'i> {
             scope,
         });
         if !empty {
+            // Deeper than the importer reads: its depth check gives the error.
+            if self.open.len() > super::text::MAX_DEPTH {
+                return None;
+            }
             self.open.push(Open { id, qname, last: 0 });
         }
         Some(())

@@ -270,6 +270,12 @@ pub(crate) fn parse<'a>(
     warnings: &mut Vec<String>,
     store: &'a mut Option<String>,
 ) -> Result<Document<'a>> {
+    // Plain XML (most files) is read by the lean reader, which bounds the nesting itself
+    // and declines a late declaration; everything else is checked and read as before.
+    if let Some(doc) = super::lean::parse(text) {
+        refuse_xacro(&doc, file)?;
+        return Ok(doc);
+    }
     check_depth(text, file)?;
     let late = late_declaration(text).is_some();
     let doc = if late {
@@ -280,8 +286,6 @@ pub(crate) fn parse<'a>(
         ));
         let out = declare_prefixes(out, file, warnings)?;
         super::xml::parse_document(store.insert(out), file)?
-    } else if let Some(doc) = super::lean::parse(text) {
-        doc
     } else {
         match roxmltree::Document::parse_with_options(text, options()) {
             Err(roxmltree::Error::UnknownNamespace(..)) => {

@@ -158,14 +158,19 @@ impl<'a> Source<'a> {
         let Some(s) = node.attribute(attr) else {
             return Ok(None);
         };
-        let vals: Option<Vec<f64>> = s.split_whitespace().map(parse_f64).collect();
-        match vals {
-            Some(v) if v.len() == N => {
-                let mut out = [0.0; N];
-                out.copy_from_slice(&v);
-                Ok(Some(out))
+        // Exactly N finite numbers, read into place.
+        let mut out = [0.0; N];
+        let mut words = s.split_whitespace();
+        let mut ok = true;
+        for o in out.iter_mut() {
+            match words.next().and_then(parse_f64) {
+                Some(v) => *o = v,
+                None => ok = false,
             }
-            _ => Err(self.error(
+        }
+        match ok && words.next().is_none() {
+            true => Ok(Some(out)),
+            false => Err(self.error(
                 node,
                 format!(
                     "{}: attribute `{attr}` = \"{s}\" must be {N} finite numbers",
@@ -324,8 +329,7 @@ pub(crate) fn parse_f64(s: &str) -> Option<f64> {
 
 /// First child element with this local name.
 pub(crate) fn child<'a>(node: Node<'a, 'a>, name: &str) -> Option<Node<'a, 'a>> {
-    node.children()
-        .find(|c| c.is_element() && c.tag_name().name() == name)
+    node.children().find(|c| c.is_named(name))
 }
 
 /// Whether the element is in the `mech` namespace.

@@ -15,13 +15,15 @@ use std::ops::Range;
 const XML_URI: &str = "http://www.w3.org/XML/1998/namespace";
 
 /// A string of the document: a byte range of the input text, or of the document's own
-/// buffer when `owned` (strings `roxmltree` expanded).
+/// buffer (strings `roxmltree` expanded) when the length has its top bit set.
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Str {
-    pub(super) start: u32,
-    pub(super) len: u32,
-    pub(super) owned: bool,
+    start: u32,
+    len: u32,
 }
+
+/// The top bit of [`Str::len`]: the string is in [`Document::owned`].
+const OWNED: u32 = 1 << 31;
 
 impl Str {
     /// The byte range `r` of the input text.
@@ -29,8 +31,12 @@ impl Str {
         Str {
             start: r.start as u32,
             len: (r.end - r.start) as u32,
-            owned: false,
         }
+    }
+
+    /// Its length in bytes.
+    fn bytes(self) -> usize {
+        (self.len & !OWNED) as usize
     }
 }
 
@@ -58,18 +64,18 @@ pub(super) struct NodeData {
     pub(super) range: (u32, u32),
     /// An element's local name; a text's or comment's content.
     pub(super) name: Str,
-    /// An element's namespace URI.
-    pub(super) ns: Option<Str>,
+    /// An element's namespace URI: 1 + its index in [`Document::scope`], 0 for none.
+    pub(super) ns: u32,
     /// An element's attributes: a range of [`Document::attrs`].
     pub(super) attrs: (u32, u32),
     /// An element's namespaces in scope: a range of [`Document::scope`].
     pub(super) scope: (u32, u32),
 }
 
-/// An attribute: namespace URI, local name, value.
+/// An attribute: namespace URI (as [`NodeData::ns`]), local name, value.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct AttrData {
-    pub(super) ns: Option<Str>,
+    pub(super) ns: u32,
     pub(super) name: Str,
     pub(super) value: Str,
 }
@@ -80,7 +86,8 @@ pub(crate) struct Document<'i> {
     pub(super) owned: String,
     pub(super) nodes: Vec<NodeData>,
     pub(super) attrs: Vec<AttrData>,
-    /// In-scope namespaces of elements: `(prefix, uri)`, an element's own declarations first.
+    /// In-scope namespaces of elements: `(prefix, uri)`, an element's own declarations first;
+    /// also the URIs that names refer to.
     pub(super) scope: Vec<(Option<Str>, Str)>,
 }
 
@@ -88,8 +95,8 @@ impl<'i> Document<'i> {
     /// The text of `s`.
     #[inline]
     pub(super) fn str(&self, s: Str) -> &str {
-        let (a, b) = (s.start as usize, (s.start + s.len) as usize);
-        if s.owned {
+        let (a, b) = (s.start as usize, s.start as usize + s.bytes());
+        if s.len & OWNED != 0 {
             &self.owned[a..b]
         } else {
             &self.text[a..b]
@@ -99,7 +106,13 @@ impl<'i> Document<'i> {
     /// Whether `s` is `name`, lengths first.
     #[inline]
     fn is(&self, s: Str, name: &str) -> bool {
-        s.len as usize == name.len() && self.str(s) == name
+        s.bytes() == name.len() && self.str(s) == name
+    }
+
+    /// The namespace URI of a name's `ns` ([`NodeData::ns`]).
+    #[inline]
+    fn uri(&self, ns: u32) -> Option<&str> {
+        (ns != 0).then(|| self.str(self.scope[ns as usize - 1].1))
     }
 
     /// The text the document was read from.
@@ -139,8 +152,7 @@ impl<'i> Document<'i> {
             owned.push_str(s);
             Str {
                 start,
-                len: s.len() as u32,
-                owned: true,
+                len: s.len() as u32 | OWNED,
             }
         };
         // Depth-first with an explicit stack of (roxmltree node, parent index); siblings are
@@ -163,17 +175,24 @@ impl<'i> Document<'i> {
                 end: id + 1,
                 range: (n.range().start as u32, n.range().end as u32),
                 name: Str::default(),
-                ns: None,
+                ns: 0,
                 attrs: (0, 0),
                 scope: (0, 0),
             };
             match kind {
                 Kind::Element => {
                     data.name = own(&mut out.owned, n.tag_name().name());
-                    data.ns = n.tag_name().namespace().map(|u| own(&mut out.owned, u));
+                    // A name's URI: an entry of the scope table outside every element's range.
+                    let uri = |owned: &mut String, scope: &mut Vec<_>, u: Option<&str>| {
+                        u.map_or(0, |u| {
+                            scope.push((None, own(owned, u)));
+                            scope.len() as u32
+                        })
+                    };
+                    data.ns = uri(&mut out.owned, &mut out.scope, n.tag_name().namespace());
                     let a0 = out.attrs.len() as u32;
                     for a in n.attributes() {
-                        let ns = a.namespace().map(|u| own(&mut out.owned, u));
+                        let ns = uri(&mut out.owned, &mut out.scope, a.namespace());
                         let name = own(&mut out.owned, a.name());
                         let value = own(&mut out.owned, a.value());
                         out.attrs.push(AttrData { ns, name, value });
@@ -311,7 +330,7 @@ impl<'a, 'i> Node<'a, 'i> {
             return ExpandedName { ns: None, name: "" };
         }
         ExpandedName {
-            ns: d.ns.map(|s| self.doc.str(s)),
+            ns: self.doc.uri(d.ns),
             name: self.doc.str(d.name),
         }
     }
@@ -330,7 +349,7 @@ impl<'a, 'i> Node<'a, 'i> {
         doc.attrs[a as usize..b as usize]
             .iter()
             .map(move |x| Attribute {
-                ns: x.ns.map(|s| doc.str(s)),
+                ns: doc.uri(x.ns),
                 name: doc.str(x.name),
                 value: doc.str(x.value),
             })
@@ -342,7 +361,7 @@ impl<'a, 'i> Node<'a, 'i> {
         let (a, b) = self.d().attrs;
         doc.attrs[a as usize..b as usize]
             .iter()
-            .find(|x| x.ns.is_none() && doc.is(x.name, name))
+            .find(|x| x.ns == 0 && doc.is(x.name, name))
             .map(|x| doc.str(x.value))
     }
 

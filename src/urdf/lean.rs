@@ -86,7 +86,7 @@ pub(super) fn parse(text: &str) -> Option<Document<'_>> {
         end: 0,
         range: (0, b.len() as u32),
         name: Str::default(),
-        ns: None,
+        ns: 0,
         attrs: (0, 0),
         scope: (0, 0),
     });
@@ -253,7 +253,7 @@ impl<'i> Reader<'i> {
             end: 0,
             range: (range.0 as u32, range.1 as u32),
             name: Str::of(name.0..name.1),
-            ns: None,
+            ns: 0,
             attrs: (0, 0),
             scope: (0, 0),
         }
@@ -404,13 +404,16 @@ impl<'i> Reader<'i> {
             }
             (s0 as u32, self.doc.scope.len() as u32)
         };
-        let lookup = |doc: &Document, p: &str| -> Option<Option<Str>> {
-            let found = doc.scope[scope.0 as usize..scope.1 as usize]
+        // A prefix's namespace: 1 + the index of its scope entry, 0 for none (no prefix and no
+        // default namespace); `None` for an undeclared prefix.
+        let lookup = |doc: &Document, p: &str| -> Option<u32> {
+            let (a, b) = (scope.0 as usize, scope.1 as usize);
+            let found = doc.scope[a..b]
                 .iter()
-                .find(|x| x.0.map(|q| doc.str(q)) == (!p.is_empty()).then_some(p));
+                .position(|x| x.0.map(|q| doc.str(q)) == (!p.is_empty()).then_some(p));
             match found {
-                Some(x) => Some(Some(x.1)),
-                None if p.is_empty() => Some(None),
+                Some(k) => Some((a + k + 1) as u32),
+                None if p.is_empty() => Some(0),
                 None => None,
             }
         };
@@ -422,14 +425,15 @@ impl<'i> Reader<'i> {
                 continue;
             }
             let ans = if p.is_empty() {
-                None
+                0
             } else {
                 lookup(&self.doc, p)?
             };
-            let uri = |x: Option<Str>| x.map(|u| self.doc.str(u));
-            let duplicate = self.doc.attrs[a0..]
+            let doc = &self.doc;
+            let uri = |x: u32| (x != 0).then(|| doc.str(doc.scope[x as usize - 1].1));
+            let duplicate = doc.attrs[a0..]
                 .iter()
-                .any(|x| self.doc.str(x.name) == l && uri(x.ns) == uri(ans));
+                .any(|x| doc.str(x.name) == l && uri(x.ns) == uri(ans));
             if duplicate {
                 return None;
             }

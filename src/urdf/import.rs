@@ -404,7 +404,7 @@ fn locate_invalid(src: &Source, robot: Node, e: crate::Error) -> crate::Error {
             && !name.is_empty()
             && ["name", "joint", "link"]
                 .iter()
-                .any(|a| n.attribute(*a) == Some(name.as_str()))
+                .any(|a| n.attribute(a) == Some(name.as_str()))
     };
     let element = robot
         .descendants()
@@ -441,7 +441,7 @@ fn locate_model(src: &Source, robot: Node, message: &str) -> crate::Error {
             && !name.is_empty()
             && ["name", "joint", "link"]
                 .iter()
-                .any(|a| n.attribute(*a) == Some(name))
+                .any(|a| n.attribute(a) == Some(name))
     };
     let node = tags
         .iter()

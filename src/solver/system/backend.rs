@@ -47,9 +47,8 @@ impl Backend {
     /// [`SPARSE_FROM_COORDINATES`] the tree factors for a mechanism without joint stops (its
     /// partitions fit a tree: `O(N)` with fixed-size blocks, faster than the general sparse
     /// factors on chains and ropes, BENCHMARKS.md; with closed loops, each factor that does not
-    /// fit a tree with a small border takes the sparse factors: a ladder's thousand loops give
-    /// `Φ_u` super-nodes, module `tree::merge`, and its KKT matrix the sparse LDLᵀ), the
-    /// sparse ones otherwise. A mechanism without closed
+    /// fit a tree with a small border is factored by super-nodes, module `tree::merge`: a
+    /// ladder's thousand loops), the sparse ones otherwise. A mechanism without closed
     /// loops but with stops is given the sparse factors here and the tree ones by each round
     /// of its solve ([`Backend::of_round`]; before the projected stop search, the tree
     /// factors' last Newton steps stalled on Romeo's finger stops at a reduced gradient of

@@ -5,6 +5,7 @@ use super::merge::{phi_u_runs, MAX_NODE};
 use super::phi_u::MAX_BORDER;
 use crate::constraints::Constraints;
 use crate::model::Model;
+use crate::solver::sparse::kkt::Factored;
 use crate::solver::system::{Backend, Factors, KktMatrix, System};
 use crate::solver::{LinearAlgebra, Options};
 use crate::urdf::{load_str, ImportOptions};
@@ -84,9 +85,8 @@ fn merged_runs_make_phi_u_block_triangular() {
     );
 }
 
-/// On a ladder of 30 rungs the tree factors of `Φ_u` (super-nodes, no border) give the sparse
-/// factors' multipliers, reduced gradient, tangent step and corrector to 10⁻¹⁰; the KKT matrix
-/// (border above its limit) takes the sparse LDLᵀ.
+/// On a ladder of 30 rungs the tree factors (super-nodes, no border) give the sparse factors'
+/// multipliers, reduced gradient, tangent step, corrector, KKT step and inertia to 10⁻¹⁰.
 #[test]
 fn long_ladder_phi_u_by_super_nodes_matches_the_sparse_factors() {
     let model = ladder(30);
@@ -119,8 +119,43 @@ fn long_ladder_phi_u_by_super_nodes_matches_the_sparse_factors() {
     tree.correct(&mut qt, &part, 1e-12, 20)
         .expect("tree corrects");
     assert!(close(&qs, &qt, 1e-10), "corrector");
-    tree.factor_kkt(&q, &part, &et, true, 1e-3);
-    assert!(matches!(tree.work.kkt, Some(KktMatrix::Sparse(_))));
+    // KKT: the super-nodes' step and inertia, LDLᵀ and LU.
+    let fs = sparse.factor_kkt(&q, &part, &es, true, 1e-3);
+    let ft = tree.factor_kkt(&q, &part, &et, true, 1e-3);
+    let Some(KktMatrix::Tree(k)) = &tree.work.kkt else {
+        panic!("tree KKT");
+    };
+    assert_eq!(k.border_size(), 0);
+    assert_eq!(fs, ft, "factored (inertia)");
+    assert!(matches!(ft, Factored::Ldlt { .. }), "{ft:?}");
+    let b = DVector::from_fn(q.len(), |i, _| (0.3 * i as f64).cos());
+    let xs = sparse.kkt_solve(&b).expect("sparse KKT solve");
+    let xt = tree.kkt_solve(&b).expect("tree KKT solve");
+    assert!(close(&xs, &xt, 1e-10), "KKT solution");
+    assert_eq!(tree.kkt_fall_back_to_lu(), Factored::Lu);
+    let xl = tree.kkt_solve(&b).expect("tree KKT solve by LU");
+    assert!(close(&xs, &xl, 1e-10), "KKT solution by LU");
+}
+
+/// The KKT matrix of a ladder by super-nodes: with a negative curvature (the shift `−σ` above
+/// the smallest eigenvalues of the reduced Hessian) the inertia still equals the sparse LDLᵀ's.
+#[test]
+fn long_ladder_kkt_inertia_by_super_nodes_matches_the_sparse_one() {
+    let model = ladder(30);
+    let q0 = crate::solver::initial_state(&model).q;
+    let q =
+        crate::solver::assemble_only(&model, q0, &mut Default::default(), &[]).expect("assembles");
+    let mut sparse = System::new(&model, Constraints::new(&model, &[]), Backend::Sparse);
+    let mut tree = System::new(&model, Constraints::new(&model, &[]), Backend::Tree);
+    let part = sparse.partition(&q);
+    let es = sparse.evaluate(&q, &part).expect("sparse evaluation");
+    let et = tree.evaluate(&q, &part).expect("tree evaluation");
+    for delta in [1e-3, 0.0, -1e-1, -10.0] {
+        let fs = sparse.factor_kkt(&q, &part, &es, true, delta);
+        let ft = tree.factor_kkt(&q, &part, &et, true, delta);
+        assert!(matches!(tree.work.kkt, Some(KktMatrix::Tree(_))));
+        assert_eq!(fs, ft, "δ = {delta}");
+    }
 }
 
 /// The automatic choice takes the tree factors for a long ladder (no stops), with the same

@@ -11,11 +11,10 @@
 //!   blocks and stored into the 13 × 13 blocks in one pass;
 //! - `kkt`: its block LDLᵀ (block LU as the fallback), solves and refinement;
 //! - `border`: the dense Schur complement of the border;
-//! - `merge`: super-nodes of `Φ_u` where its border would be too large (a ladder).
+//! - `merge`: super-nodes where the border would be too large (a ladder: a loop per rung).
 //!
 //! The sparse path (module `sparse`) stays the reference and the fallback: where a partition's
-//! structure does not fit (a KKT border or a super-node above its limit), the system uses it
-//! instead.
+//! structure does not fit (a super-node above its limit), the system uses it instead.
 
 mod border;
 pub(crate) mod dense;

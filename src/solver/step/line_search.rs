@@ -81,24 +81,32 @@ pub(crate) fn line_search(
     };
     for _ in 0..MAX_TRIALS {
         let caps: Vec<Stop> = stops.iter().filter(|s| s.alpha < alpha).copied().collect();
+        // `Φ` of the trial point, where the second-order correction has just evaluated it.
+        let mut phi_in_scratch = false;
         let mut qt = if caps.is_empty() {
             let qt = sys.problem.retraction.point(q, dq, alpha);
             let tolerance = options.constraint_tolerance;
-            line.second_order
-                .then(|| corrected_point(sys, part, (q, dq, alpha), &qt, tolerance))
-                .flatten()
-                .unwrap_or(qt)
+            if line.second_order {
+                let got = corrected_point(sys, part, (q, dq, alpha), &qt, tolerance);
+                phi_in_scratch = got.phi_in_scratch;
+                got.point.unwrap_or(qt)
+            } else {
+                qt
+            }
         } else {
             let bodies: Vec<(usize, f64)> = caps.iter().map(|s| (s.body, s.alpha)).collect();
             sys.problem.retraction.bent_point(q, dq, alpha, &bodies)
         };
         if sys
-            .correct_from(
+            .correct_evaluated(
                 &mut qt,
                 part,
-                options.constraint_tolerance,
-                options.max_corrector_iterations,
+                (
+                    options.constraint_tolerance,
+                    options.max_corrector_iterations,
+                ),
                 Some(&eval.factors),
+                phi_in_scratch,
             )
             .is_err()
         {

@@ -32,25 +32,45 @@ use crate::solver::partition::Partition;
 use crate::solver::system::System;
 use nalgebra::DVector;
 
+/// What [`corrected_point`] leaves: the corrected trial point (`None`: the plain one is the
+/// trial), and whether the scratch holds `Φ` of the trial point so chosen (the corrector then
+/// starts from it instead of evaluating it again: the same values, module `system::corrector`).
+pub(crate) struct Corrected {
+    pub(crate) point: Option<DVector<f64>>,
+    pub(crate) phi_in_scratch: bool,
+}
+
 /// The trial point at `α` along the tangent `dq` from `q` on the search path, corrected to
 /// second order where that lowers the residual of the independent rows above `tolerance`
-/// (module docs); `None` when no correction applies (the plain point is then the trial).
+/// (module docs); `point` is `None` when no correction applies (the plain point `qt` is then
+/// the trial).
 pub(crate) fn corrected_point(
     sys: &mut System,
     part: &Partition,
     (q, dq, alpha): (&DVector<f64>, &DVector<f64>, f64),
     qt: &DVector<f64>,
     tolerance: f64,
-) -> Option<DVector<f64>> {
+) -> Corrected {
+    let plain = Corrected {
+        point: None,
+        phi_in_scratch: true,
+    };
     let before = residual(sys, part, qt);
     if !before.is_finite() || before <= tolerance {
-        return None;
+        return plain;
     }
-    let dq2 = correction(sys, part)?;
+    let Some(dq2) = correction(sys, part) else {
+        return plain;
+    };
     let step = dq * alpha + dq2;
     let qc = sys.problem.retraction.point(q, &step, 1.0);
     let after = residual(sys, part, &qc);
-    (after < before).then_some(qc)
+    // The scratch now holds `Φ(q_c)`: of the trial only where the correction is taken.
+    let better = after < before;
+    Corrected {
+        point: better.then_some(qc),
+        phi_in_scratch: better,
+    }
 }
 
 /// `‖D Φ(q)‖∞` over the independent rows (leaves `Φ(q)` in the scratch).
@@ -114,8 +134,12 @@ mod tests {
         for alpha in [0.4, 0.2, 0.1, 0.05] {
             let qt = sys.problem.retraction.point(&q, &dq, alpha);
             let before = residual(&mut sys, &part, &qt);
-            let qc = corrected_point(&mut sys, &part, (&q, &dq, alpha), &qt, 1e-14)
-                .expect("the correction lowers the residual");
+            let got = corrected_point(&mut sys, &part, (&q, &dq, alpha), &qt, 1e-14);
+            assert!(got.phi_in_scratch);
+            let qc = got.point.expect("the correction lowers the residual");
+            let mut phi_c = DVector::zeros(sys.phi().len());
+            sys.problem.cons.evaluate(&model, &qc, &mut phi_c, None);
+            assert_eq!(sys.phi(), &phi_c, "Φ(q_c) in the scratch");
             let after = residual(&mut sys, &part, &qc);
             assert!(
                 after < 0.5 * before,

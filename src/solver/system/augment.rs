@@ -126,9 +126,9 @@ impl System<'_> {
             _ => AugmentPlan::new(part, m, entries),
         };
         let floor = 1e-6 * wdiag.iter().fold(0.0f64, |x, &y| x.max(y)) + 1e-12;
-        // The pending body pair and its accumulated `Σ ρ g gᵀ` (column-major, as `LMat`).
+        // The pending body pair and its accumulated `Σ ρ g gᵀ` (handed to the sink as it is).
         let mut pending: Option<[Option<BodyId>; 2]> = None;
-        let mut acc = [0.0f64; NL * NL];
+        let mut acc = LMat::zeros();
         for g in &plan.groups {
             let range = g.start..g.end;
             let group = &entries[range.clone()];
@@ -148,24 +148,25 @@ impl System<'_> {
             }
             if pending != Some(bodies) {
                 if let Some(b) = pending.take() {
-                    sink.add_block(&b, &LMat::from_column_slice(&acc), 1.0);
+                    sink.add_block(&b, &acc, 1.0);
                 }
                 pending = Some(bodies);
-                acc = [0.0; NL * NL];
+                acc.as_mut_slice().fill(0.0);
             }
             add_outer(&mut acc, &gv, rho);
         }
         if let Some(b) = pending.take() {
-            sink.add_block(&b, &LMat::from_column_slice(&acc), 1.0);
+            sink.add_block(&b, &acc, 1.0);
         }
         work.augment = Some(plan);
         work.wdiag = wdiag;
     }
 }
 
-/// `acc += g gᵀ ρ` (column-major `NL × NL`), entry by entry as `(g_i g_j) ρ`, over the columns
-/// of `g`'s nonzero entries: a zero `g_i` adds a signed zero, which changes no sum.
-fn add_outer(acc: &mut [f64; NL * NL], g: &[f64; NL], rho: f64) {
+/// `acc += g gᵀ ρ`, entry by entry as `(g_i g_j) ρ`, over the columns of `g`'s nonzero
+/// entries: a zero `g_i` adds a signed zero, which changes no sum.
+fn add_outer(acc: &mut LMat, g: &[f64; NL], rho: f64) {
+    let acc = acc.as_mut_slice();
     for (j, &gj) in g.iter().enumerate() {
         if gj != 0.0 {
             let col = &mut acc[NL * j..NL * j + NL];

@@ -57,7 +57,21 @@ impl System<'_> {
         part: &Partition,
         tol: f64,
         max_iterations: usize,
+        chord: Option<&Factors>,
+    ) -> Result<usize, CorrectorFailure> {
+        self.correct_evaluated(q, part, (tol, max_iterations), chord, false)
+    }
+
+    /// [`System::correct_from`]; with `phi_in_scratch` the scratch holds `Φ(q)` already (the
+    /// second-order correction of a line search evaluated it), and a first chord step starts
+    /// from it instead of evaluating `Φ(q)` again (the same values: `Φ` alone at the same `q`).
+    pub(crate) fn correct_evaluated(
+        &mut self,
+        q: &mut DVector<f64>,
+        part: &Partition,
+        (tol, max_iterations): (f64, usize),
         mut chord: Option<&Factors>,
+        phi_in_scratch: bool,
     ) -> Result<usize, CorrectorFailure> {
         let mut first = f64::INFINITY;
         let mut last = f64::INFINITY;
@@ -68,7 +82,7 @@ impl System<'_> {
             // here, the evaluation at the point that follows finds the triplets in place.
             if chord.is_none() {
                 self.triplets(q);
-            } else {
+            } else if !(it == 0 && phi_in_scratch) {
                 self.residual(q);
             }
             let res = self

@@ -59,7 +59,7 @@ impl DenseLu {
                     continue;
                 }
                 for &j in &nonzero {
-                    m[(j, k)] = a * m[(j, i)] + m[(j, k)];
+                    m[(j, k)] += a * m[(j, i)];
                 }
             }
         }

@@ -6,6 +6,7 @@
 //! link frame is `J` at zero displacement). An endpoint may also be a `mech:frame` (folded into
 //! the origin) or the undeclared `world`.
 
+use super::dom::Node;
 use super::limits::{limits, urdf_limits};
 use super::xml::{child, Source};
 use crate::error::Result;
@@ -13,7 +14,6 @@ use crate::joint::Frame;
 use crate::model::{joint_type, JointKind};
 use crate::names::NameMap;
 use nalgebra::{Isometry3, Vector3};
-use roxmltree::Node;
 
 /// The namespace URI Drake uses for its URDF extensions.
 pub(super) const DRAKE_NS: &str = "http://drake.mit.edu";

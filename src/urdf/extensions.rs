@@ -4,6 +4,7 @@
 //! springs, joint springs, loads, efforts, locks and initial values. Command-line locks and
 //! initial values override the file's.
 
+use super::dom::Node;
 use super::import::Builder;
 use super::xml::{child, Source};
 use super::ImportOptions;
@@ -13,7 +14,6 @@ use crate::model::{
     Mimic, Spring, SpringEnd, SpringMode,
 };
 use nalgebra::Vector3;
-use roxmltree::Node;
 
 fn force_law(src: &Source, node: Node, what: &dyn std::fmt::Display) -> Result<ForceLaw> {
     let stiffness = src.f64_opt(node, "stiffness")?;

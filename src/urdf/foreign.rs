@@ -2,6 +2,7 @@
 //! `<gazebo reference="J"><springStiffness>k</springStiffness><springReference>q0`
 //! `</springReference></gazebo>` to a joint spring. Damping is accepted and ignored (statics).
 
+use super::dom::Node;
 use super::edges::drake_part;
 use super::import::Builder;
 use super::xml::{child, parse_f64, Source};
@@ -9,7 +10,6 @@ use crate::error::Result;
 use crate::model::{
     ForceLaw, JointSpring, Spring, SpringEnd, SpringMode, LARGEST_LENGTH, LARGEST_MAGNITUDE,
 };
-use roxmltree::Node;
 
 pub(super) fn read(src: &Source, drake: &[Node], gazebo: &[Node], b: &mut Builder) -> Result<()> {
     for (k, &n) in drake

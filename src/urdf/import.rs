@@ -12,6 +12,7 @@
 //! The root link is welded to the world (its frame is the world frame) unless a floating base
 //! is asked for.
 
+use super::dom::Node;
 use super::edges::{self, Declaration, Edge, FrameMap, Frames, DRAKE_NS};
 use super::extensions;
 use super::links::read_link;
@@ -25,7 +26,6 @@ use crate::model::{BodyId, Joint, JointId, JointKind, ModelBuilder};
 use crate::names::NameMap;
 use crate::state::State;
 use nalgebra::{Isometry3, Matrix3, UnitQuaternion, Vector3};
-use roxmltree::Node;
 
 /// The import context shared with the extension readers: the model builder and the names
 /// it resolves.
@@ -404,7 +404,7 @@ fn locate_invalid(src: &Source, robot: Node, e: crate::Error) -> crate::Error {
             && !name.is_empty()
             && ["name", "joint", "link"]
                 .iter()
-                .any(|a| n.attribute(*a) == Some(name.as_str()))
+                .any(|a| n.attribute(a) == Some(name.as_str()))
     };
     let element = robot
         .descendants()
@@ -441,7 +441,7 @@ fn locate_model(src: &Source, robot: Node, message: &str) -> crate::Error {
             && !name.is_empty()
             && ["name", "joint", "link"]
                 .iter()
-                .any(|a| n.attribute(*a) == Some(name))
+                .any(|a| n.attribute(a) == Some(name))
     };
     let node = tags
         .iter()

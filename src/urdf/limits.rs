@@ -2,10 +2,10 @@
 //! coordinate, `lower ≤ q ≤ upper` when limits are enforced. URDF joints are read as urdfdom
 //! reads them (a missing bound is 0), with a located warning where that reading is unusual.
 
+use super::dom::Node;
 use super::xml::{child, Source};
 use crate::error::Result;
 use crate::model::JointKind;
-use roxmltree::Node;
 
 /// Position limits from `<limit lower upper>` (a missing bound is 0, as in urdfdom);
 /// `lower > upper` is an error.

@@ -4,12 +4,12 @@
 //! An `<inertial>` at `origin = (R, c)` with tensor `I₀` gives the link-frame inertia
 //! `R I₀ Rᵀ` about the centre of mass `c`.
 
+use super::dom::Node;
 use super::xml::{child, parse_f64, Source};
 use crate::error::Result;
 use crate::geometry::{Geometry, PackagePaths, ShapeKind};
 use crate::model::{Inertial, LARGEST_LENGTH};
 use nalgebra::{Matrix3, Vector3};
-use roxmltree::Node;
 
 /// Mass properties and geometry of one link, in its link frame.
 pub(super) struct LinkIn {

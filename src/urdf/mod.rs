@@ -1,16 +1,22 @@
 //! The input boundary: URDF text (with the `mech:` extensions of `docs/urdf-extensions.md`) to a
 //! validated [`Model`]. Nothing else in the crate sees XML.
 //!
-//! The file is read with `roxmltree`, which keeps the position of every element, so that each
-//! error names `FILE:LINE:COLUMN` and the element. The standard URDF tree and the extension
-//! elements are read in one pass; the spanning tree is the URDF `<joint>` tree, and every
-//! `mech:loop_joint` closes a loop.
+//! The file is read into a compact document (module `dom`) that keeps the position of every
+//! element, so that each error names `FILE:LINE:COLUMN` and the element: plain XML (ASCII, no
+//! references, DTD or CDATA: what URDF files are) by a one-pass reader (module `lean`),
+//! anything else, and every malformed file, by `roxmltree`, whose errors are the ones
+//! reported. The standard URDF tree and the extension elements are read in one pass; the
+//! spanning tree is the URDF `<joint>` tree, and every `mech:loop_joint` closes a loop.
 
 mod base;
+mod dom;
+#[cfg(test)]
+mod dom_tests;
 mod edges;
 mod extensions;
 mod foreign;
 mod import;
+mod lean;
 mod limits;
 mod links;
 mod mimic;

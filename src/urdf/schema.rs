@@ -6,9 +6,9 @@
 //! Children of `mech:` elements may be written with or without the prefix; attributes of other
 //! namespaces (`xml:`, a tool's own) are left alone.
 
+use super::dom::Node;
 use super::xml::{Source, MECH_NS};
 use crate::error::Result;
-use roxmltree::Node;
 
 /// A child element: local name and attributes.
 struct Child {

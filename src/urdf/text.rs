@@ -7,6 +7,7 @@
 //! Repairs keep every byte offset of the original text where they can (a misplaced declaration
 //! is blanked, not removed), so that line and column numbers in messages are those of the file.
 
+use super::dom::Document;
 use crate::error::{Error, Result};
 
 /// Largest URDF file read \[bytes\] (256 MiB): a description of 100,000 links is ~50 MB.
@@ -268,7 +269,13 @@ pub(crate) fn parse<'a>(
     file: &str,
     warnings: &mut Vec<String>,
     store: &'a mut Option<String>,
-) -> Result<roxmltree::Document<'a>> {
+) -> Result<Document<'a>> {
+    // Plain XML (most files) is read by the lean reader, which bounds the nesting itself
+    // and declines a late declaration; everything else is checked and read as before.
+    if let Some(doc) = super::lean::parse(text) {
+        refuse_xacro(&doc, file)?;
+        return Ok(doc);
+    }
     check_depth(text, file)?;
     let late = late_declaration(text).is_some();
     let doc = if late {
@@ -301,7 +308,7 @@ fn options() -> roxmltree::ParsingOptions {
 }
 
 /// Refuses a xacro file: an element in a xacro namespace or an attribute with `${`.
-fn refuse_xacro(doc: &roxmltree::Document, file: &str) -> Result<()> {
+fn refuse_xacro(doc: &Document, file: &str) -> Result<()> {
     // Neither can appear without `${` or `xacro` in the text, or an entity reference that
     // would spell one (a byte search; the element scan walks every attribute of the file).
     let text = doc.input_text();
@@ -314,11 +321,11 @@ fn refuse_xacro(doc: &roxmltree::Document, file: &str) -> Result<()> {
             .namespace()
             .is_some_and(|u| u.contains("xacro"));
         if xacro || n.attributes().any(|a| a.value().contains("${")) {
-            let p = doc.text_pos_at(n.range().start);
+            let (line, col) = line_col(text, n.range().start);
             return Err(Error::Input {
                 file: file.to_string(),
-                line: p.row,
-                col: p.col,
+                line,
+                col,
                 message: XACRO.into(),
                 element: n.tag_name().name().to_string(),
             });
@@ -393,7 +400,8 @@ mod tests {
     fn xacro_is_refused_also_through_references() {
         let refused = |t: &str| {
             let doc = roxmltree::Document::parse_with_options(t, options()).unwrap();
-            refuse_xacro(&doc, "f").is_err()
+            refuse_xacro(&Document::from_roxmltree(&doc), "f").is_err()
+                && super::super::lean::parse(t).is_none_or(|d| refuse_xacro(&d, "f").is_err())
         };
         assert!(refused(r#"<robot><link name="${a}"/></robot>"#));
         assert!(refused(r#"<robot><link name="&#36;{a}"/></robot>"#));

@@ -1,10 +1,10 @@
 //! XML reading helpers that turn every problem into an [`Error::Input`] naming the file,
 //! line, column and element.
 
+use super::dom::{Document, Node};
 use crate::error::{Error, Result};
 use crate::model::LARGEST_LENGTH;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
-use roxmltree::Node;
 
 /// The namespace URI of restpose's extension elements.
 pub(crate) const MECH_NS: &str = "urn:urdf-mech:1";
@@ -12,7 +12,7 @@ pub(crate) const MECH_NS: &str = "urn:urdf-mech:1";
 /// Source document with its file name, for error positions.
 pub(crate) struct Source<'a> {
     pub(crate) file: &'a str,
-    pub(crate) doc: &'a roxmltree::Document<'a>,
+    pub(crate) doc: &'a Document<'a>,
     /// Byte offset of the start of each line: positions by binary search, where roxmltree's
     /// `text_pos_at` scans the document from its start (quadratic over a file's warnings).
     line_starts: Vec<usize>,
@@ -20,7 +20,7 @@ pub(crate) struct Source<'a> {
 
 impl<'a> Source<'a> {
     /// The source of `doc`, read from `file`.
-    pub(crate) fn new(file: &'a str, doc: &'a roxmltree::Document<'a>) -> Self {
+    pub(crate) fn new(file: &'a str, doc: &'a Document<'a>) -> Self {
         let text = doc.input_text();
         let line_starts = std::iter::once(0)
             .chain(text.match_indices('\n').map(|(i, _)| i + 1))
@@ -158,14 +158,19 @@ impl<'a> Source<'a> {
         let Some(s) = node.attribute(attr) else {
             return Ok(None);
         };
-        let vals: Option<Vec<f64>> = s.split_whitespace().map(parse_f64).collect();
-        match vals {
-            Some(v) if v.len() == N => {
-                let mut out = [0.0; N];
-                out.copy_from_slice(&v);
-                Ok(Some(out))
+        // Exactly N finite numbers, read into place.
+        let mut out = [0.0; N];
+        let mut words = s.split_whitespace();
+        let mut ok = true;
+        for o in out.iter_mut() {
+            match words.next().and_then(parse_f64) {
+                Some(v) => *o = v,
+                None => ok = false,
             }
-            _ => Err(self.error(
+        }
+        match ok && words.next().is_none() {
+            true => Ok(Some(out)),
+            false => Err(self.error(
                 node,
                 format!(
                     "{}: attribute `{attr}` = \"{s}\" must be {N} finite numbers",
@@ -275,9 +280,12 @@ impl<'a> Source<'a> {
     }
 }
 
-/// Parses XML text (DTDs allowed); a malformed document is an [`Error::Input`] at the
-/// position of the problem.
-pub(crate) fn parse_document<'a>(text: &'a str, file: &str) -> Result<roxmltree::Document<'a>> {
+/// Parses XML text (DTDs allowed): by [`super::lean::parse`], or by `roxmltree` where it
+/// declines; a malformed document is an [`Error::Input`] at the position of the problem.
+pub(crate) fn parse_document<'a>(text: &'a str, file: &str) -> Result<Document<'a>> {
+    if let Some(doc) = super::lean::parse(text) {
+        return Ok(doc);
+    }
     let opts = roxmltree::ParsingOptions {
         allow_dtd: true,
         ..Default::default()
@@ -285,12 +293,12 @@ pub(crate) fn parse_document<'a>(text: &'a str, file: &str) -> Result<roxmltree:
     located(roxmltree::Document::parse_with_options(text, opts), file)
 }
 
-/// The parser's result with its error located in `file`.
+/// `roxmltree`'s result as a [`Document`], its error located in `file`.
 pub(crate) fn located<'a>(
     parsed: std::result::Result<roxmltree::Document<'a>, roxmltree::Error>,
     file: &str,
-) -> Result<roxmltree::Document<'a>> {
-    parsed.map_err(|e| {
+) -> Result<Document<'a>> {
+    parsed.map(|d| Document::from_roxmltree(&d)).map_err(|e| {
         let p = e.pos();
         Error::Input {
             file: file.to_string(),
@@ -321,8 +329,7 @@ pub(crate) fn parse_f64(s: &str) -> Option<f64> {
 
 /// First child element with this local name.
 pub(crate) fn child<'a>(node: Node<'a, 'a>, name: &str) -> Option<Node<'a, 'a>> {
-    node.children()
-        .find(|c| c.is_element() && c.tag_name().name() == name)
+    node.children().find(|c| c.is_named(name))
 }
 
 /// Whether the element is in the `mech` namespace.

@@ -1,0 +1,475 @@
+//! The importer's XML document: a compact tree of elements, text and comments in document
+//! order, with the subset of `roxmltree`'s node interface the importer reads (names and their
+//! namespaces, attributes, text, byte ranges, in-scope prefixes).
+//!
+//! A document comes from one of two readers with the same result:
+//! [`super::lean::parse`], a reader of the plain XML that URDF files are written in (ASCII,
+//! no entity references, no DTD), which declines anything else; or `roxmltree`, which reads
+//! every XML document and reports every error, converted here by [`Document::from_roxmltree`].
+//! Each node is 48 bytes with its strings borrowed from the text (`roxmltree` keeps 72 and a
+//! table regrown by copies on files written one element per line).
+
+use std::ops::Range;
+
+/// The namespace URI bound to the `xml` prefix.
+const XML_URI: &str = "http://www.w3.org/XML/1998/namespace";
+
+/// A string of the document: a byte range of the input text, or of the document's own
+/// buffer (strings `roxmltree` expanded) when the length has its top bit set.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Str {
+    start: u32,
+    len: u32,
+}
+
+/// The top bit of [`Str::len`]: the string is in [`Document::owned`].
+const OWNED: u32 = 1 << 31;
+
+impl Str {
+    /// The byte range `r` of the input text.
+    pub(super) fn of(r: Range<usize>) -> Str {
+        Str {
+            start: r.start as u32,
+            len: (r.end - r.start) as u32,
+        }
+    }
+
+    /// Its length in bytes.
+    fn bytes(self) -> usize {
+        (self.len & !OWNED) as usize
+    }
+}
+
+/// What a node is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Kind {
+    /// The document itself (node 0).
+    Root,
+    Element,
+    Text,
+    Comment,
+    /// A processing instruction.
+    Other,
+}
+
+/// One node; siblings and subtrees by index (node 0, the root, is nobody's sibling).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct NodeData {
+    pub(super) kind: Kind,
+    pub(super) parent: u32,
+    /// Next sibling, 0 if none.
+    pub(super) next_sibling: u32,
+    /// One past the node's last descendant.
+    pub(super) end: u32,
+    pub(super) range: (u32, u32),
+    /// An element's local name; a text's or comment's content.
+    pub(super) name: Str,
+    /// An element's namespace URI: 1 + its index in [`Document::scope`], 0 for none.
+    pub(super) ns: u32,
+    /// An element's attributes: a range of [`Document::attrs`].
+    pub(super) attrs: (u32, u32),
+    /// An element's namespaces in scope: a range of [`Document::scope`].
+    pub(super) scope: (u32, u32),
+}
+
+/// An attribute: namespace URI (as [`NodeData::ns`]), local name, value.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct AttrData {
+    pub(super) ns: u32,
+    pub(super) name: Str,
+    pub(super) value: Str,
+}
+
+/// A parsed XML document.
+pub(crate) struct Document<'i> {
+    pub(super) text: &'i str,
+    pub(super) owned: String,
+    pub(super) nodes: Vec<NodeData>,
+    pub(super) attrs: Vec<AttrData>,
+    /// In-scope namespaces of elements: `(prefix, uri)`, an element's own declarations first;
+    /// also the URIs that names refer to.
+    pub(super) scope: Vec<(Option<Str>, Str)>,
+}
+
+impl<'i> Document<'i> {
+    /// The text of `s`.
+    #[inline]
+    pub(super) fn str(&self, s: Str) -> &str {
+        let (a, b) = (s.start as usize, s.start as usize + s.bytes());
+        if s.len & OWNED != 0 {
+            &self.owned[a..b]
+        } else {
+            &self.text[a..b]
+        }
+    }
+
+    /// Whether `s` is `name`, lengths first.
+    #[inline]
+    fn is(&self, s: Str, name: &str) -> bool {
+        s.bytes() == name.len() && self.str(s) == name
+    }
+
+    /// The namespace URI of a name's `ns` ([`NodeData::ns`]).
+    #[inline]
+    fn uri(&self, ns: u32) -> Option<&str> {
+        (ns != 0).then(|| self.str(self.scope[ns as usize - 1].1))
+    }
+
+    /// The text the document was read from.
+    pub(crate) fn input_text(&self) -> &'i str {
+        self.text
+    }
+
+    /// The document node.
+    pub(crate) fn root(&self) -> Node<'_, 'i> {
+        Node { doc: self, id: 0 }
+    }
+
+    /// The root element.
+    pub(crate) fn root_element(&self) -> Node<'_, 'i> {
+        self.root()
+            .children()
+            .find(|n| n.is_element())
+            .unwrap_or(self.root())
+    }
+
+    /// Every node in document order, the document node first.
+    pub(crate) fn descendants(&self) -> Descendants<'_, 'i> {
+        self.root().descendants()
+    }
+
+    /// `roxmltree`'s document, converted.
+    pub(crate) fn from_roxmltree(doc: &roxmltree::Document<'i>) -> Document<'i> {
+        let mut out = Document {
+            text: doc.input_text(),
+            owned: String::new(),
+            nodes: Vec::new(),
+            attrs: Vec::new(),
+            scope: Vec::new(),
+        };
+        let own = |owned: &mut String, s: &str| {
+            let start = owned.len() as u32;
+            owned.push_str(s);
+            Str {
+                start,
+                len: s.len() as u32 | OWNED,
+            }
+        };
+        // Depth-first with an explicit stack of (roxmltree node, parent index); siblings are
+        // linked when the next one is placed.
+        let mut last_child: Vec<u32> = Vec::new();
+        let mut stack = vec![(doc.root(), 0u32, 0usize)];
+        while let Some((n, parent, depth)) = stack.pop() {
+            let id = out.nodes.len() as u32;
+            let kind = match n.node_type() {
+                roxmltree::NodeType::Root => Kind::Root,
+                roxmltree::NodeType::Element => Kind::Element,
+                roxmltree::NodeType::Text => Kind::Text,
+                roxmltree::NodeType::Comment => Kind::Comment,
+                roxmltree::NodeType::PI => Kind::Other,
+            };
+            let mut data = NodeData {
+                kind,
+                parent,
+                next_sibling: 0,
+                end: id + 1,
+                range: (n.range().start as u32, n.range().end as u32),
+                name: Str::default(),
+                ns: 0,
+                attrs: (0, 0),
+                scope: (0, 0),
+            };
+            match kind {
+                Kind::Element => {
+                    data.name = own(&mut out.owned, n.tag_name().name());
+                    // A name's URI: an entry of the scope table outside every element's range.
+                    let uri = |owned: &mut String, scope: &mut Vec<_>, u: Option<&str>| {
+                        u.map_or(0, |u| {
+                            scope.push((None, own(owned, u)));
+                            scope.len() as u32
+                        })
+                    };
+                    data.ns = uri(&mut out.owned, &mut out.scope, n.tag_name().namespace());
+                    let a0 = out.attrs.len() as u32;
+                    for a in n.attributes() {
+                        let ns = uri(&mut out.owned, &mut out.scope, a.namespace());
+                        let name = own(&mut out.owned, a.name());
+                        let value = own(&mut out.owned, a.value());
+                        out.attrs.push(AttrData { ns, name, value });
+                    }
+                    data.attrs = (a0, out.attrs.len() as u32);
+                    let s0 = out.scope.len() as u32;
+                    for s in n.namespaces() {
+                        let p = s.name().map(|p| own(&mut out.owned, p));
+                        let u = own(&mut out.owned, s.uri());
+                        out.scope.push((p, u));
+                    }
+                    data.scope = (s0, out.scope.len() as u32);
+                }
+                Kind::Text | Kind::Comment => {
+                    data.name = own(&mut out.owned, n.text().unwrap_or(""));
+                }
+                _ => {}
+            }
+            // The previous node at this depth under the same parent (`u32::MAX`: none yet).
+            last_child.truncate(depth + 1);
+            match last_child.get_mut(depth) {
+                Some(prev) => {
+                    if *prev != u32::MAX {
+                        out.nodes[*prev as usize].next_sibling = id;
+                    }
+                    *prev = id;
+                }
+                None => last_child.push(id),
+            }
+            last_child.push(u32::MAX);
+            out.nodes.push(data);
+            let children: Vec<_> = n.children().collect();
+            for c in children.into_iter().rev() {
+                stack.push((c, id, depth + 1));
+            }
+        }
+        // Subtree ends, from the last node back: a node ends where its last descendant does.
+        for i in (1..out.nodes.len()).rev() {
+            let (p, e) = (out.nodes[i].parent as usize, out.nodes[i].end);
+            if out.nodes[p].end < e {
+                out.nodes[p].end = e;
+            }
+        }
+        out
+    }
+}
+
+/// A node of a [`Document`] (copyable, compared by identity).
+#[derive(Clone, Copy)]
+pub(crate) struct Node<'a, 'i> {
+    doc: &'a Document<'i>,
+    id: u32,
+}
+
+impl PartialEq for Node<'_, '_> {
+    fn eq(&self, other: &Self) -> bool {
+        std::ptr::eq(self.doc, other.doc) && self.id == other.id
+    }
+}
+
+impl std::fmt::Debug for Node<'_, '_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Node({}, {:?})", self.id, self.d().kind)
+    }
+}
+
+/// An element's name with its namespace URI.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct ExpandedName<'a> {
+    ns: Option<&'a str>,
+    name: &'a str,
+}
+
+impl<'a> ExpandedName<'a> {
+    /// The local name.
+    pub(crate) fn name(&self) -> &'a str {
+        self.name
+    }
+
+    /// The namespace URI.
+    pub(crate) fn namespace(&self) -> Option<&'a str> {
+        self.ns
+    }
+}
+
+/// An attribute of an element.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Attribute<'a> {
+    ns: Option<&'a str>,
+    name: &'a str,
+    value: &'a str,
+}
+
+impl<'a> Attribute<'a> {
+    /// The local name.
+    pub(crate) fn name(&self) -> &'a str {
+        self.name
+    }
+
+    /// The namespace URI (none for an unprefixed attribute).
+    pub(crate) fn namespace(&self) -> Option<&'a str> {
+        self.ns
+    }
+
+    /// The value.
+    pub(crate) fn value(&self) -> &'a str {
+        self.value
+    }
+}
+
+impl<'a, 'i> Node<'a, 'i> {
+    fn d(&self) -> &'a NodeData {
+        &self.doc.nodes[self.id as usize]
+    }
+
+    fn at(&self, id: u32) -> Node<'a, 'i> {
+        Node { doc: self.doc, id }
+    }
+
+    /// Whether the node is an element.
+    pub(crate) fn is_element(&self) -> bool {
+        self.d().kind == Kind::Element
+    }
+
+    /// Whether the node is text.
+    #[cfg(test)]
+    pub(crate) fn is_text(&self) -> bool {
+        self.d().kind == Kind::Text
+    }
+
+    /// An element's name (empty for other nodes).
+    pub(crate) fn tag_name(&self) -> ExpandedName<'a> {
+        let d = self.d();
+        if d.kind != Kind::Element {
+            return ExpandedName { ns: None, name: "" };
+        }
+        ExpandedName {
+            ns: self.doc.uri(d.ns),
+            name: self.doc.str(d.name),
+        }
+    }
+
+    /// Whether the node is an element of local name `name` (any namespace).
+    #[inline]
+    pub(crate) fn is_named(&self, name: &str) -> bool {
+        let d = self.d();
+        d.kind == Kind::Element && self.doc.is(d.name, name)
+    }
+
+    /// The attributes of an element.
+    pub(crate) fn attributes(&self) -> impl Iterator<Item = Attribute<'a>> + 'a {
+        let doc = self.doc;
+        let (a, b) = self.d().attrs;
+        doc.attrs[a as usize..b as usize]
+            .iter()
+            .map(move |x| Attribute {
+                ns: doc.uri(x.ns),
+                name: doc.str(x.name),
+                value: doc.str(x.value),
+            })
+    }
+
+    /// The value of the unprefixed attribute `name`.
+    pub(crate) fn attribute(&self, name: &str) -> Option<&'a str> {
+        let doc = self.doc;
+        let (a, b) = self.d().attrs;
+        doc.attrs[a as usize..b as usize]
+            .iter()
+            .find(|x| x.ns == 0 && doc.is(x.name, name))
+            .map(|x| doc.str(x.value))
+    }
+
+    /// Whether the element has the unprefixed attribute `name`.
+    pub(crate) fn has_attribute(&self, name: &str) -> bool {
+        self.attribute(name).is_some()
+    }
+
+    /// An element's first child if it is text; a text's or comment's content.
+    pub(crate) fn text(&self) -> Option<&'a str> {
+        let d = self.d();
+        match d.kind {
+            Kind::Element => {
+                let c = self.id + 1;
+                (c < d.end && self.doc.nodes[c as usize].kind == Kind::Text)
+                    .then(|| self.doc.str(self.doc.nodes[c as usize].name))
+            }
+            Kind::Text | Kind::Comment => Some(self.doc.str(d.name)),
+            _ => None,
+        }
+    }
+
+    /// Byte range of the node in the text.
+    pub(crate) fn range(&self) -> Range<usize> {
+        let (a, b) = self.d().range;
+        a as usize..b as usize
+    }
+
+    /// The parent node.
+    pub(crate) fn parent(&self) -> Option<Node<'a, 'i>> {
+        (self.id != 0).then(|| self.at(self.d().parent))
+    }
+
+    /// The parent if it is an element.
+    pub(crate) fn parent_element(&self) -> Option<Node<'a, 'i>> {
+        self.ancestors().skip(1).find(|n| n.is_element())
+    }
+
+    /// The node and its ancestors up to the document node.
+    pub(crate) fn ancestors(&self) -> impl Iterator<Item = Node<'a, 'i>> {
+        std::iter::successors(Some(*self), |n| n.parent())
+    }
+
+    /// The children, in document order.
+    pub(crate) fn children(&self) -> Children<'a, 'i> {
+        let d = self.d();
+        Children {
+            node: (self.id + 1 < d.end).then(|| self.at(self.id + 1)),
+        }
+    }
+
+    /// The node and every node under it, in document order.
+    pub(crate) fn descendants(&self) -> Descendants<'a, 'i> {
+        Descendants {
+            doc: self.doc,
+            next: self.id,
+            end: self.d().end,
+        }
+    }
+
+    /// The prefix bound to `uri` in the element's scope (`None` for the default namespace).
+    pub(crate) fn lookup_prefix(&self, uri: &str) -> Option<&'a str> {
+        if uri == XML_URI {
+            return Some("xml");
+        }
+        let doc = self.doc;
+        let d = self.d();
+        if d.kind != Kind::Element {
+            return None;
+        }
+        doc.scope[d.scope.0 as usize..d.scope.1 as usize]
+            .iter()
+            .find(|(_, u)| doc.str(*u) == uri)
+            .and_then(|(p, _)| p.map(|p| doc.str(p)))
+    }
+}
+
+/// Iterator over a node's children.
+pub(crate) struct Children<'a, 'i> {
+    node: Option<Node<'a, 'i>>,
+}
+
+impl<'a, 'i> Iterator for Children<'a, 'i> {
+    type Item = Node<'a, 'i>;
+    fn next(&mut self) -> Option<Self::Item> {
+        let n = self.node?;
+        let s = n.d().next_sibling;
+        self.node = (s != 0).then(|| n.at(s));
+        Some(n)
+    }
+}
+
+/// Iterator over a subtree in document order.
+pub(crate) struct Descendants<'a, 'i> {
+    doc: &'a Document<'i>,
+    next: u32,
+    end: u32,
+}
+
+impl<'a, 'i> Iterator for Descendants<'a, 'i> {
+    type Item = Node<'a, 'i>;
+    fn next(&mut self) -> Option<Self::Item> {
+        (self.next < self.end).then(|| {
+            self.next += 1;
+            Node {
+                doc: self.doc,
+                id: self.next - 1,
+            }
+        })
+    }
+}

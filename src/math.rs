@@ -128,7 +128,9 @@ pub fn rotation_vector(r: &Matrix3<f64>) -> Vector3<f64> {
 /// Wraps an angle into (−π, π].
 pub fn wrap_angle(a: f64) -> f64 {
     let two_pi = 2.0 * std::f64::consts::PI;
-    let mut w = a % two_pi;
+    // `a % 2π` is `a` itself, exactly, for `|a| < 2π` (the usual case: an angle read near its
+    // branch), without the call to `fmod`.
+    let mut w = if a.abs() < two_pi { a } else { a % two_pi };
     if w <= -std::f64::consts::PI {
         w += two_pi;
     } else if w > std::f64::consts::PI {
@@ -249,6 +251,37 @@ mod tests {
             let r = align_z(&axis);
             assert!((r * Vector3::z() - axis).norm() < 1e-12);
         }
+    }
+
+    #[test]
+    fn wrap_angle_without_fmod_is_bit_for_bit() {
+        let two_pi = 2.0 * std::f64::consts::PI;
+        let mut seed = 3u64;
+        for i in 0..20000 {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let u = (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
+            let a = u * 4.0 * two_pi * if i % 2 == 0 { 1.0 } else { 1e-3 };
+            for x in [
+                a,
+                two_pi,
+                -two_pi,
+                std::f64::consts::PI,
+                -std::f64::consts::PI,
+                0.0,
+                -0.0,
+            ] {
+                let mut w = x % two_pi;
+                if w <= -std::f64::consts::PI {
+                    w += two_pi;
+                } else if w > std::f64::consts::PI {
+                    w -= two_pi;
+                }
+                assert_eq!(wrap_angle(x).to_bits(), w.to_bits(), "{x}");
+            }
+        }
+        assert!(wrap_angle(f64::NAN).is_nan());
     }
 
     #[test]

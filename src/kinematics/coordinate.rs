@@ -81,6 +81,39 @@ pub(crate) fn coordinate_value(
     })
 }
 
+/// [`coordinate_value`] of a coordinate 0 read as [`Read::Angle`] (bit for bit the same
+/// number: the same operations on the same frames), with how far the child's `x₁` lies from
+/// the parent's joint axis `z₀`: `ρ = |(x₀·x₁, y₀·x₁)| / (|x₀| |x₁|)`, the sine of the angle
+/// between `x₁` and `z₀` (1 where the joint's rows hold). A rotation of `x₁` by `φ` turns the
+/// angle at a rate of at most `|φ̇| / ρ` (module `solver::inequality::bend`). `None` where
+/// coordinate 0 is not read as such an angle.
+pub(crate) fn angle_value_and_spread(
+    joint: &Joint,
+    pair: &Pair,
+    reference: f64,
+) -> Option<(f64, f64)> {
+    let c = joint.kind.spec().coordinates.first()?;
+    if c.read != Read::Angle {
+        return None;
+    }
+    let a = [rotation(&pair.p[0]), rotation(&pair.p[1])];
+    let f = &joint.body_from_joint;
+    let axis = |k: usize, e: Vector3<f64>| a[k] * (f[k].rotation * e);
+    let (x0, y0, x1) = (
+        axis(0, Vector3::x()),
+        axis(0, Vector3::y()),
+        axis(1, Vector3::x()),
+    );
+    let (s, co) = (y0.dot(&x1), x0.dot(&x1));
+    let v = s.atan2(co);
+    let value = if c.angle && reference.is_finite() {
+        reference + wrap_angle(v - reference)
+    } else {
+        v
+    };
+    Some((value, s.hypot(co) / (x0.norm() * x1.norm())))
+}
+
 /// `θ_b + wrap(θ − θ_b)` with the derivatives of `θ`.
 pub(crate) fn on_branch(mut s: Scalar, reference: f64) -> Scalar {
     if reference.is_finite() {
@@ -155,7 +188,7 @@ mod tests {
             JointKind::Distance { length: 0.3 },
             JointKind::PointOnLine,
         ];
-        let mut read = 0;
+        let (mut read, mut spread) = (0, 0);
         for kind in kinds {
             let mut j = revolute();
             j.kind = kind;
@@ -172,10 +205,19 @@ mod tests {
                         let value = coordinate_value(&j, &pair, dof, reference);
                         assert_eq!(jet, value, "{kind:?} dof {dof} seed {seed}");
                         read += usize::from(value.is_some());
+                        // With the spread of `x₁` from the axis: the same value, bit for bit.
+                        if let (0, Some((v, rho))) =
+                            (dof, angle_value_and_spread(&j, &pair, reference))
+                        {
+                            assert_eq!(Some(v.to_bits()), value.map(f64::to_bits), "{kind:?}");
+                            assert!((0.0..=1.0 + 1e-12).contains(&rho), "{kind:?}: ρ {rho}");
+                            spread += 1;
+                        }
                     }
                 }
             }
         }
         assert!(read > 100);
+        assert!(spread >= 36, "{spread}");
     }
 }

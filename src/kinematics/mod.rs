@@ -14,6 +14,8 @@ mod frames;
 mod motion;
 
 pub use branches::Branches;
-pub(crate) use coordinate::{coordinate, coordinate_value, on_branch, vector};
+pub(crate) use coordinate::{
+    angle_value_and_spread, coordinate, coordinate_value, on_branch, vector,
+};
 pub(crate) use frames::{angle, frames};
 pub(crate) use motion::motion;

@@ -31,10 +31,13 @@
 //! - J. J. Moré, G. Toraldo, "Algorithms for bound constrained quadratic programming problems",
 //!   *Numer. Math.* 55 (1989) 377–400.
 
-use super::active_set::Guard;
+use super::active_set::{dimensionless, Guard};
 use crate::constraints::unilateral::{self, Unilateral};
+use crate::kinematics::Branches;
+use crate::model::{JointId, Model};
+use crate::solver::step::retraction::angular_velocity;
 use crate::solver::system::System;
-use nalgebra::DVector;
+use nalgebra::{DVector, Vector3};
 
 /// An inactive stop the path reaches: the guard's index `k`, the body its joint moves, `α_k`.
 #[derive(Clone, Copy, Debug)]
@@ -48,15 +51,29 @@ pub(crate) struct Stop {
 const PROBE: f64 = 1e-3;
 
 impl Guard<'_> {
-    /// The inactive stops of tree joints that the path from `q` along `dq` closes, with the
-    /// step length at which each is reached. Stops within the tolerance at the start (rows
-    /// just released) are left to the guard.
-    pub(crate) fn stops(&self, sys: &System, q: &DVector<f64>, dq: &DVector<f64>) -> Vec<Stop> {
+    /// The inactive stops of tree joints that the path from `q` along `dq` closes before the
+    /// step length `alpha_max`, with the step length at which each is reached. Stops within
+    /// the tolerance at the start (rows just released) are left to the guard.
+    ///
+    /// Each joint's angle is read once for its two stops, and a stop the path cannot reach
+    /// before `alpha_max` ([`Reading::unreachable`]) costs no probe: the line search only
+    /// ever bends at stops with `α_k < α ≤ alpha_max`, so the list is the full one's without
+    /// entries it would never read (`alpha_max = ∞`: the full list).
+    pub(crate) fn stops(
+        &self,
+        sys: &System,
+        q: &DVector<f64>,
+        dq: &DVector<f64>,
+        alpha_max: f64,
+    ) -> Vec<Stop> {
         let model = sys.problem.model;
         let branches = &sys.problem.cons.branches;
         let ret = &sys.problem.retraction;
         let mut probe = None;
         let mut out = Vec::new();
+        let mut last: Option<(JointId, Option<Reading>)> = None;
+        // Every body's angular velocity along `dq` (a parent's is read by each child joint).
+        let mut omega = None;
         for (k, u) in self.inactive.iter().enumerate() {
             let Unilateral::Limit {
                 joint,
@@ -69,17 +86,30 @@ impl Guard<'_> {
             let Some(body) = ret.body_of(joint.0) else {
                 continue;
             };
-            if self.gap(k, q, branches) <= self.tol {
+            let reading = match last {
+                Some((j, r)) if j == joint => r,
+                _ => Reading::at(model, joint, q, branches, || {
+                    omega
+                        .get_or_insert_with(|| angular_velocities(q, dq))
+                        .as_slice()
+                }),
+            };
+            last = Some((joint, reading));
+            // (Where the angle is undefined the gap is infinite and the probe reads none.)
+            let Some(reading) = reading else {
+                continue;
+            };
+            let g0 = unilateral::limit_gap(reading.theta, bound, value);
+            if dimensionless(model, u, g0) <= self.tol {
+                continue;
+            }
+            if reading.unreachable(g0, value, alpha_max) {
                 continue;
             }
             let qp = probe.get_or_insert_with(|| ret.point(q, dq, PROBE));
-            let (Some(t0), Some(t1)) = (
-                unilateral::limit_angle(model, joint, q, branches),
-                unilateral::limit_angle(model, joint, qp, branches),
-            ) else {
+            let Some(t1) = unilateral::limit_angle(model, joint, qp, branches) else {
                 continue;
             };
-            let g0 = unilateral::limit_gap(t0, bound, value);
             let rate = (unilateral::limit_gap(t1, bound, value) - g0) / PROBE;
             if rate < 0.0 && g0 > 0.0 {
                 out.push(Stop {
@@ -101,3 +131,91 @@ impl Guard<'_> {
             .collect()
     }
 }
+
+/// Every body's world angular velocity along the tangent `dq` at `q`.
+fn angular_velocities(q: &DVector<f64>, dq: &DVector<f64>) -> Vec<Vector3<f64>> {
+    (0..q.len() / 7)
+        .map(|b| angular_velocity(q, dq, b))
+        .collect()
+}
+
+/// A limited joint's coordinate at the start of a step, as the stop search reads it.
+#[derive(Clone, Copy, Debug)]
+struct Reading {
+    /// The coordinate, bit for bit [`unilateral::limit_angle`].
+    theta: f64,
+    /// The branch it is read on.
+    reference: f64,
+    /// For an angle read as `atan2(y₀·x₁, x₀·x₁)`: `R = |ω_r| / (ρ − PROBE |ω_r|)`, `ρ` of
+    /// [`crate::kinematics::angle_value_and_spread`] (`None` where `x₁` lies near the axis:
+    /// `ρ < 0.1`, or the probe could bring it there).
+    rate: Option<f64>,
+}
+
+impl Reading {
+    /// The coordinate of `joint` at `q` (`None` where it is undefined), and for an angle
+    /// the bound of its rate along the tangent whose body angular velocities `omega` gives
+    /// ([`Reading::unreachable`]).
+    fn at<'w>(
+        model: &Model,
+        joint: JointId,
+        q: &DVector<f64>,
+        branches: &Branches,
+        omega: impl FnOnce() -> &'w [Vector3<f64>],
+    ) -> Option<Self> {
+        let j = &model.joints[joint.0];
+        let reference = branches.get(joint, 0);
+        let pair = crate::jet::pair_of(&j.bodies, q, false);
+        if let (Some(child), Some((theta, rho))) = (
+            j.bodies[1],
+            crate::kinematics::angle_value_and_spread(j, &pair, reference),
+        ) {
+            let omega = omega();
+            let wa = j.bodies[0].map_or_else(Vector3::zeros, |a| omega[a.0]);
+            let w = (omega[child.0] - wa).norm();
+            let room = rho - PROBE * w;
+            return Some(Reading {
+                theta,
+                reference,
+                rate: (room >= 0.5 * rho && rho >= 0.1).then(|| w / room),
+            });
+        }
+        Some(Reading {
+            theta: unilateral::limit_angle(model, joint, q, branches)?,
+            reference,
+            rate: None,
+        })
+    }
+
+    /// Whether a stop at `value` whose gap is `g0 > 0` at the start is certainly reached, if
+    /// at all, at no `α_k` below `alpha_max` (so the probe may be skipped).
+    ///
+    /// Along the retraction the child's `x₁` turns relative to the parent's frame by the
+    /// rotation `R(α ω_r)`, `ω_r = ω_b − ω_a` (module `step::retraction`; the parent's own
+    /// motion turns both frames alike), so the angle `atan2(y₀·x₁, x₀·x₁)` changes at a rate of
+    /// at most `|ω_r| / ρ(α)` with `ρ(α) ≥ ρ(0) − α |ω_r|`: over the probe `[0, PROBE]` the
+    /// probe's difference quotient is at most `R = |ω_r| / (ρ(0) − PROBE |ω_r|)` in magnitude
+    /// (plus its rounding), and `α_k = g0 / |rate| ≥ g0 / R`. Not where the probe could cross
+    /// the branch cut at `θ_b ± π` (its difference quotient would then be `±2π / PROBE`), nor
+    /// where `x₁` lies near the joint axis.
+    fn unreachable(&self, g0: f64, value: f64, alpha_max: f64) -> bool {
+        let Some(rate) = self.rate else {
+            return false;
+        };
+        let centre = if self.reference.is_finite() {
+            self.reference
+        } else {
+            0.0
+        };
+        // The rounding of the probe's difference quotient (two readings on the branch and
+        // two gaps), far above its few units in the last place.
+        let size = self.theta.abs() + centre.abs() + value.abs() + 8.0;
+        let rate = rate * (1.0 + 1e-6) + 1e3 * f64::EPSILON * size / PROBE;
+        let turn = (self.theta - centre).abs() + PROBE * rate;
+        g0 > 0.0 && turn < 3.0 && g0 >= alpha_max * rate
+    }
+}
+
+#[cfg(test)]
+#[path = "bend_tests.rs"]
+mod tests;

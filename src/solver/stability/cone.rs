@@ -136,6 +136,12 @@ pub(crate) fn stability_touching(
         return all_held
             .or_else(|| crate::solver::stability_on(model, state, strong, backend, eigenvalues));
     }
+    // Too many faces: the tangent space of the strong rows alone, without partitioning it
+    // here first (where it has no degree of freedom, neither has that of all rows, and
+    // `stability_on` gives both the same answer).
+    if weak.len() > MAX_WEAK {
+        return crate::solver::stability_on(model, state, strong, backend, eigenvalues);
+    }
     let all: Vec<Active> = strong.iter().chain(weak).copied().collect();
     let q = &state.q;
     let cons = Constraints::new(model, &crate::solver::lock_values(model))
@@ -147,7 +153,7 @@ pub(crate) fn stability_touching(
     if dof == 0 {
         return crate::solver::stability_on(model, state, &all, backend, eigenvalues);
     }
-    if dof > EXACT_UP_TO || weak.len() > MAX_WEAK {
+    if dof > EXACT_UP_TO {
         return crate::solver::stability_on(model, state, strong, backend, eigenvalues);
     }
     let eval = sys.evaluate(q, &part)?;

@@ -76,7 +76,7 @@ pub(crate) fn line_search(
     let gnorm = eval.grad_v.amax();
     // The inactive stops the path reaches, and where (module `inequality::bend`).
     let stops = match (guard, options.stop_search) {
-        (Some(g), StopSearch::Projected) => g.stops(sys, q, dq),
+        (Some(g), StopSearch::Projected) => g.stops(sys, q, dq, alpha),
         _ => Vec::new(),
     };
     for _ in 0..MAX_TRIALS {

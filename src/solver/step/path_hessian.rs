@@ -74,10 +74,17 @@ pub(crate) fn path_curvature(
             &solved
         }
     };
+    // Each body's angular velocity once per column (its own edge's and its children's twists
+    // read it), in one buffer for the column.
+    let mut dq = DVector::zeros(z.nrows());
+    let mut spin = vec![Vector3::zeros(); bodies];
     for i in 0..dof {
-        let dq = z.column(i).into_owned();
+        dq.copy_from(&z.column(i));
+        for (b, w) in spin.iter_mut().enumerate() {
+            *w = angular_velocity(q, &dq, b);
+        }
         for b in 0..bodies {
-            let (w, v) = relative_twist(q, &dq, b, parents[b]);
+            let (w, v) = twist_of(q, &dq, &spin, b, parents[b]);
             omega[b].set_column(i, &w);
             vel[b].set_column(i, &v);
         }
@@ -171,16 +178,31 @@ fn sum_above(
 
 /// The relative twist of body `b`'s tree edge for the tangent `dq` (module `retraction`):
 /// `ω_b − ω_a` and the velocity `ẋ_b − ẋ_a − ω_a × (x_b − x_a)` at the child's origin.
+#[cfg(test)]
 fn relative_twist(
     q: &DVector<f64>,
     dq: &DVector<f64>,
     b: usize,
     parent: Option<usize>,
 ) -> (Vector3<f64>, Vector3<f64>) {
-    let wb = angular_velocity(q, dq, b);
+    let spin: Vec<Vector3<f64>> = (0..q.len() / 7)
+        .map(|k| angular_velocity(q, dq, k))
+        .collect();
+    twist_of(q, dq, &spin, b, parent)
+}
+
+/// [`relative_twist`] with the bodies' angular velocities `spin` for `dq` at hand.
+fn twist_of(
+    q: &DVector<f64>,
+    dq: &DVector<f64>,
+    spin: &[Vector3<f64>],
+    b: usize,
+    parent: Option<usize>,
+) -> (Vector3<f64>, Vector3<f64>) {
+    let wb = spin[b];
     match parent {
         Some(a) => {
-            let wa = angular_velocity(q, dq, a);
+            let wa = spin[a];
             let va = position(dq, a) + wa.cross(&(position(q, b) - position(q, a)));
             (wb - wa, position(dq, b) - va)
         }

@@ -102,14 +102,15 @@ impl Retraction {
     /// The largest rotation rate of a body relative to its tree parent, `max_b |ω_b − ω_a|`
     /// (for a revolute joint its rate `|θ̇|`): the step measured in joint coordinates.
     pub(crate) fn joint_rotation(&self, q: &DVector<f64>, dq: &DVector<f64>) -> f64 {
+        // Each body's angular velocity once (a parent's is read by each of its children).
+        let w: Vec<Vector3<f64>> = (0..self.order.len())
+            .map(|b| angular_velocity(q, dq, b))
+            .collect();
         self.order
             .iter()
-            .map(|&(b, a)| {
-                let wb = angular_velocity(q, dq, b);
-                match a {
-                    Some(a) => (wb - angular_velocity(q, dq, a)).norm(),
-                    None => wb.norm(),
-                }
+            .map(|&(b, a)| match a {
+                Some(a) => (w[b] - w[a]).norm(),
+                None => w[b].norm(),
             })
             .fold(0.0, f64::max)
     }

@@ -44,10 +44,11 @@ pub(crate) enum Backend {
 
 impl Backend {
     /// The backend `choice` asks for; automatic: by the size of `model`, and above
-    /// [`SPARSE_FROM_COORDINATES`] the tree factors for a mechanism without closed loops or
-    /// joint stops (its partitions fit a tree: `O(N)` with fixed-size blocks, faster than the
-    /// general sparse factors on chains and ropes, BENCHMARKS.md), the sparse ones otherwise:
-    /// a ladder's thousand loops would not fit a small border. A mechanism without closed
+    /// [`SPARSE_FROM_COORDINATES`] the tree factors for a mechanism without joint stops (its
+    /// partitions fit a tree: `O(N)` with fixed-size blocks, faster than the general sparse
+    /// factors on chains and ropes, BENCHMARKS.md; with closed loops, each factor that does not
+    /// fit a tree with a small border is factored by super-nodes, module `tree::merge`: a
+    /// ladder's thousand loops), the sparse ones otherwise. A mechanism without closed
     /// loops but with stops is given the sparse factors here and the tree ones by each round
     /// of its solve ([`Backend::of_round`]; before the projected stop search, the tree
     /// factors' last Newton steps stalled on Romeo's finger stops at a reduced gradient of
@@ -58,7 +59,7 @@ impl Backend {
     pub(crate) fn choose(model: &Model, choice: LinearAlgebra) -> Self {
         match choice {
             LinearAlgebra::Auto if model.coordinate_count() > SPARSE_FROM_COORDINATES => {
-                if open(model) && model.joints.iter().all(|j| j.limits.is_none()) {
+                if model.joints.iter().all(|j| j.limits.is_none()) {
                     Backend::Tree
                 } else {
                     Backend::Sparse

@@ -2,21 +2,19 @@
 //! `Φ_uᵀ x = b`, `Φ_v x` and `Φ_vᵀ y`, dense (nalgebra's LU with partial pivoting), sparse
 //! (faer's sparse LU) or block triangular along the tree (module `tree::phi_u`).
 
+use super::dense_lu::DenseLu;
 use super::{Backend, System};
 use crate::solver::partition::Partition;
 use crate::solver::sparse::factor::{SparseFactors, Split};
 use crate::solver::tree::phi_u::{TreeLu, TreeSplit};
-use nalgebra::{DMatrix, DVector, LU};
+use nalgebra::{DMatrix, DVector};
 use std::sync::Arc;
 
 /// The factorization of `Φ_u` and the values of `Φ_v` at one configuration.
 #[derive(Clone)]
 pub(crate) enum Factors {
     /// Dense LU with partial pivoting (small models).
-    Dense {
-        lu: LU<f64, nalgebra::Dyn, nalgebra::Dyn>,
-        phi_v: DMatrix<f64>,
-    },
+    Dense { lu: DenseLu, phi_v: DMatrix<f64> },
     /// faer's sparse LU.
     Sparse(SparseFactors),
     /// Block triangular along the tree (shared with the pool that reuses its buffers).
@@ -28,11 +26,8 @@ impl Factors {
     pub(crate) fn solve(&self, b: &DVector<f64>) -> Option<DVector<f64>> {
         match self {
             Factors::Dense { lu, .. } => {
-                if b.is_empty() {
-                    Some(b.clone())
-                } else {
-                    lu.solve(b)
-                }
+                let mut x = b.clone();
+                (b.is_empty() || lu.solve_mut(&mut x)).then_some(x)
             }
             Factors::Sparse(f) => {
                 let mut x = b.clone();
@@ -89,7 +84,8 @@ impl Factors {
     pub(crate) fn pivot_ratio(&self) -> Option<f64> {
         match self {
             Factors::Dense { lu, .. } => {
-                let d = lu.u().diagonal().abs();
+                // `U`'s diagonal, read in place (`lu.u()` would copy the whole triangle).
+                let d = lu.packed().diagonal().abs();
                 Some(if d.is_empty() { 1.0 } else { d.min() / d.max() })
             }
             Factors::Tree(f) => f.pivot_ratio(),
@@ -110,15 +106,23 @@ impl Factors {
     }
 }
 
-/// Solves `Aᵀ x = b` with the factors `P A = L U` of `A`: `Uᵀ y = b`, `Lᵀ z = y`, `x = Pᵀ z`.
-fn solve_transpose(
-    lu: &LU<f64, nalgebra::Dyn, nalgebra::Dyn>,
-    b: DVector<f64>,
-) -> Option<DVector<f64>> {
-    let y = lu.u().tr_solve_upper_triangular(&b)?;
-    let mut z = lu.l().tr_solve_lower_triangular(&y)?;
-    lu.p().inv_permute_rows(&mut z);
-    Some(z)
+/// Solves `Aᵀ x = b` with the factors `P A = L U` of `A`: `Uᵀ y = b`, `Lᵀ z = y`, `x = Pᵀ z`,
+/// on the packed factors in place (`U` on and above the diagonal, `L` below it with a unit
+/// diagonal) instead of the copies `lu.u()` and `lu.l()` (two `r × r` matrices per solve):
+/// nalgebra's `tr_solve_upper_triangular` reads only that triangle, and the unit-diagonal
+/// substitution is its `tr_solve_lower_triangular` on `lu.l()` step by step (the same dot
+/// products, the division by 1 exact), so the same bits.
+fn solve_transpose(lu: &DenseLu, mut b: DVector<f64>) -> Option<DVector<f64>> {
+    let packed = lu.packed();
+    if !packed.tr_solve_upper_triangular_mut(&mut b) {
+        return None;
+    }
+    for i in (0..packed.nrows()).rev() {
+        let dot = packed.view_range(i + 1.., i).dot(&b.view_range(i + 1.., 0));
+        b[i] = (b[i] - dot) / 1.0;
+    }
+    lu.p().inv_permute_rows(&mut b);
+    Some(b)
 }
 
 impl System<'_> {
@@ -184,8 +188,48 @@ impl System<'_> {
             }
         }
         Some(Factors::Dense {
-            lu: phi_u.lu(),
+            lu: DenseLu::new(phi_u),
             phi_v,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The transposed solve on the packed factors equals the one through the copies `lu.u()`
+    /// and `lu.l()` bit for bit, solves `Aᵀ x = b`, and refuses a singular `U`; the pivot
+    /// ratio is that of `lu.u()`'s diagonal.
+    #[test]
+    fn transposed_solve_in_place_is_that_of_the_copies() {
+        let mut s = 99u64;
+        let mut r = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+        };
+        let bits = |v: &DVector<f64>| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for n in [1, 2, 7, 30] {
+            let a = DMatrix::from_fn(n, n, |_, _| r());
+            let b = DVector::from_fn(n, |_, _| r());
+            let lu = a.clone().lu();
+            let y = lu.u().tr_solve_upper_triangular(&b).unwrap();
+            let mut copies = lu.l().tr_solve_lower_triangular(&y).unwrap();
+            lu.p().inv_permute_rows(&mut copies);
+            let lu = DenseLu::new(a.clone());
+            let packed = solve_transpose(&lu, b.clone()).unwrap();
+            assert_eq!(bits(&copies), bits(&packed), "n = {n}");
+            assert!((a.transpose() * &packed - &b).amax() < 1e-9, "n = {n}");
+            let d = a.clone().lu().u().diagonal().abs();
+            let dense = Factors::Dense {
+                lu,
+                phi_v: DMatrix::zeros(n, 0),
+            };
+            assert_eq!(dense.pivot_ratio(), Some(d.min() / d.max()));
+        }
+        let singular = DenseLu::new(DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 4.0]));
+        assert!(solve_transpose(&singular, DVector::from_vec(vec![1.0, 1.0])).is_none());
     }
 }

@@ -14,13 +14,14 @@
 //!
 //! A [`System`] is a [`Problem`] (model, constraint rows, scaling: built once), a
 //! [`Workspace`] (scratch, reused) and a [`Backend`] (dense or sparse, chosen once). The
-//! factors of `Φ_u` are module `factors`.
+//! factors of `Φ_u` are module `factors` (dense: module `dense_lu`).
 
 mod augment;
 mod backend;
 mod base;
 mod basis_products;
 mod corrector;
+mod dense_lu;
 mod factors;
 mod kkt;
 mod kkt_matrix;

@@ -11,6 +11,7 @@ pub(crate) fn ldlt(a: &mut [f64], d: usize) -> Option<usize> {
         13 => ldlt_with(a, 13, &mut [0.0; 13]),
         14 => ldlt_with(a, 14, &mut [0.0; 14]),
         8 => ldlt_with(a, 8, &mut [0.0; 8]),
+        27 => ldlt_with(a, 27, &mut [0.0; 27]),
         _ => ldlt_any(a, d),
     }
 }
@@ -63,6 +64,10 @@ pub(crate) fn ldlt_solve(f: &[f64], d: usize, x: &mut [f64], w: usize) {
         (14, 7) => ldlt_solve_rows::<7>(f, 14, x),
         (8, 1) => ldlt_solve_impl(f, 8, x, 1),
         (8, 7) => ldlt_solve_rows::<7>(f, 8, x),
+        // A ladder's super-nodes of the KKT matrix (module `merge`).
+        (27, 1) => ldlt_solve_impl(f, 27, x, 1),
+        (27, 7) => ldlt_solve_rows::<7>(f, 27, x),
+        (14, 18) => ldlt_solve_rows::<18>(f, 14, x),
         _ => ldlt_solve_impl(f, d, x, w),
     }
 }
@@ -147,6 +152,8 @@ pub(crate) fn lu(a: &mut [f64], d: usize, piv: &mut [u16]) -> bool {
         6 => lu_impl(a, 6, piv),
         7 => lu_impl(a, 7, piv),
         13 => lu_impl(a, 13, piv),
+        14 => lu_impl(a, 14, piv),
+        21 => lu_impl(a, 21, piv),
         _ => lu_impl(a, d, piv),
     }
 }
@@ -194,6 +201,9 @@ pub(crate) fn lu_solve(f: &[f64], piv: &[u16], d: usize, x: &mut [f64], w: usize
         (7, 1) => lu_solve_impl(f, piv, 7, x, 1),
         (13, 1) => lu_solve_impl(f, piv, 13, x, 1),
         (13, 7) => lu_solve_impl(f, piv, 13, x, 7),
+        // A ladder's super-nodes of `Φ_u` (module `merge`): the model's, the self-check's.
+        (14, 1) => lu_solve_impl(f, piv, 14, x, 1),
+        (21, 1) => lu_solve_impl(f, piv, 21, x, 1),
         _ => lu_solve_impl(f, piv, d, x, w),
     }
 }
@@ -240,6 +250,8 @@ pub(crate) fn lu_solve_transpose(f: &[f64], piv: &[u16], d: usize, x: &mut [f64]
     match d {
         6 => lu_solve_transpose_impl(f, piv, 6, x),
         7 => lu_solve_transpose_impl(f, piv, 7, x),
+        14 => lu_solve_transpose_impl(f, piv, 14, x),
+        21 => lu_solve_transpose_impl(f, piv, 21, x),
         _ => lu_solve_transpose_impl(f, piv, d, x),
     }
 }
@@ -274,6 +286,8 @@ pub(crate) fn sub_tr_mul(c: &[f64], y: &[f64], out: &mut [f64], d: usize, w: usi
     match (d, w) {
         (13, 7) => sub_tr_mul_impl(c, y, out, 13, 7),
         (14, 7) => sub_tr_mul_impl(c, y, out, 14, 7),
+        (14, 18) => sub_tr_mul_impl(c, y, out, 14, 18),
+        (27, 7) => sub_tr_mul_impl(c, y, out, 27, 7),
         _ => sub_tr_mul_impl(c, y, out, d, w),
     }
 }
@@ -295,6 +309,9 @@ pub(crate) fn sub_mul(xm: &[f64], y: &[f64], x: &mut [f64], d: usize, w: usize) 
         (13, 7) => sub_mul_impl(xm, y, x, 13, 7),
         (14, 7) => sub_mul_impl(xm, y, x, 14, 7),
         (13, 13) => sub_mul_impl(xm, y, x, 13, 13),
+        (14, 18) => sub_mul_impl(xm, y, x, 14, 18),
+        (27, 7) => sub_mul_impl(xm, y, x, 27, 7),
+        (27, 27) => sub_mul_impl(xm, y, x, 27, 27),
         _ => sub_mul_impl(xm, y, x, d, w),
     }
 }
@@ -317,6 +334,8 @@ pub(crate) fn sub_tr_mul_block(c: &[f64], x: &[f64], p: &mut [f64], d: usize, w:
     match (d, w, dp) {
         (13, 7, 13) => sub_tr_mul_block_impl(c, x, p, 13, 7, 13),
         (14, 7, 14) => sub_tr_mul_block_impl(c, x, p, 14, 7, 14),
+        (14, 18, 27) => sub_tr_mul_block_impl(c, x, p, 14, 18, 27),
+        (27, 7, 14) => sub_tr_mul_block_impl(c, x, p, 27, 7, 14),
         _ => sub_tr_mul_block_impl(c, x, p, d, w, dp),
     }
 }

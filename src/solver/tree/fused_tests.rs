@@ -125,11 +125,38 @@ fn fused_blocks_equal_the_general_assembly_bit_for_bit() {
     assert!(fused_cases >= 6, "{fused_cases} models on the tree path");
 }
 
-/// Where the tree structure does not fit (a ladder's border above its limit: the general
-/// sparse KKT matrix), the fused pass declines and leaves that matrix in place.
+/// Where the tree structure does not fit (a hub closing a loop onto each of nine links, all
+/// hanging from the world: a border of 8 nodes above its limit, and a super-node of 9, module
+/// `merge`, too; the general sparse KKT matrix), the fused pass declines and leaves that
+/// matrix in place.
 #[test]
 fn fused_pass_leaves_a_sparse_kkt_matrix_in_place() {
-    let model = from_text(&crate::generate::ladder(40));
+    let inertial = "<inertial><origin xyz=\"0.1 0 0\"/><mass value=\"1\"/><inertia ixx=\"1e-4\" \
+                    ixy=\"0\" ixz=\"0\" iyy=\"3.4e-3\" iyz=\"0\" izz=\"3.4e-3\"/></inertial>";
+    let mut hub = String::from(
+        "<?xml version=\"1.0\"?>\n<robot name=\"hub\" xmlns:mech=\"urn:urdf-mech:1\">\n  <link name=\"world\"/>\n",
+    );
+    // The hub last: the elimination takes it first (equal depths, higher index first).
+    for (name, k) in (0..9)
+        .map(|k| (format!("spoke{k}"), k))
+        .chain([("hub".into(), 9)])
+    {
+        hub += &format!(
+            "  <link name=\"{name}\">{inertial}</link>\n  <joint name=\"hang_{name}\" \
+             type=\"continuous\"><parent link=\"world\"/><child link=\"{name}\"/><origin \
+             xyz=\"0 {k} 0\"/><axis xyz=\"0 1 0\"/></joint>\n"
+        );
+    }
+    for k in 0..9 {
+        hub += &format!(
+            "  <mech:loop_joint name=\"close{k}\" type=\"revolute\"><parent link=\"hub\"/>\
+             <origin xyz=\"0.2 0 0\"/><child link=\"spoke{k}\"/><child_origin xyz=\"0.2 0 0\"/>\
+             <axis xyz=\"0 1 0\"/></mech:loop_joint>\n"
+        );
+    }
+    hub += "  <mech:gravity xyz=\"0 0 -9.81\"/>\n</robot>\n";
+    let model = from_text(&hub);
+    assert_eq!(model.joints.iter().filter(|j| !j.tree).count(), 9);
     let mut sys = System::new(&model, Constraints::new(&model, &[]), Backend::Tree);
     let q = crate::solver::initial_state(&model).q;
     let part = sys.partition(&q);

@@ -10,15 +10,19 @@
 //! - `fused`: the Newton step's assembly of `W`, its terms added into the tree's body-pair
 //!   blocks and stored into the 13 × 13 blocks in one pass;
 //! - `kkt`: its block LDLᵀ (block LU as the fallback), solves and refinement;
-//! - `border`: the dense Schur complement of the border.
+//! - `border`: the dense Schur complement of the border;
+//! - `merge`: super-nodes where the border would be too large (a ladder: a loop per rung).
 //!
 //! The sparse path (module `sparse`) stays the reference and the fallback: where a partition's
-//! structure does not fit (a border above its limit), the system uses it instead.
+//! structure does not fit (a super-node above its limit), the system uses it instead.
 
 mod border;
 pub(crate) mod dense;
 pub(crate) mod fused;
 pub(crate) mod kkt;
+mod merge;
+#[cfg(test)]
+mod merge_tests;
 pub(crate) mod phi_u;
 mod shape;
 #[cfg(test)]

@@ -23,8 +23,8 @@ use super::shape::FIRST;
 use crate::solver::partition::Partition;
 use std::sync::Arc;
 
-/// Borders larger than this (pivot positions) are not factored here (the general sparse LU
-/// is used instead).
+/// Borders larger than this (pivot positions) are merged into super-nodes instead (module
+/// `merge`; the general sparse LU where those would be too large).
 pub(crate) const MAX_BORDER: usize = 64;
 
 /// The block structure of `Φ_u` under one partition (built once per partition).
@@ -103,24 +103,10 @@ impl TreeSplit {
         for (k, &c) in part.independent.iter().enumerate() {
             ind_pos[c] = k as u32;
         }
-        // Runs of pivots on one body.
-        let mut run_of = vec![0u32; order];
-        let mut runs = 0u32;
-        for k in 0..order {
-            if k > 0 && part.dependent[k] / 7 != part.dependent[k - 1] / 7 {
-                runs += 1;
-            }
-            run_of[k] = runs;
-        }
-        let runs = if order == 0 { 0 } else { runs as usize + 1 };
-        // A run with an entry in an earlier run's column goes to the border.
-        let mut bordered = vec![false; runs];
-        for e in entries {
-            let (p, q) = (row_pos[e.0], col_pos[e.1]);
-            if p != u32::MAX && q != u32::MAX && run_of[q as usize] < run_of[p as usize] {
-                bordered[run_of[p as usize] as usize] = true;
-            }
-        }
+        // Runs of pivots on one body; those with an entry in an earlier run's column go to
+        // the border, or are merged into super-nodes where it would be too large (`merge`).
+        let (run_of, runs, bordered) =
+            super::merge::phi_u_runs(part, entries, &row_pos, &col_pos, MAX_BORDER)?;
         let border_positions: Vec<usize> = (0..order)
             .filter(|&k| bordered[run_of[k] as usize])
             .collect();

@@ -16,8 +16,8 @@ use crate::solver::partition::Partition;
 use crate::solver::sparse::hessian::BlockHessian;
 use std::collections::HashMap;
 
-/// Borders larger than this (unknowns) are not factored here (the general sparse LDLᵀ is used
-/// instead).
+/// Borders larger than this (unknowns) are merged into super-nodes instead (module `merge`;
+/// the general sparse LDLᵀ where those would be too large).
 pub(crate) const MAX_BORDER: usize = 96;
 
 /// Where a value goes: `flat` slots below `flat_len`, border slots above, or nowhere (the
@@ -156,8 +156,13 @@ impl Shape {
             }
         }
         if border_unknowns.len() > MAX_BORDER {
-            return None;
+            // Too large for a dense Schur complement: the nodes a loop couples are merged into
+            // super-nodes instead (module `merge`), and nothing is bordered.
+            (members, parent) = super::merge::kkt_nodes(part, n, &row_pos, entries, &hess.keys)?;
+            in_border = vec![false; members.len()];
+            border_unknowns.clear();
         }
+        let nodes = members.len();
         // Tree-space positions: kept nodes in order, then the border.
         let mut tpos = vec![0usize; dim];
         let mut perm = Vec::with_capacity(dim);

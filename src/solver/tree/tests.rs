@@ -154,7 +154,8 @@ fn tree_solves_match_the_sparse_ones() {
         ("solo12", solo12(), Frictionless),
         // Sticking feet: a unique rest pose (frictionless, the base could slide).
         ("solo12 standing on the ground", standing, Stick),
-        // 60 loops: a border too large for the tree factors, so the sparse ones.
+        // 60 loops: a border too large for the dense Schur complement, so super-nodes (module
+        // `merge`).
         (
             "long ladder",
             from_text(&crate::generate::ladder(60)),

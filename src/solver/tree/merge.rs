@@ -1,0 +1,234 @@
+//! Super-nodes: where a partition's border would be too large for its dense Schur complement
+//! (a ladder: a closed loop per rung, 7 of its 20 pivots of `Φ_u` and 13 KKT unknowns per rung
+//! in the border), the nodes a loop couples are merged into one node instead, so that the
+//! merged nodes form a tree again and the border is empty.
+//!
+//! - **`Φ_u`** (block upper triangular on a tree: node `i`'s rows reach only its own and later
+//!   nodes' columns). A run `r` whose rows reach the columns of an earlier run spans the
+//!   interval of runs `[first(r), r]`, `first(r) = min { run(q) : Φ_u[p, q] ≠ 0, run(p) = r }`;
+//!   overlapping intervals are merged into one node (their pivot positions are consecutive),
+//!   so every entry below the block diagonal lies in a merged node's diagonal block, factored by
+//!   LU with partial pivoting like any other.
+//! - **KKT** (symmetric, eliminated leaves first). A node whose elimination would couple more
+//!   than one later node (fill) merges those later nodes into one, placed at the latest of
+//!   them:
+//!
+//!   ```text
+//!   later(i) = { find(j) : j adjacent to a member of i, find(j) after i }
+//!   |later(i)| > 1  ⇒  union(later(i)),   parent(i) = find(later(i))
+//!   ```
+//!
+//!   Eliminating a node then fills nothing (its one later neighbour is its parent), and a merge
+//!   never touches a node already eliminated (it merges later nodes only): a tree of
+//!   super-nodes. Rows pivoted away from their body's run (a loop's) join the node being built
+//!   when they are pivoted, as in the sparse LDLᵀ's order; a merged node lists its members'
+//!   coordinates, then their rows (its children reach the coordinates: narrow couplings). The
+//!   LDLᵀ of another symmetric order of the same matrix has the same inertia (Sylvester).
+//!
+//! A super-node larger than [`MAX_NODE`] unknowns or pivots refuses the tree factors (the
+//! sparse ones are used). On a ladder the model's `Φ_u` has a merged node of 14 pivots and a
+//! run of 6 per rung, the self-check's (module `verify::held`: a lock row per coordinate) one of
+//! 21 pivots per rung; its KKT matrix a rung's node (14 unknowns, coupled to 18 of its parent's)
+//! and a rung's two posts merged (27 unknowns, coupled to 7), a chain of 2 nodes per rung.
+
+use crate::solver::partition::Partition;
+
+/// Super-nodes larger than this (unknowns or pivots) are not factored here.
+pub(crate) const MAX_NODE: usize = 64;
+
+/// The runs of pivots of `Φ_u` (consecutive pivots on one body's columns): `(run_of, runs,
+/// bordered)`, each position's run, their number and the runs with an entry in an earlier
+/// run's column. If those runs hold more than `max_border` pivots, overlapping runs are merged
+/// instead (module doc) and none is bordered; `None` if a merged run exceeds [`MAX_NODE`].
+pub(crate) fn phi_u_runs(
+    part: &Partition,
+    entries: &[(usize, usize, f64)],
+    row_pos: &[u32],
+    col_pos: &[u32],
+    max_border: usize,
+) -> Option<(Vec<u32>, usize, Vec<bool>)> {
+    let order = part.rows.len();
+    let mut run_of = vec![0u32; order];
+    let mut runs = 0u32;
+    for k in 0..order {
+        if k > 0 && part.dependent[k] / 7 != part.dependent[k - 1] / 7 {
+            runs += 1;
+        }
+        run_of[k] = runs;
+    }
+    let runs = if order == 0 { 0 } else { runs as usize + 1 };
+    // The earliest run each run's rows reach (itself if none before).
+    let mut first: Vec<u32> = (0..runs as u32).collect();
+    for e in entries {
+        let (p, q) = (row_pos[e.0], col_pos[e.1]);
+        if p != u32::MAX && q != u32::MAX {
+            let (rp, rq) = (run_of[p as usize] as usize, run_of[q as usize]);
+            first[rp] = first[rp].min(rq);
+        }
+    }
+    let bordered: Vec<bool> = (0..runs).map(|r| first[r] < r as u32).collect();
+    let border = (0..order).filter(|&k| bordered[run_of[k] as usize]).count();
+    if border <= max_border {
+        return Some((run_of, runs, bordered));
+    }
+    // Merge the intervals `[first[r], r]`, from the last run down.
+    let mut group = vec![0u32; runs];
+    let mut groups = 0u32;
+    let mut r = runs;
+    while r > 0 {
+        let hi = r - 1;
+        let mut lo = first[hi] as usize;
+        let mut s = hi;
+        loop {
+            lo = lo.min(first[s] as usize);
+            group[s] = groups;
+            if s == 0 || s - 1 < lo {
+                break;
+            }
+            s -= 1;
+        }
+        groups += 1;
+        r = s;
+    }
+    // Groups were numbered from the last run: renumber in position order, and check sizes.
+    let groups = groups as usize;
+    let mut size = vec![0usize; groups];
+    for k in 0..order {
+        let g = groups - 1 - group[run_of[k] as usize] as usize;
+        run_of[k] = g as u32;
+        size[g] += 1;
+    }
+    if size.iter().any(|&s| s > MAX_NODE) {
+        return None;
+    }
+    Some((run_of, groups, vec![false; groups]))
+}
+
+/// The KKT matrix's super-nodes for `part` (module doc): `(members, parent)`, each node's
+/// unknowns (coordinates `0 .. n`, rows `n + k`) in elimination order and its parent
+/// (`u32::MAX`: a root); `None` if a super-node exceeds [`MAX_NODE`] unknowns.
+pub(crate) fn kkt_nodes(
+    part: &Partition,
+    n: usize,
+    row_pos: &[u32],
+    entries: &[(usize, usize, f64)],
+    keys: &[(usize, usize)],
+) -> Option<(Vec<Vec<usize>>, Vec<u32>)> {
+    let nb = n / 7;
+    let mut body_node = vec![u32::MAX; nb];
+    let mut members: Vec<Vec<usize>> = Vec::new();
+    for (k, &c) in part.dependent.iter().enumerate() {
+        let b = c / 7;
+        if body_node[b] == u32::MAX {
+            body_node[b] = members.len() as u32;
+            members.push((7 * b..7 * b + 7).collect());
+        }
+        if let Some(m) = members.last_mut() {
+            m.push(n + k);
+        }
+    }
+    for b in 0..nb {
+        if body_node[b] == u32::MAX {
+            body_node[b] = members.len() as u32;
+            members.push((7 * b..7 * b + 7).collect());
+        }
+    }
+    let nodes = members.len();
+    let mut row_node = vec![u32::MAX; part.rows.len()];
+    for (i, m) in members.iter().enumerate() {
+        for &u in m.iter().filter(|&&u| u >= n) {
+            row_node[u - n] = i as u32;
+        }
+    }
+    let mut adj: Vec<Vec<u32>> = vec![Vec::new(); nodes];
+    let mut couple = |a: u32, b: u32| {
+        if a != b && a != u32::MAX && b != u32::MAX {
+            adj[a as usize].push(b);
+            adj[b as usize].push(a);
+        }
+    };
+    for &(a, b) in keys {
+        couple(body_node[a], body_node[b]);
+    }
+    for e in entries {
+        if row_pos[e.0] != u32::MAX {
+            couple(row_node[row_pos[e.0] as usize], body_node[e.1 / 7]);
+        }
+    }
+    // Union-find whose representative is the set's latest node; `set[r]`: its member nodes.
+    let mut rep: Vec<u32> = (0..nodes as u32).collect();
+    let mut set: Vec<Vec<u32>> = (0..nodes as u32).map(|i| vec![i]).collect();
+    let mut size: Vec<usize> = members.iter().map(Vec::len).collect();
+    let mut parent = vec![u32::MAX; nodes];
+    let mut later = Vec::new();
+    for i in 0..nodes {
+        if find(&mut rep, i as u32) != i as u32 {
+            continue;
+        }
+        later.clear();
+        for &m in &set[i] {
+            for &j in &adj[m as usize] {
+                let r = find(&mut rep, j);
+                if r > i as u32 {
+                    later.push(r);
+                }
+            }
+        }
+        later.sort_unstable();
+        later.dedup();
+        let Some(&top) = later.last() else {
+            continue;
+        };
+        for &s in &later[..later.len() - 1] {
+            rep[s as usize] = top;
+            let moved = std::mem::take(&mut set[s as usize]);
+            set[top as usize].extend(moved);
+            size[top as usize] += size[s as usize];
+        }
+        if size[top as usize] > MAX_NODE {
+            return None;
+        }
+        parent[i] = top;
+    }
+    // The super-nodes in the order of their latest member: the members' coordinates first,
+    // then their rows (the children reach the coordinates: narrow couplings).
+    let mut index = vec![u32::MAX; nodes];
+    let mut merged = Vec::new();
+    for i in 0..nodes {
+        if rep[i] == i as u32 {
+            index[i] = merged.len() as u32;
+            let mut own = std::mem::take(&mut set[i]);
+            own.sort_unstable();
+            let all = || {
+                own.iter()
+                    .flat_map(|&m| members[m as usize].iter().copied())
+            };
+            let node: Vec<usize> = if own.len() == 1 {
+                all().collect()
+            } else {
+                all()
+                    .filter(|&u| u < n)
+                    .chain(all().filter(|&u| u >= n))
+                    .collect()
+            };
+            merged.push(node);
+        }
+    }
+    let mut par = vec![u32::MAX; merged.len()];
+    for i in 0..nodes {
+        if rep[i] == i as u32 && parent[i] != u32::MAX {
+            par[index[i] as usize] = index[find(&mut rep, parent[i]) as usize];
+        }
+    }
+    Some((merged, par))
+}
+
+/// The representative of `i`'s set (path halving).
+fn find(rep: &mut [u32], mut i: u32) -> u32 {
+    while rep[i as usize] != i {
+        let up = rep[rep[i as usize] as usize];
+        rep[i as usize] = up;
+        i = up;
+    }
+    i
+}

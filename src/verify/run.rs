@@ -109,14 +109,15 @@ pub(super) fn verify_on(
             // locked system is built, which reuses it (the two systems alive at once, on two
             // threads, were most of `verify`'s fresh pages: each costs a page fault). The
             // model's rows go to the locked system (module `model_rows`).
-            let stability = solved
-                .as_ref()
-                .filter(|_| assembled && list.is_empty() && !skip)
-                .and_then(|(part, eval)| {
-                    crate::solver::stability_of(&mut sys, &state.q, part, eval, eigenvalues)
-                });
+            // The verdict takes the evaluation (its factors are freed before the KKT matrix
+            // is built, which reuses their memory).
+            let stability = match solved {
+                Some((part, eval)) if assembled && list.is_empty() && !skip => {
+                    crate::solver::stability_of(&mut sys, &state.q, &part, eval, eigenvalues)
+                }
+                _ => None,
+            };
             sys.work.kkt = None;
-            drop(solved);
             let given = held::ModelRows::take(&mut sys, &state.q, values.len());
             drop(sys);
             let held = held::held(

@@ -60,12 +60,32 @@ pub(crate) fn inertia_verdict(
     part: &Partition,
     eval: &Eval,
 ) -> Option<ByInertia> {
-    // Assembles `Ŵ` and the KKT matrix; only its shifted factorizations are needed (the
+    let largest = largest_at(sys, q, part, eval);
+    inertia_verdict_knowing(sys, q, part, largest)
+}
+
+/// The first half of [`inertia_verdict`], the only one that reads `eval` (its factors of
+/// `Φ_u`): `W` (augmented, as the KKT matrix takes it) into the block Hessian and `λ_max`
+/// of `Ĥ` by power iteration. A caller that owns `eval` may free it before the second half
+/// ([`inertia_verdict_knowing`]), whose KKT matrix then reuses its memory (`verify`).
+pub(crate) fn largest_at(sys: &mut System, q: &DVector<f64>, part: &Partition, eval: &Eval) -> f64 {
+    sys.kkt_blocks(q, part, eval);
+    largest_eigenvalue(sys, part, eval)
+}
+
+/// The second half of [`inertia_verdict`], from `λ_max` = `largest` ([`largest_at`] at the
+/// same point, the block Hessian it left unchanged).
+pub(crate) fn inertia_verdict_knowing(
+    sys: &mut System,
+    q: &DVector<f64>,
+    part: &Partition,
+    largest: f64,
+) -> Option<ByInertia> {
+    // The KKT matrix of those blocks; only its shifted factorizations are needed (the
     // unshifted one is singular where the pose is neutral).
-    if !sys.assemble_kkt(q, part, eval) {
+    if !sys.assemble_kkt_of_blocks(q, part) {
         return None;
     }
-    let largest = largest_eigenvalue(sys, part, eval);
     let tol = 1e-10 * largest.max(1.0);
     if !tol.is_finite() {
         return None;

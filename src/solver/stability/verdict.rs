@@ -181,7 +181,7 @@ pub(crate) fn stability_on(
         });
     }
     let eval = sys.evaluate(q, &part)?;
-    stability_of(&mut sys, q, &part, &eval, eigenvalues)
+    stability_of(&mut sys, q, &part, eval, eigenvalues)
 }
 
 /// The verdict with the system of the model's rows already partitioned and evaluated at
@@ -191,19 +191,27 @@ pub(crate) fn stability_on(
 /// `spectrum::LISTED_UP_TO` degrees of freedom) and `eigenvalues` is false, the verdict comes
 /// from the inertia of the shifted KKT matrix alone (module `stability::inertia`), without
 /// eigenvalues or mode shapes; the spectrum (exact up to `spectrum::EXACT_UP_TO`, Lanczos
-/// above) only if that inertia cannot be trusted.
+/// above) only if that inertia cannot be trusted. `eval` is taken: on the inertia path its
+/// factors of `Φ_u` (and the system's split they came from) are freed once `λ_max` is known,
+/// before the KKT matrix is built (which reuses their memory: fewer fresh pages); the
+/// spectrum after an untrusted inertia evaluates again (the same numbers: the same `q`,
+/// partition and triplets).
 pub(crate) fn stability_of(
     sys: &mut System,
     q: &nalgebra::DVector<f64>,
     part: &Partition,
-    eval: &crate::solver::system::Eval,
+    eval: crate::solver::system::Eval,
     eigenvalues: bool,
 ) -> Option<Stability> {
     if part.independent.is_empty() {
         return None;
     }
+    let mut eval = Some(eval);
     if !spectrum::listed(sys.backend, part.independent.len()) && !eigenvalues {
-        if let Some(judged) = inertia::inertia_verdict(sys, q, part, eval) {
+        let largest = inertia::largest_at(sys, q, part, eval.as_ref()?);
+        drop(eval.take());
+        sys.work.tree_split = None;
+        if let Some(judged) = inertia::inertia_verdict_knowing(sys, q, part, largest) {
             return Some(Stability {
                 verdict: judged.verdict,
                 tolerance: judged.tolerance,
@@ -212,6 +220,10 @@ pub(crate) fn stability_of(
             });
         }
     }
-    let eig = spectrum::spectrum(sys, q, part, eval);
-    Some(from_spectrum(sys, q, part, eval, &eig))
+    let eval = match eval {
+        Some(e) => e,
+        None => sys.evaluate(q, part)?,
+    };
+    let eig = spectrum::spectrum(sys, q, part, &eval);
+    Some(from_spectrum(sys, q, part, &eval, &eig))
 }

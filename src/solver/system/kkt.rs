@@ -125,9 +125,20 @@ impl System<'_> {
     /// Assembles `W` at `q` and the KKT matrix (as [`System::factor_kkt`]) without factoring
     /// it; false if its structure cannot be built.
     pub(crate) fn assemble_kkt(&mut self, q: &DVector<f64>, part: &Partition, eval: &Eval) -> bool {
+        self.kkt_blocks(q, part, eval);
+        self.assemble_kkt_of_blocks(q, part)
+    }
+
+    /// The first half of [`System::assemble_kkt`]: `W` (augmented) into the block Hessian and
+    /// the triplets at `q`; the second, [`System::assemble_kkt_of_blocks`], needs no `Eval`.
+    pub(crate) fn kkt_blocks(&mut self, q: &DVector<f64>, part: &Partition, eval: &Eval) {
         self.lagrangian_blocks(q, part, eval);
         self.triplets(q);
         self.augment(part);
+    }
+
+    /// The KKT matrix of the blocks and triplets of [`System::kkt_blocks`], assembled.
+    pub(crate) fn assemble_kkt_of_blocks(&mut self, q: &DVector<f64>, part: &Partition) -> bool {
         let (m, n) = (self.problem.cons.len(), q.len());
         let (triplets, blocks) = (self.work.jac.entries.len(), self.work.hess.keys.len());
         if !self

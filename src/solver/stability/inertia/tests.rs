@@ -181,3 +181,40 @@ fn verdicts_match_lanczos_on_large_chains() {
         }
     }
 }
+
+/// `stability_of` takes the evaluation and frees its factors once `λ_max` is known
+/// ([`largest_at`], then [`inertia_verdict_knowing`]): the verdict and tolerance are those of
+/// [`inertia_verdict`] with the evaluation kept, bit for bit (both backends, stable and
+/// unstable chains), and an evaluation made again after that release (the spectrum after an
+/// untrusted inertia) equals the first.
+#[test]
+fn verdict_that_frees_the_factors_is_the_same() {
+    let n = crate::solver::spectrum::EXACT_UP_TO + 100;
+    for flip in [false, true] {
+        let model = chain(n, flip);
+        let q = bent(&model, n, 0.3);
+        for backend in [Backend::Sparse, Backend::Tree] {
+            let cons = || Constraints::new(&model, &[]);
+            let mut kept = System::new(&model, cons(), backend);
+            let part = kept.partition(&q);
+            let eval = kept.evaluate(&q, &part).unwrap();
+            let whole = inertia_verdict(&mut kept, &q, &part, &eval).unwrap();
+            let mut sys = System::new(&model, cons(), backend);
+            let part = sys.partition(&q);
+            let first = sys.evaluate(&q, &part).unwrap();
+            let judged = crate::solver::stability_of(&mut sys, &q, &part, first, false).unwrap();
+            assert_eq!(judged.verdict, whole.verdict);
+            assert_eq!(judged.tolerance, whole.tolerance);
+            assert_eq!(judged.verdict == Verdict::Unstable, flip);
+            let again = sys.evaluate(&q, &part).unwrap();
+            assert_eq!(again.mu, eval.mu);
+            assert_eq!(again.grad_v, eval.grad_v);
+            assert_eq!(again.energy.total, eval.energy.total);
+            let x = DVector::from_fn(part.independent.len(), |i, _| (i as f64 * 0.37).sin());
+            assert_eq!(
+                sys.tangent_step(&part, &again, &x),
+                kept.tangent_step(&part, &eval, &x)
+            );
+        }
+    }
+}

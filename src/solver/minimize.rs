@@ -41,6 +41,7 @@
 
 use super::inequality::active_set::Guard;
 use super::inequality::release::Release;
+use super::inequality::release_trial::First;
 use super::options::{Method, Options};
 use super::partition::Partition;
 use super::report::{Diagnostics, Iterate, Termination};
@@ -79,7 +80,7 @@ pub(crate) struct Outcome {
 
 /// Relative rounding floor of the reduced gradient: `max(gradient_tolerance, 1e-13 Σ|V_k|)`,
 /// `V_k` the energy's terms; above the default 1e-8 J only where they add up to over 10⁵ J.
-const GRADIENT_FLOOR: f64 = 1e-13;
+pub(crate) const GRADIENT_FLOOR: f64 = 1e-13;
 
 /// A dense or tree partition whose smallest-to-largest pivot ratio of `Φ_u` has fallen below
 /// this fraction of its value where the partition was made is checked against a fresh one: as
@@ -91,7 +92,7 @@ const PIVOT_DRIFT: f64 = 0.85;
 
 /// Up to this many degrees of freedom the sparse path too steps by the exact reduced Hessian's
 /// eigen-decomposition, not the shifted KKT system (whose shift cut Tiago's steps 200-fold).
-const EXACT_NEWTON_DOF: usize = 64;
+pub(crate) const EXACT_NEWTON_DOF: usize = 64;
 
 /// The minimizer's state between iterations.
 struct Search {
@@ -170,11 +171,9 @@ pub(crate) fn minimize(
         valley: Watch::default(),
         settle: Settle::default(),
     };
-    let mut termination = Termination::MaxIterations;
-    let mut eigen = None;
-    let mut inertia = None;
-    let mut blocked = None;
-    let mut released = Vec::new();
+    let (mut termination, mut eigen, mut inertia) = (Termination::MaxIterations, None, None);
+    let (mut blocked, mut released) = (None, Vec::new());
+    let mut first = release.and_then(Release::first);
     loop {
         // The gradient cannot be resolved below the rounding of the energy's terms.
         let gtol = options
@@ -191,8 +190,12 @@ pub(crate) fn minimize(
             }
         }
         let judging = std::time::Instant::now(); // the verdict at a rest: `timings.stability`
-        let (eig, test) = convergence_test(sys, &mut s, gtol, options);
-        let negative_curvature = match test {
+        let mut reused = First::taken(&mut first, (&s.q, &s.part, &s.eval), gtol, &mut s.diag);
+        let (eig, test) = match reused.as_mut() {
+            Some((e, _)) => (e.take(), Test::Continue),
+            None => convergence_test(sys, &mut s, gtol, options),
+        };
+        let saddle = match test {
             Test::Converged(e, v) => {
                 s.diag.timings.stability += judging.elapsed().as_secs_f64();
                 (eigen, inertia) = (e, v);
@@ -205,14 +208,10 @@ pub(crate) fn minimize(
         if s.iteration >= options.max_iterations {
             break;
         }
-        let (d, kkt) = reduced_step(
-            sys,
-            &mut s,
-            eig.as_ref(),
-            negative_curvature,
-            guard,
-            options,
-        );
+        let (d, kkt) = match reused {
+            Some((_, d)) => (d, false),
+            None => reduced_step(sys, &mut s, eig.as_ref(), saddle, guard, options),
+        };
         let step = cap_step(sys, &s.part, &s.eval, &s.q, d, options);
         let slope = s.eval.grad_v.dot(&step.d);
         let failures_before = s.diag.corrector_failures;
@@ -278,6 +277,8 @@ pub(crate) fn minimize(
             }
         }
     }
+    // The first direction of the release that started the round (`release_trial`), not taken.
+    s.diag.release_trials += usize::from(first.is_some());
     // A step accepted just before leaving the loop (blocked, unbounded) is recorded here.
     record(&mut s, options, false);
     s.diag.gradient_norm = s.eval.grad_v.amax();
@@ -390,8 +391,7 @@ fn reduced_step(
         guard,
         options,
     );
-    let saddle = negative_curvature.is_some();
-    s.diag.negative_curvature_steps += usize::from(escaped || saddle);
+    s.diag.negative_curvature_steps += usize::from(escaped || negative_curvature.is_some());
     if d.dot(g) > 0.0 && !escaped {
         s.qn = QuasiNewton::new(dof, options.method);
         return (-g.clone(), kkt);

@@ -174,6 +174,11 @@ impl serde::Serialize for Mode {
     }
 }
 
+/// Whether a counter is 0 (left out of the JSON).
+fn is_zero(n: &usize) -> bool {
+    *n == 0
+}
+
 /// Counters of what the solver had to do.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct Diagnostics {
@@ -191,6 +196,11 @@ pub struct Diagnostics {
     pub repartitions: usize,
     /// Steps taken along a direction of negative curvature (leaving a saddle or maximum).
     pub negative_curvature_steps: usize,
+    /// Reduced directions computed only to decide which of several stops leave the active
+    /// set together (module `inequality::release_trial`), not taken by any iteration; left
+    /// out of the JSON when 0.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub release_trials: usize,
     /// Final `‖∂V/∂v‖∞` \[J\].
     pub gradient_norm: f64,
     /// Gradient tolerance applied: the requested one, or the rounding floor
@@ -240,6 +250,7 @@ impl Diagnostics {
         self.step_halvings += other.step_halvings;
         self.repartitions += other.repartitions;
         self.negative_curvature_steps += other.negative_curvature_steps;
+        self.release_trials += other.release_trials;
         // The time spent judging stability (every round's and stage's rest), so that the
         // caller's `iterations` (the rest of the solve) does not count it.
         self.timings.stability += other.timings.stability;

@@ -201,6 +201,9 @@ pub(crate) fn solve(
     let mut hits: Vec<Unilateral> = Vec::new();
     // A row that leaves again alone and comes straight back (module `release`).
     let mut returns = super::release::Returns::default();
+    // Stops that the step kept held at the last release (module `release_trial`): not
+    // eligible to leave early in the next round; and that round's first direction.
+    let mut next = super::release_trial::Next::default();
     loop {
         let mut branches = state.branches.clone();
         let q = super::guard::project_past_false_hits(
@@ -218,16 +221,20 @@ pub(crate) fn solve(
             .filter(|u| !active.iter().any(|a| a.row == **u))
             .copied()
             .collect();
-        let guard = Guard::new(model, options, inactive, &active, tol, &q)
+        let prior = std::mem::take(&mut next);
+        let mut guard = Guard::new(model, options, inactive, &active, tol, &q)
             .with_true_gaps(&std::mem::take(&mut let_go))
             .holding(&active, locks, options);
+        guard.falling = prior.falling;
         // `max_iterations` bounds the iterations of all rounds together.
         let budget = Options {
             max_iterations: options.max_iterations.saturating_sub(iterations),
             ..options.clone()
         };
-        let release = super::release::Release::new(model, &active, &released_before, threshold)
-            .holding_patch_neighbours(&active);
+        let not_early = [released_before.as_slice(), &prior.kept].concat();
+        let release = super::release::Release::new(model, &active, &not_early, threshold)
+            .holding_patch_neighbours(&active)
+            .starting_with(prior.first);
         let round = crate::solver::solve_round(
             model,
             crate::State { q, branches },
@@ -267,8 +274,14 @@ pub(crate) fn solve(
             if report.termination == crate::solver::Termination::LineSearchFailed {
                 let_go = round.released.iter().map(|&i| active[i].row).collect();
             }
-            let mut gone = round.released.clone();
-            gone.sort_unstable();
+            let gone = super::release_trial::decide(
+                (model, options, locks),
+                &state,
+                (&active, &all),
+                (&released_before, threshold),
+                round.released.clone(),
+            )
+            .counted(&mut counters, &mut next);
             changes += super::release::leave(
                 (model, options, &state.q),
                 &gone,
@@ -336,7 +349,10 @@ pub(crate) fn solve(
                     returns.left(active[i].row, energy);
                 }
             } else {
-                gone = fresh;
+                let ctx = (model, options, locks);
+                let early = (released_before.as_slice(), threshold);
+                gone = super::release_trial::decide(ctx, &state, (&active, &all), early, fresh)
+                    .counted(&mut counters, &mut next);
             }
             if !gone.is_empty() {
                 gone.sort_unstable();
@@ -386,7 +402,8 @@ pub(crate) fn solve(
         report.diagnostics.free_directions = own.free_directions;
         report.diagnostics.load_steps = 1;
         report.active_set_changes = changes;
-        let sticking = describe(model, options, &state, &round.multipliers, &mut report);
+        let sticking =
+            super::describe::describe(model, options, &state, &round.multipliers, &mut report);
         report.friction = crate::solver::friction::verdict(&sticking, round.chosen);
         crate::solver::friction::settle_states(&mut report.contacts, report.friction.as_ref());
         report.balance = crate::solver::balance::Balance::of(model, &state, &report.contacts);
@@ -419,82 +436,4 @@ pub(crate) fn solve(
         report.diagnostics.timings.stability += judging + judged.elapsed().as_secs_f64();
         return Ok((state, report));
     }
-}
-
-/// Fills the report's `contacts` and `active_limits` from the multipliers of the active rows;
-/// returns each sticking contact's need and coefficient.
-fn describe(
-    model: &Model,
-    options: &Options,
-    state: &crate::State,
-    multipliers: &[(Active, Vec<f64>)],
-    report: &mut crate::solver::Report,
-) -> Vec<(f64, Option<f64>)> {
-    let mut sticking = Vec::new();
-    use crate::solver::report::{ActiveLimit, Contact, ContactState};
-    let tiny = 1e-12 * force_scale(model);
-    for (a, m) in multipliers {
-        match a.row {
-            Unilateral::Limit {
-                joint,
-                bound,
-                value,
-            } => {
-                let effort = match bound {
-                    unilateral::Bound::Lower => m[0],
-                    unilateral::Bound::Upper => -m[0],
-                };
-                let (effort_limit, exceeds_effort_limit) =
-                    crate::solver::friction::effort_check(model, joint, effort);
-                report.active_limits.push(ActiveLimit {
-                    joint: model.joints[joint.0].name.clone(),
-                    bound: bound.name().into(),
-                    value,
-                    effort,
-                    effort_limit,
-                    exceeds_effort_limit,
-                })
-            }
-            Unilateral::Contact { point, ground } => {
-                let c = &model.contact_points[point];
-                let x = unilateral::point_world(model, point, &state.q);
-                let (_, normal) = unilateral::surface(model, ground, &x);
-                let gap = unilateral::gap(model, &a.row, &state.q, &state.branches).unwrap_or(0.0);
-                let mut ft = Vector3::zeros();
-                if a.anchor.is_some() {
-                    let [t1, t2] = unilateral::tangents(&normal);
-                    ft = t1 * m[1] + t2 * m[2];
-                }
-                let fnorm = m[0];
-                let required = crate::solver::friction::needs_mu(
-                    fnorm,
-                    if ft.norm() <= tiny { 0.0 } else { ft.norm() },
-                );
-                let mu = options.contact().mu_of(&c.settings);
-                let contact_state = match (a.anchor, mu) {
-                    (None, _) => ContactState::Touching,
-                    (Some(_), Some(mu)) if crate::solver::friction::slips(required, mu) => {
-                        ContactState::Slipping
-                    }
-                    (Some(_), _) => ContactState::Sticking,
-                };
-                if a.anchor.is_some() {
-                    sticking.push((required, mu));
-                }
-                let p = touch_point(model, a, &state.q).unwrap_or_default();
-                report.contacts.push(Contact {
-                    link: c.link.clone(),
-                    ground: unilateral::surface_name(model, ground).to_string(),
-                    point_world: p.into(),
-                    normal_world: normal.into(),
-                    gap,
-                    normal_force: fnorm,
-                    tangential_force: ft.into(),
-                    required_friction: required,
-                    state: contact_state,
-                });
-            }
-        }
-    }
-    sticking
 }

@@ -35,6 +35,9 @@ pub(crate) struct Guard<'m> {
     /// The round's active rows and locks, where frictionless contacts are held on their
     /// grounds along a step (module `hold`).
     pub(super) held: Option<super::hold::Held>,
+    /// The round follows a release of several stops decided by the step: the stops fall from
+    /// them (module `release_trial`).
+    pub(crate) falling: bool,
 }
 
 impl<'m> Guard<'m> {
@@ -72,6 +75,7 @@ impl<'m> Guard<'m> {
             falsi: !sticking && rolls.is_empty(),
             rolls,
             held: None,
+            falling: false,
         }
     }
 

@@ -6,20 +6,24 @@
 //! - `bend`: the search path projected onto the joint stops (several reached at once).
 //! - `hold`: frictionless contacts held on their grounds along a step (several met at once).
 //! - `release`: when active rows leave (early, before a round is stationary; several at once).
+//! - `release_trial`: several stops leave together only if the step moves off them.
 //! - `let_go`: contacts that no longer hold a floating body when a round stalls.
 //! - `patch`: rounded hulls (mesh feet) rolling on one sticking pivot.
 //! - `stall`: a round whose steps shrink towards an obstacle's edge ends.
 //! - `rolling`: sticking spheres re-anchored where they touch after rolling.
+//! - `describe`: the report's stops and contacts from the active rows' multipliers.
 //! - `distribution`: the least-norm force distribution of a statically indeterminate support.
 
 pub(crate) mod active_set;
 pub(crate) mod bend;
+pub(crate) mod describe;
 pub(crate) mod distribution;
 pub(crate) mod guard;
 pub(crate) mod hold;
 pub(crate) mod let_go;
 pub(crate) mod patch;
 pub(crate) mod release;
+pub(crate) mod release_trial;
 pub(crate) mod rolling;
 pub(crate) mod stall;
 #[cfg(test)]

@@ -139,6 +139,9 @@ pub(crate) struct Release<'m> {
     threshold: f64,
     /// Whether the round stalls at an obstacle's edge.
     stall: super::stall::Stall,
+    /// The first direction of the round, computed by the release that started it (module
+    /// `release_trial`).
+    first: Option<super::release_trial::First>,
 }
 
 impl<'m> Release<'m> {
@@ -168,7 +171,19 @@ impl<'m> Release<'m> {
                 .collect(),
             threshold,
             stall: super::stall::Stall::new(model, active),
+            first: None,
         }
+    }
+
+    /// The test with the round's first direction `first` (module `release_trial`).
+    pub(crate) fn starting_with(mut self, first: Option<super::release_trial::First>) -> Self {
+        self.first = first;
+        self
+    }
+
+    /// The round's first direction, where the release that started it computed one.
+    pub(crate) fn first(&self) -> Option<&super::release_trial::First> {
+        self.first.as_ref()
     }
 
     /// The test with the neighbours of sticking pivots among `active` (contacts on a pivot's

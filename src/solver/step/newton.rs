@@ -32,6 +32,15 @@
 //! block's step is long (the Allegro hands' fingers straight up while the thumb falls:
 //! 40 → 23 iterations).
 //!
+//! In the round that follows a release of several stops decided by the step (module
+//! `inequality::release_trial`), the stops released fall from their boundaries, where they
+//! were held on the concave side: there every direction of negative curvature whose magnitude
+//! step is shorter than its saddle step is escaped, near a stationary point or not
+//! ([`newton_step_within`] with `near` infinite; the energy test of module `escape` kept). The
+//! classical simple humanoid's wrist roll fell from its released stop in magnitude steps of
+//! 0.1 … 0.4 rad through curvatures −2.3 … −0.2 (31 → 30 iterations, no rest of the corpus
+//! moved); taken in every round (session 26), the same escape moved Panda, G1 and Alex's rests.
+//!
 //! ## References
 //! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §3.4.
 //! - J. J. Moré, D. C. Sorensen, On the use of directions of negative curvature in a modified
@@ -51,7 +60,7 @@ const EIGENVALUE_FLOOR: f64 = 1e-12;
 /// energy test of module `escape`), G1 and the classical simple humanoid of
 /// example-robot-data ended `max_iterations`; with no such bound iCub took 59 → 120
 /// iterations.
-const NEAR_STATIONARY: f64 = 0.1;
+pub(crate) const NEAR_STATIONARY: f64 = 0.1;
 
 /// A decoupled block of the Hessian (one finger of a hand with a fixed palm) is escaped on its
 /// own, while the rest of the step is long, where its slopes are at most this fraction of
@@ -73,6 +82,19 @@ pub(crate) fn newton_step(
     g: &DVector<f64>,
     escape: Option<f64>,
 ) -> (DVector<f64>, Vec<(usize, f64, f64)>) {
+    newton_step_within(e, g, escape, NEAR_STATIONARY)
+}
+
+/// [`newton_step`] with the escape taken where the magnitude step is shorter than `near c`
+/// (`NEAR_STATIONARY`; infinite in the round after a release decided by the step, module
+/// `inequality::release_trial`: every direction of negative curvature whose magnitude step is
+/// shorter than its saddle step).
+pub(crate) fn newton_step_within(
+    e: &Spectrum,
+    g: &DVector<f64>,
+    escape: Option<f64>,
+    near: f64,
+) -> (DVector<f64>, Vec<(usize, f64, f64)>) {
     let floor = EIGENVALUE_FLOOR * e.values.amax().max(1e-12);
     let n = g.len();
     let slopes: Vec<f64> = (0..n).map(|i| e.vectors.column(i).dot(g)).collect();
@@ -91,7 +113,7 @@ pub(crate) fn newton_step(
     // leg: eigenvectors on one block, module `stability::blocks`) whose own step is short and
     // whose slopes are rounding while the others move (`BLOCK_AT_REST`).
     let group = groups(e);
-    let whole = escape.is_some_and(|c| step(&t).amax() < NEAR_STATIONARY * c);
+    let whole = escape.is_some_and(|c| step(&t).amax() < near * c);
     let gmax = g.amax();
     // Per group (indexed by its root): its share of the step and whether its slopes vanish.
     let mut share = vec![DVector::zeros(n); n];
@@ -253,6 +275,28 @@ mod tests {
             assert!((d[i] - t).abs() < 1e-15);
             assert!(newton.abs() < 1e-7, "the magnitude step was {newton}");
         }
+    }
+
+    #[test]
+    fn after_a_release_decided_by_the_step_the_escape_is_taken_on_a_long_step() {
+        // f = −½ x² + y² far from stationary (‖s‖∞ = 0.5 ≥ 0.1 c): the magnitude step along x
+        // (0.05) is shorter than its saddle step (0.3); only with `near` infinite (the round
+        // after a release decided by the step) is x escaped, downhill.
+        let h = DMatrix::from_diagonal(&DVector::from_vec(vec![-1.0, 2.0]));
+        let g = DVector::from_vec(vec![-0.05, 1.0]);
+        let (d, escaped) = newton_step(&spectrum(&h), &g, Some(0.3));
+        assert!(escaped.is_empty(), "{escaped:?}");
+        assert!((d[0] - 0.05).abs() < 1e-15, "{d}");
+        let (d, escaped) = newton_step_within(&spectrum(&h), &g, Some(0.3), f64::INFINITY);
+        assert_eq!(escaped.len(), 1, "{escaped:?}");
+        assert!(
+            (d[0] - 0.3).abs() < 1e-15 && (d[1] + 0.5).abs() < 1e-15,
+            "{d}"
+        );
+        // A direction whose magnitude step is already longer keeps it.
+        let g = DVector::from_vec(vec![-0.5, 1.0]);
+        let (d, escaped) = newton_step_within(&spectrum(&h), &g, Some(0.3), f64::INFINITY);
+        assert!(escaped.is_empty() && (d[0] - 0.5).abs() < 1e-15, "{d}");
     }
 
     #[test]

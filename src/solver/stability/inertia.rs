@@ -61,7 +61,7 @@ pub(crate) fn inertia_verdict(
     eval: &Eval,
 ) -> Option<ByInertia> {
     let largest = largest_at(sys, q, part, eval);
-    inertia_verdict_knowing(sys, q, part, largest)
+    inertia_verdict_knowing(sys, q, part, largest, false)
 }
 
 /// The first half of [`inertia_verdict`], the only one that reads `eval` (its factors of
@@ -74,17 +74,24 @@ pub(crate) fn largest_at(sys: &mut System, q: &DVector<f64>, part: &Partition, e
 }
 
 /// The second half of [`inertia_verdict`], from `λ_max` = `largest` ([`largest_at`] at the
-/// same point, the block Hessian it left unchanged).
+/// same point, the block Hessian it left unchanged). With `free_blocks` the block Hessian is
+/// freed once the KKT matrix is assembled from it, before the first factorization, whose
+/// factors then reuse its memory (fewer fresh pages: `verify`, whose system assembles
+/// nothing after its verdict; a later assembly builds the blocks again).
 pub(crate) fn inertia_verdict_knowing(
     sys: &mut System,
     q: &DVector<f64>,
     part: &Partition,
     largest: f64,
+    free_blocks: bool,
 ) -> Option<ByInertia> {
     // The KKT matrix of those blocks; only its shifted factorizations are needed (the
     // unshifted one is singular where the pose is neutral).
     if !sys.assemble_kkt_of_blocks(q, part) {
         return None;
+    }
+    if free_blocks {
+        sys.work.hess = Default::default();
     }
     let tol = 1e-10 * largest.max(1.0);
     if !tol.is_finite() {

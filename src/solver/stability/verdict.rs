@@ -193,7 +193,8 @@ pub(crate) fn stability_on(
 /// eigenvalues or mode shapes; the spectrum (exact up to `spectrum::EXACT_UP_TO`, Lanczos
 /// above) only if that inertia cannot be trusted. `eval` is taken: on the inertia path its
 /// factors of `Φ_u` (and the system's split they came from) are freed once `λ_max` is known,
-/// before the KKT matrix is built (which reuses their memory: fewer fresh pages); the
+/// before the KKT matrix is built (which reuses their memory: fewer fresh pages), and the
+/// block Hessian once that matrix is assembled (its factors reuse that memory); the
 /// spectrum after an untrusted inertia evaluates again (the same numbers: the same `q`,
 /// partition and triplets).
 pub(crate) fn stability_of(
@@ -211,7 +212,7 @@ pub(crate) fn stability_of(
         let largest = inertia::largest_at(sys, q, part, eval.as_ref()?);
         drop(eval.take());
         sys.work.tree_split = None;
-        if let Some(judged) = inertia::inertia_verdict_knowing(sys, q, part, largest) {
+        if let Some(judged) = inertia::inertia_verdict_knowing(sys, q, part, largest, true) {
             return Some(Stability {
                 verdict: judged.verdict,
                 tolerance: judged.tolerance,

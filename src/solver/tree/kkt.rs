@@ -15,7 +15,8 @@
 //! accurate, each block is factored by LU with partial pivoting instead. A solve runs
 //! `y_i = K_i⁻¹ r_i`, `r_p −= C_iᵀ y_i` from the leaves and `x_i = y_i − X_i x_p` back from
 //! the root, then the border (module `border`), then iterative refinement like the sparse
-//! path's. Values, factors and scratch are allocated once per structure.
+//! path's. Values, factors and scratch are allocated once per structure (the factors at its
+//! first factorization).
 //!
 //! Assembly writes every slot once per Newton step without clearing the values first: a `W`
 //! entry stores its (scaled) Hessian block entry, a Jacobian entry stores its first triplet
@@ -46,8 +47,10 @@ pub(crate) struct TreeKkt {
     pub(super) values: Vec<f64>,
     /// The shifts `δ` and `−σ` now in `values`.
     pub(super) shifts: Shifts,
-    /// Factors: the flat blocks (`L D` or `L U` in place; `X_i` in the coupling slots), the
-    /// border's values and `S`, the pivots of LU.
+    /// Factors: the flat blocks (`L D` or `L U` in place; `X_i` in the coupling slots; empty
+    /// until the first factorization, so that memory freed between the assembly and it, such
+    /// as the verdict's block Hessian, is reused), the border's values and `S`, the pivots of
+    /// LU.
     factors: Vec<f64>,
     border: Vec<f64>,
     piv: Vec<u16>,
@@ -91,7 +94,7 @@ impl TreeKkt {
             blocks: hess.keys.len(),
             values: vec![0.0; total],
             shifts: Shifts::default(),
-            factors: vec![0.0; shape.flat_len],
+            factors: Vec::new(),
             border: vec![0.0; shape.border.len()],
             piv: vec![0; shape.tree_len],
             border_piv: vec![0; shape.border.size()],
@@ -215,6 +218,9 @@ impl TreeKkt {
     /// The tree part of [`TreeKkt::factor_blocks`] (and the row sums).
     fn factor_tree(&mut self, lu: bool) -> Option<usize> {
         let s = &self.shape;
+        if self.factors.len() != s.flat_len {
+            self.factors = vec![0.0; s.flat_len];
+        }
         // Each block is copied from the values when first touched (its own turn, or its first
         // child's update), so that a body's values are read once, while in cache.
         let fresh = &mut self.fresh;

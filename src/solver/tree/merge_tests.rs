@@ -5,8 +5,7 @@ use super::merge::{phi_u_runs, MAX_NODE};
 use super::phi_u::MAX_BORDER;
 use crate::constraints::Constraints;
 use crate::model::Model;
-use crate::solver::sparse::kkt::Factored;
-use crate::solver::system::{Backend, Factors, KktMatrix, System};
+use crate::solver::system::{Backend, KktMatrix, System};
 use crate::solver::{LinearAlgebra, Options};
 use crate::urdf::{load_str, ImportOptions};
 use nalgebra::DVector;
@@ -89,52 +88,8 @@ fn merged_runs_make_phi_u_block_triangular() {
 /// multipliers, reduced gradient, tangent step, corrector, KKT step and inertia to 10⁻¹⁰.
 #[test]
 fn long_ladder_phi_u_by_super_nodes_matches_the_sparse_factors() {
-    let model = ladder(30);
-    let q0 = crate::solver::initial_state(&model).q;
-    let q =
-        crate::solver::assemble_only(&model, q0, &mut Default::default(), &[]).expect("assembles");
-    let mut sparse = System::new(&model, Constraints::new(&model, &[]), Backend::Sparse);
-    let mut tree = System::new(&model, Constraints::new(&model, &[]), Backend::Tree);
-    let part = sparse.partition(&q);
-    assert_eq!(part.dependent, tree.partition(&q).dependent);
-    let es = sparse.evaluate(&q, &part).expect("sparse evaluation");
-    let et = tree.evaluate(&q, &part).expect("tree evaluation");
-    let Factors::Tree(f) = &et.factors else {
-        panic!("the tree factors of Φ_u");
-    };
-    assert_eq!(f.border_size(), 0);
-    assert!(close(&es.mu, &et.mu, 1e-10), "μ {} vs {}", es.mu, et.mu);
-    assert!(close(&es.grad_v, &et.grad_v, 1e-10), "∇f");
-    let dv = DVector::from_fn(part.independent.len(), |i, _| (i as f64 + 0.5).sin());
-    let (zs, zt) = (
-        sparse.tangent_step(&part, &es, &dv),
-        tree.tangent_step(&part, &et, &dv),
-    );
-    assert!(close(&zs, &zt, 1e-10), "Z δv");
-    let mut qs = &q + &zs * 1e-3;
-    let mut qt = qs.clone();
-    sparse
-        .correct(&mut qs, &part, 1e-12, 20)
-        .expect("sparse corrects");
-    tree.correct(&mut qt, &part, 1e-12, 20)
-        .expect("tree corrects");
-    assert!(close(&qs, &qt, 1e-10), "corrector");
-    // KKT: the super-nodes' step and inertia, LDLᵀ and LU.
-    let fs = sparse.factor_kkt(&q, &part, &es, true, 1e-3);
-    let ft = tree.factor_kkt(&q, &part, &et, true, 1e-3);
-    let Some(KktMatrix::Tree(k)) = &tree.work.kkt else {
-        panic!("tree KKT");
-    };
-    assert_eq!(k.border_size(), 0);
-    assert_eq!(fs, ft, "factored (inertia)");
-    assert!(matches!(ft, Factored::Ldlt { .. }), "{ft:?}");
-    let b = DVector::from_fn(q.len(), |i, _| (0.3 * i as f64).cos());
-    let xs = sparse.kkt_solve(&b).expect("sparse KKT solve");
-    let xt = tree.kkt_solve(&b).expect("tree KKT solve");
-    assert!(close(&xs, &xt, 1e-10), "KKT solution");
-    assert_eq!(tree.kkt_fall_back_to_lu(), Factored::Lu);
-    let xl = tree.kkt_solve(&b).expect("tree KKT solve by LU");
-    assert!(close(&xs, &xl, 1e-10), "KKT solution by LU");
+    let borders = super::tests::compare_with_sparse("ladder of 30", &ladder(30), &[], 1e-10);
+    assert_eq!(borders, (0, 0), "(Φ_u, KKT) borders");
 }
 
 /// The KKT matrix of a ladder by super-nodes: with a negative curvature (the shift `−σ` above

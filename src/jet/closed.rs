@@ -24,6 +24,7 @@ use crate::joint::{Row, V};
 use crate::math::{b_matrix, rotation};
 use crate::model::Joint;
 use nalgebra::{Matrix3, Matrix3x4, Matrix4, SMatrix, Vector3};
+pub(crate) mod euler;
 
 /// `Σ_k t_k r_k + A(p_k) s_k` with `B_k = B(p_k, s_k)`; `on[k]` whether side `k` enters.
 #[derive(Clone, Copy, Debug)]

@@ -10,7 +10,7 @@
 //! runs over the values.
 
 use super::System;
-use crate::jet::{HessianSink, LMat, NL};
+use crate::jet::{HessianSink, LMat, EULER, NL};
 use crate::model::BodyId;
 use crate::solver::partition::Partition;
 
@@ -164,9 +164,27 @@ impl System<'_> {
 }
 
 /// `acc += g gᵀ ρ`, entry by entry as `(g_i g_j) ρ`, over the columns of `g`'s nonzero
-/// entries: a zero `g_i` adds a signed zero, which changes no sum.
+/// entries: a zero `g_i` adds a signed zero, which changes no sum (the sums start at `+0`, so
+/// they are never `−0`). A row on the Euler parameters alone (a dot product of two axes, a
+/// normalization) therefore adds over their rows only ([`EULER`]: the two runs `3..7`,
+/// `10..14`).
 fn add_outer(acc: &mut LMat, g: &[f64; NL], rho: f64) {
     let acc = acc.as_mut_slice();
+    let euler_only = g[0..3].iter().chain(&g[7..10]).all(|&x| x == 0.0);
+    if euler_only {
+        for &j in &EULER {
+            let gj = g[j];
+            if gj != 0.0 {
+                for run in [3..7, 10..14] {
+                    let col = &mut acc[NL * j + run.start..NL * j + run.end];
+                    for (a, &gi) in col.iter_mut().zip(&g[run]) {
+                        *a += gi * gj * rho;
+                    }
+                }
+            }
+        }
+        return;
+    }
     for (j, &gj) in g.iter().enumerate() {
         if gj != 0.0 {
             let col = &mut acc[NL * j..NL * j + NL];

@@ -148,7 +148,7 @@ impl System<'_> {
             }
             if pending != Some(bodies) {
                 if let Some(b) = pending.take() {
-                    sink.add_block(&b, &acc, 1.0);
+                    sink.add_symmetric_block(&b, &acc, 1.0);
                 }
                 pending = Some(bodies);
                 acc.as_mut_slice().fill(0.0);
@@ -156,7 +156,7 @@ impl System<'_> {
             add_outer(&mut acc, &gv, rho);
         }
         if let Some(b) = pending.take() {
-            sink.add_block(&b, &acc, 1.0);
+            sink.add_symmetric_block(&b, &acc, 1.0);
         }
         work.augment = Some(plan);
         work.wdiag = wdiag;
@@ -168,6 +168,10 @@ impl System<'_> {
 /// they are never `−0`). A row on the Euler parameters alone (a dot product of two axes, a
 /// normalization) therefore adds over their rows only ([`EULER`]: the two runs `3..7`,
 /// `10..14`).
+///
+/// Entries `(i, j)` and `(j, i)` sum the same products `g_i g_j = g_j g_i` in the same order
+/// (the signed zeros aside), so the sum is symmetric to the last bit: the sink may read it
+/// either way ([`HessianSink::add_symmetric_block`]).
 fn add_outer(acc: &mut LMat, g: &[f64; NL], rho: f64) {
     let acc = acc.as_mut_slice();
     let euler_only = g[0..3].iter().chain(&g[7..10]).all(|&x| x == 0.0);

@@ -132,9 +132,9 @@ impl System<'_> {
         for g in &plan.groups {
             let range = g.start..g.end;
             let group = &entries[range.clone()];
-            let rho = group.iter().fold(floor, |a, e| a.max(wdiag[e.1]))
-                * self.problem.scaling.rows[g.row].powi(2);
+            let row_scale = self.problem.scaling.rows[g.row].powi(2);
             let Some(bodies) = g.bodies else {
+                let rho = group.iter().fold(floor, |a, e| a.max(wdiag[e.1])) * row_scale;
                 for a in group {
                     for b in group {
                         sink.add_entry(a.1, b.1, rho * a.2 * b.2);
@@ -142,10 +142,15 @@ impl System<'_> {
                 }
                 continue;
             };
-            let mut gv = [0.0f64; NL];
+            // `ρ`'s reach and the row's local entries in one pass (the same maxima in the
+            // same order as the fold above).
+            let mut gv: Local = [0.0; 16];
+            let mut reach = floor;
             for (e, &i) in group.iter().zip(&plan.local[range]) {
-                gv[i as usize] += e.2;
+                reach = reach.max(wdiag[e.1]);
+                gv[usize::from(i) & 15] += e.2;
             }
+            let rho = reach * row_scale;
             if pending != Some(bodies) {
                 if let Some(b) = pending.take() {
                     sink.add_symmetric_block(&b, &acc, 1.0);
@@ -163,6 +168,10 @@ impl System<'_> {
     }
 }
 
+/// A row's entries in its pair's local order: 14 used, 16 so that a local index masked by
+/// 15 needs no bounds check.
+type Local = [f64; 16];
+
 /// `acc += g gᵀ ρ`, entry by entry as `(g_i g_j) ρ`, over the columns of `g`'s nonzero
 /// entries: a zero `g_i` adds a signed zero, which changes no sum (the sums start at `+0`, so
 /// they are never `−0`). A row on the Euler parameters alone (a dot product of two axes, a
@@ -172,8 +181,9 @@ impl System<'_> {
 /// Entries `(i, j)` and `(j, i)` sum the same products `g_i g_j = g_j g_i` in the same order
 /// (the signed zeros aside), so the sum is symmetric to the last bit: the sink may read it
 /// either way ([`HessianSink::add_symmetric_block`]).
-fn add_outer(acc: &mut LMat, g: &[f64; NL], rho: f64) {
+fn add_outer(acc: &mut LMat, g: &Local, rho: f64) {
     let acc = acc.as_mut_slice();
+    let g = &g[..NL];
     let euler_only = g[0..3].iter().chain(&g[7..10]).all(|&x| x == 0.0);
     if euler_only {
         for &j in &EULER {

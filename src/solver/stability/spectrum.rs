@@ -59,7 +59,8 @@ pub(crate) struct Spectrum {
 }
 
 impl Spectrum {
-    /// Eigenvalue tolerance of the stability verdict: `1e-10 max(|λ|max, 1)`. Rounding
+    /// Eigenvalue tolerance of the stability verdict: `1e-10 max(|λ|max, 1)` (`largest`: exact
+    /// where all eigenvalues are known, else the estimate `λ̃ ≤ |λ|max` of module `largest`). Rounding
     /// perturbs `Ŵ` by about `ε |Ŵ|` and the basis `Z` amplifies it by its conditioning, so the
     /// eigenvalues are resolved to about `10⁻¹² … 10⁻¹⁰ |λ|max`; a spread of stiffnesses
     /// beyond 10¹⁰ is called neutral. (The 10,000-link benchmark chain spans 74 … 2.4·10¹⁰.)

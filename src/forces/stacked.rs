@@ -255,7 +255,7 @@ mod tests {
         let bodies = j.bodies;
         let (k, theta0) = (3.5, 0.4);
         let spring = |q: &Pair| {
-            let mut pair = q.clone();
+            let mut pair = *q;
             pair.hess = true;
             let theta = revolute_angle(&j, &pair);
             let delta = theta.v - theta0;

@@ -26,4 +26,8 @@ mod merge_tests;
 pub(crate) mod phi_u;
 mod shape;
 #[cfg(test)]
+mod shape_reference;
+#[cfg(test)]
+mod shape_tests;
+#[cfg(test)]
 mod tests;

@@ -9,6 +9,12 @@
 //! through the Jacobian entries of its rows. A node coupled to one later node (its parent) is
 //! eliminated without fill; where it is coupled to more, all but the first go to the border
 //! (module `border`), with the rows pivoted away from their body's run (loop rows).
+//!
+//! Built in `O(N)` by runs of triplets: a row's entries on one body come as consecutive
+//! columns, which lie at consecutive positions `t, t + 1, …` of one node; along such a run the
+//! node pair is the same (one coupling, one reach, the last's), the slot of `(row, t + j)` is
+//! that of `(row, t)` plus `j` and its mirror's plus `j` times the width of the column's block.
+//! The construction triplet by triplet stays as the tests' reference (`shape_reference`).
 
 use super::border::Border;
 use super::fused::Run;

@@ -1,9 +1,10 @@
-//! The structure of the tree KKT matrix as `Shape::new` built it through session 27, entry by
-//! entry (`O(N)` with a large constant): the reference the faster construction is compared
-//! against, field by field (test `shape_tests`).
+//! The structure of the tree KKT matrix as `Shape::new` and `merge::kkt_nodes` built it
+//! through session 27, triplet by triplet (`O(N)` with a large constant): the reference the
+//! construction by runs is compared against, field by field (`shape_tests`).
 
 use super::border::Border;
 use super::fused::Run;
+use super::merge::MAX_NODE;
 use super::shape::{Shape, FIRST, MAX_BORDER, SKIP};
 use crate::solver::partition::Partition;
 use crate::solver::sparse::hessian::BlockHessian;
@@ -105,7 +106,7 @@ pub(super) fn reference(
     if border_unknowns.len() > MAX_BORDER {
         // Too large for a dense Schur complement: the nodes a loop couples are merged into
         // super-nodes instead (module `merge`), and nothing is bordered.
-        (members, parent) = super::merge::kkt_nodes(part, n, &row_pos, entries, &hess.keys)?;
+        (members, parent) = kkt_nodes_reference(part, n, &row_pos, entries, &hess.keys)?;
         in_border = vec![false; members.len()];
         border_unknowns.clear();
     }
@@ -302,4 +303,133 @@ pub(super) fn reference(
         diag_slots,
         bare_diag,
     })
+}
+
+/// `merge::kkt_nodes` as built through session 27 (every triplet coupled, module `merge`'s doc): `(members, parent)`, each node's
+/// unknowns (coordinates `0 .. n`, rows `n + k`) in elimination order and its parent
+/// (`u32::MAX`: a root); `None` if a super-node exceeds [`MAX_NODE`] unknowns.
+fn kkt_nodes_reference(
+    part: &Partition,
+    n: usize,
+    row_pos: &[u32],
+    entries: &[(usize, usize, f64)],
+    keys: &[(usize, usize)],
+) -> Option<(Vec<Vec<usize>>, Vec<u32>)> {
+    let nb = n / 7;
+    let mut body_node = vec![u32::MAX; nb];
+    let mut members: Vec<Vec<usize>> = Vec::new();
+    for (k, &c) in part.dependent.iter().enumerate() {
+        let b = c / 7;
+        if body_node[b] == u32::MAX {
+            body_node[b] = members.len() as u32;
+            members.push((7 * b..7 * b + 7).collect());
+        }
+        if let Some(m) = members.last_mut() {
+            m.push(n + k);
+        }
+    }
+    for b in 0..nb {
+        if body_node[b] == u32::MAX {
+            body_node[b] = members.len() as u32;
+            members.push((7 * b..7 * b + 7).collect());
+        }
+    }
+    let nodes = members.len();
+    let mut row_node = vec![u32::MAX; part.rows.len()];
+    for (i, m) in members.iter().enumerate() {
+        for &u in m.iter().filter(|&&u| u >= n) {
+            row_node[u - n] = i as u32;
+        }
+    }
+    let mut adj: Vec<Vec<u32>> = vec![Vec::new(); nodes];
+    let mut couple = |a: u32, b: u32| {
+        if a != b && a != u32::MAX && b != u32::MAX {
+            adj[a as usize].push(b);
+            adj[b as usize].push(a);
+        }
+    };
+    for &(a, b) in keys {
+        couple(body_node[a], body_node[b]);
+    }
+    for e in entries {
+        if row_pos[e.0] != u32::MAX {
+            couple(row_node[row_pos[e.0] as usize], body_node[e.1 / 7]);
+        }
+    }
+    // Union-find whose representative is the set's latest node; `set[r]`: its member nodes.
+    let mut rep: Vec<u32> = (0..nodes as u32).collect();
+    let mut set: Vec<Vec<u32>> = (0..nodes as u32).map(|i| vec![i]).collect();
+    let mut size: Vec<usize> = members.iter().map(Vec::len).collect();
+    let mut parent = vec![u32::MAX; nodes];
+    let mut later = Vec::new();
+    for i in 0..nodes {
+        if find(&mut rep, i as u32) != i as u32 {
+            continue;
+        }
+        later.clear();
+        for &m in &set[i] {
+            for &j in &adj[m as usize] {
+                let r = find(&mut rep, j);
+                if r > i as u32 {
+                    later.push(r);
+                }
+            }
+        }
+        later.sort_unstable();
+        later.dedup();
+        let Some(&top) = later.last() else {
+            continue;
+        };
+        for &s in &later[..later.len() - 1] {
+            rep[s as usize] = top;
+            let moved = std::mem::take(&mut set[s as usize]);
+            set[top as usize].extend(moved);
+            size[top as usize] += size[s as usize];
+        }
+        if size[top as usize] > MAX_NODE {
+            return None;
+        }
+        parent[i] = top;
+    }
+    // The super-nodes in the order of their latest member: the members' coordinates first,
+    // then their rows (the children reach the coordinates: narrow couplings).
+    let mut index = vec![u32::MAX; nodes];
+    let mut merged = Vec::new();
+    for i in 0..nodes {
+        if rep[i] == i as u32 {
+            index[i] = merged.len() as u32;
+            let mut own = std::mem::take(&mut set[i]);
+            own.sort_unstable();
+            let all = || {
+                own.iter()
+                    .flat_map(|&m| members[m as usize].iter().copied())
+            };
+            let node: Vec<usize> = if own.len() == 1 {
+                all().collect()
+            } else {
+                all()
+                    .filter(|&u| u < n)
+                    .chain(all().filter(|&u| u >= n))
+                    .collect()
+            };
+            merged.push(node);
+        }
+    }
+    let mut par = vec![u32::MAX; merged.len()];
+    for i in 0..nodes {
+        if rep[i] == i as u32 && parent[i] != u32::MAX {
+            par[index[i] as usize] = index[find(&mut rep, parent[i]) as usize];
+        }
+    }
+    Some((merged, par))
+}
+
+/// The representative of `i`'s set (path halving).
+fn find(rep: &mut [u32], mut i: u32) -> u32 {
+    while rep[i as usize] != i {
+        let up = rep[rep[i as usize] as usize];
+        rep[i as usize] = up;
+        i = up;
+    }
+    i
 }

@@ -9,6 +9,9 @@ use crate::model::{JointId, Model};
 use crate::solver::system::{Backend, System};
 use crate::urdf::{load_file, load_str, ImportOptions};
 
+/// Joint locks `(joint, coordinate, value)`.
+type Locks = Vec<(JointId, usize, f64)>;
+
 fn from_text(text: &str) -> Model {
     load_str(text, "shape.urdf", &ImportOptions::default())
         .expect("model loads")
@@ -46,7 +49,7 @@ fn shape_by_runs_equals_the_shape_entry_by_entry() {
     let solo12 = load_file(solo12, &ImportOptions::default())
         .expect("solo12 loads")
         .model;
-    let cases: Vec<(&str, Model, Vec<(JointId, usize, f64)>)> = vec![
+    let cases: Vec<(&str, Model, Locks)> = vec![
         (
             "chain",
             from_text(&crate::generate::chain(40, false)),

@@ -49,12 +49,8 @@ impl Block {
         self.bodies.clear();
         self.bodies.push(b);
         for &r in &self.rows {
-            let mut last = usize::MAX;
-            for &(c, _) in rows.row(r) {
-                if c / 7 != last {
-                    last = c / 7;
-                    slot(&mut self.bodies, last);
-                }
+            for &body in rows.bodies(r) {
+                slot(&mut self.bodies, body);
             }
         }
         let w = 7 * self.bodies.len();
@@ -94,11 +90,22 @@ impl Block {
                 continue;
             }
             let f = row[k] / a_ik;
-            for (e, &v) in row.iter_mut().zip(pivot_row.iter()) {
-                *e -= f * v;
-            }
             row[k] = 0.0;
-            self.rmax[j] = row.iter().fold(0.0, |a, &v| a.max(v.abs()));
+            let mut max = 0.0f64;
+            for (e, &v) in row[..k].iter_mut().zip(&pivot_row[..k]) {
+                *e -= f * v;
+                // `fold(0, f64::max)` of the magnitudes (NaN ignored).
+                if e.abs() > max {
+                    max = e.abs();
+                }
+            }
+            for (e, &v) in row[k + 1..].iter_mut().zip(&pivot_row[k + 1..]) {
+                *e -= f * v;
+                if e.abs() > max {
+                    max = e.abs();
+                }
+            }
+            self.rmax[j] = max;
             if self.rmax[j] <= tol {
                 self.live[j] = false;
                 active[self.rows[j]] = false;

@@ -1,8 +1,8 @@
 //! The rows of `D Φ_q S` as the solver's sparse partition builds them, in one pass over the
 //! Jacobian's triplets (grouped by ascending row): row `r`'s scaled entries
-//! `a_rc = row_scale[r] · v · scale[c]` (duplicates summed in triplet order into the first one,
-//! zeros dropped, the others in triplet order), with what the elimination of module `rank`
-//! reads of them: each row's largest entry `max_c |a_rc|`, the rows touching each body, the
+//! `a_rc = row_scale[r] · v · scale[c]` (duplicates summed in triplet order, zeros dropped; in
+//! the order of their first nonzero term, which no reader depends on), with what the
+//! elimination of module `rank` reads of them: each row's largest entry `max_c |a_rc|`, the rows touching each body, the
 //! body of each row lying on one body alone and its reach there (its largest entry in the
 //! translation columns and in the Euler-parameter columns).
 
@@ -20,6 +20,9 @@ pub(super) struct Rows {
     /// `body_rows[body_start[b]..body_start[b + 1]]`.
     pub(super) body_start: Vec<usize>,
     pub(super) body_rows: Vec<usize>,
+    /// The bodies of each row's runs of entries on one body: `runs[run_at[r]..run_at[r + 1]]`.
+    runs: Vec<usize>,
+    run_at: Vec<usize>,
 }
 
 impl Rows {
@@ -54,36 +57,62 @@ impl Rows {
             rest = tail;
             let start = out.len();
             let row_scale = row_scale[r];
+            // Zeros skipped (`x + 0 = x`: a sum keeps its value without them), duplicates
+            // summed in triplet order; the largest entry and the runs by body as they come
+            // (`c` in `lo..hi` on the last run's body).
+            let (mut summed, mut max) = (false, 0.0f64);
+            let (mut lo, mut hi) = (usize::MAX, 0);
             for &(_, c, v) in seg {
                 if c >= n {
                     return None;
                 }
                 let a = v * row_scale * scale[c];
+                if a == 0.0 {
+                    continue;
+                }
                 let s = &mut seen[c];
                 if s.0 == r {
                     out[s.1].1 += a;
-                } else {
-                    *s = (r, out.len());
-                    out.push((c, a));
+                    summed = true;
+                    continue;
+                }
+                *s = (r, out.len());
+                out.push((c, a));
+                // `max_c |a_rc|` as `fold(0, f64::max)` gives it (NaN ignored).
+                if a.abs() > max {
+                    max = a.abs();
+                }
+                if c < lo || c >= hi {
+                    lo = c - c % 7;
+                    hi = lo + 7;
+                    runs.push(c / 7);
+                    body_start[c / 7 + 1] += 1;
                 }
             }
-            // Zeros dropped (the order kept), the largest entry, the runs by body.
-            let (mut kept, mut max, mut last) = (start, 0.0f64, usize::MAX);
-            for i in start..out.len() {
-                let e = out[i];
-                if e.1 != 0.0 {
-                    out[kept] = e;
-                    kept += 1;
-                    max = max.max(e.1.abs());
-                    if e.0 / 7 != last {
-                        last = e.0 / 7;
-                        runs.push(last);
-                        body_start[last + 1] += 1;
+            if summed {
+                // Counted again without the sums that cancelled (the order kept).
+                for &body in &runs[run_at[r]..] {
+                    body_start[body + 1] -= 1;
+                }
+                runs.truncate(run_at[r]);
+                let (mut kept, mut last) = (start, usize::MAX);
+                max = 0.0;
+                for i in start..out.len() {
+                    let e = out[i];
+                    if e.1 != 0.0 {
+                        out[kept] = e;
+                        kept += 1;
+                        max = max.max(e.1.abs());
+                        if e.0 / 7 != last {
+                            last = e.0 / 7;
+                            runs.push(last);
+                            body_start[last + 1] += 1;
+                        }
                     }
                 }
+                out.truncate(kept);
             }
-            out.truncate(kept);
-            at.push(kept);
+            at.push(out.len());
             rmax[r] = max;
             let first_run = run_at[r];
             run_at.push(runs.len());
@@ -121,12 +150,19 @@ impl Rows {
             reach,
             body_start,
             body_rows,
+            runs,
+            run_at,
         })
     }
 
     /// Row `r`'s entries.
     pub(super) fn row(&self, r: usize) -> &[(usize, f64)] {
         &self.entries[self.at[r]..self.at[r + 1]]
+    }
+
+    /// The bodies row `r` touches (a body once per run of its entries there).
+    pub(super) fn bodies(&self, r: usize) -> &[usize] {
+        &self.runs[self.run_at[r]..self.run_at[r + 1]]
     }
 
     /// The rows touching body `b`, each once (ascending).

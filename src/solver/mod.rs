@@ -259,7 +259,7 @@ pub(crate) fn solve_round(
     // from it (and judges stability itself if it ends there).
     // Where the minimizer judged by the KKT inertia (many degrees of freedom), that verdict,
     // unless eigenvalues are asked for (module `stability::at_rest`): then the spectrum, with
-    // that verdict's `λ_max` (the same power iteration at the same point).
+    // that verdict's `λ_max` (the same estimate at the same point).
     let stability = (dof > 0 && out.blocked.is_none() && out.released.is_empty()).then(|| {
         if let (Some(judged), false) = (out.inertia, options.eigenvalues) {
             diagnostics.eigenvalues_by = "inertia".into();

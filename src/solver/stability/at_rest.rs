@@ -22,7 +22,7 @@ use nalgebra::DVector;
 /// few degrees of freedom); else the inertia verdict first (stored in `verdict`), and the
 /// spectrum only when that verdict is `unstable` and the minimizer is to leave
 /// (`allow_unstable` false), or when the inertia cannot be trusted. The spectrum after an
-/// inertia verdict takes its `λ_max` (the same power iteration at the same point).
+/// inertia verdict takes its `λ_max` (the same estimate at the same point: module `largest`).
 pub(crate) fn for_minimizer(
     sys: &mut System,
     q: &DVector<f64>,

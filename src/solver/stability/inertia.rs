@@ -14,7 +14,8 @@
 //! (Sylvester's law of inertia with Haynsworth's additivity over the constraint block): the
 //! number of negative pivots of its LDLᵀ minus `m` is exactly the number of eigenvalues of `Ĥ`
 //! below `σ`. The verdict of [`Stability`](crate::solver::Stability) with tolerance `t = 10⁻¹⁰ max(λ_max, 1)`
-//! (`λ_max` by power iteration, as on the Lanczos path) then needs one or two factorizations:
+//! (`λ_max` estimated by a few Lanczos steps on `Ĥ`, never above `|λ|max`: module `largest`,
+//! as on the Lanczos path) then needs one or two factorizations:
 //!
 //! - `#{λ < t} = 0`: **stable** (every eigenvalue above the tolerance);
 //! - else `#{λ < −t} > 0`: **unstable**;
@@ -35,15 +36,15 @@
 //! - N. I. M. Gould, "On practical conditions for the existence and uniqueness of solutions
 //!   to the general equality quadratic programming problem", *Math. Program.* 32 (1985).
 
-use super::spectrum::largest_eigenvalue;
+use super::largest::largest_eigenvalue;
 use crate::solver::partition::Partition;
 use crate::solver::report::Verdict;
 use crate::solver::sparse::kkt::Factored;
 use crate::solver::system::{Eval, System};
 use nalgebra::DVector;
 
-/// A verdict by inertia: the verdict, its tolerance `t = 10⁻¹⁰ max(λ_max, 1)`, and the power
-/// iteration's `λ_max` it came from (the spectrum at the same point, if it is wanted after
+/// A verdict by inertia: the verdict, its tolerance `t = 10⁻¹⁰ max(λ_max, 1)`, and the
+/// estimate `λ_max` it came from (module `largest`) (the spectrum at the same point, if it is wanted after
 /// all, takes it instead of iterating again: `spectrum::spectrum_knowing`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct ByInertia {
@@ -66,7 +67,7 @@ pub(crate) fn inertia_verdict(
 
 /// The first half of [`inertia_verdict`], the only one that reads `eval` (its factors of
 /// `Φ_u`): `W` (augmented, as the KKT matrix takes it) into the block Hessian and `λ_max`
-/// of `Ĥ` by power iteration. A caller that owns `eval` may free it before the second half
+/// of `Ĥ` (module `largest`). A caller that owns `eval` may free it before the second half
 /// ([`inertia_verdict_knowing`]), whose KKT matrix then reuses its memory (`verify`).
 pub(crate) fn largest_at(sys: &mut System, q: &DVector<f64>, part: &Partition, eval: &Eval) -> f64 {
     sys.kkt_blocks(q, part, eval);

@@ -20,5 +20,6 @@ pub(crate) mod cone;
 pub(crate) mod eigen;
 pub(crate) mod inertia;
 pub(crate) mod joint_space;
+pub(crate) mod largest;
 pub(crate) mod spectrum;
 pub(crate) mod verdict;

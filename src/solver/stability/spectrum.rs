@@ -9,8 +9,8 @@
 //! coordinates): Lanczos finds the extreme eigenvalues of `Ĥ⁻¹` first, which are the smallest
 //! positive eigenvalues of `Ĥ` and, if there is any negative eigenvalue, the negative end. Only
 //! Ritz pairs with residual `|β_k s_ki| ≤ 10⁻⁸ |θ_i|` are kept. The largest eigenvalue (scale
-//! of the verdict's tolerance) comes from 12 steps of power iteration on `Ĥ` (a few per cent
-//! suffice for a tolerance). When the KKT matrix was factored by an accurate LDLᵀ, the number
+//! of the verdict's tolerance) is estimated by a few Lanczos steps on `Ĥ` itself (module
+//! `largest`: within 10 % of an eigenvalue and never above `|λ|max`). When the KKT matrix was factored by an accurate LDLᵀ, the number
 //! of its negative pivots minus the number of rows is the number of negative eigenvalues of `Ĥ`
 //! (Sylvester's law of inertia): an exact count, whatever Lanczos found.
 //!
@@ -19,6 +19,7 @@
 
 use super::blocks::block_symmetric_eigen;
 use super::eigen::symmetric_eigen;
+use super::largest::largest_eigenvalue;
 use crate::solver::partition::Partition;
 use crate::solver::sparse::kkt::Factored;
 use crate::solver::system::{Backend, Eval, System};
@@ -58,7 +59,8 @@ pub(crate) struct Spectrum {
 }
 
 impl Spectrum {
-    /// Eigenvalue tolerance of the stability verdict: `1e-10 max(|λ|max, 1)`. Rounding
+    /// Eigenvalue tolerance of the stability verdict: `1e-10 max(|λ|max, 1)` (`largest`: exact
+    /// where all eigenvalues are known, else the estimate `λ̃ ≤ |λ|max` of module `largest`). Rounding
     /// perturbs `Ŵ` by about `ε |Ŵ|` and the basis `Z` amplifies it by its conditioning, so the
     /// eigenvalues are resolved to about `10⁻¹² … 10⁻¹⁰ |λ|max`; a spread of stiffnesses
     /// beyond 10¹⁰ is called neutral. (The 10,000-link benchmark chain spans 74 … 2.4·10¹⁰.)
@@ -117,7 +119,7 @@ pub(crate) fn spectrum(
     spectrum_knowing(sys, q, part, eval, None)
 }
 
-/// [`spectrum`], with the power iteration's `λ_max` at this same point if already at hand
+/// [`spectrum`], with the estimate `λ_max` (module `largest`) at this same point if already at hand
 /// (an inertia verdict's: `stability::inertia::ByInertia`), not iterated again.
 pub(crate) fn spectrum_knowing(
     sys: &mut System,
@@ -177,7 +179,7 @@ fn lanczos(
             None
         }
     };
-    // The largest eigenvalue: power iteration on `Ĥ` (products through `Φ_u`'s factors and
+    // The largest eigenvalue: Lanczos on `Ĥ` (module `largest`: products through `Φ_u`'s factors and
     // `W`); the smallest: Lanczos through the KKT factors.
     let largest = largest.unwrap_or_else(|| largest_eigenvalue(sys, part, eval));
     let steps = lanczos_steps(sys, part, n, negative_by_inertia);
@@ -213,24 +215,6 @@ fn lanczos(
         negative_by_inertia,
         basis: None,
     })
-}
-
-/// The largest eigenvalue of `Ĥ` by 12 steps of power iteration (a few per cent suffice for
-/// the tolerance it scales).
-pub(crate) fn largest_eigenvalue(sys: &System, part: &Partition, eval: &Eval) -> f64 {
-    let dof = part.independent.len();
-    let mut x = DVector::from_fn(dof, |i, _| 1.0 + 0.1 * ((i * 7919 % 101) as f64 / 101.0));
-    x /= x.norm();
-    let mut largest = 0.0f64;
-    for _ in 0..12 {
-        let y = sys.reduced_apply(part, eval, &x);
-        largest = y.norm();
-        if largest == 0.0 || !largest.is_finite() {
-            break;
-        }
-        x = y / largest;
-    }
-    largest
 }
 
 /// The Lanczos recurrence on `Ĥ⁻¹` (applied by the KKT factors) with full

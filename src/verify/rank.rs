@@ -15,7 +15,8 @@
 //! are never read again: `b`'s step depends only on the original entries of its own rows. This
 //! module repeats exactly those steps body by body on copies of the rows touching `b` (so the
 //! same pivots are chosen, in the same order, with the same floating-point operations on every
-//! entry), and gives up (`None`) at the first body where a row touching it stays active (a
+//! nonzero entry: dense copies, module `rank_block`, of the rows expanded once, module
+//! `rank_rows`), and gives up (`None`) at the first body where a row touching it stays active (a
 //! loop's rows, which carry fill to other bodies): the caller then runs the full partition.
 //! Every row then ends a pivot row or redundant: the pivots in their order are the partition's
 //! dependent columns and independent rows, the other rows its redundant ones, the columns left

@@ -2,9 +2,9 @@
 //! Jacobian's triplets (grouped by ascending row): row `r`'s scaled entries
 //! `a_rc = row_scale[r] · v · scale[c]` (duplicates summed in triplet order, zeros dropped; in
 //! the order of their first nonzero term, which no reader depends on), with what the
-//! elimination of module `rank` reads of them: each row's largest entry `max_c |a_rc|`, the rows touching each body, the
-//! body of each row lying on one body alone and its reach there (its largest entry in the
-//! translation columns and in the Euler-parameter columns).
+//! elimination of module `rank` reads of them: each row's largest entry `max_c |a_rc|`, the
+//! rows touching each body, the body of each row lying on one body alone and its reach there
+//! (its largest entry in the translation columns and in the Euler-parameter columns).
 
 /// The expanded rows: row `r` is `entries[at[r]..at[r + 1]]`.
 pub(super) struct Rows {

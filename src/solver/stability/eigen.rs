@@ -61,10 +61,7 @@ pub(crate) fn symmetric_eigen(a: &DMatrix<f64>) -> (DVector<f64>, DMatrix<f64>) 
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_by(|&i, &j| vals[i].total_cmp(&vals[j]));
     let sorted_vals = DVector::from_fn(n, |i, _| vals[order[i]]);
-    let mut sorted_vecs = DMatrix::zeros(n, n);
-    for (c, &o) in order.iter().enumerate() {
-        sorted_vecs.column_mut(c).copy_from(&vecs.column(o));
-    }
+    let sorted_vecs = DMatrix::from_fn(n, n, |r, c| vecs[(r, order[c])]);
     (sorted_vals, sorted_vecs)
 }
 

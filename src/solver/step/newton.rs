@@ -101,12 +101,10 @@ pub(crate) fn newton_step_within(
     let mut t: Vec<f64> = (0..n)
         .map(|i| -slopes[i] / e.values[i].abs().max(floor))
         .collect();
-    // `Σ v_i t_i`, each term added as `d += v_i · t_i` (in place, no vector per term).
-    let vs = e.vectors.as_slice();
     let step = |t: &[f64]| {
         let mut d = DVector::zeros(n);
-        for (v, &ti) in vs.chunks_exact(n.max(1)).zip(t) {
-            add_scaled(d.as_mut_slice(), v, ti);
+        for (i, ti) in t.iter().enumerate() {
+            d += e.vectors.column(i) * *ti;
         }
         d
     };
@@ -118,15 +116,15 @@ pub(crate) fn newton_step_within(
     let whole = escape.is_some_and(|c| step(&t).amax() < near * c);
     let gmax = g.amax();
     // Per group (indexed by its root): its share of the step and whether its slopes vanish.
-    let mut share = DMatrix::zeros(n, n);
+    let mut share = vec![DVector::zeros(n); n];
     let mut still = vec![true; n];
-    for (i, v) in vs.chunks_exact(n.max(1)).enumerate() {
-        add_scaled(share.column_mut(group[i]).as_mut_slice(), v, t[i]);
+    for i in 0..n {
+        share[group[i]] += e.vectors.column(i) * t[i];
         still[group[i]] &= slopes[i].abs() <= BLOCK_AT_REST * gmax;
     }
     let near: Vec<bool> = (0..n)
         .map(|i| {
-            let block = escape.is_some_and(|c| share.column(group[i]).amax() < NEAR_STATIONARY * c);
+            let block = escape.is_some_and(|c| share[group[i]].amax() < NEAR_STATIONARY * c);
             whole || (still[group[i]] && block)
         })
         .collect();
@@ -184,13 +182,6 @@ impl Settle {
         let band = self.band.take();
         self.from = band.map_or(f64::INFINITY, |_| gnorm);
         band
-    }
-}
-
-/// `d += v · t` entry by entry (nalgebra's `d += v * t`, without the vector `v * t`).
-fn add_scaled(d: &mut [f64], v: &[f64], t: f64) {
-    for (x, y) in d.iter_mut().zip(v) {
-        *x += y * t;
     }
 }
 

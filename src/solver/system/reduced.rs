@@ -157,11 +157,9 @@ impl System<'_> {
                 for (b, &c) in part.independent.iter().enumerate() {
                     z[(c, b)] = scale[b];
                 }
-                let n = z.nrows();
-                let zs = z.as_mut_slice();
-                for (&c, xk) in part.dependent.iter().zip(x.chunks_exact(dof.max(1))) {
-                    for (b, &v) in xk.iter().enumerate() {
-                        zs[c + b * n] = v;
+                for (k, &c) in part.dependent.iter().enumerate() {
+                    for (b, &v) in x[k * dof..(k + 1) * dof].iter().enumerate() {
+                        z[(c, b)] = v;
                     }
                 }
                 return;

@@ -75,40 +75,48 @@ impl Lin {
 
     /// The world point of the body-frame point `s` of side `k`.
     pub(crate) fn point(pair: &Pair, rot: &Rotations, k: usize, s: &Vector3<f64>) -> Lin {
-        let mut l = Lin::vector(pair, rot, k, s);
-        l.v += pair.r[k];
-        l.t[k] = 1.0;
+        let mut l = Lin::ZERO;
+        l.set_point(pair, rot, k, s);
         l
+    }
+
+    /// [`Lin::point`] written over `self` (no copy of the whole vector).
+    fn set_point(&mut self, pair: &Pair, rot: &Rotations, k: usize, s: &Vector3<f64>) {
+        self.set_vector(pair, rot, k, s);
+        self.v += pair.r[k];
+        self.t[k] = 1.0;
     }
 
     /// The world direction of the body-frame vector `a` of side `k`.
     pub(crate) fn vector(pair: &Pair, rot: &Rotations, k: usize, a: &Vector3<f64>) -> Lin {
-        let mut l = Lin {
-            v: rot.0[k] * a,
-            t: [0.0; 2],
-            s: [Vector3::zeros(); 2],
-            b: [Matrix3x4::zeros(); 2],
-            on: [false; 2],
-        };
-        l.s[k] = *a;
-        l.b[k] = b_matrix(&pair.p[k], a);
-        l.on[k] = true;
+        let mut l = Lin::ZERO;
+        l.set_vector(pair, rot, k, a);
         l
     }
 
-    /// `self − o` for two points of different sides (`d = o₁ − o₀`).
-    pub(crate) fn minus(&self, o: &Lin) -> Lin {
-        let mut l = *self;
-        l.v -= o.v;
+    /// [`Lin::vector`] written over `self` (no copy of the whole vector).
+    fn set_vector(&mut self, pair: &Pair, rot: &Rotations, k: usize, a: &Vector3<f64>) {
+        self.v = rot.0[k] * a;
+        self.t = [0.0; 2];
+        self.s = [Vector3::zeros(); 2];
+        self.b = [Matrix3x4::zeros(); 2];
+        self.on = [false; 2];
+        self.s[k] = *a;
+        self.b[k] = b_matrix(&pair.p[k], a);
+        self.on[k] = true;
+    }
+
+    /// `self −= o` for two points of different sides (`d = o₁ − o₀`).
+    fn subtract(&mut self, o: &Lin) {
+        self.v -= o.v;
         for k in 0..2 {
             if o.on[k] {
-                l.t[k] -= o.t[k];
-                l.s[k] -= o.s[k];
-                l.b[k] -= o.b[k];
-                l.on[k] = true;
+                self.t[k] -= o.t[k];
+                self.s[k] -= o.s[k];
+                self.b[k] -= o.b[k];
+                self.on[k] = true;
             }
         }
-        l
     }
 }
 
@@ -287,7 +295,8 @@ pub(crate) struct Frames {
 }
 
 impl Frames {
-    /// The vectors `layout` uses, for the frames of `joint` at `pair`.
+    /// The vectors `layout` uses, for the frames of `joint` at `pair` (written in place).
+    #[inline(always)]
     fn of(joint: &Joint, pair: &Pair, layout: &[Row]) -> Self {
         let rot = Rotations::of(pair);
         let mut need = [false; 7];
@@ -302,32 +311,29 @@ impl Frames {
         }
         // Each side's joint rotation once.
         let mut r: [Option<Matrix3<f64>>; 2] = [None, None];
-        let mut axis = |k: usize, i: usize| {
+        let mut axis = |slot: &mut Lin, k: usize, i: usize| {
             let jr = &joint.body_from_joint[k].rotation;
             let r = r[k].get_or_insert_with(|| *jr.to_rotation_matrix().matrix());
-            Lin::vector(pair, &rot, k, &r.column(i).into_owned())
+            slot.set_vector(pair, &rot, k, &r.column(i).into_owned());
         };
-        let mut vectors = [Lin::ZERO; 7];
-        for (v, slot) in vectors.iter_mut().enumerate() {
+        let mut f = Frames {
+            vectors: [Lin::ZERO; 7],
+        };
+        for (v, slot) in f.vectors.iter_mut().enumerate() {
             if !need[v] {
                 continue;
             }
-            *slot = match v {
+            match v {
                 0 => {
-                    let o = |k: usize| {
-                        Lin::point(pair, &rot, k, &joint.body_from_joint[k].translation.vector)
-                    };
-                    o(1).minus(&o(0))
+                    let o = |k: usize| &joint.body_from_joint[k].translation.vector;
+                    slot.set_point(pair, &rot, 1, o(1));
+                    slot.subtract(&Lin::point(pair, &rot, 0, o(0)));
                 }
-                1 => axis(0, 0),
-                2 => axis(0, 1),
-                3 => axis(0, 2),
-                4 => axis(1, 0),
-                5 => axis(1, 1),
-                _ => axis(1, 2),
-            };
+                // The axes `x₀ y₀ z₀ x₁ y₁ z₁`.
+                _ => axis(slot, (v - 1) / 3, (v - 1) % 3),
+            }
         }
-        Frames { vectors }
+        f
     }
 
     fn get(&self, v: V) -> &Lin {
@@ -404,12 +410,7 @@ pub(crate) fn values(joint: &Joint, pair: &Pair, out: &mut Vec<f64>) {
         let point = |k: usize| a[k] * f[k].translation.vector + pair.r[k];
         let x = match v {
             V::D => point(1) - point(0),
-            V::X0 => axis(0, 0),
-            V::Y0 => axis(0, 1),
-            V::Z0 => axis(0, 2),
-            V::X1 => axis(1, 0),
-            V::Y1 => axis(1, 1),
-            V::Z1 => axis(1, 2),
+            _ => axis((v as usize - 1) / 3, (v as usize - 1) % 3),
         };
         memo[v as usize] = Some(x);
         x

@@ -47,7 +47,11 @@ fn vectors(q: &Pair) -> ([Vec3Jet; 3], [Lin; 3]) {
             q.vector(1, &Vector3::y()),
         ],
         [
-            Lin::point(q, &rot, 1, &s1()).minus(&Lin::point(q, &rot, 0, &s0())),
+            {
+                let mut d = Lin::point(q, &rot, 1, &s1());
+                d.subtract(&Lin::point(q, &rot, 0, &s0()));
+                d
+            },
             Lin::vector(q, &rot, 0, &Vector3::new(0.6, 0.0, -0.8)),
             Lin::vector(q, &rot, 1, &Vector3::y()),
         ],

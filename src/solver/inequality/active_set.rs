@@ -224,7 +224,8 @@ pub(crate) fn solve(
         let prior = std::mem::take(&mut next);
         let mut guard = Guard::new(model, options, inactive, &active, tol, &q)
             .with_true_gaps(&std::mem::take(&mut let_go))
-            .holding(&active, locks, options);
+            .holding(&active, locks, options)
+            .rolling_on(&active);
         guard.falling = prior.falling;
         // `max_iterations` bounds the iterations of all rounds together.
         let budget = Options {

@@ -38,6 +38,8 @@ pub(crate) struct Guard<'m> {
     /// The round follows a release of several stops decided by the step: the stops fall from
     /// them (module `release_trial`).
     pub(crate) falling: bool,
+    /// Per inactive inequality: a contact on the patch of a sticking pivot (module `together`).
+    pub(super) on_patch: Vec<bool>,
 }
 
 impl<'m> Guard<'m> {
@@ -76,6 +78,7 @@ impl<'m> Guard<'m> {
             rolls,
             held: None,
             falling: false,
+            on_patch: Vec::new(),
         }
     }
 

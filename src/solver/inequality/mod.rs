@@ -11,6 +11,7 @@
 //! - `patch`: rounded hulls (mesh feet) rolling on one sticking pivot.
 //! - `stall`: a round whose steps shrink towards an obstacle's edge ends.
 //! - `rolling`: sticking spheres re-anchored where they touch after rolling.
+//! - `together`: two rolling hulls meeting their next vertices in the same step.
 //! - `describe`: the report's stops and contacts from the active rows' multipliers.
 //! - `distribution`: the least-norm force distribution of a statically indeterminate support.
 
@@ -26,5 +27,6 @@ pub(crate) mod release;
 pub(crate) mod release_trial;
 pub(crate) mod rolling;
 pub(crate) mod stall;
+pub(crate) mod together;
 #[cfg(test)]
 mod values_tests;

@@ -137,6 +137,23 @@ pub(crate) fn line_search(
             // Cut the step where the first inequality reaches its boundary.
             if let Some((qb, k)) = guard.boundary(sys, q, dq, alpha, Some(&qt), part, options, eval)
             {
+                // Sticking contacts touching just after the first, met together (module
+                // `inequality::together`).
+                let cut = (&qb, k.as_slice());
+                if let Some((q2, k2)) = guard.together(sys, q, dq, cut, alpha, part, options, eval)
+                {
+                    if let Some(e2) = sys.evaluate(&q2, part) {
+                        diag.function_evaluations += 1;
+                        if e2.merit <= f + roundoff_of(eval, &e2) {
+                            return Some(Trial {
+                                q: q2,
+                                eval: e2,
+                                alpha: 0.0,
+                                blocked: Some(k2),
+                            });
+                        }
+                    }
+                }
                 if let Some(eb) = sys.evaluate(&qb, part) {
                     diag.function_evaluations += 1;
                     if eb.merit <= f + roundoff_of(eval, &eb) {

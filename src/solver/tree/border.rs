@@ -23,6 +23,7 @@
 use super::dense;
 
 /// Which unknowns form the border and where its entries sit.
+#[cfg_attr(test, derive(Debug, PartialEq))]
 pub(crate) struct Border {
     /// The border's unknowns (indices in the caller's numbering), in border order.
     positions: Vec<usize>,

@@ -150,10 +150,15 @@ pub(crate) fn kkt_nodes(
     for &(a, b) in keys {
         couple(body_node[a], body_node[b]);
     }
+    // A triplet on the row and body of the one before it couples the same nodes (the lists
+    // are read as sets): a row's run of columns on a body is coupled once.
+    let mut last = (usize::MAX, usize::MAX);
     for e in entries {
-        if row_pos[e.0] != u32::MAX {
-            couple(row_node[row_pos[e.0] as usize], body_node[e.1 / 7]);
+        let key = (e.0, e.1 / 7);
+        if key != last && row_pos[e.0] != u32::MAX {
+            couple(row_node[row_pos[e.0] as usize], body_node[key.1]);
         }
+        last = key;
     }
     // Union-find whose representative is the set's latest node; `set[r]`: its member nodes.
     let mut rep: Vec<u32> = (0..nodes as u32).collect();

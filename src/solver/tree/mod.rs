@@ -6,6 +6,7 @@
 //!
 //! - `dense`: the block kernels (LDLᵀ without pivoting, LU with partial pivoting);
 //! - `phi_u`: `Φ_u` as a block upper triangular matrix (corrector, multipliers, tangent steps);
+//! - `segments`: its off-diagonal entries as dense row × column segments for the solves;
 //! - `shape`: the KKT matrix's nodes, parents, border and value slots, once per partition;
 //! - `fused`: the Newton step's assembly of `W`, its terms added into the tree's body-pair
 //!   blocks and stored into the 13 × 13 blocks in one pass;
@@ -24,6 +25,11 @@ mod merge;
 #[cfg(test)]
 mod merge_tests;
 pub(crate) mod phi_u;
+mod segments;
 mod shape;
+#[cfg(test)]
+mod shape_reference;
+#[cfg(test)]
+mod shape_tests;
 #[cfg(test)]
 mod tests;

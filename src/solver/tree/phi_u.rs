@@ -19,6 +19,7 @@
 
 use super::border::Border;
 use super::dense;
+use super::segments::Segments;
 use super::shape::FIRST;
 use crate::solver::partition::Partition;
 use std::sync::Arc;
@@ -39,6 +40,8 @@ pub(crate) struct Shape {
     /// node `i`'s are `off[off_at[i] .. off_at[i + 1]]`.
     off: Vec<(u32, u32)>,
     off_at: Vec<usize>,
+    /// The same entries as dense segments (the solves' updates, module `segments`).
+    segments: Segments,
     border: Border,
     /// `(row position, independent position)` of the `Φ_v` entries.
     v_at: Vec<(u32, u32)>,
@@ -223,6 +226,7 @@ impl TreeSplit {
                 order,
                 span,
                 diag_at,
+                segments: Segments::new(&off, &off_at),
                 off,
                 off_at,
                 border,
@@ -336,10 +340,7 @@ impl TreeLu {
             let (a, b) = s.span[i];
             let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];
             dense::lu_solve_transpose(blk, &self.piv[a..b], b - a, &mut x[a..b]);
-            let r = s.off_at[i]..s.off_at[i + 1];
-            for (&(p, q), &v) in s.off[r.clone()].iter().zip(&off[r]) {
-                x[q as usize] -= v * x[p as usize];
-            }
+            s.segments.transposed(i, off, x);
         }
     }
 
@@ -360,10 +361,7 @@ impl TreeLu {
         let (diag, rest) = self.vals.split_at(s.off0);
         let off = &rest[..s.border0 - s.off0];
         for i in (first..nodes).rev() {
-            let r = s.off_at[i]..s.off_at[i + 1];
-            for (&(p, q), &v) in s.off[r.clone()].iter().zip(&off[r]) {
-                x[p as usize] -= v * x[q as usize];
-            }
+            s.segments.forward(i, off, x);
             let (a, b) = s.span[i];
             let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];
             dense::lu_solve(blk, &self.piv[a..b], b - a, &mut x[a..b], 1);

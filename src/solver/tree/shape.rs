@@ -9,6 +9,12 @@
 //! through the Jacobian entries of its rows. A node coupled to one later node (its parent) is
 //! eliminated without fill; where it is coupled to more, all but the first go to the border
 //! (module `border`), with the rows pivoted away from their body's run (loop rows).
+//!
+//! Built in `O(N)` by runs of triplets: a row's entries on one body come as consecutive
+//! columns, which lie at consecutive positions `t, t + 1, …` of one node; along such a run the
+//! node pair is the same (one coupling, one reach, the last's), the slot of `(row, t + j)` is
+//! that of `(row, t)` plus `j` and its mirror's plus `j` times the width of the column's block.
+//! The construction triplet by triplet stays as the tests' reference (`shape_reference`).
 
 use super::border::Border;
 use super::fused::Run;
@@ -29,6 +35,7 @@ pub(crate) const SKIP: u32 = u32::MAX;
 pub(crate) const FIRST: u32 = 1 << 31;
 
 /// The structure of the tree KKT matrix.
+#[cfg_attr(test, derive(Debug, PartialEq))]
 pub(crate) struct Shape {
     /// Coordinates `n` and rows.
     pub(crate) n: usize,
@@ -117,10 +124,15 @@ impl Shape {
         for &(a, b) in &hess.keys {
             couple(body_node[a], body_node[b]);
         }
+        // A triplet on the row and body of the one before it adds the same pair (the lists are
+        // sorted and deduplicated below): the rows' runs of 7 columns are read once.
+        let mut last = (usize::MAX, usize::MAX);
         for e in entries {
-            if row_pos[e.0] != u32::MAX {
-                couple(owner[n + row_pos[e.0] as usize], body_node[e.1 / 7]);
+            let key = (e.0, e.1 / 7);
+            if key != last && row_pos[e.0] != u32::MAX {
+                couple(owner[n + row_pos[e.0] as usize], body_node[key.1]);
             }
+            last = key;
         }
         let mut in_border = vec![false; nodes];
         let mut parent = vec![u32::MAX; nodes];
@@ -201,6 +213,32 @@ impl Shape {
                 node_of[t] = i as u32;
             }
         }
+        // The triplets by runs `first .. end`: a row's consecutive columns on one body whose 7
+        // coordinates lie in order at consecutive positions of one node (as the nodes list
+        // them; the triplets come so), where the slots of a run follow from its first.
+        let lined = |b: usize| {
+            let t = tpos[7 * b];
+            t < tree_len && (1..7).all(|k| tpos[7 * b + k] == t + k && node_of[t + k] == node_of[t])
+        };
+        let lined: Vec<bool> = (0..nb).map(lined).collect();
+        let mut runs: Vec<(usize, usize)> = Vec::with_capacity(entries.len() / 4 + 1);
+        let mut first = 0;
+        while first < entries.len() {
+            let (r, c) = (entries[first].0, entries[first].1);
+            let mut end = first + 1;
+            if lined[c / 7] {
+                let last = c - c % 7 + 6;
+                while end < entries.len()
+                    && entries[end].0 == r
+                    && entries[end].1 == c + (end - first)
+                    && entries[end].1 <= last
+                {
+                    end += 1;
+                }
+            }
+            runs.push((first, end));
+            first = end;
+        }
         // Coupling widths: the parent's leading unknowns reached.
         let mut w = vec![0usize; kept];
         let mut reach = |u1: usize, u2: usize| {
@@ -218,7 +256,10 @@ impl Shape {
         for &(a, b) in &hess.keys {
             reach(7 * a + 6, 7 * b + 6);
         }
-        for e in entries {
+        // Along a run the column's position grows and the nodes stay: its last triplet reaches
+        // furthest.
+        for &(_, end) in &runs {
+            let e = &entries[end - 1];
             if row_pos[e.0] != u32::MAX {
                 reach(n + row_pos[e.0] as usize, e.1);
             }
@@ -299,35 +340,48 @@ impl Shape {
             }
             block_slots.push(s);
         }
-        let mut jac_slots = Vec::with_capacity(entries.len());
-        for e in entries {
-            jac_slots.push(match row_pos[e.0] {
-                u32::MAX => [SKIP, SKIP],
-                k => {
-                    let r = n + k as usize;
-                    let (t1, t2) = (tpos[r], tpos[e.1]);
-                    if t1 < tree_len && t2 < tree_len {
-                        [tree_slot(t1, t2)?, tree_slot(t2, t1)?]
-                    } else {
-                        [locate(r, e.1)?, locate(e.1, r)?]
-                    }
+        if flat >= FIRST as usize {
+            return None;
+        }
+        // Each slot's first triplet flagged as it is listed (`reached`: the slots listed so
+        // far, the border's appended as they come).
+        let mut reached = vec![false; flat];
+        let mut jac_slots: Vec<[u32; 2]> = Vec::with_capacity(entries.len());
+        // Along a run in the tree, the next column's slot is the next one in the row's block,
+        // and its mirror's one row further in the column's block (`step`: the block's width),
+        // or both stay the mirror of a coupling ([`SKIP`]).
+        for &(first, end) in &runs {
+            let e = &entries[first];
+            let k = row_pos[e.0];
+            if k == u32::MAX {
+                jac_slots.extend(std::iter::repeat_n([SKIP, SKIP], end - first));
+                continue;
+            }
+            let r = n + k as usize;
+            let (t1, t2) = (tpos[r], tpos[e.1]);
+            if t1 < tree_len && t2 < tree_len {
+                let (a, b) = (node_of[t2] as usize, node_of[t1] as usize);
+                let step = if a == b { d[a] } else { w[a] } as u32;
+                let [s1, s2] = [tree_slot(t1, t2)?, tree_slot(t2, t1)?];
+                for j in 0..(end - first) as u32 {
+                    let at = |s: u32, by: u32| if s == SKIP { SKIP } else { s + j * by };
+                    let (a, b) = (at(s1, 1), at(s2, step));
+                    jac_slots.push([flag_first(&mut reached, a), flag_first(&mut reached, b)]);
                 }
-            });
+            } else {
+                for e in &entries[first..end] {
+                    let (a, b) = (locate(r, e.1)?, locate(e.1, r)?);
+                    jac_slots.push([flag_first(&mut reached, a), flag_first(&mut reached, b)]);
+                }
+            }
         }
         let diag_slots = (0..n).map(|c| locate(c, c)).collect::<Option<Vec<_>>>()?;
         let total = flat + border_slot.len();
         if total >= FIRST as usize {
             return None;
         }
-        // Flag each slot's first triplet; list the diagonal slots no block reaches.
-        let mut reached = vec![false; total];
-        for slots in &mut jac_slots {
-            for slot in slots.iter_mut().filter(|s| **s != SKIP) {
-                if !std::mem::replace(&mut reached[*slot as usize], true) {
-                    *slot |= FIRST;
-                }
-            }
-        }
+        // The diagonal slots no block reaches.
+        reached.resize(total, false);
         for s in block_slots.iter().flatten().filter(|&&s| s != SKIP) {
             reached[*s as usize] = true;
         }
@@ -355,5 +409,23 @@ impl Shape {
             diag_slots,
             bare_diag,
         })
+    }
+}
+
+/// `slot`, flagged [`FIRST`] if no triplet before reached it (`reached`, grown to the border's
+/// slots as they come); [`SKIP`] as it is.
+#[inline]
+fn flag_first(reached: &mut Vec<bool>, slot: u32) -> u32 {
+    if slot == SKIP {
+        return SKIP;
+    }
+    let i = slot as usize;
+    if i >= reached.len() {
+        reached.resize(i + 1, false);
+    }
+    if std::mem::replace(&mut reached[i], true) {
+        slot
+    } else {
+        slot | FIRST
     }
 }

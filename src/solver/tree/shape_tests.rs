@@ -1,0 +1,91 @@
+//! The KKT structure built by runs (`Shape::new`) against the one built entry by entry
+//! (`shape_reference`): every field equal (nodes, parents, widths, slots, border) on chains,
+//! a chain with locks (extra rows on bodies), a branched tree, a rope, loops (a spatial
+//! four-bar and a short ladder: the border) and a long ladder (super-nodes).
+use super::shape::Shape;
+use super::shape_reference::reference;
+use crate::constraints::Constraints;
+use crate::model::{JointId, Model};
+use crate::solver::system::{Backend, System};
+use crate::urdf::{load_file, load_str, ImportOptions};
+
+/// Joint locks `(joint, coordinate, value)`.
+type Locks = Vec<(JointId, usize, f64)>;
+
+fn from_text(text: &str) -> Model {
+    load_str(text, "shape.urdf", &ImportOptions::default())
+        .expect("model loads")
+        .model
+}
+
+/// The structure of `model` (with `locks`) at its assembled point, by both constructions;
+/// returns the border size and the node count.
+fn compare(name: &str, model: &Model, locks: &[(JointId, usize, f64)]) -> (usize, usize) {
+    let q0 = crate::solver::initial_state(model).q;
+    let q =
+        crate::solver::assemble_only(model, q0, &mut Default::default(), &[]).expect("assembles");
+    let mut sys = System::new(model, Constraints::new(model, locks), Backend::Tree);
+    let part = sys.partition(&q);
+    let eval = sys.evaluate(&q, &part).expect("evaluates");
+    sys.kkt_blocks(&q, &part, &eval);
+    let (m, n) = (sys.problem.cons.len(), q.len());
+    let (entries, hess) = (&sys.work.jac.entries, &sys.work.hess);
+    let fast = Shape::new(&part, m, n, entries, hess);
+    let slow = reference(&part, m, n, entries, hess);
+    assert_eq!(fast.is_some(), slow.is_some(), "{name}: fits");
+    let (Some(fast), Some(slow)) = (fast, slow) else {
+        panic!("{name}: no tree structure");
+    };
+    assert_eq!(fast, slow, "{name}");
+    (fast.border.size(), fast.at.len())
+}
+
+#[test]
+fn shape_by_runs_equals_the_shape_entry_by_entry() {
+    let solo12 = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/robots/solo12/solo12_ground.urdf"
+    );
+    let solo12 = load_file(solo12, &ImportOptions::default())
+        .expect("solo12 loads")
+        .model;
+    let cases: Vec<(&str, Model, Locks)> = vec![
+        (
+            "chain",
+            from_text(&crate::generate::chain(40, false)),
+            vec![],
+        ),
+        (
+            "planar chain",
+            from_text(&crate::generate::chain(15, true)),
+            vec![],
+        ),
+        (
+            "chain with locks",
+            from_text(&crate::generate::chain(9, false)),
+            vec![(JointId(2), 0, 0.2), (JointId(6), 0, -0.1)],
+        ),
+        ("solo12", solo12, vec![]),
+        ("rope", from_text(&crate::generate::rope(20)), vec![]),
+        (
+            "four-bar",
+            from_text(include_str!("../../../robots/four_bar_spatial.urdf")),
+            vec![],
+        ),
+        ("ladder", from_text(&crate::generate::ladder(3)), vec![]),
+        (
+            "long ladder",
+            from_text(&crate::generate::ladder(30)),
+            vec![],
+        ),
+    ];
+    for (name, model, locks) in cases {
+        let (border, nodes) = compare(name, &model, &locks);
+        let loops = matches!(name, "four-bar" | "ladder");
+        assert_eq!(border > 0, loops, "{name}: border {border}");
+        // The long ladder's loops merge bodies into super-nodes: fewer nodes than bodies.
+        if name == "long ladder" {
+            assert!(nodes < model.bodies.len(), "{name}: {nodes} nodes");
+        }
+    }
+}

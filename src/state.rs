@@ -12,7 +12,7 @@
 
 use crate::jet::pair_of;
 use crate::joint::TreeMotion;
-use crate::kinematics::{coordinate, motion, Branches};
+use crate::kinematics::{coordinate_value, motion, Branches};
 use crate::math::{euler_parameters, unit_quaternion};
 use crate::model::{BodyId, JointId, Model};
 use nalgebra::{DVector, Isometry3, Translation3, Vector4};
@@ -220,8 +220,9 @@ impl State {
         let pair = pair_of(&j.bodies, &self.q, false);
         let n = j.kind.scalar_coordinates();
         if n > 0 {
+            // The values alone: bit for bit the coordinates' jets' values.
             (0..n)
-                .map(|d| coordinate(j, &pair, d, self.branches.get(id, d)).map_or(0.0, |s| s.v))
+                .map(|d| coordinate_value(j, &pair, d, self.branches.get(id, d)).unwrap_or(0.0))
                 .collect()
         } else {
             let pose = |k: usize| match j.bodies[k] {

@@ -39,6 +39,8 @@ mod lexicographic;
 mod model_rows;
 mod pose;
 mod rank;
+mod rank_block;
+mod rank_rows;
 mod reduced;
 mod run;
 mod unilateral;

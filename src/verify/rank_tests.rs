@@ -225,3 +225,81 @@ fn same_partition_as_the_sparse_partition() {
         }
     }
 }
+
+/// The rows expanded in one pass (module `rank_rows`) against a plain reference on triplets
+/// with duplicates, zeros, a sum that cancels, rows on one body, on two and empty: the same
+/// entries (as sets; their order is not read), maxima, bodies, rows touching each body, and
+/// reach; out-of-order or out-of-range triplets give `None`.
+#[test]
+fn rows_expanded_as_the_partition_builds_them() {
+    use super::super::rank_rows::Rows;
+    let (m, n) = (6, 21);
+    let t = vec![
+        (0, 3, 2.0),
+        (0, 1, 0.0),
+        (0, 3, -0.5),
+        (0, 5, 1.0),
+        (1, 2, 1.0),
+        (1, 9, -4.0),
+        (1, 2, -1.0),
+        (1, 3, 0.25),
+        (2, 15, 3.0),
+        (2, 0, 0.0),
+        (2, 8, 0.5),
+        (2, 16, -7.0),
+        (4, 0, 0.0),
+        (4, 14, 0.0),
+        (4, 14, 2.0),
+        (5, 20, 1e-300),
+        (5, 1, 1.0),
+    ];
+    let row_scale = [1.0, 2.0, 0.5, 1.0, 3.0, 1.0];
+    let scale: Vec<f64> = (0..n).map(|c| 1.0 + 0.125 * c as f64).collect();
+    let rows = Rows::new(m, n, &t, &row_scale, &scale).unwrap();
+    for r in 0..m {
+        // Reference: sums in triplet order, zeros dropped.
+        let mut sums: Vec<(usize, f64)> = Vec::new();
+        for &(_, c, v) in t.iter().filter(|e| e.0 == r) {
+            let a = v * row_scale[r] * scale[c];
+            match sums.iter_mut().find(|e| e.0 == c) {
+                Some(e) => e.1 += a,
+                None => sums.push((c, a)),
+            }
+        }
+        sums.retain(|e| e.1 != 0.0);
+        let mut got = rows.row(r).to_vec();
+        got.sort_by_key(|e| e.0);
+        sums.sort_by_key(|e| e.0);
+        assert_eq!(got, sums, "row {r}");
+        let max = sums.iter().fold(0.0f64, |a, e| a.max(e.1.abs()));
+        assert_eq!(rows.rmax[r], max, "row {r}");
+        let mut bodies: Vec<usize> = sums.iter().map(|e| e.0 / 7).collect();
+        bodies.dedup();
+        let one = bodies.len() == 1;
+        assert_eq!(rows.own_of[r], if one { bodies[0] } else { usize::MAX });
+        if one {
+            for kind in 0..2 {
+                let reach = sums
+                    .iter()
+                    .filter(|e| usize::from(e.0 % 7 >= 3) == kind)
+                    .fold(0.0f64, |a, e| a.max(e.1.abs()));
+                assert_eq!(rows.reach[r][kind], reach, "row {r}");
+            }
+        }
+    }
+    // Row 1's column 2 cancels (its column 3 keeps it on body 0); row 2's zero on body 0
+    // does not touch it, and its two runs on body 2 count once; row 4's only nonzero entry
+    // is on body 2.
+    let mut touching = Vec::new();
+    for (b, want) in [(0, vec![0, 1, 5]), (1, vec![1, 2]), (2, vec![2, 4, 5])] {
+        rows.touching(b, &mut touching);
+        assert_eq!(touching, want, "body {b}");
+    }
+    let mut swapped = t.clone();
+    swapped.swap(3, 4);
+    assert!(Rows::new(m, n, &swapped, &row_scale, &scale).is_none());
+    let mut outside = t.clone();
+    outside[2].1 = n;
+    assert!(Rows::new(m, n, &outside, &row_scale, &scale).is_none());
+    assert!(Rows::new(m - 1, n, &t, &row_scale, &scale).is_none());
+}

@@ -353,6 +353,30 @@ pub(crate) trait HessianSink {
     ) {
         self.add_block(bodies, &euler_to_local(hp), c);
     }
+    /// Adds `c h` for a local Hessian `h` symmetric to the last bit (`h[(i, j)]` and
+    /// `h[(j, i)]` the same number, as the augmentation's sums: a sink may read either, see
+    /// [`add_symmetric_part`]). By default [`HessianSink::add_block`].
+    fn add_symmetric_block(
+        &mut self,
+        bodies: &[Option<crate::model::BodyId>; 2],
+        h: &LMat,
+        c: f64,
+    ) {
+        self.add_block(bodies, h, c);
+    }
+}
+
+/// `blk[7 i + j] += c h[(7 sa + i, 7 sb + j)]` for the sides `(sa, sb)` of a local Hessian `h`
+/// symmetric to the last bit, read as `h[(7 sb + j, 7 sa + i)]`: along `h`'s columns (as it
+/// is stored), so that both runs are contiguous. The same numbers as the row-wise read.
+pub(crate) fn add_symmetric_part(blk: &mut [f64; 49], h: &LMat, sa: usize, sb: usize, c: f64) {
+    let h = h.as_slice();
+    for (i, row) in blk.chunks_exact_mut(7).enumerate() {
+        let at = NL * (7 * sa + i) + 7 * sb;
+        for (x, &v) in row.iter_mut().zip(&h[at..at + 7]) {
+            *x += c * v;
+        }
+    }
 }
 
 /// The Euler-parameter coordinates of a body pair (local indices).

@@ -6,12 +6,14 @@
 //! `θ_a(q) − m θ_b(q) − c = 0`.
 
 pub(crate) mod joint;
+mod pair_sum;
 pub(crate) mod unilateral;
 
-use crate::jet::{pair_of, HessianSink, LMat, Scalar};
+use crate::jet::{closed, pair_of, HessianSink, Scalar};
 use crate::kinematics::{coordinate, Branches};
 use crate::model::{BodyId, JointId, Model};
 use nalgebra::{DMatrix, DVector};
+use pair_sum::PairSum;
 
 /// A sparse matrix in triplet (coordinate) form.
 #[derive(Clone, Debug, Default)]
@@ -355,43 +357,24 @@ impl Constraints {
         w: &DVector<f64>,
         h: &mut dyn HessianSink,
     ) {
-        let mut pending: Option<([Option<BodyId>; 2], LMat)> = None;
-        let flush = |p: &mut Option<([Option<BodyId>; 2], LMat)>, h: &mut dyn HessianSink| {
-            if let Some((bodies, acc)) = p.take() {
-                h.add_block(&bodies, &acc, 1.0);
-            }
-        };
+        let mut sum = PairSum::new();
         self.for_each_row(model, q, true, false, |row, term| match term {
             Term::Jet(bodies, s, c) => {
                 if w[row] != 0.0 {
-                    let same = pending.as_ref().is_some_and(|(b, _)| {
-                        b.iter()
-                            .map(|x| x.map(|y| y.0))
-                            .eq(bodies.iter().map(|x| x.map(|y| y.0)))
-                    });
-                    if !same {
-                        flush(&mut pending, h);
-                        pending = Some((*bodies, LMat::zeros()));
-                    }
-                    if let (Some((_, acc)), Some(sh)) = (pending.as_mut(), s.h.as_deref()) {
-                        *acc += sh * (c * w[row]);
+                    sum.of(bodies, h);
+                    if let Some(sh) = s.h.as_deref() {
+                        *sum.full() += sh * (c * w[row]);
                     }
                 }
             }
             Term::Closed(j, pair) => {
                 let ws = &w.as_slice()[row..row + joint::row_count(j)];
                 if ws.iter().any(|&x| x != 0.0) {
-                    let same = pending.as_ref().is_some_and(|(b, _)| {
-                        b.iter()
-                            .map(|x| x.map(|y| y.0))
-                            .eq(j.bodies.iter().map(|x| x.map(|y| y.0)))
-                    });
-                    if !same {
-                        flush(&mut pending, h);
-                        pending = Some((j.bodies, LMat::zeros()));
-                    }
-                    if let Some((_, acc)) = pending.as_mut() {
-                        crate::jet::closed::add_weighted_hessian(j, pair, ws, acc);
+                    match sum.of(&j.bodies, h) {
+                        Some(hp) if closed::euler::euler_only(j) => {
+                            closed::euler::add_weighted_hessian_euler(j, pair, ws, hp);
+                        }
+                        _ => closed::add_weighted_hessian(j, pair, ws, sum.full()),
                     }
                 }
             }
@@ -403,7 +386,7 @@ impl Constraints {
             }
             Term::Value(_) => {}
         });
-        flush(&mut pending, h);
+        sum.flush(h);
     }
 }
 

@@ -24,6 +24,7 @@ use crate::joint::{Row, V};
 use crate::math::{b_matrix, rotation};
 use crate::model::Joint;
 use nalgebra::{Matrix3, Matrix3x4, Matrix4, SMatrix, Vector3};
+pub(crate) mod euler;
 
 /// `Σ_k t_k r_k + A(p_k) s_k` with `B_k = B(p_k, s_k)`; `on[k]` whether side `k` enters.
 #[derive(Clone, Copy, Debug)]
@@ -250,9 +251,8 @@ pub(crate) fn dot_hessian(a: &Lin, b: &Lin, c: f64, h: &mut LMat) {
     linear_hessian(b, &(a.v * c), h);
 }
 
-/// [`dot_hessian`] into the Euler-parameter rows and columns of the pair
-/// ([`crate::jet::EULER`]), for two directions (`t = 0` on both sides: no `r` terms, so the
-/// full Hessian is zero elsewhere): the same entries, added in the same order.
+/// [`dot_hessian`] on the pair's Euler parameters ([`crate::jet::EULER`]) for two directions
+/// (`t = 0`: the full Hessian is zero elsewhere): the same entries, added in the same order.
 pub(crate) fn dot_hessian_euler(a: &Lin, b: &Lin, c: f64, h: &mut SMatrix<f64, 8, 8>) {
     if a.t != [0.0; 2] || b.t != [0.0; 2] {
         // Not two directions: the full Hessian, restricted.

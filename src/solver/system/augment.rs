@@ -10,7 +10,7 @@
 //! runs over the values.
 
 use super::System;
-use crate::jet::{HessianSink, LMat, NL};
+use crate::jet::{HessianSink, LMat, EULER, NL};
 use crate::model::BodyId;
 use crate::solver::partition::Partition;
 
@@ -132,9 +132,9 @@ impl System<'_> {
         for g in &plan.groups {
             let range = g.start..g.end;
             let group = &entries[range.clone()];
-            let rho = group.iter().fold(floor, |a, e| a.max(wdiag[e.1]))
-                * self.problem.scaling.rows[g.row].powi(2);
+            let row_scale = self.problem.scaling.rows[g.row].powi(2);
             let Some(bodies) = g.bodies else {
+                let rho = group.iter().fold(floor, |a, e| a.max(wdiag[e.1])) * row_scale;
                 for a in group {
                     for b in group {
                         sink.add_entry(a.1, b.1, rho * a.2 * b.2);
@@ -142,13 +142,18 @@ impl System<'_> {
                 }
                 continue;
             };
-            let mut gv = [0.0f64; NL];
+            // `ρ`'s reach and the row's local entries in one pass (the same maxima in the
+            // same order as the fold above).
+            let mut gv: Local = [0.0; 16];
+            let mut reach = floor;
             for (e, &i) in group.iter().zip(&plan.local[range]) {
-                gv[i as usize] += e.2;
+                reach = reach.max(wdiag[e.1]);
+                gv[usize::from(i) & 15] += e.2;
             }
+            let rho = reach * row_scale;
             if pending != Some(bodies) {
                 if let Some(b) = pending.take() {
-                    sink.add_block(&b, &acc, 1.0);
+                    sink.add_symmetric_block(&b, &acc, 1.0);
                 }
                 pending = Some(bodies);
                 acc.as_mut_slice().fill(0.0);
@@ -156,17 +161,44 @@ impl System<'_> {
             add_outer(&mut acc, &gv, rho);
         }
         if let Some(b) = pending.take() {
-            sink.add_block(&b, &acc, 1.0);
+            sink.add_symmetric_block(&b, &acc, 1.0);
         }
         work.augment = Some(plan);
         work.wdiag = wdiag;
     }
 }
 
+/// A row's entries in its pair's local order: 14 used, 16 so that a local index masked by
+/// 15 needs no bounds check.
+type Local = [f64; 16];
+
 /// `acc += g gᵀ ρ`, entry by entry as `(g_i g_j) ρ`, over the columns of `g`'s nonzero
-/// entries: a zero `g_i` adds a signed zero, which changes no sum.
-fn add_outer(acc: &mut LMat, g: &[f64; NL], rho: f64) {
+/// entries: a zero `g_i` adds a signed zero, which changes no sum (the sums start at `+0`, so
+/// they are never `−0`). A row on the Euler parameters alone (a dot product of two axes, a
+/// normalization) therefore adds over their rows only ([`EULER`]: the two runs `3..7`,
+/// `10..14`).
+///
+/// Entries `(i, j)` and `(j, i)` sum the same products `g_i g_j = g_j g_i` in the same order
+/// (the signed zeros aside), so the sum is symmetric to the last bit: the sink may read it
+/// either way ([`HessianSink::add_symmetric_block`]).
+fn add_outer(acc: &mut LMat, g: &Local, rho: f64) {
     let acc = acc.as_mut_slice();
+    let g = &g[..NL];
+    let euler_only = g[0..3].iter().chain(&g[7..10]).all(|&x| x == 0.0);
+    if euler_only {
+        for &j in &EULER {
+            let gj = g[j];
+            if gj != 0.0 {
+                for run in [3..7, 10..14] {
+                    let col = &mut acc[NL * j + run.start..NL * j + run.end];
+                    for (a, &gi) in col.iter_mut().zip(&g[run]) {
+                        *a += gi * gj * rho;
+                    }
+                }
+            }
+        }
+        return;
+    }
     for (j, &gj) in g.iter().enumerate() {
         if gj != 0.0 {
             let col = &mut acc[NL * j..NL * j + NL];

@@ -20,7 +20,7 @@
 
 use super::kkt::TreeKkt;
 use super::shape::SKIP;
-use crate::jet::{euler_to_local, HessianSink, LMat};
+use crate::jet::{add_symmetric_part, euler_to_local, HessianSink, LMat};
 use crate::model::BodyId;
 use nalgebra::SMatrix;
 
@@ -126,6 +126,20 @@ impl HessianSink for FusedSink<'_> {
                             blk[7 * i + j] += c * h[(7 * sa + i, 7 * sb + j)];
                         }
                     }
+                }
+            }
+        }
+    }
+
+    /// As [`HessianSink::add_block`], reading `h` along its columns
+    /// ([`crate::jet::add_symmetric_part`]).
+    fn add_symmetric_block(&mut self, bodies: &[Option<BodyId>; 2], h: &LMat, c: f64) {
+        for sa in 0..2 {
+            let Some(a) = bodies[sa] else { continue };
+            for sb in 0..2 {
+                let Some(b) = bodies[sb] else { continue };
+                if let Some(k) = self.block(a, b) {
+                    add_symmetric_part(&mut self.blocks[k], h, sa, sb, c);
                 }
             }
         }

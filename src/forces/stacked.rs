@@ -14,8 +14,8 @@
 //! formed over those 8 coordinates of the pair (not 14), and no term allocates.
 
 use crate::jet::closed::{linear_gradient, linear_hessian_euler, quadratic_form, Lin, Rotations};
-use crate::math::{b_matrix, rotation};
 use crate::jet::{HessianSink, LVec, Pair};
+use crate::math::{b_matrix, rotation};
 use crate::model::{BodyId, Joint};
 use nalgebra::{DVector, SMatrix, Vector3, Vector4};
 
@@ -89,7 +89,10 @@ pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair) -> Angle {
     let (a0, a1) = (rotation(p0), rotation(p1));
     let r0 = joint.body_from_joint[0].rotation.to_rotation_matrix();
     let r1 = joint.body_from_joint[1].rotation.to_rotation_matrix();
-    let (bx0, by0) = (r0.matrix().column(0).into_owned(), r0.matrix().column(1).into_owned());
+    let (bx0, by0) = (
+        r0.matrix().column(0).into_owned(),
+        r0.matrix().column(1).into_owned(),
+    );
     let bx1 = r1.matrix().column(0).into_owned();
     let (x0, y0, x1) = (a0 * bx0, a0 * by0, a1 * bx1);
     let (b0x, b0y, b1x) = (b_matrix(p0, &bx0), b_matrix(p0, &by0), b_matrix(p1, &bx1));

@@ -106,13 +106,15 @@ pub(crate) fn phi_u_runs(
 
 /// The KKT matrix's super-nodes for `part` (module doc): `(members, parent)`, each node's
 /// unknowns (coordinates `0 .. n`, rows `n + k`) in elimination order and its parent
-/// (`u32::MAX`: a root); `None` if a super-node exceeds [`MAX_NODE`] unknowns.
+/// (`u32::MAX`: a root); `None` if a super-node exceeds [`MAX_NODE`] unknowns. `by_runs`: a
+/// row's run of triplets on one body coupled once (else each triplet: the same nodes).
 pub(crate) fn kkt_nodes(
     part: &Partition,
     n: usize,
     row_pos: &[u32],
     entries: &[(usize, usize, f64)],
     keys: &[(usize, usize)],
+    by_runs: bool,
 ) -> Option<(Vec<Vec<usize>>, Vec<u32>)> {
     let nb = n / 7;
     let mut body_node = vec![u32::MAX; nb];
@@ -155,7 +157,7 @@ pub(crate) fn kkt_nodes(
     let mut last = (usize::MAX, usize::MAX);
     for e in entries {
         let key = (e.0, e.1 / 7);
-        if key != last && row_pos[e.0] != u32::MAX {
+        if (key != last || !by_runs) && row_pos[e.0] != u32::MAX {
             couple(row_node[row_pos[e.0] as usize], body_node[key.1]);
         }
         last = key;

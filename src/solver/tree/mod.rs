@@ -28,8 +28,6 @@ pub(crate) mod phi_u;
 mod segments;
 mod shape;
 #[cfg(test)]
-mod shape_reference;
-#[cfg(test)]
 mod shape_tests;
 #[cfg(test)]
 mod tests;

@@ -14,7 +14,7 @@
 //! columns, which lie at consecutive positions `t, t + 1, …` of one node; along such a run the
 //! node pair is the same (one coupling, one reach, the last's), the slot of `(row, t + j)` is
 //! that of `(row, t)` plus `j` and its mirror's plus `j` times the width of the column's block.
-//! The construction triplet by triplet stays as the tests' reference (`shape_reference`).
+//! The construction triplet by triplet (`Shape::build` with `by_runs` false) is the tests' reference.
 
 use super::border::Border;
 use super::fused::Run;
@@ -78,6 +78,19 @@ impl Shape {
         entries: &[(usize, usize, f64)],
         hess: &BlockHessian,
     ) -> Option<Self> {
+        Self::build(part, m, n, entries, hess, true)
+    }
+
+    /// [`Shape::new`], reading the triplets by runs (`by_runs`) or one by one: the same
+    /// structure either way (the runs only save work; `shape_tests` compares the two).
+    pub(crate) fn build(
+        part: &Partition,
+        m: usize,
+        n: usize,
+        entries: &[(usize, usize, f64)],
+        hess: &BlockHessian,
+        by_runs: bool,
+    ) -> Option<Self> {
         let rows = part.rows.len();
         let dim = n + rows;
         let nb = n / 7;
@@ -129,7 +142,7 @@ impl Shape {
         let mut last = (usize::MAX, usize::MAX);
         for e in entries {
             let key = (e.0, e.1 / 7);
-            if key != last && row_pos[e.0] != u32::MAX {
+            if (key != last || !by_runs) && row_pos[e.0] != u32::MAX {
                 couple(owner[n + row_pos[e.0] as usize], body_node[key.1]);
             }
             last = key;
@@ -170,7 +183,8 @@ impl Shape {
         if border_unknowns.len() > MAX_BORDER {
             // Too large for a dense Schur complement: the nodes a loop couples are merged into
             // super-nodes instead (module `merge`), and nothing is bordered.
-            (members, parent) = super::merge::kkt_nodes(part, n, &row_pos, entries, &hess.keys)?;
+            (members, parent) =
+                super::merge::kkt_nodes(part, n, &row_pos, entries, &hess.keys, by_runs)?;
             in_border = vec![false; members.len()];
             border_unknowns.clear();
         }
@@ -218,7 +232,9 @@ impl Shape {
         // them; the triplets come so), where the slots of a run follow from its first.
         let lined = |b: usize| {
             let t = tpos[7 * b];
-            t < tree_len && (1..7).all(|k| tpos[7 * b + k] == t + k && node_of[t + k] == node_of[t])
+            by_runs
+                && t < tree_len
+                && (1..7).all(|k| tpos[7 * b + k] == t + k && node_of[t + k] == node_of[t])
         };
         let lined: Vec<bool> = (0..nb).map(lined).collect();
         let mut runs: Vec<(usize, usize)> = Vec::with_capacity(entries.len() / 4 + 1);

@@ -1,9 +1,8 @@
 //! The KKT structure built by runs (`Shape::new`) against the one built entry by entry
-//! (`shape_reference`): every field equal (nodes, parents, widths, slots, border) on chains,
+//! (`Shape::build` with `by_runs` false: each triplet coupled and located on its own): every field equal (nodes, parents, widths, slots, border) on chains,
 //! a chain with locks (extra rows on bodies), a branched tree, a rope, loops (a spatial
 //! four-bar and a short ladder: the border) and a long ladder (super-nodes).
 use super::shape::Shape;
-use super::shape_reference::reference;
 use crate::constraints::Constraints;
 use crate::model::{JointId, Model};
 use crate::solver::system::{Backend, System};
@@ -31,7 +30,7 @@ fn compare(name: &str, model: &Model, locks: &[(JointId, usize, f64)]) -> (usize
     let (m, n) = (sys.problem.cons.len(), q.len());
     let (entries, hess) = (&sys.work.jac.entries, &sys.work.hess);
     let fast = Shape::new(&part, m, n, entries, hess);
-    let slow = reference(&part, m, n, entries, hess);
+    let slow = Shape::build(&part, m, n, entries, hess, false);
     assert_eq!(fast.is_some(), slow.is_some(), "{name}: fits");
     let (Some(fast), Some(slow)) = (fast, slow) else {
         panic!("{name}: no tree structure");

@@ -5,6 +5,7 @@
 
 use crate::constraints::{Constraints, Triplets};
 use crate::error::{Error, Result};
+use crate::forces::Energy;
 use crate::model::Model;
 use crate::solver::system::System;
 use crate::state::State;
@@ -33,7 +34,7 @@ pub(crate) fn guard_system_energy(
     sys: &mut System,
     state: &State,
     at: &str,
-) -> Result<Option<(f64, DVector<f64>)>> {
+) -> Result<Option<(Energy, DVector<f64>)>> {
     let model = sys.problem.model;
     finite_coordinates(model, state, at)?;
     sys.triplets(&state.q);
@@ -47,7 +48,7 @@ pub(crate) fn guard_values_energy(
     sys: &System,
     state: &State,
     at: &str,
-) -> Result<Option<(f64, DVector<f64>)>> {
+) -> Result<Option<(Energy, DVector<f64>)>> {
     let model = sys.problem.model;
     finite_coordinates(model, state, at)?;
     finite_rows(
@@ -92,12 +93,12 @@ fn finite_rows(
 
 /// `V(q)` and `∇V(q)` finite: what it evaluated (`None` where a force-table term is undefined
 /// at `state`: that error has its own message, raised by the caller's checks).
-fn finite_energy(model: &Model, state: &State, at: &str) -> Result<Option<(f64, DVector<f64>)>> {
+fn finite_energy(model: &Model, state: &State, at: &str) -> Result<Option<(Energy, DVector<f64>)>> {
     let q = &state.q;
     let mut g = DVector::zeros(q.len());
     let Some(e) = crate::forces::potential(model, &state.branches, q, &mut g, None) else {
         return Ok(None);
     };
     crate::forces::finite::check(model, &state.branches, q, e.total, &g, at)?;
-    Ok(Some((e.total, g)))
+    Ok(Some((e, g)))
 }

@@ -345,13 +345,12 @@ fn solve_once(
         at: "the given pose".into(),
         rows,
     };
-    // The model's rows from the balance check where they are this system's first ones.
-    if let Some(rows) = given {
-        rows.install(&mut sys, &state.q);
-    }
+    // The model's rows from the balance check where they are this system's first ones, and
+    // with them the guard's `V` and `∇V` (the same pose and branches).
+    let known = given.and_then(|rows| rows.install(&mut sys, &state.q));
     let part = super::rank::partition(&mut sys, &state.q);
     let mut eval = sys
-        .evaluate(&state.q, &part)
+        .evaluate_knowing(&state.q, &part, known)
         .ok_or_else(|| singular(part.rows.len()))?;
     if let Some(c) = carried {
         // The multipliers and the reduced gradient are linear in ∇V: with `c` taken off it,

@@ -1,4 +1,4 @@
-//! The model's rows evaluated once for the balance check and the forces.
+//! The model's rows and the energy evaluated once for the balance check and the forces.
 //!
 //! The balance check (module `reduced`) evaluates `Φ` and the triplets of `Φ_q` of the model's
 //! rows `Constraints::new(model, locks)` at the pose. The locked system of module `held` is
@@ -8,9 +8,12 @@
 //! alone, so the locked system's values and triplets are the balance check's followed by those
 //! of its last blocks: only those are evaluated again ([`ModelRows::install`]), and every
 //! number is the one a full evaluation gives (the same operations on the same inputs, in the
-//! same order; the triplets in the same order).
+//! same order; the triplets in the same order). The energy `V` and its gradient `∇V`, which
+//! depend on the pose alone, are the finiteness guard's (module `reduced`), taken by the
+//! locked system's evaluation instead of evaluating them again.
 
 use crate::constraints::{Constraints, Triplets};
+use crate::forces::Energy;
 use crate::solver::system::System;
 use nalgebra::DVector;
 
@@ -25,13 +28,21 @@ pub(super) struct ModelRows {
     shapes: Vec<BlockShape>,
     /// The configuration the rows were evaluated at.
     at: DVector<f64>,
+    /// `V` and `∇V` at `at` on the same branches (the guard's).
+    potential: (Energy, DVector<f64>),
 }
 
 impl ModelRows {
     /// The rows `sys` last evaluated at `q`, taken from it (`None` if it has not evaluated
     /// them there, or with mimics, whose rows follow the locks), with room in the triplets
-    /// for `extra` more rows on two bodies (in place where module `reduced` reserved it).
-    pub(super) fn take(sys: &mut System, q: &DVector<f64>, extra: usize) -> Option<Self> {
+    /// for `extra` more rows on two bodies (in place where module `reduced` reserved it), and
+    /// `V` and `∇V` at `q` on the branches of `sys` (`potential`).
+    pub(super) fn take(
+        sys: &mut System,
+        q: &DVector<f64>,
+        extra: usize,
+        potential: (Energy, DVector<f64>),
+    ) -> Option<Self> {
         let w = &mut sys.work;
         if !w.jac_fresh || w.jac_at != *q || !sys.problem.model.mimics.is_empty() {
             return None;
@@ -54,6 +65,7 @@ impl ModelRows {
                 .map(|b| (std::mem::discriminant(&b.kind), b.first))
                 .collect(),
             at: q.clone(),
+            potential,
         })
     }
 
@@ -71,12 +83,17 @@ impl ModelRows {
     }
 
     /// Puts the rows of `sys` at `q` into its workspace, as `System::triplets` would: these
-    /// rows, then the evaluation of its blocks after them. Evaluates them all where `sys` does
-    /// not start with these rows' blocks.
-    pub(super) fn install(self, sys: &mut System, q: &DVector<f64>) {
+    /// rows, then the evaluation of its blocks after them; returns `V` and `∇V` at `q`, for
+    /// `System::evaluate_knowing` (a system on the same branches). Evaluates them all where
+    /// `sys` does not start with these rows' blocks (and returns `None`).
+    pub(super) fn install(
+        self,
+        sys: &mut System,
+        q: &DVector<f64>,
+    ) -> Option<(Energy, DVector<f64>)> {
         if !self.fits(&sys.problem.cons, q) {
             sys.triplets(q);
-            return;
+            return None;
         }
         let model = sys.problem.model;
         let mut tail = sys.problem.cons.clone();
@@ -97,6 +114,7 @@ impl ModelRows {
         w.phi = phi;
         w.jac_at = self.at;
         w.jac_fresh = true;
+        Some(self.potential)
     }
 }
 
@@ -138,14 +156,28 @@ mod tests {
                 let system = |rows: &[_]| {
                     System::new(&model, Constraints::new(&model, rows), Backend::Sparse)
                 };
+                let mut g = DVector::zeros(state.q.len());
+                let energy =
+                    crate::forces::potential(&model, &state.branches, &state.q, &mut g, None)
+                        .unwrap();
                 let mut balance = system(&locks);
                 balance.triplets(&state.q);
-                let rows = ModelRows::take(&mut balance, &state.q, coords.len()).unwrap();
+                let rows =
+                    ModelRows::take(&mut balance, &state.q, coords.len(), (energy, g.clone()))
+                        .unwrap();
                 let mut own = system(&all);
                 own.triplets(&state.q);
                 let mut installed = system(&all);
-                rows.install(&mut installed, &state.q);
+                let known = rows.install(&mut installed, &state.q);
                 assert!(installed.work.jac_fresh);
+                // The evaluation with the given `V`, `∇V` is the one that evaluates them.
+                let part = own.partition(&state.q);
+                let evaluated = own.evaluate(&state.q, &part).unwrap();
+                let given = installed.evaluate_knowing(&state.q, &part, known).unwrap();
+                assert_eq!(evaluated.energy, given.energy, "{}", model.name);
+                assert_eq!(evaluated.mu, given.mu, "{}", model.name);
+                assert_eq!(evaluated.grad_v, given.grad_v, "{}", model.name);
+                assert_eq!(evaluated.merit, given.merit, "{}", model.name);
                 assert_eq!(own.work.jac.entries, installed.work.jac.entries);
                 assert_eq!(own.work.jac.rows, installed.work.jac.rows);
                 assert_eq!(own.work.phi, installed.work.phi, "{}", model.name);
@@ -158,9 +190,9 @@ mod tests {
                 // The locked system's rows do not start the balance check's: not used.
                 let mut locked = system(&all);
                 locked.triplets(&state.q);
-                let rows = ModelRows::take(&mut locked, &state.q, 0).unwrap();
+                let rows = ModelRows::take(&mut locked, &state.q, 0, (energy, g)).unwrap();
                 let mut other = system(&locks);
-                rows.install(&mut other, &state.q);
+                assert!(rows.install(&mut other, &state.q).is_none());
                 let mut fresh = system(&locks);
                 fresh.triplets(&state.q);
                 assert_eq!(other.work.jac.entries, fresh.work.jac.entries);
@@ -182,6 +214,7 @@ mod tests {
             Backend::Sparse,
         );
         sys.triplets(&state.q);
-        assert!(ModelRows::take(&mut sys, &state.q, 0).is_none());
+        let potential = (Default::default(), DVector::zeros(state.q.len()));
+        assert!(ModelRows::take(&mut sys, &state.q, 0, potential).is_none());
     }
 }

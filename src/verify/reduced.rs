@@ -12,10 +12,13 @@
 //! The partition and evaluation are kept for the stability verdict. Where neither the
 //! projected gradient nor the verdict is asked (`analyze`'s self-check, which judges the pose
 //! by its residual and the forces of module `held`), the rows and the energy are evaluated
-//! without a partition.
+//! without a partition. The energy and its gradient are evaluated once, by the finiteness
+//! guard: the evaluation of the partition and the forces' locked system take them
+//! (`System::evaluate_knowing`).
 
 use crate::constraints::Constraints;
 use crate::error::{Error, Result};
+use crate::forces::Energy;
 use crate::model::{JointId, Model};
 use crate::solver::partition::Partition;
 use crate::solver::system::{coordinate_scale, Backend, Eval, System};
@@ -38,6 +41,9 @@ pub(super) struct Reduced<'a> {
     /// partitioned): what the stability verdict needs too.
     pub(super) sys: System<'a>,
     pub(super) solved: Option<(Partition, Eval)>,
+    /// `V(q)` and `∇V(q)`, evaluated once by the finiteness guard: the evaluation of this
+    /// system's partition and the forces' locked system (module `model_rows`) take them.
+    pub(super) potential: (Energy, DVector<f64>),
 }
 
 /// Partitions and evaluates the rows of `model` plus its `locks` at `q` on the sparse path
@@ -93,17 +99,18 @@ pub(super) fn reduced<'a>(
     if !partition {
         return Ok(Reduced {
             phi: sys.phi().clone(),
-            energy: guard_energy,
+            energy: guard_energy.total,
             reduced_gradient: f64::NAN,
             force_scale,
             dof: 0,
             sys,
             solved: None,
+            potential: (guard_energy, g),
         });
     }
     let part = super::rank::partition(&mut sys, q);
     let eval = sys
-        .evaluate(q, &part)
+        .evaluate_knowing(q, &part, Some((guard_energy, g.clone())))
         .ok_or_else(|| Error::SingularPartition {
             at: "the given pose".into(),
             rows: part.rows.len(),
@@ -116,5 +123,6 @@ pub(super) fn reduced<'a>(
         dof: part.independent.len(),
         sys,
         solved: Some((part, eval)),
+        potential: (guard_energy, g),
     })
 }

@@ -90,6 +90,7 @@ pub(super) fn verify_on(
                 force_scale,
                 mut sys,
                 solved,
+                potential,
                 ..
             } = r;
             let assembled = scaled <= tol.constraint;
@@ -118,7 +119,7 @@ pub(super) fn verify_on(
                 _ => None,
             };
             sys.work.kkt = None;
-            let given = held::ModelRows::take(&mut sys, &state.q, values.len());
+            let given = held::ModelRows::take(&mut sys, &state.q, values.len(), potential);
             drop(sys);
             let held = held::held(
                 model,

@@ -144,7 +144,8 @@ fn held_from_the_balance_checks_system_is_held_from_its_own() {
             // Without the first solve (`analyze`'s self-check): the same numbers (a zero
             // added or not: `==` takes −0 for 0).
             let skipped = held(super::held::Free::Skip, None);
-            let rows = super::held::ModelRows::take(&mut r.sys, &state.q, values.len());
+            let potential = r.potential.clone();
+            let rows = super::held::ModelRows::take(&mut r.sys, &state.q, values.len(), potential);
             assert!(rows.is_some(), "{}: the balance check's rows", model.name);
             let reused = held(super::held::Free::Skip, rows);
             for other in [&given, &skipped, &reused] {

@@ -31,15 +31,33 @@ impl System<'_> {
     /// Energy, multipliers and reduced gradient at a feasible `q`; `None` where the energy is
     /// undefined or `Φ_u` is singular.
     pub(crate) fn evaluate(&mut self, q: &DVector<f64>, part: &Partition) -> Option<Eval> {
+        self.evaluate_knowing(q, part, None)
+    }
+
+    /// [`System::evaluate`] with `V(q)` and `∇V(q)` given where the caller has evaluated them
+    /// already (`forces::potential` at `q` on this system's branches: `verify`'s finiteness
+    /// guard), instead of evaluating them again: the same numbers.
+    pub(crate) fn evaluate_knowing(
+        &mut self,
+        q: &DVector<f64>,
+        part: &Partition,
+        known: Option<(Energy, DVector<f64>)>,
+    ) -> Option<Eval> {
         self.triplets(q);
-        let mut grad_q = DVector::zeros(q.len());
-        let energy = potential(
-            self.problem.model,
-            &self.problem.cons.branches,
-            q,
-            &mut grad_q,
-            None,
-        )?;
+        let (energy, grad_q) = match known {
+            Some(known) => known,
+            None => {
+                let mut grad_q = DVector::zeros(q.len());
+                let energy = potential(
+                    self.problem.model,
+                    &self.problem.cons.branches,
+                    q,
+                    &mut grad_q,
+                    None,
+                )?;
+                (energy, grad_q)
+            }
+        };
         let dof = part.independent.len();
         let factors = self.factors(part)?;
         let v_u = DVector::from_iterator(

@@ -117,3 +117,45 @@ fn weighted_points_equal_the_jets_and_finite_differences() {
         }
     }
 }
+
+/// A component row's gradient read off `t_k I` and `B_k` equals [`linear_gradient`] of the
+/// unit vector bit for bit (a zero's sign included), on a point difference and on directions
+/// of either side, at poses where some entries of `B_k` are exact zeros (the identity, a
+/// quarter turn) and at general ones.
+#[test]
+fn component_gradient_is_linear_gradient_bit_for_bit() {
+    let mut pairs: Vec<Pair> = (0..6).map(sample_pair).collect();
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    for p in [
+        nalgebra::Vector4::new(1.0, 0.0, 0.0, 0.0),
+        nalgebra::Vector4::new(h, 0.0, 0.0, -h),
+    ] {
+        let mut pair = sample_pair(9);
+        pair.p = [p, nalgebra::Vector4::new(0.0, -1.0, 0.0, 0.0)];
+        pairs.push(pair);
+    }
+    let mut zeros = 0;
+    for (n, q) in pairs.iter().enumerate() {
+        for a in vectors(q).1 {
+            zeros +=
+                a.b.iter()
+                    .flat_map(|b| b.iter())
+                    .filter(|x| **x == 0.0)
+                    .count();
+            for m in 0..3 {
+                let mut general = LVec::zeros();
+                linear_gradient(&a, &Vector3::ith(m, 1.0), &mut general);
+                let mut read = LVec::zeros();
+                component_gradient(&a, m, &mut read);
+                for i in 0..crate::jet::NL {
+                    assert_eq!(
+                        general[i].to_bits(),
+                        read[i].to_bits(),
+                        "pair {n} m {m} [{i}]"
+                    );
+                }
+            }
+        }
+    }
+    assert!(zeros > 0);
+}

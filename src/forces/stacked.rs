@@ -12,6 +12,12 @@
 //! regrouped (see [`revolute_angle`]; equal to rounding), and a spring `U(θ)` adds
 //! `U'' ∇θ ∇θᵀ + U' ∇²θ`; but `θ` depends on the Euler parameters only, so its Hessian is
 //! formed over those 8 coordinates of the pair (not 14), and no term allocates.
+//!
+//! Where no Hessian is asked for (every evaluation of the line search and of the reduced
+//! gradient), the same terms give their value and gradient alone: `θ` and
+//! `∇θ = (C ∇S − S ∇C) / ρ` by the first half of [`revolute_angle`]
+//! ([`revolute_angle_gradient`]), a weighted point by its side 0 alone
+//! ([`weighted_point_gradient`]); both to the last bit the generic path's.
 
 use crate::jet::closed::{linear_gradient, linear_hessian_euler, quadratic_form, Lin, Rotations};
 use crate::jet::{HessianSink, LVec, Pair};
@@ -56,7 +62,7 @@ pub(crate) fn scatter_gradient(
 }
 
 /// `wᵀ (r_k + A(p_k) s)` of side `k` with its gradient into `grad` and Hessian into `hess`
-/// (as [`crate::jet::closed::weighted_point`] and [`crate::jet::scatter`] with `c = 1`);
+/// (as the general `closed::weighted_point` and [`crate::jet::scatter`] with `c = 1`);
 /// returns the value.
 pub(crate) fn weighted_point(
     bodies: &[Option<BodyId>; 2],
@@ -77,7 +83,7 @@ pub(crate) fn weighted_point(
 }
 
 /// `wᵀ (r₀ + A(p₀) s)` of side 0 (the one `body`) with its gradient added into `grad`, without
-/// the Hessian: [`crate::jet::closed::weighted_point`] and [`crate::jet::scatter`] with `c = 1`
+/// the Hessian: the general `closed::weighted_point` and [`crate::jet::scatter`] with `c = 1`
 /// to the last bit (the same operations on side 0; nothing formed for the empty side 1);
 /// returns the value.
 pub(crate) fn weighted_point_gradient(
@@ -345,7 +351,7 @@ mod tests {
             // Weighted point.
             let one = [Some(BodyId(1)), None];
             let (s, w) = (Vector3::new(0.3, -0.1, 0.25), Vector3::new(1.0, -2.0, 9.81));
-            let boxed = crate::jet::closed::weighted_point(&pair, 0, &s, &w);
+            let boxed = crate::jet::closed::tests::weighted_point(&pair, 0, &s, &w);
             assert!(hess_or_zero(&boxed.h).amax() > 0.0);
             let (g0, h0) = hessian_of(|g, h| {
                 crate::jet::scatter(&one, &boxed, 1.0, g, Some(h as &mut dyn HessianSink));
@@ -387,7 +393,7 @@ mod tests {
             }
             let (s, w) = (Vector3::new(0.3, -0.1, 0.25), Vector3::new(1.0, -2.0, 9.81));
             let body = [Some(BodyId(2)), None];
-            let boxed = crate::jet::closed::weighted_point(&pair, 0, &s, &w);
+            let boxed = crate::jet::closed::tests::weighted_point(&pair, 0, &s, &w);
             let mut g0 = DVector::zeros(21);
             crate::jet::scatter(&body, &boxed, 1.0, &mut g0, None);
             let mut g1 = DVector::zeros(21);

@@ -371,16 +371,6 @@ pub(crate) fn supports(joint: &Joint) -> bool {
     layout(joint).is_some()
 }
 
-/// Values and gradients of the rows of `joint` into `out` (cleared first; no Hessians): those
-/// of [`rows_each`].
-#[cfg(test)]
-pub(crate) fn rows(joint: &Joint, pair: &Pair, out: &mut Vec<Scalar>) {
-    out.clear();
-    rows_each(joint, pair, |_, v, g| {
-        out.push(Scalar { v, g: *g, h: None })
-    });
-}
-
 /// Values and gradients of the rows of `joint` (no Hessians), handed to `emit(k, Φ_k, ∇Φ_k)`
 /// in row order: nothing collected, nothing copied.
 #[inline(always)]
@@ -503,26 +493,6 @@ pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair) -> Scalar {
         }
     };
     pair.atan2(&scalar(&y0, &x1), &scalar(&x0, &x1))
-}
-
-/// The weighted point `wᵀ (r_k + A(p_k) s)` of side `k` (gravity, dead loads), with the
-/// Hessian when `pair.hess`: the reference of the tests of `forces::stacked`.
-#[cfg(test)]
-pub(crate) fn weighted_point(pair: &Pair, k: usize, s: &Vector3<f64>, w: &Vector3<f64>) -> Scalar {
-    let rot = Rotations::of(pair);
-    let p = Lin::point(pair, &rot, k, s);
-    let mut g = LVec::zeros();
-    linear_gradient(&p, w, &mut g);
-    let h = pair.hess.then(|| {
-        let mut h = Box::new(LMat::zeros());
-        linear_hessian(&p, w, &mut h);
-        h
-    });
-    Scalar {
-        v: w.dot(&p.v),
-        g,
-        h,
-    }
 }
 
 #[cfg(test)]

@@ -4,6 +4,34 @@ use super::*;
 use crate::jet::testing::{check_scalar, sample_pair};
 use crate::jet::{hess_or_zero, Vec3Jet};
 
+/// Values and gradients of the rows of `joint` into `out` (cleared first; no Hessians): those
+/// of [`super::rows_each`].
+pub(crate) fn rows(joint: &Joint, pair: &Pair, out: &mut Vec<Scalar>) {
+    out.clear();
+    super::rows_each(joint, pair, |_, v, g| {
+        out.push(Scalar { v, g: *g, h: None })
+    });
+}
+
+/// The weighted point `wᵀ (r_k + A(p_k) s)` of side `k` (gravity, dead loads), with the
+/// Hessian when `pair.hess`: the general path, the reference of the tests of `forces::stacked`.
+pub(crate) fn weighted_point(pair: &Pair, k: usize, s: &Vector3<f64>, w: &Vector3<f64>) -> Scalar {
+    let rot = Rotations::of(pair);
+    let p = Lin::point(pair, &rot, k, s);
+    let mut g = LVec::zeros();
+    linear_gradient(&p, w, &mut g);
+    let h = pair.hess.then(|| {
+        let mut h = Box::new(LMat::zeros());
+        linear_hessian(&p, w, &mut h);
+        h
+    });
+    Scalar {
+        v: w.dot(&p.v),
+        g,
+        h,
+    }
+}
+
 /// Relative agreement of two scalars' value, gradient and Hessian.
 pub(crate) fn assert_same(a: &Scalar, b: &Scalar, what: &str) {
     let scale = 1.0 + a.v.abs() + a.g.amax() + hess_or_zero(&a.h).amax();

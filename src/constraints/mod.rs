@@ -288,17 +288,16 @@ impl Constraints {
                 t.entries.reserve_exact(14 * self.len);
             }
         }
-        let mut closed = Vec::with_capacity(6);
         let mut closed_values = Vec::with_capacity(6);
         fn push(
             phi: &mut DVector<f64>,
             jac: Option<&mut Triplets>,
             row: usize,
             bodies: &[Option<BodyId>; 2],
-            s: &Scalar,
+            (v, g): (f64, &crate::jet::LVec),
             c: f64,
         ) {
-            phi[row] += c * s.v;
+            phi[row] += c * v;
             if let Some(t) = jac {
                 // Zeros too: the sparsity pattern must not depend on `q`. A row on two bodies
                 // writes its 14 entries in one exact-size run (the same triplets, in the same
@@ -307,20 +306,20 @@ impl Constraints {
                     let (a, b) = (7 * a.0, 7 * b.0);
                     t.entries.extend((0..crate::jet::NL).map(|i| {
                         let gi = if i < 7 { a + i } else { b + i - 7 };
-                        (row, gi, c * s.g[i])
+                        (row, gi, c * g[i])
                     }));
                     return;
                 }
                 for i in 0..crate::jet::NL {
                     if let Some(gi) = crate::jet::global_index(bodies, i) {
-                        t.entries.push((row, gi, c * s.g[i]));
+                        t.entries.push((row, gi, c * g[i]));
                     }
                 }
             }
         }
         let values_only = jac.is_none();
         self.for_each_row(model, q, false, values_only, |row, term| match term {
-            Term::Jet(bodies, s, c) => push(phi, jac.as_deref_mut(), row, bodies, s, c),
+            Term::Jet(bodies, s, c) => push(phi, jac.as_deref_mut(), row, bodies, (s.v, &s.g), c),
             // `push`'s `phi[row] += 1.0 · v`.
             Term::Value(v) => phi[row] += 1.0 * v,
             Term::Closed(j, pair) if jac.is_none() => {
@@ -330,10 +329,9 @@ impl Constraints {
                 }
             }
             Term::Closed(j, pair) => {
-                crate::jet::closed::rows(j, pair, &mut closed);
-                for (k, s) in closed.iter().enumerate() {
-                    push(phi, jac.as_deref_mut(), row + k, &j.bodies, s, 1.0);
-                }
+                crate::jet::closed::rows_each(j, pair, |k, v, g| {
+                    push(phi, jac.as_deref_mut(), row + k, &j.bodies, (v, g), 1.0);
+                });
             }
             Term::Normalization(b) => {
                 let i = 7 * b.0 + 3;

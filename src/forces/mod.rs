@@ -78,25 +78,23 @@ pub(crate) fn potential(
         let bodies = [Some(BodyId(i)), None];
         let pair = pair_of(&bodies, q, want_h);
         let w = -b.gravity_mass * model.gravity;
-        if let Some((g, h)) = add.derivatives() {
-            let v = stacked::weighted_point(&bodies, &pair, &b.gravity_com, &w, g, h);
-            add.value(v, 1.0, &mut e.gravity);
-            continue;
-        }
-        let s = closed::weighted_point(&pair, 0, &b.gravity_com, &w);
-        add.term(&bodies, &s, 1.0, &mut e.gravity);
+        let v = match add.derivatives() {
+            Some((g, h)) => stacked::weighted_point(&bodies, &pair, &b.gravity_com, &w, g, h),
+            None => {
+                stacked::weighted_point_gradient(BodyId(i), &pair, &b.gravity_com, &w, add.grad)
+            }
+        };
+        add.value(v, 1.0, &mut e.gravity);
     }
     for l in &model.loads {
         let bodies = [Some(l.body), None];
         let pair = pair_of(&bodies, q, want_h);
         let w = -l.force;
-        if let Some((g, h)) = add.derivatives() {
-            let v = stacked::weighted_point(&bodies, &pair, &l.point, &w, g, h);
-            add.value(v, 1.0, &mut e.loads);
-            continue;
-        }
-        let s = closed::weighted_point(&pair, 0, &l.point, &w);
-        add.term(&bodies, &s, 1.0, &mut e.loads);
+        let v = match add.derivatives() {
+            Some((g, h)) => stacked::weighted_point(&bodies, &pair, &l.point, &w, g, h),
+            None => stacked::weighted_point_gradient(l.body, &pair, &l.point, &w, add.grad),
+        };
+        add.value(v, 1.0, &mut e.loads);
     }
     for s in &model.springs {
         let bodies = [s.ends[0].body, s.ends[1].body];
@@ -129,6 +127,14 @@ pub(crate) fn potential(
             add.value(u, 1.0, &mut e.joint_springs);
             continue;
         }
+        if let Some((theta, grad)) = revolute_angle(j, &pair, js.dof).filter(|_| !want_h) {
+            let v = on_branch(theta, reference);
+            let (u, f, _) = law::evaluate(&js.law, SpringMode::Both, v - js.reference)?;
+            // `Scalar::compose`'s gradient `f ∇θ`, added with `c = 1`.
+            stacked::scatter_gradient(&j.bodies, &(grad * f), 1.0, add.grad);
+            add.value(u, 1.0, &mut e.joint_springs);
+            continue;
+        }
         let theta = joint_coordinate(j, &pair, js.dof, reference)?;
         let (u, f, k) = law::evaluate(&js.law, SpringMode::Both, theta.v - js.reference)?;
         add.term(
@@ -148,6 +154,12 @@ pub(crate) fn potential(
         {
             let v = on_branch(theta.v, reference);
             stacked::scatter_angle(&j.bodies, &theta, None, -ef.value, g, h);
+            add.value(v, -ef.value, &mut e.loads);
+            continue;
+        }
+        if let Some((theta, grad)) = revolute_angle(j, &pair, ef.dof).filter(|_| !want_h) {
+            let v = on_branch(theta, reference);
+            stacked::scatter_gradient(&j.bodies, &grad, -ef.value, add.grad);
             add.value(v, -ef.value, &mut e.loads);
             continue;
         }
@@ -197,6 +209,21 @@ fn stacked_angle(joint: &crate::model::Joint, pair: &Pair, dof: usize) -> Option
         (JointKind::Revolute | JointKind::Continuous, 0)
     )
     .then(|| stacked::revolute_angle(joint, pair))
+}
+
+/// A revolute angle (`dof` 0 of a revolute or continuous joint) and its gradient, without the
+/// Hessian (module `stacked`), `None` for any other coordinate.
+fn revolute_angle(
+    joint: &crate::model::Joint,
+    pair: &Pair,
+    dof: usize,
+) -> Option<(f64, crate::jet::LVec)> {
+    use crate::model::JointKind;
+    matches!(
+        (joint.kind, dof),
+        (JointKind::Revolute | JointKind::Continuous, 0)
+    )
+    .then(|| stacked::revolute_angle_gradient(joint, pair))
 }
 
 /// The angle `v` read on the branch `reference` ([`crate::kinematics::on_branch`]).

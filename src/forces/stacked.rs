@@ -12,12 +12,18 @@
 //! regrouped (see [`revolute_angle`]; equal to rounding), and a spring `U(θ)` adds
 //! `U'' ∇θ ∇θᵀ + U' ∇²θ`; but `θ` depends on the Euler parameters only, so its Hessian is
 //! formed over those 8 coordinates of the pair (not 14), and no term allocates.
+//!
+//! Where no Hessian is asked for (every evaluation of the line search and of the reduced
+//! gradient), the same terms give their value and gradient alone: `θ` and
+//! `∇θ = (C ∇S − S ∇C) / ρ` by the first half of [`revolute_angle`]
+//! ([`revolute_angle_gradient`]), a weighted point by its side 0 alone
+//! ([`weighted_point_gradient`]); both to the last bit the generic path's.
 
 use crate::jet::closed::{linear_gradient, linear_hessian_euler, quadratic_form, Lin, Rotations};
 use crate::jet::{HessianSink, LVec, Pair};
 use crate::math::{b_matrix, rotation};
 use crate::model::{BodyId, Joint};
-use nalgebra::{DVector, SMatrix, Vector3, Vector4};
+use nalgebra::{DVector, Matrix3x4, SMatrix, Vector3, Vector4};
 
 /// The Euler-parameter coordinates of a body pair (local indices).
 const P: [usize; 8] = crate::jet::EULER;
@@ -32,6 +38,17 @@ fn scatter(
     grad: &mut DVector<f64>,
     hess: &mut dyn HessianSink,
 ) {
+    scatter_gradient(bodies, g, c, grad);
+    hess.add_euler_block(bodies, hp, c);
+}
+
+/// `c ∇f` into `grad` (as [`crate::jet::scatter`] adds the gradient).
+pub(crate) fn scatter_gradient(
+    bodies: &[Option<BodyId>; 2],
+    g: &LVec,
+    c: f64,
+    grad: &mut DVector<f64>,
+) {
     // Each side's 7 entries as one slice (one bounds check, not one per entry).
     let grad = grad.as_mut_slice();
     for (k, body) in bodies.iter().enumerate() {
@@ -42,11 +59,10 @@ fn scatter(
             }
         }
     }
-    hess.add_euler_block(bodies, hp, c);
 }
 
 /// `wᵀ (r_k + A(p_k) s)` of side `k` with its gradient into `grad` and Hessian into `hess`
-/// (as [`crate::jet::closed::weighted_point`] and [`crate::jet::scatter`] with `c = 1`);
+/// (as the general `closed::weighted_point` and [`crate::jet::scatter`] with `c = 1`);
 /// returns the value.
 pub(crate) fn weighted_point(
     bodies: &[Option<BodyId>; 2],
@@ -64,6 +80,30 @@ pub(crate) fn weighted_point(
     linear_hessian_euler(&p, w, &mut h);
     scatter(bodies, &g, &h, 1.0, grad, hess);
     w.dot(&p.v)
+}
+
+/// `wᵀ (r₀ + A(p₀) s)` of side 0 (the one `body`) with its gradient added into `grad`, without
+/// the Hessian: the general `closed::weighted_point` and [`crate::jet::scatter`] with `c = 1`
+/// to the last bit (the same operations on side 0; nothing formed for the empty side 1);
+/// returns the value.
+pub(crate) fn weighted_point_gradient(
+    body: BodyId,
+    pair: &Pair,
+    s: &Vector3<f64>,
+    w: &Vector3<f64>,
+    grad: &mut DVector<f64>,
+) -> f64 {
+    let v = rotation(&pair.p[0]) * s + pair.r[0];
+    let gp = b_matrix(&pair.p[0], s).tr_mul(w);
+    let out = &mut grad.as_mut_slice()[7 * body.0..7 * body.0 + 7];
+    // `linear_gradient` into zeros (`t = 1` on the position), then `scatter`'s `1 · g`.
+    for i in 0..3 {
+        out[i] += 1.0 * (0.0 + 1.0 * w[i]);
+    }
+    for i in 0..4 {
+        out[3 + i] += 1.0 * (0.0 + gp[i]);
+    }
+    w.dot(&v)
 }
 
 /// A revolute angle `θ` (not yet on its branch), its gradient and its Hessian over [`P`].
@@ -85,6 +125,77 @@ pub(crate) struct Angle {
 /// the `p₀ p₁` block (and its transpose), `2 M(ŵ, x₁)` on `p₀ p₀`, `2 M(x̂₁, w)` on `p₁ p₁`.
 /// One dot-product Hessian instead of two, no division per entry.
 pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair) -> Angle {
+    let FirstOrder {
+        v,
+        g: n,
+        x0,
+        y0,
+        x1,
+        bx0,
+        by0,
+        bx1,
+        b0x,
+        b0y,
+        b1x,
+        gs,
+        gc,
+        s,
+        c,
+        rho,
+    } = first_order(joint, pair);
+    let (cr, sr) = (c / rho, s / rho);
+    let (wb, w, bw) = (by0 * cr - bx0 * sr, y0 * cr - x0 * sr, b0y * cr - b0x * sr);
+    let mut h = SMatrix::<f64, 8, 8>::zeros();
+    h.fixed_view_mut::<4, 4>(0, 0)
+        .copy_from(&(quadratic_form(&wb, &x1) * 2.0));
+    h.fixed_view_mut::<4, 4>(4, 4)
+        .copy_from(&(quadratic_form(&bx1, &w) * 2.0));
+    let pp = bw.tr_mul(&b1x);
+    h.fixed_view_mut::<4, 4>(0, 4).copy_from(&pp);
+    h.fixed_view_mut::<4, 4>(4, 0).copy_from(&pp.transpose());
+    let (mut pn, mut pd) = ([0.0f64; 8], [0.0f64; 8]);
+    for (a, &i) in P.iter().enumerate() {
+        (pn[a], pd[a]) = (n[i], (gs[i] * s + gc[i] * c) / rho);
+    }
+    let hm = h.as_mut_slice();
+    for b in 0..8 {
+        for a in 0..8 {
+            hm[8 * b + a] -= pn[a] * pd[b] + pd[a] * pn[b];
+        }
+    }
+    Angle { v, g: n, h }
+}
+
+/// `θ` of the revolute `joint` at `pair` and its gradient alone (no Hessian): the value and
+/// gradient of [`revolute_angle`], the same operations.
+pub(crate) fn revolute_angle_gradient(joint: &Joint, pair: &Pair) -> (f64, LVec) {
+    let f = first_order(joint, pair);
+    (f.v, f.g)
+}
+
+/// `θ`, `∇θ` (`Pair::atan2`'s) and the vectors and factors they are formed from, which the
+/// Hessian reuses.
+struct FirstOrder {
+    v: f64,
+    g: LVec,
+    x0: Vector3<f64>,
+    y0: Vector3<f64>,
+    x1: Vector3<f64>,
+    bx0: Vector3<f64>,
+    by0: Vector3<f64>,
+    bx1: Vector3<f64>,
+    b0x: Matrix3x4<f64>,
+    b0y: Matrix3x4<f64>,
+    b1x: Matrix3x4<f64>,
+    gs: LVec,
+    gc: LVec,
+    s: f64,
+    c: f64,
+    rho: f64,
+}
+
+#[inline(always)]
+fn first_order(joint: &Joint, pair: &Pair) -> FirstOrder {
     let (p0, p1) = (&pair.p[0], &pair.p[1]);
     let (a0, a1) = (rotation(p0), rotation(p1));
     let r0 = joint.body_from_joint[0].rotation.to_rotation_matrix();
@@ -111,30 +222,23 @@ pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair) -> Angle {
     // `Pair::atan2`'s gradient.
     let rho = s * s + c * c;
     let n = gs * (c / rho) - gc * (s / rho);
-    let (cr, sr) = (c / rho, s / rho);
-    let (wb, w, bw) = (by0 * cr - bx0 * sr, y0 * cr - x0 * sr, b0y * cr - b0x * sr);
-    let mut h = SMatrix::<f64, 8, 8>::zeros();
-    h.fixed_view_mut::<4, 4>(0, 0)
-        .copy_from(&(quadratic_form(&wb, &x1) * 2.0));
-    h.fixed_view_mut::<4, 4>(4, 4)
-        .copy_from(&(quadratic_form(&bx1, &w) * 2.0));
-    let pp = bw.tr_mul(&b1x);
-    h.fixed_view_mut::<4, 4>(0, 4).copy_from(&pp);
-    h.fixed_view_mut::<4, 4>(4, 0).copy_from(&pp.transpose());
-    let (mut pn, mut pd) = ([0.0f64; 8], [0.0f64; 8]);
-    for (a, &i) in P.iter().enumerate() {
-        (pn[a], pd[a]) = (n[i], (gs[i] * s + gc[i] * c) / rho);
-    }
-    let hm = h.as_mut_slice();
-    for b in 0..8 {
-        for a in 0..8 {
-            hm[8 * b + a] -= pn[a] * pd[b] + pd[a] * pn[b];
-        }
-    }
-    Angle {
+    FirstOrder {
         v: s.atan2(c),
         g: n,
-        h,
+        x0,
+        y0,
+        x1,
+        bx0,
+        by0,
+        bx1,
+        b0x,
+        b0y,
+        b1x,
+        gs,
+        gc,
+        s,
+        c,
+        rho,
     }
 }
 
@@ -247,7 +351,7 @@ mod tests {
             // Weighted point.
             let one = [Some(BodyId(1)), None];
             let (s, w) = (Vector3::new(0.3, -0.1, 0.25), Vector3::new(1.0, -2.0, 9.81));
-            let boxed = crate::jet::closed::weighted_point(&pair, 0, &s, &w);
+            let boxed = crate::jet::closed::tests::weighted_point(&pair, 0, &s, &w);
             assert!(hess_or_zero(&boxed.h).amax() > 0.0);
             let (g0, h0) = hessian_of(|g, h| {
                 crate::jet::scatter(&one, &boxed, 1.0, g, Some(h as &mut dyn HessianSink));
@@ -261,6 +365,41 @@ mod tests {
             };
             assert_eq!(v, boxed.v);
             assert_eq!((g0, h0), (g1, h1), "seed {seed}");
+        }
+    }
+
+    /// Without the Hessian: the angle's value and gradient and the weighted point's value and
+    /// gradient, added into a vector, are the boxed generic path's to the last bit (compared
+    /// as bits, so that a zero's sign counts).
+    #[test]
+    fn gradient_only_terms_equal_the_boxed_path_bit_for_bit() {
+        let bits = |g: &DVector<f64>| g.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        let j = joint();
+        for seed in 0..6 {
+            let pair = sample_pair(seed);
+            let du = 0.7 - seed as f64;
+            let theta = crate::jet::closed::revolute_angle(&j, &pair);
+            let (v, g) = revolute_angle_gradient(&j, &pair);
+            assert_eq!(v.to_bits(), theta.v.to_bits(), "seed {seed}");
+            // A spring `U(θ)` (`Scalar::compose`, scattered with `c = 1`) and an effort.
+            for (c, du) in [(1.0, du), (-2.5, 1.0)] {
+                let boxed = theta.clone().scale(du);
+                let mut g0 = DVector::zeros(21);
+                crate::jet::scatter(&j.bodies, &boxed, c, &mut g0, None);
+                let mut g1 = DVector::zeros(21);
+                scatter_gradient(&j.bodies, &(g * du), c, &mut g1);
+                assert_eq!(bits(&g0), bits(&g1), "seed {seed}");
+                assert!(g1.amax() > 0.0);
+            }
+            let (s, w) = (Vector3::new(0.3, -0.1, 0.25), Vector3::new(1.0, -2.0, 9.81));
+            let body = [Some(BodyId(2)), None];
+            let boxed = crate::jet::closed::tests::weighted_point(&pair, 0, &s, &w);
+            let mut g0 = DVector::zeros(21);
+            crate::jet::scatter(&body, &boxed, 1.0, &mut g0, None);
+            let mut g1 = DVector::zeros(21);
+            let v = weighted_point_gradient(BodyId(2), &pair, &s, &w, &mut g1);
+            assert_eq!(v.to_bits(), boxed.v.to_bits(), "seed {seed}");
+            assert_eq!(bits(&g0), bits(&g1), "seed {seed}");
         }
     }
 

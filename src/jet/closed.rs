@@ -166,6 +166,23 @@ pub(crate) fn linear_gradient(a: &Lin, w: &Vector3<f64>, g: &mut LVec) {
     }
 }
 
+/// `∇a_m = ∇(e_mᵀ a)` added into `g`: [`linear_gradient`] for the unit vector `e_m`, which
+/// reads row `m` of `t_k I` and of `B_k`. Its products with the zero components of `e_m`
+/// are zeros, which leave a finite sum unchanged but for the sign of a zero result, and each
+/// sum enters `g` by an addition (to the zero `g` starts from, in [`rows_each`]), which
+/// clears that sign: the same numbers to the last bit.
+fn component_gradient(a: &Lin, m: usize, g: &mut LVec) {
+    for k in 0..2 {
+        if a.on[k] {
+            let o = 7 * k;
+            g[o + m] += a.t[k];
+            for i in 0..4 {
+                g[o + 3 + i] += a.b[k][(m, i)];
+            }
+        }
+    }
+}
+
 /// `∇²(wᵀa) = C(a, w)` for a constant `w` added into `h`.
 pub(crate) fn linear_hessian(a: &Lin, w: &Vector3<f64>, h: &mut LMat) {
     for k in 0..2 {
@@ -354,18 +371,19 @@ pub(crate) fn supports(joint: &Joint) -> bool {
     layout(joint).is_some()
 }
 
-/// Values and gradients of the rows of `joint` into `out` (cleared first; no Hessians).
-pub(crate) fn rows(joint: &Joint, pair: &Pair, out: &mut Vec<Scalar>) {
-    out.clear();
+/// Values and gradients of the rows of `joint` (no Hessians), handed to `emit(k, Φ_k, ∇Φ_k)`
+/// in row order: nothing collected, nothing copied.
+#[inline(always)]
+pub(crate) fn rows_each(joint: &Joint, pair: &Pair, mut emit: impl FnMut(usize, f64, &LVec)) {
     let Some(layout) = layout(joint) else {
         return;
     };
     let f = Frames::of(joint, pair, layout);
-    for row in layout {
+    for (k, row) in layout.iter().enumerate() {
         let mut g = LVec::zeros();
         let v = match *row {
             Row::Component(m) => {
-                linear_gradient(f.get(V::D), &Vector3::ith(m, 1.0), &mut g);
+                component_gradient(f.get(V::D), m, &mut g);
                 f.get(V::D).v[m]
             }
             Row::Dot(a, b) => {
@@ -381,7 +399,7 @@ pub(crate) fn rows(joint: &Joint, pair: &Pair, out: &mut Vec<Scalar>) {
             }
             Row::Thread => unreachable!("a thread row has no closed form (Spec::closed_form)"),
         };
-        out.push(Scalar { v, g, h: None });
+        emit(k, v, &g);
     }
 }
 
@@ -475,25 +493,6 @@ pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair) -> Scalar {
         }
     };
     pair.atan2(&scalar(&y0, &x1), &scalar(&x0, &x1))
-}
-
-/// The weighted point `wᵀ (r_k + A(p_k) s)` of side `k` (gravity, dead loads), with the
-/// Hessian when `pair.hess`.
-pub(crate) fn weighted_point(pair: &Pair, k: usize, s: &Vector3<f64>, w: &Vector3<f64>) -> Scalar {
-    let rot = Rotations::of(pair);
-    let p = Lin::point(pair, &rot, k, s);
-    let mut g = LVec::zeros();
-    linear_gradient(&p, w, &mut g);
-    let h = pair.hess.then(|| {
-        let mut h = Box::new(LMat::zeros());
-        linear_hessian(&p, w, &mut h);
-        h
-    });
-    Scalar {
-        v: w.dot(&p.v),
-        g,
-        h,
-    }
 }
 
 #[cfg(test)]

@@ -46,11 +46,11 @@ fn kinds() -> Vec<JointKind> {
         .collect()
 }
 
-/// One closed-form row as a scalar: value and gradient from [`closed::rows`], Hessian from
+/// One closed-form row as a scalar: value and gradient from `closed::tests::rows`, Hessian from
 /// [`closed::add_weighted_hessian`] with the unit weight on row `r`.
 fn closed_row(j: &Joint, pair: &Pair, r: usize) -> Scalar {
     let mut out = Vec::new();
-    closed::rows(j, pair, &mut out);
+    closed::tests::rows(j, pair, &mut out);
     let mut w = vec![0.0; out.len()];
     w[r] = 1.0;
     let mut h = Box::new(crate::jet::LMat::zeros());

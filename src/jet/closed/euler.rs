@@ -173,7 +173,7 @@ mod tests {
                 for r in 0..rows {
                     let row = |q: &Pair| {
                         let mut out = Vec::new();
-                        super::super::rows(&j, q, &mut out);
+                        super::super::tests::rows(&j, q, &mut out);
                         let mut unit = vec![0.0; rows];
                         unit[r] = 1.0;
                         let mut hp = SMatrix::<f64, 8, 8>::zeros();

@@ -4,6 +4,34 @@ use super::*;
 use crate::jet::testing::{check_scalar, sample_pair};
 use crate::jet::{hess_or_zero, Vec3Jet};
 
+/// Values and gradients of the rows of `joint` into `out` (cleared first; no Hessians): those
+/// of [`super::rows_each`].
+pub(crate) fn rows(joint: &Joint, pair: &Pair, out: &mut Vec<Scalar>) {
+    out.clear();
+    super::rows_each(joint, pair, |_, v, g| {
+        out.push(Scalar { v, g: *g, h: None })
+    });
+}
+
+/// The weighted point `wᵀ (r_k + A(p_k) s)` of side `k` (gravity, dead loads), with the
+/// Hessian when `pair.hess`: the general path, the reference of the tests of `forces::stacked`.
+pub(crate) fn weighted_point(pair: &Pair, k: usize, s: &Vector3<f64>, w: &Vector3<f64>) -> Scalar {
+    let rot = Rotations::of(pair);
+    let p = Lin::point(pair, &rot, k, s);
+    let mut g = LVec::zeros();
+    linear_gradient(&p, w, &mut g);
+    let h = pair.hess.then(|| {
+        let mut h = Box::new(LMat::zeros());
+        linear_hessian(&p, w, &mut h);
+        h
+    });
+    Scalar {
+        v: w.dot(&p.v),
+        g,
+        h,
+    }
+}
+
 /// Relative agreement of two scalars' value, gradient and Hessian.
 pub(crate) fn assert_same(a: &Scalar, b: &Scalar, what: &str) {
     let scale = 1.0 + a.v.abs() + a.g.amax() + hess_or_zero(&a.h).amax();
@@ -116,4 +144,46 @@ fn weighted_points_equal_the_jets_and_finite_differences() {
             check_scalar(&pair, &|q| weighted_point(q, k, &s1(), &w), &what);
         }
     }
+}
+
+/// A component row's gradient read off `t_k I` and `B_k` equals [`linear_gradient`] of the
+/// unit vector bit for bit (a zero's sign included), on a point difference and on directions
+/// of either side, at poses where some entries of `B_k` are exact zeros (the identity, a
+/// quarter turn) and at general ones.
+#[test]
+fn component_gradient_is_linear_gradient_bit_for_bit() {
+    let mut pairs: Vec<Pair> = (0..6).map(sample_pair).collect();
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    for p in [
+        nalgebra::Vector4::new(1.0, 0.0, 0.0, 0.0),
+        nalgebra::Vector4::new(h, 0.0, 0.0, -h),
+    ] {
+        let mut pair = sample_pair(9);
+        pair.p = [p, nalgebra::Vector4::new(0.0, -1.0, 0.0, 0.0)];
+        pairs.push(pair);
+    }
+    let mut zeros = 0;
+    for (n, q) in pairs.iter().enumerate() {
+        for a in vectors(q).1 {
+            zeros +=
+                a.b.iter()
+                    .flat_map(|b| b.iter())
+                    .filter(|x| **x == 0.0)
+                    .count();
+            for m in 0..3 {
+                let mut general = LVec::zeros();
+                linear_gradient(&a, &Vector3::ith(m, 1.0), &mut general);
+                let mut read = LVec::zeros();
+                component_gradient(&a, m, &mut read);
+                for i in 0..crate::jet::NL {
+                    assert_eq!(
+                        general[i].to_bits(),
+                        read[i].to_bits(),
+                        "pair {n} m {m} [{i}]"
+                    );
+                }
+            }
+        }
+    }
+    assert!(zeros > 0);
 }

@@ -66,7 +66,11 @@ fn unrolled_ldlt_and_solves_are_the_general_loops_bit_for_bit() {
         assert!(negative > 0, "d {d}: indefinite");
         for i in 0..d {
             for j in 0..=i {
-                assert_eq!(f[i * d + j].to_bits(), g[i * d + j].to_bits(), "d {d} ({i}, {j})");
+                assert_eq!(
+                    f[i * d + j].to_bits(),
+                    g[i * d + j].to_bits(),
+                    "d {d} ({i}, {j})"
+                );
             }
         }
         assert!(f[(d - 1) * d] == 0.0, "d {d}: a zero in L");
@@ -124,7 +128,13 @@ fn lu_solves_both_ways() {
 /// the rest of the parent's block as it was; the full update is `p − Cᵀ X` to rounding.
 #[test]
 fn lower_schur_update_is_the_full_ones_lower_triangle() {
-    for (d, w, dp) in [(13, 7, 13), (14, 7, 14), (14, 18, 27), (27, 7, 14), (9, 5, 11)] {
+    for (d, w, dp) in [
+        (13, 7, 13),
+        (14, 7, 14),
+        (14, 18, 27),
+        (27, 7, 14),
+        (9, 5, 11),
+    ] {
         let mut c = right_sides(d, w, 1 + d as u64);
         c[w + 1] = 0.0;
         let x = row_major(&sample(d, w, 2 + w as u64));

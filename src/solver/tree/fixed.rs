@@ -14,16 +14,11 @@
 //! are theirs to the last bit. Column `j` of `L` is also stored as row `j` above the diagonal:
 //! the later columns read it there as a row (`L_ik` for all `i > j` at once).
 
-/// The `D × D` row-major block `a` as rows.
-fn rows<const D: usize>(a: &mut [f64]) -> Option<&mut [[f64; D]; D]> {
-    a.get_mut(..D * D)?.as_chunks_mut::<D>().0.try_into().ok()
-}
-
 /// `A = L D Lᵀ` in place (see `dense::ldlt`; the upper triangle is left holding `Lᵀ`).
 #[inline(never)]
 pub(super) fn ldlt<const D: usize>(a: &mut [f64]) -> Option<usize> {
     const { assert!(D <= 27) };
-    let a = rows::<D>(a)?;
+    let a = a.get_mut(..D * D)?;
     let (mut v, mut diag) = ([0.0; D], [0.0; D]);
     let mut negative = 0;
     macro_rules! columns {
@@ -39,16 +34,17 @@ pub(super) fn ldlt<const D: usize>(a: &mut [f64]) -> Option<usize> {
     Some(negative)
 }
 
-/// Column `J` of [`ldlt`]: its pivot `D_J` (whether negative; `None` if zero or not finite)
-/// and `L_iJ` for `i > J`, with `v` and `diag` (the pivots so far) as scratch.
+/// Column `J` of [`ldlt`] on the `D × D` row-major `a`: its pivot `D_J` (whether negative;
+/// `None` if zero or not finite) and `L_iJ` for `i > J`, with `v` and `diag` (the pivots so
+/// far) as scratch.
 #[inline(always)]
 fn column<const D: usize, const J: usize>(
-    a: &mut [[f64; D]; D],
+    a: &mut [f64],
     v: &mut [f64; D],
     diag: &mut [f64; D],
 ) -> Option<bool> {
-    let (done, rest) = a.split_at_mut(J);
-    let (row, below) = rest.split_first_mut()?;
+    let (done, rest) = a.split_at_mut(J * D);
+    let (row, below) = rest.split_at_mut(D);
     for k in 0..J {
         v[k] = row[k] * diag[k];
     }
@@ -63,17 +59,17 @@ fn column<const D: usize, const J: usize>(
     diag[J] = djj;
     let mut s = [0.0; D];
     for i in J + 1..D {
-        s[i] = below[i - J - 1][J];
+        s[i] = below[(i - J - 1) * D + J];
     }
     for k in 0..J {
-        let (vk, lk) = (v[k], &done[k]);
+        let (vk, lk) = (v[k], &done[k * D..k * D + D]);
         for i in J + 1..D {
             s[i] -= lk[i] * vk;
         }
     }
     for i in J + 1..D {
         let l = s[i] / djj;
-        below[i - J - 1][J] = l;
+        below[(i - J - 1) * D + J] = l;
         row[i] = l;
     }
     Some(djj < 0.0)
@@ -84,14 +80,7 @@ fn column<const D: usize, const J: usize>(
 #[inline(never)]
 pub(super) fn ldlt_solve<const D: usize, const W: usize>(f: &[f64], x: &mut [f64]) {
     const { assert!(D <= 27) };
-    let Some(f) = f.get(..D * D) else { return };
-    let Ok(f) = <&[[f64; D]; D]>::try_from(f.as_chunks::<D>().0) else {
-        return;
-    };
-    let Some(x) = x.get_mut(..D * W) else { return };
-    let Ok(x) = <&mut [[f64; W]; D]>::try_from(x.as_chunks_mut::<W>().0) else {
-        return;
-    };
+    let (f, x) = (&f[..D * D], &mut x[..D * W]);
     macro_rules! each_row {
         ($step:ident: $($i:literal)*) => {
             $(
@@ -105,42 +94,40 @@ pub(super) fn ldlt_solve<const D: usize, const W: usize>(f: &[f64], x: &mut [f64
     each_row!(backward: 26 25 24 23 22 21 20 19 18 17 16 15 14 13 12 11 10 9 8 7 6 5 4 3 2 1 0);
 }
 
-/// Row `I` of `L y = x`.
+/// Row `I` of `L y = x` (`f` is `D × D`, `x` is `D × W`, both row-major).
 #[inline(always)]
-fn forward<const D: usize, const W: usize, const I: usize>(
-    f: &[[f64; D]; D],
-    x: &mut [[f64; W]; D],
-) {
-    let mut acc = x[I];
+fn forward<const D: usize, const W: usize, const I: usize>(f: &[f64], x: &mut [f64]) {
+    let (done, rest) = x.split_at_mut(I * W);
+    let mut acc = [0.0; W];
+    acc.copy_from_slice(&rest[..W]);
     for k in 0..I {
-        let l = f[I][k];
+        let l = f[I * D + k];
         if l != 0.0 {
             for c in 0..W {
-                acc[c] -= l * x[k][c];
+                acc[c] -= l * done[k * W + c];
             }
         }
     }
-    x[I] = acc;
+    rest[..W].copy_from_slice(&acc);
 }
 
 /// Row `I` of `D Lᵀ x = y` (rows after `I` finished).
 #[inline(always)]
-fn backward<const D: usize, const W: usize, const I: usize>(
-    f: &[[f64; D]; D],
-    x: &mut [[f64; W]; D],
-) {
-    let mut acc = x[I];
-    let p = 1.0 / f[I][I];
+fn backward<const D: usize, const W: usize, const I: usize>(f: &[f64], x: &mut [f64]) {
+    let (head, later) = x.split_at_mut(I * W + W);
+    let mut acc = [0.0; W];
+    acc.copy_from_slice(&head[I * W..]);
+    let p = 1.0 / f[I * D + I];
     for a in acc.iter_mut() {
         *a *= p;
     }
     for k in I + 1..D {
-        let l = f[k][I];
+        let l = f[k * D + I];
         if l != 0.0 {
             for c in 0..W {
-                acc[c] -= l * x[k][c];
+                acc[c] -= l * later[(k - I - 1) * W + c];
             }
         }
     }
-    x[I] = acc;
+    head[I * W..].copy_from_slice(&acc);
 }

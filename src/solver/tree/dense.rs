@@ -2,16 +2,24 @@
 //! a border): symmetric `A = L D Lᵀ` without pivoting (its negative pivots count the negative
 //! eigenvalues: Sylvester's law of inertia) and `P A = L U` with partial pivoting, in place,
 //! with their solves. No allocation.
+//!
+//! A chain's and a ladder's block sizes (`d` = 8, 13, 14, 27) factor and solve by the
+//! unrolled kernels of module `fixed`: the same operations on each entry in the same order
+//! (the same results to the last bit; `dense_tests` checks them against the general loops
+//! below). The Schur update of a parent's block writes only the lower triangle that
+//! [`ldlt`] reads.
+
+use super::fixed;
 
 /// `A = L D Lᵀ` in place (`L` unit lower below the diagonal, `D` on it) of the symmetric `d × d`
-/// block `a` (both triangles given; the upper one is left as it was); the number of negative
-/// pivots, or `None` on a zero or non-finite pivot.
+/// block `a` (its lower triangle read; the upper one is scratch: `Lᵀ` for the sizes of
+/// module `fixed`); the number of negative pivots, or `None` on a zero or non-finite pivot.
 pub(crate) fn ldlt(a: &mut [f64], d: usize) -> Option<usize> {
     match d {
-        13 => ldlt_with(a, 13, &mut [0.0; 13]),
-        14 => ldlt_with(a, 14, &mut [0.0; 14]),
-        8 => ldlt_with(a, 8, &mut [0.0; 8]),
-        27 => ldlt_with(a, 27, &mut [0.0; 27]),
+        13 => fixed::ldlt::<13>(a),
+        14 => fixed::ldlt::<14>(a),
+        8 => fixed::ldlt::<8>(a),
+        27 => fixed::ldlt::<27>(a),
         _ => ldlt_any(a, d),
     }
 }
@@ -55,62 +63,19 @@ fn ldlt_with(a: &mut [f64], d: usize, v: &mut [f64]) -> Option<usize> {
 
 /// `x ← A⁻¹ x` for the factors of [`ldlt`]; `x` is `d × w` row-major (`w` right sides).
 pub(crate) fn ldlt_solve(f: &[f64], d: usize, x: &mut [f64], w: usize) {
-    // Constant sizes of a chain's blocks, so that the loops are unrolled; with 7 right sides
-    // (the couplings `X_i`) each row of `x` is updated in registers.
+    // Constant sizes of a chain's and a ladder's blocks (module `fixed`).
     match (d, w) {
-        (13, 1) => ldlt_solve_impl(f, 13, x, 1),
-        (13, 7) => ldlt_solve_rows::<7>(f, 13, x),
-        (14, 1) => ldlt_solve_impl(f, 14, x, 1),
-        (14, 7) => ldlt_solve_rows::<7>(f, 14, x),
-        (8, 1) => ldlt_solve_impl(f, 8, x, 1),
-        (8, 7) => ldlt_solve_rows::<7>(f, 8, x),
+        (13, 1) => fixed::ldlt_solve::<13, 1>(f, x),
+        (13, 7) => fixed::ldlt_solve::<13, 7>(f, x),
+        (14, 1) => fixed::ldlt_solve::<14, 1>(f, x),
+        (14, 7) => fixed::ldlt_solve::<14, 7>(f, x),
+        (8, 1) => fixed::ldlt_solve::<8, 1>(f, x),
+        (8, 7) => fixed::ldlt_solve::<8, 7>(f, x),
         // A ladder's super-nodes of the KKT matrix (module `merge`).
-        (27, 1) => ldlt_solve_impl(f, 27, x, 1),
-        (27, 7) => ldlt_solve_rows::<7>(f, 27, x),
-        (14, 18) => ldlt_solve_rows::<18>(f, 14, x),
+        (27, 1) => fixed::ldlt_solve::<27, 1>(f, x),
+        (27, 7) => fixed::ldlt_solve::<27, 7>(f, x),
+        (14, 18) => fixed::ldlt_solve::<14, 18>(f, x),
         _ => ldlt_solve_impl(f, d, x, w),
-    }
-}
-
-/// [`ldlt_solve`] for `W` right sides: each row of `x` is taken into a local array, updated
-/// by the rows it depends on and stored once. Every entry sees the same operations in the
-/// same order as in [`ldlt_solve_impl`] (the same results to the last bit).
-#[inline(always)]
-fn ldlt_solve_rows<const W: usize>(f: &[f64], d: usize, x: &mut [f64]) {
-    let (f, x) = (&f[..d * d], &mut x[..d * W]);
-    for i in 0..d {
-        let mut acc = [0.0; W];
-        acc.copy_from_slice(&x[i * W..i * W + W]);
-        for k in 0..i {
-            let l = f[i * d + k];
-            if l != 0.0 {
-                let xk = &x[k * W..k * W + W];
-                for c in 0..W {
-                    acc[c] -= l * xk[c];
-                }
-            }
-        }
-        x[i * W..i * W + W].copy_from_slice(&acc);
-    }
-    for i in (0..d).rev() {
-        let mut acc = [0.0; W];
-        acc.copy_from_slice(&x[i * W..i * W + W]);
-        // The diagonal scaling of row `i` (the middle pass of `ldlt_solve_impl`): no row
-        // reads row `i` between that pass and this point.
-        let p = 1.0 / f[i * d + i];
-        for a in acc.iter_mut() {
-            *a *= p;
-        }
-        for k in i + 1..d {
-            let l = f[k * d + i];
-            if l != 0.0 {
-                let xk = &x[k * W..k * W + W];
-                for c in 0..W {
-                    acc[c] -= l * xk[c];
-                }
-            }
-        }
-        x[i * W..i * W + W].copy_from_slice(&acc);
     }
 }
 
@@ -329,25 +294,38 @@ fn sub_mul_impl(xm: &[f64], y: &[f64], x: &mut [f64], d: usize, w: usize) {
 }
 
 /// `p −= Cᵀ X` into the leading `w × w` block of the `dp × dp` row-major `p`, for `d × w`
-/// row-major `C` and `X` (the Schur update of a parent's block).
-pub(crate) fn sub_tr_mul_block(c: &[f64], x: &[f64], p: &mut [f64], d: usize, w: usize, dp: usize) {
+/// row-major `C` and `X` (the Schur update of a parent's block); with `lower`, into its lower
+/// triangle only (what [`ldlt`] reads).
+pub(crate) fn sub_tr_mul_block(
+    c: &[f64],
+    x: &[f64],
+    p: &mut [f64],
+    (d, w, dp): (usize, usize, usize),
+    lower: bool,
+) {
     match (d, w, dp) {
-        (13, 7, 13) => sub_tr_mul_block_impl(c, x, p, 13, 7, 13),
-        (14, 7, 14) => sub_tr_mul_block_impl(c, x, p, 14, 7, 14),
-        (14, 18, 27) => sub_tr_mul_block_impl(c, x, p, 14, 18, 27),
-        (27, 7, 14) => sub_tr_mul_block_impl(c, x, p, 27, 7, 14),
-        _ => sub_tr_mul_block_impl(c, x, p, d, w, dp),
+        (13, 7, 13) => sub_tr_mul_block_impl(c, x, p, (13, 7, 13), lower),
+        (14, 7, 14) => sub_tr_mul_block_impl(c, x, p, (14, 7, 14), lower),
+        (14, 18, 27) => sub_tr_mul_block_impl(c, x, p, (14, 18, 27), lower),
+        (27, 7, 14) => sub_tr_mul_block_impl(c, x, p, (27, 7, 14), lower),
+        _ => sub_tr_mul_block_impl(c, x, p, (d, w, dp), lower),
     }
 }
 
 #[inline(always)]
-fn sub_tr_mul_block_impl(c: &[f64], x: &[f64], p: &mut [f64], d: usize, w: usize, dp: usize) {
+fn sub_tr_mul_block_impl(
+    c: &[f64],
+    x: &[f64],
+    p: &mut [f64],
+    (d, w, dp): (usize, usize, usize),
+    lower: bool,
+) {
     let (c, x, p) = (&c[..d * w], &x[..d * w], &mut p[..dp * dp]);
     for k in 0..d {
         for a in 0..w {
             let cka = c[k * w + a];
             if cka != 0.0 {
-                for b in 0..w {
+                for b in 0..if lower { a + 1 } else { w } {
                     p[a * dp + b] -= cka * x[k * w + b];
                 }
             }
@@ -356,84 +334,5 @@ fn sub_tr_mul_block_impl(c: &[f64], x: &[f64], p: &mut [f64], d: usize, w: usize
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use nalgebra::{DMatrix, DVector};
-
-    fn sample(d: usize, seed: u64) -> DMatrix<f64> {
-        let mut s = seed;
-        let mut r = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        };
-        DMatrix::from_fn(d, d, |_, _| r())
-    }
-
-    fn row_major(m: &DMatrix<f64>) -> Vec<f64> {
-        m.transpose().as_slice().to_vec()
-    }
-
-    #[test]
-    fn ldlt_solves_and_counts_negative_eigenvalues() {
-        for d in [1, 6, 13, 70] {
-            let b = sample(d, d as u64);
-            let a = &b + b.transpose();
-            let mut f = row_major(&a);
-            let negative = ldlt(&mut f, d).expect("nonsingular");
-            let eig = a.clone().symmetric_eigenvalues();
-            assert_eq!(negative, eig.iter().filter(|&&x| x < 0.0).count());
-            let x0 = DVector::from_fn(d, |i, _| (i as f64 + 1.0).sin());
-            let mut x = (&a * &x0).as_slice().to_vec();
-            ldlt_solve(&f, d, &mut x, 1);
-            for i in 0..d {
-                assert!((x[i] - x0[i]).abs() < 1e-8, "d {d}: {} vs {}", x[i], x0[i]);
-            }
-        }
-    }
-
-    /// The row-by-row solves of the chain's block sizes give the general loop's results bit
-    /// for bit (zeros in `L` included: their updates are skipped by both).
-    #[test]
-    fn ldlt_solve_by_rows_equals_the_general_loop() {
-        for d in [8, 13, 14] {
-            let b = sample(d, 3 + d as u64);
-            let mut a = &b + b.transpose();
-            // Zeros in the lower triangle, as in a KKT block's position coordinates.
-            a[(d - 1, 0)] = 0.0;
-            a[(0, d - 1)] = 0.0;
-            let mut f = row_major(&a);
-            ldlt(&mut f, d).expect("nonsingular");
-            for w in [1, 7] {
-                let x0: Vec<f64> = (0..d * w).map(|i| (i as f64 * 0.37).sin()).collect();
-                let (mut x1, mut x2) = (x0.clone(), x0.clone());
-                ldlt_solve(&f, d, &mut x1, w);
-                ldlt_solve_impl(&f, d, &mut x2, w);
-                assert!(x1.iter().zip(&x2).all(|(p, q)| p.to_bits() == q.to_bits()));
-            }
-        }
-    }
-
-    #[test]
-    fn lu_solves_both_ways() {
-        for d in [1, 6, 13, 20] {
-            let a = sample(d, 7 + d as u64);
-            let mut f = row_major(&a);
-            let mut piv = vec![0u16; d];
-            assert!(lu(&mut f, d, &mut piv));
-            let x0 = DVector::from_fn(d, |i, _| (i as f64 + 2.0).cos());
-            // Two right sides at once: x0 and 2 x0.
-            let ax = &a * &x0;
-            let mut x: Vec<f64> = (0..d).flat_map(|i| [ax[i], 2.0 * ax[i]]).collect();
-            lu_solve(&f, &piv, d, &mut x, 2);
-            let mut t = (a.transpose() * &x0).as_slice().to_vec();
-            lu_solve_transpose(&f, &piv, d, &mut t);
-            for i in 0..d {
-                assert!((x[2 * i] - x0[i]).abs() < 1e-9);
-                assert!((x[2 * i + 1] - 2.0 * x0[i]).abs() < 1e-9);
-                assert!((t[i] - x0[i]).abs() < 1e-9);
-            }
-        }
-    }
-}
+#[path = "dense_tests.rs"]
+mod tests;

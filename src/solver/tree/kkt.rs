@@ -291,7 +291,7 @@ impl TreeKkt {
                 before[r.start - base..r.end - base].copy_from_slice(&values[r]);
             }
             let pblk = &mut before[s.diag_at[p] - base..s.diag_at[p] - base + dp * dp];
-            dense::sub_tr_mul_block(c, x, pblk, d, w, dp);
+            dense::sub_tr_mul_block(c, x, pblk, (d, w, dp), !lu);
         }
         Some(negative)
     }

@@ -5,6 +5,7 @@
 //! Schur complement.
 //!
 //! - `dense`: the block kernels (LDLᵀ without pivoting, LU with partial pivoting);
+//! - `fixed`: LDLᵀ and its solves unrolled for a chain's and a ladder's block sizes;
 //! - `phi_u`: `Φ_u` as a block upper triangular matrix (corrector, multipliers, tangent steps);
 //! - `segments`: its off-diagonal entries as dense row × column segments for the solves;
 //! - `shape`: the KKT matrix's nodes, parents, border and value slots, once per partition;
@@ -19,6 +20,7 @@
 
 mod border;
 pub(crate) mod dense;
+mod fixed;
 pub(crate) mod fused;
 pub(crate) mod kkt;
 mod merge;

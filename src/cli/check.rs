@@ -2,7 +2,7 @@
 
 use super::args::{CheckArgs, Format};
 use super::exit;
-use super::print::{self, out};
+use super::print;
 use restpose::export::summary::ModelSummary;
 use restpose::urdf::load_file;
 
@@ -24,10 +24,13 @@ pub(crate) fn run(a: &CheckArgs) -> anyhow::Result<u8> {
         print::model_listing(&s, &mut listing);
     }
     if let Some(path) = &a.json {
-        print::write_json(path, &serde_json::to_string_pretty(&s)?)?;
+        print::write_json(path, &restpose::export::pretty_json(&s)?)?;
     }
     match a.format {
-        Format::Json if !stdout_json => out!("{}", serde_json::to_string_pretty(&s)?),
+        Format::Json if !stdout_json => print::write_json(
+            std::path::Path::new("-"),
+            &restpose::export::pretty_json(&s)?,
+        )?,
         Format::Text if !stdout_json => print::model_with_listing(&s, &listing),
         _ => {}
     }

@@ -30,12 +30,18 @@ pub(crate) fn is_stdout(path: Option<&std::path::PathBuf>) -> bool {
     path.is_some_and(|p| p.as_os_str() == "-")
 }
 
-/// Writes JSON text to `path` atomically, or to standard output for `-`.
-pub(crate) fn write_json(path: &std::path::Path, text: &str) -> anyhow::Result<()> {
+/// Writes JSON text to `path` atomically, or to standard output for `-` (with a line break
+/// after it).
+pub(crate) fn write_json(path: &std::path::Path, text: &[u8]) -> anyhow::Result<()> {
     if path.as_os_str() == "-" {
-        out!("{text}");
+        use std::io::Write;
+        let mut stdout = std::io::stdout().lock();
+        let _ = stdout
+            .write_all(text)
+            .and_then(|_| stdout.write_all(b"\n"))
+            .and_then(|_| stdout.flush());
     } else {
-        restpose::export::write_atomic(path, text.as_bytes())?;
+        restpose::export::write_atomic(path, text)?;
     }
     Ok(())
 }

@@ -141,7 +141,7 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
         eigenvalues,
     )?;
     if let Some(path) = &a.json {
-        print::write_json(path, &serde_json::to_string_pretty(&v)?)?;
+        print::write_json(path, &restpose::export::pretty_json(&v)?)?;
     }
     if !print::is_stdout(a.json.as_ref()) {
         if a.quiet {

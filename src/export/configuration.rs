@@ -16,6 +16,7 @@
 
 use crate::joint::Entry as Value;
 use crate::model::{JointId, JointKind, Model};
+use crate::names::NameMap;
 use crate::state::State;
 
 /// Whose configuration vector.
@@ -64,11 +65,12 @@ pub(crate) fn configuration_of(
     let tree: Vec<usize> = (0..model.joints.len())
         .filter(|&j| model.joints[j].tree)
         .collect();
-    let children_of_joints: std::collections::HashSet<&str> = tree
+    // Looked up by name only (never iterated in hash order), hashed by the names' hasher.
+    let children_of_joints: NameMap<&str, ()> = tree
         .iter()
-        .map(|&j| model.joints[j].child_link.as_str())
+        .map(|&j| (model.joints[j].child_link.as_str(), ()))
         .collect();
-    let mut children: std::collections::HashMap<&str, Vec<usize>> = Default::default();
+    let mut children: NameMap<&str, Vec<usize>> = NameMap::default();
     for &j in &tree {
         children
             .entry(model.joints[j].parent_link.as_str())
@@ -84,7 +86,7 @@ pub(crate) fn configuration_of(
     let roots: Vec<_> = model
         .links
         .iter()
-        .filter(|l| !children_of_joints.contains(l.name.as_str()))
+        .filter(|l| !children_of_joints.contains_key(l.name.as_str()))
         .collect();
     for root in roots {
         if let Some(b) = root.body {

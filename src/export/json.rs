@@ -281,6 +281,12 @@ impl AnalysisResult {
 
     /// Pretty JSON text.
     pub fn to_json(&self) -> String {
-        serde_json::to_string_pretty(self).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
+        String::from_utf8(self.to_json_bytes())
+            .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned())
+    }
+
+    /// Pretty JSON text as bytes (UTF-8), as [`AnalysisResult::to_json`] without its copy.
+    pub fn to_json_bytes(&self) -> Vec<u8> {
+        super::pretty_json(self).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}").into_bytes())
     }
 }

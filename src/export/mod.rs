@@ -4,11 +4,14 @@
 
 pub mod buried;
 pub mod configuration;
+mod indent;
 pub mod joint_states;
 pub mod json;
 pub mod mujoco;
 pub mod srdf;
 pub mod summary;
+
+pub use indent::pretty_json;
 
 use crate::error::{Error, Result};
 use std::io::Write;

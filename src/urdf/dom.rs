@@ -103,16 +103,24 @@ impl<'i> Document<'i> {
         }
     }
 
-    /// Whether `s` is `name`, lengths first.
+    /// Whether `s` is `name`, lengths first, then byte by byte (names are a few bytes: no
+    /// call to `memcmp`).
     #[inline]
     fn is(&self, s: Str, name: &str) -> bool {
-        s.bytes() == name.len() && self.str(s) == name
+        s.bytes() == name.len() && self.str(s).bytes().zip(name.bytes()).all(|(a, b)| a == b)
     }
 
     /// The namespace URI of a name's `ns` ([`NodeData::ns`]).
     #[inline]
     fn uri(&self, ns: u32) -> Option<&str> {
         (ns != 0).then(|| self.str(self.scope[ns as usize - 1].1))
+    }
+
+    /// Whether a namespace URI of the document contains `part`.
+    pub(crate) fn mentions_uri(&self, part: &str) -> bool {
+        self.scope
+            .iter()
+            .any(|&(_, uri)| self.str(uri).contains(part))
     }
 
     /// The text the document was read from.
@@ -348,6 +356,20 @@ impl<'a, 'i> Node<'a, 'i> {
         let (a, b) = self.d().attrs;
         doc.attrs[a as usize..b as usize]
             .iter()
+            .map(move |x| Attribute {
+                ns: doc.uri(x.ns),
+                name: doc.str(x.name),
+                value: doc.str(x.value),
+            })
+    }
+
+    /// The attributes of an element that are in a namespace.
+    pub(crate) fn namespaced_attributes(&self) -> impl Iterator<Item = Attribute<'a>> + 'a {
+        let doc = self.doc;
+        let (a, b) = self.d().attrs;
+        doc.attrs[a as usize..b as usize]
+            .iter()
+            .filter(|x| x.ns != 0)
             .map(move |x| Attribute {
                 ns: doc.uri(x.ns),
                 name: doc.str(x.name),

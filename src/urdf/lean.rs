@@ -10,6 +10,7 @@
 //! reports every error with its position: what this reader accepts, `roxmltree` accepts too,
 //! into the same document (compared node by node in the tests, `super::dom_tests`).
 
+use super::byte_class::{CLASS, NAME_CHAR, NAME_START, NOT_IN_VALUE, SPACE};
 use super::dom::{AttrData, Document, Kind, NodeData, Str};
 
 /// The URI of the `xml` prefix and the reserved one of `xmlns`.
@@ -115,24 +116,22 @@ pub(super) fn parse(text: &str) -> Option<Document<'_>> {
 }
 
 fn name_start(c: u8) -> bool {
-    c.is_ascii_alphabetic() || c == b'_'
-}
-
-fn name_char(c: u8) -> bool {
-    c.is_ascii_alphanumeric() || matches!(c, b'_' | b'-' | b'.')
-}
-
-fn space(c: u8) -> bool {
-    matches!(c, b' ' | b'\n' | b'\t')
+    CLASS[c as usize] & NAME_START != 0
 }
 
 impl<'i> Reader<'i> {
+    /// The length of the run of bytes of class `class` from `self.i`.
+    fn run(&self, class: u8) -> usize {
+        let rest = self.b.get(self.i..).unwrap_or_default();
+        rest.iter()
+            .position(|&c| CLASS[c as usize] & class == 0)
+            .unwrap_or(rest.len())
+    }
+
     fn skip_space(&mut self) -> bool {
-        let from = self.i;
-        while self.b.get(self.i).is_some_and(|&c| space(c)) {
-            self.i += 1;
-        }
-        self.i > from
+        let n = self.run(SPACE);
+        self.i += n;
+        n > 0
     }
 
     fn eat(&mut self, s: &[u8]) -> Option<()> {
@@ -145,9 +144,7 @@ impl<'i> Reader<'i> {
         if !name_start(*self.b.get(self.i)?) {
             return None;
         }
-        while self.b.get(self.i).is_some_and(|&c| name_char(c)) {
-            self.i += 1;
-        }
+        self.i += self.run(NAME_CHAR);
         Some((from, self.i))
     }
 
@@ -169,9 +166,11 @@ impl<'i> Reader<'i> {
             return None;
         }
         let from = self.i + 1;
-        let len = self.b[from..].iter().position(|&c| c == q)?;
-        let v = &self.b[from..from + len];
-        if v.iter().any(|&c| matches!(c, b'<' | b'\n' | b'\t')) {
+        // One pass: the first quote or forbidden byte ends the scan.
+        let len = self.b[from..]
+            .iter()
+            .position(|&c| c == q || CLASS[c as usize] & NOT_IN_VALUE != 0)?;
+        if self.b[from + len] != q {
             return None;
         }
         self.i = from + len + 1;
@@ -323,6 +322,9 @@ impl<'i> Reader<'i> {
         let (prefix, local) = self.qname()?;
         let qname = (prefix.0, self.i);
         self.raw.clear();
+        // No attribute with a prefix and none named `xmlns`: no declaration, every attribute
+        // in no namespace.
+        let mut plain = true;
         let empty = loop {
             let spaced = self.skip_space();
             match *self.b.get(self.i)? {
@@ -340,6 +342,7 @@ impl<'i> Reader<'i> {
                     self.eat(b"=")?;
                     self.skip_space();
                     let value = self.quoted()?;
+                    plain &= p.0 == p.1 && &self.b[l.0..l.1] != b"xmlns";
                     self.raw.push(Raw {
                         prefix: p,
                         local: l,
@@ -362,7 +365,7 @@ impl<'i> Reader<'i> {
             _ => (0, 0),
         };
         let s0 = self.doc.scope.len();
-        for a in &self.raw {
+        for a in self.raw.iter().filter(|_| !plain) {
             let (p, l, v) = (s(a.prefix), s(a.local), s(a.value));
             let declared = match (p, l) {
                 ("xmlns", "xml" | "xmlns") => return None,
@@ -419,7 +422,26 @@ impl<'i> Reader<'i> {
         };
         let ns = lookup(&self.doc, s(prefix))?;
         let a0 = self.doc.attrs.len();
-        for a in &self.raw {
+        if plain {
+            // A duplicate is a repeated name.
+            let b = self.b;
+            let name = |a: &Raw| &b[a.local.0..a.local.1];
+            for (k, a) in self.raw.iter().enumerate() {
+                let same = |x: &Raw| {
+                    let (p, q) = (name(x), name(a));
+                    p.len() == q.len() && p.iter().zip(q).all(|(u, v)| u == v)
+                };
+                if self.raw[..k].iter().any(same) {
+                    return None;
+                }
+                self.doc.attrs.push(AttrData {
+                    ns: 0,
+                    name: Str::of(a.local.0..a.local.1),
+                    value: Str::of(a.value.0..a.value.1),
+                });
+            }
+        }
+        for a in self.raw.iter().filter(|_| !plain) {
             let (p, l) = (s(a.prefix), s(a.local));
             if p == "xmlns" || (p.is_empty() && l == "xmlns") {
                 continue;

@@ -9,6 +9,7 @@
 //! spanning tree is the URDF `<joint>` tree, and every `mech:loop_joint` closes a loop.
 
 mod base;
+mod byte_class;
 mod dom;
 #[cfg(test)]
 mod dom_tests;

@@ -188,11 +188,12 @@ pub(super) fn suggest<'a>(name: &str, known: impl IntoIterator<Item = &'a str>) 
     }
 }
 
-/// Checks the attributes (unqualified or `mech:`) and child elements of `node`.
+/// Checks the attributes (unqualified or `mech:`) and child elements of `node`; `what`
+/// describes it in messages (formatted only for an error).
 fn check_node(
     src: &Source,
     node: Node,
-    what: &str,
+    what: &dyn Fn() -> String,
     attributes: &[&str],
     children: &[Child],
 ) -> Result<()> {
@@ -202,7 +203,8 @@ fn check_node(
             return Err(src.error(
                 node,
                 format!(
-                    "{what} has no attribute `{}`: {}",
+                    "{} has no attribute `{}`: {}",
+                    what(),
                     a.name(),
                     suggest(a.name(), attributes.iter().copied())
                 ),
@@ -223,7 +225,7 @@ fn check_node(
                 .unwrap_or_default();
             return Err(src.error(
                 c,
-                format!("{what}{named} has a second <{name}>: it takes one"),
+                format!("{}{named} has a second <{name}>: it takes one", what()),
             ));
         }
         seen.push(name);
@@ -231,7 +233,8 @@ fn check_node(
             return Err(src.error(
                 c,
                 format!(
-                    "{what} has no child element <{name}>: {}",
+                    "{} has no child element <{name}>: {}",
+                    what(),
                     suggest(name, children.iter().map(|s| s.name))
                 ),
             ));
@@ -239,7 +242,7 @@ fn check_node(
         check_node(
             src,
             c,
-            &format!("<{name}> of {what}"),
+            &|| format!("<{name}> of {}", what()),
             spec.attributes,
             spec.children,
         )?;
@@ -267,7 +270,10 @@ pub(super) fn check(src: &Source, robot: Node, warnings: &mut Vec<String>) -> Re
                 ));
             }
         }
-        if let Some(a) = n.attributes().find(|a| a.namespace() == Some(MECH_NS)) {
+        if let Some(a) = n
+            .namespaced_attributes()
+            .find(|a| a.namespace() == Some(MECH_NS))
+        {
             if !n
                 .ancestors()
                 .any(|x| x.tag_name().namespace() == Some(MECH_NS))
@@ -300,7 +306,7 @@ pub(super) fn check(src: &Source, robot: Node, warnings: &mut Vec<String>) -> Re
             check_node(
                 src,
                 n,
-                &format!("<mech:{name}>"),
+                &|| format!("<mech:{name}>"),
                 spec.attributes,
                 spec.children,
             )?;

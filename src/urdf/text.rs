@@ -309,10 +309,12 @@ fn options() -> roxmltree::ParsingOptions {
 
 /// Refuses a xacro file: an element in a xacro namespace or an attribute with `${`.
 fn refuse_xacro(doc: &Document, file: &str) -> Result<()> {
-    // Neither can appear without `${` or `xacro` in the text, or an entity reference that
-    // would spell one (a byte search; the element scan walks every attribute of the file).
+    // Neither can appear without a `$` in the text and a namespace URI with `xacro` (every
+    // element's namespace is one of the document's URIs), or an entity reference that would
+    // spell one (byte searches; the element scan walks every attribute of the file).
     let text = doc.input_text();
-    if !text.contains("${") && !text.contains("xacro") && !text.contains('&') {
+    let b = text.as_bytes();
+    if !b.contains(&b'$') && !doc.mentions_uri("xacro") && !b.contains(&b'&') {
         return Ok(());
     }
     for n in doc.descendants().filter(|n| n.is_element()) {

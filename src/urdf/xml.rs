@@ -163,7 +163,9 @@ impl<'a> Source<'a> {
         let mut words = s.split_whitespace();
         let mut ok = true;
         for o in out.iter_mut() {
-            match words.next().and_then(parse_f64) {
+            // A word has no surrounding whitespace: parsed without `trim`.
+            let number = |w: &str| w.parse::<f64>().ok().filter(|v| v.is_finite());
+            match words.next().and_then(number) {
                 Some(v) => *o = v,
                 None => ok = false,
             }

@@ -1,0 +1,144 @@
+//! Pretty JSON, byte for byte as `serde_json`'s `PrettyFormatter` writes it (a value or key
+//! per line, two spaces a level, `": "` after a key, `[]` and `{}` when empty), with each
+//! separator, line break and indentation written at once from one static run of spaces
+//! instead of a write per level.
+
+use serde_json::ser::Formatter;
+use std::io;
+
+/// `,`, a line break and the indentation of [`MAX_LEVEL`] levels: the line break before a
+/// first entry at level `l` is `BREAK[1..2 + 2 l]`, before a later one `BREAK[..2 + 2 l]`.
+const BREAK: &[u8; 2 + 2 * MAX_LEVEL] = &{
+    let mut b = [b' '; 2 + 2 * MAX_LEVEL];
+    b[0] = b',';
+    b[1] = b'\n';
+    b
+};
+
+/// The deepest level indented from [`BREAK`] (deeper ones are written level by level).
+const MAX_LEVEL: usize = 31;
+
+/// The formatter: the current level and whether the innermost array or object has an entry.
+#[derive(Debug, Default)]
+pub(super) struct Indented {
+    level: usize,
+    has_value: bool,
+}
+
+impl Indented {
+    /// A line break at the current level, after `,` unless `first`.
+    fn line<W: ?Sized + io::Write>(&self, w: &mut W, first: bool) -> io::Result<()> {
+        let from = usize::from(first);
+        match BREAK.get(from..2 + 2 * self.level) {
+            Some(run) => w.write_all(run),
+            None => {
+                w.write_all(&BREAK[from..2])?;
+                for _ in 0..self.level {
+                    w.write_all(b"  ")?;
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+impl Formatter for Indented {
+    fn begin_array<W: ?Sized + io::Write>(&mut self, w: &mut W) -> io::Result<()> {
+        self.level += 1;
+        self.has_value = false;
+        w.write_all(b"[")
+    }
+
+    fn end_array<W: ?Sized + io::Write>(&mut self, w: &mut W) -> io::Result<()> {
+        self.level -= 1;
+        if self.has_value {
+            self.line(w, true)?;
+        }
+        w.write_all(b"]")
+    }
+
+    fn begin_array_value<W: ?Sized + io::Write>(
+        &mut self,
+        w: &mut W,
+        first: bool,
+    ) -> io::Result<()> {
+        self.line(w, first)
+    }
+
+    fn end_array_value<W: ?Sized + io::Write>(&mut self, _w: &mut W) -> io::Result<()> {
+        self.has_value = true;
+        Ok(())
+    }
+
+    fn begin_object<W: ?Sized + io::Write>(&mut self, w: &mut W) -> io::Result<()> {
+        self.level += 1;
+        self.has_value = false;
+        w.write_all(b"{")
+    }
+
+    fn end_object<W: ?Sized + io::Write>(&mut self, w: &mut W) -> io::Result<()> {
+        self.level -= 1;
+        if self.has_value {
+            self.line(w, true)?;
+        }
+        w.write_all(b"}")
+    }
+
+    fn begin_object_key<W: ?Sized + io::Write>(
+        &mut self,
+        w: &mut W,
+        first: bool,
+    ) -> io::Result<()> {
+        self.line(w, first)
+    }
+
+    fn begin_object_value<W: ?Sized + io::Write>(&mut self, w: &mut W) -> io::Result<()> {
+        w.write_all(b": ")
+    }
+
+    fn end_object_value<W: ?Sized + io::Write>(&mut self, _w: &mut W) -> io::Result<()> {
+        self.has_value = true;
+        Ok(())
+    }
+}
+
+/// `value` as pretty JSON text, as `serde_json::to_string_pretty` writes it.
+///
+/// # Errors
+/// The serializer's error (a map key that is not a string).
+pub fn pretty_json<T: serde::Serialize + ?Sized>(value: &T) -> serde_json::Result<Vec<u8>> {
+    let mut out = Vec::with_capacity(4096);
+    let mut ser = serde_json::Serializer::with_formatter(&mut out, Indented::default());
+    value.serialize(&mut ser)?;
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The same bytes as `serde_json`'s pretty printer, on empty and nested arrays and
+    /// objects, non-finite numbers, escapes and levels deeper than the static run.
+    #[test]
+    fn same_bytes_as_serde_json_pretty() {
+        let mut deep = serde_json::json!([1, {"k": []}]);
+        for k in 0..40 {
+            deep = serde_json::json!({ format!("level{k}"): [deep, {}, [], k] });
+        }
+        let values = [
+            serde_json::json!(null),
+            serde_json::json!([]),
+            serde_json::json!({}),
+            serde_json::json!({"a": [], "b": {}, "c": [[], [{}]], "d": "q\"\n\u{1}é"}),
+            serde_json::json!([1.5, -0.0, 1e300, 2.2250738585072014e-308, 7, -3]),
+            deep,
+        ];
+        for v in &values {
+            let ours = String::from_utf8(pretty_json(v).unwrap()).unwrap();
+            assert_eq!(ours, serde_json::to_string_pretty(v).unwrap());
+        }
+        let floats = [f64::NAN, f64::INFINITY, 0.1, 1.0 / 3.0];
+        let ours = String::from_utf8(pretty_json(&floats).unwrap()).unwrap();
+        assert_eq!(ours, serde_json::to_string_pretty(&floats).unwrap());
+    }
+}

@@ -227,7 +227,9 @@ impl Block {
     pub(crate) fn best_pivot(&self, free: &[bool; 7], tol: f64) -> Option<(usize, usize)> {
         let (mut best, mut bar) = (None, 0.0);
         for (i, row) in self.a.chunks_exact(self.w).enumerate() {
-            if !self.live[i] {
+            // No entry of a copy exceeds its maximum: a copy whose maximum cannot pass the bar
+            // is not read (the same choice as reading it; `bar` is 0 before the first).
+            if !self.live[i] || self.rmax[i] <= bar {
                 continue;
             }
             let least = THRESHOLD * self.rmax[i];

@@ -106,11 +106,9 @@ fn sparse_dof(model: &Model, start: State, cons: Constraints) -> Result<usize> {
     if energy.is_none() {
         return Err(undefined(model, &state));
     }
-    // Closed loops and mimics couple bodies beyond a joint's two: their elimination has fill
-    // between bodies, where the fill-free route would give up; the partition counts them.
-    let fast = if super::coupled(model) {
-        None
-    } else {
+    // The count of the sparse partition's pivots on dense copies; where that route gives up
+    // (a long loop, a contact row carried on), the partition counts them.
+    let fast = {
         let jac = &sys.work.jac;
         let scaling = &sys.problem.scaling;
         super::rank::free_columns(

@@ -39,8 +39,6 @@ mod lexicographic;
 mod model_rows;
 mod pose;
 mod rank;
-mod rank_block;
-mod rank_rows;
 mod reduced;
 mod run;
 mod unilateral;
@@ -158,8 +156,8 @@ pub struct Verification {
     pub unilateral: UnilateralCheck,
 }
 
-/// Whether closed loops or mimics couple bodies beyond a joint's two: their elimination has
-/// fill between bodies, where the fill-free route of module `rank` would give up.
+/// Whether closed loops or mimics couple bodies beyond a joint's two (no tree count of the
+/// degrees of freedom).
 fn coupled(model: &Model) -> bool {
     model.joints.iter().any(|j| !j.tree && !j.merged) || !model.mimics.is_empty()
 }

@@ -129,14 +129,29 @@ impl Backend {
     ) -> Partition {
         let scaling = &problem.scaling;
         match self {
-            Backend::Sparse | Backend::Tree => crate::solver::sparse::partition::partition(
-                problem.model,
-                problem.cons.len(),
-                coordinates,
-                &jac.entries,
-                &scaling.rows,
-                &scaling.columns,
-            ),
+            Backend::Sparse | Backend::Tree => {
+                let (model, m, n) = (problem.model, problem.cons.len(), coordinates);
+                let (rows, columns) = (&scaling.rows, &scaling.columns);
+                // The same partition, on dense copies of each body's rows where they answer.
+                crate::solver::sparse::fill_free::partition(
+                    model,
+                    m,
+                    n,
+                    &jac.entries,
+                    rows,
+                    columns,
+                )
+                .unwrap_or_else(|| {
+                    crate::solver::sparse::partition::partition(
+                        model,
+                        m,
+                        n,
+                        &jac.entries,
+                        rows,
+                        columns,
+                    )
+                })
+            }
             Backend::Dense => partition(&jac.to_dense(), &scaling.rows, &scaling.columns),
         }
     }

@@ -2,24 +2,24 @@
 //! Jacobian's triplets (grouped by ascending row): row `r`'s scaled entries
 //! `a_rc = row_scale[r] · v · scale[c]` (duplicates summed in triplet order, zeros dropped; in
 //! the order of their first nonzero term, which no reader depends on), with what the
-//! elimination of module `rank` reads of them: each row's largest entry `max_c |a_rc|`, the
+//! elimination of module `fill_free` reads of them: each row's largest entry `max_c |a_rc|`, the
 //! rows touching each body, the body of each row lying on one body alone and its reach there
 //! (its largest entry in the translation columns and in the Euler-parameter columns).
 
 /// The expanded rows: row `r` is `entries[at[r]..at[r + 1]]`.
-pub(super) struct Rows {
-    pub(super) entries: Vec<(usize, f64)>,
-    pub(super) at: Vec<usize>,
+pub(crate) struct Rows {
+    pub(crate) entries: Vec<(usize, f64)>,
+    pub(crate) at: Vec<usize>,
     /// `max_c |a_rc|` of each row (0 for an empty one).
-    pub(super) rmax: Vec<f64>,
+    pub(crate) rmax: Vec<f64>,
     /// The body of each row whose entries all lie on one body (`usize::MAX` otherwise).
-    pub(super) own_of: Vec<usize>,
+    pub(crate) own_of: Vec<usize>,
     /// The reach of those rows on their body: `[translations, Euler parameters]`.
-    pub(super) reach: Vec<[f64; 2]>,
+    pub(crate) reach: Vec<[f64; 2]>,
     /// The rows touching body `b` (ascending; a row once per run of its entries on `b`):
     /// `body_rows[body_start[b]..body_start[b + 1]]`.
-    pub(super) body_start: Vec<usize>,
-    pub(super) body_rows: Vec<usize>,
+    pub(crate) body_start: Vec<usize>,
+    pub(crate) body_rows: Vec<usize>,
     /// The bodies of each row's runs of entries on one body: `runs[run_at[r]..run_at[r + 1]]`.
     runs: Vec<usize>,
     run_at: Vec<usize>,
@@ -28,7 +28,7 @@ pub(super) struct Rows {
 impl Rows {
     /// The rows of the `m × n` triplets `entries` with their scales, `None` unless the
     /// triplets are grouped by ascending row and inside the matrix.
-    pub(super) fn new(
+    pub(crate) fn new(
         m: usize,
         n: usize,
         entries: &[(usize, usize, f64)],
@@ -156,17 +156,17 @@ impl Rows {
     }
 
     /// Row `r`'s entries.
-    pub(super) fn row(&self, r: usize) -> &[(usize, f64)] {
+    pub(crate) fn row(&self, r: usize) -> &[(usize, f64)] {
         &self.entries[self.at[r]..self.at[r + 1]]
     }
 
     /// The bodies row `r` touches (a body once per run of its entries there).
-    pub(super) fn bodies(&self, r: usize) -> &[usize] {
+    pub(crate) fn bodies(&self, r: usize) -> &[usize] {
         &self.runs[self.run_at[r]..self.run_at[r + 1]]
     }
 
     /// The rows touching body `b`, each once (ascending).
-    pub(super) fn touching(&self, b: usize, out: &mut Vec<usize>) {
+    pub(crate) fn touching(&self, b: usize, out: &mut Vec<usize>) {
         out.clear();
         out.extend_from_slice(&self.body_rows[self.body_start[b]..self.body_start[b + 1]]);
         out.dedup();

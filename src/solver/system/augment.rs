@@ -254,7 +254,8 @@ mod tests {
     }
 
     /// The augmentation adds `Σ_k R_k ∇Φ_k ∇Φ_kᵀ` over the independent rows, with `R_k` as the
-    /// module says, computed here densely from the triplets; and a second assembly under the
+    /// module says, computed here densely from the triplets (`c ∈ row k`: the coordinates of
+    /// the bodies of its triplets); and a second assembly under the
     /// same partition (the plan reused) adds exactly what a fresh plan adds.
     #[test]
     fn augmentation_adds_the_weighted_gram_matrix_of_the_independent_rows() {
@@ -276,7 +277,8 @@ mod tests {
             let before = dense(&sys.work.hess, n);
             sys.augment(&part);
             let after = dense(&sys.work.hess, n);
-            // Reference: ρ_k from W's scaled diagonal, the row's gradient from the triplets.
+            // Reference: ρ_k from W's scaled diagonal over the coordinates of the row's bodies
+            // (a normalization's entries), the row's gradient from the triplets.
             let cols = &sys.problem.scaling.columns;
             let wdiag: Vec<f64> = (0..n)
                 .map(|c| before[(c, c)].abs() * cols[c].powi(2))
@@ -288,7 +290,12 @@ mod tests {
                 let mut reach = floor;
                 for e in sys.work.jac.entries.iter().filter(|e| e.0 == r) {
                     g[e.1] += e.2;
-                    reach = reach.max(wdiag[e.1]);
+                    let body = e.1 - e.1 % 7;
+                    if sys.problem.cons.is_normalization(r) {
+                        reach = reach.max(wdiag[e.1]);
+                    } else {
+                        reach = wdiag[body..body + 7].iter().fold(reach, |a, &x| a.max(x));
+                    }
                 }
                 let rho = reach * sys.problem.scaling.rows[r].powi(2);
                 expected += &g * g.transpose() * rho;

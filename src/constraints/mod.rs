@@ -325,16 +325,22 @@ impl Constraints {
             if let Some(t) = jac {
                 // The entries of the row's pattern, zeros too: the sparsity pattern must not
                 // depend on `q`. Those outside it are zero at every `q` (`Row::pattern`).
-                if pattern == ALL {
-                    if let [Some(a), Some(b)] = bodies {
-                        // One exact-size run (the same triplets, in the same order, as below).
-                        let (a, b) = (7 * a.0, 7 * b.0);
+                if let [Some(a), Some(b)] = bodies {
+                    // One exact-size run (the same triplets, in the same order, as below).
+                    let (a, b) = (7 * a.0, 7 * b.0);
+                    if pattern == ALL {
                         t.entries.extend((0..crate::jet::NL).map(|i| {
                             let gi = if i < 7 { a + i } else { b + i - 7 };
                             (row, gi, c * s.g[i])
                         }));
-                        return;
+                    } else {
+                        let kept = (0..crate::jet::NL).filter(|i| pattern & (1 << i) != 0);
+                        t.entries.extend(kept.map(|i| {
+                            let gi = if i < 7 { a + i } else { b + i - 7 };
+                            (row, gi, c * s.g[i])
+                        }));
                     }
+                    return;
                 }
                 let mut bits = pattern;
                 while bits != 0 {

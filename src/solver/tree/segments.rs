@@ -97,6 +97,9 @@ impl Segments {
         for s in &self.seg[self.at[i] as usize..self.at[i + 1] as usize] {
             let (rows, cols, v) = self.parts(s, off);
             match cols.len() {
+                3 => forward_fixed::<3>(rows, cols, v, x),
+                4 => forward_fixed::<4>(rows, cols, v, x),
+                5 => forward_fixed::<5>(rows, cols, v, x),
                 6 => forward_fixed::<6>(rows, cols, v, x),
                 7 => forward_fixed::<7>(rows, cols, v, x),
                 c if c <= GATHER => {
@@ -128,6 +131,9 @@ impl Segments {
         for s in &self.seg[self.at[i] as usize..self.at[i + 1] as usize] {
             let (rows, cols, v) = self.parts(s, off);
             match cols.len() {
+                3 if s.distinct => transposed_fixed::<3>(rows, cols, v, x),
+                4 if s.distinct => transposed_fixed::<4>(rows, cols, v, x),
+                5 if s.distinct => transposed_fixed::<5>(rows, cols, v, x),
                 6 if s.distinct => transposed_fixed::<6>(rows, cols, v, x),
                 7 if s.distinct => transposed_fixed::<7>(rows, cols, v, x),
                 c if s.distinct && c <= GATHER => {

@@ -235,7 +235,10 @@ impl Constraints {
                     let j = &model.joints[id.0];
                     let pair = pair_of(&j.bodies, q, hess);
                     if let Some(s) = coordinate(j, &pair, *dof, self.branches.get(*id, *dof)) {
-                        visit(block.first, Term::Jet(&j.bodies, &s.minus(*value), 1.0, ALL));
+                        visit(
+                            block.first,
+                            Term::Jet(&j.bodies, &s.minus(*value), 1.0, ALL),
+                        );
                     }
                 }
                 BlockKind::Unilateral(a) => {
@@ -369,7 +372,15 @@ impl Constraints {
                 crate::jet::closed::rows(j, pair, &mut closed);
                 let layout = j.kind.spec().rows;
                 for (k, (s, r)) in closed.iter().zip(layout).enumerate() {
-                    push(phi, jac.as_deref_mut(), row + k, &j.bodies, s, 1.0, r.pattern());
+                    push(
+                        phi,
+                        jac.as_deref_mut(),
+                        row + k,
+                        &j.bodies,
+                        s,
+                        1.0,
+                        r.pattern(),
+                    );
                 }
             }
             Term::Normalization(b) => {

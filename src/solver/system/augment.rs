@@ -141,7 +141,11 @@ impl System<'_> {
         // Each body's largest `D_c² |W_cc|` (a maximum: the same in any order).
         let mut body_max = std::mem::take(&mut work.body_max);
         body_max.clear();
-        body_max.extend(wdiag.chunks_exact(7).map(|w| w.iter().fold(floor, |a, &x| a.max(x))));
+        body_max.extend(
+            wdiag
+                .chunks_exact(7)
+                .map(|w| w.iter().fold(floor, |a, &x| a.max(x))),
+        );
         // The pending body pair and its accumulated `Σ ρ g gᵀ` (handed to the sink as it is).
         let mut pending: Option<[Option<BodyId>; 2]> = None;
         let mut acc = LMat::zeros();

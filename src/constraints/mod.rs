@@ -10,6 +10,7 @@ mod pair_sum;
 pub(crate) mod unilateral;
 
 use crate::jet::{closed, pair_of, HessianSink, Scalar};
+use crate::joint::{Pattern, ALL};
 use crate::kinematics::{coordinate, Branches};
 use crate::model::{BodyId, JointId, Model};
 use nalgebra::{DMatrix, DVector};
@@ -60,9 +61,10 @@ pub(crate) struct Block {
     pub(crate) first: usize,
 }
 
-/// One contribution to a row: `c f` for a local jet `f` of a body pair, or a normalization row.
+/// One contribution to a row: `c f` for a local jet `f` of a body pair (its entries outside
+/// the [`Pattern`] zero at every `q`, left out of `Φ_q`'s triplets), or a normalization row.
 enum Term<'a> {
-    Jet(&'a [Option<BodyId>; 2], &'a Scalar, f64),
+    Jet(&'a [Option<BodyId>; 2], &'a Scalar, f64, Pattern),
     Normalization(BodyId),
     /// The rows of a joint with closed-form derivatives ([`crate::jet::closed`]), from
     /// `row` on.
@@ -219,8 +221,9 @@ impl Constraints {
                         continue;
                     }
                     joint::rows(j, &pair, self.branches.get(*id, 0), &mut buf);
-                    for (k, s) in buf.iter().enumerate() {
-                        visit(block.first + k, Term::Jet(&j.bodies, s, 1.0));
+                    let layout = j.kind.spec().rows;
+                    for (k, (s, row)) in buf.iter().zip(layout).enumerate() {
+                        visit(block.first + k, Term::Jet(&j.bodies, s, 1.0, row.pattern()));
                     }
                 }
                 BlockKind::Normalization(b) => visit(block.first, Term::Normalization(*b)),
@@ -232,7 +235,10 @@ impl Constraints {
                     let j = &model.joints[id.0];
                     let pair = pair_of(&j.bodies, q, hess);
                     if let Some(s) = coordinate(j, &pair, *dof, self.branches.get(*id, *dof)) {
-                        visit(block.first, Term::Jet(&j.bodies, &s.minus(*value), 1.0));
+                        visit(
+                            block.first,
+                            Term::Jet(&j.bodies, &s.minus(*value), 1.0, ALL),
+                        );
                     }
                 }
                 BlockKind::Unilateral(a) => {
@@ -247,7 +253,7 @@ impl Constraints {
                         .is_some()
                     {
                         for (k, s) in buf.iter().enumerate() {
-                            visit(block.first + k, Term::Jet(&bodies, s, 1.0));
+                            visit(block.first + k, Term::Jet(&bodies, s, 1.0, ALL));
                         }
                     }
                 }
@@ -261,12 +267,31 @@ impl Constraints {
                         coordinate(ja, &pa, 0, self.branches.get(m.joint, 0)),
                         coordinate(jb, &pb, 0, self.branches.get(m.reference, 0)),
                     ) {
-                        visit(block.first, Term::Jet(&ja.bodies, &a.minus(m.offset), 1.0));
-                        visit(block.first, Term::Jet(&jb.bodies, &b, -m.multiplier));
+                        let a = a.minus(m.offset);
+                        visit(block.first, Term::Jet(&ja.bodies, &a, 1.0, ALL));
+                        visit(block.first, Term::Jet(&jb.bodies, &b, -m.multiplier, ALL));
                     }
                 }
             }
         }
+    }
+
+    /// An upper bound on the number of triplets of `Φ_q`: the entries of each joint row's
+    /// pattern, 14 for every other row (a mimic row's two jets: 28).
+    fn triplet_bound(&self, model: &Model) -> usize {
+        let mut bound = 0;
+        for (k, block) in self.blocks.iter().enumerate() {
+            let end = self.blocks.get(k + 1).map_or(self.len, |b| b.first);
+            bound += match &block.kind {
+                BlockKind::Joint(id) => {
+                    let rows = model.joints[id.0].kind.spec().rows;
+                    rows.iter().map(|r| r.pattern().count_ones() as usize).sum()
+                }
+                BlockKind::Mimic(_) => 28,
+                _ => 14 * (end - block.first),
+            };
+        }
+        bound
     }
 
     /// `Φ(q)` into `phi`, and `Φ_q` into `jac` when given.
@@ -282,10 +307,10 @@ impl Constraints {
             t.rows = self.len;
             t.cols = q.len();
             t.entries.clear();
-            // At most 14 entries a row (two bodies) but for mimic rows: reserve once, exactly,
-            // rather than by doubling (a quarter of the triplets' memory on large models).
+            // Reserve once, exactly, rather than by doubling (a quarter of the triplets' memory
+            // on large models).
             if t.entries.capacity() == 0 {
-                t.entries.reserve_exact(14 * self.len);
+                t.entries.reserve_exact(self.triplet_bound(model));
             }
         }
         let mut closed_values = Vec::with_capacity(6);
@@ -296,21 +321,33 @@ impl Constraints {
             bodies: &[Option<BodyId>; 2],
             (v, g): (f64, &crate::jet::LVec),
             c: f64,
+            pattern: Pattern,
         ) {
             phi[row] += c * v;
             if let Some(t) = jac {
-                // Zeros too: the sparsity pattern must not depend on `q`. A row on two bodies
-                // writes its 14 entries in one exact-size run (the same triplets, in the same
-                // order, as the loop below).
+                // The entries of the row's pattern, zeros too: the sparsity pattern must not
+                // depend on `q`. Those outside it are zero at every `q` (`Row::pattern`).
                 if let [Some(a), Some(b)] = bodies {
+                    // One exact-size run (the same triplets, in the same order, as below).
                     let (a, b) = (7 * a.0, 7 * b.0);
-                    t.entries.extend((0..crate::jet::NL).map(|i| {
-                        let gi = if i < 7 { a + i } else { b + i - 7 };
-                        (row, gi, c * g[i])
-                    }));
+                    if pattern == ALL {
+                        t.entries.extend((0..crate::jet::NL).map(|i| {
+                            let gi = if i < 7 { a + i } else { b + i - 7 };
+                            (row, gi, c * g[i])
+                        }));
+                    } else {
+                        let kept = (0..crate::jet::NL).filter(|i| pattern & (1 << i) != 0);
+                        t.entries.extend(kept.map(|i| {
+                            let gi = if i < 7 { a + i } else { b + i - 7 };
+                            (row, gi, c * g[i])
+                        }));
+                    }
                     return;
                 }
-                for i in 0..crate::jet::NL {
+                let mut bits = pattern;
+                while bits != 0 {
+                    let i = bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
                     if let Some(gi) = crate::jet::global_index(bodies, i) {
                         t.entries.push((row, gi, c * g[i]));
                     }
@@ -319,7 +356,9 @@ impl Constraints {
         }
         let values_only = jac.is_none();
         self.for_each_row(model, q, false, values_only, |row, term| match term {
-            Term::Jet(bodies, s, c) => push(phi, jac.as_deref_mut(), row, bodies, (s.v, &s.g), c),
+            Term::Jet(bodies, s, c, pattern) => {
+                push(phi, jac.as_deref_mut(), row, bodies, (s.v, &s.g), c, pattern);
+            }
             // `push`'s `phi[row] += 1.0 · v`.
             Term::Value(v) => phi[row] += 1.0 * v,
             Term::Closed(j, pair) if jac.is_none() => {
@@ -329,19 +368,11 @@ impl Constraints {
                 }
             }
             Term::Closed(j, pair) => {
+                let layout = j.kind.spec().rows;
                 crate::jet::closed::rows_each(j, pair, |k, v, g| {
-                    push(phi, jac.as_deref_mut(), row + k, &j.bodies, (v, g), 1.0);
+                    let pattern = layout[k].pattern();
+                    push(phi, jac.as_deref_mut(), row + k, &j.bodies, (v, g), 1.0, pattern);
                 });
-            }
-            Term::Normalization(b) => {
-                let i = 7 * b.0 + 3;
-                let p = q.rows(i, 4);
-                phi[row] = p.dot(&p) - 1.0;
-                if let Some(t) = jac.as_deref_mut() {
-                    for k in 0..4 {
-                        t.entries.push((row, i + k, 2.0 * q[i + k]));
-                    }
-                }
             }
         });
     }
@@ -357,7 +388,7 @@ impl Constraints {
     ) {
         let mut sum = PairSum::new();
         self.for_each_row(model, q, true, false, |row, term| match term {
-            Term::Jet(bodies, s, c) => {
+            Term::Jet(bodies, s, c, _) => {
                 if w[row] != 0.0 {
                     sum.of(bodies, h);
                     if let Some(sh) = s.h.as_deref() {

@@ -35,6 +35,6 @@ mod universal;
 pub use kind::JointKind;
 pub(crate) use kind::MAX_SCALAR_COORDINATES;
 pub use spec::{Declared, Name};
-pub(crate) use spec::{Entry, Frame, Read, Row, Spec, TreeMotion, V};
+pub(crate) use spec::{Entry, Frame, Pattern, Read, Row, Spec, TreeMotion, ALL, V};
 pub(crate) use table::spec;
 pub use table::{joint_type, joint_types, JointType, KINDS};

@@ -44,6 +44,34 @@ pub(crate) enum Row {
     Thread,
 }
 
+/// A row's entries on the pair's 14 coordinates (`7 side + k`, `k`: `x y z e0 e1 e2 e3`) that
+/// are not zero at every configuration, as bits ([`Row::pattern`]).
+pub(crate) type Pattern = u16;
+
+/// Every entry of the pair.
+pub(crate) const ALL: Pattern = (1 << 14) - 1;
+
+/// The Euler parameters of both sides.
+const EULER: Pattern = 0b1111000 | 0b1111000 << 7;
+
+impl Row {
+    /// The entries of the row's gradient that can be nonzero (the others are zero at every
+    /// `q`, by the row's form): with `∂u/∂r_k = t_k I` for a vector `u` of side `k` (`t = 1`
+    /// for a point, `0` for an axis, `±1` for `d`), the position entries of
+    ///
+    /// - a component `d_m`: `∂d_m/∂r_k = t_k e_m`, so only `r_k`'s component `m`;
+    /// - a dot product of two axes `aᵀb`: `t^a = t^b = 0`, so none;
+    ///
+    /// and every entry of a row with `d` in a product (`a_iᵀ d`, `dᵀd`, the thread).
+    pub(crate) const fn pattern(self) -> Pattern {
+        match self {
+            Row::Component(m) => EULER | (1 << m) | (1 << (7 + m)),
+            Row::Dot(V::D, _) | Row::Dot(_, V::D) | Row::Length | Row::Thread => ALL,
+            Row::Dot(_, _) => EULER,
+        }
+    }
+}
+
 /// How a scalar coordinate is read from the joint frames.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Read {

@@ -200,3 +200,40 @@ fn motion_satisfies_the_rows_and_reads_back_its_values() {
         }
     }
 }
+
+/// Each row's pattern ([`crate::joint::Row::pattern`]) holds its gradient's entries that are
+/// not zero at every `q`: at random poses and frames, the entries left out are exactly zero in
+/// closed form and in the generic jets (a pattern that left out a nonzero entry fails here),
+/// and every entry kept is nonzero at some pose (none kept for nothing).
+#[test]
+fn row_patterns_leave_out_only_entries_zero_at_every_pose() {
+    for kind in kinds() {
+        let j = joint(kind);
+        let layout = kind.spec().rows;
+        let mut seen = vec![0u16; layout.len()];
+        for seed in 0..8 {
+            let pair = sample_pair(seed);
+            let mut jets = Vec::new();
+            rows(&j, &pair, 0.0, &mut jets);
+            let mut closed_rows = Vec::new();
+            closed::rows(&j, &pair, &mut closed_rows);
+            for (r, row) in layout.iter().enumerate() {
+                let pattern = row.pattern();
+                let what = |i| format!("{} row {} entry {i}", kind.name(), row_names(&j)[r]);
+                for s in std::iter::once(&jets[r]).chain(closed_rows.get(r)) {
+                    for i in 0..crate::jet::NL {
+                        if pattern & (1 << i) == 0 {
+                            assert_eq!(s.g[i], 0.0, "{} seed {seed}", what(i));
+                        } else if s.g[i] != 0.0 {
+                            seen[r] |= 1 << i;
+                        }
+                    }
+                }
+            }
+        }
+        for (r, row) in layout.iter().enumerate() {
+            let name = row_names(&j)[r];
+            assert_eq!(seen[r], row.pattern(), "{} row {name}", kind.name());
+        }
+    }
+}

@@ -1,6 +1,8 @@
 //! The augmentation of the KKT system's `W` block: `W += Φ_qᵀ D R D Φ_q` over the independent
 //! rows (module `kkt`), with `R_k = max(ρ₀, max_{c ∈ row k} D_c² |W_cc|) d_k²` and
-//! `ρ₀ = 10⁻⁶ max_c D_c² |W_cc| + 10⁻¹²`.
+//! `ρ₀ = 10⁻⁶ max_c D_c² |W_cc| + 10⁻¹²`, where `c ∈ row k` runs over the coordinates of the
+//! bodies the row is on (all 7 of each, its entries that are zero at every `q` included:
+//! `joint::Row::pattern`), a normalization row's Euler parameters alone.
 //!
 //! A row on one or two bodies adds `ρ g gᵀ` to their `14 × 14` pair block (`g` the row's
 //! entries in the pair's local order); consecutive rows on the same pair are summed before
@@ -10,6 +12,7 @@
 //! runs over the values.
 
 use super::System;
+use crate::constraints::Constraints;
 use crate::jet::{HessianSink, LMat, EULER, NL};
 use crate::model::BodyId;
 use crate::solver::partition::Partition;
@@ -21,6 +24,9 @@ struct Group {
     row: usize,
     /// The row's bodies in order of first appearance; `None` for a row on more than two.
     bodies: Option<[Option<BodyId>; 2]>,
+    /// Whether `R_k`'s reach runs over all 7 coordinates of the bodies (every row on one or
+    /// two bodies but a normalization), else over the row's entries.
+    whole_bodies: bool,
 }
 
 /// The rows of the augmentation under one partition and one triplet pattern.
@@ -33,7 +39,12 @@ pub(crate) struct AugmentPlan {
 }
 
 impl AugmentPlan {
-    fn new(part: &Partition, m: usize, entries: &[(usize, usize, f64)]) -> Self {
+    fn new(
+        part: &Partition,
+        cons: &Constraints,
+        m: usize,
+        entries: &[(usize, usize, f64)],
+    ) -> Self {
         let mut in_part = vec![false; m];
         for &r in &part.rows {
             in_part[r] = true;
@@ -75,6 +86,7 @@ impl AugmentPlan {
                 end,
                 row,
                 bodies: on_two.then_some(bodies),
+                whole_bodies: on_two && !cons.is_normalization(row),
             });
         }
         AugmentPlan {
@@ -123,9 +135,17 @@ impl System<'_> {
         let entries = &work.jac.entries;
         let plan = match work.augment.take() {
             Some(p) if p.fits(part, entries.len()) => p,
-            _ => AugmentPlan::new(part, m, entries),
+            _ => AugmentPlan::new(part, &self.problem.cons, m, entries),
         };
         let floor = 1e-6 * wdiag.iter().fold(0.0f64, |x, &y| x.max(y)) + 1e-12;
+        // Each body's largest `D_c² |W_cc|` (a maximum: the same in any order).
+        let mut body_max = std::mem::take(&mut work.body_max);
+        body_max.clear();
+        body_max.extend(
+            wdiag
+                .chunks_exact(7)
+                .map(|w| w.iter().fold(floor, |a, &x| a.max(x))),
+        );
         // The pending body pair and its accumulated `Σ ρ g gᵀ` (handed to the sink as it is).
         let mut pending: Option<[Option<BodyId>; 2]> = None;
         let mut acc = LMat::zeros();
@@ -142,13 +162,20 @@ impl System<'_> {
                 }
                 continue;
             };
-            // `ρ`'s reach and the row's local entries in one pass (the same maxima in the
-            // same order as the fold above).
             let mut gv: Local = [0.0; 16];
             let mut reach = floor;
-            for (e, &i) in group.iter().zip(&plan.local[range]) {
-                reach = reach.max(wdiag[e.1]);
-                gv[usize::from(i) & 15] += e.2;
+            if g.whole_bodies {
+                for b in bodies.iter().flatten() {
+                    reach = reach.max(body_max[b.0]);
+                }
+                for (e, &i) in group.iter().zip(&plan.local[range]) {
+                    gv[usize::from(i) & 15] += e.2;
+                }
+            } else {
+                for (e, &i) in group.iter().zip(&plan.local[range]) {
+                    reach = reach.max(wdiag[e.1]);
+                    gv[usize::from(i) & 15] += e.2;
+                }
             }
             let rho = reach * row_scale;
             if pending != Some(bodies) {
@@ -165,6 +192,7 @@ impl System<'_> {
         }
         work.augment = Some(plan);
         work.wdiag = wdiag;
+        work.body_max = body_max;
     }
 }
 
@@ -230,7 +258,8 @@ mod tests {
     }
 
     /// The augmentation adds `Σ_k R_k ∇Φ_k ∇Φ_kᵀ` over the independent rows, with `R_k` as the
-    /// module says, computed here densely from the triplets; and a second assembly under the
+    /// module says, computed here densely from the triplets (`c ∈ row k`: the coordinates of
+    /// the bodies of its triplets); and a second assembly under the
     /// same partition (the plan reused) adds exactly what a fresh plan adds.
     #[test]
     fn augmentation_adds_the_weighted_gram_matrix_of_the_independent_rows() {
@@ -252,7 +281,8 @@ mod tests {
             let before = dense(&sys.work.hess, n);
             sys.augment(&part);
             let after = dense(&sys.work.hess, n);
-            // Reference: ρ_k from W's scaled diagonal, the row's gradient from the triplets.
+            // Reference: ρ_k from W's scaled diagonal over the coordinates of the row's bodies
+            // (a normalization's entries), the row's gradient from the triplets.
             let cols = &sys.problem.scaling.columns;
             let wdiag: Vec<f64> = (0..n)
                 .map(|c| before[(c, c)].abs() * cols[c].powi(2))
@@ -264,7 +294,12 @@ mod tests {
                 let mut reach = floor;
                 for e in sys.work.jac.entries.iter().filter(|e| e.0 == r) {
                     g[e.1] += e.2;
-                    reach = reach.max(wdiag[e.1]);
+                    let body = e.1 - e.1 % 7;
+                    if sys.problem.cons.is_normalization(r) {
+                        reach = reach.max(wdiag[e.1]);
+                    } else {
+                        reach = wdiag[body..body + 7].iter().fold(reach, |a, &x| a.max(x));
+                    }
                 }
                 let rho = reach * sys.problem.scaling.rows[r].powi(2);
                 expected += &g * g.transpose() * rho;

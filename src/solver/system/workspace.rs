@@ -36,10 +36,11 @@ pub(crate) struct Workspace {
     pub(crate) augment: Option<AugmentPlan>,
     /// Scratch of each assembly of `W` (module `reduced`, `augment`): the energy gradient
     /// that comes with its Hessian, the multiplier weights over all rows, `W`'s scaled
-    /// diagonal.
+    /// diagonal and each body's largest entry of it.
     pub(crate) grad: DVector<f64>,
     pub(crate) weights: DVector<f64>,
     pub(crate) wdiag: Vec<f64>,
+    pub(crate) body_max: Vec<f64>,
 }
 
 impl Workspace {
@@ -60,6 +61,7 @@ impl Workspace {
             grad: DVector::zeros(0),
             weights: DVector::zeros(0),
             wdiag: Vec::new(),
+            body_max: Vec::new(),
         }
     }
 }

@@ -2,7 +2,9 @@
 //! `(p, q, v)` are held in the triplets' order; a run of consecutive entries on one row `p` is
 //! a row, and consecutive rows with the same distinct columns `q₁ … q_c` form an `r × c`
 //! segment whose values are already row-major in that order (a joint's rows on its parent's
-//! dependent coordinates: one `5 × 6` segment per body of a chain). The solves' updates
+//! dependent coordinates: on a chain, a revolute joint's two axis rows on the Euler
+//! parameters as one segment and each of its three point rows as one row, since the entries
+//! zero at every `q` are left out of the triplets, `joint::Row::pattern`). The solves' updates
 //!
 //! ```text
 //! Φ_u x = r:   x_p −= Σ_q v_pq x_q    (row by row, q in the entries' order)
@@ -97,6 +99,9 @@ impl Segments {
         for s in &self.seg[self.at[i] as usize..self.at[i + 1] as usize] {
             let (rows, cols, v) = self.parts(s, off);
             match cols.len() {
+                3 => forward_fixed::<3>(rows, cols, v, x),
+                4 => forward_fixed::<4>(rows, cols, v, x),
+                5 => forward_fixed::<5>(rows, cols, v, x),
                 6 => forward_fixed::<6>(rows, cols, v, x),
                 7 => forward_fixed::<7>(rows, cols, v, x),
                 c if c <= GATHER => {
@@ -128,6 +133,9 @@ impl Segments {
         for s in &self.seg[self.at[i] as usize..self.at[i + 1] as usize] {
             let (rows, cols, v) = self.parts(s, off);
             match cols.len() {
+                3 if s.distinct => transposed_fixed::<3>(rows, cols, v, x),
+                4 if s.distinct => transposed_fixed::<4>(rows, cols, v, x),
+                5 if s.distinct => transposed_fixed::<5>(rows, cols, v, x),
                 6 if s.distinct => transposed_fixed::<6>(rows, cols, v, x),
                 7 if s.distinct => transposed_fixed::<7>(rows, cols, v, x),
                 c if s.distinct && c <= GATHER => {
@@ -199,8 +207,9 @@ mod tests {
     use super::*;
 
     /// The segment updates give the entry-by-entry loops' results bit for bit, both ways, on
-    /// uniform blocks (a chain's `5 × 6`, `7`-wide, wide ones), rows of differing columns, a
-    /// repeated column, a row split in two runs and rows longer than the gathered side.
+    /// uniform blocks (`5 × 6`, `7`-wide, 3 to 5 columns as a chain's rows give, wide ones),
+    /// rows of differing columns, a repeated column, a row split in two runs and rows longer
+    /// than the gathered side.
     #[test]
     fn segments_equal_the_entry_loops_bit_for_bit() {
         let mut s = 5u64;
@@ -232,6 +241,9 @@ mod tests {
             .concat(),
             block(&[29, 49], &wide),
             block(&tall, &[50, 51]),
+            block(&[100, 101, 102], &[103, 104, 105, 106, 107]),
+            block(&[108, 109], &[110, 111, 112, 113]),
+            block(&[114, 115], &[116, 117, 118]),
             Vec::new(),
         ];
         let mut off = Vec::new();

@@ -6,8 +6,9 @@
 //! A chain's and a ladder's block sizes (`d` = 8, 13, 14, 27) factor and solve by the
 //! unrolled kernels of module `fixed`: the same operations on each entry in the same order
 //! (the same results to the last bit; `dense_tests` checks them against the general loops
-//! below). The Schur update of a parent's block writes only the lower triangle that
-//! [`ldlt`] reads.
+//! below); so do the products of the solves and the residual (`x −= X y`, `out −= Cᵀ y`),
+//! the LU of `Φ_u`'s blocks (`d` = 6, 7, 13, 14, 21) and a chain's Schur update of a parent's
+//! block, which writes only the lower triangle that [`ldlt`] reads.
 
 use super::fixed;
 
@@ -114,11 +115,11 @@ fn ldlt_solve_impl(f: &[f64], d: usize, x: &mut [f64], w: usize) {
 /// a zero or non-finite pivot.
 pub(crate) fn lu(a: &mut [f64], d: usize, piv: &mut [u16]) -> bool {
     match d {
-        6 => lu_impl(a, 6, piv),
-        7 => lu_impl(a, 7, piv),
-        13 => lu_impl(a, 13, piv),
-        14 => lu_impl(a, 14, piv),
-        21 => lu_impl(a, 21, piv),
+        6 => fixed::lu::<6>(a, piv),
+        7 => fixed::lu::<7>(a, piv),
+        13 => fixed::lu::<13>(a, piv),
+        14 => fixed::lu::<14>(a, piv),
+        21 => fixed::lu::<21>(a, piv),
         _ => lu_impl(a, d, piv),
     }
 }
@@ -249,10 +250,10 @@ fn lu_solve_transpose_impl(f: &[f64], piv: &[u16], d: usize, x: &mut [f64]) {
 /// `out −= Cᵀ y` for a `d × w` row-major `C`.
 pub(crate) fn sub_tr_mul(c: &[f64], y: &[f64], out: &mut [f64], d: usize, w: usize) {
     match (d, w) {
-        (13, 7) => sub_tr_mul_impl(c, y, out, 13, 7),
-        (14, 7) => sub_tr_mul_impl(c, y, out, 14, 7),
-        (14, 18) => sub_tr_mul_impl(c, y, out, 14, 18),
-        (27, 7) => sub_tr_mul_impl(c, y, out, 27, 7),
+        (13, 7) => fixed::sub_tr_mul::<13, 7>(c, y, out),
+        (14, 7) => fixed::sub_tr_mul::<14, 7>(c, y, out),
+        (14, 18) => fixed::sub_tr_mul::<14, 18>(c, y, out),
+        (27, 7) => fixed::sub_tr_mul::<27, 7>(c, y, out),
         _ => sub_tr_mul_impl(c, y, out, d, w),
     }
 }
@@ -271,12 +272,13 @@ fn sub_tr_mul_impl(c: &[f64], y: &[f64], out: &mut [f64], d: usize, w: usize) {
 /// `x −= X y` for a `d × w` row-major `X`.
 pub(crate) fn sub_mul(xm: &[f64], y: &[f64], x: &mut [f64], d: usize, w: usize) {
     match (d, w) {
-        (13, 7) => sub_mul_impl(xm, y, x, 13, 7),
-        (14, 7) => sub_mul_impl(xm, y, x, 14, 7),
-        (13, 13) => sub_mul_impl(xm, y, x, 13, 13),
-        (14, 18) => sub_mul_impl(xm, y, x, 14, 18),
-        (27, 7) => sub_mul_impl(xm, y, x, 27, 7),
-        (27, 27) => sub_mul_impl(xm, y, x, 27, 27),
+        (13, 7) => fixed::sub_mul::<13, 7>(xm, y, x),
+        (14, 7) => fixed::sub_mul::<14, 7>(xm, y, x),
+        (13, 13) => fixed::sub_mul::<13, 13>(xm, y, x),
+        (14, 14) => fixed::sub_mul::<14, 14>(xm, y, x),
+        (14, 18) => fixed::sub_mul::<14, 18>(xm, y, x),
+        (27, 7) => fixed::sub_mul::<27, 7>(xm, y, x),
+        (27, 27) => fixed::sub_mul::<27, 27>(xm, y, x),
         _ => sub_mul_impl(xm, y, x, d, w),
     }
 }
@@ -303,6 +305,14 @@ pub(crate) fn sub_tr_mul_block(
     (d, w, dp): (usize, usize, usize),
     lower: bool,
 ) {
+    if lower {
+        // A chain's sizes (module `fixed`; a ladder's measured slower that way).
+        match (d, w, dp) {
+            (13, 7, 13) => return fixed::sub_tr_mul_lower::<13, 7, 13>(c, x, p),
+            (14, 7, 14) => return fixed::sub_tr_mul_lower::<14, 7, 14>(c, x, p),
+            _ => {}
+        }
+    }
     match (d, w, dp) {
         (13, 7, 13) => sub_tr_mul_block_impl(c, x, p, (13, 7, 13), lower),
         (14, 7, 14) => sub_tr_mul_block_impl(c, x, p, (14, 7, 14), lower),

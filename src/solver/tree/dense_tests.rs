@@ -162,3 +162,85 @@ fn lower_schur_update_is_the_full_ones_lower_triangle() {
         }
     }
 }
+
+/// The unrolled products (`x −= X y`, `out −= Cᵀ y`) and LU are the general loops bit for bit
+/// (a zero multiplier, whose terms LU skips, and signed zeros included).
+#[test]
+fn unrolled_products_and_lu_are_the_general_loops_bit_for_bit() {
+    for (d, w) in [
+        (13, 7),
+        (14, 7),
+        (13, 13),
+        (14, 14),
+        (14, 18),
+        (27, 7),
+        (27, 27),
+    ] {
+        let xm = right_sides(d, w, 11 + d as u64);
+        let (y, x0) = (right_sides(w, 1, 12), right_sides(d, 1, 13));
+        let (mut x, mut g) = (x0.clone(), x0.clone());
+        sub_mul(&xm, &y, &mut x, d, w);
+        sub_mul_impl(&xm, &y, &mut g, d, w);
+        assert!(same_bits(&x, &g), "sub_mul ({d}, {w})");
+        let (mut out, mut h) = (y.clone(), y.clone());
+        sub_tr_mul(&xm, &x0, &mut out, d, w);
+        sub_tr_mul_impl(&xm, &x0, &mut h, d, w);
+        assert!(same_bits(&out, &h), "sub_tr_mul ({d}, {w})");
+    }
+    for d in [6, 7, 13, 14, 21] {
+        let mut a = row_major(&sample(d, d, 21 + d as u64));
+        // Column 1 zero below the diagonal (zero multipliers where the first step leaves
+        // them zero) and a signed zero.
+        for i in 2..d {
+            a[i * d + 1] = 0.0;
+        }
+        a[1] = -0.0;
+        let (mut f, mut g) = (a.clone(), a);
+        let (mut pf, mut pg) = (vec![0u16; d], vec![0u16; d]);
+        assert!(lu(&mut f, d, &mut pf), "d {d}");
+        assert!(lu_impl(&mut g, d, &mut pg), "d {d}");
+        assert_eq!(pf, pg, "d {d}");
+        assert!(same_bits(&f, &g), "lu d {d}");
+    }
+}
+
+/// The unrolled row sums of `|K|` are the general loop's bit for bit, and they are the sums.
+#[test]
+fn unrolled_row_sums_are_the_general_loops_bit_for_bit() {
+    use super::super::norm::{add_node, node_any};
+    for (d, w) in [
+        (13, 7),
+        (13, 0),
+        (14, 7),
+        (14, 0),
+        (8, 7),
+        (27, 7),
+        (14, 18),
+        (27, 0),
+    ] {
+        let blk = kkt_block(d, 31 + d as u64);
+        let c = right_sides(d, w.max(1), 32);
+        let (own0, up0) = (
+            row_major(&sample(d, 1, 33)),
+            row_major(&sample(w.max(1), 1, 34)),
+        );
+        let (mut own, mut up) = (own0.clone(), up0.clone());
+        let (mut own_g, mut up_g) = (own0.clone(), up0.clone());
+        add_node(&blk, &c, &mut own, &mut up[..w], (d, w));
+        node_any(&blk, &c, &mut own_g, &mut up_g[..w], (d, w));
+        assert!(
+            same_bits(&own, &own_g) && same_bits(&up, &up_g),
+            "({d}, {w})"
+        );
+        for a in 0..d {
+            let want = own0[a]
+                + (0..d).map(|b| blk[a * d + b].abs()).sum::<f64>()
+                + (0..w).map(|b| c[a * w + b].abs()).sum::<f64>();
+            assert!((own[a] - want).abs() < 1e-12, "({d}, {w}) row {a}");
+        }
+        for b in 0..w {
+            let want = up0[b] + (0..d).map(|a| c[a * w + b].abs()).sum::<f64>();
+            assert!((up[b] - want).abs() < 1e-12, "({d}, {w}) column {b}");
+        }
+    }
+}

@@ -13,6 +13,11 @@
 //! (sums term by term in increasing `k`, a solve's terms with `L = 0` skipped), so the results
 //! are theirs to the last bit. Column `j` of `L` is also stored as row `j` above the diagonal:
 //! the later columns read it there as a row (`L_ik` for all `i > j` at once).
+//!
+//! The same treatment for the other block kernels of the tree, each keeping what it
+//! accumulates in registers: LU with partial pivoting (step `K` of the elimination a function
+//! of `D` and `K`), the Schur update `P −= Cᵀ X` on a parent's lower triangle (one row of `P`
+//! at a time), and the products `x −= X y`, `out −= Cᵀ y` of the solves.
 
 /// `A = L D Lᵀ` in place (see `dense::ldlt`; the upper triangle is left holding `Lᵀ`).
 #[inline(never)]
@@ -130,4 +135,137 @@ fn backward<const D: usize, const W: usize, const I: usize>(f: &[f64], x: &mut [
         }
     }
     head[I * W..].copy_from_slice(&acc);
+}
+
+/// `P −= Cᵀ X` on the lower triangle of the leading `W × W` block of the `DP × DP` row-major
+/// `p`, for `D × W` row-major `C` and `X` (see `dense::sub_tr_mul_block`): row `A` of `P` is
+/// held in registers while the `D` rows of `C` and `X` pass, each entry updated in increasing
+/// `k` with the terms of `C_kA = 0` skipped, as in the general loop.
+#[inline(never)]
+pub(super) fn sub_tr_mul_lower<const D: usize, const W: usize, const DP: usize>(
+    c: &[f64],
+    x: &[f64],
+    p: &mut [f64],
+) {
+    const { assert!(W <= 18 && W <= DP) };
+    let (c, x, p) = (&c[..D * W], &x[..D * W], &mut p[..DP * DP]);
+    macro_rules! each_row {
+        ($($a:literal)*) => {
+            $(
+                if $a < W {
+                    lower_row::<D, W, DP, $a>(c, x, p);
+                }
+            )*
+        };
+    }
+    each_row!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17);
+}
+
+/// Row `A` of [`sub_tr_mul_lower`] (its entries `0..=A`).
+#[inline(always)]
+fn lower_row<const D: usize, const W: usize, const DP: usize, const A: usize>(
+    c: &[f64],
+    x: &[f64],
+    p: &mut [f64],
+) {
+    let row = &mut p[A * DP..A * DP + A + 1];
+    let mut acc = [0.0; W];
+    acc[..=A].copy_from_slice(row);
+    for k in 0..D {
+        let cka = c[k * W + A];
+        if cka != 0.0 {
+            let xk = &x[k * W..k * W + A + 1];
+            for b in 0..=A {
+                acc[b] -= cka * xk[b];
+            }
+        }
+    }
+    row.copy_from_slice(&acc[..=A]);
+}
+
+/// `x −= X y` for a `D × W` row-major `X` (see `dense::sub_mul`): `y` held in registers, each
+/// row's sum from zero in increasing column order.
+#[inline(never)]
+pub(super) fn sub_mul<const D: usize, const W: usize>(xm: &[f64], y: &[f64], x: &mut [f64]) {
+    let (xm, x) = (&xm[..D * W], &mut x[..D]);
+    let mut yw = [0.0; W];
+    yw.copy_from_slice(&y[..W]);
+    for a in 0..D {
+        let row = &xm[a * W..a * W + W];
+        let mut sum = 0.0;
+        for b in 0..W {
+            sum += row[b] * yw[b];
+        }
+        x[a] -= sum;
+    }
+}
+
+/// `out −= Cᵀ y` for a `D × W` row-major `C` (see `dense::sub_tr_mul`): `out` held in
+/// registers, each entry updated in increasing `k`.
+#[inline(never)]
+pub(super) fn sub_tr_mul<const D: usize, const W: usize>(c: &[f64], y: &[f64], out: &mut [f64]) {
+    let (c, y) = (&c[..D * W], &y[..D]);
+    let mut acc = [0.0; W];
+    acc.copy_from_slice(&out[..W]);
+    for k in 0..D {
+        let (yk, ck) = (y[k], &c[k * W..k * W + W]);
+        for b in 0..W {
+            acc[b] -= ck[b] * yk;
+        }
+    }
+    out[..W].copy_from_slice(&acc);
+}
+
+/// `P A = L U` in place with partial pivoting (see `dense::lu`), step `K` of the elimination
+/// a function of the constants `D` and `K`; `false` on a zero or non-finite pivot.
+#[inline(never)]
+pub(super) fn lu<const D: usize>(a: &mut [f64], piv: &mut [u16]) -> bool {
+    const { assert!(D <= 21) };
+    let (a, piv) = (&mut a[..D * D], &mut piv[..D]);
+    macro_rules! steps {
+        ($($k:literal)*) => {
+            $(
+                if $k < D && !lu_step::<D, $k>(a, piv) {
+                    return false;
+                }
+            )*
+        };
+    }
+    steps!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20);
+    true
+}
+
+/// Step `K` of [`lu`]: the pivot in column `K`, the rows swapped, the rows below eliminated
+/// (the terms of a zero multiplier skipped).
+#[inline(always)]
+fn lu_step<const D: usize, const K: usize>(a: &mut [f64], piv: &mut [u16]) -> bool {
+    let mut p = K;
+    let mut best = a[K * D + K].abs();
+    for i in K + 1..D {
+        let v = a[i * D + K].abs();
+        if v > best {
+            best = v;
+            p = i;
+        }
+    }
+    piv[K] = p as u16;
+    if !best.is_finite() || best == 0.0 {
+        return false;
+    }
+    let (top, below) = a.split_at_mut((K + 1) * D);
+    let row = &mut top[K * D..];
+    if p != K {
+        row.swap_with_slice(&mut below[(p - K - 1) * D..(p - K) * D]);
+    }
+    let inv = 1.0 / row[K];
+    for r in below.chunks_exact_mut(D) {
+        let l = r[K] * inv;
+        r[K] = l;
+        if l != 0.0 {
+            for c in K + 1..D {
+                r[c] -= l * row[c];
+            }
+        }
+    }
+    true
 }

@@ -26,6 +26,7 @@
 
 use super::dense;
 use super::fused::BlockMap;
+use super::norm;
 use super::shape::{Shape, FIRST, SKIP};
 use crate::solver::partition::Partition;
 use crate::solver::sparse::hessian::BlockHessian;
@@ -226,8 +227,8 @@ impl TreeKkt {
         let fresh = &mut self.fresh;
         fresh.iter_mut().for_each(|f| *f = true);
         let (values, factors) = (&self.values, &mut self.factors);
-        // ‖K‖∞ (for the backward error of solves), row sums taken while the blocks are in
-        // cache: couplings count for both of their rows.
+        // ‖K‖∞ (for the backward error of solves; every factorization is solved), row sums
+        // taken while the blocks are in cache (module `norm`).
         let sums = &mut self.row_sums;
         sums.iter_mut().for_each(|x| *x = 0.0);
         s.border.add_row_sums(&values[s.flat_len..], sums);
@@ -239,24 +240,14 @@ impl TreeKkt {
                 factors[r.clone()].copy_from_slice(&values[r]);
             }
             let blk = &values[s.diag_at[i]..s.diag_at[i] + d * d];
-            let own = &mut sums[at..at + d];
-            for (a, row) in own.iter_mut().zip(blk.chunks_exact(d.max(1))) {
-                *a += row.iter().map(|v| v.abs()).sum::<f64>();
-            }
             if s.parent[i] != u32::MAX && w > 0 {
-                // The same additions in the same order, on slices (the parent's unknowns come
-                // after the node's own in tree-space order).
+                // The parent's unknowns come after the node's own in tree-space order.
                 let pa = s.at[s.parent[i] as usize];
                 let (head, tail) = sums.split_at_mut(pa);
-                let (own, up) = (&mut head[at..at + d], &mut tail[..w]);
                 let c = &values[s.coup_at[i]..s.coup_at[i] + d * w];
-                for (sa, crow) in own.iter_mut().zip(c.chunks_exact(w)) {
-                    for (sb, &x) in up.iter_mut().zip(crow) {
-                        let v = x.abs();
-                        *sa += v;
-                        *sb += v;
-                    }
-                }
+                norm::add_node(blk, c, &mut head[at..at + d], tail, (d, w));
+            } else {
+                norm::add_node(blk, &[], &mut sums[at..at + d], &mut [], (d, 0));
             }
             let (fd, rest) = factors.split_at_mut(s.diag_at[i] + d * d);
             let blk = &mut fd[s.diag_at[i]..];

@@ -5,12 +5,14 @@
 //! Schur complement.
 //!
 //! - `dense`: the block kernels (LDLᵀ without pivoting, LU with partial pivoting);
-//! - `fixed`: LDLᵀ and its solves unrolled for a chain's and a ladder's block sizes;
+//! - `fixed`: LDLᵀ, LU, the Schur update and the solves' products unrolled for a chain's and a
+//!   ladder's block sizes;
 //! - `phi_u`: `Φ_u` as a block upper triangular matrix (corrector, multipliers, tangent steps);
 //! - `segments`: its off-diagonal entries as dense row × column segments for the solves;
 //! - `shape`: the KKT matrix's nodes, parents, border and value slots, once per partition;
 //! - `fused`: the Newton step's assembly of `W`, its terms added into the tree's body-pair
 //!   blocks and stored into the 13 × 13 blocks in one pass;
+//! - `norm`: the row sums of `|K|` for `‖K‖∞`, node by node;
 //! - `kkt`: its block LDLᵀ (block LU as the fallback), solves and refinement;
 //! - `border`: the dense Schur complement of the border;
 //! - `merge`: super-nodes where the border would be too large (a ladder: a loop per rung).
@@ -26,6 +28,7 @@ pub(crate) mod kkt;
 mod merge;
 #[cfg(test)]
 mod merge_tests;
+mod norm;
 pub(crate) mod phi_u;
 mod segments;
 mod shape;

@@ -374,6 +374,16 @@ impl Constraints {
                     push(phi, jac.as_deref_mut(), row + k, &j.bodies, (v, g), 1.0, pattern);
                 });
             }
+            Term::Normalization(b) => {
+                let i = 7 * b.0 + 3;
+                let p = q.rows(i, 4);
+                phi[row] = p.dot(&p) - 1.0;
+                if let Some(t) = jac.as_deref_mut() {
+                    for k in 0..4 {
+                        t.entries.push((row, i + k, 2.0 * q[i + k]));
+                    }
+                }
+            }
         });
     }
 

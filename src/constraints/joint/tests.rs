@@ -216,7 +216,7 @@ fn row_patterns_leave_out_only_entries_zero_at_every_pose() {
             let mut jets = Vec::new();
             rows(&j, &pair, 0.0, &mut jets);
             let mut closed_rows = Vec::new();
-            closed::rows(&j, &pair, &mut closed_rows);
+            closed::tests::rows(&j, &pair, &mut closed_rows);
             for (r, row) in layout.iter().enumerate() {
                 let pattern = row.pattern();
                 let what = |i| format!("{} row {} entry {i}", kind.name(), row_names(&j)[r]);

@@ -357,7 +357,15 @@ impl Constraints {
         let values_only = jac.is_none();
         self.for_each_row(model, q, false, values_only, |row, term| match term {
             Term::Jet(bodies, s, c, pattern) => {
-                push(phi, jac.as_deref_mut(), row, bodies, (s.v, &s.g), c, pattern);
+                push(
+                    phi,
+                    jac.as_deref_mut(),
+                    row,
+                    bodies,
+                    (s.v, &s.g),
+                    c,
+                    pattern,
+                );
             }
             // `push`'s `phi[row] += 1.0 · v`.
             Term::Value(v) => phi[row] += 1.0 * v,
@@ -371,7 +379,15 @@ impl Constraints {
                 let layout = j.kind.spec().rows;
                 crate::jet::closed::rows_each(j, pair, |k, v, g| {
                     let pattern = layout[k].pattern();
-                    push(phi, jac.as_deref_mut(), row + k, &j.bodies, (v, g), 1.0, pattern);
+                    push(
+                        phi,
+                        jac.as_deref_mut(),
+                        row + k,
+                        &j.bodies,
+                        (v, g),
+                        1.0,
+                        pattern,
+                    );
                 });
             }
             Term::Normalization(b) => {

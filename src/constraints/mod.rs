@@ -7,33 +7,16 @@
 
 pub(crate) mod joint;
 mod pair_sum;
+mod triplets;
 pub(crate) mod unilateral;
 
 use crate::jet::{closed, pair_of, HessianSink, Scalar};
 use crate::joint::{Pattern, ALL};
 use crate::kinematics::{coordinate, Branches};
 use crate::model::{BodyId, JointId, Model};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 use pair_sum::PairSum;
-
-/// A sparse matrix in triplet (coordinate) form.
-#[derive(Clone, Debug, Default)]
-pub(crate) struct Triplets {
-    pub(crate) rows: usize,
-    pub(crate) cols: usize,
-    pub(crate) entries: Vec<(usize, usize, f64)>,
-}
-
-impl Triplets {
-    /// Dense copy (duplicates summed).
-    pub(crate) fn to_dense(&self) -> DMatrix<f64> {
-        let mut m = DMatrix::zeros(self.rows, self.cols);
-        for &(i, j, v) in &self.entries {
-            m[(i, j)] += v;
-        }
-        m
-    }
-}
+pub(crate) use triplets::Triplets;
 
 /// What a block of rows expresses.
 #[derive(Clone, Debug)]

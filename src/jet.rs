@@ -216,6 +216,46 @@ pub(crate) mod testing {
         Pair { r, p, hess: true }
     }
 
+    /// A joint of `kind` between bodies 0 and 1 with skewed, non-trivial frames on both sides:
+    /// the one fixture of the joint-row tests.
+    pub(crate) fn sample_joint(kind: crate::model::JointKind) -> crate::model::Joint {
+        use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+        let f0 = Isometry3::from_parts(
+            Translation3::new(0.1, 0.2, -0.3),
+            UnitQuaternion::from_euler_angles(0.3, -0.2, 0.9),
+        );
+        let f1 = Isometry3::from_parts(
+            Translation3::new(-0.2, 0.05, 0.4),
+            UnitQuaternion::from_euler_angles(-0.5, 0.4, 0.1),
+        );
+        crate::model::Joint {
+            name: "j".into(),
+            kind,
+            parent_link: "a".into(),
+            child_link: "b".into(),
+            bodies: [Some(crate::model::BodyId(0)), Some(crate::model::BodyId(1))],
+            body_from_joint: [f0, f1],
+            tree: false,
+            merged: false,
+            limits: None,
+            effort_limit: None,
+            source: None,
+        }
+    }
+
+    /// Every joint kind of the table ([`crate::joint::KINDS`]), its parameter (if any) not zero.
+    pub(crate) fn every_kind() -> Vec<crate::model::JointKind> {
+        use crate::model::JointKind;
+        crate::joint::KINDS
+            .iter()
+            .map(|k| match *k {
+                JointKind::Screw { .. } => JointKind::Screw { pitch: 0.01 },
+                JointKind::Distance { .. } => JointKind::Distance { length: 0.7 },
+                k => k,
+            })
+            .collect()
+    }
+
     fn shifted(pair: &Pair, i: usize, h: f64) -> Pair {
         let mut out = *pair;
         let (k, c) = (i / 7, i % 7);

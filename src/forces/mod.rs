@@ -296,36 +296,14 @@ pub(crate) fn has_energy(model: &Model) -> bool {
 mod tests {
     use super::*;
     use crate::jet::closed::tests::assert_same;
-    use crate::jet::testing::{check_scalar, sample_pair};
-    use crate::model::{Joint, JointKind};
-    use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+    use crate::jet::testing::{check_scalar, sample_joint, sample_pair};
+    use crate::model::JointKind;
 
     /// The closed-form revolute angle equals the generic jets' (value, gradient, Hessian) and
     /// matches central differences.
     #[test]
     fn closed_form_revolute_angle_equals_the_jets() {
-        let joint = Joint {
-            name: "j".into(),
-            kind: JointKind::Revolute,
-            parent_link: "a".into(),
-            child_link: "b".into(),
-            bodies: [Some(BodyId(0)), Some(BodyId(1))],
-            body_from_joint: [
-                Isometry3::from_parts(
-                    Translation3::new(0.1, 0.2, -0.3),
-                    UnitQuaternion::from_euler_angles(0.3, -0.2, 0.9),
-                ),
-                Isometry3::from_parts(
-                    Translation3::new(-0.2, 0.05, 0.4),
-                    UnitQuaternion::from_euler_angles(-0.5, 0.4, 0.1),
-                ),
-            ],
-            tree: false,
-            merged: false,
-            limits: None,
-            effort_limit: None,
-            source: None,
-        };
+        let joint = sample_joint(JointKind::Revolute);
         for seed in 0..5 {
             let pair = sample_pair(seed);
             for reference in [0.0, 7.0] {

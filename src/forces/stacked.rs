@@ -274,33 +274,8 @@ pub(crate) fn scatter_angle(
 mod tests {
     use super::*;
     use crate::jet::hess_or_zero;
-    use crate::jet::testing::sample_pair;
-    use nalgebra::{DMatrix, Isometry3, Translation3, UnitQuaternion};
-
-    fn joint() -> Joint {
-        Joint {
-            name: "j".into(),
-            kind: crate::model::JointKind::Revolute,
-            parent_link: "a".into(),
-            child_link: "b".into(),
-            bodies: [Some(BodyId(0)), Some(BodyId(1))],
-            body_from_joint: [
-                Isometry3::from_parts(
-                    Translation3::new(0.1, 0.2, -0.3),
-                    UnitQuaternion::from_euler_angles(0.3, -0.2, 0.9),
-                ),
-                Isometry3::from_parts(
-                    Translation3::new(-0.2, 0.05, 0.4),
-                    UnitQuaternion::from_euler_angles(-0.5, 0.4, 0.1),
-                ),
-            ],
-            tree: false,
-            merged: false,
-            limits: None,
-            effort_limit: None,
-            source: None,
-        }
-    }
+    use crate::jet::testing::{sample_joint, sample_pair};
+    use nalgebra::DMatrix;
 
     /// The gradient and Hessian over two bodies that `f` adds to zeros.
     fn hessian_of(
@@ -317,7 +292,7 @@ mod tests {
     /// effort `−τ θ`) to rounding (`1e-13` of its largest entry).
     #[test]
     fn stacked_terms_equal_the_boxed_path() {
-        let j = joint();
+        let j = sample_joint(crate::model::JointKind::Revolute);
         let bodies = j.bodies;
         for seed in 0..6 {
             let mut pair = sample_pair(seed);
@@ -374,7 +349,7 @@ mod tests {
     #[test]
     fn gradient_only_terms_equal_the_boxed_path_bit_for_bit() {
         let bits = |g: &DVector<f64>| g.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-        let j = joint();
+        let j = sample_joint(crate::model::JointKind::Revolute);
         for seed in 0..6 {
             let pair = sample_pair(seed);
             let du = 0.7 - seed as f64;
@@ -408,7 +383,7 @@ mod tests {
     /// match central differences.
     #[test]
     fn stacked_spring_matches_central_differences() {
-        let j = joint();
+        let j = sample_joint(crate::model::JointKind::Revolute);
         let bodies = j.bodies;
         let (k, theta0) = (3.5, 0.4);
         let spring = |q: &Pair| {

@@ -6,45 +6,9 @@ use super::*;
 use crate::jet::closed;
 use crate::jet::closed::tests::assert_same;
 use crate::jet::hess_or_zero;
-use crate::jet::testing::{check_scalar, sample_pair};
-use crate::model::{BodyId, JointKind};
+use crate::jet::testing::{check_scalar, every_kind, sample_joint, sample_pair};
+use crate::model::JointKind;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
-
-fn joint(kind: JointKind) -> Joint {
-    let f0 = Isometry3::from_parts(
-        Translation3::new(0.1, 0.2, -0.3),
-        UnitQuaternion::from_euler_angles(0.3, -0.2, 0.9),
-    );
-    let f1 = Isometry3::from_parts(
-        Translation3::new(-0.2, 0.05, 0.4),
-        UnitQuaternion::from_euler_angles(-0.5, 0.4, 0.1),
-    );
-    Joint {
-        name: "j".into(),
-        kind,
-        parent_link: "a".into(),
-        child_link: "b".into(),
-        bodies: [Some(BodyId(0)), Some(BodyId(1))],
-        body_from_joint: [f0, f1],
-        tree: false,
-        merged: false,
-        limits: None,
-        effort_limit: None,
-        source: None,
-    }
-}
-
-/// Every kind of the table, with its parameter (if any) not zero.
-fn kinds() -> Vec<JointKind> {
-    crate::joint::KINDS
-        .iter()
-        .map(|k| match *k {
-            JointKind::Screw { .. } => JointKind::Screw { pitch: 0.01 },
-            JointKind::Distance { .. } => JointKind::Distance { length: 0.7 },
-            k => k,
-        })
-        .collect()
-}
 
 /// One closed-form row as a scalar: value and gradient from `closed::tests::rows`, Hessian from
 /// [`closed::add_weighted_hessian`] with the unit weight on row `r`.
@@ -68,8 +32,8 @@ fn closed_row(j: &Joint, pair: &Pair, r: usize) -> Scalar {
 /// multipliers) to rounding, and their derivatives match central differences.
 #[test]
 fn closed_form_rows_equal_the_jets_and_finite_differences() {
-    for kind in kinds() {
-        let j = joint(kind);
+    for kind in every_kind() {
+        let j = sample_joint(kind);
         if !closed::supports(&j) {
             assert!(!kind.spec().closed_form, "{}", kind.name());
             continue;
@@ -100,8 +64,8 @@ fn closed_form_rows_equal_the_jets_and_finite_differences() {
 
 #[test]
 fn every_row_jacobian_and_hessian_match_finite_differences() {
-    for kind in kinds() {
-        let j = joint(kind);
+    for kind in every_kind() {
+        let j = sample_joint(kind);
         for seed in 0..3 {
             let pair = sample_pair(seed);
             let mut out = Vec::new();
@@ -155,8 +119,8 @@ fn motion_satisfies_the_rows_and_reads_back_its_values() {
         Translation3::new(0.5, -0.1, 0.2),
         UnitQuaternion::from_euler_angles(0.7, 0.1, -0.4),
     );
-    for kind in kinds() {
-        let j = joint(kind);
+    for kind in every_kind() {
+        let j = sample_joint(kind);
         let v = sample_values(kind);
         let m = crate::kinematics::motion(kind, &v);
         let child = parent * j.body_from_joint[0] * m * j.body_from_joint[1].inverse();
@@ -207,8 +171,8 @@ fn motion_satisfies_the_rows_and_reads_back_its_values() {
 /// and every entry kept is nonzero at some pose (none kept for nothing).
 #[test]
 fn row_patterns_leave_out_only_entries_zero_at_every_pose() {
-    for kind in kinds() {
-        let j = joint(kind);
+    for kind in every_kind() {
+        let j = sample_joint(kind);
         let layout = kind.spec().rows;
         let mut seen = vec![0u16; layout.len()];
         for seed in 0..8 {

@@ -97,47 +97,8 @@ pub(crate) fn add_weighted_hessian_euler(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::jet::testing::{check_scalar, sample_pair};
+    use crate::jet::testing::{check_scalar, every_kind, sample_joint, sample_pair};
     use crate::jet::{euler_to_local, LMat, Scalar, EULER};
-    use crate::model::{BodyId, JointKind};
-    use nalgebra::{Isometry3, Translation3, UnitQuaternion};
-
-    fn joint(kind: JointKind) -> Joint {
-        Joint {
-            name: "j".into(),
-            kind,
-            parent_link: "a".into(),
-            child_link: "b".into(),
-            bodies: [Some(BodyId(0)), Some(BodyId(1))],
-            body_from_joint: [
-                Isometry3::from_parts(
-                    Translation3::new(0.1, 0.2, -0.3),
-                    UnitQuaternion::from_euler_angles(0.3, -0.2, 0.9),
-                ),
-                Isometry3::from_parts(
-                    Translation3::new(-0.2, 0.05, 0.4),
-                    UnitQuaternion::from_euler_angles(-0.5, 0.4, 0.1),
-                ),
-            ],
-            tree: false,
-            merged: false,
-            limits: None,
-            effort_limit: None,
-            source: None,
-        }
-    }
-
-    /// Every kind of the table, with its parameter (if any) not zero.
-    fn kinds() -> Vec<JointKind> {
-        crate::joint::KINDS
-            .iter()
-            .map(|k| match *k {
-                JointKind::Screw { .. } => JointKind::Screw { pitch: 0.01 },
-                JointKind::Distance { .. } => JointKind::Distance { length: 0.7 },
-                k => k,
-            })
-            .collect()
-    }
 
     /// The Euler-parameter Hessian equals the full one bit for bit on its entries, the full one
     /// is zero elsewhere, and each row's Hessian so formed matches central differences of the
@@ -145,8 +106,8 @@ mod tests {
     #[test]
     fn euler_hessian_is_the_full_one_restricted_bit_for_bit() {
         let mut seen = 0;
-        for kind in kinds() {
-            let j = joint(kind);
+        for kind in every_kind() {
+            let j = sample_joint(kind);
             if !euler_only(&j) {
                 continue;
             }

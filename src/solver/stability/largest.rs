@@ -69,13 +69,7 @@ fn lanczos_largest(
             return a.abs();
         }
         alpha.push(a);
-        // Twice, for an orthonormal basis to rounding (Kahan's "twice is enough").
-        for _ in 0..2 {
-            for b in &basis {
-                let c = w.dot(b);
-                w.axpy(-c, b, 1.0);
-            }
-        }
+        orthogonalize_twice(&mut w, &basis);
         let b = w.norm();
         beta.push(b);
         let (theta, r) = extreme_ritz(&alpha, &beta);
@@ -85,6 +79,18 @@ fn lanczos_largest(
         basis.push(w / b);
     }
     unreachable!("the loop returns at its last step")
+}
+
+/// Full reorthogonalization of `w` against the Lanczos `basis`, twice, for an orthonormal basis
+/// to rounding (Kahan's "twice is enough"): `w ← w − Σ_b (w · b) b`, basis vector by basis
+/// vector.
+pub(super) fn orthogonalize_twice(w: &mut DVector<f64>, basis: &[DVector<f64>]) {
+    for _ in 0..2 {
+        for b in basis {
+            let c = w.dot(b);
+            w.axpy(-c, b, 1.0);
+        }
+    }
 }
 
 /// The Ritz value of largest magnitude of the Lanczos tridiagonal `T_k` (diagonal `alpha`,

@@ -19,7 +19,7 @@
 
 use super::blocks::block_symmetric_eigen;
 use super::eigen::symmetric_eigen;
-use super::largest::largest_eigenvalue;
+use super::largest::{largest_eigenvalue, orthogonalize_twice};
 use crate::solver::partition::Partition;
 use crate::solver::sparse::kkt::Factored;
 use crate::solver::system::{Backend, Eval, System};
@@ -253,12 +253,7 @@ fn lanczos_steps(
         let mut w = apply_inverse(&basis[k])?;
         let a = w.dot(&basis[k]);
         alpha.push(a);
-        for _ in 0..2 {
-            for b in &basis {
-                let c = w.dot(b);
-                w.axpy(-c, b, 1.0);
-            }
-        }
+        orthogonalize_twice(&mut w, &basis);
         let bnorm = w.norm();
         beta.push(bnorm);
         if bnorm <= 1e-14 * a.abs().max(1e-300)

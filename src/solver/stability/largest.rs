@@ -93,12 +93,10 @@ pub(super) fn orthogonalize_twice(w: &mut DVector<f64>, basis: &[DVector<f64>]) 
     }
 }
 
-/// The Ritz value of largest magnitude of the Lanczos tridiagonal `T_k` (diagonal `alpha`,
-/// off-diagonal `beta`, `beta[k−1]` the residual's norm) and its residual bound
-/// `r = β_k |s_k|`.
-fn extreme_ritz(alpha: &[f64], beta: &[f64]) -> (f64, f64) {
+/// The Lanczos tridiagonal `T_k`: diagonal `alpha`, off-diagonal `beta` (its first `k − 1`).
+pub(super) fn tridiagonal(alpha: &[f64], beta: &[f64]) -> DMatrix<f64> {
     let k = alpha.len();
-    let t = DMatrix::from_fn(k, k, |i, j| {
+    DMatrix::from_fn(k, k, |i, j| {
         if i == j {
             alpha[i]
         } else if i + 1 == j || j + 1 == i {
@@ -106,7 +104,15 @@ fn extreme_ritz(alpha: &[f64], beta: &[f64]) -> (f64, f64) {
         } else {
             0.0
         }
-    });
+    })
+}
+
+/// The Ritz value of largest magnitude of the Lanczos tridiagonal `T_k` (diagonal `alpha`,
+/// off-diagonal `beta`, `beta[k−1]` the residual's norm) and its residual bound
+/// `r = β_k |s_k|`.
+fn extreme_ritz(alpha: &[f64], beta: &[f64]) -> (f64, f64) {
+    let k = alpha.len();
+    let t = tridiagonal(alpha, beta);
     let (theta, s) = symmetric_eigen(&t);
     // Ascending: the largest magnitude is at one end.
     let i = if theta[k - 1].abs() >= theta[0].abs() {

@@ -19,7 +19,7 @@
 
 use super::blocks::block_symmetric_eigen;
 use super::eigen::symmetric_eigen;
-use super::largest::{largest_eigenvalue, orthogonalize_twice};
+use super::largest::{largest_eigenvalue, orthogonalize_twice, tridiagonal};
 use crate::solver::partition::Partition;
 use crate::solver::sparse::kkt::Factored;
 use crate::solver::system::{Backend, Eval, System};
@@ -270,17 +270,7 @@ fn lanczos_steps(
 /// The Ritz values `θ` (ascending) and vectors of the Lanczos tridiagonal matrix with diagonal
 /// `alpha` and off-diagonal `beta`.
 fn ritz(alpha: &[f64], beta: &[f64]) -> (DVector<f64>, DMatrix<f64>) {
-    let k = alpha.len();
-    let t = DMatrix::from_fn(k, k, |i, j| {
-        if i == j {
-            alpha[i]
-        } else if i + 1 == j || j + 1 == i {
-            beta[i.min(j)]
-        } else {
-            0.0
-        }
-    });
-    symmetric_eigen(&t)
+    symmetric_eigen(&tridiagonal(alpha, beta))
 }
 
 /// Whether the `WANTED` largest Ritz values of the tridiagonal `T_k` (`alpha`, `beta`; the

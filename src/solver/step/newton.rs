@@ -97,14 +97,16 @@ pub(crate) fn newton_step_within(
 ) -> (DVector<f64>, Vec<(usize, f64, f64)>) {
     let floor = EIGENVALUE_FLOOR * e.values.amax().max(1e-12);
     let n = g.len();
+    let column = |i: usize| &e.vectors.as_slice()[i * n..(i + 1) * n];
     let slopes: Vec<f64> = (0..n).map(|i| e.vectors.column(i).dot(g)).collect();
     let mut t: Vec<f64> = (0..n)
         .map(|i| -slopes[i] / e.values[i].abs().max(floor))
         .collect();
+    // `Σ v_i t_i`, each term `v_i t_i` added in place (the sums of `d += v_i * t_i`).
     let step = |t: &[f64]| {
         let mut d = DVector::zeros(n);
         for (i, ti) in t.iter().enumerate() {
-            d += e.vectors.column(i) * *ti;
+            add_scaled(d.as_mut_slice(), column(i), *ti);
         }
         d
     };
@@ -116,15 +118,17 @@ pub(crate) fn newton_step_within(
     let whole = escape.is_some_and(|c| step(&t).amax() < near * c);
     let gmax = g.amax();
     // Per group (indexed by its root): its share of the step and whether its slopes vanish.
-    let mut share = vec![DVector::zeros(n); n];
+    let mut share = DMatrix::zeros(n, n);
     let mut still = vec![true; n];
     for i in 0..n {
-        share[group[i]] += e.vectors.column(i) * t[i];
+        let g = group[i];
+        add_scaled(&mut share.as_mut_slice()[g * n..(g + 1) * n], column(i), t[i]);
         still[group[i]] &= slopes[i].abs() <= BLOCK_AT_REST * gmax;
     }
     let near: Vec<bool> = (0..n)
         .map(|i| {
-            let block = escape.is_some_and(|c| share[group[i]].amax() < NEAR_STATIONARY * c);
+            let block =
+                escape.is_some_and(|c| share.column(group[i]).amax() < NEAR_STATIONARY * c);
             whole || (still[group[i]] && block)
         })
         .collect();
@@ -140,6 +144,14 @@ pub(crate) fn newton_step_within(
         }
     }
     (step(&t), escaped)
+}
+
+/// `d += v t` entry by entry: the sums of `d += v * t` (each product `v_k t`, then added),
+/// without the vector of products.
+fn add_scaled(d: &mut [f64], v: &[f64], t: f64) {
+    for (dk, vk) in d.iter_mut().zip(v) {
+        *dk += vk * t;
+    }
 }
 
 /// The settling step where the convergence test finds the lowest eigenvalue within the

@@ -58,6 +58,23 @@ pub(crate) fn path_curvature(
     eval: &Eval,
     basis: Option<&DMatrix<f64>>,
 ) -> DMatrix<f64> {
+    curvature_of(sys, q, part, eval, basis, true)
+}
+
+/// [`path_curvature`], with `skip_still`: the twists of the edges that a column of `Z` does
+/// not move (the body's and its parent's blocks of the column zero, `q` finite) left at zero
+/// instead of computed. Computed, they are `±0` (`ω = 2 (e₀ δe − δe₀ e + e × δe) / |p|²` of
+/// a zero `δp`, differences and cross products of zeros), and a zero's sign changes only the
+/// sign of a zero result in the sums and products that follow; the entries of `m` below are
+/// never `−0` (sums from `+0`), so `C` is the same to the last bit either way.
+fn curvature_of(
+    sys: &System,
+    q: &DVector<f64>,
+    part: &Partition,
+    eval: &Eval,
+    basis: Option<&DMatrix<f64>>,
+    skip_still: bool,
+) -> DMatrix<f64> {
     let dof = part.independent.len();
     let columns = &sys.problem.scaling.columns;
     let parents = sys.problem.retraction.parents();
@@ -75,15 +92,26 @@ pub(crate) fn path_curvature(
         }
     };
     // Each body's angular velocity once per column (its own edge's and its children's twists
-    // read it), in one buffer for the column.
+    // read it), in one buffer for the column. Where neither the body nor its parent moves
+    // along the column (`Z`'s blocks zero) the twist is zero and is left so (`skip_still`).
+    let skip_still = skip_still && q.iter().all(|v| v.is_finite());
     let mut dq = DVector::zeros(z.nrows());
     let mut spin = vec![Vector3::zeros(); bodies];
+    let mut moves = vec![true; bodies];
     for i in 0..dof {
         dq.copy_from(&z.column(i));
         for (b, w) in spin.iter_mut().enumerate() {
-            *w = angular_velocity(q, &dq, b);
+            moves[b] = !skip_still || dq.as_slice()[7 * b..7 * b + 7].iter().any(|&v| v != 0.0);
+            *w = if moves[b] {
+                angular_velocity(q, &dq, b)
+            } else {
+                Vector3::zeros()
+            };
         }
         for b in 0..bodies {
+            if !moves[b] && parents[b].is_none_or(|a| !moves[a]) {
+                continue;
+            }
             let (w, v) = twist_of(q, &dq, &spin, b, parents[b]);
             omega[b].set_column(i, &w);
             vel[b].set_column(i, &v);
@@ -134,9 +162,47 @@ pub(crate) fn path_curvature(
             mm.transpose() - Matrix3::identity() * (s + 0.25 * r[0]) - 0.25 * rv.cross_matrix();
         let k_vel = -g.cross_matrix();
         let kt = k_omega * &omega[l] + k_vel * &vel[l];
-        m.gemm_tr(1.0, &a, &kt, 1.0);
+        add_tr_product(&mut m, &a, &kt);
     }
     (&m + m.transpose()) * 0.5
+}
+
+/// `m += aᵀ b` (`a`, `b`: `3 × dof`; `m` without `−0` entries), nalgebra's
+/// `m.gemm_tr(1.0, a, b, 1.0)` to the last bit, over the columns `b_j` that are not zero and
+/// the range of columns `a_i` from the first to the last that is not zero. On a tree a column
+/// of `Z` moves the bodies on one side of its joint only, so an edge's twists are zero for the
+/// columns whose motion does not reach it (a chain: a third of the `dof²` pairs are left).
+///
+/// `gemm_tr` sets `m_ij = 1·(a_i · b_j) + 1·m_ij` with the three-term dot
+/// `(a_0 b_0 + a_1 b_1) + a_2 b_2`. Where `a_i` or `b_j` is zero (`±0` entries) and the other
+/// finite, the dot is `±0`, and `m_ij + ±0 = m_ij` (a sum is `−0` only when both terms are).
+/// Where an entry of `a` or `b` is not finite, nothing is skipped.
+fn add_tr_product(
+    m: &mut DMatrix<f64>,
+    a: &nalgebra::Matrix3xX<f64>,
+    b: &nalgebra::Matrix3xX<f64>,
+) {
+    let (a_s, b_s) = (a.as_slice(), b.as_slice());
+    if !a_s.iter().chain(b_s).all(|v| v.is_finite()) {
+        m.gemm_tr(1.0, a, b, 1.0);
+        return;
+    }
+    let zero = |x: &[f64]| x.iter().all(|&v| v == 0.0);
+    let Some(first) = a_s.chunks_exact(3).position(|c| !zero(c)) else {
+        return;
+    };
+    let last = a_s.chunks_exact(3).rposition(|c| !zero(c)).unwrap_or(first);
+    let rows = &a_s[3 * first..3 * last + 3];
+    let dof = m.nrows();
+    for (bj, mj) in b_s.chunks_exact(3).zip(m.as_mut_slice().chunks_exact_mut(dof)) {
+        if zero(bj) {
+            continue;
+        }
+        for (ai, mij) in rows.chunks_exact(3).zip(&mut mj[first..=last]) {
+            let dot = ai[0] * bj[0] + ai[1] * bj[1] + ai[2] * bj[2];
+            *mij = dot + *mij;
+        }
+    }
 }
 
 /// `Σ ω_k` over the edges `k` above `l` (nearer the root), summed from the root down and kept
@@ -274,6 +340,99 @@ mod tests {
     use crate::urdf::{load_str, ImportOptions};
 
     use crate::solver::step::retraction::tests::ARM;
+
+    /// The product over the nonzero columns equals nalgebra's `gemm_tr` bit for bit, on
+    /// columns with zeros of both signs, partly zero columns, `−0` products and a non-finite
+    /// entry.
+    #[test]
+    fn tr_product_skipping_zero_columns_changes_no_bit() {
+        let dof = 9;
+        let mut s = 7u64;
+        let mut r = || {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+        };
+        for trial in 0..4 {
+            let mut a = nalgebra::Matrix3xX::from_fn(dof, |_, _| r());
+            let mut b = nalgebra::Matrix3xX::from_fn(dof, |_, _| r());
+            for j in [0, 3, 4] {
+                a.column_mut(j).copy_from_slice(&[0.0, -0.0, 0.0]);
+            }
+            for j in [1, 4, 8] {
+                b.column_mut(j).copy_from_slice(&[-0.0, -0.0, -0.0]);
+            }
+            // Partly zero columns and a product that is `−0`.
+            a[(1, 5)] = 0.0;
+            b[(0, 2)] = -0.0;
+            a[(2, 6)] = -0.0;
+            b[(2, 6)] = 0.0;
+            if trial == 3 {
+                b[(1, 7)] = f64::INFINITY;
+            }
+            let mut plain = DMatrix::from_fn(dof, dof, |i, j| if (i + j) % 3 == 0 { 0.0 } else { r() });
+            let mut skipped = plain.clone();
+            for _ in 0..2 {
+                plain.gemm_tr(1.0, &a, &b, 1.0);
+                add_tr_product(&mut skipped, &a, &b);
+            }
+            for (x, y) in plain.iter().zip(skipped.iter()) {
+                assert!(
+                    x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()),
+                    "trial {trial}: {x:e} against {y:e}"
+                );
+            }
+            assert!(plain.iter().any(|&v| v == 0.0), "the test meets zero entries");
+        }
+    }
+
+    /// `C` with the twists of unmoved edges left at zero equals `C` with every twist
+    /// computed, bit for bit, on a chain (the tree path: `Z`'s blocks above each joint zero)
+    /// and on the branched arm, fixed and floating.
+    #[test]
+    fn still_edges_skipped_change_no_bit() {
+        let chain = crate::generate::chain(12, false);
+        let cases = [
+            (chain.as_str(), Backend::Tree, false),
+            (ARM, Backend::Dense, false),
+            (ARM, Backend::Tree, true),
+        ];
+        for (text, backend, floating) in cases {
+            let options = ImportOptions {
+                floating_base: floating,
+                ..ImportOptions::default()
+            };
+            let model = load_str(text, "m.urdf", &options).unwrap().model;
+            let values: crate::state::JointValues = if text == ARM {
+                [("pan", 0.4), ("slide", 0.1), ("roll", -0.7), ("lift", 1.1)]
+                    .iter()
+                    .map(|(n, v)| (n.to_string(), vec![*v]))
+                    .collect()
+            } else {
+                (0..12)
+                    .map(|i| (format!("joint{i}"), vec![0.3 * (i as f64).sin()]))
+                    .collect()
+            };
+            let q = State::from_joint_values(&model, &values).q;
+            let sys = &mut System::new(&model, Constraints::new(&model, &[]), backend);
+            let part = sys.partition(&q);
+            let eval = sys.evaluate(&q, &part).unwrap();
+            let z = sys.null_basis(&part, &eval);
+            let still = z
+                .as_slice()
+                .chunks_exact(7)
+                .filter(|blk| blk.iter().all(|&v| v == 0.0))
+                .count();
+            if matches!(backend, Backend::Tree) && !floating {
+                assert!(still > 0, "the chain's columns leave bodies still");
+            }
+            let fast = curvature_of(sys, &q, &part, &eval, Some(&z), true);
+            let full = curvature_of(sys, &q, &part, &eval, Some(&z), false);
+            assert!(fast.amax() > 0.0);
+            for (x, y) in fast.iter().zip(full.iter()) {
+                assert_eq!(x.to_bits(), y.to_bits(), "{backend:?}: {x:e} against {y:e}");
+            }
+        }
+    }
 
     /// `C` equals the central second differences of `∇fᵀ v̂` along the search path, on a
     /// fixed and a floating base, away from equilibrium.

@@ -8,7 +8,8 @@
 //!   direction of negative curvature.
 //! - `newton`: the dense Newton step from the eigen-decomposition of the Hessian along the
 //!   search path.
-//! - `path_hessian`: that Hessian, `Ĥ + C`, `C` the search path's curvature times `∇f`.
+//! - `path_hessian`: that Hessian, `Ĥ + C`, `C` the search path's curvature times `∇f`;
+//!   `tr_product`: its per-edge products `aᵀ b` over the columns that are not zero.
 //! - `quasi_newton`: the BFGS / DFP inverse-Hessian approximation `B ≈ Ĥ⁻¹`.
 //! - `step_cap`: the step limit, every body's Euler parameters moving by at most `max_step`.
 //! - `line_search`: the backtracking line search along a reduced step `d` (`δq = Z d`).
@@ -27,3 +28,4 @@ pub(super) mod quasi_newton;
 pub(super) mod retraction;
 pub(super) mod second_order;
 pub(super) mod step_cap;
+mod tr_product;

@@ -122,13 +122,16 @@ pub(crate) fn newton_step_within(
     let mut still = vec![true; n];
     for i in 0..n {
         let g = group[i];
-        add_scaled(&mut share.as_mut_slice()[g * n..(g + 1) * n], column(i), t[i]);
+        add_scaled(
+            &mut share.as_mut_slice()[g * n..(g + 1) * n],
+            column(i),
+            t[i],
+        );
         still[group[i]] &= slopes[i].abs() <= BLOCK_AT_REST * gmax;
     }
     let near: Vec<bool> = (0..n)
         .map(|i| {
-            let block =
-                escape.is_some_and(|c| share.column(group[i]).amax() < NEAR_STATIONARY * c);
+            let block = escape.is_some_and(|c| share.column(group[i]).amax() < NEAR_STATIONARY * c);
             whole || (still[group[i]] && block)
         })
         .collect();

@@ -10,7 +10,7 @@ use nalgebra::DMatrix;
 /// of `Z` moves the bodies on one side of its joint only, so an edge's twists are zero for the
 /// columns whose motion does not reach it (a chain of 20: about a third of the `dof²` pairs are left).
 ///
-/// `gemm_tr` sets `m_ij = 1·(a_i · b_j) + 1·m_ij` with the three-term dot
+/// `gemm_tr` sets `m_ij = 1·(a_i · b_j) + 1·m_ij` (here `m_ij + a_i · b_j`: the same sum) with the three-term dot
 /// `(a_0 b_0 + a_1 b_1) + a_2 b_2`. Where `a_i` or `b_j` is zero (`±0` entries) and the other
 /// finite, the dot is `±0`, and `m_ij + ±0 = m_ij` (a sum is `−0` only when both terms are).
 /// Where an entry of `a` or `b` is not finite, nothing is skipped.
@@ -40,7 +40,7 @@ pub(super) fn add_tr_product(
         }
         for (ai, mij) in rows.chunks_exact(3).zip(&mut mj[first..=last]) {
             let dot = ai[0] * bj[0] + ai[1] * bj[1] + ai[2] * bj[2];
-            *mij = dot + *mij;
+            *mij += dot;
         }
     }
 }

@@ -3,7 +3,9 @@
 //! left it ([`Changed`]). Copy `i` is row `rows[i]` (ascending), its entry on column
 //! `7 bodies[j] + k` at `a[i w + 7 j + k]` (`bodies[0] = b`, `w = 7 len(bodies)`), zero where
 //! the row has none. A copy holds the whole row (every body it touches), so its maximum is the
-//! row's.
+//! row's. Each copy also carries its span, the bodies where it may be nonzero (those of its
+//! row, and those of every pivot copy that updated it): a pivot reads and writes the copies
+//! there only, and a copy is kept from there.
 //!
 //! The steps are the solver's on the rows' sparse copies, to the bit: a pivot on `a_ik`
 //! updates `a_jl ← a_jl − (a_jk / a_ik) a_il` on every column, where the sparse step updates
@@ -87,8 +89,15 @@ pub(crate) struct Block {
     rmax: Vec<f64>,
     /// Whether each copy is still active.
     pub(crate) live: Vec<bool>,
-    /// Scratch of [`Block::pivot`]: whether the pivot copy has a nonzero entry on each body.
-    touched: Vec<bool>,
+    /// The bodies (bit `j`: `bodies[j]`, for `j < 64`) where each copy may have a nonzero
+    /// entry: it is zero on every other.
+    spans: Vec<u64>,
+}
+
+/// The bit of the body at slot `j` in a copy's span (none beyond 64 bodies, more than a step
+/// may span: the route gives up there before reading a span).
+fn bit(j: usize) -> u64 {
+    1u64.checked_shl(j as u32).unwrap_or(0)
 }
 
 /// The index of body `body` in `bodies`, added at the end if absent.
@@ -130,11 +139,14 @@ impl Block {
         self.a.resize(self.rows.len() * w, 0.0);
         self.rmax.clear();
         self.live.clear();
+        self.spans.clear();
         for (copy, &r) in self.a.chunks_exact_mut(w).zip(&self.rows) {
+            let mut span = 0;
             if let Some((bodies, a, rmax)) = changed.get(r) {
                 for (&body, seg) in bodies.iter().zip(a.chunks_exact(7)) {
-                    let base = 7 * slot(&mut self.bodies, body);
-                    copy[base..base + 7].copy_from_slice(seg);
+                    let j = slot(&mut self.bodies, body);
+                    span |= bit(j);
+                    copy[7 * j..7 * j + 7].copy_from_slice(seg);
                 }
                 self.rmax.push(rmax);
             } else {
@@ -143,12 +155,15 @@ impl Block {
                     let body = c / 7;
                     if body != last {
                         last = body;
-                        base = 7 * slot(&mut self.bodies, body);
+                        let j = slot(&mut self.bodies, body);
+                        span |= bit(j);
+                        base = 7 * j;
                     }
                     copy[base + (c - 7 * body)] = v;
                 }
                 self.rmax.push(rows.rmax[r]);
             }
+            self.spans.push(span);
             self.live.push(true);
         }
     }
@@ -185,7 +200,11 @@ impl Block {
             }
             let r = self.rows[i];
             let start = changed.bodies.len();
-            for (&body, seg) in self.bodies.iter().zip(row.chunks_exact(7)) {
+            let mut span = self.spans[i];
+            while span != 0 {
+                let j = span.trailing_zeros() as usize;
+                span &= span - 1;
+                let (body, seg) = (self.bodies[j], &row[7 * j..7 * j + 7]);
                 if seg.iter().any(|&v| v != 0.0) {
                     changed.bodies.push(body);
                     changed.values.extend_from_slice(seg);
@@ -202,8 +221,8 @@ impl Block {
     /// The partition's pivot on copy `i` in column `k` of the body: the column eliminated
     /// from the other active copies, `a_j ← a_j − (a_jk / a_ik) a_i`; a copy left with no
     /// entry above `tol` is redundant. `active` follows the copies' rows. The update runs over
-    /// the bodies where the pivot copy has a nonzero entry: elsewhere `a_jl − f · 0` leaves a
-    /// nonzero `a_jl` as it is (the module's note on zeros), and only the maximum reads them.
+    /// the pivot copy's span: elsewhere `a_jl − f · 0` leaves a nonzero `a_jl` as it is (the
+    /// module's note on zeros), and only the maximum reads copy `j` there (on its own span).
     pub(crate) fn pivot(&mut self, i: usize, k: usize, active: &mut [bool], tol: f64) {
         let w = self.w;
         self.live[i] = false;
@@ -211,13 +230,8 @@ impl Block {
         let (head, rest) = self.a.split_at_mut(i * w);
         let (pivot_row, tail) = rest.split_at_mut(w);
         let a_ik = pivot_row[k];
-        let touched = &mut self.touched;
-        touched.clear();
-        touched.extend(
-            pivot_row
-                .chunks_exact(7)
-                .map(|seg| seg.iter().any(|&v| v != 0.0)),
-        );
+        // Slot 0 (body `b`, where `a_ik ≠ 0`) is in the pivot's span.
+        let pivot_span = self.spans[i] | 1;
         for j in 0..self.live.len() {
             if j == i || !self.live[j] {
                 continue;
@@ -232,34 +246,36 @@ impl Block {
             }
             let f = row[k] / a_ik;
             row[k] = 0.0;
-            // `fold(0, f64::max)` of the magnitudes (NaN ignored), in any order.
+            // `fold(0, f64::max)` of the magnitudes (NaN ignored), in any order; zero outside
+            // the spans.
             let mut max = 0.0f64;
             let mut at_most = |e: f64| {
                 if e.abs() > max {
                     max = e.abs();
                 }
             };
-            // The body's own columns (the pivot copy is nonzero there, at `k`).
-            let (own, others) = row.split_at_mut(7);
-            for (l, (e, &v)) in own.iter_mut().zip(&pivot_row[..7]).enumerate() {
+            for (l, (e, &v)) in row[..7].iter_mut().zip(&pivot_row[..7]).enumerate() {
                 if l != k {
                     *e -= f * v;
-                    at_most(*e);
                 }
+                at_most(*e);
             }
-            let segments = others
-                .chunks_exact_mut(7)
-                .zip(pivot_row[7..].chunks_exact(7));
-            for (seg, (row_seg, pivot_seg)) in touched[1..].iter().zip(segments) {
-                if *seg {
-                    for (e, &v) in row_seg.iter_mut().zip(pivot_seg) {
+            let span = self.spans[j] | pivot_span;
+            let mut rest = span & !1;
+            while rest != 0 {
+                let s = rest.trailing_zeros() as usize;
+                rest &= rest - 1;
+                let seg = &mut row[7 * s..7 * s + 7];
+                if pivot_span & (1 << s) != 0 {
+                    for (e, &v) in seg.iter_mut().zip(&pivot_row[7 * s..7 * s + 7]) {
                         *e -= f * v;
                         at_most(*e);
                     }
                 } else {
-                    row_seg.iter().for_each(|&e| at_most(e));
+                    seg.iter().for_each(|&e| at_most(e));
                 }
             }
+            self.spans[j] = span;
             self.rmax[j] = max;
             if self.rmax[j] <= tol {
                 self.live[j] = false;

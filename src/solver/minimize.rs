@@ -76,6 +76,9 @@ pub(crate) struct Outcome {
     pub(crate) blocked: Option<Vec<usize>>,
     /// The active inequalities (the round's indices) to release (module `inequality::release`).
     pub(crate) released: Vec<usize>,
+    /// The end of the step tried where the last step was cut at a rolling hull's next vertex
+    /// (module `inequality::roll_on`).
+    pub(crate) carry: Option<DVector<f64>>,
 }
 
 /// Relative rounding floor of the reduced gradient: `max(gradient_tolerance, 1e-13 Σ|V_k|)`,
@@ -174,6 +177,8 @@ pub(crate) fn minimize(
     let (mut termination, mut eigen, mut inertia) = (Termination::MaxIterations, None, None);
     let (mut blocked, mut released) = (None, Vec::new());
     let mut first = release.and_then(Release::first);
+    let mut carry_in = release.and_then(Release::carry);
+    let mut carry_out = None;
     loop {
         // The gradient cannot be resolved below the rounding of the energy's terms.
         let gtol = options
@@ -208,9 +213,17 @@ pub(crate) fn minimize(
         if s.iteration >= options.max_iterations {
             break;
         }
-        let (d, kkt) = match reused {
-            Some((_, d)) => (d, false),
-            None => reduced_step(sys, &mut s, eig.as_ref(), saddle, guard, options),
+        // Rolling on from the last round's cut step (module `inequality::roll_on`).
+        let rolled = carry_in.take().and_then(|t| {
+            let columns = &sys.problem.scaling.columns;
+            let d = independent_change(&s.part.independent, columns, &s.q, t);
+            (s.iteration == 0 && s.eval.grad_v.dot(&d) < 0.0).then_some(d)
+        });
+        let carried = rolled.is_some();
+        let (d, kkt) = match (rolled, reused) {
+            (Some(d), _) => (d, false),
+            (None, Some((_, d))) => (d, false),
+            (None, None) => reduced_step(sys, &mut s, eig.as_ref(), saddle, guard, options),
         };
         let step = cap_step(sys, &s.part, &s.eval, &s.q, d, options);
         let slope = s.eval.grad_v.dot(&step.d);
@@ -236,13 +249,24 @@ pub(crate) fn minimize(
         let trial = line_search(sys, &line, alpha, guard, options, &mut s.diag);
         match trial {
             Some(t) if t.blocked.is_some() => {
+                let rolls = guard.is_some_and(|g| {
+                    t.blocked
+                        .iter()
+                        .flatten()
+                        .all(|&k| !g.is_roll_limit(k) && g.rolls(k))
+                });
+                if rolls && t.tried > 0.0 {
+                    carry_out = Some(sys.problem.retraction.point(&s.q, &step.dq, t.tried));
+                }
                 blocked = t.blocked;
                 s.q = t.q;
                 sys.problem.cons.branches.follow(sys.problem.model, &s.q);
                 s.eval = t.eval;
-                s.iteration += 1;
+                s.iteration += usize::from(!carried);
                 break;
             }
+            // A continuation that reaches no inequality is dropped (`inequality::roll_on`).
+            Some(_) if carried => continue,
             Some(t) => {
                 let alpha = t.alpha;
                 let before = s.eval.grad_v.amax();
@@ -295,6 +319,7 @@ pub(crate) fn minimize(
         diagnostics: s.diag,
         blocked,
         released,
+        carry: carry_out,
     })
 }
 

@@ -28,7 +28,7 @@
 //! 6. **Accept** ([`accept_step`]): quasi-Newton update, and the unbounded test (a linear
 //!    descent that goes on, module `unbounded`); with inequalities, the stall test (steps
 //!    shrinking towards an obstacle's edge end the round, module `inequality::stall`).
-//! 7. **Refresh the partition** ([`refresh_partition`], paper step (b)): anew when `Φ_u` is
+//! 7. **Refresh the partition** ([`refresh_partition`](refresh::refresh_partition), paper step (b)): anew when `Φ_u` is
 //!    ill-conditioned, when its pivots have drifted ([`PIVOT_DRIFT`]) and a fresh full
 //!    pivoting differs, when a sparse partition's second-pass choices change or (sparse, tree)
 //!    a fresh one differs after a failed correction. When the line search finds no step, the
@@ -57,6 +57,11 @@ use super::system::{Backend, Eval, System};
 use super::unbounded::LinearDescent;
 use super::valley::Watch;
 use nalgebra::DVector;
+use refresh::{refresh_partition, repartition};
+
+// A child module (it reads the search's state), kept beside this file.
+#[path = "minimize_refresh.rs"]
+mod refresh;
 
 /// Outcome of the minimization.
 pub(crate) struct Outcome {
@@ -76,6 +81,9 @@ pub(crate) struct Outcome {
     pub(crate) blocked: Option<Vec<usize>>,
     /// The active inequalities (the round's indices) to release (module `inequality::release`).
     pub(crate) released: Vec<usize>,
+    /// The end of the step tried where the last step was cut at a rolling hull's next vertex
+    /// (module `inequality::roll_on`).
+    pub(crate) carry: Option<DVector<f64>>,
 }
 
 /// Relative rounding floor of the reduced gradient: `max(gradient_tolerance, 1e-13 Σ|V_k|)`,
@@ -174,6 +182,8 @@ pub(crate) fn minimize(
     let (mut termination, mut eigen, mut inertia) = (Termination::MaxIterations, None, None);
     let (mut blocked, mut released) = (None, Vec::new());
     let mut first = release.and_then(Release::first);
+    let mut carry_in = release.and_then(Release::carry);
+    let mut carry_out = None;
     loop {
         // The gradient cannot be resolved below the rounding of the energy's terms.
         let gtol = options
@@ -208,9 +218,17 @@ pub(crate) fn minimize(
         if s.iteration >= options.max_iterations {
             break;
         }
-        let (d, kkt) = match reused {
-            Some((_, d)) => (d, false),
-            None => reduced_step(sys, &mut s, eig.as_ref(), saddle, guard, options),
+        // Rolling on from the last round's cut step (module `inequality::roll_on`).
+        let rolled = carry_in.take().and_then(|t| {
+            let columns = &sys.problem.scaling.columns;
+            let d = independent_change(&s.part.independent, columns, &s.q, t);
+            (s.iteration == 0 && s.eval.grad_v.dot(&d) < 0.0).then_some(d)
+        });
+        let carried = rolled.is_some();
+        let (d, kkt) = match (rolled, reused) {
+            (Some(d), _) => (d, false),
+            (None, Some((_, d))) => (d, false),
+            (None, None) => reduced_step(sys, &mut s, eig.as_ref(), saddle, guard, options),
         };
         let step = cap_step(sys, &s.part, &s.eval, &s.q, d, options);
         let slope = s.eval.grad_v.dot(&step.d);
@@ -236,13 +254,24 @@ pub(crate) fn minimize(
         let trial = line_search(sys, &line, alpha, guard, options, &mut s.diag);
         match trial {
             Some(t) if t.blocked.is_some() => {
+                let rolls = guard.is_some_and(|g| {
+                    t.blocked
+                        .iter()
+                        .flatten()
+                        .all(|&k| !g.is_roll_limit(k) && g.rolls(k))
+                });
+                if rolls && t.tried > 0.0 {
+                    carry_out = Some(sys.problem.retraction.point(&s.q, &step.dq, t.tried));
+                }
                 blocked = t.blocked;
                 s.q = t.q;
                 sys.problem.cons.branches.follow(sys.problem.model, &s.q);
                 s.eval = t.eval;
-                s.iteration += 1;
+                s.iteration += usize::from(!carried);
                 break;
             }
+            // A continuation that reaches no inequality is dropped (`inequality::roll_on`).
+            Some(_) if carried => continue,
             Some(t) => {
                 let alpha = t.alpha;
                 let before = s.eval.grad_v.amax();
@@ -295,6 +324,7 @@ pub(crate) fn minimize(
         diagnostics: s.diag,
         blocked,
         released,
+        carry: carry_out,
     })
 }
 
@@ -445,56 +475,4 @@ fn accept_step(
     (!may_be_stopped && (linear || s.linear_steps >= 5))
         || s.eval.energy.total < -1e15
         || (0..q.len()).any(|i| i % 7 < 3 && q[i].abs() > 1e6 * sys.problem.model.length_scale)
-}
-
-/// Stage 7: re-partitions when `Φ_u` is ill-conditioned, or (dense, tree) when its pivots drifted
-/// and a fresh full pivoting differs, or (sparse, second-pass choices) when the partition at `q`
-/// makes other ones, or (sparse or tree factors) when a fresh one differs after a step that
-/// needed a failed correction (a folded chart: docs/method.md, "Re-partition"). Not on any
-/// change (nearly equal levers would flip from step to step). `None` if evaluating `q` fails.
-fn refresh_partition(sys: &mut System, s: &mut Search, corrector_failed: bool) -> Option<()> {
-    let drifted = match (s.eval.factors.pivot_ratio(), s.pivot_reference) {
-        (Some(now), Some(reference)) => now < PIVOT_DRIFT * reference,
-        _ => false,
-    };
-    if s.eval.factors.ill_conditioned() {
-        repartition(sys, s)?;
-    } else if drifted {
-        // The dependent coordinates chosen at the start of this partition are losing their
-        // hold: a fresh full pivoting at `q`, adopted if it differs.
-        let fresh = sys.partition(&s.q);
-        if !fresh.same_split(&s.part) {
-            adopt(sys, s, fresh)?;
-        }
-        s.pivot_reference = s.eval.factors.pivot_ratio();
-    } else if !s.part.second_pass.is_empty() || (corrector_failed && sys.backend != Backend::Dense)
-    {
-        let fresh = sys.partition(&s.q);
-        if fresh.second_pass != s.part.second_pass
-            || (s.part.second_pass.is_empty() && !fresh.same_split(&s.part))
-        {
-            adopt(sys, s, fresh)?;
-        }
-    }
-    Some(())
-}
-
-/// A fresh partition at `q` (paper step (b)), evaluated, with a reset quasi-Newton matrix.
-fn repartition(sys: &mut System, s: &mut Search) -> Option<()> {
-    let part = sys.partition(&s.q);
-    s.diag.repartitions += 1;
-    s.eval = sys.evaluate(&s.q, &part)?;
-    s.qn = QuasiNewton::new(part.independent.len(), s.method);
-    s.part = part;
-    s.pivot_reference = s.eval.factors.pivot_ratio();
-    Some(())
-}
-
-/// Replaces the partition by `fresh`, evaluated at `q`, with a reset quasi-Newton matrix.
-fn adopt(sys: &mut System, s: &mut Search, fresh: Partition) -> Option<()> {
-    s.diag.repartitions += 1;
-    s.eval = sys.evaluate(&s.q, &fresh)?;
-    s.part = fresh;
-    s.qn = QuasiNewton::new(s.part.independent.len(), s.method);
-    Some(())
 }

@@ -181,6 +181,9 @@ pub(crate) struct Round {
     /// The active inequalities (indices into the active list) that leave before the round
     /// was stationary (module `inequality::release`).
     pub(crate) released: Vec<usize>,
+    /// The end of the step tried where the last step was cut at a rolling hull's next vertex
+    /// (module `inequality::roll_on`).
+    pub(crate) carry: Option<nalgebra::DVector<f64>>,
     /// Multipliers of the rows of each active inequality.
     pub(crate) multipliers: Vec<(Active, Vec<f64>)>,
     /// `required_mu` and slipping, where module `friction` chose the distribution.
@@ -304,6 +307,7 @@ pub(crate) fn solve_round(
     let multipliers = active_set::active_multipliers(&sys.problem.cons, &mu);
     let blocked = out.blocked;
     let released = out.released;
+    let carry = out.carry;
     // After the minimizer's verdict at the rest (`minimize::convergence_test`).
     diagnostics.timings.stability += stability_started.elapsed().as_secs_f64();
     let mut history = out.history;
@@ -361,6 +365,7 @@ pub(crate) fn solve_round(
         report,
         blocked,
         released,
+        carry,
         multipliers,
         chosen,
     })

@@ -204,6 +204,10 @@ pub(crate) fn solve(
     // Stops that the step kept held at the last release (module `release_trial`): not
     // eligible to leave early in the next round; and that round's first direction.
     let mut next = super::release_trial::Next::default();
+    // The end of a step cut at a rolling hull's next vertex, passed across the hand-over to
+    // the round after it (module `roll_on`).
+    let mut roll_on = super::roll_on::RollOn::default();
+    let mut carry = None;
     loop {
         let mut branches = state.branches.clone();
         let q = super::guard::project_past_false_hits(
@@ -235,7 +239,8 @@ pub(crate) fn solve(
         let not_early = [released_before.as_slice(), &prior.kept].concat();
         let release = super::release::Release::new(model, &active, &not_early, threshold)
             .holding_patch_neighbours(&active)
-            .starting_with(prior.first);
+            .starting_with(prior.first)
+            .carrying(carry.take());
         let round = crate::solver::solve_round(
             model,
             crate::State { q, branches },
@@ -258,6 +263,12 @@ pub(crate) fn solve(
             std::mem::take(&mut report.iterates),
         );
         let energy = history.last().map_or(0.0, |h| h.potential_energy);
+        carry = roll_on.after_round(
+            report.iterations,
+            round.blocked.is_some(),
+            !round.released.is_empty(),
+            round.carry,
+        );
         let met: Vec<Unilateral> = round
             .blocked
             .iter()

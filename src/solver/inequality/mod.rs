@@ -12,6 +12,7 @@
 //! - `stall`: a round whose steps shrink towards an obstacle's edge ends.
 //! - `rolling`: sticking spheres re-anchored where they touch after rolling.
 //! - `together`: two rolling hulls meeting their next vertices in the same step.
+//! - `roll_on`: a step cut at a rolling hull's next vertex goes on after the hand-over.
 //! - `describe`: the report's stops and contacts from the active rows' multipliers.
 //! - `distribution`: the least-norm force distribution of a statically indeterminate support.
 
@@ -25,6 +26,7 @@ pub(crate) mod let_go;
 pub(crate) mod patch;
 pub(crate) mod release;
 pub(crate) mod release_trial;
+pub(crate) mod roll_on;
 pub(crate) mod rolling;
 pub(crate) mod stall;
 pub(crate) mod together;

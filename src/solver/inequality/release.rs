@@ -142,6 +142,8 @@ pub(crate) struct Release<'m> {
     /// The first direction of the round, computed by the release that started it (module
     /// `release_trial`).
     first: Option<super::release_trial::First>,
+    /// The end of the last round's step cut at a rolling hull's next vertex (module `roll_on`).
+    carry: Option<nalgebra::DVector<f64>>,
 }
 
 impl<'m> Release<'m> {
@@ -172,6 +174,7 @@ impl<'m> Release<'m> {
             threshold,
             stall: super::stall::Stall::new(model, active),
             first: None,
+            carry: None,
         }
     }
 
@@ -179,6 +182,17 @@ impl<'m> Release<'m> {
     pub(crate) fn starting_with(mut self, first: Option<super::release_trial::First>) -> Self {
         self.first = first;
         self
+    }
+
+    /// The release with the end of the last round's step to roll on to.
+    pub(crate) fn carrying(mut self, carry: Option<nalgebra::DVector<f64>>) -> Self {
+        self.carry = carry;
+        self
+    }
+
+    /// The end of the last round's step to roll on to, if any.
+    pub(crate) fn carry(&self) -> Option<&nalgebra::DVector<f64>> {
+        self.carry.as_ref()
     }
 
     /// The round's first direction, where the release that started it computed one.

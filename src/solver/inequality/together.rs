@@ -51,7 +51,7 @@ impl Guard<'_> {
     }
 
     /// Whether inactive inequality `k` lies on the patch of a sticking pivot.
-    fn rolls(&self, k: usize) -> bool {
+    pub(crate) fn rolls(&self, k: usize) -> bool {
         self.on_patch.get(k).copied().unwrap_or(false)
     }
 

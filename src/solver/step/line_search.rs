@@ -59,6 +59,8 @@ pub(crate) struct Trial {
     pub(crate) alpha: f64,
     /// The inactive inequalities (indices into the guard's list) whose boundary cut the step.
     pub(crate) blocked: Option<Vec<usize>>,
+    /// The step length tried when the point was found (for a cut step, the one that crossed).
+    pub(crate) tried: f64,
 }
 
 /// Backtracks along `line` from the step length `alpha` (module docs); `None` when no step
@@ -130,6 +132,7 @@ pub(crate) fn line_search(
                             eval: eh,
                             alpha,
                             blocked: Some(k),
+                            tried: alpha,
                         });
                     }
                 }
@@ -150,6 +153,7 @@ pub(crate) fn line_search(
                                 eval: e2,
                                 alpha: 0.0,
                                 blocked: Some(k2),
+                                tried: alpha,
                             });
                         }
                     }
@@ -162,6 +166,7 @@ pub(crate) fn line_search(
                             eval: eb,
                             alpha: 0.0,
                             blocked: Some(k),
+                            tried: alpha,
                         });
                     }
                 }
@@ -207,6 +212,7 @@ pub(crate) fn line_search(
                 eval: et,
                 alpha,
                 blocked: (!reached.is_empty()).then_some(reached),
+                tried: alpha,
             });
         }
         // Quadratic interpolation of f along d, safeguarded.

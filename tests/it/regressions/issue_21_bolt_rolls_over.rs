@@ -9,7 +9,10 @@
 //! point (module `inequality::release`), and the same fall ends in 51 iterations, 66 rounds,
 //! on a rest that `verify` passes. With the projected stop search it took 54; where both feet
 //! (or thighs) roll onto their next vertices within 5 % of the same step, the two vertices are
-//! now met together (module `inequality::together`): 49 iterations, 60 rounds.
+//! now met together (module `inequality::together`): 49 iterations, 60 rounds. Where a step
+//! cut at a rolling hull's next vertex is followed by a hand-over without a step, the next round
+//! rolls on towards the end of the step tried, counted as no iteration where it reaches the
+//! next vertex (module `inequality::roll_on`): 36 iterations, 61 rounds.
 
 use std::process::Command;
 
@@ -44,8 +47,9 @@ fn bolt_falls_onto_its_trunk_without_releasing_the_vertices_it_rolls_onto() {
     assert_eq!(v["termination"], "converged");
     let iterations = v["iterations"].as_u64().unwrap();
     assert!(
-        iterations <= 50,
-        "{iterations} iterations (78 before, 54 before the vertices met together)"
+        iterations <= 36,
+        "{iterations} iterations (78 before, 54 before the vertices met together, 49 before the \
+         roll on across the hand-overs)"
     );
     assert_eq!(v["stability"]["verdict"], "stable");
     // It lies on its trunk: the base link carries part of the weight.

@@ -14,7 +14,7 @@
 //! columns, which lie at consecutive positions `t, t + 1, …` of one node; along such a run the
 //! node pair is the same (one coupling, one reach, the last's), the slot of `(row, t + j)` is
 //! that of `(row, t)` plus `j` and its mirror's plus `j` times the width of the column's block.
-//! The construction triplet by triplet (`Shape::build` with `by_runs` false) is the tests' reference.
+//! The construction triplet by triplet (`Shape::build` with `fast` false) is the tests' reference.
 
 use super::border::Border;
 use super::fused::Run;
@@ -81,15 +81,17 @@ impl Shape {
         Self::build(part, m, n, entries, hess, true)
     }
 
-    /// [`Shape::new`], reading the triplets by runs (`by_runs`) or one by one: the same
-    /// structure either way (the runs only save work; `shape_tests` compares the two).
+    /// [`Shape::new`] (`fast`), or the reference construction (`shape_tests` compares the
+    /// two): each triplet read on its own, the couplings listed even where the loop rows
+    /// alone overfill the border, each slot of a triplet flagged on its own, the bare
+    /// diagonal found from every block slot. The same structure either way.
     pub(crate) fn build(
         part: &Partition,
         m: usize,
         n: usize,
         entries: &[(usize, usize, f64)],
         hess: &BlockHessian,
-        by_runs: bool,
+        fast: bool,
     ) -> Option<Self> {
         let rows = part.rows.len();
         let dim = n + rows;
@@ -98,106 +100,60 @@ impl Shape {
         for (k, &r) in part.rows.iter().enumerate() {
             row_pos[r] = k as u32;
         }
-        // Nodes in elimination order; `owner[u]`: the node of unknown `u` (MAX: border row).
+        // Nodes in elimination order: a body's coordinates and the rows of its first run of
+        // pivots (`owned`; the rows pivoted at a body after another's run are border rows).
         let mut body_node = vec![u32::MAX; nb];
-        let mut members: Vec<Vec<usize>> = Vec::new();
-        let mut owner = vec![u32::MAX; dim];
+        let mut members = Members::with_capacity(nb, dim);
+        let mut owned = 0;
         for (k, &c) in part.dependent.iter().enumerate() {
             let b = c / 7;
             if body_node[b] == u32::MAX {
-                body_node[b] = members.len() as u32;
-                members.push((7 * b..7 * b + 7).collect());
+                body_node[b] = members.count() as u32;
+                members.open_body(b);
             }
-            let i = body_node[b] as usize;
-            if i + 1 == members.len() {
-                members[i].push(n + k);
+            if body_node[b] as usize + 1 == members.count() {
+                members.push(n + k);
+                owned += 1;
             }
         }
         for b in 0..nb {
             if body_node[b] == u32::MAX {
-                body_node[b] = members.len() as u32;
-                members.push((7 * b..7 * b + 7).collect());
+                body_node[b] = members.count() as u32;
+                members.open_body(b);
             }
         }
-        for (i, m) in members.iter().enumerate() {
-            for &u in m {
-                owner[u] = i as u32;
+        // The rows pivoted away from their body's run lie in the border whatever the nodes'
+        // couplings: more than [`MAX_BORDER`] of them decide for the super-nodes at once
+        // (`fast`; the reference finds the border too large after listing the couplings).
+        let bordered = if fast && rows - owned > MAX_BORDER {
+            None
+        } else {
+            border_nodes(&members, &body_node, n, &row_pos, entries, &hess.keys, fast)
+        };
+        let (members, parent, in_border, border_unknowns) = match bordered {
+            Some((parent, in_border, border_unknowns)) => {
+                (members, parent, in_border, border_unknowns)
             }
-        }
-        let nodes = members.len();
-        // Node couplings: every pair of unknowns with a value (listed straight into `later`,
-        // in the same order, without a list of all pairs first).
-        let mut later: Vec<Vec<u32>> = vec![Vec::new(); nodes];
-        let mut couple = |a: u32, b: u32| {
-            if a != u32::MAX && b != u32::MAX && a != b {
-                let (lo, hi) = (a.min(b), a.max(b));
-                later[lo as usize].push(hi);
+            None => {
+                // Too large for a dense Schur complement: the nodes a loop couples are merged
+                // into super-nodes instead (module `merge`), and nothing is bordered.
+                let (members, parent) =
+                    super::merge::kkt_nodes(part, n, &row_pos, entries, &hess.keys, fast)?;
+                let in_border = vec![false; members.count()];
+                (members, parent, in_border, Vec::new())
             }
         };
-        for &(a, b) in &hess.keys {
-            couple(body_node[a], body_node[b]);
-        }
-        // A triplet on the row and body of the one before it adds the same pair (the lists are
-        // sorted and deduplicated below): the rows' runs of 7 columns are read once.
-        let mut last = (usize::MAX, usize::MAX);
-        for e in entries {
-            let key = (e.0, e.1 / 7);
-            if (key != last || !by_runs) && row_pos[e.0] != u32::MAX {
-                couple(owner[n + row_pos[e.0] as usize], body_node[key.1]);
-            }
-            last = key;
-        }
-        let mut in_border = vec![false; nodes];
-        let mut parent = vec![u32::MAX; nodes];
-        for i in 0..nodes {
-            if in_border[i] {
-                continue;
-            }
-            let l = &mut later[i];
-            l.sort_unstable();
-            l.dedup();
-            let mut kept = None;
-            for &j in l.iter() {
-                if in_border[j as usize] {
-                    continue;
-                }
-                match kept {
-                    None => kept = Some(j),
-                    Some(_) => in_border[j as usize] = true,
-                }
-            }
-            parent[i] = kept.unwrap_or(u32::MAX);
-        }
-        // Parents bordered after their children were kept: none.
-        for i in 0..nodes {
-            if parent[i] != u32::MAX && in_border[parent[i] as usize] {
-                parent[i] = u32::MAX;
-            }
-        }
-        let mut border_unknowns: Vec<usize> = (0..dim).filter(|&u| owner[u] == u32::MAX).collect();
-        for (i, m) in members.iter().enumerate() {
-            if in_border[i] {
-                border_unknowns.extend_from_slice(m);
-            }
-        }
-        if border_unknowns.len() > MAX_BORDER {
-            // Too large for a dense Schur complement: the nodes a loop couples are merged into
-            // super-nodes instead (module `merge`), and nothing is bordered.
-            (members, parent) =
-                super::merge::kkt_nodes(part, n, &row_pos, entries, &hess.keys, by_runs)?;
-            in_border = vec![false; members.len()];
-            border_unknowns.clear();
-        }
-        let nodes = members.len();
+        let nodes = members.count();
         // Tree-space positions: kept nodes in order, then the border.
         let mut tpos = vec![0usize; dim];
         let mut perm = Vec::with_capacity(dim);
         let mut node_map = vec![u32::MAX; nodes];
         let (mut at, mut d, mut par) = (Vec::new(), Vec::new(), Vec::new());
-        for (i, m) in members.iter().enumerate() {
+        for i in 0..nodes {
             if in_border[i] {
                 continue;
             }
+            let m = members.get(i);
             node_map[i] = at.len() as u32;
             at.push(perm.len());
             d.push(m.len());
@@ -232,8 +188,7 @@ impl Shape {
         // them; the triplets come so), where the slots of a run follow from its first.
         let lined = |b: usize| {
             let t = tpos[7 * b];
-            by_runs
-                && t < tree_len
+            fast && t < tree_len
                 && (1..7).all(|k| tpos[7 * b + k] == t + k && node_of[t + k] == node_of[t])
         };
         let lined: Vec<bool> = (0..nb).map(lined).collect();
@@ -362,6 +317,7 @@ impl Shape {
         // Each slot's first triplet flagged as it is listed (`reached`: the slots listed so
         // far, the border's appended as they come).
         let mut reached = vec![false; flat];
+        let flag = if fast { flag_pair } else { flag_each };
         let mut jac_slots: Vec<[u32; 2]> = Vec::with_capacity(entries.len());
         // Along a run in the tree, the next column's slot is the next one in the row's block,
         // and its mirror's one row further in the column's block (`step`: the block's width),
@@ -381,31 +337,46 @@ impl Shape {
                 let [s1, s2] = [tree_slot(t1, t2)?, tree_slot(t2, t1)?];
                 for j in 0..(end - first) as u32 {
                     let at = |s: u32, by: u32| if s == SKIP { SKIP } else { s + j * by };
-                    let (a, b) = (at(s1, 1), at(s2, step));
-                    jac_slots.push([flag_first(&mut reached, a), flag_first(&mut reached, b)]);
+                    jac_slots.push(flag(&mut reached, at(s1, 1), at(s2, step)));
                 }
             } else {
                 for e in &entries[first..end] {
                     let (a, b) = (locate(r, e.1)?, locate(e.1, r)?);
-                    jac_slots.push([flag_first(&mut reached, a), flag_first(&mut reached, b)]);
+                    jac_slots.push(flag(&mut reached, a, b));
                 }
             }
         }
-        let diag_slots = (0..n).map(|c| locate(c, c)).collect::<Option<Vec<_>>>()?;
+        let mut diag_slots = Vec::with_capacity(n);
+        for c in 0..n {
+            diag_slots.push(locate(c, c)?);
+        }
         let total = flat + border_slot.len();
         if total >= FIRST as usize {
             return None;
         }
-        // The diagonal slots no block reaches.
-        reached.resize(total, false);
-        for s in block_slots.iter().flatten().filter(|&&s| s != SKIP) {
-            reached[*s as usize] = true;
-        }
-        let bare_diag = diag_slots
-            .iter()
-            .copied()
-            .filter(|&s| !reached[s as usize])
-            .collect();
+        // The diagonal slots no block reaches: a slot holds one pair of unknowns, so the
+        // diagonal of coordinate `c` is reached by the block `(b, b)` of its body only (`fast`),
+        // or found from every block slot.
+        let bare_diag = if fast {
+            let mut own_block = vec![false; nb];
+            for &(a, b) in &hess.keys {
+                own_block[a] |= a == b;
+            }
+            (0..n)
+                .filter(|&c| !own_block[c / 7])
+                .map(|c| diag_slots[c])
+                .collect()
+        } else {
+            reached.resize(total, false);
+            for s in block_slots.iter().flatten().filter(|&&s| s != SKIP) {
+                reached[*s as usize] = true;
+            }
+            diag_slots
+                .iter()
+                .copied()
+                .filter(|&s| !reached[s as usize])
+                .collect()
+        };
         Some(Shape {
             n,
             rows,
@@ -426,6 +397,148 @@ impl Shape {
             bare_diag,
         })
     }
+}
+
+/// The unknowns of each node, node after node: node `i` holds `list[start[i] .. start[i + 1]]`.
+#[derive(Default)]
+pub(crate) struct Members {
+    start: Vec<usize>,
+    list: Vec<usize>,
+}
+
+impl Members {
+    /// Room for `nodes` nodes of `unknowns` in all.
+    pub(crate) fn with_capacity(nodes: usize, unknowns: usize) -> Self {
+        Members {
+            start: Vec::with_capacity(nodes),
+            list: Vec::with_capacity(unknowns),
+        }
+    }
+
+    /// Number of nodes.
+    pub(crate) fn count(&self) -> usize {
+        self.start.len()
+    }
+
+    /// Opens a node (empty).
+    pub(crate) fn open(&mut self) {
+        self.start.push(self.list.len());
+    }
+
+    /// Opens a node holding body `b`'s 7 coordinates.
+    pub(crate) fn open_body(&mut self, b: usize) {
+        self.open();
+        self.list.extend(7 * b..7 * b + 7);
+    }
+
+    /// Adds unknown `u` to the last node.
+    pub(crate) fn push(&mut self, u: usize) {
+        self.list.push(u);
+    }
+
+    /// Node `i`'s unknowns.
+    pub(crate) fn get(&self, i: usize) -> &[usize] {
+        let end = self.start.get(i + 1).copied().unwrap_or(self.list.len());
+        &self.list[self.start[i]..end]
+    }
+}
+
+/// Each node's parent, the nodes in the border and the border's unknowns (rows pivoted away
+/// from their body's run, then the bordered nodes' unknowns): a node coupled to several later
+/// nodes keeps the first as its parent and borders the others (module doc). `None` if the
+/// border exceeds [`MAX_BORDER`]. `by_runs`: a row's run of triplets on one body coupled once.
+fn border_nodes(
+    members: &Members,
+    body_node: &[u32],
+    n: usize,
+    row_pos: &[u32],
+    entries: &[(usize, usize, f64)],
+    keys: &[(usize, usize)],
+    by_runs: bool,
+) -> Option<(Vec<u32>, Vec<bool>, Vec<usize>)> {
+    let nodes = members.count();
+    let dim = n + row_pos.iter().filter(|&&k| k != u32::MAX).count();
+    let mut owner = vec![u32::MAX; dim];
+    for i in 0..nodes {
+        for &u in members.get(i) {
+            owner[u] = i as u32;
+        }
+    }
+    // Node couplings: every pair of unknowns with a value (listed straight into `later`,
+    // in the same order, without a list of all pairs first).
+    let mut later: Vec<Vec<u32>> = vec![Vec::new(); nodes];
+    let mut couple = |a: u32, b: u32| {
+        if a != u32::MAX && b != u32::MAX && a != b {
+            let (lo, hi) = (a.min(b), a.max(b));
+            later[lo as usize].push(hi);
+        }
+    };
+    for &(a, b) in keys {
+        couple(body_node[a], body_node[b]);
+    }
+    // A triplet on the row and body of the one before it adds the same pair (the lists are
+    // sorted and deduplicated below): the rows' runs of 7 columns are read once.
+    let mut last = (usize::MAX, usize::MAX);
+    for e in entries {
+        let key = (e.0, e.1 / 7);
+        if (key != last || !by_runs) && row_pos[e.0] != u32::MAX {
+            couple(owner[n + row_pos[e.0] as usize], body_node[key.1]);
+        }
+        last = key;
+    }
+    let mut in_border = vec![false; nodes];
+    let mut parent = vec![u32::MAX; nodes];
+    for i in 0..nodes {
+        if in_border[i] {
+            continue;
+        }
+        let l = &mut later[i];
+        l.sort_unstable();
+        l.dedup();
+        let mut kept = None;
+        for &j in l.iter() {
+            if in_border[j as usize] {
+                continue;
+            }
+            match kept {
+                None => kept = Some(j),
+                Some(_) => in_border[j as usize] = true,
+            }
+        }
+        parent[i] = kept.unwrap_or(u32::MAX);
+    }
+    // Parents bordered after their children were kept: none.
+    for i in 0..nodes {
+        if parent[i] != u32::MAX && in_border[parent[i] as usize] {
+            parent[i] = u32::MAX;
+        }
+    }
+    let mut border_unknowns: Vec<usize> = (0..dim).filter(|&u| owner[u] == u32::MAX).collect();
+    for i in 0..nodes {
+        if in_border[i] {
+            border_unknowns.extend_from_slice(members.get(i));
+        }
+    }
+    if border_unknowns.len() > MAX_BORDER {
+        return None;
+    }
+    Some((parent, in_border, border_unknowns))
+}
+
+/// A triplet's slot `a` and its mirror's `b`, each flagged [`FIRST`] if no triplet before
+/// reached it (`reached`, grown to the border's slots as they come); [`SKIP`] as it is.
+fn flag_each(reached: &mut Vec<bool>, a: u32, b: u32) -> [u32; 2] {
+    [flag_first(reached, a), flag_first(reached, b)]
+}
+
+/// [`flag_each`] by one test: a slot holds one ordered pair of unknowns and the mirror's pair
+/// `(column, row)` comes from no other triplet, so both are first when the pair is; the pair
+/// is known by the slot of the two that is not [`SKIP`] (one is, for a coupling's mirror).
+#[inline]
+fn flag_pair(reached: &mut Vec<bool>, a: u32, b: u32) -> [u32; 2] {
+    let key = if a != SKIP { a } else { b };
+    let first = flag_first(reached, key) & FIRST;
+    [a | first, b | first]
 }
 
 /// `slot`, flagged [`FIRST`] if no triplet before reached it (`reached`, grown to the border's

@@ -107,28 +107,24 @@ pub(crate) fn phi_u_runs(
 
 /// The KKT matrix's super-nodes for `part` (module doc): `(members, parent)`, each node's
 /// unknowns (coordinates `0 .. n`, rows `n + k`) in elimination order and its parent
-/// (`u32::MAX`: a root); `None` if a super-node exceeds [`MAX_NODE`] unknowns. `by_runs`: a
-/// row's run of triplets on one body coupled once (else each triplet: the same nodes).
+/// (`u32::MAX`: a root); `None` if a super-node exceeds [`MAX_NODE`] unknowns. `pairs`: the
+/// coupled nodes `(a, b, _)` (module `shape`'s nodes, each row in the node of the run it is
+/// pivoted in: those numbered here).
 pub(crate) fn kkt_nodes(
     part: &Partition,
     n: usize,
-    row_pos: &[u32],
-    entries: &[(usize, usize, f64)],
-    keys: &[(usize, usize)],
-    by_runs: bool,
+    pairs: &[(u32, u32, bool)],
 ) -> Option<(Members, Vec<u32>)> {
     let nb = n / 7;
     let rows = part.rows.len();
     let mut body_node = vec![u32::MAX; nb];
     let mut members = Members::with_capacity(nb, n + rows);
-    let mut row_node = vec![u32::MAX; rows];
     for (k, &c) in part.dependent.iter().enumerate() {
         let b = c / 7;
         if body_node[b] == u32::MAX {
             body_node[b] = members.count() as u32;
             members.open_body(b);
         }
-        row_node[k] = members.count() as u32 - 1;
         members.push(n + k);
     }
     for b in 0..nb {
@@ -138,29 +134,9 @@ pub(crate) fn kkt_nodes(
         }
     }
     let nodes = members.count();
-    // The coupled pairs of nodes, then each node's neighbours (`adj_at[i] .. adj_at[i + 1]`
-    // of `adj`; read as sets).
-    let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(keys.len() + entries.len() / 4);
-    let mut couple = |a: u32, b: u32| {
-        if a != b && a != u32::MAX && b != u32::MAX {
-            pairs.push((a, b));
-        }
-    };
-    for &(a, b) in keys {
-        couple(body_node[a], body_node[b]);
-    }
-    // A triplet on the row and body of the one before it couples the same nodes: a row's run
-    // of columns on a body is coupled once.
-    let mut last = (usize::MAX, usize::MAX);
-    for e in entries {
-        let key = (e.0, e.1 / 7);
-        if (key != last || !by_runs) && row_pos[e.0] != u32::MAX {
-            couple(row_node[row_pos[e.0] as usize], body_node[key.1]);
-        }
-        last = key;
-    }
+    // Each node's neighbours, `adj_at[i] .. adj_at[i + 1]` of `adj` (read as sets).
     let mut adj_at = vec![0usize; nodes + 1];
-    for &(a, b) in &pairs {
+    for &(a, b, _) in pairs {
         adj_at[a as usize + 1] += 1;
         adj_at[b as usize + 1] += 1;
     }
@@ -169,7 +145,7 @@ pub(crate) fn kkt_nodes(
     }
     let mut fill = adj_at.clone();
     let mut adj = vec![0u32; adj_at[nodes]];
-    for &(a, b) in &pairs {
+    for &(a, b, _) in pairs {
         adj[fill[a as usize]] = b;
         fill[a as usize] += 1;
         adj[fill[b as usize]] = a;

@@ -82,9 +82,9 @@ impl Shape {
     }
 
     /// [`Shape::new`] (`fast`), or the reference construction (`shape_tests` compares the
-    /// two): each triplet read on its own, the couplings listed even where the loop rows
-    /// alone overfill the border, each slot of a triplet flagged on its own, the bare
-    /// diagonal found from every block slot. The same structure either way.
+    /// two): each triplet read on its own, the border completed before its size is tested,
+    /// each slot of a triplet flagged on its own, the bare diagonal found from every block
+    /// slot. The same structure either way.
     pub(crate) fn build(
         part: &Partition,
         m: usize,
@@ -101,19 +101,23 @@ impl Shape {
             row_pos[r] = k as u32;
         }
         // Nodes in elimination order: a body's coordinates and the rows of its first run of
-        // pivots (`owned`; the rows pivoted at a body after another's run are border rows).
+        // pivots (`owned`). A row pivoted at a body after another body's run (a loop's) is a
+        // border row, or joins the node of the run it is pivoted in among super-nodes
+        // (`row_node`: that node for every row).
         let mut body_node = vec![u32::MAX; nb];
         let mut members = Members::with_capacity(nb, dim);
-        let mut owned = 0;
+        let mut row_node = vec![0u32; rows];
+        let mut owned = vec![false; rows];
         for (k, &c) in part.dependent.iter().enumerate() {
             let b = c / 7;
             if body_node[b] == u32::MAX {
                 body_node[b] = members.count() as u32;
                 members.open_body(b);
             }
-            if body_node[b] as usize + 1 == members.count() {
+            row_node[k] = members.count() as u32 - 1;
+            if body_node[b] == row_node[k] {
                 members.push(n + k);
-                owned += 1;
+                owned[k] = true;
             }
         }
         for b in 0..nb {
@@ -122,14 +126,8 @@ impl Shape {
                 members.open_body(b);
             }
         }
-        // The rows pivoted away from their body's run lie in the border whatever the nodes'
-        // couplings: more than [`MAX_BORDER`] of them decide for the super-nodes at once
-        // (`fast`; the reference finds the border too large after listing the couplings).
-        let bordered = if fast && rows - owned > MAX_BORDER {
-            None
-        } else {
-            border_nodes(&members, &body_node, n, &row_pos, entries, &hess.keys, fast)
-        };
+        let pairs = node_pairs(&body_node, &row_node, &owned, &row_pos, entries, &hess.keys, fast);
+        let bordered = border_nodes(&members, &pairs, &owned, n, fast);
         let (members, parent, in_border, border_unknowns) = match bordered {
             Some((parent, in_border, border_unknowns)) => {
                 (members, parent, in_border, border_unknowns)
@@ -137,8 +135,7 @@ impl Shape {
             None => {
                 // Too large for a dense Schur complement: the nodes a loop couples are merged
                 // into super-nodes instead (module `merge`), and nothing is bordered.
-                let (members, parent) =
-                    super::merge::kkt_nodes(part, n, &row_pos, entries, &hess.keys, fast)?;
+                let (members, parent) = super::merge::kkt_nodes(part, n, &pairs)?;
                 let in_border = vec![false; members.count()];
                 (members, parent, in_border, Vec::new())
             }
@@ -317,7 +314,6 @@ impl Shape {
         // Each slot's first triplet flagged as it is listed (`reached`: the slots listed so
         // far, the border's appended as they come).
         let mut reached = vec![false; flat];
-        let flag = if fast { flag_pair } else { flag_each };
         let mut jac_slots: Vec<[u32; 2]> = Vec::with_capacity(entries.len());
         // Along a run in the tree, the next column's slot is the next one in the row's block,
         // and its mirror's one row further in the column's block (`step`: the block's width),
@@ -335,14 +331,30 @@ impl Shape {
                 let (a, b) = (node_of[t2] as usize, node_of[t1] as usize);
                 let step = if a == b { d[a] } else { w[a] } as u32;
                 let [s1, s2] = [tree_slot(t1, t2)?, tree_slot(t2, t1)?];
-                for j in 0..(end - first) as u32 {
-                    let at = |s: u32, by: u32| if s == SKIP { SKIP } else { s + j * by };
-                    jac_slots.push(flag(&mut reached, at(s1, 1), at(s2, step)));
+                let at = |s: u32, j: u32, by: u32| if s == SKIP { SKIP } else { s + j * by };
+                if fast {
+                    // One test per triplet, at the pair's slot that is not the mirror of a
+                    // coupling (`flag_pair`; in the tree, inside `reached`).
+                    let (key, by) = if s1 != SKIP { (s1, 1) } else { (s2, step) };
+                    for j in 0..(end - first) as u32 {
+                        let seen = std::mem::replace(&mut reached[(key + j * by) as usize], true);
+                        let first = if seen { 0 } else { FIRST };
+                        jac_slots.push([at(s1, j, 1) | first, at(s2, j, step) | first]);
+                    }
+                } else {
+                    for j in 0..(end - first) as u32 {
+                        let (a, b) = (at(s1, j, 1), at(s2, j, step));
+                        jac_slots.push(flag_each(&mut reached, a, b));
+                    }
                 }
             } else {
                 for e in &entries[first..end] {
                     let (a, b) = (locate(r, e.1)?, locate(e.1, r)?);
-                    jac_slots.push(flag(&mut reached, a, b));
+                    jac_slots.push(if fast {
+                        flag_pair(&mut reached, a, b)
+                    } else {
+                        flag_each(&mut reached, a, b)
+                    });
                 }
             }
         }
@@ -443,69 +455,103 @@ impl Members {
     }
 }
 
-/// Each node's parent, the nodes in the border and the border's unknowns (rows pivoted away
-/// from their body's run, then the bordered nodes' unknowns): a node coupled to several later
-/// nodes keeps the first as its parent and borders the others (module doc). `None` if the
-/// border exceeds [`MAX_BORDER`]. `by_runs`: a row's run of triplets on one body coupled once.
-fn border_nodes(
-    members: &Members,
+/// The pairs of nodes coupled by a value `(a, b, owned)`: the Hessian blocks' bodies', then
+/// each Jacobian triplet's row node (`row_node`) and column body's (`owned`: the row is its
+/// node's own, not a border row). `by_runs`: a row's run of triplets on one body (the same
+/// pair) listed once.
+fn node_pairs(
     body_node: &[u32],
-    n: usize,
+    row_node: &[u32],
+    owned: &[bool],
     row_pos: &[u32],
     entries: &[(usize, usize, f64)],
     keys: &[(usize, usize)],
     by_runs: bool,
-) -> Option<(Vec<u32>, Vec<bool>, Vec<usize>)> {
-    let nodes = members.count();
-    let dim = n + row_pos.iter().filter(|&&k| k != u32::MAX).count();
-    let mut owner = vec![u32::MAX; dim];
-    for i in 0..nodes {
-        for &u in members.get(i) {
-            owner[u] = i as u32;
-        }
-    }
-    // Node couplings: every pair of unknowns with a value (listed straight into `later`,
-    // in the same order, without a list of all pairs first).
-    let mut later: Vec<Vec<u32>> = vec![Vec::new(); nodes];
-    let mut couple = |a: u32, b: u32| {
-        if a != u32::MAX && b != u32::MAX && a != b {
-            let (lo, hi) = (a.min(b), a.max(b));
-            later[lo as usize].push(hi);
-        }
-    };
+) -> Vec<(u32, u32, bool)> {
+    let mut pairs = Vec::with_capacity(keys.len() + entries.len() / 4);
     for &(a, b) in keys {
-        couple(body_node[a], body_node[b]);
+        let (a, b) = (body_node[a], body_node[b]);
+        if a != b {
+            pairs.push((a, b, true));
+        }
     }
-    // A triplet on the row and body of the one before it adds the same pair (the lists are
-    // sorted and deduplicated below): the rows' runs of 7 columns are read once.
     let mut last = (usize::MAX, usize::MAX);
     for e in entries {
         let key = (e.0, e.1 / 7);
         if (key != last || !by_runs) && row_pos[e.0] != u32::MAX {
-            couple(owner[n + row_pos[e.0] as usize], body_node[key.1]);
+            let k = row_pos[e.0] as usize;
+            let (a, b) = (row_node[k], body_node[key.1]);
+            if a != b {
+                pairs.push((a, b, owned[k]));
+            }
         }
         last = key;
     }
+    pairs
+}
+
+/// Each node's parent, the nodes in the border and the border's unknowns (the border rows,
+/// then the bordered nodes' unknowns), from the pairs of nodes coupled through owned rows: a
+/// node coupled to several later nodes keeps the first as its parent and borders the others
+/// (module doc). `None` if the border exceeds [`MAX_BORDER`] (`fast`: as soon as it does).
+fn border_nodes(
+    members: &Members,
+    pairs: &[(u32, u32, bool)],
+    owned: &[bool],
+    n: usize,
+    fast: bool,
+) -> Option<(Vec<u32>, Vec<bool>, Vec<usize>)> {
+    let nodes = members.count();
+    // Each node's later neighbours: `later[at[i] .. at[i + 1]]`.
+    let mut at = vec![0usize; nodes + 1];
+    for &(a, b, own) in pairs {
+        if own {
+            at[a.min(b) as usize + 1] += 1;
+        }
+    }
+    for i in 0..nodes {
+        at[i + 1] += at[i];
+    }
+    let mut fill = at.clone();
+    let mut later = vec![0u32; at[nodes]];
+    for &(a, b, own) in pairs {
+        if own {
+            let lo = a.min(b) as usize;
+            later[fill[lo]] = a.max(b);
+            fill[lo] += 1;
+        }
+    }
+    let mut size = owned.iter().filter(|&&o| !o).count();
     let mut in_border = vec![false; nodes];
     let mut parent = vec![u32::MAX; nodes];
     for i in 0..nodes {
         if in_border[i] {
             continue;
         }
-        let l = &mut later[i];
+        let l = &mut later[at[i]..at[i + 1]];
         l.sort_unstable();
-        l.dedup();
         let mut kept = None;
+        let mut prev = u32::MAX;
         for &j in l.iter() {
-            if in_border[j as usize] {
+            if j == prev || in_border[j as usize] {
                 continue;
             }
+            prev = j;
             match kept {
                 None => kept = Some(j),
-                Some(_) => in_border[j as usize] = true,
+                Some(_) => {
+                    in_border[j as usize] = true;
+                    size += members.get(j as usize).len();
+                    if fast && size > MAX_BORDER {
+                        return None;
+                    }
+                }
             }
         }
         parent[i] = kept.unwrap_or(u32::MAX);
+    }
+    if size > MAX_BORDER {
+        return None;
     }
     // Parents bordered after their children were kept: none.
     for i in 0..nodes {
@@ -513,14 +559,14 @@ fn border_nodes(
             parent[i] = u32::MAX;
         }
     }
-    let mut border_unknowns: Vec<usize> = (0..dim).filter(|&u| owner[u] == u32::MAX).collect();
+    let mut border_unknowns: Vec<usize> = (0..owned.len())
+        .filter(|&k| !owned[k])
+        .map(|k| n + k)
+        .collect();
     for i in 0..nodes {
         if in_border[i] {
             border_unknowns.extend_from_slice(members.get(i));
         }
-    }
-    if border_unknowns.len() > MAX_BORDER {
-        return None;
     }
     Some((parent, in_border, border_unknowns))
 }

@@ -126,7 +126,8 @@ impl Shape {
                 members.open_body(b);
             }
         }
-        let pairs = node_pairs(&body_node, &row_node, &owned, &row_pos, entries, &hess.keys, fast);
+        let mut runs = triplet_runs(entries, fast);
+        let pairs = node_pairs(&body_node, &row_node, &owned, &row_pos, entries, &runs, &hess.keys);
         let bordered = border_nodes(&members, &pairs, &owned, n, fast);
         let (members, parent, in_border, border_unknowns) = match bordered {
             Some((parent, in_border, border_unknowns)) => {
@@ -180,32 +181,24 @@ impl Shape {
                 node_of[t] = i as u32;
             }
         }
-        // The triplets by runs `first .. end`: a row's consecutive columns on one body whose 7
-        // coordinates lie in order at consecutive positions of one node (as the nodes list
-        // them; the triplets come so), where the slots of a run follow from its first.
+        // A run's slots follow from its first where its body's 7 coordinates lie in order at
+        // consecutive positions of one node (`lined`: as the nodes list them); elsewhere (the
+        // border's bodies) each triplet is placed on its own.
         let lined = |b: usize| {
             let t = tpos[7 * b];
             fast && t < tree_len
                 && (1..7).all(|k| tpos[7 * b + k] == t + k && node_of[t + k] == node_of[t])
         };
         let lined: Vec<bool> = (0..nb).map(lined).collect();
-        let mut runs: Vec<(usize, usize)> = Vec::with_capacity(entries.len() / 4 + 1);
-        let mut first = 0;
-        while first < entries.len() {
-            let (r, c) = (entries[first].0, entries[first].1);
-            let mut end = first + 1;
-            if lined[c / 7] {
-                let last = c - c % 7 + 6;
-                while end < entries.len()
-                    && entries[end].0 == r
-                    && entries[end].1 == c + (end - first)
-                    && entries[end].1 <= last
-                {
-                    end += 1;
-                }
-            }
-            runs.push((first, end));
-            first = end;
+        if !lined.iter().all(|&l| l) {
+            runs = runs
+                .iter()
+                .flat_map(|&(first, end)| {
+                    let whole = lined[entries[first].1 / 7];
+                    let cut = if whole { end - first } else { 1 };
+                    (first..end).step_by(cut).map(move |f| (f, (f + cut).min(end)))
+                })
+                .collect();
         }
         // Coupling widths: the parent's leading unknowns reached.
         let mut w = vec![0usize; kept];
@@ -335,8 +328,20 @@ impl Shape {
                 if fast {
                     // One test per triplet, at the pair's slot that is not the mirror of a
                     // coupling (`flag_pair`; in the tree, inside `reached`).
+                    let len = (end - first) as u32;
+                    if s1 != SKIP {
+                        let span = &mut reached[s1 as usize..(s1 + len) as usize];
+                        if !span.contains(&true) {
+                            // No slot of the run reached before: all first.
+                            span.fill(true);
+                            for j in 0..len {
+                                jac_slots.push([(s1 + j) | FIRST, at(s2, j, step) | FIRST]);
+                            }
+                            continue;
+                        }
+                    }
                     let (key, by) = if s1 != SKIP { (s1, 1) } else { (s2, step) };
-                    for j in 0..(end - first) as u32 {
+                    for j in 0..len {
                         let seen = std::mem::replace(&mut reached[(key + j * by) as usize], true);
                         let first = if seen { 0 } else { FIRST };
                         jac_slots.push([at(s1, j, 1) | first, at(s2, j, step) | first]);
@@ -455,20 +460,46 @@ impl Members {
     }
 }
 
+/// The triplets by runs `first .. end` (`fast`): a row's consecutive columns on one body,
+/// which lie at consecutive positions of one node, or each triplet on its own.
+fn triplet_runs(entries: &[(usize, usize, f64)], fast: bool) -> Vec<(usize, usize)> {
+    if !fast {
+        return (0..entries.len()).map(|i| (i, i + 1)).collect();
+    }
+    let mut runs = Vec::with_capacity(entries.len() / 4 + 1);
+    let mut first = 0;
+    while first < entries.len() {
+        let (r, c) = (entries[first].0, entries[first].1);
+        let last = c - c % 7 + 6;
+        let mut end = first + 1;
+        while end < entries.len()
+            && entries[end].0 == r
+            && entries[end].1 == c + (end - first)
+            && entries[end].1 <= last
+        {
+            end += 1;
+        }
+        runs.push((first, end));
+        first = end;
+    }
+    runs
+}
+
 /// The pairs of nodes coupled by a value `(a, b, owned)`: the Hessian blocks' bodies', then
-/// each Jacobian triplet's row node (`row_node`) and column body's (`owned`: the row is its
-/// node's own, not a border row). `by_runs`: a row's run of triplets on one body (the same
-/// pair) listed once.
+/// each Jacobian run's row node (`row_node`) and column body's (`owned`: the row is its node's
+/// own, not a border row). A run of several triplets on the row and body of the run before it
+/// (the same pair) is not listed again; a single triplet always is (the reference lists every
+/// triplet; the pairs are read as sets, so a repeat changes nothing).
 fn node_pairs(
     body_node: &[u32],
     row_node: &[u32],
     owned: &[bool],
     row_pos: &[u32],
     entries: &[(usize, usize, f64)],
+    runs: &[(usize, usize)],
     keys: &[(usize, usize)],
-    by_runs: bool,
 ) -> Vec<(u32, u32, bool)> {
-    let mut pairs = Vec::with_capacity(keys.len() + entries.len() / 4);
+    let mut pairs = Vec::with_capacity(keys.len() + runs.len());
     for &(a, b) in keys {
         let (a, b) = (body_node[a], body_node[b]);
         if a != b {
@@ -476,9 +507,10 @@ fn node_pairs(
         }
     }
     let mut last = (usize::MAX, usize::MAX);
-    for e in entries {
+    for &(first, end) in runs {
+        let e = &entries[first];
         let key = (e.0, e.1 / 7);
-        if (key != last || !by_runs) && row_pos[e.0] != u32::MAX {
+        if (key != last || end - first == 1) && row_pos[e.0] != u32::MAX {
             let k = row_pos[e.0] as usize;
             let (a, b) = (row_node[k], body_node[key.1]);
             if a != b {

@@ -215,10 +215,18 @@ pub(crate) fn kkt_nodes(
         }
         own.sort_unstable();
         for &m in &own {
-            members.get(m).iter().filter(|&&u| u < n).for_each(|&u| merged.push(u));
+            members
+                .get(m)
+                .iter()
+                .filter(|&&u| u < n)
+                .for_each(|&u| merged.push(u));
         }
         for &m in &own {
-            members.get(m).iter().filter(|&&u| u >= n).for_each(|&u| merged.push(u));
+            members
+                .get(m)
+                .iter()
+                .filter(|&&u| u >= n)
+                .for_each(|&u| merged.push(u));
         }
     }
     let mut par = vec![u32::MAX; merged.count()];

@@ -14,6 +14,11 @@
 //! columns, which lie at consecutive positions `t, t + 1, …` of one node; along such a run the
 //! node pair is the same (one coupling, one reach, the last's), the slot of `(row, t + j)` is
 //! that of `(row, t)` plus `j` and its mirror's plus `j` times the width of the column's block.
+//! The runs and the pairs of coupled nodes are listed in one pass, shared by the bordered tree
+//! and the super-nodes (module `merge`); the border is abandoned as soon as it exceeds
+//! [`MAX_BORDER`]. A slot holds one ordered pair of unknowns, so a triplet's slot and its
+//! mirror's are first together (one test per triplet, one per run where none of its slots was
+//! reached), and a coordinate's diagonal is written by its body's own Hessian block only.
 //! The construction triplet by triplet (`Shape::build` with `fast` false) is the tests' reference.
 
 use super::border::Border;
@@ -126,8 +131,9 @@ impl Shape {
                 members.open_body(b);
             }
         }
-        let mut runs = triplet_runs(entries, fast);
-        let pairs = node_pairs(&body_node, &row_node, &owned, &row_pos, entries, &runs, &hess.keys);
+        let (mut runs, pairs) = runs_and_pairs(
+            entries, &hess.keys, &body_node, &row_node, &owned, &row_pos, fast,
+        );
         let bordered = border_nodes(&members, &pairs, &owned, n, fast);
         let (members, parent, in_border, border_unknowns) = match bordered {
             Some((parent, in_border, border_unknowns)) => {
@@ -196,7 +202,9 @@ impl Shape {
                 .flat_map(|&(first, end)| {
                     let whole = lined[entries[first].1 / 7];
                     let cut = if whole { end - first } else { 1 };
-                    (first..end).step_by(cut).map(move |f| (f, (f + cut).min(end)))
+                    (first..end)
+                        .step_by(cut)
+                        .map(move |f| (f, (f + cut).min(end)))
                 })
                 .collect();
         }
@@ -460,46 +468,23 @@ impl Members {
     }
 }
 
-/// The triplets by runs `first .. end` (`fast`): a row's consecutive columns on one body,
-/// which lie at consecutive positions of one node, or each triplet on its own.
-fn triplet_runs(entries: &[(usize, usize, f64)], fast: bool) -> Vec<(usize, usize)> {
-    if !fast {
-        return (0..entries.len()).map(|i| (i, i + 1)).collect();
-    }
-    let mut runs = Vec::with_capacity(entries.len() / 4 + 1);
-    let mut first = 0;
-    while first < entries.len() {
-        let (r, c) = (entries[first].0, entries[first].1);
-        let last = c - c % 7 + 6;
-        let mut end = first + 1;
-        while end < entries.len()
-            && entries[end].0 == r
-            && entries[end].1 == c + (end - first)
-            && entries[end].1 <= last
-        {
-            end += 1;
-        }
-        runs.push((first, end));
-        first = end;
-    }
-    runs
-}
-
-/// The pairs of nodes coupled by a value `(a, b, owned)`: the Hessian blocks' bodies', then
-/// each Jacobian run's row node (`row_node`) and column body's (`owned`: the row is its node's
-/// own, not a border row). A run of several triplets on the row and body of the run before it
-/// (the same pair) is not listed again; a single triplet always is (the reference lists every
-/// triplet; the pairs are read as sets, so a repeat changes nothing).
-fn node_pairs(
+/// The triplets by runs `first .. end` and the pairs of nodes coupled by a value
+/// `(a, b, owned)`. Runs (`fast`): a row's consecutive columns on one body, which lie at
+/// consecutive positions of one node; else each triplet on its own. Pairs: the Hessian
+/// blocks' bodies', then each run's row node (`row_node`) and column body's (`owned`: the row
+/// is its node's own, not a border row); a run on the row and body of the run before it (the
+/// same pair) is not listed again where `fast` (the pairs are read as sets).
+fn runs_and_pairs(
+    entries: &[(usize, usize, f64)],
+    keys: &[(usize, usize)],
     body_node: &[u32],
     row_node: &[u32],
     owned: &[bool],
     row_pos: &[u32],
-    entries: &[(usize, usize, f64)],
-    runs: &[(usize, usize)],
-    keys: &[(usize, usize)],
-) -> Vec<(u32, u32, bool)> {
-    let mut pairs = Vec::with_capacity(keys.len() + runs.len());
+    fast: bool,
+) -> (Vec<(usize, usize)>, Vec<(u32, u32, bool)>) {
+    let mut runs = Vec::with_capacity(entries.len() / 3 + 1);
+    let mut pairs = Vec::with_capacity(keys.len() + entries.len() / 3);
     for &(a, b) in keys {
         let (a, b) = (body_node[a], body_node[b]);
         if a != b {
@@ -507,19 +492,33 @@ fn node_pairs(
         }
     }
     let mut last = (usize::MAX, usize::MAX);
-    for &(first, end) in runs {
-        let e = &entries[first];
-        let key = (e.0, e.1 / 7);
-        if (key != last || end - first == 1) && row_pos[e.0] != u32::MAX {
-            let k = row_pos[e.0] as usize;
-            let (a, b) = (row_node[k], body_node[key.1]);
-            if a != b {
-                pairs.push((a, b, owned[k]));
+    let mut first = 0;
+    while first < entries.len() {
+        let (r, c) = (entries[first].0, entries[first].1);
+        let body = c / 7;
+        let mut end = first + 1;
+        if fast {
+            let top = 7 * body + 6;
+            while end < entries.len()
+                && entries[end].0 == r
+                && entries[end].1 == c + (end - first)
+                && entries[end].1 <= top
+            {
+                end += 1;
             }
         }
-        last = key;
+        runs.push((first, end));
+        if ((r, body) != last || !fast) && row_pos[r] != u32::MAX {
+            let k = row_pos[r] as usize;
+            let a = row_node[k];
+            if a != body_node[body] {
+                pairs.push((a, body_node[body], owned[k]));
+            }
+        }
+        last = (r, body);
+        first = end;
     }
-    pairs
+    (runs, pairs)
 }
 
 /// Each node's parent, the nodes in the border and the border's unknowns (the border rows,

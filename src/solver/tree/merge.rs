@@ -31,7 +31,7 @@
 //! 21 pivots per rung; its KKT matrix a rung's node (14 unknowns, coupled to 18 of its parent's)
 //! and a rung's two posts merged (27 unknowns, coupled to 7), a chain of 2 nodes per rung.
 
-use super::shape::Members;
+use super::nodes::Members;
 use crate::solver::partition::Partition;
 
 /// Super-nodes larger than this (unknowns or pivots) are not factored here.

@@ -31,7 +31,7 @@
 //! 21 pivots per rung; its KKT matrix a rung's node (14 unknowns, coupled to 18 of its parent's)
 //! and a rung's two posts merged (27 unknowns, coupled to 7), a chain of 2 nodes per rung.
 
-use super::nodes::Members;
+use super::nodes::{Members, Pair};
 use crate::solver::partition::Partition;
 
 /// Super-nodes larger than this (unknowns or pivots) are not factored here.
@@ -110,11 +110,7 @@ pub(crate) fn phi_u_runs(
 /// (`u32::MAX`: a root); `None` if a super-node exceeds [`MAX_NODE`] unknowns. `pairs`: the
 /// coupled nodes `(a, b, _)` (module `shape`'s nodes, each row in the node of the run it is
 /// pivoted in: those numbered here).
-pub(crate) fn kkt_nodes(
-    part: &Partition,
-    n: usize,
-    pairs: &[(u32, u32, bool)],
-) -> Option<(Members, Vec<u32>)> {
+pub(crate) fn kkt_nodes(part: &Partition, n: usize, pairs: &[Pair]) -> Option<(Members, Vec<u32>)> {
     let nb = n / 7;
     let rows = part.rows.len();
     let mut body_node = vec![u32::MAX; nb];

@@ -12,6 +12,9 @@
 
 use super::shape::MAX_BORDER;
 
+/// Two nodes coupled by a value, `(a, b, owned)`: `owned` unless the value is a border row's.
+pub(super) type Pair = (u32, u32, bool);
+
 /// The unknowns of each node, node after node: node `i` holds `list[start[i] .. start[i + 1]]`.
 #[derive(Default)]
 pub(super) struct Members {
@@ -70,7 +73,7 @@ pub(super) fn runs_and_pairs(
     owned: &[bool],
     row_pos: &[u32],
     fast: bool,
-) -> (Vec<(usize, usize)>, Vec<(u32, u32, bool)>) {
+) -> (Vec<(usize, usize)>, Vec<Pair>) {
     let mut runs = Vec::with_capacity(entries.len() / 3 + 1);
     let mut pairs = Vec::with_capacity(keys.len() + entries.len() / 3);
     for &(a, b) in keys {
@@ -115,7 +118,7 @@ pub(super) fn runs_and_pairs(
 /// (module `shape`). `None` if the border exceeds [`MAX_BORDER`] (`fast`: as soon as it does).
 pub(super) fn border_nodes(
     members: &Members,
-    pairs: &[(u32, u32, bool)],
+    pairs: &[Pair],
     owned: &[bool],
     n: usize,
     fast: bool,

@@ -31,6 +31,7 @@
 //! 21 pivots per rung; its KKT matrix a rung's node (14 unknowns, coupled to 18 of its parent's)
 //! and a rung's two posts merged (27 unknowns, coupled to 7), a chain of 2 nodes per rung.
 
+use super::nodes::{Members, Pair};
 use crate::solver::partition::Partition;
 
 /// Super-nodes larger than this (unknowns or pivots) are not factored here.
@@ -106,66 +107,52 @@ pub(crate) fn phi_u_runs(
 
 /// The KKT matrix's super-nodes for `part` (module doc): `(members, parent)`, each node's
 /// unknowns (coordinates `0 .. n`, rows `n + k`) in elimination order and its parent
-/// (`u32::MAX`: a root); `None` if a super-node exceeds [`MAX_NODE`] unknowns. `by_runs`: a
-/// row's run of triplets on one body coupled once (else each triplet: the same nodes).
-pub(crate) fn kkt_nodes(
-    part: &Partition,
-    n: usize,
-    row_pos: &[u32],
-    entries: &[(usize, usize, f64)],
-    keys: &[(usize, usize)],
-    by_runs: bool,
-) -> Option<(Vec<Vec<usize>>, Vec<u32>)> {
+/// (`u32::MAX`: a root); `None` if a super-node exceeds [`MAX_NODE`] unknowns. `pairs`: the
+/// coupled nodes `(a, b, _)` (module `shape`'s nodes, each row in the node of the run it is
+/// pivoted in: those numbered here).
+pub(crate) fn kkt_nodes(part: &Partition, n: usize, pairs: &[Pair]) -> Option<(Members, Vec<u32>)> {
     let nb = n / 7;
+    let rows = part.rows.len();
     let mut body_node = vec![u32::MAX; nb];
-    let mut members: Vec<Vec<usize>> = Vec::new();
+    let mut members = Members::with_capacity(nb, n + rows);
     for (k, &c) in part.dependent.iter().enumerate() {
         let b = c / 7;
         if body_node[b] == u32::MAX {
-            body_node[b] = members.len() as u32;
-            members.push((7 * b..7 * b + 7).collect());
+            body_node[b] = members.count() as u32;
+            members.open_body(b);
         }
-        if let Some(m) = members.last_mut() {
-            m.push(n + k);
-        }
+        members.push(n + k);
     }
     for b in 0..nb {
         if body_node[b] == u32::MAX {
-            body_node[b] = members.len() as u32;
-            members.push((7 * b..7 * b + 7).collect());
+            body_node[b] = members.count() as u32;
+            members.open_body(b);
         }
     }
-    let nodes = members.len();
-    let mut row_node = vec![u32::MAX; part.rows.len()];
-    for (i, m) in members.iter().enumerate() {
-        for &u in m.iter().filter(|&&u| u >= n) {
-            row_node[u - n] = i as u32;
-        }
+    let nodes = members.count();
+    // Each node's neighbours, `adj_at[i] .. adj_at[i + 1]` of `adj` (read as sets).
+    let mut adj_at = vec![0usize; nodes + 1];
+    for &(a, b, _) in pairs {
+        adj_at[a as usize + 1] += 1;
+        adj_at[b as usize + 1] += 1;
     }
-    let mut adj: Vec<Vec<u32>> = vec![Vec::new(); nodes];
-    let mut couple = |a: u32, b: u32| {
-        if a != b && a != u32::MAX && b != u32::MAX {
-            adj[a as usize].push(b);
-            adj[b as usize].push(a);
-        }
-    };
-    for &(a, b) in keys {
-        couple(body_node[a], body_node[b]);
+    for i in 0..nodes {
+        adj_at[i + 1] += adj_at[i];
     }
-    // A triplet on the row and body of the one before it couples the same nodes (the lists
-    // are read as sets): a row's run of columns on a body is coupled once.
-    let mut last = (usize::MAX, usize::MAX);
-    for e in entries {
-        let key = (e.0, e.1 / 7);
-        if (key != last || !by_runs) && row_pos[e.0] != u32::MAX {
-            couple(row_node[row_pos[e.0] as usize], body_node[key.1]);
-        }
-        last = key;
+    let mut fill = adj_at.clone();
+    let mut adj = vec![0u32; adj_at[nodes]];
+    for &(a, b, _) in pairs {
+        adj[fill[a as usize]] = b;
+        fill[a as usize] += 1;
+        adj[fill[b as usize]] = a;
+        fill[b as usize] += 1;
     }
-    // Union-find whose representative is the set's latest node; `set[r]`: its member nodes.
+    // Union-find whose representative is the set's latest node; a set's member nodes are
+    // linked from its representative (`next`, ending at `u32::MAX`; `tail`: the last).
     let mut rep: Vec<u32> = (0..nodes as u32).collect();
-    let mut set: Vec<Vec<u32>> = (0..nodes as u32).map(|i| vec![i]).collect();
-    let mut size: Vec<usize> = members.iter().map(Vec::len).collect();
+    let mut next = vec![u32::MAX; nodes];
+    let mut tail: Vec<u32> = (0..nodes as u32).collect();
+    let mut size: Vec<usize> = (0..nodes).map(|i| members.get(i).len()).collect();
     let mut parent = vec![u32::MAX; nodes];
     let mut later = Vec::new();
     for i in 0..nodes {
@@ -173,55 +160,72 @@ pub(crate) fn kkt_nodes(
             continue;
         }
         later.clear();
-        for &m in &set[i] {
-            for &j in &adj[m as usize] {
+        let mut m = i as u32;
+        while m != u32::MAX {
+            for &j in &adj[adj_at[m as usize]..adj_at[m as usize + 1]] {
                 let r = find(&mut rep, j);
                 if r > i as u32 {
                     later.push(r);
                 }
             }
+            m = next[m as usize];
         }
         later.sort_unstable();
         later.dedup();
         let Some(&top) = later.last() else {
             continue;
         };
+        let top = top as usize;
         for &s in &later[..later.len() - 1] {
-            rep[s as usize] = top;
-            let moved = std::mem::take(&mut set[s as usize]);
-            set[top as usize].extend(moved);
-            size[top as usize] += size[s as usize];
+            let s = s as usize;
+            rep[s] = top as u32;
+            next[tail[top] as usize] = s as u32;
+            tail[top] = tail[s];
+            size[top] += size[s];
         }
-        if size[top as usize] > MAX_NODE {
+        if size[top] > MAX_NODE {
             return None;
         }
-        parent[i] = top;
+        parent[i] = top as u32;
     }
     // The super-nodes in the order of their latest member: the members' coordinates first,
     // then their rows (the children reach the coordinates: narrow couplings).
     let mut index = vec![u32::MAX; nodes];
-    let mut merged = Vec::new();
+    let mut merged = Members::with_capacity(nodes, n + rows);
+    let mut own = Vec::new();
     for i in 0..nodes {
-        if rep[i] == i as u32 {
-            index[i] = merged.len() as u32;
-            let mut own = std::mem::take(&mut set[i]);
-            own.sort_unstable();
-            let all = || {
-                own.iter()
-                    .flat_map(|&m| members[m as usize].iter().copied())
-            };
-            let node: Vec<usize> = if own.len() == 1 {
-                all().collect()
-            } else {
-                all()
-                    .filter(|&u| u < n)
-                    .chain(all().filter(|&u| u >= n))
-                    .collect()
-            };
-            merged.push(node);
+        if rep[i] != i as u32 {
+            continue;
+        }
+        index[i] = merged.count() as u32;
+        merged.open();
+        if next[i] == u32::MAX {
+            members.get(i).iter().for_each(|&u| merged.push(u));
+            continue;
+        }
+        own.clear();
+        let mut m = i as u32;
+        while m != u32::MAX {
+            own.push(m as usize);
+            m = next[m as usize];
+        }
+        own.sort_unstable();
+        for &m in &own {
+            members
+                .get(m)
+                .iter()
+                .filter(|&&u| u < n)
+                .for_each(|&u| merged.push(u));
+        }
+        for &m in &own {
+            members
+                .get(m)
+                .iter()
+                .filter(|&&u| u >= n)
+                .for_each(|&u| merged.push(u));
         }
     }
-    let mut par = vec![u32::MAX; merged.len()];
+    let mut par = vec![u32::MAX; merged.count()];
     for i in 0..nodes {
         if rep[i] == i as u32 && parent[i] != u32::MAX {
             par[index[i] as usize] = index[find(&mut rep, parent[i]) as usize];

@@ -10,6 +10,7 @@
 //! - `phi_u`: `Φ_u` as a block upper triangular matrix (corrector, multipliers, tangent steps);
 //! - `segments`: its off-diagonal entries as dense row × column segments for the solves;
 //! - `shape`: the KKT matrix's nodes, parents, border and value slots, once per partition;
+//! - `nodes`: its nodes' unknowns, the pairs of nodes coupled by a value, the bordered tree;
 //! - `fused`: the Newton step's assembly of `W`, its terms added into the tree's body-pair
 //!   blocks and stored into the 13 × 13 blocks in one pass;
 //! - `norm`: the row sums of `|K|` for `‖K‖∞`, node by node;
@@ -28,6 +29,7 @@ pub(crate) mod kkt;
 mod merge;
 #[cfg(test)]
 mod merge_tests;
+mod nodes;
 mod norm;
 pub(crate) mod phi_u;
 mod segments;

@@ -14,10 +14,16 @@
 //! columns, which lie at consecutive positions `t, t + 1, …` of one node; along such a run the
 //! node pair is the same (one coupling, one reach, the last's), the slot of `(row, t + j)` is
 //! that of `(row, t)` plus `j` and its mirror's plus `j` times the width of the column's block.
-//! The construction triplet by triplet (`Shape::build` with `by_runs` false) is the tests' reference.
+//! The runs and the pairs of coupled nodes are listed in one pass, shared by the bordered tree
+//! and the super-nodes (module `merge`); the border is abandoned as soon as it exceeds
+//! [`MAX_BORDER`]. A slot holds one ordered pair of unknowns, so a triplet's slot and its
+//! mirror's are first together (one test per triplet, one per run where none of its slots was
+//! reached), and a coordinate's diagonal is written by its body's own Hessian block only.
+//! The construction triplet by triplet (`Shape::build` with `fast` false) is the tests' reference.
 
 use super::border::Border;
 use super::fused::Run;
+use super::nodes::{border_nodes, runs_and_pairs, Members};
 use crate::solver::partition::Partition;
 use crate::solver::sparse::hessian::BlockHessian;
 use std::collections::HashMap;
@@ -81,15 +87,17 @@ impl Shape {
         Self::build(part, m, n, entries, hess, true)
     }
 
-    /// [`Shape::new`], reading the triplets by runs (`by_runs`) or one by one: the same
-    /// structure either way (the runs only save work; `shape_tests` compares the two).
+    /// [`Shape::new`] (`fast`), or the reference construction (`shape_tests` compares the
+    /// two): each triplet read on its own, the border completed before its size is tested,
+    /// each slot of a triplet flagged on its own, the bare diagonal found from every block
+    /// slot. The same structure either way.
     pub(crate) fn build(
         part: &Partition,
         m: usize,
         n: usize,
         entries: &[(usize, usize, f64)],
         hess: &BlockHessian,
-        by_runs: bool,
+        fast: bool,
     ) -> Option<Self> {
         let rows = part.rows.len();
         let dim = n + rows;
@@ -98,106 +106,59 @@ impl Shape {
         for (k, &r) in part.rows.iter().enumerate() {
             row_pos[r] = k as u32;
         }
-        // Nodes in elimination order; `owner[u]`: the node of unknown `u` (MAX: border row).
+        // Nodes in elimination order: a body's coordinates and the rows of its first run of
+        // pivots (`owned`). A row pivoted at a body after another body's run (a loop's) is a
+        // border row, or joins the node of the run it is pivoted in among super-nodes
+        // (`row_node`: that node for every row).
         let mut body_node = vec![u32::MAX; nb];
-        let mut members: Vec<Vec<usize>> = Vec::new();
-        let mut owner = vec![u32::MAX; dim];
+        let mut members = Members::with_capacity(nb, dim);
+        let mut row_node = vec![0u32; rows];
+        let mut owned = vec![false; rows];
         for (k, &c) in part.dependent.iter().enumerate() {
             let b = c / 7;
             if body_node[b] == u32::MAX {
-                body_node[b] = members.len() as u32;
-                members.push((7 * b..7 * b + 7).collect());
+                body_node[b] = members.count() as u32;
+                members.open_body(b);
             }
-            let i = body_node[b] as usize;
-            if i + 1 == members.len() {
-                members[i].push(n + k);
+            row_node[k] = members.count() as u32 - 1;
+            if body_node[b] == row_node[k] {
+                members.push(n + k);
+                owned[k] = true;
             }
         }
         for b in 0..nb {
             if body_node[b] == u32::MAX {
-                body_node[b] = members.len() as u32;
-                members.push((7 * b..7 * b + 7).collect());
+                body_node[b] = members.count() as u32;
+                members.open_body(b);
             }
         }
-        for (i, m) in members.iter().enumerate() {
-            for &u in m {
-                owner[u] = i as u32;
+        let (mut runs, pairs) = runs_and_pairs(
+            entries, &hess.keys, &body_node, &row_node, &owned, &row_pos, fast,
+        );
+        let bordered = border_nodes(&members, &pairs, &owned, n, fast);
+        let (members, parent, in_border, border_unknowns) = match bordered {
+            Some((parent, in_border, border_unknowns)) => {
+                (members, parent, in_border, border_unknowns)
             }
-        }
-        let nodes = members.len();
-        // Node couplings: every pair of unknowns with a value (listed straight into `later`,
-        // in the same order, without a list of all pairs first).
-        let mut later: Vec<Vec<u32>> = vec![Vec::new(); nodes];
-        let mut couple = |a: u32, b: u32| {
-            if a != u32::MAX && b != u32::MAX && a != b {
-                let (lo, hi) = (a.min(b), a.max(b));
-                later[lo as usize].push(hi);
+            None => {
+                // Too large for a dense Schur complement: the nodes a loop couples are merged
+                // into super-nodes instead (module `merge`), and nothing is bordered.
+                let (members, parent) = super::merge::kkt_nodes(part, n, &pairs)?;
+                let in_border = vec![false; members.count()];
+                (members, parent, in_border, Vec::new())
             }
         };
-        for &(a, b) in &hess.keys {
-            couple(body_node[a], body_node[b]);
-        }
-        // A triplet on the row and body of the one before it adds the same pair (the lists are
-        // sorted and deduplicated below): the rows' runs of 7 columns are read once.
-        let mut last = (usize::MAX, usize::MAX);
-        for e in entries {
-            let key = (e.0, e.1 / 7);
-            if (key != last || !by_runs) && row_pos[e.0] != u32::MAX {
-                couple(owner[n + row_pos[e.0] as usize], body_node[key.1]);
-            }
-            last = key;
-        }
-        let mut in_border = vec![false; nodes];
-        let mut parent = vec![u32::MAX; nodes];
-        for i in 0..nodes {
-            if in_border[i] {
-                continue;
-            }
-            let l = &mut later[i];
-            l.sort_unstable();
-            l.dedup();
-            let mut kept = None;
-            for &j in l.iter() {
-                if in_border[j as usize] {
-                    continue;
-                }
-                match kept {
-                    None => kept = Some(j),
-                    Some(_) => in_border[j as usize] = true,
-                }
-            }
-            parent[i] = kept.unwrap_or(u32::MAX);
-        }
-        // Parents bordered after their children were kept: none.
-        for i in 0..nodes {
-            if parent[i] != u32::MAX && in_border[parent[i] as usize] {
-                parent[i] = u32::MAX;
-            }
-        }
-        let mut border_unknowns: Vec<usize> = (0..dim).filter(|&u| owner[u] == u32::MAX).collect();
-        for (i, m) in members.iter().enumerate() {
-            if in_border[i] {
-                border_unknowns.extend_from_slice(m);
-            }
-        }
-        if border_unknowns.len() > MAX_BORDER {
-            // Too large for a dense Schur complement: the nodes a loop couples are merged into
-            // super-nodes instead (module `merge`), and nothing is bordered.
-            (members, parent) =
-                super::merge::kkt_nodes(part, n, &row_pos, entries, &hess.keys, by_runs)?;
-            in_border = vec![false; members.len()];
-            border_unknowns.clear();
-        }
-        let nodes = members.len();
+        let nodes = members.count();
         // Tree-space positions: kept nodes in order, then the border.
         let mut tpos = vec![0usize; dim];
         let mut perm = Vec::with_capacity(dim);
         let mut node_map = vec![u32::MAX; nodes];
         let (mut at, mut d, mut par) = (Vec::new(), Vec::new(), Vec::new());
-        for (i, m) in members.iter().enumerate() {
+        for i in 0..nodes {
             if in_border[i] {
                 continue;
             }
+            let m = members.get(i);
             node_map[i] = at.len() as u32;
             at.push(perm.len());
             d.push(m.len());
@@ -227,33 +188,26 @@ impl Shape {
                 node_of[t] = i as u32;
             }
         }
-        // The triplets by runs `first .. end`: a row's consecutive columns on one body whose 7
-        // coordinates lie in order at consecutive positions of one node (as the nodes list
-        // them; the triplets come so), where the slots of a run follow from its first.
+        // A run's slots follow from its first where its body's 7 coordinates lie in order at
+        // consecutive positions of one node (`lined`: as the nodes list them); elsewhere (the
+        // border's bodies) each triplet is placed on its own.
         let lined = |b: usize| {
             let t = tpos[7 * b];
-            by_runs
-                && t < tree_len
+            fast && t < tree_len
                 && (1..7).all(|k| tpos[7 * b + k] == t + k && node_of[t + k] == node_of[t])
         };
         let lined: Vec<bool> = (0..nb).map(lined).collect();
-        let mut runs: Vec<(usize, usize)> = Vec::with_capacity(entries.len() / 4 + 1);
-        let mut first = 0;
-        while first < entries.len() {
-            let (r, c) = (entries[first].0, entries[first].1);
-            let mut end = first + 1;
-            if lined[c / 7] {
-                let last = c - c % 7 + 6;
-                while end < entries.len()
-                    && entries[end].0 == r
-                    && entries[end].1 == c + (end - first)
-                    && entries[end].1 <= last
-                {
-                    end += 1;
-                }
-            }
-            runs.push((first, end));
-            first = end;
+        if !lined.iter().all(|&l| l) {
+            runs = runs
+                .iter()
+                .flat_map(|&(first, end)| {
+                    let whole = lined[entries[first].1 / 7];
+                    let cut = if whole { end - first } else { 1 };
+                    (first..end)
+                        .step_by(cut)
+                        .map(move |f| (f, (f + cut).min(end)))
+                })
+                .collect();
         }
         // Coupling widths: the parent's leading unknowns reached.
         let mut w = vec![0usize; kept];
@@ -379,33 +333,76 @@ impl Shape {
                 let (a, b) = (node_of[t2] as usize, node_of[t1] as usize);
                 let step = if a == b { d[a] } else { w[a] } as u32;
                 let [s1, s2] = [tree_slot(t1, t2)?, tree_slot(t2, t1)?];
-                for j in 0..(end - first) as u32 {
-                    let at = |s: u32, by: u32| if s == SKIP { SKIP } else { s + j * by };
-                    let (a, b) = (at(s1, 1), at(s2, step));
-                    jac_slots.push([flag_first(&mut reached, a), flag_first(&mut reached, b)]);
+                let at = |s: u32, j: u32, by: u32| if s == SKIP { SKIP } else { s + j * by };
+                if fast {
+                    // One test per triplet, at the pair's slot that is not the mirror of a
+                    // coupling (`flag_pair`; in the tree, inside `reached`).
+                    let len = (end - first) as u32;
+                    if s1 != SKIP {
+                        let span = &mut reached[s1 as usize..(s1 + len) as usize];
+                        if !span.contains(&true) {
+                            // No slot of the run reached before: all first.
+                            span.fill(true);
+                            for j in 0..len {
+                                jac_slots.push([(s1 + j) | FIRST, at(s2, j, step) | FIRST]);
+                            }
+                            continue;
+                        }
+                    }
+                    let (key, by) = if s1 != SKIP { (s1, 1) } else { (s2, step) };
+                    for j in 0..len {
+                        let seen = std::mem::replace(&mut reached[(key + j * by) as usize], true);
+                        let first = if seen { 0 } else { FIRST };
+                        jac_slots.push([at(s1, j, 1) | first, at(s2, j, step) | first]);
+                    }
+                } else {
+                    for j in 0..(end - first) as u32 {
+                        let (a, b) = (at(s1, j, 1), at(s2, j, step));
+                        jac_slots.push(flag_each(&mut reached, a, b));
+                    }
                 }
             } else {
                 for e in &entries[first..end] {
                     let (a, b) = (locate(r, e.1)?, locate(e.1, r)?);
-                    jac_slots.push([flag_first(&mut reached, a), flag_first(&mut reached, b)]);
+                    jac_slots.push(if fast {
+                        flag_pair(&mut reached, a, b)
+                    } else {
+                        flag_each(&mut reached, a, b)
+                    });
                 }
             }
         }
-        let diag_slots = (0..n).map(|c| locate(c, c)).collect::<Option<Vec<_>>>()?;
+        let mut diag_slots = Vec::with_capacity(n);
+        for c in 0..n {
+            diag_slots.push(locate(c, c)?);
+        }
         let total = flat + border_slot.len();
         if total >= FIRST as usize {
             return None;
         }
-        // The diagonal slots no block reaches.
-        reached.resize(total, false);
-        for s in block_slots.iter().flatten().filter(|&&s| s != SKIP) {
-            reached[*s as usize] = true;
-        }
-        let bare_diag = diag_slots
-            .iter()
-            .copied()
-            .filter(|&s| !reached[s as usize])
-            .collect();
+        // The diagonal slots no block reaches: a slot holds one pair of unknowns, so the
+        // diagonal of coordinate `c` is reached by the block `(b, b)` of its body only (`fast`),
+        // or found from every block slot.
+        let bare_diag = if fast {
+            let mut own_block = vec![false; nb];
+            for &(a, b) in &hess.keys {
+                own_block[a] |= a == b;
+            }
+            (0..n)
+                .filter(|&c| !own_block[c / 7])
+                .map(|c| diag_slots[c])
+                .collect()
+        } else {
+            reached.resize(total, false);
+            for s in block_slots.iter().flatten().filter(|&&s| s != SKIP) {
+                reached[*s as usize] = true;
+            }
+            diag_slots
+                .iter()
+                .copied()
+                .filter(|&s| !reached[s as usize])
+                .collect()
+        };
         Some(Shape {
             n,
             rows,
@@ -426,6 +423,22 @@ impl Shape {
             bare_diag,
         })
     }
+}
+
+/// A triplet's slot `a` and its mirror's `b`, each flagged [`FIRST`] if no triplet before
+/// reached it (`reached`, grown to the border's slots as they come); [`SKIP`] as it is.
+fn flag_each(reached: &mut Vec<bool>, a: u32, b: u32) -> [u32; 2] {
+    [flag_first(reached, a), flag_first(reached, b)]
+}
+
+/// [`flag_each`] by one test: a slot holds one ordered pair of unknowns and the mirror's pair
+/// `(column, row)` comes from no other triplet, so both are first when the pair is; the pair
+/// is known by the slot of the two that is not [`SKIP`] (one is, for a coupling's mirror).
+#[inline]
+fn flag_pair(reached: &mut Vec<bool>, a: u32, b: u32) -> [u32; 2] {
+    let key = if a != SKIP { a } else { b };
+    let first = flag_first(reached, key) & FIRST;
+    [a | first, b | first]
 }
 
 /// `slot`, flagged [`FIRST`] if no triplet before reached it (`reached`, grown to the border's

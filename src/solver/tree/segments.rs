@@ -44,9 +44,12 @@ impl Segments {
     /// The segments of the entries `off` (grouped by node: node `i`'s are
     /// `off[off_at[i] .. off_at[i + 1]]`, in the triplets' order).
     pub(crate) fn new(off: &[(u32, u32)], off_at: &[usize]) -> Self {
+        // Sized for the most a segment list can hold (a row's one row and its columns per
+        // entry; untouched capacity costs no page): no regrowth copies.
         let mut s = Segments {
             at: Vec::with_capacity(off_at.len()),
-            ..Segments::default()
+            seg: Vec::with_capacity(off.len()),
+            idx: Vec::with_capacity(2 * off.len()),
         };
         s.at.push(0);
         for w in off_at.windows(2) {
@@ -57,7 +60,9 @@ impl Segments {
                 let end = (k..w[1]).find(|&j| off[j].0 != p).unwrap_or(w[1]);
                 let cols = &off[k..end];
                 let c = cols.len();
-                let distinct = (1..c).all(|a| cols[..a].iter().all(|e| e.1 != cols[a].1));
+                // Ascending columns (a row's entries on one body) are distinct at once.
+                let distinct = cols.windows(2).all(|w| w[0].1 < w[1].1)
+                    || (1..c).all(|a| cols[..a].iter().all(|e| e.1 != cols[a].1));
                 let at = s.idx.len();
                 s.idx.push(p);
                 // Further rows with the same distinct columns join the segment.

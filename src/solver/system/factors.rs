@@ -139,7 +139,8 @@ impl System<'_> {
                 .is_some_and(|s| s.fits(part, entries.len()))
                 && work.tree_refused != Some((part.id, entries.len()))
             {
-                work.tree_split = TreeSplit::new(part, m, n, entries);
+                let open = super::backend::open(self.problem.model);
+                work.tree_split = TreeSplit::new(part, m, n, entries, open);
                 if work.tree_split.is_none() {
                     work.tree_refused = Some((part.id, entries.len()));
                 }

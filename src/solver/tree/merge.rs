@@ -37,17 +37,9 @@ use crate::solver::partition::Partition;
 /// Super-nodes larger than this (unknowns or pivots) are not factored here.
 pub(crate) const MAX_NODE: usize = 64;
 
-/// The runs of pivots of `Φ_u` (consecutive pivots on one body's columns): `(run_of, runs,
-/// bordered)`, each position's run, their number and the runs with an entry in an earlier
-/// run's column. If those runs hold more than `max_border` pivots, overlapping runs are merged
-/// instead (module doc) and none is bordered; `None` if a merged run exceeds [`MAX_NODE`].
-pub(crate) fn phi_u_runs(
-    part: &Partition,
-    entries: &[(usize, usize, f64)],
-    row_pos: &[u32],
-    col_pos: &[u32],
-    max_border: usize,
-) -> Option<(Vec<u32>, usize, Vec<bool>)> {
+/// The runs of pivots of `Φ_u` (consecutive pivots on one body's columns): each position's
+/// run and their number.
+pub(crate) fn runs(part: &Partition) -> (Vec<u32>, usize) {
     let order = part.rows.len();
     let mut run_of = vec![0u32; order];
     let mut runs = 0u32;
@@ -57,14 +49,40 @@ pub(crate) fn phi_u_runs(
         }
         run_of[k] = runs;
     }
-    let runs = if order == 0 { 0 } else { runs as usize + 1 };
-    // The earliest run each run's rows reach (itself if none before).
+    (run_of, if order == 0 { 0 } else { runs as usize + 1 })
+}
+
+/// The runs of pivots of `Φ_u` (consecutive pivots on one body's columns) of the `m × n`
+/// Jacobian `entries`: `(run_of, runs, bordered)`, each position's run, their number and the
+/// runs with an entry in an earlier run's column. If those runs hold more than `max_border`
+/// pivots, overlapping runs are merged instead (module doc) and none is bordered; `None` if a
+/// merged run exceeds [`MAX_NODE`].
+pub(crate) fn phi_u_runs(
+    part: &Partition,
+    m: usize,
+    n: usize,
+    entries: &[(usize, usize, f64)],
+    max_border: usize,
+) -> Option<(Vec<u32>, usize, Vec<bool>)> {
+    let order = part.rows.len();
+    let (mut run_of, runs) = runs(part);
+    // Each pivot row's and each dependent column's run (`u32::MAX`: none), looked up once.
+    let mut row_run = vec![u32::MAX; m];
+    for (&r, &k) in part.rows.iter().zip(&run_of) {
+        row_run[r] = k;
+    }
+    let mut col_run = vec![u32::MAX; n];
+    for (&c, &k) in part.dependent.iter().zip(&run_of) {
+        col_run[c] = k;
+    }
+    // The earliest run each run's rows reach (itself if none before; a column outside `Φ_u`
+    // reads `u32::MAX`, which lowers nothing).
     let mut first: Vec<u32> = (0..runs as u32).collect();
     for e in entries {
-        let (p, q) = (row_pos[e.0], col_pos[e.1]);
-        if p != u32::MAX && q != u32::MAX {
-            let (rp, rq) = (run_of[p as usize] as usize, run_of[q as usize]);
-            first[rp] = first[rp].min(rq);
+        let rp = row_run[e.0];
+        if rp != u32::MAX {
+            let f = &mut first[rp as usize];
+            *f = (*f).min(col_run[e.1]);
         }
     }
     let bordered: Vec<bool> = (0..runs).map(|r| first[r] < r as u32).collect();

@@ -54,8 +54,7 @@ fn merged_runs_make_phi_u_block_triangular() {
             .count()
     };
     // The runs alone: a border of 7 pivots per rung, above the limit.
-    let (runs_of, runs, bordered) =
-        phi_u_runs(&part, entries, &row_pos, &col_pos, usize::MAX).expect("runs");
+    let (runs_of, runs, bordered) = phi_u_runs(&part, m, n, entries, usize::MAX).expect("runs");
     let border: usize = (0..part.rows.len())
         .filter(|&k| bordered[runs_of[k] as usize])
         .count();
@@ -63,7 +62,7 @@ fn merged_runs_make_phi_u_block_triangular() {
     assert!(below(&runs_of) > 0);
     // Merged: nothing below the block diagonal, no border, fewer and bounded nodes.
     let (node_of, nodes, bordered) =
-        phi_u_runs(&part, entries, &row_pos, &col_pos, MAX_BORDER).expect("super-nodes");
+        phi_u_runs(&part, m, n, entries, MAX_BORDER).expect("super-nodes");
     assert!(bordered.iter().all(|&b| !b));
     assert_eq!(below(&node_of), 0);
     assert!(nodes < runs && nodes >= 30, "{nodes} nodes of {runs} runs");

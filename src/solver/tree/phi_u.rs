@@ -15,7 +15,8 @@
 //! with one LU with partial pivoting per diagonal block (`≤ 7 × 7`) and no fill. Nodes with an
 //! entry before their own (the rows closing a loop, pivoted last) form a **border** `B`; with
 //! `T` the rest, `Φ_u = [T C; R D]` is solved through the dense Schur complement
-//! `S = D − R T⁻¹ C` (module `border`).
+//! `S = D − R T⁻¹ C` (module `border`). Where each Jacobian triplet goes in the factor buffer
+//! is laid out once per partition (module `split`).
 
 use super::border::Border;
 use super::dense;
@@ -23,6 +24,8 @@ use super::segments::Segments;
 use super::shape::FIRST;
 use crate::solver::partition::Partition;
 use std::sync::Arc;
+
+mod split;
 
 /// Borders larger than this (pivot positions) are merged into super-nodes instead (module
 /// `merge`; the general sparse LU where those would be too large).
@@ -81,167 +84,6 @@ pub(crate) struct TreeLu {
 }
 
 impl TreeSplit {
-    /// The structure of `Φ_u` under `part` for the triplets `entries` of an `m × n` Jacobian;
-    /// `None` if it is not block triangular up to a border of at most [`MAX_BORDER`] pivots.
-    pub(crate) fn new(
-        part: &Partition,
-        m: usize,
-        n: usize,
-        entries: &[(usize, usize, f64)],
-    ) -> Option<Self> {
-        // Positions and triplet numbers are held as `u32`.
-        if u32::try_from(entries.len().max(m).max(n)).is_err() {
-            return None;
-        }
-        let order = part.rows.len();
-        let mut row_pos = vec![u32::MAX; m];
-        for (k, &r) in part.rows.iter().enumerate() {
-            row_pos[r] = k as u32;
-        }
-        let mut col_pos = vec![u32::MAX; n];
-        for (k, &c) in part.dependent.iter().enumerate() {
-            col_pos[c] = k as u32;
-        }
-        let mut ind_pos = vec![u32::MAX; n];
-        for (k, &c) in part.independent.iter().enumerate() {
-            ind_pos[c] = k as u32;
-        }
-        // Runs of pivots on one body; those with an entry in an earlier run's column go to
-        // the border, or are merged into super-nodes where it would be too large (`merge`).
-        let (run_of, runs, bordered) =
-            super::merge::phi_u_runs(part, entries, &row_pos, &col_pos, MAX_BORDER)?;
-        let border_positions: Vec<usize> = (0..order)
-            .filter(|&k| bordered[run_of[k] as usize])
-            .collect();
-        if border_positions.len() > MAX_BORDER {
-            return None;
-        }
-        // Tree nodes: the runs not in the border (a run's positions are consecutive).
-        let mut node_of = vec![u32::MAX; order];
-        let mut span: Vec<(usize, usize)> = Vec::with_capacity(runs);
-        let mut last_run = u32::MAX;
-        for k in 0..order {
-            if bordered[run_of[k] as usize] {
-                continue;
-            }
-            if run_of[k] != last_run {
-                span.push((k, k));
-                last_run = run_of[k];
-            }
-            if let Some(s) = span.last_mut() {
-                s.1 = k + 1;
-            }
-            node_of[k] = (span.len() - 1) as u32;
-        }
-        let nodes = span.len();
-        let mut diag_at = Vec::with_capacity(nodes + 1);
-        diag_at.push(0usize);
-        for i in 0..nodes {
-            let d = span[i].1 - span[i].0;
-            diag_at.push(diag_at[i] + d * d);
-        }
-        // Off-diagonal entries of T, grouped by row node (counting sort).
-        let mut count = vec![0usize; nodes + 1];
-        let mut border = Border::new(&border_positions, order);
-        // Slots by kind first (diagonal, off-diagonal, border, `Φ_v`), offset once all are known.
-        let (diag_len, mut border_at) = (diag_at[nodes], Vec::new());
-        let mut slots = vec![u32::MAX; entries.len()];
-        // Sized for every triplet (untouched capacity costs no page): no regrowth copies.
-        let mut v_at = Vec::with_capacity(entries.len());
-        let mut pending = Vec::with_capacity(entries.len());
-        let mut pending_v = Vec::with_capacity(entries.len());
-        for (t, e) in entries.iter().enumerate() {
-            let p = row_pos[e.0];
-            if p == u32::MAX {
-                continue;
-            }
-            let q = col_pos[e.1];
-            if q == u32::MAX {
-                if ind_pos[e.1] != u32::MAX {
-                    pending_v.push(t as u32);
-                    v_at.push((p, ind_pos[e.1]));
-                }
-                continue;
-            }
-            let (p, q) = (p as usize, q as usize);
-            let (np, nq) = (node_of[p], node_of[q]);
-            if np == u32::MAX || nq == u32::MAX {
-                border_at.push((t as u32, border.add(p, q) as u32));
-            } else if np == nq {
-                let i = np as usize;
-                let (a, b) = (p - span[i].0, q - span[i].0);
-                let d = span[i].1 - span[i].0;
-                slots[t] = (diag_at[i] + a * d + b) as u32;
-            } else {
-                count[np as usize + 1] += 1;
-                pending.push((t as u32, p as u32, q as u32));
-            }
-        }
-        for i in 0..nodes {
-            count[i + 1] += count[i];
-        }
-        let off_at = count.clone();
-        let mut off = vec![(0u32, 0u32); pending.len()];
-        for &(t, p, q) in &pending {
-            let (t, p, q) = (t as usize, p as usize, q as usize);
-            let i = node_of[p] as usize;
-            let at = count[i];
-            count[i] += 1;
-            off[at] = (p as u32, q as u32);
-            slots[t] = (diag_len + at) as u32;
-        }
-        let off0 = diag_len;
-        let border0 = off0 + off.len();
-        let v0 = border0 + border.len();
-        let len = v0 + v_at.len() + 1;
-        for (t, k) in border_at {
-            slots[t as usize] = (border0 + k as usize) as u32;
-        }
-        for (k, t) in pending_v.into_iter().enumerate() {
-            slots[t as usize] = (v0 + k) as u32;
-        }
-        // The triplets no block holds go to the spare last slot.
-        let spare = u32::try_from(len - 1).ok().filter(|&s| s < FIRST)?;
-        for s in &mut slots {
-            if *s == u32::MAX {
-                *s = spare;
-            }
-        }
-        // The first triplet to reach a slot stores its value, the others add theirs; the
-        // slots no triplet reaches (zeros of the diagonal blocks, factored in place) are
-        // zeroed by each factorization: no pass over the whole buffer.
-        let mut reached = vec![false; len];
-        for s in &mut slots {
-            let at = *s as usize;
-            if !reached[at] {
-                reached[at] = true;
-                *s |= FIRST;
-            }
-        }
-        let bare = (0..len as u32).filter(|&k| !reached[k as usize]).collect();
-        Some(TreeSplit {
-            id: part.id,
-            triplets: entries.len(),
-            shape: Arc::new(Shape {
-                order,
-                span,
-                diag_at,
-                segments: Segments::new(&off, &off_at),
-                off,
-                off_at,
-                border,
-                v_at,
-                off0,
-                border0,
-                v0,
-                len,
-            }),
-            slots,
-            bare,
-            pool: Vec::new(),
-        })
-    }
-
     /// Whether this split was built for `part` and a Jacobian of `triplets` entries.
     pub(crate) fn fits(&self, part: &Partition, triplets: usize) -> bool {
         self.triplets == triplets && self.id == part.id

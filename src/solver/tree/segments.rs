@@ -44,9 +44,12 @@ impl Segments {
     /// The segments of the entries `off` (grouped by node: node `i`'s are
     /// `off[off_at[i] .. off_at[i + 1]]`, in the triplets' order).
     pub(crate) fn new(off: &[(u32, u32)], off_at: &[usize]) -> Self {
+        // Sized for the most a segment list can hold (a row's one row and its columns per
+        // entry; untouched capacity costs no page): no regrowth copies.
         let mut s = Segments {
             at: Vec::with_capacity(off_at.len()),
-            ..Segments::default()
+            seg: Vec::with_capacity(off.len()),
+            idx: Vec::with_capacity(2 * off.len()),
         };
         s.at.push(0);
         for w in off_at.windows(2) {
@@ -57,7 +60,7 @@ impl Segments {
                 let end = (k..w[1]).find(|&j| off[j].0 != p).unwrap_or(w[1]);
                 let cols = &off[k..end];
                 let c = cols.len();
-                let distinct = (1..c).all(|a| cols[..a].iter().all(|e| e.1 != cols[a].1));
+                let distinct = distinct(cols);
                 let at = s.idx.len();
                 s.idx.push(p);
                 // Further rows with the same distinct columns join the segment.
@@ -167,6 +170,24 @@ impl Segments {
     }
 }
 
+/// Whether the entries' columns are distinct: by a bit per column above the least where
+/// they span fewer than 64 positions (a row's entries on one body), else pair by pair.
+fn distinct(cols: &[(u32, u32)]) -> bool {
+    let lo = cols.iter().fold(u32::MAX, |a, e| a.min(e.1));
+    let mut seen = 0u64;
+    for e in cols {
+        let d = e.1 - lo;
+        if d >= 64 {
+            return (1..cols.len()).all(|a| cols[..a].iter().all(|e| e.1 != cols[a].1));
+        }
+        if (seen >> d) & 1 != 0 {
+            return false;
+        }
+        seen |= 1 << d;
+    }
+    true
+}
+
 /// [`Segments::forward`] on a segment of `C` columns (unrolled, the read side in registers).
 #[inline(always)]
 fn forward_fixed<const C: usize>(rows: &[u32], cols: &[u32], v: &[f64], x: &mut [f64]) {
@@ -256,6 +277,11 @@ mod tests {
         let x0: Vec<f64> = (0..n).map(|_| rnd()).collect();
         let seg = Segments::new(&off, &off_at);
         assert_eq!(seg.at.len(), nodes.len() + 1);
+        // Distinct columns: near each other or far apart, a repeat either way.
+        let row = |cols: &[u32]| cols.iter().map(|&q| (0, q)).collect::<Vec<_>>();
+        assert!(distinct(&row(&[])) && distinct(&row(&[9])));
+        assert!(distinct(&row(&[12, 10, 11, 70])) && distinct(&row(&[5, 200, 6])));
+        assert!(!distinct(&row(&[12, 10, 12])) && !distinct(&row(&[5, 200, 6, 200])));
         // The chain's block is one segment.
         assert_eq!((seg.seg[0].rows, seg.seg[0].cols), (5, 6));
         let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();

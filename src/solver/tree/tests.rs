@@ -236,3 +236,34 @@ fn reused_phi_u_buffers_equal_fresh_ones_bit_for_bit() {
         assert!(bits(&zr, &zf), "{name}: Z δv");
     }
 }
+
+/// The tree route of an open mechanism (each run of pivots on one body a node, one pass over
+/// the triplets) builds the split of `Φ_u` that the general construction (the border test
+/// over the triplets, module `merge`) builds, to the last slot: on chains, with locks (extra
+/// rows on bodies), on a branched tree; where a row reaches an earlier node (the loops) it
+/// gives way to the general construction, with its border or super-nodes.
+#[test]
+fn tree_route_split_is_the_general_one() {
+    use crate::solver::tree::phi_u::TreeSplit;
+    let long_ladder = from_text(&crate::generate::ladder(30));
+    for (name, model, locks) in cases()
+        .into_iter()
+        .chain([("long ladder", long_ladder, vec![])])
+    {
+        let q0 = crate::solver::initial_state(&model).q;
+        let q = crate::solver::assemble_only(&model, q0, &mut Default::default(), &[])
+            .expect("assembles");
+        let mut sys = System::new(&model, Constraints::new(&model, &locks), Backend::Tree);
+        let part = sys.partition(&q);
+        sys.evaluate(&q, &part).expect("evaluates");
+        let entries = &sys.work.jac.entries;
+        let (m, n) = (sys.problem.cons.len(), q.len());
+        let tree = TreeSplit::new(&part, m, n, entries, true).expect(name);
+        let general = TreeSplit::new(&part, m, n, entries, false).expect(name);
+        assert_eq!(tree.layout(), general.layout(), "{name}");
+        let (_, (off, _, border, v_at), _) = tree.layout();
+        assert!(!off.is_empty() && !v_at.is_empty(), "{name}");
+        let loops = matches!(name, "four-bar" | "ladder");
+        assert_eq!(!border.is_empty(), loops, "{name}");
+    }
+}

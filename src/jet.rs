@@ -198,15 +198,9 @@ pub(crate) mod testing {
 
     /// A reproducible non-unit pose pair (raw Euler parameters, as inside the corrector).
     pub(crate) fn sample_pair(seed: u64) -> Pair {
-        let mut s = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        let mut next = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        };
+        let mut lcg = crate::lcg::Lcg::new(seed);
+        lcg.next_u64();
+        let mut next = || lcg.signed();
         let mut r = [Vector3::zeros(); 2];
         let mut p = [Vector4::zeros(); 2];
         for k in 0..2 {

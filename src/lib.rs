@@ -33,6 +33,8 @@ pub mod geometry;
 pub(crate) mod jet;
 pub mod joint;
 pub mod kinematics;
+#[cfg(test)]
+pub(crate) mod lcg;
 pub mod math;
 pub mod model;
 pub mod names;

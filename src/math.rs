@@ -146,13 +146,8 @@ mod tests {
 
     #[test]
     fn b_matrix_entrywise_equals_the_products_exactly() {
-        let mut state = 7u64;
-        let mut rnd = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((state >> 11) as f64 / (1u64 << 53) as f64) * 4.0 - 2.0
-        };
+        let mut lcg = crate::lcg::Lcg::new(7);
+        let mut rnd = || lcg.unit() * 4.0 - 2.0;
         for _ in 0..20_000 {
             let p = Vector4::new(rnd(), rnd(), rnd(), rnd());
             let a = Vector3::new(rnd(), rnd(), rnd());
@@ -256,12 +251,9 @@ mod tests {
     #[test]
     fn wrap_angle_without_fmod_is_bit_for_bit() {
         let two_pi = 2.0 * std::f64::consts::PI;
-        let mut seed = 3u64;
+        let mut lcg = crate::lcg::Lcg::new(3);
         for i in 0..20000 {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            let u = (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
+            let u = lcg.signed();
             let a = u * 4.0 * two_pi * if i % 2 == 0 { 1.0 } else { 1e-3 };
             for x in [
                 a,

@@ -259,13 +259,8 @@ mod tests {
     /// redundant rows and scaling.
     #[test]
     fn equals_the_permuted_index_reference() {
-        let mut seed = 12345u64;
-        let mut next = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut lcg = crate::lcg::Lcg::new(12345);
+        let mut next = || lcg.unit();
         for trial in 0..2000 {
             let m = 1 + trial % 17;
             let n = 1 + (trial * 7) % 23;

@@ -45,18 +45,10 @@ fn limited_chain(n: usize, limit: f64) -> String {
     s + "</robot>\n"
 }
 
-/// A pseudo-random number in `[−1, 1)`.
-fn next(seed: &mut u64) -> f64 {
-    *seed = seed
-        .wrapping_mul(6364136223846793005)
-        .wrapping_add(1442695040888963407);
-    (*seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-}
-
 #[test]
 fn skips_only_stops_the_line_search_cannot_read() {
     let options = Options::default();
-    let mut seed = 11u64;
+    let mut lcg = crate::lcg::Lcg::new(11);
     let (mut kept, mut full) = (0, 0);
     for (n, limit, floating) in [(6, 1.2, false), (9, 3.0, true), (12, 0.4, false)] {
         let import = ImportOptions {
@@ -74,7 +66,7 @@ fn skips_only_stops_the_line_search_cannot_read() {
                 .joints
                 .iter()
                 .filter(|j| j.limits.is_some())
-                .map(|j| (j.name.clone(), vec![0.98 * limit * next(&mut seed)]))
+                .map(|j| (j.name.clone(), vec![0.98 * limit * lcg.signed()]))
                 .collect();
             let start = State::from_joint_values(&model, &values);
             let q = start.q;
@@ -82,8 +74,8 @@ fn skips_only_stops_the_line_search_cannot_read() {
             let mut sys = System::new(&model, cons, Backend::of(&model, &options));
             let part = sys.partition(&q);
             let eval = sys.evaluate(&q, &part).unwrap();
-            let scale = 10f64.powf(2.0 * next(&mut seed));
-            let d = DVector::from_fn(part.independent.len(), |_, _| scale * next(&mut seed));
+            let scale = 10f64.powf(2.0 * lcg.signed());
+            let d = DVector::from_fn(part.independent.len(), |_, _| scale * lcg.signed());
             let dq = sys.tangent_step(&part, &eval, &d);
             let guard = Guard::new(&model, &options, all.clone(), &[], 1e-9, &q);
             let every = guard.stops(&sys, &q, &dq, f64::INFINITY);

@@ -134,13 +134,8 @@ mod tests {
     /// duplicates, every column's rows ascending and unique, each position found.
     #[test]
     fn counting_sort_equals_a_global_sort() {
-        let mut s = 7u64;
-        let mut next = |m: u64| {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 33) % m) as usize
-        };
+        let mut lcg = crate::lcg::Lcg::new(7);
+        let mut next = |m: u64| ((lcg.next_u64() >> 33) % m) as usize;
         let positions: Vec<(usize, usize)> = (0..2000).map(|_| (next(50), next(40))).collect();
         let p = Pattern::with_capacity(50, 40, positions.len(), positions.iter().copied());
         let mut sorted: Vec<(usize, usize)> = positions.iter().map(|&(r, c)| (c, r)).collect();

@@ -255,13 +255,8 @@ mod tests {
     /// over sampled directions (never above it, and within the sampling's resolution).
     #[test]
     fn equals_sampled_minimum_in_three_dimensions() {
-        let mut seed = 7u64;
-        let mut next = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut lcg = crate::lcg::Lcg::new(7);
+        let mut next = || lcg.signed();
         for _ in 0..40 {
             let b = DMatrix::from_fn(3, 3, |_, _| next());
             let h = (&b + b.transpose()) * 0.5;

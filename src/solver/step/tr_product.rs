@@ -55,13 +55,8 @@ mod tests {
     #[test]
     fn tr_product_skipping_zero_columns_changes_no_bit() {
         let dof = 9;
-        let mut s = 7u64;
-        let mut r = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        };
+        let mut lcg = crate::lcg::Lcg::new(7);
+        let mut r = || lcg.signed();
         for trial in 0..4 {
             let mut a = nalgebra::Matrix3xX::from_fn(dof, |_, _| r());
             let mut b = nalgebra::Matrix3xX::from_fn(dof, |_, _| r());

@@ -146,13 +146,8 @@ mod tests {
     #[test]
     fn skipping_zeros_changes_no_bit() {
         let (n, dof) = (7 * 11, 9);
-        let mut s = 12345u64;
-        let mut r = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        };
+        let mut lcg = crate::lcg::Lcg::new(12345);
+        let mut r = || lcg.signed();
         let z = DMatrix::from_fn(n, dof, |i, j| {
             let body = i / 7;
             if body < j {

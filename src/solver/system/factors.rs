@@ -204,13 +204,8 @@ mod tests {
     /// ratio is that of `lu.u()`'s diagonal.
     #[test]
     fn transposed_solve_in_place_is_that_of_the_copies() {
-        let mut s = 99u64;
-        let mut r = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        };
+        let mut lcg = crate::lcg::Lcg::new(99);
+        let mut r = || lcg.signed();
         let bits = |v: &DVector<f64>| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         for n in [1, 2, 7, 30] {
             let a = DMatrix::from_fn(n, n, |_, _| r());

@@ -33,12 +33,9 @@ fn models() -> Vec<Model> {
 }
 
 fn random_q(n: usize, seed: u64) -> DVector<f64> {
-    let mut s = seed;
+    let mut lcg = crate::lcg::Lcg::new(seed);
     DVector::from_fn(n, |i, _| {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        let r = ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0;
+        let r = lcg.signed();
         if i % 7 == 3 {
             1.0 + 0.2 * r
         } else {

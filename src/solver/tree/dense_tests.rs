@@ -5,13 +5,8 @@ use nalgebra::{DMatrix, DVector};
 
 /// A pseudo-random `r × c` matrix in `[−1, 1)`.
 fn sample(r: usize, c: usize, seed: u64) -> DMatrix<f64> {
-    let mut s = seed;
-    let mut next = || {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-    };
+    let mut lcg = crate::lcg::Lcg::new(seed);
+    let mut next = || lcg.signed();
     DMatrix::from_fn(r, c, |_, _| next())
 }
 

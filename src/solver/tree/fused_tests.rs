@@ -54,17 +54,9 @@ fn values(sys: &System) -> Vec<f64> {
     }
 }
 
-/// A pseudo-random number in `[−1, 1)` (a fixed sequence: reproducible).
-fn noise(state: &mut u64) -> f64 {
-    *state = state
-        .wrapping_mul(6364136223846793005)
-        .wrapping_add(1442695040888963407);
-    (*state >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-}
-
 #[test]
 fn fused_blocks_equal_the_general_assembly_bit_for_bit() {
-    let mut state = 7u64;
+    let mut lcg = crate::lcg::Lcg::new(7);
     let mut fused_cases = 0;
     for (name, model, locks) in cases() {
         let q0 = crate::solver::initial_state(&model).q;
@@ -90,8 +82,8 @@ fn fused_blocks_equal_the_general_assembly_bit_for_bit() {
         }
         fused_cases += 1;
         for pose in 0..4 {
-            let qr = DVector::from_fn(q.len(), |i, _| q[i] + 0.2 * noise(&mut state));
-            let mu = eval.mu.map(|m| m * (1.0 + 0.5 * noise(&mut state)));
+            let qr = DVector::from_fn(q.len(), |i, _| q[i] + 0.2 * lcg.signed());
+            let mu = eval.mu.map(|m| m * (1.0 + 0.5 * lcg.signed()));
             let mut ev = eval.clone();
             ev.mu = mu;
             assert!(sys.assemble_kkt(&qr, &part, &ev), "{name}");

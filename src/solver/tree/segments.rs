@@ -233,13 +233,8 @@ mod tests {
     /// than the gathered side.
     #[test]
     fn segments_equal_the_entry_loops_bit_for_bit() {
-        let mut s = 5u64;
-        let mut rnd = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        };
+        let mut lcg = crate::lcg::Lcg::new(5);
+        let mut rnd = || lcg.signed();
         let n = 120u32;
         let block = |rows: &[u32], cols: &[u32]| -> Vec<(u32, u32)> {
             rows.iter()

@@ -26,12 +26,6 @@
 //! [`MAX_BODIES`] bodies in one step (a long loop's rows gather every body they pass).
 //! `verify`'s tests check that the partitions agree to the last index on every model of
 //! their set, with and without a lock on every joint coordinate.
-//!
-//! A [`Workspace`] kept by the caller between the partitions of one system (one model, one
-//! set of constraints) keeps the elimination order and the rows' structure (module `rows`,
-//! [`Rows::refill`]): a later partition whose triplets have the same pattern writes the rows'
-//! values into it (and expands afresh only the rows whose zeros changed), then takes the same
-//! steps as on rows built afresh.
 
 use super::block::{Block, Changed};
 use super::partition::elimination_order;
@@ -41,14 +35,6 @@ use crate::solver::partition::{next_id, Partition, RANK_TOLERANCE};
 
 /// The most bodies one body's step may span (beyond it the sparse partition is used).
 pub(crate) const MAX_BODIES: usize = 32;
-
-/// What one partition keeps for the next of the same system: the bodies' elimination order
-/// and the rows' structure.
-#[derive(Default)]
-pub(crate) struct Workspace {
-    order: Vec<usize>,
-    rows: Option<Rows>,
-}
 
 /// The number of free columns `n − rank` the sparse partition leaves for the `m × n` Jacobian
 /// `entries` with row and column scales, or `None` where this route gives up (then only the
@@ -61,8 +47,7 @@ pub(crate) fn free_columns(
     row_scale: &[f64],
     scale: &[f64],
 ) -> Option<usize> {
-    let work = &mut Workspace::default();
-    eliminate(model, m, n, entries, row_scale, scale, work).map(|p| n - p.order.len())
+    eliminate(model, m, n, entries, row_scale, scale).map(|p| n - p.order.len())
 }
 
 /// The pivots of the elimination: `(row, column)` in pivot order, and the second pass's
@@ -74,8 +59,7 @@ struct Pivots {
 
 /// The sparse partition (`sparse::partition::partition`, the same `Partition` but for its id)
 /// of the `m × n` Jacobian `entries` with row and column scales, or `None` where this route
-/// gives up; `work` is kept from the last partition of the same model and constraints (or
-/// empty).
+/// gives up.
 pub(crate) fn partition(
     model: &Model,
     m: usize,
@@ -83,9 +67,8 @@ pub(crate) fn partition(
     entries: &[(usize, usize, f64)],
     row_scale: &[f64],
     scale: &[f64],
-    work: &mut Workspace,
 ) -> Option<Partition> {
-    let p = eliminate(model, m, n, entries, row_scale, scale, work)?;
+    let p = eliminate(model, m, n, entries, row_scale, scale)?;
     let mut pivot_row = vec![false; m];
     let mut free = vec![true; n];
     for &(r, c) in &p.order {
@@ -112,16 +95,8 @@ fn eliminate(
     entries: &[(usize, usize, f64)],
     row_scale: &[f64],
     scale: &[f64],
-    work: &mut Workspace,
 ) -> Option<Pivots> {
-    let kept = work.rows.as_mut();
-    if !kept.is_some_and(|rows| rows.refill(m, n, entries, row_scale, scale)) {
-        work.rows = Rows::new(m, n, entries, row_scale, scale);
-    }
-    let rows = work.rows.as_ref()?;
-    if work.order.len() != model.bodies.len() {
-        work.order = elimination_order(model);
-    }
+    let rows = Rows::new(m, n, entries, row_scale, scale)?;
     let amax = rows.rmax.iter().fold(0.0f64, |a, &x| a.max(x));
     let tol = (RANK_TOLERANCE * amax).max(f64::MIN_POSITIVE);
     let mut active: Vec<bool> = rows.rmax.iter().map(|&x| x > tol).collect();
@@ -132,10 +107,10 @@ fn eliminate(
     let mut block = Block::default();
     let mut changed = Changed::new(m, n / 7);
     let mut cands = Vec::new();
-    for &b in &work.order {
+    for b in elimination_order(model) {
         rows.touching(b, &mut cands);
         changed.touching(b, &mut cands);
-        block.load(b, &cands, &active, rows, &changed);
+        block.load(b, &cands, &active, &rows, &changed);
         if block.bodies() > MAX_BODIES {
             return None;
         }
@@ -152,7 +127,7 @@ fn eliminate(
             taken += 1;
         }
         while taken < 7 {
-            let Some((i, k)) = block.best_own_pivot(&free, tol, b, rows) else {
+            let Some((i, k)) = block.best_own_pivot(&free, tol, b, &rows) else {
                 break;
             };
             pivots.order.push((block.rows[i], 7 * b + k));
@@ -161,7 +136,7 @@ fn eliminate(
             block.pivot(i, k, &mut active, tol);
             taken += 1;
         }
-        if block.carries_own_row(&free, tol, b, rows) {
+        if block.carries_own_row(&free, tol, b, &rows) {
             return None;
         }
         block.keep(&mut changed);

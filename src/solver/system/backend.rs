@@ -120,13 +120,12 @@ impl Backend {
     }
 
     /// Partition of the Jacobian `jac` of `problem` (full pivoting of the dense `Φ_q`, or the
-    /// sparse body-by-body elimination, with `work` kept from the last of `problem`).
+    /// sparse body-by-body elimination).
     pub(crate) fn partition(
         self,
         problem: &Problem,
         jac: &Triplets,
         coordinates: usize,
-        work: &mut crate::solver::sparse::fill_free::Workspace,
     ) -> Partition {
         let scaling = &problem.scaling;
         match self {
@@ -141,7 +140,6 @@ impl Backend {
                     &jac.entries,
                     rows,
                     columns,
-                    work,
                 )
                 .unwrap_or_else(|| {
                     crate::solver::sparse::partition::partition(

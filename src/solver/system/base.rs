@@ -73,8 +73,7 @@ impl<'a> System<'a> {
     /// Partition at `q` (see [`Backend::partition`]).
     pub(crate) fn partition(&mut self, q: &DVector<f64>) -> Partition {
         self.triplets(q);
-        let work = &mut self.work;
         self.backend
-            .partition(&self.problem, &work.jac, q.len(), &mut work.fill_free)
+            .partition(&self.problem, &self.work.jac, q.len())
     }
 }

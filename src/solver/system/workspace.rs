@@ -20,9 +20,6 @@ pub(crate) struct Workspace {
     /// (false once `phi` is newer; the buffer is kept).
     pub(crate) jac_at: DVector<f64>,
     pub(crate) jac_fresh: bool,
-    /// What the last partition keeps for the next (sparse path: the fill-free partition's
-    /// elimination order and rows' structure).
-    pub(crate) fill_free: crate::solver::sparse::fill_free::Workspace,
     /// The symbolic split of `Φ_q` under the last partition (sparse path).
     pub(crate) split: Option<Split>,
     /// The KKT system of the last assembly (sparse path; tree backend: tree-structured where
@@ -54,7 +51,6 @@ impl Workspace {
             jac: Triplets::default(),
             jac_at: DVector::zeros(0),
             jac_fresh: false,
-            fill_free: Default::default(),
             split: None,
             kkt: None,
             tree_split: None,

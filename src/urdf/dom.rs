@@ -93,7 +93,7 @@ pub(crate) struct Document<'i> {
 
 impl<'i> Document<'i> {
     /// The text of `s`.
-    #[inline]
+    #[inline(always)]
     pub(super) fn str(&self, s: Str) -> &str {
         let (a, b) = (s.start as usize, s.start as usize + s.bytes());
         if s.len & OWNED != 0 {
@@ -105,9 +105,20 @@ impl<'i> Document<'i> {
 
     /// Whether `s` is `name`, lengths first, then byte by byte (names are a few bytes: no
     /// call to `memcmp`).
-    #[inline]
+    #[inline(always)]
     fn is(&self, s: Str, name: &str) -> bool {
-        s.bytes() == name.len() && self.str(s).bytes().zip(name.bytes()).all(|(a, b)| a == b)
+        s.bytes() == name.len() && self.bytes(s).iter().zip(name.bytes()).all(|(&a, b)| a == b)
+    }
+
+    /// The bytes of `s` (no test of character boundaries, as [`Document::str`] has).
+    #[inline(always)]
+    fn bytes(&self, s: Str) -> &[u8] {
+        let (a, b) = (s.start as usize, s.start as usize + s.bytes());
+        if s.len & OWNED != 0 {
+            &self.owned.as_bytes()[a..b]
+        } else {
+            &self.text.as_bytes()[a..b]
+        }
     }
 
     /// The namespace URI of a name's `ns` ([`NodeData::ns`]).
@@ -312,15 +323,18 @@ impl<'a> Attribute<'a> {
 }
 
 impl<'a, 'i> Node<'a, 'i> {
+    #[inline]
     fn d(&self) -> &'a NodeData {
         &self.doc.nodes[self.id as usize]
     }
 
+    #[inline]
     fn at(&self, id: u32) -> Node<'a, 'i> {
         Node { doc: self.doc, id }
     }
 
     /// Whether the node is an element.
+    #[inline]
     pub(crate) fn is_element(&self) -> bool {
         self.d().kind == Kind::Element
     }
@@ -332,6 +346,7 @@ impl<'a, 'i> Node<'a, 'i> {
     }
 
     /// An element's name (empty for other nodes).
+    #[inline]
     pub(crate) fn tag_name(&self) -> ExpandedName<'a> {
         let d = self.d();
         if d.kind != Kind::Element {
@@ -378,6 +393,7 @@ impl<'a, 'i> Node<'a, 'i> {
     }
 
     /// The value of the unprefixed attribute `name`.
+    #[inline]
     pub(crate) fn attribute(&self, name: &str) -> Option<&'a str> {
         let doc = self.doc;
         let (a, b) = self.d().attrs;
@@ -468,6 +484,7 @@ pub(crate) struct Children<'a, 'i> {
 
 impl<'a, 'i> Iterator for Children<'a, 'i> {
     type Item = Node<'a, 'i>;
+    #[inline]
     fn next(&mut self) -> Option<Self::Item> {
         let n = self.node?;
         let s = n.d().next_sibling;

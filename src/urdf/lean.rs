@@ -130,9 +130,13 @@ impl<'i> Reader<'i> {
     }
 
     fn skip_space(&mut self) -> bool {
-        let n = self.run(SPACE);
-        self.i += n;
-        n > 0
+        // Most calls find none: one lookup before the scan.
+        let at = self.b.get(self.i).copied().unwrap_or(b'<');
+        if CLASS[at as usize] & SPACE == 0 {
+            return false;
+        }
+        self.i += self.run(SPACE);
+        true
     }
 
     fn eat(&mut self, s: &[u8]) -> Option<()> {

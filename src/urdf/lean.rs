@@ -362,7 +362,8 @@ impl<'i> Reader<'i> {
         };
         let text = self.doc.text;
         let s = |r: (usize, usize)| &text[r.0..r.1];
-        if matches!(s(prefix), "xml" | "xmlns") {
+        let written_prefix = &self.b[prefix.0..prefix.1];
+        if written_prefix == b"xml" || written_prefix == b"xmlns" {
             return None;
         }
         // Namespace declarations, in the order written; then the parent's in its order,
@@ -420,16 +421,23 @@ impl<'i> Reader<'i> {
         // default namespace); `None` for an undeclared prefix.
         let lookup = |doc: &Document, p: &str| -> Option<u32> {
             let (a, b) = (scope.0 as usize, scope.1 as usize);
-            let found = doc.scope[a..b]
-                .iter()
-                .position(|x| x.0.map(|q| doc.str(q)) == (!p.is_empty()).then_some(p));
+            // No prefix: the entry of the default namespace (none of the prefixed ones).
+            let found = match p.is_empty() {
+                true => doc.scope[a..b].iter().position(|x| x.0.is_none()),
+                false => doc.scope[a..b]
+                    .iter()
+                    .position(|x| x.0.is_some_and(|q| doc.str(q) == p)),
+            };
             match found {
                 Some(k) => Some((a + k + 1) as u32),
                 None if p.is_empty() => Some(0),
                 None => None,
             }
         };
-        let ns = lookup(&self.doc, s(prefix))?;
+        let ns = match prefix.0 == prefix.1 {
+            true => lookup(&self.doc, "")?,
+            false => lookup(&self.doc, s(prefix))?,
+        };
         let a0 = self.doc.attrs.len();
         if plain {
             // A duplicate is a repeated name.

@@ -344,10 +344,7 @@ impl<'i> Reader<'i> {
                 _ if spaced => {
                     let (p, l) = self.qname()?;
                     self.skip_space();
-                    if self.b.get(self.i) != Some(&b'=') {
-                        return None;
-                    }
-                    self.i += 1;
+                    self.eat(b"=")?;
                     self.skip_space();
                     let value = self.quoted()?;
                     plain &= p.0 == p.1 && (l.1 - l.0 != 5 || &self.b[l.0..l.1] != b"xmlns");
@@ -434,10 +431,7 @@ impl<'i> Reader<'i> {
                 None => None,
             }
         };
-        let ns = match prefix.0 == prefix.1 {
-            true => lookup(&self.doc, "")?,
-            false => lookup(&self.doc, s(prefix))?,
-        };
+        let ns = lookup(&self.doc, if prefix.0 == prefix.1 { "" } else { s(prefix) })?;
         let a0 = self.doc.attrs.len();
         if plain {
             // A duplicate is a repeated name.

@@ -11,6 +11,7 @@
 mod base;
 mod byte_class;
 mod dom;
+mod dom_convert;
 #[cfg(test)]
 mod dom_tests;
 mod edges;

@@ -246,7 +246,7 @@ impl<'a, 'i> Node<'a, 'i> {
     }
 
     /// An element's name (empty for other nodes).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn tag_name(&self) -> ExpandedName<'a> {
         let d = self.d();
         if d.kind != Kind::Element {

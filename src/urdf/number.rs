@@ -28,7 +28,8 @@ pub(super) fn finite_trimmed(s: &str) -> Option<f64> {
     exact(s.as_bytes()).or_else(|| finite(s.trim()))
 }
 
-/// The value of `b` in the exact case, `None` otherwise (not that `b` is no number).
+/// The value of `b` in the exact case; `None` otherwise (which does not mean that `b` is not a
+/// number).
 fn exact(b: &[u8]) -> Option<f64> {
     let (negative, mut i) = match b.first()? {
         b'-' => (true, 1),

@@ -5,7 +5,8 @@
 //! A document comes from one of two readers with the same result:
 //! [`super::lean::parse`], a reader of the plain XML that URDF files are written in (ASCII,
 //! no entity references, no DTD), which declines anything else; or `roxmltree`, which reads
-//! every XML document and reports every error, converted here by [`Document::from_roxmltree`].
+//! every XML document and reports every error, converted by [`Document::from_roxmltree`]
+//! (module `dom_convert`).
 //! Each node is 48 bytes with its strings borrowed from the text (`roxmltree` keeps 72 and a
 //! table regrown by copies on files written one element per line).
 
@@ -18,12 +19,12 @@ const XML_URI: &str = "http://www.w3.org/XML/1998/namespace";
 /// buffer (strings `roxmltree` expanded) when the length has its top bit set.
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Str {
-    start: u32,
-    len: u32,
+    pub(super) start: u32,
+    pub(super) len: u32,
 }
 
 /// The top bit of [`Str::len`]: the string is in [`Document::owned`].
-const OWNED: u32 = 1 << 31;
+pub(super) const OWNED: u32 = 1 << 31;
 
 impl Str {
     /// The byte range `r` of the input text.
@@ -93,7 +94,7 @@ pub(crate) struct Document<'i> {
 
 impl<'i> Document<'i> {
     /// The text of `s`.
-    #[inline]
+    #[inline(always)]
     pub(super) fn str(&self, s: Str) -> &str {
         let (a, b) = (s.start as usize, s.start as usize + s.bytes());
         if s.len & OWNED != 0 {
@@ -105,9 +106,20 @@ impl<'i> Document<'i> {
 
     /// Whether `s` is `name`, lengths first, then byte by byte (names are a few bytes: no
     /// call to `memcmp`).
-    #[inline]
+    #[inline(always)]
     fn is(&self, s: Str, name: &str) -> bool {
-        s.bytes() == name.len() && self.str(s).bytes().zip(name.bytes()).all(|(a, b)| a == b)
+        s.bytes() == name.len() && self.bytes(s).iter().zip(name.bytes()).all(|(&a, b)| a == b)
+    }
+
+    /// The bytes of `s` (no character-boundary test, unlike [`Document::str`]).
+    #[inline(always)]
+    fn bytes(&self, s: Str) -> &[u8] {
+        let all = if s.len & OWNED != 0 {
+            &self.owned
+        } else {
+            self.text
+        };
+        &all.as_bytes()[s.start as usize..s.start as usize + s.bytes()]
     }
 
     /// The namespace URI of a name's `ns` ([`NodeData::ns`]).
@@ -144,107 +156,6 @@ impl<'i> Document<'i> {
     /// Every node in document order, the document node first.
     pub(crate) fn descendants(&self) -> Descendants<'_, 'i> {
         self.root().descendants()
-    }
-
-    /// `roxmltree`'s document, converted.
-    pub(crate) fn from_roxmltree(doc: &roxmltree::Document<'i>) -> Document<'i> {
-        let mut out = Document {
-            text: doc.input_text(),
-            owned: String::new(),
-            nodes: Vec::new(),
-            attrs: Vec::new(),
-            scope: Vec::new(),
-        };
-        let own = |owned: &mut String, s: &str| {
-            let start = owned.len() as u32;
-            owned.push_str(s);
-            Str {
-                start,
-                len: s.len() as u32 | OWNED,
-            }
-        };
-        // Depth-first with an explicit stack of (roxmltree node, parent index); siblings are
-        // linked when the next one is placed.
-        let mut last_child: Vec<u32> = Vec::new();
-        let mut stack = vec![(doc.root(), 0u32, 0usize)];
-        while let Some((n, parent, depth)) = stack.pop() {
-            let id = out.nodes.len() as u32;
-            let kind = match n.node_type() {
-                roxmltree::NodeType::Root => Kind::Root,
-                roxmltree::NodeType::Element => Kind::Element,
-                roxmltree::NodeType::Text => Kind::Text,
-                roxmltree::NodeType::Comment => Kind::Comment,
-                roxmltree::NodeType::PI => Kind::Other,
-            };
-            let mut data = NodeData {
-                kind,
-                parent,
-                next_sibling: 0,
-                end: id + 1,
-                range: (n.range().start as u32, n.range().end as u32),
-                name: Str::default(),
-                ns: 0,
-                attrs: (0, 0),
-                scope: (0, 0),
-            };
-            match kind {
-                Kind::Element => {
-                    data.name = own(&mut out.owned, n.tag_name().name());
-                    // A name's URI: an entry of the scope table outside every element's range.
-                    let uri = |owned: &mut String, scope: &mut Vec<_>, u: Option<&str>| {
-                        u.map_or(0, |u| {
-                            scope.push((None, own(owned, u)));
-                            scope.len() as u32
-                        })
-                    };
-                    data.ns = uri(&mut out.owned, &mut out.scope, n.tag_name().namespace());
-                    let a0 = out.attrs.len() as u32;
-                    for a in n.attributes() {
-                        let ns = uri(&mut out.owned, &mut out.scope, a.namespace());
-                        let name = own(&mut out.owned, a.name());
-                        let value = own(&mut out.owned, a.value());
-                        out.attrs.push(AttrData { ns, name, value });
-                    }
-                    data.attrs = (a0, out.attrs.len() as u32);
-                    let s0 = out.scope.len() as u32;
-                    for s in n.namespaces() {
-                        let p = s.name().map(|p| own(&mut out.owned, p));
-                        let u = own(&mut out.owned, s.uri());
-                        out.scope.push((p, u));
-                    }
-                    data.scope = (s0, out.scope.len() as u32);
-                }
-                Kind::Text | Kind::Comment => {
-                    data.name = own(&mut out.owned, n.text().unwrap_or(""));
-                }
-                _ => {}
-            }
-            // The previous node at this depth under the same parent (`u32::MAX`: none yet).
-            last_child.truncate(depth + 1);
-            match last_child.get_mut(depth) {
-                Some(prev) => {
-                    if *prev != u32::MAX {
-                        out.nodes[*prev as usize].next_sibling = id;
-                    }
-                    *prev = id;
-                }
-                None => last_child.push(id),
-            }
-            last_child.push(u32::MAX);
-            out.nodes.push(data);
-            let children: Vec<_> = n.children().collect();
-            for c in children.into_iter().rev() {
-                stack.push((c, id, depth + 1));
-            }
-        }
-        // Subtree ends, from the last node back: a node ends where its last descendant does.
-        for i in (1..out.nodes.len()).rev() {
-            let (p, e) = (out.nodes[i].parent as usize, out.nodes[i].end);
-            if out.nodes[p].end < e {
-                out.nodes[p].end = e;
-            }
-        }
-        out
     }
 }
 
@@ -312,15 +223,18 @@ impl<'a> Attribute<'a> {
 }
 
 impl<'a, 'i> Node<'a, 'i> {
+    #[inline]
     fn d(&self) -> &'a NodeData {
         &self.doc.nodes[self.id as usize]
     }
 
+    #[inline]
     fn at(&self, id: u32) -> Node<'a, 'i> {
         Node { doc: self.doc, id }
     }
 
     /// Whether the node is an element.
+    #[inline]
     pub(crate) fn is_element(&self) -> bool {
         self.d().kind == Kind::Element
     }
@@ -332,6 +246,7 @@ impl<'a, 'i> Node<'a, 'i> {
     }
 
     /// An element's name (empty for other nodes).
+    #[inline(always)]
     pub(crate) fn tag_name(&self) -> ExpandedName<'a> {
         let d = self.d();
         if d.kind != Kind::Element {
@@ -378,6 +293,7 @@ impl<'a, 'i> Node<'a, 'i> {
     }
 
     /// The value of the unprefixed attribute `name`.
+    #[inline]
     pub(crate) fn attribute(&self, name: &str) -> Option<&'a str> {
         let doc = self.doc;
         let (a, b) = self.d().attrs;
@@ -468,6 +384,7 @@ pub(crate) struct Children<'a, 'i> {
 
 impl<'a, 'i> Iterator for Children<'a, 'i> {
     type Item = Node<'a, 'i>;
+    #[inline]
     fn next(&mut self) -> Option<Self::Item> {
         let n = self.node?;
         let s = n.d().next_sibling;

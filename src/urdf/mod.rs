@@ -11,6 +11,7 @@
 mod base;
 mod byte_class;
 mod dom;
+mod dom_convert;
 #[cfg(test)]
 mod dom_tests;
 mod edges;
@@ -19,8 +20,10 @@ mod foreign;
 mod import;
 mod lean;
 mod limits;
+mod lines;
 mod links;
 mod mimic;
+mod number;
 mod schema;
 mod servo;
 mod text;

@@ -314,7 +314,7 @@ fn refuse_xacro(doc: &Document, file: &str) -> Result<()> {
     // spell one (byte searches; the element scan walks every attribute of the file).
     let text = doc.input_text();
     let b = text.as_bytes();
-    if !b.contains(&b'$') && !doc.mentions_uri("xacro") && !b.contains(&b'&') {
+    if !holds_either(b, b'$', b'&') && !doc.mentions_uri("xacro") {
         return Ok(());
     }
     for n in doc.descendants().filter(|n| n.is_element()) {
@@ -334,6 +334,15 @@ fn refuse_xacro(doc: &Document, file: &str) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// Whether `b` holds byte `x` or `y`: 32 bytes a test without an early exit inside (vector
+/// compares), where `memchr` goes a word at a time.
+fn holds_either(b: &[u8], x: u8, y: u8) -> bool {
+    let blocks = b.chunks_exact(32);
+    let tail = blocks.remainder();
+    let hit = |c: &[u8]| c.iter().fold(false, |a, &c| a | (c == x) | (c == y));
+    blocks.into_iter().any(hit) || hit(tail)
 }
 
 /// Declares on `<robot>` each prefix the parser finds used without a declaration, until it
@@ -373,6 +382,22 @@ fn declare_prefixes(mut out: String, file: &str, warnings: &mut Vec<String>) -> 
 
 #[cfg(test)]
 mod tests {
+    /// The block test finds a byte at every offset of blocks and tails, and no other.
+    #[test]
+    fn holds_either_finds_every_position() {
+        for n in [0, 1, 31, 32, 33, 64, 95, 100] {
+            let plain = vec![b'x'; n];
+            assert!(!super::holds_either(&plain, b'$', b'&'));
+            for k in 0..n {
+                for c in [b'$', b'&'] {
+                    let mut t = plain.clone();
+                    t[k] = c;
+                    assert!(super::holds_either(&t, b'$', b'&'), "{n} {k}");
+                }
+            }
+        }
+    }
+
     use super::*;
 
     #[test]

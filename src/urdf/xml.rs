@@ -21,14 +21,10 @@ pub(crate) struct Source<'a> {
 impl<'a> Source<'a> {
     /// The source of `doc`, read from `file`.
     pub(crate) fn new(file: &'a str, doc: &'a Document<'a>) -> Self {
-        let text = doc.input_text();
-        let line_starts = std::iter::once(0)
-            .chain(text.match_indices('\n').map(|(i, _)| i + 1))
-            .collect();
         Source {
             file,
             doc,
-            line_starts,
+            line_starts: super::lines::line_starts(doc.input_text()),
         }
     }
 
@@ -164,8 +160,7 @@ impl<'a> Source<'a> {
         let mut ok = true;
         for o in out.iter_mut() {
             // A word has no surrounding whitespace: parsed without `trim`.
-            let number = |w: &str| w.parse::<f64>().ok().filter(|v| v.is_finite());
-            match words.next().and_then(number) {
+            match words.next().and_then(super::number::finite) {
                 Some(v) => *o = v,
                 None => ok = false,
             }
@@ -326,10 +321,11 @@ impl std::fmt::Display for Described<'_, '_, '_> {
 
 /// Parses a finite number.
 pub(crate) fn parse_f64(s: &str) -> Option<f64> {
-    s.trim().parse::<f64>().ok().filter(|v| v.is_finite())
+    super::number::finite_trimmed(s)
 }
 
 /// First child element with this local name.
+#[inline]
 pub(crate) fn child<'a>(node: Node<'a, 'a>, name: &str) -> Option<Node<'a, 'a>> {
     node.children().find(|c| c.is_named(name))
 }

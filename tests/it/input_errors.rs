@@ -199,3 +199,25 @@ fn deep_nesting_is_refused() {
     );
     assert!(load_str(&text, "t.urdf", &ImportOptions::default()).is_ok());
 }
+
+/// The line and column of an error far into a file: line feeds at every offset of the line
+/// table's 32-byte blocks before it (and, in the second file, a non-ASCII comment, read by
+/// `roxmltree`, on the error's line: the column counts characters).
+#[test]
+fn far_errors_name_their_line_and_column() {
+    for tail in ["", "<!-- é -->"] {
+        let pads: String = (0..300)
+            .map(|i| format!("{}<!-- {} -->\n", " ".repeat(i % 41), "p".repeat(i % 67)))
+            .collect();
+        let text = with(&format!("{J}\n{pads}   {tail}<mech:spinner/>"));
+        let at = text.find("<mech:spinner").unwrap();
+        let line = text[..at].matches('\n').count() + 1;
+        let col = text[..at].rsplit('\n').next().unwrap().chars().count() + 1;
+        assert_eq!(line, 305);
+        let e = err(&text);
+        assert!(
+            e.contains(&format!("bad.urdf:{line}:{col}:")),
+            "expected line {line}, column {col}: {e}"
+        );
+    }
+}

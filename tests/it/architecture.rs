@@ -3,7 +3,7 @@
 //! has no cycle and no upward import. The table is the architecture of `docs/development.md`:
 //!
 //! ```text
-//! error, math  →  geometry | joint  →  model  →  jet  →  kinematics  →  constraints | forces
+//! (lcg, tests only)  →  error, math  →  geometry | joint  →  model  →  jet  →  kinematics  →  constraints | forces
 //!   →  state  →  urdf | generate  →  solver  →  verify  →  export | view  →  (cli)
 //! ```
 //!
@@ -15,24 +15,26 @@ use std::path::{Path, PathBuf};
 
 /// Layer of each top-level module; a module may use modules of strictly lower layers.
 const LAYERS: &[(&str, u32)] = &[
-    ("error", 0),
-    ("math", 0),
-    ("names", 0),
-    ("geometry", 1),
-    ("joint", 1),
-    ("model", 2),
-    ("jet", 3),
-    ("kinematics", 4),
-    ("constraints", 5),
-    ("forces", 5),
-    ("state", 6),
-    ("urdf", 7),
-    ("generate", 7),
-    ("solver", 8),
-    ("verify", 9),
-    ("export", 10),
-    ("view", 10),
-    ("cli", 11),
+    // Test-only: the unit tests' pseudo-random sequence (`#[cfg(test)]`).
+    ("lcg", 0),
+    ("error", 1),
+    ("math", 1),
+    ("names", 1),
+    ("geometry", 2),
+    ("joint", 2),
+    ("model", 3),
+    ("jet", 4),
+    ("kinematics", 5),
+    ("constraints", 6),
+    ("forces", 6),
+    ("state", 7),
+    ("urdf", 8),
+    ("generate", 8),
+    ("solver", 9),
+    ("verify", 10),
+    ("export", 11),
+    ("view", 11),
+    ("cli", 12),
 ];
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {

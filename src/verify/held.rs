@@ -348,7 +348,7 @@ fn solve_once(
     // The model's rows from the balance check where they are this system's first ones, and
     // with them the guard's `V` and `∇V` (the same pose and branches).
     let known = given.and_then(|rows| rows.install(&mut sys, &state.q));
-    let part = super::rank::partition(&mut sys, &state.q);
+    let part = sys.partition(&state.q);
     let mut eval = sys
         .evaluate_knowing(&state.q, &part, known)
         .ok_or_else(|| singular(part.rows.len()))?;

@@ -111,7 +111,7 @@ fn sparse_dof(model: &Model, start: State, cons: Constraints) -> Result<usize> {
     let fast = {
         let jac = &sys.work.jac;
         let scaling = &sys.problem.scaling;
-        super::rank::free_columns(
+        crate::solver::sparse::fill_free::free_columns(
             model,
             jac.rows,
             jac.cols,

@@ -38,7 +38,8 @@ mod initial_guess;
 mod lexicographic;
 mod model_rows;
 mod pose;
-mod rank;
+#[cfg(test)]
+mod rank_tests;
 mod reduced;
 mod run;
 mod unilateral;

@@ -1,5 +1,11 @@
-//! The sparse partition on dense copies (`solver::sparse::fill_free`, which `System::partition`
-//! takes where it answers) against the general sparse elimination (`sparse::partition`).
+//! The sparse partition on dense copies against the general sparse elimination, on the systems
+//! `verify` and `check` build. `System::partition` runs the elimination on dense copies of each
+//! body's rows (`solver::sparse::fill_free`) wherever that route answers (trees, ladders), the
+//! general sparse elimination (`sparse::partition`) otherwise, and must give the same
+//! `Partition` either way (to the last index, so the factors and every number computed from
+//! them are the same to the bit): `verify`'s locked system (the model's rows and a lock row per
+//! joint coordinate) and `check`'s count of free columns take it from there. Checked on every
+//! model of the test set, with and without a lock on every joint coordinate.
 
 use crate::constraints::Constraints;
 use crate::solver::system::{Backend, System};
@@ -20,7 +26,7 @@ fn both(text: &str, options: &ImportOptions) -> (Option<usize>, usize) {
         .cons
         .evaluate(&model, &q, &mut phi, Some(&mut jac));
     let s = &sys.problem.scaling;
-    let fast = super::free_columns(
+    let fast = crate::solver::sparse::fill_free::free_columns(
         &model,
         jac.rows,
         jac.cols,
@@ -114,8 +120,8 @@ fn structural_count_is_the_partition_count() {
         let model = load_str(t, "m.urdf", o).unwrap().model;
         let cons = Constraints::new(&model, &crate::solver::lock_values(&model));
         let n = crate::solver::initial_state(&model).q.len();
-        let dof = super::super::initial_guess::tree_dof(&model, &cons, n);
-        (dof, super::super::check(&model).dof)
+        let dof = super::initial_guess::tree_dof(&model, &cons, n);
+        (dof, super::check(&model).dof)
     };
     let mut answered = 0;
     for (k, t) in trees.iter().enumerate() {
@@ -163,7 +169,7 @@ fn locks_and_a_redundant_lock() {
     assert_eq!(fast, Some(partition));
 }
 
-/// The partition of `super::partition` (`System::partition`) against the general sparse
+/// The partition of `System::partition` against the general sparse
 /// elimination's at the
 /// assembled initial guess of `text` and at a pose off it (each coordinate moved): all but
 /// the id equal. `locked`: with a lock on every joint coordinate scaled down as module `held`
@@ -177,7 +183,7 @@ fn same_partition(text: &str, options: &ImportOptions, locked: bool) -> bool {
     let state = crate::state::State { q, branches };
     let mut all = locks.clone();
     if locked {
-        let coords = super::super::run::tree_coordinates(&model, &state);
+        let coords = super::run::tree_coordinates(&model, &state);
         all.extend(
             coords
                 .into_iter()
@@ -198,13 +204,13 @@ fn same_partition(text: &str, options: &ImportOptions, locked: bool) -> bool {
             .collect();
         let mut sys = System::new(&model, cons, Backend::Sparse);
         for &r in &lock_rows[locks.len()..] {
-            sys.problem.scaling.rows[r] *= super::super::held::PREFERENCE;
+            sys.problem.scaling.rows[r] *= super::held::PREFERENCE;
         }
-        let fast = super::partition(&mut sys, q);
+        let fast = sys.partition(q);
         let full = general(&mut sys, q);
         let jac = &sys.work.jac;
         let s = &sys.problem.scaling;
-        answered &= super::free_columns(
+        answered &= crate::solver::sparse::fill_free::free_columns(
             &model,
             jac.rows,
             jac.cols,

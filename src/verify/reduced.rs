@@ -108,7 +108,7 @@ pub(super) fn reduced<'a>(
             potential: (guard_energy, g),
         });
     }
-    let part = super::rank::partition(&mut sys, q);
+    let part = sys.partition(q);
     let eval = sys
         .evaluate_knowing(q, &part, Some((guard_energy, g.clone())))
         .ok_or_else(|| Error::SingularPartition {

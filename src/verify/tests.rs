@@ -302,7 +302,10 @@ fn the_self_check_on_the_dense_path_reports_what_verify_reports() {
                 assert_eq!((&a.joint, a.dof, a.locked), (&b.joint, b.dof, b.locked));
                 assert_eq!(a.effort, b.effort, "{what} {}", a.joint);
             }
-            assert!(s.projected_gradient.is_nan() && s.stability.is_none(), "{what}");
+            assert!(
+                s.projected_gradient.is_nan() && s.stability.is_none(),
+                "{what}"
+            );
             assert!(v.projected_gradient.is_finite(), "{what}");
             touching += v.unilateral.contacts.len() + v.unilateral.active_limits.len();
             if v.passed {
@@ -313,5 +316,8 @@ fn the_self_check_on_the_dense_path_reports_what_verify_reports() {
         }
     }
     // The cases pass and fail, with stops and contacts touching.
-    assert!(passed >= 5 && failed >= 4 && touching > 10, "{passed} {failed} {touching}");
+    assert!(
+        passed >= 5 && failed >= 4 && touching > 10,
+        "{passed} {failed} {touching}"
+    );
 }

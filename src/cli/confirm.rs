@@ -1,6 +1,7 @@
-//! `analyze` confirms its answer with `verify`'s independent checks (balance by the
-//! null-space projection or the sparse partition, closure, stops and contacts; no stability,
-//! which the solver has judged) on the pose exactly as `verify` reads it back from the result
+//! `analyze` confirms its answer with `verify`'s independent checks (the constraint residual,
+//! closure, the efforts and forces that hold the pose from their own partition of the model's
+//! rows with every joint coordinate locked, stops and contacts; no projected gradient, which
+//! the pass does not read, and no stability, which the solver has judged) on the pose exactly as `verify` reads it back from the result
 //! JSON: the joint values, and the world poses of the bodies joint values cannot place. An
 //! answer they reject is reported as `rejected_by_verify` (exit 3), never as converged.
 //!

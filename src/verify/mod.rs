@@ -139,8 +139,7 @@ pub struct Verification {
     pub max_imbalance: Option<Imbalance>,
     /// Generalized force no scalar joint coordinate carries (spherical, floating joints) \[J\].
     pub unassigned: f64,
-    /// `‖Nᵀ S ∇V‖∞` \[J\] (NaN where not computed: [`Eigenvalues::Skip`] on the sparse
-    /// path).
+    /// `‖Nᵀ S ∇V‖∞` \[J\] (NaN where not computed: [`Eigenvalues::Skip`]).
     pub projected_gradient: f64,
     /// Potential energy \[J\].
     pub potential_energy: f64,
@@ -291,9 +290,11 @@ pub enum Eigenvalues {
     /// on the sparse path, the low end found by Lanczos, as `analyze` reports them).
     Always,
     /// No stability verdict (`stability` is `None`): the balance checks only, as `analyze`
-    /// runs them on its own answer. On the sparse path the model's rows are then not
-    /// partitioned at all (the pass reads the residual and the forces of module `held`, which
-    /// partition their own system): `projected_gradient` is NaN there (not computed).
+    /// runs them on its own answer. The model's rows are then not partitioned at all, on
+    /// either path (no null-space basis on the dense path: the pass reads the residual and
+    /// the forces of module `held`, which partition their own system): `projected_gradient`
+    /// is NaN (not computed). The pass, the failures, the efforts and the stops' and
+    /// contacts' report are those of the other modes.
     Skip,
 }
 

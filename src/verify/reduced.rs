@@ -12,7 +12,8 @@
 //! The partition and evaluation are kept for the stability verdict. Where neither the
 //! projected gradient nor the verdict is asked (`analyze`'s self-check, which judges the pose
 //! by its residual and the forces of module `held`), the rows and the energy are evaluated
-//! without a partition. The energy and its gradient are evaluated once, by the finiteness
+//! without a partition, on the dense path too (with the forces' backend: the dense path's
+//! null-space basis of module `dense` is not formed). The energy and its gradient are evaluated once, by the finiteness
 //! guard: the evaluation of the partition and the forces' locked system take them
 //! (`System::evaluate_knowing`).
 

@@ -54,17 +54,6 @@ pub(super) fn verify_on(
     let sparse = backend != Backend::Dense;
     let skip = eigenvalues == super::Eigenvalues::Skip;
     let eigenvalues = eigenvalues == super::Eigenvalues::Always;
-    // Every check passes the finiteness guard first: on the sparse path with the rows of the
-    // balance check's system (evaluated once for both, module `reduced`).
-    let reduced = if sparse {
-        let locks = crate::solver::lock_values(model);
-        // Without the verdict (`analyze`'s self-check) no partition of the model's rows:
-        // its only other use is the projected gradient, which the pass does not read.
-        Some(reduced::reduced(model, state, &locks, backend, !skip)?)
-    } else {
-        crate::solver::finite::guard(model, state, "the given pose")?;
-        None
-    };
     // The forces on both paths from the sparse partition (module `held`): one computation,
     // so the dense and the sparse path report the same numbers (a pose balanced to the
     // solver's gradient tolerance leaves the forces determined to about that, and partitions
@@ -74,6 +63,20 @@ pub(super) fn verify_on(
         Backend::Tree
     } else {
         Backend::Sparse
+    };
+    // Every check passes the finiteness guard first: on the sparse path with the rows of the
+    // balance check's system (evaluated once for both, module `reduced`).
+    let reduced = if sparse || skip {
+        let locks = crate::solver::lock_values(model);
+        // Without the verdict (`analyze`'s self-check) no partition of the model's rows, on
+        // either path: its only other use is the projected gradient (the dense path's
+        // null-space basis), which the pass does not read. The rows are then those of the
+        // forces' system (its backend), which takes them (module `model_rows`).
+        let backend = if sparse { backend } else { forces_backend };
+        Some(reduced::reduced(model, state, &locks, backend, !skip)?)
+    } else {
+        crate::solver::finite::guard(model, state, "the given pose")?;
+        None
     };
     let mut contact = unilateral::UnilateralCheck::default();
     let list = unilateral::touching(model, state, uni, tol.gap, &mut contact);

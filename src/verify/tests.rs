@@ -238,3 +238,86 @@ fn verify_through_the_tree_factors_equals_verify_through_the_sparse_ones() {
         }
     }
 }
+
+/// `analyze`'s self-check ([`super::Eigenvalues::Skip`]) on the dense path: no null-space
+/// basis and no first solve of the forces, the balance check's rows handed to the locked
+/// system. It reports what `verify` reports there (the pass, the failures, the residual, the
+/// efforts, the unassigned force, the force scale the energy and the stops' and contacts' report, `==`), with
+/// `projected_gradient` NaN and no verdict: on a chain, a chain leaning on its stops, a
+/// ladder, the Stewart platform and a rope on the ground (frictionless and sticking), at rest
+/// and bent.
+#[test]
+fn the_self_check_on_the_dense_path_reports_what_verify_reports() {
+    use crate::solver::system::Backend;
+    let stops = crate::generate::chain(12, false)
+        .replace("type=\"continuous\"", "type=\"revolute\"")
+        .replace(
+            "<axis ",
+            "<limit lower=\"-0.02\" upper=\"0.02\" effort=\"1\" velocity=\"1\"/><axis ",
+        );
+    let stick = Unilaterals {
+        friction: crate::model::Friction::Stick,
+        ..Default::default()
+    };
+    let cases = [
+        (crate::generate::chain(12, false), Unilaterals::default()),
+        (stops, Unilaterals::default()),
+        (crate::generate::ladder(4), Unilaterals::default()),
+        (
+            include_str!("../../robots/stewart_platform.urdf").to_string(),
+            Unilaterals::default(),
+        ),
+        (crate::generate::rope(8), Unilaterals::default()),
+        (crate::generate::rope(8), stick),
+    ];
+    let (mut passed, mut failed, mut touching) = (0, 0, 0);
+    for (text, uni) in cases {
+        let model = load(&text);
+        let options = crate::solver::Options {
+            friction: uni.friction,
+            ..Default::default()
+        };
+        let (rest, _) = crate::solver::solve(&model, &options).unwrap();
+        let bent = crate::verify::assemble(&model, &bent(&model)).unwrap();
+        for state in [rest, bent] {
+            let tol = Tolerances::default();
+            let run = |e| super::run::verify_on(&model, &state, &tol, &uni, Backend::Dense, e);
+            let v = run(super::Eigenvalues::WhenCheap).unwrap();
+            let s = run(super::Eigenvalues::Skip).unwrap();
+            let what = &model.name;
+            assert_eq!(v.passed, s.passed, "{what}");
+            // Failures, contacts and stops with their forces, penetration, friction verdict.
+            assert_eq!(v.unilateral, s.unilateral, "{what}");
+            assert_eq!(
+                v.scaled_constraint_residual, s.scaled_constraint_residual,
+                "{what}"
+            );
+            assert_eq!(v.constraint_residual, s.constraint_residual, "{what}");
+            assert_eq!(v.force_scale, s.force_scale, "{what}");
+            assert_eq!(v.effort_tolerance, s.effort_tolerance, "{what}");
+            assert_eq!(v.unassigned, s.unassigned, "{what}");
+            assert_eq!(v.potential_energy, s.potential_energy, "{what}");
+            assert_eq!(v.imbalance.len(), s.imbalance.len(), "{what}");
+            for (a, b) in v.imbalance.iter().zip(&s.imbalance) {
+                assert_eq!((&a.joint, a.dof, a.locked), (&b.joint, b.dof, b.locked));
+                assert_eq!(a.effort, b.effort, "{what} {}", a.joint);
+            }
+            assert!(
+                s.projected_gradient.is_nan() && s.stability.is_none(),
+                "{what}"
+            );
+            assert!(v.projected_gradient.is_finite(), "{what}");
+            touching += v.unilateral.contacts.len() + v.unilateral.active_limits.len();
+            if v.passed {
+                passed += 1;
+            } else {
+                failed += 1;
+            }
+        }
+    }
+    // The cases pass and fail, with stops and contacts touching.
+    assert!(
+        passed >= 5 && failed >= 4 && touching > 10,
+        "{passed} {failed} {touching}"
+    );
+}

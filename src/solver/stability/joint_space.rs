@@ -142,56 +142,14 @@ pub(crate) fn joint_spectrum(
         rows[r].iter().map(|&(g, x)| x * z[(g, c)]).sum()
     });
     // Every coordinate selectable and as many as the degrees of freedom (a tree of scalar
-    // joints): all are chosen (the rows of an orthogonal `U` stay of norm 1 through the
-    // Gram–Schmidt steps), and only the rank is needed from the decomposition.
+    // joints): all are chosen, `T_I = T`, and the rank test is the inverse's conditioning,
+    // where it settles it (else the general path's singular values decide).
     let all = rows.len() == dof && selectable.iter().all(|&s| s);
-    let svd = super::eigen::svd(t.clone(), !all, false)?;
-    let top = svd.singular_values.max();
-    let rank = svd
-        .singular_values
-        .iter()
-        .filter(|&&s| s > 1e-9 * top)
-        .count();
-    if rank < dof || top <= 0.0 {
-        return None;
-    }
-    let chosen: Vec<usize> = if all {
-        (0..dof).collect()
+    let m = if all {
+        well_conditioned_inverse(&t).or_else(|| chosen_inverse(&t, &selectable))?
     } else {
-        // An orthonormal basis of T's range, then the rows with the most independent motion.
-        let u = svd.u.as_ref()?;
-        let cols: Vec<usize> = (0..svd.singular_values.len())
-            .filter(|&k| svd.singular_values[k] > 1e-9 * top)
-            .collect();
-        let mut basis = DMatrix::from_fn(rows.len(), dof, |r, c| u[(r, cols[c])]);
-        let mut chosen = Vec::with_capacity(dof);
-        for _ in 0..dof {
-            let (best, norm) = (0..rows.len())
-                .filter(|&r| selectable[r] && !chosen.contains(&r))
-                .map(|r| (r, basis.row(r).norm()))
-                .fold((usize::MAX, 0.0), |a, b| {
-                    if b.1 > a.1 * (1.0 + 1e-9) {
-                        b
-                    } else {
-                        a
-                    }
-                });
-            if best == usize::MAX || norm <= 1e-9 {
-                return None;
-            }
-            chosen.push(best);
-            let pivot = basis.row(best).transpose() / norm;
-            for r in 0..rows.len() {
-                let d = basis.row(r).dot(&pivot.transpose());
-                let mut row = basis.row_mut(r);
-                row -= pivot.transpose() * d;
-            }
-        }
-        chosen.sort_unstable();
-        chosen
+        chosen_inverse(&t, &selectable)?
     };
-    let t_i = DMatrix::from_fn(dof, dof, |r, c| t[(chosen[r], c)]);
-    let m = t_i.try_inverse()?;
     let h_theta = m.transpose() * h * &m;
     let h_theta = (&h_theta + h_theta.transpose()) * 0.5;
     let (vals, vecs) = super::eigen::symmetric_eigen(&h_theta);
@@ -217,4 +175,104 @@ pub(crate) fn joint_spectrum(
         })
         .collect();
     Some((vals.iter().copied().collect(), modes))
+}
+
+/// The smallest singular value of `T` counted, relative to the largest: below, the joint
+/// coordinates are taken not to span the feasible motions (rounding).
+const RELATIVE: f64 = 1e-9;
+
+/// `T⁻¹` for a square `t` whose Frobenius condition number `κ_F = ‖T‖_F ‖T⁻¹‖_F` is below
+/// `1/RELATIVE`: it bounds the spectral one (`κ₂ ≤ κ_F ≤ dof · κ₂`), so every `T` accepted
+/// is one [`chosen_inverse`]'s rank test accepts; from the inverse itself, without a
+/// singular value decomposition. `None` leaves the decision to [`chosen_inverse`].
+fn well_conditioned_inverse(t: &DMatrix<f64>) -> Option<DMatrix<f64>> {
+    let m = t.clone().try_inverse()?;
+    (RELATIVE * (t.norm() * m.norm()) < 1.0).then_some(m)
+}
+
+/// `T_I⁻¹` for the `dof` rows of `t` chosen (the selectable ones, `selectable`) by pivoted
+/// Gram–Schmidt on an orthonormal basis of `T`'s range (module docs); `None` where `T`'s
+/// rank (singular values above `RELATIVE` times the largest) is below `dof`.
+fn chosen_inverse(t: &DMatrix<f64>, selectable: &[bool]) -> Option<DMatrix<f64>> {
+    let (rows, dof) = t.shape();
+    let svd = super::eigen::svd(t.clone(), true, false)?;
+    let top = svd.singular_values.max();
+    let kept: Vec<usize> = (0..svd.singular_values.len())
+        .filter(|&k| svd.singular_values[k] > RELATIVE * top)
+        .collect();
+    if kept.len() < dof || top <= 0.0 {
+        return None;
+    }
+    // An orthonormal basis of T's range, then the rows with the most independent motion.
+    let u = svd.u.as_ref()?;
+    let mut basis = DMatrix::from_fn(rows, dof, |r, c| u[(r, kept[c])]);
+    let mut chosen = Vec::with_capacity(dof);
+    for _ in 0..dof {
+        let (best, norm) = (0..rows)
+            .filter(|&r| selectable[r] && !chosen.contains(&r))
+            .map(|r| (r, basis.row(r).norm()))
+            .fold((usize::MAX, 0.0), |a, b| {
+                if b.1 > a.1 * (1.0 + 1e-9) {
+                    b
+                } else {
+                    a
+                }
+            });
+        if best == usize::MAX || norm <= 1e-9 {
+            return None;
+        }
+        chosen.push(best);
+        let pivot = basis.row(best).transpose() / norm;
+        for r in 0..rows {
+            let d = basis.row(r).dot(&pivot.transpose());
+            let mut row = basis.row_mut(r);
+            row -= pivot.transpose() * d;
+        }
+    }
+    chosen.sort_unstable();
+    DMatrix::from_fn(dof, dof, |r, c| t[(chosen[r], c)]).try_inverse()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `T` (`dof × dof`) with half its singular values 1 and half `1/condition` (`κ₂` =
+    /// `condition`, `κ_F = (dof/2) κ₂`): `U diag(σ) Vᵀ`, `U` and `V` orthogonal from QR of
+    /// pseudo-random matrices.
+    fn conditioned(dof: usize, condition: f64, seed: u64) -> DMatrix<f64> {
+        let mut lcg = crate::lcg::Lcg::new(seed);
+        let mut r = || lcg.signed();
+        let u = DMatrix::from_fn(dof, dof, |_, _| r()).qr().q();
+        let v = DMatrix::from_fn(dof, dof, |_, _| r()).qr().q();
+        let s = DVector::from_fn(dof, |i, _| if 2 * i < dof { 1.0 } else { 1.0 / condition });
+        u * DMatrix::from_diagonal(&s) * v.transpose()
+    }
+
+    /// The inverse without a singular value decomposition equals the general path's (every
+    /// row chosen) to rounding where `T` is well conditioned; where `κ_F` is above `10⁹` but
+    /// `κ₂` below, it declines and the general path accepts (the decision stays the general
+    /// path's); where `κ₂` is above `10⁹`, both decline.
+    #[test]
+    fn the_inverse_without_svd_decides_as_the_singular_values() {
+        let dof = 20;
+        let all = vec![true; dof];
+        for (seed, condition) in [(1, 1.0), (2, 1e3), (3, 1e6)] {
+            let t = conditioned(dof, condition, seed);
+            let fast = well_conditioned_inverse(&t).expect("well conditioned");
+            let general = chosen_inverse(&t, &all).expect("full rank");
+            let err = (&fast - &general).amax() / general.amax();
+            assert!(
+                err < 1e-12 * condition,
+                "κ {condition}: inverses differ by {err:e}"
+            );
+        }
+        // κ₂ = 5·10⁸ < 10⁹ < κ_F = 5·10⁹.
+        let t = conditioned(dof, 5e8, 4);
+        assert!(well_conditioned_inverse(&t).is_none());
+        assert!(chosen_inverse(&t, &all).is_some());
+        let t = conditioned(dof, 1e11, 5);
+        assert!(well_conditioned_inverse(&t).is_none());
+        assert!(chosen_inverse(&t, &all).is_none());
+    }
 }

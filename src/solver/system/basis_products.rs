@@ -23,10 +23,29 @@ use nalgebra::DMatrix;
 pub(super) struct Pattern {
     /// Per column, whether each body block (7 rows) holds a nonzero.
     bodies: Vec<bool>,
-    /// Per column, the whole chunks of 8 rows that hold a nonzero (chunk numbers), in order.
-    chunks: Vec<Vec<u32>>,
+    /// The whole chunks of 8 rows that hold a nonzero (chunk numbers), column after column,
+    /// in order; column `j`'s are `chunks[starts[j]..starts[j + 1]]`.
+    chunks: Vec<u32>,
+    starts: Vec<usize>,
     /// Whether every entry of `Z` is finite.
     finite: bool,
+}
+
+/// The exponent bits of an `f64`: all set for an infinity or a NaN only.
+const EXPONENT: u64 = 0x7ff0_0000_0000_0000;
+
+/// Whether some entry of `values` is nonzero (`±0` both zero): an OR of the bits without the
+/// sign, no branch per entry.
+fn any_nonzero(values: &[f64]) -> bool {
+    values.iter().fold(0u64, |a, v| a | (v.to_bits() << 1)) != 0
+}
+
+/// Whether every entry of `values` is finite (no exponent all ones).
+fn all_finite(values: &[f64]) -> bool {
+    values
+        .iter()
+        .fold(0u64, |a, v| a.max(v.to_bits() & EXPONENT))
+        != EXPONENT
 }
 
 impl Pattern {
@@ -35,27 +54,33 @@ impl Pattern {
         let n = z.nrows();
         let blocks = n / 7;
         let mut bodies = vec![false; blocks * z.ncols()];
-        let mut chunks = Vec::with_capacity(z.ncols());
+        let mut chunks = Vec::with_capacity(z.ncols() * (n / 8));
+        let mut starts = Vec::with_capacity(z.ncols() + 1);
         let mut finite = true;
         for (j, col) in z.as_slice().chunks_exact(n.max(1)).enumerate() {
             for (b, blk) in col.chunks_exact(7).enumerate() {
-                bodies[j * blocks + b] = blk.iter().any(|&v| v != 0.0);
+                bodies[j * blocks + b] = any_nonzero(blk);
             }
-            finite &= col.iter().all(|v| v.is_finite());
-            let whole = col.chunks_exact(8);
-            chunks.push(
-                whole
-                    .enumerate()
-                    .filter(|(_, c)| c.iter().any(|&v| v != 0.0))
-                    .map(|(k, _)| k as u32)
-                    .collect(),
-            );
+            finite &= all_finite(col);
+            starts.push(chunks.len());
+            for (k, c) in col.chunks_exact(8).enumerate() {
+                if any_nonzero(c) {
+                    chunks.push(k as u32);
+                }
+            }
         }
+        starts.push(chunks.len());
         Pattern {
             bodies,
             chunks,
+            starts,
             finite,
         }
+    }
+
+    /// Column `j`'s whole chunks of 8 rows that hold a nonzero.
+    fn chunks_of(&self, j: usize) -> &[u32] {
+        &self.chunks[self.starts[j]..self.starts[j + 1]]
     }
 }
 
@@ -103,9 +128,9 @@ pub(super) fn tr_mul(z: &DMatrix<f64>, wz: &DMatrix<f64>, pattern: &Pattern) -> 
         .enumerate()
         .all(|(j, col)| {
             for (c, chunk) in col.chunks_exact(8).enumerate() {
-                used[j * whole + c] = chunk.iter().any(|&v| v != 0.0);
+                used[j * whole + c] = any_nonzero(chunk);
             }
-            col.iter().all(|v| v.is_finite())
+            all_finite(col)
         });
     if !pattern.finite || !finite {
         return z.tr_mul(wz);
@@ -116,7 +141,7 @@ pub(super) fn tr_mul(z: &DMatrix<f64>, wz: &DMatrix<f64>, pattern: &Pattern) -> 
         for (j, wj) in wz.as_slice().chunks_exact(n).enumerate() {
             let mut acc = [0.0f64; 8];
             let used = &used[j * whole..(j + 1) * whole];
-            for &c in pattern.chunks[i].iter().filter(|&&c| used[c as usize]) {
+            for &c in pattern.chunks_of(i).iter().filter(|&&c| used[c as usize]) {
                 let k = 8 * c as usize;
                 let (a, b) = (&zi[k..k + 8], &wj[k..k + 8]);
                 for l in 0..8 {

@@ -368,7 +368,7 @@ impl System<'_> {
             let w = self.lagrangian_hessian(q, part, eval);
             (z.transpose() * w * &z, keep.then_some(z))
         };
-        ((&hr + hr.transpose()) * 0.5, basis)
+        (symmetric_part(hr), basis)
     }
 
     /// `Zᵀ W Z x` with the `W` of the last block assembly (sparse path).
@@ -383,6 +383,21 @@ impl System<'_> {
         self.work.hess.mul_add(zx.as_slice(), wzx.as_mut_slice());
         self.tangent_transpose(part, eval, &wzx)
     }
+}
+
+/// `(A + Aᵀ) / 2` of a square `a`, in place: each entry `(a_ij + a_ji) · 0.5`, the
+/// operations of `(&a + a.transpose()) * 0.5` (an IEEE sum is commutative) without its two
+/// temporaries.
+fn symmetric_part(mut a: DMatrix<f64>) -> DMatrix<f64> {
+    let n = a.nrows();
+    for j in 0..n {
+        for i in 0..=j {
+            let s = (a[(i, j)] + a[(j, i)]) * 0.5;
+            a[(i, j)] = s;
+            a[(j, i)] = s;
+        }
+    }
+    a
 }
 
 /// `v` as `len` zeros, in place when it has that length already.

@@ -183,13 +183,14 @@ impl Constraints {
             .is_some_and(|k| matches!(self.blocks[k].kind, BlockKind::Normalization(_)))
     }
 
-    /// Evaluates each block's rows and hands them to `visit(row, term)`.
+    /// Evaluates each block's rows and hands them to `visit(row, term)`; with `weights`, not
+    /// a stop or contact whose rows all weigh 0 (`Σ w_i ∇²Φ_i` reads nothing of them).
     fn for_each_row(
         &self,
         model: &Model,
         q: &DVector<f64>,
         hess: bool,
-        values_only: bool,
+        (values_only, weights): (bool, Option<&DVector<f64>>),
         mut visit: impl FnMut(usize, Term),
     ) {
         let mut buf = Vec::with_capacity(6);
@@ -225,6 +226,13 @@ impl Constraints {
                     }
                 }
                 BlockKind::Unilateral(a) => {
+                    let unweighted = |w: &DVector<f64>| {
+                        let rows = w.rows(block.first, a.row_count());
+                        rows.iter().all(|&x| x == 0.0)
+                    };
+                    if weights.is_some_and(unweighted) {
+                        continue;
+                    }
                     let bodies = unilateral::bodies(model, &a.row);
                     let pair = pair_of(&bodies, q, hess);
                     if values_only {
@@ -337,7 +345,7 @@ impl Constraints {
                 }
             }
         }
-        let values_only = jac.is_none();
+        let values_only = (jac.is_none(), None);
         self.for_each_row(model, q, false, values_only, |row, term| match term {
             Term::Jet(bodies, s, c, pattern) => {
                 push(
@@ -396,7 +404,7 @@ impl Constraints {
         h: &mut dyn HessianSink,
     ) {
         let mut sum = PairSum::new();
-        self.for_each_row(model, q, true, false, |row, term| match term {
+        self.for_each_row(model, q, true, (false, Some(w)), |row, term| match term {
             Term::Jet(bodies, s, c, _) => {
                 if w[row] != 0.0 {
                     sum.of(bodies, h);

@@ -258,28 +258,6 @@ pub(crate) fn solve_round(
     let mut diagnostics = out.diagnostics;
     diagnostics.linear_algebra = sys.backend.name().into();
     let stability_started = std::time::Instant::now();
-    // A round stopped by an inequality is not a rest pose: the active-set iteration goes on
-    // from it (and judges stability itself if it ends there).
-    // Where the minimizer judged by the KKT inertia (many degrees of freedom), that verdict,
-    // unless eigenvalues are asked for (module `stability::at_rest`): then the spectrum, with
-    // that verdict's `λ_max` (the same estimate at the same point).
-    let stability = (dof > 0 && out.blocked.is_none() && out.released.is_empty()).then(|| {
-        if let (Some(judged), false) = (out.inertia, options.eigenvalues) {
-            diagnostics.eigenvalues_by = "inertia".into();
-            return Stability {
-                verdict: judged.verdict,
-                tolerance: judged.tolerance,
-                eigenvalues: Vec::new(),
-                modes: Vec::new(),
-            };
-        }
-        let largest = out.inertia.map(|judged| judged.largest);
-        let eig = out.eigen.clone().unwrap_or_else(|| {
-            spectrum::spectrum_knowing(&mut sys, &out.q, &out.part, &out.eval, largest)
-        });
-        diagnostics.eigenvalues_by = if eig.exact { "exact" } else { "lanczos" }.into();
-        verdict::from_spectrum(&sys, &out.q, &out.part, &out.eval, &eig)
-    });
     let mut mu = DVector::zeros(sys.problem.cons.len());
     for (k, &row) in out.part.rows.iter().enumerate() {
         mu[row] = out.eval.mu[k];
@@ -287,7 +265,7 @@ pub(crate) fn solve_round(
     let mut chosen = None;
     // The distribution among redundant stops and contacts, at a rest pose only: a round
     // stopped by an inequality (blocked) or before it was stationary (released) is not one,
-    // and the active-set iteration goes on from it (as for the stability verdict above).
+    // and the active-set iteration goes on from it (as for the stability verdict below).
     if !active.is_empty()
         && !out.part.redundant.is_empty()
         && out.released.is_empty()
@@ -303,8 +281,36 @@ pub(crate) fn solve_round(
             options,
         );
     }
-    let reactions = reactions::reactions(&sys, &out.q, &mu);
     let multipliers = active_set::active_multipliers(&sys.problem.cons, &mu);
+    // A round stopped by an inequality is not a rest pose: the active-set iteration goes on
+    // from it (and judges stability itself if it ends there).
+    // Where the minimizer judged by the KKT inertia (many degrees of freedom), that verdict,
+    // unless eigenvalues are asked for (module `stability::at_rest`): then the spectrum, with
+    // that verdict's `λ_max` (the same estimate at the same point).
+    let stability = (dof > 0 && out.blocked.is_none() && out.released.is_empty()).then(|| {
+        if let (Some(judged), false) = (out.inertia, options.eigenvalues) {
+            diagnostics.eigenvalues_by = "inertia".into();
+            return Some(Stability {
+                verdict: judged.verdict,
+                tolerance: judged.tolerance,
+                eigenvalues: Vec::new(),
+                modes: Vec::new(),
+            });
+        }
+        let largest = out.inertia.map(|judged| judged.largest);
+        let eig = out.eigen.clone().unwrap_or_else(|| {
+            spectrum::spectrum_knowing(&mut sys, &out.q, &out.part, &out.eval, largest)
+        });
+        diagnostics.eigenvalues_by = if eig.exact { "exact" } else { "lanczos" }.into();
+        // A converged round whose verdict the active set will not use (every active row a
+        // stop, more than `MAX_WEAK` of them touching without a force:
+        // `Release::needs_verdict`) labels how its spectrum was taken and forms no verdict.
+        let needed = out.termination != Termination::Converged
+            || release.is_none_or(|r| r.needs_verdict(&multipliers));
+        needed.then(|| verdict::from_spectrum(&sys, &out.q, &out.part, &out.eval, &eig))
+    });
+    let stability = stability.flatten();
+    let reactions = reactions::reactions(&sys, &out.q, &mu);
     let blocked = out.blocked;
     let released = out.released;
     let carry = out.carry;

@@ -240,7 +240,8 @@ pub(crate) fn solve(
         let release = super::release::Release::new(model, &active, &not_early, threshold)
             .holding_patch_neighbours(&active)
             .starting_with(prior.first)
-            .carrying(carry.take());
+            .carrying(carry.take())
+            .cycling(changes - initial >= options.max_iterations);
         let round = crate::solver::solve_round(
             model,
             crate::State { q, branches },

@@ -144,6 +144,10 @@ pub(crate) struct Release<'m> {
     first: Option<super::release_trial::First>,
     /// The end of the last round's step cut at a rolling hull's next vertex (module `roll_on`).
     carry: Option<nalgebra::DVector<f64>>,
+    /// Every active inequality is a stop and the solve is not cycling: a converged round is
+    /// either left for the next one or, at the end, judged on the critical cone
+    /// ([`Release::needs_verdict`]).
+    judged_on_cone: bool,
 }
 
 impl<'m> Release<'m> {
@@ -175,7 +179,33 @@ impl<'m> Release<'m> {
             stall: super::stall::Stall::new(model, active),
             first: None,
             carry: None,
+            judged_on_cone: active
+                .iter()
+                .all(|a| matches!(a.row, Unilateral::Limit { .. })),
         }
+    }
+
+    /// The test of a round after which the solve reports cycling (`cycling`) if it ends: its
+    /// own verdict is then the reported one.
+    pub(crate) fn cycling(mut self, cycling: bool) -> Self {
+        self.judged_on_cone &= !cycling;
+        self
+    }
+
+    /// Whether a round that converged with the active rows' `multipliers` needs its own
+    /// verdict, on the tangent space of every active row held: not where every active row is
+    /// a stop and more than `MAX_WEAK` of them touch without a force
+    /// (`stability::cone::ignores_all_held`). The active set either goes on from that round
+    /// (its verdict unused) or ends there without cycling, and then judges the rest on the
+    /// strong rows' tangent space alone (module `active_set`, `stability_verdict_after_round`);
+    /// with a contact a sticking sphere may be re-anchored instead, and the round's verdict
+    /// reported.
+    pub(crate) fn needs_verdict(&self, multipliers: &[(Active, Vec<f64>)]) -> bool {
+        if !self.judged_on_cone {
+            return true;
+        }
+        let (strong, weak) = super::active_set::split(self.model, multipliers, self.threshold);
+        !crate::solver::stability::cone::ignores_all_held(&strong, &weak)
     }
 
     /// The test with the round's first direction `first` (module `release_trial`).
@@ -372,3 +402,7 @@ mod tests {
         assert!(!r.met(&[row], 10.0, 1.0));
     }
 }
+
+#[cfg(test)]
+#[path = "release_verdict_tests.rs"]
+mod verdict_tests;

@@ -200,6 +200,14 @@ pub(crate) fn stability_touching(
     })
 }
 
+/// Whether [`stability_touching`] judges `strong` and `weak` without `all_held`: more than
+/// [`MAX_WEAK`] weak rows are left once the stops whose other stop touches too are held
+/// (Romeo's 24 fingers), and the verdict is the strong rows' alone. An active-set round that
+/// ends there need not judge the tangent space of all its rows.
+pub(crate) fn ignores_all_held(strong: &[Active], weak: &[Active]) -> bool {
+    both_stops_held(strong, weak).1.len() > MAX_WEAK
+}
+
 /// A joint whose two stops both touch without a force (a `[l, l]` range: urdfdom's reading of
 /// a `<limit>` without bounds, as on pybullet_data's minitaur knees) is held both ways:
 /// `a · d ≥ 0` and `−a · d ≥ 0` leave `a · d = 0`, which one of its stops held as a row says

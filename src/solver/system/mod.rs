@@ -31,6 +31,8 @@ pub(crate) mod residual;
 #[cfg(test)]
 mod tests;
 mod workspace;
+#[cfg(test)]
+mod zero_weight_tests;
 
 pub(crate) use backend::Backend;
 pub(crate) use base::System;

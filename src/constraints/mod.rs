@@ -14,7 +14,7 @@ use crate::jet::{closed, pair_of, HessianSink, Scalar};
 use crate::joint::{Pattern, ALL};
 use crate::kinematics::{coordinate, Branches};
 use crate::model::{BodyId, JointId, Model};
-use nalgebra::DVector;
+use nalgebra::{DVector, Matrix3};
 use pair_sum::PairSum;
 pub(crate) use triplets::Triplets;
 
@@ -50,8 +50,12 @@ enum Term<'a> {
     Jet(&'a [Option<BodyId>; 2], &'a Scalar, f64, Pattern),
     Normalization(BodyId),
     /// The rows of a joint with closed-form derivatives ([`crate::jet::closed`]), from
-    /// `row` on.
-    Closed(&'a crate::model::Joint, &'a crate::jet::Pair),
+    /// `row` on, with the rotations they are formed from.
+    Closed(
+        &'a crate::model::Joint,
+        &'a crate::jet::Pair,
+        &'a closed::JointRotations<'a>,
+    ),
     /// A row's value alone (the rows of stops and contacts when only `Φ` is asked for).
     Value(f64),
 }
@@ -69,6 +73,9 @@ pub(crate) struct Constraints {
     /// Joint rows by their closed-form derivatives where one exists (else by the generic
     /// jets, the reference the closed forms are tested against).
     pub(crate) closed_form: bool,
+    /// `R_k` of each joint's frames ([`closed::frame_rotations`]), by joint: formed once, not
+    /// at every evaluation of the joint's rows.
+    frame_rotations: Vec<[Matrix3<f64>; 2]>,
 }
 
 impl Constraints {
@@ -114,6 +121,7 @@ impl Constraints {
             length_power,
             branches: Branches::default(),
             closed_form: true,
+            frame_rotations: model.joints.iter().map(closed::frame_rotations).collect(),
         }
     }
 
@@ -194,13 +202,26 @@ impl Constraints {
     ) {
         let mut buf = Vec::with_capacity(6);
         let mut values = [0.0; 3];
+        // `A(p)` of every body once (the closed-form rows of a chain read each body's twice),
+        // the identity for the ground, as `pair_of` gives it.
+        let a = if self.closed_form {
+            crate::jet::body_rotations(q)
+        } else {
+            Vec::new()
+        };
+        let ground = crate::jet::ground_rotation();
+        let side = |b: Option<BodyId>| b.map_or(&ground, |b| &a[b.0]);
         for block in &self.blocks {
             match &block.kind {
                 BlockKind::Joint(id) => {
                     let j = &model.joints[id.0];
                     let pair = pair_of(&j.bodies, q, hess);
                     if self.closed_form && crate::jet::closed::supports(j) {
-                        visit(block.first, Term::Closed(j, &pair));
+                        let rots = closed::JointRotations {
+                            a: [side(j.bodies[0]), side(j.bodies[1])],
+                            r: &self.frame_rotations[id.0],
+                        };
+                        visit(block.first, Term::Closed(j, &pair, &rots));
                         continue;
                     }
                     joint::rows(j, &pair, self.branches.get(*id, 0), &mut buf);
@@ -352,15 +373,15 @@ impl Constraints {
             }
             // `push`'s `phi[row] += 1.0 · v`.
             Term::Value(v) => phi[row] += 1.0 * v,
-            Term::Closed(j, pair) if jac.is_none() => {
-                crate::jet::closed::values(j, pair, &mut closed_values);
+            Term::Closed(j, pair, rots) if jac.is_none() => {
+                crate::jet::closed::values(j, pair, rots, &mut closed_values);
                 for (k, v) in closed_values.iter().enumerate() {
                     phi[row + k] += v;
                 }
             }
-            Term::Closed(j, pair) => {
+            Term::Closed(j, pair, rots) => {
                 let layout = j.kind.spec().rows;
-                crate::jet::closed::rows_each(j, pair, |k, v, g| {
+                crate::jet::closed::rows_each(j, pair, rots, |k, v, g| {
                     let pattern = layout[k].pattern();
                     push(
                         phi,
@@ -405,14 +426,14 @@ impl Constraints {
                     }
                 }
             }
-            Term::Closed(j, pair) => {
+            Term::Closed(j, pair, rots) => {
                 let ws = &w.as_slice()[row..row + joint::row_count(j)];
                 if ws.iter().any(|&x| x != 0.0) {
                     match sum.of(&j.bodies, h) {
                         Some(hp) if closed::euler::euler_only(j) => {
-                            closed::euler::add_weighted_hessian_euler(j, pair, ws, hp);
+                            closed::euler::add_weighted_hessian_euler(j, pair, rots, ws, hp);
                         }
-                        _ => closed::add_weighted_hessian(j, pair, ws, sum.full()),
+                        _ => closed::add_weighted_hessian(j, pair, rots, ws, sum.full()),
                     }
                 }
             }

@@ -3,6 +3,7 @@
 use super::*;
 use crate::jet::testing::{check_scalar, sample_pair};
 use crate::jet::{hess_or_zero, Vec3Jet};
+use crate::math::rotation;
 
 /// Values and gradients of the rows of `joint` into `out` (cleared first; no Hessians): those
 /// of [`super::rows_each`].

@@ -364,6 +364,20 @@ pub(crate) fn pair_of(
     Pair { r, p, hess }
 }
 
+/// `A(p)` of every body at `q` (7 coordinates a body), formed once for all the terms that
+/// read a body's: the same numbers as [`rotation`] of the `p` that [`pair_of`] reads.
+pub(crate) fn body_rotations(q: &nalgebra::DVector<f64>) -> Vec<Matrix3<f64>> {
+    q.as_slice()
+        .chunks_exact(7)
+        .map(|x| rotation(&Vector4::new(x[3], x[4], x[5], x[6])))
+        .collect()
+}
+
+/// `A(p)` of a ground side: of the identity `p` that [`pair_of`] gives it.
+pub(crate) fn ground_rotation() -> Matrix3<f64> {
+    rotation(&Vector4::new(1.0, 0.0, 0.0, 0.0))
+}
+
 /// Global coordinate index of local coordinate `i` (`None` on a ground side).
 pub(crate) fn global_index(bodies: &[Option<crate::model::BodyId>; 2], i: usize) -> Option<usize> {
     bodies[i / 7].map(|b| 7 * b.0 + i % 7)

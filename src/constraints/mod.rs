@@ -14,7 +14,7 @@ use crate::jet::{closed, pair_of, HessianSink, Scalar};
 use crate::joint::{Pattern, ALL};
 use crate::kinematics::{coordinate, Branches};
 use crate::model::{BodyId, JointId, Model};
-use nalgebra::DVector;
+use nalgebra::{DVector, Matrix3};
 use pair_sum::PairSum;
 pub(crate) use triplets::Triplets;
 
@@ -50,8 +50,12 @@ enum Term<'a> {
     Jet(&'a [Option<BodyId>; 2], &'a Scalar, f64, Pattern),
     Normalization(BodyId),
     /// The rows of a joint with closed-form derivatives ([`crate::jet::closed`]), from
-    /// `row` on.
-    Closed(&'a crate::model::Joint, &'a crate::jet::Pair),
+    /// `row` on, with the rotations they are formed from.
+    Closed(
+        &'a crate::model::Joint,
+        &'a crate::jet::Pair,
+        &'a closed::JointRotations<'a>,
+    ),
     /// A row's value alone (the rows of stops and contacts when only `Φ` is asked for).
     Value(f64),
 }
@@ -69,6 +73,9 @@ pub(crate) struct Constraints {
     /// Joint rows by their closed-form derivatives where one exists (else by the generic
     /// jets, the reference the closed forms are tested against).
     pub(crate) closed_form: bool,
+    /// `R_k` of each joint's frames ([`closed::frame_rotations`]), by joint: formed once, not
+    /// at every evaluation of the joint's rows.
+    frame_rotations: Vec<[Matrix3<f64>; 2]>,
 }
 
 impl Constraints {
@@ -114,6 +121,7 @@ impl Constraints {
             length_power,
             branches: Branches::default(),
             closed_form: true,
+            frame_rotations: model.joints.iter().map(closed::frame_rotations).collect(),
         }
     }
 
@@ -195,13 +203,26 @@ impl Constraints {
     ) {
         let mut buf = Vec::with_capacity(6);
         let mut values = [0.0; 3];
+        // `A(p)` of every body once (the closed-form rows of a chain read each body's twice),
+        // the identity for the ground, as `pair_of` gives it.
+        let a = if self.closed_form {
+            crate::jet::body_rotations(q)
+        } else {
+            Vec::new()
+        };
+        let ground = crate::jet::ground_rotation();
+        let side = |b: Option<BodyId>| b.map_or(&ground, |b| &a[b.0]);
         for block in &self.blocks {
             match &block.kind {
                 BlockKind::Joint(id) => {
                     let j = &model.joints[id.0];
                     let pair = pair_of(&j.bodies, q, hess);
                     if self.closed_form && crate::jet::closed::supports(j) {
-                        visit(block.first, Term::Closed(j, &pair));
+                        let rots = closed::JointRotations {
+                            a: [side(j.bodies[0]), side(j.bodies[1])],
+                            r: &self.frame_rotations[id.0],
+                        };
+                        visit(block.first, Term::Closed(j, &pair, &rots));
                         continue;
                     }
                     joint::rows(j, &pair, self.branches.get(*id, 0), &mut buf);
@@ -360,15 +381,15 @@ impl Constraints {
             }
             // `push`'s `phi[row] += 1.0 · v`.
             Term::Value(v) => phi[row] += 1.0 * v,
-            Term::Closed(j, pair) if jac.is_none() => {
-                crate::jet::closed::values(j, pair, &mut closed_values);
+            Term::Closed(j, pair, rots) if jac.is_none() => {
+                crate::jet::closed::values(j, pair, rots, &mut closed_values);
                 for (k, v) in closed_values.iter().enumerate() {
                     phi[row + k] += v;
                 }
             }
-            Term::Closed(j, pair) => {
+            Term::Closed(j, pair, rots) => {
                 let layout = j.kind.spec().rows;
-                crate::jet::closed::rows_each(j, pair, |k, v, g| {
+                crate::jet::closed::rows_each(j, pair, rots, |k, v, g| {
                     let pattern = layout[k].pattern();
                     push(
                         phi,
@@ -413,14 +434,14 @@ impl Constraints {
                     }
                 }
             }
-            Term::Closed(j, pair) => {
+            Term::Closed(j, pair, rots) => {
                 let ws = &w.as_slice()[row..row + joint::row_count(j)];
                 if ws.iter().any(|&x| x != 0.0) {
                     match sum.of(&j.bodies, h) {
                         Some(hp) if closed::euler::euler_only(j) => {
-                            closed::euler::add_weighted_hessian_euler(j, pair, ws, hp);
+                            closed::euler::add_weighted_hessian_euler(j, pair, rots, ws, hp);
                         }
-                        _ => closed::add_weighted_hessian(j, pair, ws, sum.full()),
+                        _ => closed::add_weighted_hessian(j, pair, rots, ws, sum.full()),
                     }
                 }
             }
@@ -437,62 +458,4 @@ impl Constraints {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::unilateral::{Active, Bound, Unilateral};
-    use super::*;
-
-    /// Row names are made on demand from the blocks: every kind of row, with the names the
-    /// rows were given when they were stored (`joint.row`, `body.normalization`, …).
-    #[test]
-    fn row_names_follow_the_blocks() {
-        use crate::model::{JointKind, Mimic, ModelBuilder};
-        use nalgebra::{Isometry3, Matrix3, Vector3};
-        let mut b = ModelBuilder::new("r");
-        let inertia = Matrix3::identity();
-        let a = b.add_rigid_body("a", 1.0, Vector3::zeros(), inertia);
-        let c = b.add_rigid_body("b", 1.0, Vector3::zeros(), inertia);
-        let f = Isometry3::identity();
-        let j1 = b.add_joint("j1", JointKind::Revolute, None, f, Some(a), f);
-        let j2 = b.add_joint("j2", JointKind::Revolute, Some(a), f, Some(c), f);
-        b.set_limits(j1, -1.0, 1.0);
-        b.add_mimic(Mimic {
-            joint: j2,
-            reference: j1,
-            multiplier: 2.0,
-            offset: 0.0,
-        });
-        let model = b.build().unwrap();
-        let active = Active {
-            row: Unilateral::Limit {
-                joint: j1,
-                bound: Bound::Lower,
-                value: -1.0,
-            },
-            anchor: None,
-        };
-        let cons = Constraints::new(&model, &[(j1, 0, 0.5)]).with_active(&model, &[active]);
-        let names: Vec<String> = (0..cons.len()).map(|i| cons.row_name(&model, i)).collect();
-        let expected = [
-            "j1.pos_x",
-            "j1.pos_y",
-            "j1.pos_z",
-            "j1.axis_x",
-            "j1.axis_y",
-            "j2.pos_x",
-            "j2.pos_y",
-            "j2.pos_z",
-            "j2.axis_x",
-            "j2.axis_y",
-            "a.normalization",
-            "b.normalization",
-            "j1.lock[0]",
-            "j2.mimic",
-            "j1.lower_limit",
-        ];
-        assert_eq!(names, expected);
-        let normalization: Vec<usize> = (0..cons.len())
-            .filter(|&i| cons.is_normalization(i))
-            .collect();
-        assert_eq!(normalization, [10, 11]);
-    }
-}
+mod tests;

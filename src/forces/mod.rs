@@ -14,7 +14,7 @@ mod stacked;
 use crate::jet::{closed, pair_of, scatter, Pair, Scalar};
 use crate::kinematics::{coordinate, Branches};
 use crate::model::{BodyId, Model, SpringMode};
-use nalgebra::DVector;
+use nalgebra::{DVector, Matrix3};
 
 /// Potential energy split by source \[J\].
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
@@ -65,6 +65,10 @@ pub(crate) fn potential(
     hess: Option<&mut dyn crate::jet::HessianSink>,
 ) -> Option<Energy> {
     let want_h = hess.is_some();
+    // `A(p)` of every body once (gravity and the joint angles on each side read each body's),
+    // the identity for the ground, as `pair_of` gives it.
+    let (a, ground) = (crate::jet::body_rotations(q), crate::jet::ground_rotation());
+    let side = |b: Option<BodyId>| b.map_or(&ground, |b| &a[b.0]);
     let mut e = Energy::default();
     let mut add = Sum {
         magnitude: 0.0,
@@ -75,24 +79,22 @@ pub(crate) fn potential(
         if b.gravity_mass == 0.0 {
             continue;
         }
-        let bodies = [Some(BodyId(i)), None];
-        let pair = pair_of(&bodies, q, want_h);
         let w = -b.gravity_mass * model.gravity;
         let v = match add.derivatives() {
-            Some((g, h)) => stacked::weighted_point(&bodies, &pair, &b.gravity_com, &w, g, h),
+            Some((g, h)) => stacked::weighted_point(BodyId(i), q, &a[i], &b.gravity_com, &w, g, h),
             None => {
-                stacked::weighted_point_gradient(BodyId(i), &pair, &b.gravity_com, &w, add.grad)
+                stacked::weighted_point_gradient(BodyId(i), q, &a[i], &b.gravity_com, &w, add.grad)
             }
         };
         add.value(v, 1.0, &mut e.gravity);
     }
     for l in &model.loads {
-        let bodies = [Some(l.body), None];
-        let pair = pair_of(&bodies, q, want_h);
         let w = -l.force;
         let v = match add.derivatives() {
-            Some((g, h)) => stacked::weighted_point(&bodies, &pair, &l.point, &w, g, h),
-            None => stacked::weighted_point_gradient(l.body, &pair, &l.point, &w, add.grad),
+            Some((g, h)) => stacked::weighted_point(l.body, q, &a[l.body.0], &l.point, &w, g, h),
+            None => {
+                stacked::weighted_point_gradient(l.body, q, &a[l.body.0], &l.point, &w, add.grad)
+            }
         };
         add.value(v, 1.0, &mut e.loads);
     }
@@ -116,10 +118,11 @@ pub(crate) fn potential(
     for js in &model.joint_springs {
         let j = &model.joints[js.joint.0];
         let pair = pair_of(&j.bodies, q, want_h);
+        let rot = [side(j.bodies[0]), side(j.bodies[1])];
         let reference = branches.get(js.joint, js.dof);
         if let Some(((g, h), theta)) = add
             .derivatives()
-            .and_then(|d| stacked_angle(j, &pair, js.dof).map(|t| (d, t)))
+            .and_then(|d| stacked_angle(j, &pair, rot, js.dof).map(|t| (d, t)))
         {
             let v = on_branch(theta.v, reference);
             let (u, f, k) = law::evaluate(&js.law, SpringMode::Both, v - js.reference)?;
@@ -127,7 +130,7 @@ pub(crate) fn potential(
             add.value(u, 1.0, &mut e.joint_springs);
             continue;
         }
-        if let Some((theta, grad)) = revolute_angle(j, &pair, js.dof).filter(|_| !want_h) {
+        if let Some((theta, grad)) = revolute_angle(j, &pair, rot, js.dof).filter(|_| !want_h) {
             let v = on_branch(theta, reference);
             let (u, f, _) = law::evaluate(&js.law, SpringMode::Both, v - js.reference)?;
             // `Scalar::compose`'s gradient `f ∇θ`, added with `c = 1`.
@@ -147,17 +150,18 @@ pub(crate) fn potential(
     for ef in &model.efforts {
         let j = &model.joints[ef.joint.0];
         let pair = pair_of(&j.bodies, q, want_h);
+        let rot = [side(j.bodies[0]), side(j.bodies[1])];
         let reference = branches.get(ef.joint, ef.dof);
         if let Some(((g, h), theta)) = add
             .derivatives()
-            .and_then(|d| stacked_angle(j, &pair, ef.dof).map(|t| (d, t)))
+            .and_then(|d| stacked_angle(j, &pair, rot, ef.dof).map(|t| (d, t)))
         {
             let v = on_branch(theta.v, reference);
             stacked::scatter_angle(&j.bodies, &theta, None, -ef.value, g, h);
             add.value(v, -ef.value, &mut e.loads);
             continue;
         }
-        if let Some((theta, grad)) = revolute_angle(j, &pair, ef.dof).filter(|_| !want_h) {
+        if let Some((theta, grad)) = revolute_angle(j, &pair, rot, ef.dof).filter(|_| !want_h) {
             let v = on_branch(theta, reference);
             stacked::scatter_gradient(&j.bodies, &grad, -ef.value, add.grad);
             add.value(v, -ef.value, &mut e.loads);
@@ -202,13 +206,18 @@ impl<'h> Sum<'_, 'h> {
 
 /// A revolute angle (`dof` 0 of a revolute or continuous joint) with its Hessian on the stack
 /// (module `stacked`), `None` for any other coordinate.
-fn stacked_angle(joint: &crate::model::Joint, pair: &Pair, dof: usize) -> Option<stacked::Angle> {
+fn stacked_angle(
+    joint: &crate::model::Joint,
+    pair: &Pair,
+    a: [&Matrix3<f64>; 2],
+    dof: usize,
+) -> Option<stacked::Angle> {
     use crate::model::JointKind;
     matches!(
         (joint.kind, dof),
         (JointKind::Revolute | JointKind::Continuous, 0)
     )
-    .then(|| stacked::revolute_angle(joint, pair))
+    .then(|| stacked::revolute_angle(joint, pair, a))
 }
 
 /// A revolute angle (`dof` 0 of a revolute or continuous joint) and its gradient, without the
@@ -216,6 +225,7 @@ fn stacked_angle(joint: &crate::model::Joint, pair: &Pair, dof: usize) -> Option
 fn revolute_angle(
     joint: &crate::model::Joint,
     pair: &Pair,
+    a: [&Matrix3<f64>; 2],
     dof: usize,
 ) -> Option<(f64, crate::jet::LVec)> {
     use crate::model::JointKind;
@@ -223,7 +233,7 @@ fn revolute_angle(
         (joint.kind, dof),
         (JointKind::Revolute | JointKind::Continuous, 0)
     )
-    .then(|| stacked::revolute_angle_gradient(joint, pair))
+    .then(|| stacked::revolute_angle_gradient(joint, pair, a))
 }
 
 /// The angle `v` read on the branch `reference` ([`crate::kinematics::on_branch`]).

@@ -19,11 +19,11 @@
 //! ([`revolute_angle_gradient`]), a weighted point by its side 0 alone
 //! ([`weighted_point_gradient`]); both to the last bit the generic path's.
 
-use crate::jet::closed::{linear_gradient, linear_hessian_euler, quadratic_form, Lin, Rotations};
+use crate::jet::closed::quadratic_form;
 use crate::jet::{HessianSink, LVec, Pair};
-use crate::math::{b_matrix, rotation};
+use crate::math::b_matrix;
 use crate::model::{BodyId, Joint};
-use nalgebra::{DVector, Matrix3x4, SMatrix, Vector3, Vector4};
+use nalgebra::{DVector, Matrix3, Matrix3x4, SMatrix, Vector3, Vector4};
 
 /// The Euler-parameter coordinates of a body pair (local indices).
 const P: [usize; 8] = crate::jet::EULER;
@@ -61,40 +61,48 @@ pub(crate) fn scatter_gradient(
     }
 }
 
-/// `wᵀ (r_k + A(p_k) s)` of side `k` with its gradient into `grad` and Hessian into `hess`
-/// (as the general `closed::weighted_point` and [`crate::jet::scatter`] with `c = 1`);
-/// returns the value.
+/// `wᵀ (r₀ + A(p₀) s)` of side 0 (the one `body`) with its gradient into `grad` and Hessian
+/// into `hess` (as the general `closed::weighted_point` and [`crate::jet::scatter`] with
+/// `c = 1`: the value and gradient by [`weighted_point_gradient`], the Hessian `2 M(s, w)` on
+/// `p₀ p₀` added to zeros as `linear_hessian_euler` adds it); returns the value. Nothing is
+/// formed for the empty side 1.
 pub(crate) fn weighted_point(
-    bodies: &[Option<BodyId>; 2],
-    pair: &Pair,
+    body: BodyId,
+    q: &DVector<f64>,
+    a0: &Matrix3<f64>,
     s: &Vector3<f64>,
     w: &Vector3<f64>,
     grad: &mut DVector<f64>,
     hess: &mut dyn HessianSink,
 ) -> f64 {
-    let rot = Rotations::of(pair);
-    let p = Lin::point(pair, &rot, 0, s);
-    let mut g = LVec::zeros();
-    linear_gradient(&p, w, &mut g);
+    let v = weighted_point_gradient(body, q, a0, s, w, grad);
+    let m = quadratic_form(s, w) * 2.0;
     let mut h = SMatrix::<f64, 8, 8>::zeros();
-    linear_hessian_euler(&p, w, &mut h);
-    scatter(bodies, &g, &h, 1.0, grad, hess);
-    w.dot(&p.v)
+    for i in 0..4 {
+        for j in 0..4 {
+            h[(i, j)] += m[(i, j)];
+        }
+    }
+    hess.add_euler_block(&[Some(body), None], &h, 1.0);
+    v
 }
 
 /// `wᵀ (r₀ + A(p₀) s)` of side 0 (the one `body`) with its gradient added into `grad`, without
 /// the Hessian: the general `closed::weighted_point` and [`crate::jet::scatter`] with `c = 1`
-/// to the last bit (the same operations on side 0; nothing formed for the empty side 1);
+/// to the last bit (the same operations on side 0; nothing formed for the empty side 1),
+/// with `a0 = A(p₀)` and `r₀`, `p₀` read from `q` (as [`crate::jet::pair_of`] reads them);
 /// returns the value.
 pub(crate) fn weighted_point_gradient(
     body: BodyId,
-    pair: &Pair,
+    q: &DVector<f64>,
+    a0: &Matrix3<f64>,
     s: &Vector3<f64>,
     w: &Vector3<f64>,
     grad: &mut DVector<f64>,
 ) -> f64 {
-    let v = rotation(&pair.p[0]) * s + pair.r[0];
-    let gp = b_matrix(&pair.p[0], s).tr_mul(w);
+    let x = &q.as_slice()[7 * body.0..7 * body.0 + 7];
+    let v = a0 * s + Vector3::new(x[0], x[1], x[2]);
+    let gp = b_matrix(&Vector4::new(x[3], x[4], x[5], x[6]), s).tr_mul(w);
     let out = &mut grad.as_mut_slice()[7 * body.0..7 * body.0 + 7];
     // `linear_gradient` into zeros (`t = 1` on the position), then `scatter`'s `1 · g`.
     for i in 0..3 {
@@ -124,7 +132,7 @@ pub(crate) struct Angle {
 /// with `∇²(w · x₁)` as [`crate::jet::closed::dot_hessian_euler`] forms it: `B_wᵀ B_x₁` on
 /// the `p₀ p₁` block (and its transpose), `2 M(ŵ, x₁)` on `p₀ p₀`, `2 M(x̂₁, w)` on `p₁ p₁`.
 /// One dot-product Hessian instead of two, no division per entry.
-pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair) -> Angle {
+pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair, a: [&Matrix3<f64>; 2]) -> Angle {
     let FirstOrder {
         v,
         g: n,
@@ -142,7 +150,7 @@ pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair) -> Angle {
         s,
         c,
         rho,
-    } = first_order(joint, pair);
+    } = first_order(joint, pair, a);
     let (cr, sr) = (c / rho, s / rho);
     let (wb, w, bw) = (by0 * cr - bx0 * sr, y0 * cr - x0 * sr, b0y * cr - b0x * sr);
     let mut h = SMatrix::<f64, 8, 8>::zeros();
@@ -168,8 +176,12 @@ pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair) -> Angle {
 
 /// `θ` of the revolute `joint` at `pair` and its gradient alone (no Hessian): the value and
 /// gradient of [`revolute_angle`], the same operations.
-pub(crate) fn revolute_angle_gradient(joint: &Joint, pair: &Pair) -> (f64, LVec) {
-    let f = first_order(joint, pair);
+pub(crate) fn revolute_angle_gradient(
+    joint: &Joint,
+    pair: &Pair,
+    a: [&Matrix3<f64>; 2],
+) -> (f64, LVec) {
+    let f = first_order(joint, pair, a);
     (f.v, f.g)
 }
 
@@ -195,9 +207,9 @@ struct FirstOrder {
 }
 
 #[inline(always)]
-fn first_order(joint: &Joint, pair: &Pair) -> FirstOrder {
+fn first_order(joint: &Joint, pair: &Pair, a: [&Matrix3<f64>; 2]) -> FirstOrder {
     let (p0, p1) = (&pair.p[0], &pair.p[1]);
-    let (a0, a1) = (rotation(p0), rotation(p1));
+    let (a0, a1) = (a[0], a[1]);
     let r0 = joint.body_from_joint[0].rotation.to_rotation_matrix();
     let r1 = joint.body_from_joint[1].rotation.to_rotation_matrix();
     let (bx0, by0) = (
@@ -243,7 +255,10 @@ fn first_order(joint: &Joint, pair: &Pair) -> FirstOrder {
 }
 
 /// `c U(θ)` for `U` given by `(u, du, ddu)` at `θ` (`Scalar::compose`; `None`: `U = θ`):
-/// its gradient into `grad` and Hessian into `hess`.
+/// its gradient into `grad` and Hessian `U'' ∇θ ∇θᵀ + U' ∇²θ` into `hess`, formed on and
+/// below the diagonal and mirrored: [`revolute_angle`]'s `∇²θ` is symmetric to the last bit
+/// (each entry and its mirror are the same products summed in swapped order), and so is
+/// `∇θ ∇θᵀ`, so each mirrored entry is the number its own formula gives.
 pub(crate) fn scatter_angle(
     bodies: &[Option<BodyId>; 2],
     theta: &Angle,
@@ -263,8 +278,10 @@ pub(crate) fn scatter_angle(
     let mut h = SMatrix::<f64, 8, 8>::zeros();
     let (hm, th) = (h.as_mut_slice(), theta.h.as_slice());
     for b in 0..8 {
-        for a in 0..8 {
-            hm[8 * b + a] = pg[a] * pg[b] * ddu + th[8 * b + a] * du;
+        for a in b..8 {
+            let v = pg[a] * pg[b] * ddu + th[8 * b + a] * du;
+            hm[8 * b + a] = v;
+            hm[8 * a + b] = v;
         }
     }
     scatter(bodies, &(theta.g * du), &h, c, grad, hess);
@@ -276,6 +293,14 @@ mod tests {
     use crate::jet::hess_or_zero;
     use crate::jet::testing::{sample_joint, sample_pair};
     use nalgebra::DMatrix;
+
+    /// The coordinates of bodies `0..=body` with side 0 of `pair` as body `body`'s.
+    fn coordinates(body: usize, pair: &Pair) -> DVector<f64> {
+        let mut q = DVector::zeros(7 * body + 7);
+        q.rows_mut(7 * body, 3).copy_from(&pair.r[0]);
+        q.rows_mut(7 * body + 3, 4).copy_from(&pair.p[0]);
+        q
+    }
 
     /// The gradient and Hessian over two bodies that `f` adds to zeros.
     fn hessian_of(
@@ -304,8 +329,23 @@ mod tests {
             let (g0, h0) = hessian_of(|g, h| {
                 crate::jet::scatter(&bodies, &boxed, 1.0, g, Some(h as &mut dyn HessianSink));
             });
-            let stacked = revolute_angle(&j, &pair);
+            let rot = crate::jet::closed::Rotations::of(&pair);
+            let a = [&rot.0[0], &rot.0[1]];
+            let stacked = revolute_angle(&j, &pair, a);
             assert_eq!(stacked.v, theta.v);
+            // `∇²θ` symmetric to the last bit, and the spring's Hessian entry by entry
+            // `U'' ∂θ_a ∂θ_b + U' ∂²θ_ab` (the mirrored half too).
+            let (mut g1, mut h1) = (DVector::zeros(14), DMatrix::zeros(14, 14));
+            scatter_angle(&bodies, &stacked, Some((du, ddu)), 1.0, &mut g1, &mut h1);
+            for (x, &i) in P.iter().enumerate() {
+                for (y, &k) in P.iter().enumerate() {
+                    let th = stacked.h[(x, y)];
+                    assert_eq!(th.to_bits(), stacked.h[(y, x)].to_bits(), "seed {seed}");
+                    let entry = stacked.g[i] * stacked.g[k] * ddu + th * du;
+                    // The sink adds `1 · entry` to zero (bodies 0 and 1: global = local).
+                    assert_eq!(h1[(i, k)].to_bits(), (0.0 + 1.0 * entry).to_bits());
+                }
+            }
             let (g1, h1) = hessian_of(|g, h| {
                 scatter_angle(&bodies, &stacked, Some((du, ddu)), 1.0, g, h);
             });
@@ -335,7 +375,15 @@ mod tests {
             let (g1, h1) = {
                 let mut g = DVector::zeros(14);
                 let mut h = DMatrix::zeros(14, 14);
-                v += weighted_point(&one, &pair, &s, &w, &mut g, &mut h);
+                v += weighted_point(
+                    BodyId(1),
+                    &coordinates(1, &pair),
+                    a[0],
+                    &s,
+                    &w,
+                    &mut g,
+                    &mut h,
+                );
                 (g, h)
             };
             assert_eq!(v, boxed.v);
@@ -354,7 +402,9 @@ mod tests {
             let pair = sample_pair(seed);
             let du = 0.7 - seed as f64;
             let theta = crate::jet::closed::revolute_angle(&j, &pair);
-            let (v, g) = revolute_angle_gradient(&j, &pair);
+            let rot = crate::jet::closed::Rotations::of(&pair);
+            let a = [&rot.0[0], &rot.0[1]];
+            let (v, g) = revolute_angle_gradient(&j, &pair, a);
             assert_eq!(v.to_bits(), theta.v.to_bits(), "seed {seed}");
             // A spring `U(θ)` (`Scalar::compose`, scattered with `c = 1`) and an effort.
             for (c, du) in [(1.0, du), (-2.5, 1.0)] {
@@ -372,7 +422,8 @@ mod tests {
             let mut g0 = DVector::zeros(21);
             crate::jet::scatter(&body, &boxed, 1.0, &mut g0, None);
             let mut g1 = DVector::zeros(21);
-            let v = weighted_point_gradient(BodyId(2), &pair, &s, &w, &mut g1);
+            let q = coordinates(2, &pair);
+            let v = weighted_point_gradient(BodyId(2), &q, a[0], &s, &w, &mut g1);
             assert_eq!(v.to_bits(), boxed.v.to_bits(), "seed {seed}");
             assert_eq!(bits(&g0), bits(&g1), "seed {seed}");
         }
@@ -389,7 +440,8 @@ mod tests {
         let spring = |q: &Pair| {
             let mut pair = *q;
             pair.hess = true;
-            let theta = revolute_angle(&j, &pair);
+            let rot = crate::jet::closed::Rotations::of(&pair);
+            let theta = revolute_angle(&j, &pair, [&rot.0[0], &rot.0[1]]);
             let delta = theta.v - theta0;
             let (g, h) = hessian_of(|g, h| {
                 scatter_angle(&bodies, &theta, Some((k * delta, k)), 1.0, g, h);
@@ -404,7 +456,8 @@ mod tests {
         let angle = |q: &Pair| {
             let mut pair = *q;
             pair.hess = true;
-            let theta = revolute_angle(&j, &pair);
+            let rot = crate::jet::closed::Rotations::of(&pair);
+            let theta = revolute_angle(&j, &pair, [&rot.0[0], &rot.0[1]]);
             let (g, h) = hessian_of(|g, h| scatter_angle(&bodies, &theta, None, 1.0, g, h));
             crate::jet::Scalar {
                 v: theta.v,

@@ -21,10 +21,14 @@
 
 use super::{LMat, LVec, Pair, Scalar};
 use crate::joint::{Row, V};
-use crate::math::{b_matrix, rotation};
+use crate::math::b_matrix;
 use crate::model::Joint;
 use nalgebra::{Matrix3, Matrix3x4, Matrix4, SMatrix, Vector3};
 pub(crate) mod euler;
+mod rotations;
+#[cfg(test)]
+pub(crate) use rotations::OwnedRotations;
+pub(crate) use rotations::{frame_rotations, JointRotations, Rotations};
 
 /// `Σ_k t_k r_k + A(p_k) s_k` with `B_k = B(p_k, s_k)`; `on[k]` whether side `k` enters.
 #[derive(Clone, Copy, Debug)]
@@ -53,17 +57,6 @@ pub(crate) fn quadratic_form(s: &Vector3<f64>, w: &Vector3<f64>) -> Matrix4<f64>
     m
 }
 
-/// The rotation matrices of the two sides of a pair.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Rotations([Matrix3<f64>; 2]);
-
-impl Rotations {
-    /// The rotations of `pair`.
-    pub(crate) fn of(pair: &Pair) -> Self {
-        Rotations([rotation(&pair.p[0]), rotation(&pair.p[1])])
-    }
-}
-
 impl Lin {
     /// The constant zero vector.
     const ZERO: Lin = Lin {
@@ -75,29 +68,29 @@ impl Lin {
     };
 
     /// The world point of the body-frame point `s` of side `k`.
-    pub(crate) fn point(pair: &Pair, rot: &Rotations, k: usize, s: &Vector3<f64>) -> Lin {
+    pub(crate) fn point(pair: &Pair, a_k: &Matrix3<f64>, k: usize, s: &Vector3<f64>) -> Lin {
         let mut l = Lin::ZERO;
-        l.set_point(pair, rot, k, s);
+        l.set_point(pair, a_k, k, s);
         l
     }
 
     /// [`Lin::point`] written over `self` (no copy of the whole vector).
-    fn set_point(&mut self, pair: &Pair, rot: &Rotations, k: usize, s: &Vector3<f64>) {
-        self.set_vector(pair, rot, k, s);
+    fn set_point(&mut self, pair: &Pair, a_k: &Matrix3<f64>, k: usize, s: &Vector3<f64>) {
+        self.set_vector(pair, a_k, k, s);
         self.v += pair.r[k];
         self.t[k] = 1.0;
     }
 
     /// The world direction of the body-frame vector `a` of side `k`.
-    pub(crate) fn vector(pair: &Pair, rot: &Rotations, k: usize, a: &Vector3<f64>) -> Lin {
+    pub(crate) fn vector(pair: &Pair, a_k: &Matrix3<f64>, k: usize, a: &Vector3<f64>) -> Lin {
         let mut l = Lin::ZERO;
-        l.set_vector(pair, rot, k, a);
+        l.set_vector(pair, a_k, k, a);
         l
     }
 
     /// [`Lin::vector`] written over `self` (no copy of the whole vector).
-    fn set_vector(&mut self, pair: &Pair, rot: &Rotations, k: usize, a: &Vector3<f64>) {
-        self.v = rot.0[k] * a;
+    fn set_vector(&mut self, pair: &Pair, a_k: &Matrix3<f64>, k: usize, a: &Vector3<f64>) {
+        self.v = a_k * a;
         self.t = [0.0; 2];
         self.s = [Vector3::zeros(); 2];
         self.b = [Matrix3x4::zeros(); 2];
@@ -151,6 +144,7 @@ pub(crate) fn dot_gradient(a: &Lin, b: &Lin, c: f64, g: &mut LVec) {
 }
 
 /// `∇(wᵀa)` for a constant `w` added into `g`.
+#[cfg(test)]
 pub(crate) fn linear_gradient(a: &Lin, w: &Vector3<f64>, g: &mut LVec) {
     for k in 0..2 {
         if a.on[k] {
@@ -314,8 +308,7 @@ pub(crate) struct Frames {
 impl Frames {
     /// The vectors `layout` uses, for the frames of `joint` at `pair` (written in place).
     #[inline(always)]
-    fn of(joint: &Joint, pair: &Pair, layout: &[Row]) -> Self {
-        let rot = Rotations::of(pair);
+    fn of(joint: &Joint, pair: &Pair, rots: &JointRotations, layout: &[Row]) -> Self {
         let mut need = [false; 7];
         for row in layout {
             match *row {
@@ -326,12 +319,8 @@ impl Frames {
                 }
             }
         }
-        // Each side's joint rotation once.
-        let mut r: [Option<Matrix3<f64>>; 2] = [None, None];
-        let mut axis = |slot: &mut Lin, k: usize, i: usize| {
-            let jr = &joint.body_from_joint[k].rotation;
-            let r = r[k].get_or_insert_with(|| *jr.to_rotation_matrix().matrix());
-            slot.set_vector(pair, &rot, k, &r.column(i).into_owned());
+        let axis = |slot: &mut Lin, k: usize, i: usize| {
+            slot.set_vector(pair, rots.a[k], k, &rots.r[k].column(i).into_owned());
         };
         let mut f = Frames {
             vectors: [Lin::ZERO; 7],
@@ -343,8 +332,8 @@ impl Frames {
             match v {
                 0 => {
                     let o = |k: usize| &joint.body_from_joint[k].translation.vector;
-                    slot.set_point(pair, &rot, 1, o(1));
-                    slot.subtract(&Lin::point(pair, &rot, 0, o(0)));
+                    slot.set_point(pair, rots.a[1], 1, o(1));
+                    slot.subtract(&Lin::point(pair, rots.a[0], 0, o(0)));
                 }
                 // The axes `x₀ y₀ z₀ x₁ y₁ z₁`.
                 _ => axis(slot, (v - 1) / 3, (v - 1) % 3),
@@ -374,11 +363,16 @@ pub(crate) fn supports(joint: &Joint) -> bool {
 /// Values and gradients of the rows of `joint` (no Hessians), handed to `emit(k, Φ_k, ∇Φ_k)`
 /// in row order: nothing collected, nothing copied.
 #[inline(always)]
-pub(crate) fn rows_each(joint: &Joint, pair: &Pair, mut emit: impl FnMut(usize, f64, &LVec)) {
+pub(crate) fn rows_each(
+    joint: &Joint,
+    pair: &Pair,
+    rots: &JointRotations,
+    mut emit: impl FnMut(usize, f64, &LVec),
+) {
     let Some(layout) = layout(joint) else {
         return;
     };
-    let f = Frames::of(joint, pair, layout);
+    let f = Frames::of(joint, pair, rots, layout);
     for (k, row) in layout.iter().enumerate() {
         let mut g = LVec::zeros();
         let v = match *row {
@@ -405,26 +399,21 @@ pub(crate) fn rows_each(joint: &Joint, pair: &Pair, mut emit: impl FnMut(usize, 
 
 /// Values of the rows of `joint` into `out` (cleared first): the vectors alone, without
 /// derivatives.
-pub(crate) fn values(joint: &Joint, pair: &Pair, out: &mut Vec<f64>) {
+pub(crate) fn values(joint: &Joint, pair: &Pair, rots: &JointRotations, out: &mut Vec<f64>) {
     out.clear();
     let Some(layout) = layout(joint) else {
         return;
     };
-    let a = [rotation(&pair.p[0]), rotation(&pair.p[1])];
+    let (a, r) = (rots.a, rots.r);
     let f = &joint.body_from_joint;
     // The same arithmetic as `Frames::of`: values equal those of `rows` to the last bit. Each
-    // side's joint rotation and each vector are formed once (a revolute's `z₀` serves two
-    // rows).
-    let mut r: [Option<Matrix3<f64>>; 2] = [None, None];
+    // vector is formed once (a revolute's `z₀` serves two rows).
     let mut memo: [Option<Vector3<f64>>; 7] = [None; 7];
     let mut vector = |v: V| -> Vector3<f64> {
         if let Some(x) = memo[v as usize] {
             return x;
         }
-        let mut axis = |k: usize, i: usize| {
-            let r = r[k].get_or_insert_with(|| *f[k].rotation.to_rotation_matrix().matrix());
-            a[k] * r.column(i).into_owned()
-        };
+        let axis = |k: usize, i: usize| a[k] * r[k].column(i).into_owned();
         let point = |k: usize| a[k] * f[k].translation.vector + pair.r[k];
         let x = match v {
             V::D => point(1) - point(0),
@@ -447,11 +436,17 @@ pub(crate) fn values(joint: &Joint, pair: &Pair, out: &mut Vec<f64>) {
 }
 
 /// `Σ_r w_r ∇²Φ_r` over the rows of `joint` added into `h` (`w` one weight per row).
-pub(crate) fn add_weighted_hessian(joint: &Joint, pair: &Pair, w: &[f64], h: &mut LMat) {
+pub(crate) fn add_weighted_hessian(
+    joint: &Joint,
+    pair: &Pair,
+    rots: &JointRotations,
+    w: &[f64],
+    h: &mut LMat,
+) {
     let Some(layout) = layout(joint) else {
         return;
     };
-    let f = Frames::of(joint, pair, layout);
+    let f = Frames::of(joint, pair, rots, layout);
     let mut wd = Vector3::zeros();
     for (row, &c) in layout.iter().zip(w) {
         if c == 0.0 {
@@ -475,7 +470,7 @@ pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair) -> Scalar {
     let rot = Rotations::of(pair);
     let axis = |k: usize, i: usize| {
         let r = joint.body_from_joint[k].rotation.to_rotation_matrix();
-        Lin::vector(pair, &rot, k, &r.matrix().column(i).into_owned())
+        Lin::vector(pair, &rot.0[k], k, &r.matrix().column(i).into_owned())
     };
     let (x0, y0, x1) = (axis(0, 0), axis(0, 1), axis(1, 0));
     let scalar = |a: &Lin, b: &Lin| {

@@ -18,9 +18,11 @@ fn closed_row(j: &Joint, pair: &Pair, r: usize) -> Scalar {
     let mut w = vec![0.0; out.len()];
     w[r] = 1.0;
     let mut h = Box::new(crate::jet::LMat::zeros());
-    closed::add_weighted_hessian(j, pair, &w, &mut h);
+    let owned = closed::OwnedRotations::of(j, pair);
+    let rots = owned.view();
+    closed::add_weighted_hessian(j, pair, &rots, &w, &mut h);
     let mut values = Vec::new();
-    closed::values(j, pair, &mut values);
+    closed::values(j, pair, &rots, &mut values);
     assert_eq!(values[r], out[r].v);
     Scalar {
         h: Some(h),
@@ -55,7 +57,9 @@ fn closed_form_rows_equal_the_jets_and_finite_differences() {
                 expected += hess_or_zero(&s.h) * *c;
             }
             let mut got = crate::jet::LMat::zeros();
-            closed::add_weighted_hessian(&j, &pair, &w, &mut got);
+            let owned = closed::OwnedRotations::of(&j, &pair);
+            let rots = owned.view();
+            closed::add_weighted_hessian(&j, &pair, &rots, &w, &mut got);
             let d = (got - expected).amax();
             assert!(d <= 1e-12 * (1.0 + expected.amax()), "{}: {d}", kind.name());
         }
@@ -139,7 +143,12 @@ fn motion_satisfies_the_rows_and_reads_back_its_values() {
             assert!(s.v.abs() < 1e-12, "{what}: {}", s.v);
         }
         let mut values = Vec::new();
-        closed::values(&j, &pair, &mut values);
+        closed::values(
+            &j,
+            &pair,
+            &closed::OwnedRotations::of(&j, &pair).view(),
+            &mut values,
+        );
         assert!(values.iter().all(|x| x.abs() < 1e-12), "{}", kind.name());
         let n = kind.scalar_coordinates();
         for (dof, &expected) in v.iter().enumerate().take(n) {

@@ -11,11 +11,13 @@
 //! [`super::add_weighted_hessian`] restricted to [`crate::jet::EULER`], added in the same
 //! order from the same operands: the same numbers to the last bit.
 
-use super::{dot_hessian_euler, layout, linear_hessian_euler, Lin, Rotations};
+#[cfg(test)]
+use super::OwnedRotations;
+use super::{dot_hessian_euler, layout, linear_hessian_euler, JointRotations, Lin};
 use crate::jet::Pair;
 use crate::joint::{Row, V};
 use crate::model::Joint;
-use nalgebra::{Matrix3, Matrix3x4, SMatrix, Vector3};
+use nalgebra::{Matrix3x4, SMatrix, Vector3};
 
 /// Whether every row of `joint` has a Hessian zero outside the Euler parameters (no
 /// length row, no dot product with `d`); `false` for a joint without a closed form.
@@ -34,15 +36,14 @@ pub(crate) fn euler_only(joint: &Joint) -> bool {
 pub(crate) fn add_weighted_hessian_euler(
     joint: &Joint,
     pair: &Pair,
+    rots: &JointRotations,
     w: &[f64],
     hp: &mut SMatrix<f64, 8, 8>,
 ) {
     let Some(layout) = layout(joint).filter(|_| euler_only(joint)) else {
         return;
     };
-    let rot = Rotations::of(pair);
-    // The axes the rows read, each formed once in place as `Frames::of` forms it (each
-    // side's joint rotation once).
+    // The axes the rows read, each formed once in place as `Frames::of` forms it.
     let mut need = [false; 7];
     for (row, &c) in layout.iter().zip(w) {
         if let (Row::Dot(a, b), true) = (*row, c != 0.0) {
@@ -50,14 +51,12 @@ pub(crate) fn add_weighted_hessian_euler(
             need[b as usize] = true;
         }
     }
-    let mut r: [Option<Matrix3<f64>>; 2] = [None, None];
     let mut axes: [Option<Lin>; 7] = [None; 7];
     for (v, slot) in axes.iter_mut().enumerate().skip(1) {
         if need[v] {
             let (k, i) = ((v - 1) / 3, (v - 1) % 3);
-            let jr = &joint.body_from_joint[k].rotation;
-            let m = r[k].get_or_insert_with(|| *jr.to_rotation_matrix().matrix());
-            *slot = Some(Lin::vector(pair, &rot, k, &m.column(i).into_owned()));
+            let axis = rots.r[k].column(i).into_owned();
+            slot.insert(Lin::ZERO).set_vector(pair, rots.a[k], k, &axis);
         }
     }
     let mut wd = Vector3::zeros();
@@ -117,9 +116,11 @@ mod tests {
                 let pair = sample_pair(seed);
                 let w: Vec<f64> = (0..rows).map(|r| 0.7 - 0.45 * r as f64).collect();
                 let mut full = LMat::zeros();
-                super::super::add_weighted_hessian(&j, &pair, &w, &mut full);
+                let owned = OwnedRotations::of(&j, &pair);
+                let rots = owned.view();
+                super::super::add_weighted_hessian(&j, &pair, &rots, &w, &mut full);
                 let mut hp = SMatrix::<f64, 8, 8>::zeros();
-                add_weighted_hessian_euler(&j, &pair, &w, &mut hp);
+                add_weighted_hessian_euler(&j, &pair, &rots, &w, &mut hp);
                 assert!(hp.amax() > 0.0, "{}", kind.name());
                 let back = euler_to_local(&hp);
                 for (x, y) in full.iter().zip(back.iter()) {
@@ -138,7 +139,9 @@ mod tests {
                         let mut unit = vec![0.0; rows];
                         unit[r] = 1.0;
                         let mut hp = SMatrix::<f64, 8, 8>::zeros();
-                        add_weighted_hessian_euler(&j, q, &unit, &mut hp);
+                        let owned = OwnedRotations::of(&j, q);
+                        let rots = owned.view();
+                        add_weighted_hessian_euler(&j, q, &rots, &unit, &mut hp);
                         Scalar {
                             h: Some(Box::new(euler_to_local(&hp))),
                             ..out[r].clone()

@@ -3,21 +3,25 @@
 use super::*;
 use crate::jet::testing::{check_scalar, sample_pair};
 use crate::jet::{hess_or_zero, Vec3Jet};
+use crate::math::rotation;
 
 /// Values and gradients of the rows of `joint` into `out` (cleared first; no Hessians): those
 /// of [`super::rows_each`].
 pub(crate) fn rows(joint: &Joint, pair: &Pair, out: &mut Vec<Scalar>) {
     out.clear();
-    super::rows_each(joint, pair, |_, v, g| {
-        out.push(Scalar { v, g: *g, h: None })
-    });
+    super::rows_each(
+        joint,
+        pair,
+        &OwnedRotations::of(joint, pair).view(),
+        |_, v, g| out.push(Scalar { v, g: *g, h: None }),
+    );
 }
 
 /// The weighted point `wᵀ (r_k + A(p_k) s)` of side `k` (gravity, dead loads), with the
 /// Hessian when `pair.hess`: the general path, the reference of the tests of `forces::stacked`.
 pub(crate) fn weighted_point(pair: &Pair, k: usize, s: &Vector3<f64>, w: &Vector3<f64>) -> Scalar {
     let rot = Rotations::of(pair);
-    let p = Lin::point(pair, &rot, k, s);
+    let p = Lin::point(pair, &rot.0[k], k, s);
     let mut g = LVec::zeros();
     linear_gradient(&p, w, &mut g);
     let h = pair.hess.then(|| {
@@ -76,12 +80,12 @@ fn vectors(q: &Pair) -> ([Vec3Jet; 3], [Lin; 3]) {
         ],
         [
             {
-                let mut d = Lin::point(q, &rot, 1, &s1());
-                d.subtract(&Lin::point(q, &rot, 0, &s0()));
+                let mut d = Lin::point(q, &rot.0[1], 1, &s1());
+                d.subtract(&Lin::point(q, &rot.0[0], 0, &s0()));
                 d
             },
-            Lin::vector(q, &rot, 0, &Vector3::new(0.6, 0.0, -0.8)),
-            Lin::vector(q, &rot, 1, &Vector3::y()),
+            Lin::vector(q, &rot.0[0], 0, &Vector3::new(0.6, 0.0, -0.8)),
+            Lin::vector(q, &rot.0[1], 1, &Vector3::y()),
         ],
     )
 }

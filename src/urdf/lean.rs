@@ -11,7 +11,7 @@
 //! into the same document (compared node by node in the tests, `super::dom_tests`).
 
 use super::byte_class::{CLASS, NAME_CHAR, NAME_START, NOT_IN_VALUE, SPACE};
-use super::dom::{AttrData, Document, Kind, NodeData, Str};
+use super::dom::{head, AttrData, Document, Kind, NodeData, Str};
 
 /// The URI of the `xml` prefix and the reserved one of `xmlns`.
 const XML_URI: &str = "http://www.w3.org/XML/1998/namespace";
@@ -24,6 +24,8 @@ struct Open {
     qname: (usize, usize),
     /// Its last child so far (0: none).
     last: u32,
+    /// The namespace of an unprefixed name in its scope (as [`NodeData::ns`]).
+    default_ns: u32,
 }
 
 /// An attribute as written: prefix, local name, value (byte ranges).
@@ -96,6 +98,7 @@ pub(super) fn parse(text: &str) -> Option<Document<'_>> {
         id: 0,
         qname: (0, 0),
         last: 0,
+        default_ns: 0,
     });
     if b.starts_with(b"<?xml ") {
         r.declaration()?;
@@ -326,10 +329,140 @@ impl<'i> Reader<'i> {
         self.i += 1;
         let (prefix, local) = self.qname()?;
         let qname = (prefix.0, self.i);
+        let written_prefix = &self.b[prefix.0..prefix.1];
+        if written_prefix == b"xml" || written_prefix == b"xmlns" {
+            return None;
+        }
+        let open = self.open.last()?;
+        let (parent, parent_default) = (open.id as usize, open.default_ns);
+        let parent_scope = match self.doc.nodes[parent].kind {
+            Kind::Element => self.doc.nodes[parent].scope,
+            _ => (0, 0),
+        };
+        let a0 = self.doc.attrs.len();
+        let after_name = self.i;
+        // Without declarations the element's scope is its parent's.
+        let (empty, scope, default_ns) = match self.plain_attributes(a0)? {
+            Some(empty) => (empty, parent_scope, parent_default),
+            None => {
+                self.doc.attrs.truncate(a0);
+                self.i = after_name;
+                let (empty, scope) = self.declared_attributes(a0, parent_scope)?;
+                (empty, scope, self.namespace(scope, "")?)
+            }
+        };
+        let ns = if prefix.0 == prefix.1 {
+            default_ns
+        } else {
+            self.namespace(scope, &self.doc.text[prefix.0..prefix.1])?
+        };
+        let id = self.push(NodeData {
+            kind: Kind::Element,
+            parent: 0,
+            next_sibling: 0,
+            end: 0,
+            range: (start as u32, self.i as u32),
+            name: Str::of(local.0..local.1),
+            ns,
+            attrs: (a0 as u32, self.doc.attrs.len() as u32),
+            scope,
+        });
+        if !empty {
+            // Deeper than the importer reads: its depth check gives the error.
+            if self.open.len() > super::text::MAX_DEPTH {
+                return None;
+            }
+            self.open.push(Open {
+                id,
+                qname,
+                last: 0,
+                default_ns,
+            });
+        }
+        Some(())
+    }
+
+    /// The namespace of prefix `p` (empty: none written) in `scope`: 1 + the index of its
+    /// scope entry, 0 for none (no prefix and no default namespace); `None` for an undeclared
+    /// prefix.
+    fn namespace(&self, scope: (u32, u32), p: &str) -> Option<u32> {
+        let doc = &self.doc;
+        let (a, b) = (scope.0 as usize, scope.1 as usize);
+        // No prefix: the entry of the default namespace (none of the prefixed ones).
+        let found = match p.is_empty() {
+            true => doc.scope[a..b].iter().position(|x| x.0.is_none()),
+            false => doc.scope[a..b]
+                .iter()
+                .position(|x| x.0.is_some_and(|q| doc.str(q) == p)),
+        };
+        match found {
+            Some(k) => Some((a + k + 1) as u32),
+            None if p.is_empty() => Some(0),
+            None => None,
+        }
+    }
+
+    /// A start tag's attributes up to the tag's end, pushed straight into the document while
+    /// none has a prefix or is named `xmlns` (no declaration: every attribute in no
+    /// namespace, a duplicate a repeated name): whether the element is empty (`/>`), or
+    /// `Some(None)` at the first attribute that has a prefix or is `xmlns` (the tag is then
+    /// read again by [`Reader::declared_attributes`]).
+    fn plain_attributes(&mut self, a0: usize) -> Option<Option<bool>> {
+        loop {
+            let spaced = self.skip_space();
+            match *self.b.get(self.i)? {
+                b'/' => {
+                    self.eat(b"/>")?;
+                    return Some(Some(true));
+                }
+                b'>' => {
+                    self.i += 1;
+                    return Some(Some(false));
+                }
+                _ if spaced => {
+                    let (p, l) = self.qname()?;
+                    let b = self.b;
+                    let name = &b[l.0..l.1];
+                    if p.0 != p.1 || (name.len() == 5 && name == b"xmlns") {
+                        return Some(None);
+                    }
+                    self.skip_space();
+                    self.eat(b"=")?;
+                    self.skip_space();
+                    let value = self.quoted()?;
+                    let h = head(name);
+                    let same = |x: &AttrData| {
+                        x.head == h
+                            && x.name.len as usize == name.len()
+                            && (name.len() <= 4
+                                || b[x.name.start as usize + 4..][..name.len() - 4] == name[4..])
+                    };
+                    if self.doc.attrs[a0..].iter().any(same) {
+                        return None;
+                    }
+                    self.doc.attrs.push(AttrData {
+                        ns: 0,
+                        name: Str::of(l.0..l.1),
+                        value: Str::of(value.0..value.1),
+                        head: h,
+                    });
+                }
+                _ => return None,
+            }
+        }
+    }
+
+    /// A start tag's attributes where one has a prefix or is `xmlns`: the namespace
+    /// declarations, in the order written, then the parent's in its order, those not declared
+    /// again (`roxmltree`'s order of the scope); then the other attributes with their
+    /// namespaces, a duplicate the same local name and namespace URI. Whether the element is
+    /// empty (`/>`), and its scope.
+    fn declared_attributes(
+        &mut self,
+        a0: usize,
+        parent_scope: (u32, u32),
+    ) -> Option<(bool, (u32, u32))> {
         self.raw.clear();
-        // No attribute with a prefix and none named `xmlns`: no declaration, every attribute
-        // in no namespace.
-        let mut plain = true;
         let empty = loop {
             let spaced = self.skip_space();
             match *self.b.get(self.i)? {
@@ -347,7 +480,6 @@ impl<'i> Reader<'i> {
                     self.eat(b"=")?;
                     self.skip_space();
                     let value = self.quoted()?;
-                    plain &= p.0 == p.1 && (l.1 - l.0 != 5 || &self.b[l.0..l.1] != b"xmlns");
                     self.raw.push(Raw {
                         prefix: p,
                         local: l,
@@ -359,20 +491,8 @@ impl<'i> Reader<'i> {
         };
         let text = self.doc.text;
         let s = |r: (usize, usize)| &text[r.0..r.1];
-        let written_prefix = &self.b[prefix.0..prefix.1];
-        if written_prefix == b"xml" || written_prefix == b"xmlns" {
-            return None;
-        }
-        // Namespace declarations, in the order written; then the parent's in its order,
-        // those not declared again (roxmltree's order of the scope).
-        let parent = self.open.last()?.id as usize;
-        let parent_scope = match self.doc.nodes[parent].kind {
-            Kind::Element => self.doc.nodes[parent].scope,
-            _ => (0, 0),
-        };
         let s0 = self.doc.scope.len();
-        let declarations: &[Raw] = if plain { &[] } else { &self.raw };
-        for a in declarations {
+        for a in &self.raw {
             let (p, l, v) = (s(a.prefix), s(a.local), s(a.value));
             let declared = match (p, l) {
                 ("xmlns", "xml" | "xmlns") => return None,
@@ -414,45 +534,8 @@ impl<'i> Reader<'i> {
             }
             (s0 as u32, self.doc.scope.len() as u32)
         };
-        // A prefix's namespace: 1 + the index of its scope entry, 0 for none (no prefix and no
-        // default namespace); `None` for an undeclared prefix.
-        let lookup = |doc: &Document, p: &str| -> Option<u32> {
-            let (a, b) = (scope.0 as usize, scope.1 as usize);
-            // No prefix: the entry of the default namespace (none of the prefixed ones).
-            let found = match p.is_empty() {
-                true => doc.scope[a..b].iter().position(|x| x.0.is_none()),
-                false => doc.scope[a..b]
-                    .iter()
-                    .position(|x| x.0.is_some_and(|q| doc.str(q) == p)),
-            };
-            match found {
-                Some(k) => Some((a + k + 1) as u32),
-                None if p.is_empty() => Some(0),
-                None => None,
-            }
-        };
-        let ns = lookup(&self.doc, if prefix.0 == prefix.1 { "" } else { s(prefix) })?;
-        let a0 = self.doc.attrs.len();
-        if plain {
-            // A duplicate is a repeated name.
-            let b = self.b;
-            let name = |a: &Raw| &b[a.local.0..a.local.1];
-            for (k, a) in self.raw.iter().enumerate() {
-                let same = |x: &Raw| {
-                    let (p, q) = (name(x), name(a));
-                    p.len() == q.len() && p.iter().zip(q).all(|(u, v)| u == v)
-                };
-                if self.raw[..k].iter().any(same) {
-                    return None;
-                }
-                self.doc.attrs.push(AttrData {
-                    ns: 0,
-                    name: Str::of(a.local.0..a.local.1),
-                    value: Str::of(a.value.0..a.value.1),
-                });
-            }
-        }
-        for a in declarations {
+        for k in 0..self.raw.len() {
+            let a = &self.raw[k];
             let (p, l) = (s(a.prefix), s(a.local));
             if p == "xmlns" || (p.is_empty() && l == "xmlns") {
                 continue;
@@ -460,7 +543,7 @@ impl<'i> Reader<'i> {
             let ans = if p.is_empty() {
                 0
             } else {
-                lookup(&self.doc, p)?
+                self.namespace(scope, p)?
             };
             let doc = &self.doc;
             let uri = |x: u32| (x != 0).then(|| doc.str(doc.scope[x as usize - 1].1));
@@ -470,30 +553,14 @@ impl<'i> Reader<'i> {
             if duplicate {
                 return None;
             }
+            let (local, value) = (a.local, a.value);
             self.doc.attrs.push(AttrData {
                 ns: ans,
-                name: Str::of(a.local.0..a.local.1),
-                value: Str::of(a.value.0..a.value.1),
+                name: Str::of(local.0..local.1),
+                value: Str::of(value.0..value.1),
+                head: head(l.as_bytes()),
             });
         }
-        let id = self.push(NodeData {
-            kind: Kind::Element,
-            parent: 0,
-            next_sibling: 0,
-            end: 0,
-            range: (start as u32, self.i as u32),
-            name: Str::of(local.0..local.1),
-            ns,
-            attrs: (a0 as u32, self.doc.attrs.len() as u32),
-            scope,
-        });
-        if !empty {
-            // Deeper than the importer reads: its depth check gives the error.
-            if self.open.len() > super::text::MAX_DEPTH {
-                return None;
-            }
-            self.open.push(Open { id, qname, last: 0 });
-        }
-        Some(())
+        Some((empty, scope))
     }
 }

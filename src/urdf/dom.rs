@@ -73,12 +73,26 @@ pub(super) struct NodeData {
     pub(super) scope: (u32, u32),
 }
 
-/// An attribute: namespace URI (as [`NodeData::ns`]), local name, value.
+/// An attribute: namespace URI (as [`NodeData::ns`]), local name, value, and the name's
+/// [`head`] (a lookup compares heads before bytes).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct AttrData {
     pub(super) ns: u32,
     pub(super) name: Str,
     pub(super) value: Str,
+    pub(super) head: u32,
+}
+
+/// The first four bytes of `name` as a little-endian number, zero past its end: names
+/// (which hold no zero byte) of the same length and head are equal when at most four bytes
+/// long; longer ones are compared byte by byte after the head.
+#[inline(always)]
+pub(super) fn head(name: &[u8]) -> u32 {
+    let mut h = 0u32;
+    for (k, &c) in name.iter().take(4).enumerate() {
+        h |= u32::from(c) << (8 * k);
+    }
+    h
 }
 
 /// A parsed XML document.
@@ -278,6 +292,18 @@ impl<'a, 'i> Node<'a, 'i> {
             })
     }
 
+    /// Whether the node is an element in no namespace with every attribute in none.
+    #[inline]
+    pub(crate) fn is_plain_element(&self) -> bool {
+        let d = self.d();
+        let (a, b) = d.attrs;
+        d.kind == Kind::Element
+            && d.ns == 0
+            && self.doc.attrs[a as usize..b as usize]
+                .iter()
+                .all(|x| x.ns == 0)
+    }
+
     /// The attributes of an element that are in a namespace.
     pub(crate) fn namespaced_attributes(&self) -> impl Iterator<Item = Attribute<'a>> + 'a {
         let doc = self.doc;
@@ -297,9 +323,15 @@ impl<'a, 'i> Node<'a, 'i> {
     pub(crate) fn attribute(&self, name: &str) -> Option<&'a str> {
         let doc = self.doc;
         let (a, b) = self.d().attrs;
+        let (h, n) = (head(name.as_bytes()), name.len());
         doc.attrs[a as usize..b as usize]
             .iter()
-            .find(|x| x.ns == 0 && doc.is(x.name, name))
+            .find(|x| {
+                x.head == h
+                    && x.ns == 0
+                    && x.name.bytes() == n
+                    && (n <= 4 || doc.bytes(x.name)[4..] == name.as_bytes()[4..])
+            })
             .map(|x| doc.str(x.value))
     }
 

@@ -2,7 +2,7 @@
 //! strings copied into the document's own buffer (`roxmltree` expands references, so they are
 //! not byte ranges of the text), subtree ends and sibling links by index.
 
-use super::dom::{AttrData, Document, Kind, NodeData, Str, OWNED};
+use super::dom::{head, AttrData, Document, Kind, NodeData, Str, OWNED};
 
 impl<'i> Document<'i> {
     /// `roxmltree`'s document, converted.
@@ -62,7 +62,12 @@ impl<'i> Document<'i> {
                         let ns = uri(&mut out.owned, &mut out.scope, a.namespace());
                         let name = own(&mut out.owned, a.name());
                         let value = own(&mut out.owned, a.value());
-                        out.attrs.push(AttrData { ns, name, value });
+                        out.attrs.push(AttrData {
+                            ns,
+                            name,
+                            value,
+                            head: head(a.name().as_bytes()),
+                        });
                     }
                     data.attrs = (a0, out.attrs.len() as u32);
                     let s0 = out.scope.len() as u32;

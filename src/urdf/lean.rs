@@ -9,13 +9,18 @@
 //! reads the text with `roxmltree`, which reads all of XML and
 //! reports every error with its position: what this reader accepts, `roxmltree` accepts too,
 //! into the same document (compared node by node in the tests, `super::dom_tests`).
+//!
+//! A start tag's attributes go straight into the document unless one has a prefix or is
+//! `xmlns`; such a tag is read again with its namespace declarations by the child module
+//! `namespaces` (`lean_namespaces.rs`).
 
 use super::byte_class::{CLASS, NAME_CHAR, NAME_START, NOT_IN_VALUE, SPACE};
-use super::dom::{AttrData, Document, Kind, NodeData, Str};
+use super::dom::{head, AttrData, Document, Kind, NodeData, Str};
+use namespaces::Raw;
 
-/// The URI of the `xml` prefix and the reserved one of `xmlns`.
-const XML_URI: &str = "http://www.w3.org/XML/1998/namespace";
-const XMLNS_URI: &str = "http://www.w3.org/2000/xmlns/";
+// A child module (it reads the reader's state), kept beside this file.
+#[path = "lean_namespaces.rs"]
+mod namespaces;
 
 /// An element whose end tag is awaited.
 struct Open {
@@ -24,13 +29,8 @@ struct Open {
     qname: (usize, usize),
     /// Its last child so far (0: none).
     last: u32,
-}
-
-/// An attribute as written: prefix, local name, value (byte ranges).
-struct Raw {
-    prefix: (usize, usize),
-    local: (usize, usize),
-    value: (usize, usize),
+    /// The namespace of an unprefixed name in its scope (as [`NodeData::ns`]).
+    default_ns: u32,
 }
 
 struct Reader<'i> {
@@ -96,6 +96,7 @@ pub(super) fn parse(text: &str) -> Option<Document<'_>> {
         id: 0,
         qname: (0, 0),
         last: 0,
+        default_ns: 0,
     });
     if b.starts_with(b"<?xml ") {
         r.declaration()?;
@@ -326,156 +327,33 @@ impl<'i> Reader<'i> {
         self.i += 1;
         let (prefix, local) = self.qname()?;
         let qname = (prefix.0, self.i);
-        self.raw.clear();
-        // No attribute with a prefix and none named `xmlns`: no declaration, every attribute
-        // in no namespace.
-        let mut plain = true;
-        let empty = loop {
-            let spaced = self.skip_space();
-            match *self.b.get(self.i)? {
-                b'/' => {
-                    self.eat(b"/>")?;
-                    break true;
-                }
-                b'>' => {
-                    self.i += 1;
-                    break false;
-                }
-                _ if spaced => {
-                    let (p, l) = self.qname()?;
-                    self.skip_space();
-                    self.eat(b"=")?;
-                    self.skip_space();
-                    let value = self.quoted()?;
-                    plain &= p.0 == p.1 && (l.1 - l.0 != 5 || &self.b[l.0..l.1] != b"xmlns");
-                    self.raw.push(Raw {
-                        prefix: p,
-                        local: l,
-                        value,
-                    });
-                }
-                _ => return None,
-            }
-        };
-        let text = self.doc.text;
-        let s = |r: (usize, usize)| &text[r.0..r.1];
         let written_prefix = &self.b[prefix.0..prefix.1];
         if written_prefix == b"xml" || written_prefix == b"xmlns" {
             return None;
         }
-        // Namespace declarations, in the order written; then the parent's in its order,
-        // those not declared again (roxmltree's order of the scope).
-        let parent = self.open.last()?.id as usize;
+        let open = self.open.last()?;
+        let (parent, parent_default) = (open.id as usize, open.default_ns);
         let parent_scope = match self.doc.nodes[parent].kind {
             Kind::Element => self.doc.nodes[parent].scope,
             _ => (0, 0),
         };
-        let s0 = self.doc.scope.len();
-        let declarations: &[Raw] = if plain { &[] } else { &self.raw };
-        for a in declarations {
-            let (p, l, v) = (s(a.prefix), s(a.local), s(a.value));
-            let declared = match (p, l) {
-                ("xmlns", "xml" | "xmlns") => return None,
-                ("xmlns", _) => Some(Some(a.local)),
-                ("", "xmlns") => Some(None),
-                ("xml", _) => return None,
-                _ => None,
-            };
-            let Some(prefix) = declared else { continue };
-            if v.is_empty() || v == XML_URI || v == XMLNS_URI {
-                return None;
-            }
-            let same = |x: &(Option<Str>, Str)| match (x.0, prefix) {
-                (None, None) => true,
-                (Some(a), Some(b)) => self.doc.str(a) == s(b),
-                _ => false,
-            };
-            if self.doc.scope[s0..].iter().any(same) {
-                return None;
-            }
-            let entry = (
-                prefix.map(|p| Str::of(p.0..p.1)),
-                Str::of(a.value.0..a.value.1),
-            );
-            self.doc.scope.push(entry);
-        }
-        let scope = if self.doc.scope.len() == s0 {
-            parent_scope
-        } else {
-            for k in parent_scope.0..parent_scope.1 {
-                let inherited = self.doc.scope[k as usize];
-                let p = inherited.0.map(|p| self.doc.str(p));
-                let shadowed = self.doc.scope[s0..]
-                    .iter()
-                    .any(|x| x.0.map(|q| self.doc.str(q)) == p);
-                if !shadowed {
-                    self.doc.scope.push(inherited);
-                }
-            }
-            (s0 as u32, self.doc.scope.len() as u32)
-        };
-        // A prefix's namespace: 1 + the index of its scope entry, 0 for none (no prefix and no
-        // default namespace); `None` for an undeclared prefix.
-        let lookup = |doc: &Document, p: &str| -> Option<u32> {
-            let (a, b) = (scope.0 as usize, scope.1 as usize);
-            // No prefix: the entry of the default namespace (none of the prefixed ones).
-            let found = match p.is_empty() {
-                true => doc.scope[a..b].iter().position(|x| x.0.is_none()),
-                false => doc.scope[a..b]
-                    .iter()
-                    .position(|x| x.0.is_some_and(|q| doc.str(q) == p)),
-            };
-            match found {
-                Some(k) => Some((a + k + 1) as u32),
-                None if p.is_empty() => Some(0),
-                None => None,
-            }
-        };
-        let ns = lookup(&self.doc, if prefix.0 == prefix.1 { "" } else { s(prefix) })?;
         let a0 = self.doc.attrs.len();
-        if plain {
-            // A duplicate is a repeated name.
-            let b = self.b;
-            let name = |a: &Raw| &b[a.local.0..a.local.1];
-            for (k, a) in self.raw.iter().enumerate() {
-                let same = |x: &Raw| {
-                    let (p, q) = (name(x), name(a));
-                    p.len() == q.len() && p.iter().zip(q).all(|(u, v)| u == v)
-                };
-                if self.raw[..k].iter().any(same) {
-                    return None;
-                }
-                self.doc.attrs.push(AttrData {
-                    ns: 0,
-                    name: Str::of(a.local.0..a.local.1),
-                    value: Str::of(a.value.0..a.value.1),
-                });
+        let after_name = self.i;
+        // Without declarations the element's scope is its parent's.
+        let (empty, scope, default_ns) = match self.plain_attributes(a0)? {
+            Some(empty) => (empty, parent_scope, parent_default),
+            None => {
+                self.doc.attrs.truncate(a0);
+                self.i = after_name;
+                let (empty, scope) = self.declared_attributes(a0, parent_scope)?;
+                (empty, scope, self.namespace(scope, "")?)
             }
-        }
-        for a in declarations {
-            let (p, l) = (s(a.prefix), s(a.local));
-            if p == "xmlns" || (p.is_empty() && l == "xmlns") {
-                continue;
-            }
-            let ans = if p.is_empty() {
-                0
-            } else {
-                lookup(&self.doc, p)?
-            };
-            let doc = &self.doc;
-            let uri = |x: u32| (x != 0).then(|| doc.str(doc.scope[x as usize - 1].1));
-            let duplicate = doc.attrs[a0..]
-                .iter()
-                .any(|x| doc.str(x.name) == l && uri(x.ns) == uri(ans));
-            if duplicate {
-                return None;
-            }
-            self.doc.attrs.push(AttrData {
-                ns: ans,
-                name: Str::of(a.local.0..a.local.1),
-                value: Str::of(a.value.0..a.value.1),
-            });
-        }
+        };
+        let ns = if prefix.0 == prefix.1 {
+            default_ns
+        } else {
+            self.namespace(scope, &self.doc.text[prefix.0..prefix.1])?
+        };
         let id = self.push(NodeData {
             kind: Kind::Element,
             parent: 0,
@@ -492,8 +370,63 @@ impl<'i> Reader<'i> {
             if self.open.len() > super::text::MAX_DEPTH {
                 return None;
             }
-            self.open.push(Open { id, qname, last: 0 });
+            self.open.push(Open {
+                id,
+                qname,
+                last: 0,
+                default_ns,
+            });
         }
         Some(())
+    }
+
+    /// A start tag's attributes up to the tag's end, pushed straight into the document while
+    /// none has a prefix or is named `xmlns` (no declaration: every attribute in no
+    /// namespace, a duplicate a repeated name): whether the element is empty (`/>`), or
+    /// `Some(None)` at the first attribute that has a prefix or is `xmlns` (the tag is then
+    /// read again by [`Reader::declared_attributes`]).
+    fn plain_attributes(&mut self, a0: usize) -> Option<Option<bool>> {
+        loop {
+            let spaced = self.skip_space();
+            match *self.b.get(self.i)? {
+                b'/' => {
+                    self.eat(b"/>")?;
+                    return Some(Some(true));
+                }
+                b'>' => {
+                    self.i += 1;
+                    return Some(Some(false));
+                }
+                _ if spaced => {
+                    let (p, l) = self.qname()?;
+                    let b = self.b;
+                    let name = &b[l.0..l.1];
+                    if p.0 != p.1 || (name.len() == 5 && name == b"xmlns") {
+                        return Some(None);
+                    }
+                    self.skip_space();
+                    self.eat(b"=")?;
+                    self.skip_space();
+                    let value = self.quoted()?;
+                    let h = head(name);
+                    let same = |x: &AttrData| {
+                        x.head == h
+                            && x.name.len as usize == name.len()
+                            && (name.len() <= 4
+                                || b[x.name.start as usize + 4..][..name.len() - 4] == name[4..])
+                    };
+                    if self.doc.attrs[a0..].iter().any(same) {
+                        return None;
+                    }
+                    self.doc.attrs.push(AttrData {
+                        ns: 0,
+                        name: Str::of(l.0..l.1),
+                        value: Str::of(value.0..value.1),
+                        head: h,
+                    });
+                }
+                _ => return None,
+            }
+        }
     }
 }

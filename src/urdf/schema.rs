@@ -258,6 +258,10 @@ fn check_node(
 pub(super) fn check(src: &Source, robot: Node, warnings: &mut Vec<String>) -> Result<()> {
     let mut warned = false;
     for n in robot.descendants().filter(|n| n.is_element()) {
+        // In no namespace, nor any of its attributes: nothing to check.
+        if n.is_plain_element() {
+            continue;
+        }
         let ns = n.tag_name().namespace();
         if let Some(uri) = ns.filter(|&u| u != MECH_NS) {
             if !warned && n.lookup_prefix(uri) == Some("mech") {

@@ -80,19 +80,6 @@ pub(crate) fn ldlt_solve(f: &[f64], d: usize, x: &mut [f64], w: usize) {
     }
 }
 
-/// `x ← A⁻¹ b` for the factors of [`ldlt`], `b` (`d × w`) read from `src`: [`ldlt_solve`] on
-/// a copy of `b`, the copy made by the first read of each row for a chain's sizes.
-pub(crate) fn ldlt_solve_from(f: &[f64], d: usize, src: &[f64], x: &mut [f64], w: usize) {
-    match (d, w) {
-        (13, 7) => fixed::ldlt_solve_from::<13, 7>(f, src, x),
-        (14, 7) => fixed::ldlt_solve_from::<14, 7>(f, src, x),
-        _ => {
-            x[..d * w].copy_from_slice(&src[..d * w]);
-            ldlt_solve(f, d, x, w);
-        }
-    }
-}
-
 #[inline(always)]
 fn ldlt_solve_impl(f: &[f64], d: usize, x: &mut [f64], w: usize) {
     let (f, x) = (&f[..d * d], &mut x[..d * w]);

@@ -84,23 +84,6 @@ fn column<const D: usize, const J: usize>(
 /// `x` is `D × W` row-major, each row finished in registers.
 #[inline(never)]
 pub(super) fn ldlt_solve<const D: usize, const W: usize>(f: &[f64], x: &mut [f64]) {
-    solve::<D, W>(f, None, x);
-}
-
-/// `x ← A⁻¹ b` for the factors of [`ldlt`]: [`ldlt_solve`] with the right side `b` read from
-/// `src` as each row's first read (the same operations as copying `b` into `x` first).
-#[inline(never)]
-pub(super) fn ldlt_solve_from<const D: usize, const W: usize>(
-    f: &[f64],
-    src: &[f64],
-    x: &mut [f64],
-) {
-    solve::<D, W>(f, Some(&src[..D * W]), x);
-}
-
-/// [`ldlt_solve`], its right side in `src` if given, else in `x`.
-#[inline(always)]
-fn solve<const D: usize, const W: usize>(f: &[f64], src: Option<&[f64]>, x: &mut [f64]) {
     const { assert!(D <= 27) };
     let (f, x) = (&f[..D * D], &mut x[..D * W]);
     macro_rules! each_row {
@@ -111,32 +94,17 @@ fn solve<const D: usize, const W: usize>(f: &[f64], src: Option<&[f64]>, x: &mut
                 }
             )*
         };
-        ($step:ident ($src:ident): $($i:literal)*) => {
-            $(
-                if $i < D {
-                    $step::<D, W, $i>(f, $src, x);
-                }
-            )*
-        };
     }
-    each_row!(forward(src): 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26);
+    each_row!(forward: 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26);
     each_row!(backward: 26 25 24 23 22 21 20 19 18 17 16 15 14 13 12 11 10 9 8 7 6 5 4 3 2 1 0);
 }
 
-/// Row `I` of `L y = b` (`f` is `D × D`, `x` is `D × W`, both row-major; `b` in `src` if
-/// given, else in `x`).
+/// Row `I` of `L y = x` (`f` is `D × D`, `x` is `D × W`, both row-major).
 #[inline(always)]
-fn forward<const D: usize, const W: usize, const I: usize>(
-    f: &[f64],
-    src: Option<&[f64]>,
-    x: &mut [f64],
-) {
+fn forward<const D: usize, const W: usize, const I: usize>(f: &[f64], x: &mut [f64]) {
     let (done, rest) = x.split_at_mut(I * W);
     let mut acc = [0.0; W];
-    match src {
-        Some(b) => acc.copy_from_slice(&b[I * W..I * W + W]),
-        None => acc.copy_from_slice(&rest[..W]),
-    }
+    acc.copy_from_slice(&rest[..W]);
     for k in 0..I {
         let l = f[I * D + k];
         if l != 0.0 {

@@ -268,11 +268,11 @@ impl TreeKkt {
             let (before, after) = rest.split_at_mut(s.coup_at[i] - base);
             let x = &mut after[..d * w];
             let c = &values[s.coup_at[i]..s.coup_at[i] + d * w];
+            x.copy_from_slice(c);
             if lu {
-                x.copy_from_slice(c);
                 dense::lu_solve(blk, piv, d, x, w);
             } else {
-                dense::ldlt_solve_from(blk, d, c, x, w);
+                dense::ldlt_solve(blk, d, x, w);
             }
             let p = p as usize;
             let dp = s.d[p];

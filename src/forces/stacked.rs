@@ -210,13 +210,9 @@ struct FirstOrder {
 fn first_order(joint: &Joint, pair: &Pair, a: [&Matrix3<f64>; 2]) -> FirstOrder {
     let (p0, p1) = (&pair.p[0], &pair.p[1]);
     let (a0, a1) = (a[0], a[1]);
-    let r0 = joint.body_from_joint[0].rotation.to_rotation_matrix();
-    let r1 = joint.body_from_joint[1].rotation.to_rotation_matrix();
-    let (bx0, by0) = (
-        r0.matrix().column(0).into_owned(),
-        r0.matrix().column(1).into_owned(),
-    );
-    let bx1 = r1.matrix().column(0).into_owned();
+    let [r0, r1] = crate::jet::closed::frame_rotations(joint);
+    let (bx0, by0) = (r0.column(0).into_owned(), r0.column(1).into_owned());
+    let bx1 = r1.column(0).into_owned();
     let (x0, y0, x1) = (a0 * bx0, a0 * by0, a1 * bx1);
     let (b0x, b0y, b1x) = (b_matrix(p0, &bx0), b_matrix(p0, &by0), b_matrix(p1, &bx1));
     // `∇S`, `∇C` (as `dot_gradient`: zero on the positions).

@@ -467,11 +467,8 @@ pub(crate) fn add_weighted_hessian(
 /// The revolute angle `atan2(y₀·x₁, x₀·x₁)` about the parent's `z` (as
 /// [`crate::kinematics::angle`], in (−π, π]), with the Hessian when `pair.hess`.
 pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair) -> Scalar {
-    let rot = Rotations::of(pair);
-    let axis = |k: usize, i: usize| {
-        let r = joint.body_from_joint[k].rotation.to_rotation_matrix();
-        Lin::vector(pair, &rot.0[k], k, &r.matrix().column(i).into_owned())
-    };
+    let (rot, r) = (Rotations::of(pair), frame_rotations(joint));
+    let axis = |k: usize, i: usize| Lin::vector(pair, &rot.0[k], k, &r[k].column(i).into_owned());
     let (x0, y0, x1) = (axis(0, 0), axis(0, 1), axis(1, 0));
     let scalar = |a: &Lin, b: &Lin| {
         let mut g = LVec::zeros();

@@ -151,7 +151,7 @@ pub(crate) fn joint_spectrum(
         chosen_inverse(&t, &selectable)?
     };
     let h_theta = m.transpose() * h * &m;
-    let h_theta = (&h_theta + h_theta.transpose()) * 0.5;
+    let h_theta = crate::solver::system::symmetric_part(h_theta);
     let (vals, vecs) = super::eigen::symmetric_eigen(&h_theta);
     let modes = (0..shown.min(dof))
         .map(|k| {

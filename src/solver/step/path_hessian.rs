@@ -33,7 +33,7 @@ use crate::solver::stability::blocks::block_symmetric_eigen;
 use crate::solver::stability::spectrum::Spectrum;
 use crate::solver::step::retraction::angular_velocity;
 use crate::solver::step::tr_product::add_tr_product;
-use crate::solver::system::{Eval, System};
+use crate::solver::system::{symmetric_part, Eval, System};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3, Vector4};
 use std::collections::BTreeMap;
 
@@ -165,7 +165,7 @@ fn curvature_of(
         let kt = k_omega * &omega[l] + k_vel * &vel[l];
         add_tr_product(&mut m, &a, &kt);
     }
-    (&m + m.transpose()) * 0.5
+    symmetric_part(m)
 }
 
 /// `Σ ω_k` over the edges `k` above `l` (nearer the root), summed from the root down and kept
@@ -281,7 +281,7 @@ pub(crate) fn along_path(
 ) -> Spectrum {
     let mut h = &e.vectors * DMatrix::from_diagonal(&e.values) * e.vectors.transpose();
     h += path_curvature(sys, q, part, eval, e.basis.as_ref());
-    let h = (&h + h.transpose()) * 0.5;
+    let h = symmetric_part(h);
     // Per decoupled block (fingers, legs): each eigenvector on one of them.
     let (values, vectors) = block_symmetric_eigen(&h);
     Spectrum {

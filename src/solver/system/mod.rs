@@ -40,5 +40,5 @@ pub(crate) use factors::Factors;
 #[cfg(test)]
 pub(crate) use kkt_matrix::KktMatrix;
 pub(crate) use problem::{coordinate_scale, Problem, Scaling};
-pub(crate) use reduced::Eval;
+pub(crate) use reduced::{symmetric_part, Eval};
 pub(crate) use workspace::Workspace;

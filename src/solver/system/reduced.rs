@@ -388,7 +388,7 @@ impl System<'_> {
 /// `(A + Aᵀ) / 2` of a square `a`, in place: each entry `(a_ij + a_ji) · 0.5`, the
 /// operations of `(&a + a.transpose()) * 0.5` (an IEEE sum is commutative) without its two
 /// temporaries.
-fn symmetric_part(mut a: DMatrix<f64>) -> DMatrix<f64> {
+pub(crate) fn symmetric_part(mut a: DMatrix<f64>) -> DMatrix<f64> {
     let n = a.nrows();
     for j in 0..n {
         for i in 0..=j {

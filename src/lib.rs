@@ -25,6 +25,7 @@
 //! ```
 
 pub mod constraints;
+pub mod cpu;
 pub mod error;
 pub mod export;
 pub mod forces;

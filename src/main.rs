@@ -13,6 +13,16 @@ use std::process::ExitCode;
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn main() -> ExitCode {
+    // A build for extensions this CPU lacks refuses before it meets one (module `cpu`).
+    let missing = restpose::cpu::unsupported();
+    if !missing.is_empty() {
+        eprintln!(
+            "error: this CPU lacks {}: {}",
+            missing.join(", "),
+            restpose::cpu::REMEDY
+        );
+        return ExitCode::from(cli::exit::INPUT);
+    }
     let cli = Cli::parse();
     let out = match &cli.command {
         Command::Analyze(a) => cli::analyze::run(a),

@@ -25,6 +25,15 @@ use pyo3::prelude::*;
 /// The extension module.
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // A build for extensions this CPU lacks refuses to import (`restpose::cpu`).
+    let missing = restpose::cpu::unsupported();
+    if !missing.is_empty() {
+        return Err(pyo3::exceptions::PyImportError::new_err(format!(
+            "this CPU lacks {}: {}",
+            missing.join(", "),
+            restpose::cpu::REMEDY
+        )));
+    }
     m.add_class::<model::Model>()?;
     m.add_class::<result::Result>()?;
     m.add_class::<builder::ModelBuilder>()?;

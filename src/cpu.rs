@@ -1,0 +1,104 @@
+//! The instruction-set extensions this build was compiled for, checked against the CPU it
+//! runs on.
+//!
+//! Builds from this repository target **x86-64-v3** on x86-64 (`.cargo/config.toml`:
+//! `-C target-cpu=x86-64-v3`: AVX, AVX2, FMA, BMI1/2, F16C, LZCNT and the SSE levels below;
+//! Intel Haswell (2013) and AMD Excavator (2015) or later). The compiler then vectorizes the
+//! solver's fixed-size block loops four doubles wide: 4 – 5 % less CPU on a 1,000-link chain,
+//! the ladder and the rope, every answer bit for bit the baseline build's (Rust never fuses
+//! `a * b + c` into an FMA, so the rounding of each operation is the same; BENCHMARKS.md).
+//! Built for the baseline instead (`RUSTFLAGS="-C target-cpu=x86-64"`), nothing here is
+//! required and [`unsupported`] is always empty.
+//!
+//! A binary built for extensions the CPU lacks would die on the first such instruction
+//! (`SIGILL`); the command line and the Python module call [`unsupported`] first and refuse
+//! with [`REMEDY`] instead. The check is a few `cfg!` constants and calls into the standard
+//! library's feature detection (compiled for the baseline): best effort, since the compiler
+//! may still use an extension in the check's own few instructions.
+
+/// The message for a CPU that lacks what this build needs: the remedy, after the missing list.
+pub const REMEDY: &str = "this restpose was built for x86-64-v3 (the repository's \
+     .cargo/config.toml); rebuild it for this CPU with RUSTFLAGS=\"-C target-cpu=native\" \
+     (or \"-C target-cpu=x86-64\" for any x86-64), e.g. \
+     `RUSTFLAGS=\"-C target-cpu=native\" cargo install --path .`";
+
+/// The extensions this build was compiled for (of those the detection knows), in the
+/// order of the x86-64 levels; empty on other architectures or a baseline build.
+pub fn required() -> Vec<&'static str> {
+    let mut out = Vec::new();
+    #[cfg(target_arch = "x86_64")]
+    {
+        macro_rules! compiled_for {
+            ($($f:tt),*) => {
+                $(if cfg!(target_feature = $f) {
+                    out.push($f);
+                })*
+            };
+        }
+        compiled_for!(
+            "sse3", "ssse3", "sse4.1", "sse4.2", "popcnt", "avx", "avx2", "fma", "bmi1", "bmi2",
+            "f16c", "lzcnt"
+        );
+    }
+    out
+}
+
+/// The extensions of [`required`] that this CPU lacks (empty: the build runs here).
+pub fn unsupported() -> Vec<&'static str> {
+    #[cfg(target_arch = "x86_64")]
+    {
+        required().into_iter().filter(|f| !detected(f)).collect()
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        Vec::new()
+    }
+}
+
+/// Whether the CPU has extension `f` (one of [`required`]'s names).
+#[cfg(target_arch = "x86_64")]
+fn detected(f: &str) -> bool {
+    use std::arch::is_x86_feature_detected as has;
+    match f {
+        "sse3" => has!("sse3"),
+        "ssse3" => has!("ssse3"),
+        "sse4.1" => has!("sse4.1"),
+        "sse4.2" => has!("sse4.2"),
+        "popcnt" => has!("popcnt"),
+        "avx" => has!("avx"),
+        "avx2" => has!("avx2"),
+        "fma" => has!("fma"),
+        "bmi1" => has!("bmi1"),
+        "bmi2" => has!("bmi2"),
+        "f16c" => has!("f16c"),
+        "lzcnt" => has!("lzcnt"),
+        _ => false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The list follows the build's own target features: with the repository's configuration
+    /// on x86-64 it names AVX2 and FMA, and a baseline build names neither.
+    #[test]
+    fn required_follows_the_build() {
+        let r = required();
+        assert_eq!(r.contains(&"avx2"), cfg!(target_feature = "avx2"));
+        assert_eq!(r.contains(&"fma"), cfg!(target_feature = "fma"));
+        #[cfg(not(target_arch = "x86_64"))]
+        assert!(r.is_empty());
+    }
+
+    /// The machine that runs the tests runs this build (else the tests could not run), and
+    /// the detection agrees with it extension by extension.
+    #[test]
+    fn this_machine_is_supported() {
+        assert_eq!(unsupported(), Vec::<&str>::new());
+        #[cfg(target_arch = "x86_64")]
+        for f in required() {
+            assert!(detected(f), "{f} compiled for but not detected");
+        }
+    }
+}

@@ -3,7 +3,7 @@
 //! has no cycle and no upward import. The table is the architecture of `docs/development.md`:
 //!
 //! ```text
-//! (lcg, tests only)  →  error, math  →  geometry | joint  →  model  →  jet  →  kinematics  →  constraints | forces
+//! (lcg, tests only)  →  error, math, names, cpu  →  geometry | joint  →  model  →  jet  →  kinematics  →  constraints | forces
 //!   →  state  →  urdf | generate  →  solver  →  verify  →  export | view  →  (cli)
 //! ```
 //!
@@ -20,6 +20,8 @@ const LAYERS: &[(&str, u32)] = &[
     ("error", 1),
     ("math", 1),
     ("names", 1),
+    // The CPU extensions of the build against the machine's (uses nothing of the crate).
+    ("cpu", 1),
     ("geometry", 2),
     ("joint", 2),
     ("model", 3),

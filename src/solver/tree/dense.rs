@@ -67,14 +67,14 @@ pub(crate) fn ldlt_solve(f: &[f64], d: usize, x: &mut [f64], w: usize) {
     // Constant sizes of a chain's and a ladder's blocks (module `fixed`).
     match (d, w) {
         (13, 1) => fixed::ldlt_solve::<13, 1>(f, x),
-        (13, 7) => fixed::ldlt_solve_padded::<13, 7, 8>(f, x),
+        (13, 7) => fixed::ldlt_solve::<13, 7>(f, x),
         (14, 1) => fixed::ldlt_solve::<14, 1>(f, x),
-        (14, 7) => fixed::ldlt_solve_padded::<14, 7, 8>(f, x),
+        (14, 7) => fixed::ldlt_solve::<14, 7>(f, x),
         (8, 1) => fixed::ldlt_solve::<8, 1>(f, x),
-        (8, 7) => fixed::ldlt_solve_padded::<8, 7, 8>(f, x),
+        (8, 7) => fixed::ldlt_solve::<8, 7>(f, x),
         // A ladder's super-nodes of the KKT matrix (module `merge`).
         (27, 1) => fixed::ldlt_solve::<27, 1>(f, x),
-        (27, 7) => fixed::ldlt_solve_padded::<27, 7, 8>(f, x),
+        (27, 7) => fixed::ldlt_solve::<27, 7>(f, x),
         (14, 18) => fixed::ldlt_solve::<14, 18>(f, x),
         _ => ldlt_solve_impl(f, d, x, w),
     }

@@ -53,12 +53,7 @@ fn right_sides(d: usize, w: usize, seed: u64) -> Vec<f64> {
 
 #[test]
 fn unrolled_ldlt_and_solves_are_the_general_loops_bit_for_bit() {
-    for (d, ws) in [
-        (8, &[1, 7][..]),
-        (13, &[1, 7]),
-        (14, &[1, 7, 18]),
-        (27, &[1, 7]),
-    ] {
+    for (d, ws) in [(8, [1, 7]), (13, [1, 7]), (14, [7, 18]), (27, [1, 7])] {
         let a = kkt_block(d, d as u64);
         let (mut f, mut g) = (a.clone(), a);
         let negative = ldlt(&mut f, d).expect("nonsingular");
@@ -74,7 +69,7 @@ fn unrolled_ldlt_and_solves_are_the_general_loops_bit_for_bit() {
             }
         }
         assert!(f[(d - 1) * d] == 0.0, "d {d}: a zero in L");
-        for &w in ws {
+        for w in ws {
             let x0 = right_sides(d, w, 5 + d as u64);
             let (mut x, mut y) = (x0.clone(), x0);
             ldlt_solve(&f, d, &mut x, w);

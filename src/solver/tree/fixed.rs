@@ -80,41 +80,12 @@ fn column<const D: usize, const J: usize>(
     Some(djj < 0.0)
 }
 
-/// `x ← A⁻¹ x` for the factors of [`ldlt`] (both triangles read: a single right side's
-/// forward pass reads the columns of `L` as the rows of `Lᵀ` above the diagonal); `x` is
-/// `D × W` row-major, each row finished in registers.
+/// `x ← A⁻¹ x` for the factors of [`ldlt`] (or `dense::ldlt`'s: the lower triangle is read);
+/// `x` is `D × W` row-major, each row finished in registers.
 #[inline(never)]
 pub(super) fn ldlt_solve<const D: usize, const W: usize>(f: &[f64], x: &mut [f64]) {
-    solve::<D, W>(&f[..D * D], &mut x[..D * W]);
-}
-
-/// [`ldlt_solve`] for `W` right sides solved as `WP > W` (a whole number of vector lanes: 7 → 8):
-/// `x` is copied into a `D × WP` scratch whose columns `W..WP` repeat column `W − 1`; they are
-/// computed (each lane of a row's update is independent of the others) and never read back.
-/// (Zeros there would let the compiler split the rows into pieces again, to skip what it
-/// knows stays zero.)
-#[inline(never)]
-pub(super) fn ldlt_solve_padded<const D: usize, const W: usize, const WP: usize>(
-    f: &[f64],
-    x: &mut [f64],
-) {
-    const { assert!(W < WP) };
-    let x = &mut x[..D * W];
-    let mut wide = [[0.0; WP]; D];
-    for (row, src) in wide.iter_mut().zip(x.chunks_exact(W)) {
-        row[..W].copy_from_slice(src);
-        row[W..].fill(src[W - 1]);
-    }
-    solve::<D, WP>(&f[..D * D], wide.as_flattened_mut());
-    for (dst, row) in x.chunks_exact_mut(W).zip(&wide) {
-        dst.copy_from_slice(&row[..W]);
-    }
-}
-
-/// The forward and backward passes of [`ldlt_solve`].
-#[inline(always)]
-fn solve<const D: usize, const W: usize>(f: &[f64], x: &mut [f64]) {
     const { assert!(D <= 27) };
+    let (f, x) = (&f[..D * D], &mut x[..D * W]);
     macro_rules! each_row {
         ($step:ident: $($i:literal)*) => {
             $(
@@ -124,36 +95,8 @@ fn solve<const D: usize, const W: usize>(f: &[f64], x: &mut [f64]) {
             )*
         };
     }
-    if W == 1 {
-        let mut y = [0.0; D];
-        y.copy_from_slice(&x[..D]);
-        macro_rules! each_column {
-            ($($k:literal)*) => {
-                $(
-                    if $k < D {
-                        forward_column::<D, $k>(f, &mut y);
-                    }
-                )*
-            };
-        }
-        each_column!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26);
-        x[..D].copy_from_slice(&y);
-    } else {
-        each_row!(forward: 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26);
-    }
+    each_row!(forward: 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26);
     each_row!(backward: 26 25 24 23 22 21 20 19 18 17 16 15 14 13 12 11 10 9 8 7 6 5 4 3 2 1 0);
-}
-
-/// Column `K` of `L y = x` for one right side, once `y_K` is final: `y_i −= L_iK y_K` for all
-/// `i > K` at once (`L_iK` read as row `K` of `Lᵀ`), a term with `L_iK = 0` skipped. Each
-/// `y_i` still takes its terms in increasing `k`, as in the row form [`forward`].
-#[inline(always)]
-fn forward_column<const D: usize, const K: usize>(f: &[f64], y: &mut [f64; D]) {
-    let (yk, lk) = (y[K], &f[K * D..K * D + D]);
-    for i in K + 1..D {
-        let l = lk[i];
-        y[i] = if l != 0.0 { y[i] - l * yk } else { y[i] };
-    }
 }
 
 /// Row `I` of `L y = x` (`f` is `D × D`, `x` is `D × W`, both row-major).

@@ -22,58 +22,44 @@ pub const REMEDY: &str = "this restpose was built for x86-64-v3 (the repository'
      (or \"-C target-cpu=x86-64\" for any x86-64), e.g. \
      `RUSTFLAGS=\"-C target-cpu=native\" cargo install --path .`";
 
-/// The extensions this build was compiled for (of those the detection knows), in the
-/// order of the x86-64 levels; empty on other architectures or a baseline build.
-pub fn required() -> Vec<&'static str> {
-    let mut out = Vec::new();
-    #[cfg(target_arch = "x86_64")]
-    {
-        macro_rules! compiled_for {
-            ($($f:tt),*) => {
-                $(if cfg!(target_feature = $f) {
-                    out.push($f);
-                })*
-            };
-        }
-        compiled_for!(
-            "sse3", "ssse3", "sse4.1", "sse4.2", "popcnt", "avx", "avx2", "fma", "bmi1", "bmi2",
-            "f16c", "lzcnt"
-        );
+/// Each extension the detection knows, in the order of the x86-64 levels: its name, whether
+/// this build was compiled for it, whether this CPU has it.
+#[cfg(target_arch = "x86_64")]
+fn extensions() -> Vec<(&'static str, bool, bool)> {
+    macro_rules! each {
+        ($($f:tt),*) => {
+            vec![$(($f, cfg!(target_feature = $f), std::arch::is_x86_feature_detected!($f))),*]
+        };
     }
-    out
+    each!(
+        "sse3", "ssse3", "sse4.1", "sse4.2", "popcnt", "avx", "avx2", "fma", "bmi1", "bmi2",
+        "f16c", "lzcnt"
+    )
+}
+
+/// No extension is known on other architectures.
+#[cfg(not(target_arch = "x86_64"))]
+fn extensions() -> Vec<(&'static str, bool, bool)> {
+    Vec::new()
+}
+
+/// The extensions this build was compiled for (of those the detection knows), in the order
+/// of the x86-64 levels; empty on other architectures or a baseline build.
+pub fn required() -> Vec<&'static str> {
+    extensions()
+        .into_iter()
+        .filter(|e| e.1)
+        .map(|e| e.0)
+        .collect()
 }
 
 /// The extensions of [`required`] that this CPU lacks (empty: the build runs here).
 pub fn unsupported() -> Vec<&'static str> {
-    #[cfg(target_arch = "x86_64")]
-    {
-        required().into_iter().filter(|f| !detected(f)).collect()
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        Vec::new()
-    }
-}
-
-/// Whether the CPU has extension `f` (one of [`required`]'s names).
-#[cfg(target_arch = "x86_64")]
-fn detected(f: &str) -> bool {
-    use std::arch::is_x86_feature_detected as has;
-    match f {
-        "sse3" => has!("sse3"),
-        "ssse3" => has!("ssse3"),
-        "sse4.1" => has!("sse4.1"),
-        "sse4.2" => has!("sse4.2"),
-        "popcnt" => has!("popcnt"),
-        "avx" => has!("avx"),
-        "avx2" => has!("avx2"),
-        "fma" => has!("fma"),
-        "bmi1" => has!("bmi1"),
-        "bmi2" => has!("bmi2"),
-        "f16c" => has!("f16c"),
-        "lzcnt" => has!("lzcnt"),
-        _ => false,
-    }
+    extensions()
+        .into_iter()
+        .filter(|e| e.1 && !e.2)
+        .map(|e| e.0)
+        .collect()
 }
 
 #[cfg(test)]
@@ -96,9 +82,8 @@ mod tests {
     #[test]
     fn this_machine_is_supported() {
         assert_eq!(unsupported(), Vec::<&str>::new());
-        #[cfg(target_arch = "x86_64")]
-        for f in required() {
-            assert!(detected(f), "{f} compiled for but not detected");
+        for (f, compiled, detected) in extensions() {
+            assert!(!compiled || detected, "{f} compiled for but not detected");
         }
     }
 }

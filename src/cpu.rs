@@ -17,10 +17,10 @@
 //! may still use an extension in the check's own few instructions.
 
 /// The message for a CPU that lacks what this build needs: the remedy, after the missing list.
-pub const REMEDY: &str = "this restpose was built for x86-64-v3 (the repository's \
-     .cargo/config.toml); rebuild it for this CPU with RUSTFLAGS=\"-C target-cpu=native\" \
-     (or \"-C target-cpu=x86-64\" for any x86-64), e.g. \
-     `RUSTFLAGS=\"-C target-cpu=native\" cargo install --path .`";
+pub const REMEDY: &str = "this restpose was built for a newer CPU (the repository's \
+     .cargo/config.toml targets x86-64-v3, unless RUSTFLAGS named another); rebuild it for \
+     this CPU with RUSTFLAGS=\"-C target-cpu=native\" (or \"-C target-cpu=x86-64\" for any \
+     x86-64), e.g. `RUSTFLAGS=\"-C target-cpu=native\" cargo install --path .`";
 
 /// Each extension the detection knows, in the order of the x86-64 levels: its name, whether
 /// this build was compiled for it, whether this CPU has it.

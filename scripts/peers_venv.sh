@@ -1,4 +1,5 @@
-# Sourced by peers_check.sh, stand_check.sh, pinocchio_corpus.sh and pybullet_corpus.sh (from
+# Sourced by peers_check.sh, stand_check.sh, pinocchio_corpus.sh, pybullet_corpus.sh and
+# rtb_corpus.sh (from
 # the repository root): the venv with the real tools from PyPI, created once and reused
 # (RESTPOSE_PEERS_VENV, default ~/.cache/restpose-peers/venv; versions pinned below), the binary
 # to check (RESTPOSE, default: built here with cargo), example-robot-data's robots directory in
@@ -6,8 +7,10 @@
 # Exits 1 on a failure, 2 when PyPI is unreachable and the venv does not exist yet.
 VENV="${RESTPOSE_PEERS_VENV:-$HOME/.cache/restpose-peers/venv}"
 # pybullet only for its data (pybullet_data/: scripts/pybullet_corpus.sh); a wheel, never a
-# build from source.
-PACKAGES=(mujoco==4.0.0 pin==4.1.0 example-robot-data==6.0.0 pybullet==3.2.7)
+# build from source. rtb-data (the Robotics Toolbox's robot descriptions), ROS's xacro and
+# pycollada for scripts/rtb_corpus.sh.
+PACKAGES=(mujoco==4.0.0 pin==4.1.0 example-robot-data==6.0.0 pybullet==3.2.7 rtb-data==2.0.0
+          xacro==2.1.1 pycollada==0.9.3)
 
 if [[ -z "${RESTPOSE:-}" ]]; then
     cargo build --release --quiet --bin restpose || exit 1

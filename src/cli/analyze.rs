@@ -49,6 +49,25 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
                  --inertia-from-geometry DENSITY"
             )
         }
+        restpose::Error::ConstantEnergy { .. } => {
+            // --inertia-from-geometry was given and weighed nothing: say why even under -q,
+            // which keeps the import's warnings off standard error.
+            let why: Vec<&String> = loaded
+                .warnings
+                .iter()
+                .filter(|w| w.contains("no mass from geometry"))
+                .collect();
+            match why.first() {
+                Some(first) => anyhow::anyhow!(
+                    "{e}; --inertia-from-geometry could not weigh {} link(s), the first: {first}",
+                    why.len()
+                ),
+                None => anyhow::anyhow!(
+                    "{e}; --inertia-from-geometry found no link without <inertial> that has \
+                     geometry"
+                ),
+            }
+        }
         restpose::Error::Assembly { ref remedy, .. } if remedy.contains("mech:base") => {
             anyhow::anyhow!(
                 "{e}; on the command line: --base-xyz X Y Z (and --base-rpy) for the base, \

@@ -1,7 +1,16 @@
 //! Mass properties from geometry (`--inertia-from-geometry ρ`): each shape's mass `ρ V`,
 //! centre of mass and inertia (parry3d), moved to the link frame and summed with the
-//! parallel-axis theorem.
+//! parallel-axis theorem,
+//!
+//! ```text
+//! m = Σ mᵢ,   c = Σ mᵢ cᵢ / m,   I = Σ Rᵢ Iᵢ Rᵢᵀ + mᵢ (|cᵢ − c|² 1 − (cᵢ − c)(cᵢ − c)ᵀ)
+//! ```
+//!
+//! A mesh that is not closed encloses no defined volume: the meshes whose volume is uncertain
+//! by more than [`super::closure::OPEN_MESH_TOLERANCE`] are listed with the result
+//! ([`GeometryMass::open_meshes`]) for the import to warn.
 
+use super::closure::{volume_uncertainty, OPEN_MESH_TOLERANCE};
 use super::{load_mesh, Geometry, GeometryError, ShapeKind};
 use nalgebra::{Isometry3, Matrix3, Vector3};
 use parry3d_f64::mass_properties::MassProperties;
@@ -17,8 +26,14 @@ fn pose(iso: &Isometry3<f64>) -> Pose {
     )
 }
 
-fn shape_mass(shape: &ShapeKind, density: f64) -> Result<MassProperties, GeometryError> {
-    Ok(match shape {
+/// A shape's mass properties, and for a mesh the relative uncertainty of its volume
+/// ([`volume_uncertainty`]).
+fn shape_mass(
+    shape: &ShapeKind,
+    density: f64,
+) -> Result<(MassProperties, Option<f64>), GeometryError> {
+    let mut uncertainty = None;
+    let mass = match shape {
         ShapeKind::Box { size } => {
             Cuboid::new(Vector::new(size.x / 2.0, size.y / 2.0, size.z / 2.0))
                 .mass_properties(density)
@@ -39,6 +54,7 @@ fn shape_mass(shape: &ShapeKind, density: f64) -> Result<MassProperties, Geometr
             ..
         } => {
             let (v, f) = load_mesh(path, scale)?;
+            uncertainty = Some(volume_uncertainty(&v, &f));
             let v = v
                 .into_iter()
                 .map(|p| Vector::new(p[0], p[1], p[2]))
@@ -53,21 +69,40 @@ fn shape_mass(shape: &ShapeKind, density: f64) -> Result<MassProperties, Geometr
         ShapeKind::Mesh {
             uri, path: None, ..
         } => return Err(GeometryError::MeshNotFound { uri: uri.clone() }),
-    })
+    };
+    Ok((mass, uncertainty))
+}
+
+/// The mass properties of a link's geometry.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GeometryMass {
+    /// Mass \[kg\].
+    pub mass: f64,
+    /// Centre of mass in the link frame \[m\].
+    pub com: Vector3<f64>,
+    /// Inertia about the centre of mass, link axes \[kg m²\].
+    pub inertia: Matrix3<f64>,
+    /// Meshes that are not closed: their URI as written and the relative uncertainty of the
+    /// volume they enclose (above [`OPEN_MESH_TOLERANCE`]; module `closure`).
+    pub open_meshes: Vec<(String, f64)>,
 }
 
 /// Mass \[kg\], centre of mass and inertia about it (link frame) of `geometry` at `density`
-/// \[kg/m³\].
+/// \[kg/m³\], and the meshes among it that are not closed.
 ///
 /// # Errors
 /// A message if a mesh cannot be read or the result is not a positive mass.
-pub fn mass_properties(
-    geometry: &[Geometry],
-    density: f64,
-) -> Result<(f64, Vector3<f64>, Matrix3<f64>), GeometryError> {
+pub fn mass_properties(geometry: &[Geometry], density: f64) -> Result<GeometryMass, GeometryError> {
     let mut total: Option<MassProperties> = None;
+    let mut open_meshes = Vec::new();
     for g in geometry {
-        let mp = shape_mass(&g.shape, density)?.transform_by(&pose(&g.link_from_shape));
+        let (mp, uncertainty) = shape_mass(&g.shape, density)?;
+        if let (Some(u), ShapeKind::Mesh { uri, .. }) = (uncertainty, &g.shape) {
+            if u > OPEN_MESH_TOLERANCE || u.is_nan() {
+                open_meshes.push((uri.clone(), u));
+            }
+        }
+        let mp = mp.transform_by(&pose(&g.link_from_shape));
         total = Some(match total {
             Some(t) => t + mp,
             None => mp,
@@ -81,11 +116,12 @@ pub fn mass_properties(
     let c = mp.local_com;
     let i = mp.reconstruct_inertia_matrix();
     let cols = i.to_cols_array();
-    Ok((
+    Ok(GeometryMass {
         mass,
-        Vector3::new(c.x, c.y, c.z),
-        Matrix3::from_column_slice(&cols),
-    ))
+        com: Vector3::new(c.x, c.y, c.z),
+        inertia: Matrix3::from_column_slice(&cols),
+        open_meshes,
+    })
 }
 
 #[cfg(test)]
@@ -99,7 +135,12 @@ mod tests {
             link_from_shape: Isometry3::translation(x, 0.0, 0.0),
             shape,
         };
-        let (m, c, i) = mass_properties(
+        let GeometryMass {
+            mass: m,
+            com: c,
+            inertia: i,
+            ..
+        } = mass_properties(
             &[g(
                 ShapeKind::Box {
                     size: Vector3::new(1.0, 2.0, 3.0),
@@ -112,7 +153,11 @@ mod tests {
         assert!((m - 60.0).abs() < 1e-9);
         assert!((c - Vector3::new(0.5, 0.0, 0.0)).norm() < 1e-12);
         assert!((i[(0, 0)] - 60.0 * (4.0 + 9.0) / 12.0).abs() < 1e-9);
-        let (m, _, i) = mass_properties(
+        let GeometryMass {
+            mass: m,
+            inertia: i,
+            ..
+        } = mass_properties(
             &[g(
                 ShapeKind::Cylinder {
                     radius: 0.5,

@@ -16,8 +16,10 @@
 //!   `surface`: the signed distance to a shape's surface (closest point and normal, the
 //!   obstacles' gap rows); `curvature`: its Hessian;
 //!   `contact`: the contact points of a collision shape; `distance`: parry3d's signed
-//!   distances (independent checks); `mass`: mass properties; `error`: what can go wrong.
+//!   distances (independent checks); `mass`: mass properties; `closure`: whether a mesh is
+//!   closed enough to enclose a volume; `error`: what can go wrong.
 
+mod closure;
 mod contact;
 mod curvature;
 mod distance;
@@ -29,12 +31,13 @@ mod package;
 mod shape;
 mod surface;
 
+pub use closure::{volume_uncertainty, OPEN_MESH_TOLERANCE};
 pub use contact::{contact_points, CYLINDER_RIM_POINTS};
 pub(crate) use curvature::curvature;
 pub use distance::{parry_cylinder_signed_distance, parry_signed_distance};
 pub use error::GeometryError;
 pub use hull::Hull;
-pub use mass::mass_properties;
+pub use mass::{mass_properties, GeometryMass};
 pub use mesh::{convex_hull, convex_hull_of, load_mesh, Triangles, Triangles3, MAX_MESH_BYTES};
 pub use package::{PackagePaths, UNKNOWN_PACKAGE_HINT};
 pub use shape::{Geometry, ShapeKind};

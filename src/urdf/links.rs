@@ -209,7 +209,26 @@ pub(super) fn read_link(
         };
         if !shapes.is_empty() {
             match crate::geometry::mass_properties(shapes, density) {
-                Ok((mass, com, inertia)) => l.inertial = Inertial { mass, com, inertia },
+                Ok(g) => {
+                    for (uri, u) in &g.open_meshes {
+                        warnings.push(src.warning(
+                            node,
+                            format!(
+                                "link `{}`: mesh `{uri}` is not closed: the volume it encloses \
+                                 changes by up to {:.2} % with the point it is measured from, \
+                                 and so does the mass --inertia-from-geometry gives the link \
+                                 (close the mesh, or give the link an <inertial>)",
+                                l.name,
+                                100.0 * u
+                            ),
+                        ));
+                    }
+                    l.inertial = Inertial {
+                        mass: g.mass,
+                        com: g.com,
+                        inertia: g.inertia,
+                    };
+                }
                 Err(why) => warnings.push(src.warning(
                     node,
                     format!("link `{}`: no mass from geometry: {why}", l.name),

@@ -163,6 +163,56 @@ fn missing_mesh_is_a_warning() {
     );
 }
 
+/// A mesh with a hole encloses no defined volume: --inertia-from-geometry still gives the link
+/// a mass, and warns with the file position, the link, the mesh and how uncertain the volume
+/// is (the cube without its top face: the area of the hole times the box diagonal over three,
+/// against the volume the five faces left enclose from the vertex centroid).
+#[test]
+fn an_open_mesh_used_for_mass_is_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    write_cube_meshes(dir.path());
+    let closed = std::fs::read_to_string(dir.path().join("cube.stl")).unwrap();
+    // The two facets of the top face (z = 0.5 at every vertex) taken out.
+    let facets: Vec<&str> = closed.split("facet normal").collect();
+    let kept: Vec<&str> = facets
+        .iter()
+        .copied()
+        .filter(|f| f.matches(" 0.5\n").count() < 3)
+        .collect();
+    assert_eq!(kept.len(), facets.len() - 2, "the top face's two facets");
+    std::fs::write(dir.path().join("open.stl"), kept.join("facet normal")).unwrap();
+    let file = dir.path().join("arm.urdf");
+    std::fs::write(&file, arm("open.stl")).unwrap();
+    let opts = ImportOptions {
+        inertia_density: Some(1000.0),
+        ..Default::default()
+    };
+    let l = load_file(&file, &opts).unwrap();
+    assert!(l.model.bodies()[0].mass > 0.0);
+    let w: Vec<&String> = l
+        .warnings
+        .iter()
+        .filter(|w| w.contains("is not closed"))
+        .collect();
+    assert_eq!(w.len(), 1, "{:?}", l.warnings);
+    assert!(
+        w[0].contains("arm.urdf:2:") && w[0].contains("link `arm`") && w[0].contains("open.stl"),
+        "{}",
+        w[0]
+    );
+    // The uncertainty in percent, between 10 and 100 for a missing sixth of a cube.
+    let pct: f64 = w[0]
+        .split("up to ")
+        .nth(1)
+        .and_then(|s| s.split(' ').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap();
+    assert!((10.0..100.0).contains(&pct), "{pct}");
+    // The closed cube: no such warning.
+    std::fs::write(&file, arm("cube.stl")).unwrap();
+    assert!(load_file(&file, &opts).unwrap().warnings.is_empty());
+}
+
 /// The library's warning for a missing package says what to do in library terms (no CLI
 /// option); the CLI says it with its `--package` option, naming the package.
 #[test]
@@ -193,6 +243,36 @@ fn missing_package_hint_is_the_library_s_and_the_cli_names_its_option() {
             "{sub}: {err}"
         );
     }
+}
+
+/// `analyze -q --inertia-from-geometry` on a robot whose only mass was to come from a mesh
+/// that is not found: the error (exit 1) says why nothing was weighed, though `-q` keeps the
+/// import's warnings off standard error.
+#[test]
+fn inertia_from_geometry_that_weighs_nothing_says_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("arm.urdf");
+    std::fs::write(
+        &file,
+        r#"<robot name="r"><link name="world"/>
+  <link name="arm"><collision><geometry><mesh filename="package://nowhere/cube.stl"/></geometry></collision></link>
+  <joint name="j" type="revolute"><parent link="world"/><child link="arm"/><axis xyz="0 1 0"/></joint></robot>"#,
+    )
+    .unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_restpose"))
+        .args(["analyze", "-q", file.to_str().unwrap()])
+        .args(["--inertia-from-geometry", "1000"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("is constant")
+            && err.contains("could not weigh 1 link(s)")
+            && err.contains("link `arm`: no mass from geometry")
+            && err.contains("nowhere/cube.stl"),
+        "{err}"
+    );
 }
 
 #[test]

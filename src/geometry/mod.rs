@@ -4,7 +4,8 @@
 //!
 //! Mesh URIs are resolved in this order: `package://PKG/…` and `model://PKG/…` through a
 //! `--package PKG=DIR` option, then `ROS_PACKAGE_PATH` (`DIR/PKG`) and `AMENT_PREFIX_PATH`
-//! (`DIR/share/PKG`), then by walking up from the URDF's folder for a folder named `PKG`;
+//! (`DIR/share/PKG`), then by walking up from the URDF's folder (its absolute path) for a
+//! folder named `PKG`;
 //! `file://` and plain paths are taken as they are (relative to the URDF's folder). STL, OBJ
 //! and COLLADA meshes are read with `mesh-loader`.
 //!

@@ -1,7 +1,8 @@
 //! Mesh URIs to files: `package://PKG/…` and `model://PKG/…` through the package directories
 //! given, then `ROS_PACKAGE_PATH` (`DIR/PKG`) and `AMENT_PREFIX_PATH` (`DIR/share/PKG`), then
-//! by walking up from the URDF's folder for a folder named `PKG`; `file://` and plain paths
-//! as they are (relative to the URDF's folder).
+//! by walking up from the URDF's folder (its absolute path, so also above the working
+//! directory) for a folder named `PKG`; `file://` and plain paths as they are (relative to the
+//! URDF's folder).
 
 use super::GeometryError;
 use std::path::{Path, PathBuf};
@@ -60,7 +61,18 @@ impl PackagePaths {
                 }
             }
         }
-        let mut up: Option<&Path> = Some(base.as_path());
+        // Walk up from the folder's absolute, resolved path: a URDF named relative to the
+        // working directory (`restpose analyze model.urdf` in the robot's own folder) must
+        // still find the package folder above it, beyond the working directory.
+        let start = if base.as_os_str().is_empty() {
+            PathBuf::from(".")
+        } else {
+            base.clone()
+        };
+        let start = std::fs::canonicalize(&start)
+            .or_else(|_| std::path::absolute(&start))
+            .unwrap_or(start);
+        let mut up: Option<&Path> = Some(start.as_path());
         while let Some(dir) = up {
             if dir.file_name().is_some_and(|n| n == pkg) {
                 candidates.push(dir.to_path_buf());

@@ -193,7 +193,7 @@ pub(super) fn read_link(
             let local = Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
             let r = origin.rotation.to_rotation_matrix();
             l.inertial.inertia = r.matrix() * local * r.matrix().transpose();
-            if let Some(why) = inertia_problem(&local) {
+            if let Some(why) = inertia_problem(&local, l.inertial.mass) {
                 warnings.push(src.warning(
                     i,
                     format!("link `{}`: the inertia tensor is not physically valid ({why}); statics does not use it", l.name),
@@ -239,14 +239,21 @@ pub(super) fn read_link(
     Ok(l)
 }
 
+/// A link's principal moments below `m r²` with this `r` \[m\] (its mass within a
+/// micrometre) are a point mass's zeros: exporters write a point mass's tensor as entries of
+/// 10⁻²⁰ – 10⁻³⁵ kg m² of either sign (icub-models), which is no invalid inertia.
+const POINT_MASS_RADIUS: f64 = 1e-6;
+
 /// Why an inertia tensor is not physically valid (a principal moment negative, or one larger
-/// than the sum of the other two), if it is not.
-fn inertia_problem(i: &Matrix3<f64>) -> Option<String> {
+/// than the sum of the other two, beyond `max(10⁻⁹ |I|, m (1 µm)²)`), if it is not.
+fn inertia_problem(i: &Matrix3<f64>, mass: f64) -> Option<String> {
     let Some(e) = nalgebra::SymmetricEigen::try_new(*i, f64::EPSILON, 1000).map(|e| e.eigenvalues)
     else {
         return Some("its eigenvalues cannot be computed".into());
     };
-    let tol = 1e-9 * e.amax().max(f64::MIN_POSITIVE);
+    let tol = (1e-9 * e.amax())
+        .max(mass * POINT_MASS_RADIUS * POINT_MASS_RADIUS)
+        .max(f64::MIN_POSITIVE);
     if e.min() < -tol {
         return Some(format!("principal moment {:.3e} < 0", e.min()));
     }

@@ -184,6 +184,40 @@ fn loop_element_becomes_a_tree_edge_when_needed() {
     assert_abs_diff_eq!(5.0 * (th - 0.5), -9.81 * th.sin(), epsilon = 1e-9);
 }
 
+/// A point mass written as an inertia tensor of rounding-level entries of either sign (as
+/// icub-models' exporter writes it: `ixz="2.40741e-35"`, `ixx="-5.42101e-20"`) is no invalid
+/// inertia, while a tensor negative beyond the mass within a micrometre still is.
+#[test]
+fn a_point_mass_s_rounding_zeros_are_no_invalid_inertia() {
+    let robot = |tensor: &str| {
+        format!(
+            r#"<robot name="r"><link name="base"/>
+      <link name="arm"><inertial><origin xyz="0.5 0 0"/><mass value="1.33687"/><inertia {tensor}/></inertial></link>
+      <joint name="j" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 1 0"/></joint></robot>"#
+        )
+    };
+    let invalid = |tensor: &str| {
+        load_str(&robot(tensor), "p.urdf", &ImportOptions::default())
+            .unwrap()
+            .warnings
+            .iter()
+            .any(|w| w.contains("inertia tensor is not physically valid"))
+    };
+    assert!(!invalid(
+        r#"ixx="0" ixy="0" ixz="2.40741e-35" iyy="0" iyz="0" izz="0""#
+    ));
+    assert!(!invalid(
+        r#"ixx="-5.42101e-20" ixy="0" ixz="0" iyy="-5.42101e-20" iyz="0" izz="0""#
+    ));
+    assert!(!invalid(
+        r#"ixx="2.71051e-20" ixy="-1.69407e-21" ixz="1.35525e-20" iyy="5.42101e-20" iyz="3.38813e-21" izz="1.35525e-20""#
+    ));
+    // −10⁻⁹ kg m² on a 1.3 kg link: its mass within 30 µm, not a rounding zero.
+    assert!(invalid(
+        r#"ixx="-1e-9" ixy="0" ixz="0" iyy="0" iyz="0" izz="0""#
+    ));
+}
+
 /// Massless dummy frames and a long fixed chain cost no coordinates; an invalid inertia is a
 /// warning.
 #[test]

@@ -145,6 +145,50 @@ fn inertia_from_mesh_geometry_in_every_format() {
     );
 }
 
+/// `restpose check arm.urdf` run in the URDF's own folder (a relative path, as users type it):
+/// the walk up for `package://mypkg/` goes on above the working directory and finds the
+/// package, as it does from an absolute path (icub-models: every mesh was "not found" when the
+/// model was named relative to its folder).
+#[test]
+fn a_package_above_the_working_directory_is_found_from_a_relative_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let pkg = dir.path().join("mypkg");
+    let meshes = pkg.join("meshes");
+    let urdf_dir = pkg.join("robots").join("arm1");
+    std::fs::create_dir_all(&meshes).unwrap();
+    std::fs::create_dir_all(&urdf_dir).unwrap();
+    write_cube_meshes(&meshes);
+    std::fs::write(
+        urdf_dir.join("arm.urdf"),
+        arm("package://mypkg/meshes/cube.stl"),
+    )
+    .unwrap();
+    for (cwd, path) in [
+        (urdf_dir.clone(), "arm.urdf".to_string()),
+        (pkg.join("robots"), "arm1/arm.urdf".to_string()),
+        (pkg.join("robots"), "./arm1/../arm1/arm.urdf".to_string()),
+    ] {
+        let o = Command::new(env!("CARGO_BIN_EXE_restpose"))
+            .current_dir(&cwd)
+            .args([
+                "check",
+                &path,
+                "--inertia-from-geometry",
+                "1000",
+                "--json",
+                "-",
+            ])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{path}: {err}");
+        assert!(!err.contains("not found"), "{path}: {err}");
+        let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let mass = j["bodies"][0]["mass"].as_f64().unwrap();
+        assert_abs_diff_eq!(mass, 8.0, epsilon = 1e-9);
+    }
+}
+
 /// A missing mesh is a warning with the file position, never an error or a panic; without
 /// --inertia-from-geometry a link with no <inertial> stays massless.
 #[test]

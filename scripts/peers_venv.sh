@@ -7,10 +7,10 @@
 # Exits 1 on a failure, 2 when PyPI is unreachable and the venv does not exist yet.
 VENV="${RESTPOSE_PEERS_VENV:-$HOME/.cache/restpose-peers/venv}"
 # pybullet only for its data (pybullet_data/: scripts/pybullet_corpus.sh); a wheel, never a
-# build from source. rtb-data (the Robotics Toolbox's robot descriptions), ROS's xacro and
-# pycollada for scripts/rtb_corpus.sh.
+# build from source. rtb-data (the Robotics Toolbox's robot descriptions), ROS's xacro,
+# pycollada, icub-models and gym-ignition-models for scripts/rtb_corpus.sh.
 PACKAGES=(mujoco==4.0.0 pin==4.1.0 example-robot-data==6.0.0 pybullet==3.2.7 rtb-data==2.0.0
-          xacro==2.1.1 pycollada==0.9.3)
+          xacro==2.1.1 pycollada==0.9.3 icub-models==3.2.0 gym-ignition-models==1.1.1)
 
 if [[ -z "${RESTPOSE:-}" ]]; then
     cargo build --release --quiet --bin restpose || exit 1

@@ -270,15 +270,20 @@ def with_masses(urdf, out, rtb):
 
 # --- the corpus -----------------------------------------------------------------------------
 
-def run_restpose(path, rtb):
+def rtb_options(rtb):
+    """rtb-data's options: masses from geometry, every package of PACKAGES."""
+    out = ["--inertia-from-geometry", str(DENSITY)]
+    for name, folder in sorted(PACKAGES.items()):
+        out += ["--package", f"{name}={os.path.join(rtb, folder)}"]
+    return out
+
+
+def run_restpose(path, options):
     """(result or None, error line, seconds, crashed)."""
     import pinocchio_corpus as pc
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "r.json")
-        cmd = [pc.RESTPOSE, "analyze", "-q", path, "--load-steps", "1", "--inertia-from-geometry",
-               str(DENSITY), "--json", out]
-        for name, folder in sorted(PACKAGES.items()):
-            cmd += ["--package", f"{name}={os.path.join(rtb, folder)}"]
+        cmd = [pc.RESTPOSE, "analyze", "-q", path, "--load-steps", "1", "--json", out] + options
         t0 = time.time()
         try:
             p = subprocess.run(cmd, capture_output=True, text=True, timeout=pc.TIMEOUT)
@@ -292,12 +297,10 @@ def run_restpose(path, rtb):
         return json.load(open(out)), "", dt, crashed
 
 
-def open_mesh_warnings(path, rtb):
+def open_mesh_warnings(path, options):
     """The links restpose warns have a mesh that is not closed (`check --json`)."""
     import pinocchio_corpus as pc
-    cmd = [pc.RESTPOSE, "check", path, "--inertia-from-geometry", str(DENSITY), "--json", "-"]
-    for name, folder in sorted(PACKAGES.items()):
-        cmd += ["--package", f"{name}={os.path.join(rtb, folder)}"]
+    cmd = [pc.RESTPOSE, "check", path, "--json", "-"] + options
     p = subprocess.run(cmd, capture_output=True, text=True, timeout=pc.TIMEOUT)
     warnings = json.loads(p.stdout).get("warnings", []) if p.stdout.strip() else []
     return sorted({w.split("link `", 1)[1].split("`", 1)[0] for w in warnings
@@ -318,10 +321,20 @@ def same_rest(a, b):
     return ""
 
 
-def files(rtb):
+def sets():
+    """(set, its root, its files, restpose's options, masses from geometry)."""
+    rtb = os.environ["RTB_DATA"]
     found = glob.glob(f"{rtb}/**/*.urdf", recursive=True) + glob.glob(f"{rtb}/**/*.xacro",
                                                                        recursive=True)
-    return sorted(f for f in found if "/meshes/" not in f)
+    yield ("rtb-data", rtb, sorted(f for f in found if "/meshes/" not in f), rtb_options(rtb),
+           True)
+    # icub-models: the IIT iCub variants, with their own masses (links without <inertial> are
+    # massless frames, as urdfdom reads them: no --inertia-from-geometry).
+    icub = os.environ["ICUB_MODELS"]
+    yield ("icub-models", icub, sorted(glob.glob(f"{icub}/robots/*/model.urdf")),
+           ["--package", f"iCub={icub}"], False)
+    gym = os.environ["GYM_IGNITION_MODELS"]
+    yield ("gym-ignition-models", gym, sorted(glob.glob(f"{gym}/*/*.urdf")), [], False)
 
 
 def main():
@@ -331,12 +344,16 @@ def main():
     unchecked, open_meshes = [], []
     print(f"{'file':62s} {'termination':15s} {'iter':>4s} {'xacro':>6s} {'FK [m]':>8s} "
           f"{'dV [J]':>8s} {'τ resid.':>8s}")
+    cases = [(group, root, path, options, geometry)
+             for group, root, paths, options, geometry in sets() for path in paths]
     with tempfile.TemporaryDirectory() as tmp:
-        for k, path in enumerate(files(rtb)):
-            name = os.path.relpath(path, rtb)
-            row = {"file": name}
+        for k, (group, root, path, options, geometry) in enumerate(cases):
+            name = os.path.relpath(path, root)
+            if group != "rtb-data":
+                name = f"{group}: {name}"
+            row = {"set": group, "file": name}
             rows.append(row)
-            r, err, dt, crashed = run_restpose(path, rtb)
+            r, err, dt, crashed = run_restpose(path, options)
             row["time"] = dt
             if crashed:
                 failures.append(f"{name}: restpose crashed: {err}")
@@ -362,7 +379,7 @@ def main():
                                         f"expansion), restpose: {err or 'solved'}")
                     print(f"{name:62s} refused: macro library (no <link>), as xacro expands it")
                     continue
-                r2, err2, _, crashed2 = run_restpose(urdf, rtb)
+                r2, err2, _, crashed2 = run_restpose(urdf, options)
                 if crashed2:
                     failures.append(f"{name}: restpose crashed on xacro's expansion: {err2}")
                     continue
@@ -388,7 +405,10 @@ def main():
             row.update(termination=r["termination"], iterations=r["iterations"],
                        energy_total=r["energy"]["total"],
                        corrector_failures=r["diagnostics"]["corrector_failures"])
-            pin_file, why, open_links = with_masses(urdf, os.path.join(tmp, f"{k}.pin.urdf"), rtb)
+            pin_file, why, open_links = urdf, "", []
+            if geometry:
+                pin_file, why, open_links = with_masses(urdf, os.path.join(tmp, f"{k}.pin.urdf"),
+                                                        rtb)
             if pin_file is None:
                 unchecked.append(f"{name}: {why}")
                 print(f"{name:62s} {r['termination']:15s} {r['iterations']:4d} {xacro_note:>6s}"
@@ -396,7 +416,7 @@ def main():
                 continue
             if open_links:
                 open_meshes.append(f"{name}: {', '.join(open_links)}")
-            warned = open_mesh_warnings(path, rtb)
+            warned = open_mesh_warnings(path, options) if geometry else []
             if warned != sorted(open_links):
                 failures.append(f"{name}: restpose warns of open meshes on {warned}, this "
                                 f"script finds {sorted(open_links)}")
@@ -409,19 +429,25 @@ def main():
             print(f"{name:62s} {r['termination']:15s} {r['iterations']:4d} {xacro_note:>6s} "
                   f"{fk:8.1e} {de:8.1e} {res if converged else float('nan'):8.1e}"
                   + ("  FAIL" if bad else ""))
-    done = [x for x in rows if x.get("termination") == "converged"]
-    its = sorted(x["iterations"] for x in done)
-    print(f"\n{len(rows)} files: {len(done)} converged, "
-          + ", ".join(f"{sum(1 for x in rows if x.get('termination') == t)} {t}"
-                      for t in sorted({x.get('termination') for x in rows} - {'converged'})))
+    print()
+    for group in dict.fromkeys(x["set"] for x in rows):
+        mine = [x for x in rows if x["set"] == group]
+        done = [x for x in mine if x.get("termination") == "converged"]
+        its = sorted(x["iterations"] for x in done)
+        print(f"{group}: {len(mine)} files, {len(done)} converged"
+              + "".join(f", {sum(1 for x in mine if x.get('termination') == t)} {t}"
+                        for t in sorted({x.get('termination') for x in mine} - {'converged'}))
+              + f"; {sum(1 for x in mine if 'fk' in x)} checked by Pinocchio")
+        if its:
+            bins = [(0, 10), (11, 20), (21, 30), (31, 50), (51, 100), (101, 200)]
+            print("  iterations of the converged: "
+                  + ", ".join(f"{lo}–{hi}: {sum(1 for i in its if lo <= i <= hi)}"
+                              for lo, hi in bins)
+                  + f"; median {its[len(its) // 2]}, largest {its[-1]}, "
+                  f"≤ 30: {sum(1 for i in its if i <= 30)}")
     print(f"xacro files solved by both expansions alike: "
           f"{sum(1 for x in rows if x.get('xacro') == 'same')}; refused by both: "
           f"{sum(1 for x in rows if x.get('xacro') in ('both', 'both refuse', 'macro library'))}")
-    if its:
-        bins = [(0, 10), (11, 20), (21, 30), (31, 50), (51, 100), (101, 200)]
-        print("iterations of the converged: "
-              + ", ".join(f"{lo}–{hi}: {sum(1 for i in its if lo <= i <= hi)}" for lo, hi in bins)
-              + f"; median {its[len(its) // 2]}, ≤ 30: {sum(1 for i in its if i <= 30)}")
     for u in unchecked:
         print("  not checked by Pinocchio: " + u)
     for o in open_meshes:
@@ -431,7 +457,7 @@ def main():
     for f in failures:
         print("  FAILED " + f)
     checked = sum(1 for x in rows if "fk" in x)
-    print(f"rtb corpus: {checked} rests checked by Pinocchio, {len(failures)} failures")
+    print(f"wheels corpus: {checked} rests checked by Pinocchio, {len(failures)} failures")
     sys.exit(1 if failures else 0)
 
 

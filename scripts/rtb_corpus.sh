@@ -15,5 +15,6 @@ cd "$(dirname "$0")/.."
 
 source scripts/peers_venv.sh
 RTB_DATA="$("$VENV/bin/python" -c 'import os, rtbdata; print(os.path.dirname(rtbdata.__file__))')"
-RESTPOSE="$RESTPOSE" ERD_ROBOTS="$ERD_ROBOTS" RTB_DATA="$RTB_DATA" PYTHONPATH=scripts \
-    "$VENV/bin/python" scripts/rtb_corpus.py
+GYM_IGNITION_MODELS="$("$VENV/bin/python" -c 'import os, gym_ignition_models as g; print(os.path.dirname(g.__file__))')"
+RESTPOSE="$RESTPOSE" ERD_ROBOTS="$ERD_ROBOTS" RTB_DATA="$RTB_DATA" ICUB_MODELS="$VENV/share/iCub" \
+    GYM_IGNITION_MODELS="$GYM_IGNITION_MODELS" PYTHONPATH=scripts "$VENV/bin/python" scripts/rtb_corpus.py

@@ -1,5 +1,5 @@
 # Sourced by peers_check.sh, stand_check.sh, pinocchio_corpus.sh, pybullet_corpus.sh and
-# rtb_corpus.sh (from
+# wheels_corpus.sh (from
 # the repository root): the venv with the real tools from PyPI, created once and reused
 # (RESTPOSE_PEERS_VENV, default ~/.cache/restpose-peers/venv; versions pinned below), the binary
 # to check (RESTPOSE, default: built here with cargo), example-robot-data's robots directory in
@@ -8,7 +8,7 @@
 VENV="${RESTPOSE_PEERS_VENV:-$HOME/.cache/restpose-peers/venv}"
 # pybullet only for its data (pybullet_data/: scripts/pybullet_corpus.sh); a wheel, never a
 # build from source. rtb-data (the Robotics Toolbox's robot descriptions), ROS's xacro,
-# pycollada, icub-models and gym-ignition-models for scripts/rtb_corpus.sh.
+# pycollada, icub-models and gym-ignition-models for scripts/wheels_corpus.sh.
 PACKAGES=(mujoco==4.0.0 pin==4.1.0 example-robot-data==6.0.0 pybullet==3.2.7 rtb-data==2.0.0
           xacro==2.1.1 pycollada==0.9.3 icub-models==3.2.0 gym-ignition-models==1.1.1)
 

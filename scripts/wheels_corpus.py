@@ -1,9 +1,13 @@
-"""restpose on the robot descriptions of rtb-data 2.0.0 (PyPI: the data of the Robotics Toolbox
-for Python): its xacro files expanded by restpose (the `xacro-rs` crate) checked against ROS's
-own xacro (PyPI `xacro` 2.1.1), and every rest pose checked by Pinocchio. Run by
-scripts/rtb_corpus.sh.
+"""restpose on robot descriptions published as PyPI wheels beyond example-robot-data and
+pybullet_data, every rest checked by Pinocchio. Run by scripts/wheels_corpus.sh. Three wheels:
 
-For every `*.urdf` and `*.xacro` file of the wheel (outside `meshes/`):
+- rtb-data 2.0.0 (the data of the Robotics Toolbox for Python), whose xacro files expanded by
+  restpose (the `xacro-rs` crate) are checked against ROS's own xacro (PyPI `xacro` 2.1.1);
+- icub-models 3.2.0 (the IIT iCub variants) and gym-ignition-models 1.1.1, with their own
+  masses: hanging, checked by Pinocchio as in scripts/pinocchio_corpus.py (step 3 below
+  without masses from geometry).
+
+For every `*.urdf` and `*.xacro` file of rtb-data (outside `meshes/`):
 
   1. `restpose analyze FILE -q --load-steps 1 --inertia-from-geometry 1000 --package …`: the
      direct solve, hanging from the fixed base; the links without `<inertial>` (most of these
@@ -29,11 +33,12 @@ For every `*.urdf` and `*.xacro` file of the wheel (outside `meshes/`):
 
 A disagreement, a crash (a panic, a signal, a timeout) or a refusal by one expansion that the
 other does not share fails. Prints a table and the iteration-count distribution of the
-converged solves; exits 1 on any failure.
+converged solves per wheel; exits 1 on any failure.
 
-Environment: RESTPOSE (the binary), RTB_DATA (the `rtbdata` folder), ERD_ROBOTS (read by
-pinocchio_corpus), CORPUS_TIMEOUT (s, default 120), CORPUS_JSON (write every row there).
-`rtb_corpus.py --expand IN OUT` expands one xacro file with Python's xacro (a child process per
+Environment: RESTPOSE (the binary), RTB_DATA (the `rtbdata` folder), ICUB_MODELS (the
+wheel's `share/iCub`), GYM_IGNITION_MODELS (the `gym_ignition_models` folder), ERD_ROBOTS
+(read by pinocchio_corpus), CORPUS_TIMEOUT (s, default 120), CORPUS_JSON (write every row
+there). `wheels_corpus.py --expand IN OUT` expands one xacro file with Python's xacro (a child process per
 file: xacro keeps module state between files).
 """
 
@@ -87,7 +92,7 @@ def expand_here(src, out, rtb):
 
     def find(pkg):
         if pkg not in PACKAGES:
-            raise sa.SubstitutionException(f"package {pkg} is not in rtb_corpus.PACKAGES")
+            raise sa.SubstitutionException(f"package {pkg} is not in wheels_corpus.PACKAGES")
         return os.path.join(rtb, PACKAGES[pkg])
 
     sa._eval_find = find

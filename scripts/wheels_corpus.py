@@ -449,7 +449,8 @@ def main():
                   + ", ".join(f"{lo}–{hi}: {sum(1 for i in its if lo <= i <= hi)}"
                               for lo, hi in bins)
                   + f"; median {its[len(its) // 2]}, largest {its[-1]}, "
-                  f"≤ 30: {sum(1 for i in its if i <= 30)}")
+                  f"≤ 30: {sum(1 for i in its if i <= 30)}; corrector failures "
+                  f"{sum(x['corrector_failures'] for x in done)}")
     print(f"xacro files solved by both expansions alike: "
           f"{sum(1 for x in rows if x.get('xacro') == 'same')}; refused by both: "
           f"{sum(1 for x in rows if x.get('xacro') in ('both', 'both refuse', 'macro library'))}")

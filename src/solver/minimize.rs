@@ -47,7 +47,7 @@ use super::partition::Partition;
 use super::report::{Diagnostics, Iterate, Termination};
 use super::stability::spectrum::Spectrum;
 use super::stability::{at_rest::for_minimizer, inertia::ByInertia};
-use super::step::direction::direction;
+use super::step::direction::{direction, Direction};
 use super::step::line_search::{line_search, Line, Trial};
 use super::step::newton::Settle;
 use super::step::quasi_newton::QuasiNewton;
@@ -225,9 +225,9 @@ pub(crate) fn minimize(
             (s.iteration == 0 && s.eval.grad_v.dot(&d) < 0.0).then_some(d)
         });
         let carried = rolled.is_some();
-        let (d, kkt) = match (rolled, reused) {
-            (Some(d), _) => (d, false),
-            (None, Some((_, d))) => (d, false),
+        let (d, kkt, along_path) = match (rolled, reused) {
+            (Some(d), _) => (d, false, None),
+            (None, Some((_, d))) => (d, false, None),
             (None, None) => reduced_step(sys, &mut s, eig.as_ref(), saddle, guard, options),
         };
         let step = cap_step(sys, &s.part, &s.eval, &s.q, d, options);
@@ -241,7 +241,7 @@ pub(crate) fn minimize(
             s.reach
         };
         // In a curved valley, from the first stalled step on (module `valley`).
-        let valley = s.valley.step(eig.as_ref(), &s.history);
+        let valley = s.valley.step(eig.as_ref(), along_path.as_ref(), &s.history);
         let line = Line {
             q: &s.q,
             part: &s.part,
@@ -399,7 +399,8 @@ fn convergence_test(
 }
 
 /// Stage 3: the reduced step `d` (module docs, module `step::direction`); steepest descent
-/// (and a reset quasi-Newton matrix) when not downhill; and whether `sys` keeps its KKT factors.
+/// (and a reset quasi-Newton matrix) when not downhill; whether `sys` keeps its KKT factors;
+/// and the spectrum of the Hessian along the path where the step was taken with it.
 fn reduced_step(
     sys: &mut System,
     s: &mut Search,
@@ -407,11 +408,16 @@ fn reduced_step(
     negative_curvature: Option<DVector<f64>>,
     guard: Option<&Guard>,
     options: &Options,
-) -> (DVector<f64>, bool) {
+) -> (DVector<f64>, bool, Option<Spectrum>) {
     let dof = s.part.independent.len();
     let settle = s.settle.take(s.eval.grad_v.amax());
     let g = &s.eval.grad_v;
-    let (d, escaped, kkt) = direction(
+    let Direction {
+        d,
+        escaped,
+        kkt,
+        along_path,
+    } = direction(
         sys,
         (&s.q, &s.part, &s.eval),
         eig,
@@ -424,9 +430,9 @@ fn reduced_step(
     s.diag.negative_curvature_steps += usize::from(escaped || negative_curvature.is_some());
     if d.dot(g) > 0.0 && !escaped {
         s.qn = QuasiNewton::new(dof, options.method);
-        return (-g.clone(), kkt);
+        return (-g.clone(), kkt, along_path);
     }
-    (d, kkt)
+    (d, kkt, along_path)
 }
 
 /// Stage 6: moves to the accepted trial point: the line search's next start, the quasi-Newton

@@ -242,7 +242,12 @@ fn pushed_back(
         })
         .flatten();
     let binv = DMatrix::identity(dof, dof);
-    let (mut d, escaped, kkt) = crate::solver::step::direction::direction(
+    let crate::solver::step::direction::Direction {
+        mut d,
+        escaped,
+        kkt,
+        ..
+    } = crate::solver::step::direction::direction(
         &mut sys,
         (q, &part, &eval),
         eig.as_ref(),

@@ -23,11 +23,35 @@ use crate::solver::step::path_hessian::path_keeps_rows;
 use crate::solver::system::{Eval, System};
 use nalgebra::{DMatrix, DVector};
 
+/// The reduced step of one iteration (the output of [`direction`]).
+pub(crate) struct Direction {
+    /// The reduced step `d`.
+    pub(crate) d: DVector<f64>,
+    /// Whether it escaped along a direction of negative curvature.
+    pub(crate) escaped: bool,
+    /// Whether it is the KKT direction, whose factors then stay in `sys` (module
+    /// `second_order`).
+    pub(crate) kkt: bool,
+    /// The spectrum of the Hessian along the path `Ĥ + C` where the step was taken with it
+    /// (item 1; module `path_hessian`), for the valley watch (module `valley`).
+    pub(crate) along_path: Option<Spectrum>,
+}
+
+impl Direction {
+    fn plain(d: DVector<f64>, kkt: bool) -> Self {
+        Direction {
+            d,
+            escaped: false,
+            kkt,
+            along_path: None,
+        }
+    }
+}
+
 /// The reduced step at `(q, part, eval)` (module docs), `eig` the reduced Hessian's spectrum
 /// when computed, `negative_curvature` the saddle's direction when the point is stationary,
 /// `settle` the Hessian's error where the convergence test asked for the settling step,
-/// `binv` the quasi-Newton inverse Hessian; whether it escaped along negative curvature; and
-/// whether it is the KKT direction, whose factors then stay in `sys` (module `second_order`).
+/// `binv` the quasi-Newton inverse Hessian.
 pub(crate) fn direction(
     sys: &mut System,
     (q, part, eval): (&DVector<f64>, &Partition, &Eval),
@@ -37,31 +61,35 @@ pub(crate) fn direction(
     binv: &DMatrix<f64>,
     guard: Option<&Guard>,
     options: &Options,
-) -> (DVector<f64>, bool, bool) {
+) -> Direction {
     let g = &eval.grad_v;
     if let (Some(band), Some(e)) = (settle, eig.filter(|e| e.exact)) {
-        return (settling_step(e, g, band), false, false);
+        return Direction::plain(settling_step(e, g, band), false);
     }
     let along = eig
         .filter(|e| e.exact && options.method == Method::Newton && path_keeps_rows(sys))
         .map(|e| escape_step(sys, q, part, eval, e, guard, options));
     match (along, negative_curvature) {
-        (Some((d, escaped)), nc) if escaped || nc.is_none() => (d, escaped, false),
+        (Some((d, escaped, path)), nc) if escaped || nc.is_none() => Direction {
+            d,
+            escaped,
+            kkt: false,
+            along_path: Some(path),
+        },
         (_, Some(nc)) => {
             let sign = if nc.dot(g) > 0.0 { -1.0 } else { 1.0 };
-            (
-                nc * (sign * options.max_step / nc.amax().max(1e-300)),
-                false,
-                false,
-            )
+            let d = nc * (sign * options.max_step / nc.amax().max(1e-300));
+            Direction::plain(d, false)
         }
         _ => match (eig, options.method) {
-            (Some(e), Method::Newton) if e.exact => (newton_step(e, g, None).0, false, false),
+            (Some(e), Method::Newton) if e.exact => {
+                Direction::plain(newton_step(e, g, None).0, false)
+            }
             (_, Method::Newton) => {
                 let (d, kkt) = kkt_direction(sys, q, part, eval);
-                (d, false, kkt)
+                Direction::plain(d, kkt)
             }
-            _ => (-(binv * g), false, false),
+            _ => Direction::plain(-(binv * g), false),
         },
     }
 }

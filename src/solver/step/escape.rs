@@ -31,7 +31,9 @@ use crate::solver::system::{Eval, System};
 use nalgebra::DVector;
 
 /// The Newton step `d` along the path at `q`, `e` the exact spectrum of `Ĥ` there (module
-/// docs), and whether it escaped along a direction of negative curvature.
+/// docs), whether it escaped along a direction of negative curvature, and the spectrum of
+/// `Ĥ + C` it was taken with (module `path_hessian`; the valley watch reads it, module
+/// `valley`).
 pub(crate) fn escape_step(
     sys: &mut System,
     q: &DVector<f64>,
@@ -40,8 +42,9 @@ pub(crate) fn escape_step(
     e: &Spectrum,
     guard: Option<&Guard>,
     options: &Options,
-) -> (DVector<f64>, bool) {
-    let e = &along_path(sys, q, part, eval, e);
+) -> (DVector<f64>, bool, Spectrum) {
+    let path = along_path(sys, q, part, eval, e);
+    let e = &path;
     // Near a stationary point; anywhere after a release decided by the step (module docs).
     let near = if guard.is_some_and(|g| g.falling) {
         f64::INFINITY
@@ -72,5 +75,5 @@ pub(crate) fn escape_step(
         d += &v * (chosen.unwrap_or(newton) - t);
         escaped |= chosen.is_some();
     }
-    (d, escaped)
+    (d, escaped, path)
 }

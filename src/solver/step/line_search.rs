@@ -182,7 +182,7 @@ pub(crate) fn line_search(
         };
         diag.function_evaluations += 1;
         let (qt, et) = match line.valley {
-            Some(v) => v.correct(sys, part, options, diag, (qt, et)),
+            Some(v) => v.correct(sys, part, (options, guard), diag, (qt, et)),
             None => (qt, et),
         };
         let ft = et.merit;

@@ -13,6 +13,7 @@ mod issue_21_free_arm_converges_directly;
 mod issue_21_ground_start;
 mod issue_21_knees_on_both_stops;
 mod issue_21_legs_up_fall_at_once;
+mod issue_21_neutral_base_wrist_valley;
 mod issue_21_neutral_yaw_converges;
 mod issue_21_newton_along_the_path;
 mod issue_21_release_decided_by_step;

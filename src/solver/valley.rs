@@ -53,6 +53,19 @@
 //! it is taken as the rest only when the Newton step along the soft eigenvectors is below
 //! [`SETTLED`] ([`Watch::unsettled`]).
 //!
+//! ## Stops
+//!
+//! The stiff step moves joints the line search's trial point did not move, and can carry one
+//! across an inactive stop: icub-models' iCubGenova03 (hanging, its massless neck links) had
+//! its neck roll, held at its upper stop by the bent trial point, carried 0.235 rad past it by
+//! the correction; the point was accepted, the next round's first step met the violated stop at
+//! `α = 0` and the round after projected the pose back onto it, 0.034 J uphill (and 5
+//! iterations to come back). With the projected search the correction's path is bent at the
+//! stops as the line search's is (module `inequality::bend`: a stop at its boundary that the
+//! correction closes is held from its start), those stops join the active set with the ones
+//! the trial point reached, and a correction step that still violates an inactive inequality
+//! (through the corrector) is not taken.
+//!
 //! ## References
 //! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §15.6
 //!   (second-order correction), §3.4.
@@ -60,6 +73,7 @@
 //!   function, *Computer Journal* 3 (1960) 175–184 (the curved valley).
 
 use super::inequality::active_set::Guard;
+use super::inequality::bend::Stop;
 use super::options::Options;
 use super::partition::Partition;
 use super::report::{Diagnostics, Iterate};
@@ -254,9 +268,10 @@ impl Valley {
     }
 
     /// The trial point `(q, eval)` moved to the valley floor by up to [`CORRECTIONS`] stiff
-    /// Newton steps, each kept while it lowers both the merit and the gradient and, in a valley
-    /// read beside a neutral direction, crosses no inactive inequality of `guard` (module
-    /// docs).
+    /// Newton steps, each kept while it lowers both the merit and the gradient and, under a
+    /// `guard`, violates no inactive inequality (in a valley read beside a neutral direction
+    /// checked before the trial point is evaluated); the stops a kept step holds at their
+    /// boundary (the projected search) are added to `held` (module docs, "Stops").
     pub(crate) fn correct(
         &self,
         sys: &mut System,
@@ -264,6 +279,7 @@ impl Valley {
         (options, guard): (&Options, Option<&Guard>),
         diag: &mut Diagnostics,
         (mut q, mut eval): (DVector<f64>, Eval),
+        held: &mut Vec<Stop>,
     ) -> (DVector<f64>, Eval) {
         for _ in 0..CORRECTIONS {
             // The stiff directions of the trial point itself: they turn with the soft
@@ -274,7 +290,23 @@ impl Valley {
                 break;
             };
             let dq = sys.tangent_step(part, &eval, &d);
-            let mut qc = sys.problem.retraction.point(&q, &dq, 1.0);
+            // The stops the correction reaches (those at their boundary that it closes from
+            // its start) held there, as along the line search's bent path (module docs).
+            let bend = options.stop_search == super::options::StopSearch::Projected;
+            let caps: Vec<Stop> = match guard.filter(|_| bend) {
+                Some(g) => g
+                    .stops_from(sys, &q, &dq, 1.0, true)
+                    .into_iter()
+                    .filter(|s| s.alpha < 1.0)
+                    .collect(),
+                None => Vec::new(),
+            };
+            let mut qc = if caps.is_empty() {
+                sys.problem.retraction.point(&q, &dq, 1.0)
+            } else {
+                let bodies: Vec<(usize, f64)> = caps.iter().map(|s| (s.body, s.alpha)).collect();
+                sys.problem.retraction.bent_point(&q, &dq, 1.0, &bodies)
+            };
             if sys
                 .correct_from(
                     &mut qc,
@@ -295,10 +327,14 @@ impl Valley {
                 break;
             };
             diag.function_evaluations += 1;
-            if ec.merit > eval.merit || ec.grad_v.amax() >= eval.grad_v.amax() {
+            if ec.merit > eval.merit
+                || ec.grad_v.amax() >= eval.grad_v.amax()
+                || guard.is_some_and(|g| g.violated(sys, &qc))
+            {
                 break;
             }
             (q, eval) = (qc, ec);
+            held.extend(caps);
         }
         (q, eval)
     }

@@ -10,7 +10,8 @@
 //! - at a stationary point, the multipliers `λ_k` of the active rows (`V_qᵀ = Φ_qᵀ μ`) are the
 //!   stops' efforts and the contacts' normal forces; those below `−force_tolerance · F` (`F`
 //!   the weight and loads of the mechanism) leave `A`: all of them the first time, later only
-//!   the most negative; a round also ends before it is stationary when a multiplier pulls
+//!   the most negative (or those the step moves off together, module `release_trial`); a
+//!   round also ends before it is stationary when a multiplier pulls
 //!   hard relative to the reduced gradient (module `release`); a round whose line search
 //!   fails releases its pulling rows likewise, and where none pulls, the contacts that no
 //!   longer hold a floating body (module `let_go`);
@@ -287,7 +288,7 @@ pub(crate) fn solve(
             if report.termination == crate::solver::Termination::LineSearchFailed {
                 let_go = round.released.iter().map(|&i| active[i].row).collect();
             }
-            let gone = super::release_trial::decide(
+            let gone = super::release_trial::decide_early(
                 (model, options, locks),
                 &state,
                 (&active, &all),
@@ -356,14 +357,27 @@ pub(crate) fn solve(
                 .copied()
                 .filter(|&i| !released_before.contains(&active[i].row))
                 .collect();
+            let ctx = (model, options, locks);
+            let early = (released_before.as_slice(), threshold);
             if fresh.is_empty() {
-                gone.truncate(1);
-                if let Some(&i) = gone.first() {
+                // Rows released before leave together only where the step with all of them
+                // released moves off every one (module `release_trial`); else the one
+                // pulling hardest leaves alone.
+                let decided = (gone.len() >= 2).then(|| {
+                    super::release_trial::decide(ctx, &state, (&active, &all), early, gone.clone())
+                });
+                match decided {
+                    Some(d) if d.consistent() => gone = d.counted(&mut counters, &mut next),
+                    Some(d) => {
+                        d.counted(&mut counters, &mut super::release_trial::Next::default());
+                        gone.truncate(1);
+                    }
+                    None => gone.truncate(1),
+                }
+                if let [i] = gone[..] {
                     returns.left(active[i].row, energy);
                 }
             } else {
-                let ctx = (model, options, locks);
-                let early = (released_before.as_slice(), threshold);
                 gone = super::release_trial::decide(ctx, &state, (&active, &all), early, fresh)
                     .counted(&mut counters, &mut next);
             }

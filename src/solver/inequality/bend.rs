@@ -66,6 +66,19 @@ impl Guard<'_> {
         dq: &DVector<f64>,
         alpha_max: f64,
     ) -> Vec<Stop> {
+        self.stops_from(sys, q, dq, alpha_max, false)
+    }
+
+    /// [`Guard::stops`], and where `at_boundary`, the stops within the tolerance at `q` that
+    /// the path closes, held from `α = 0`.
+    pub(crate) fn stops_from(
+        &self,
+        sys: &System,
+        q: &DVector<f64>,
+        dq: &DVector<f64>,
+        alpha_max: f64,
+        at_boundary: bool,
+    ) -> Vec<Stop> {
         let model = sys.problem.model;
         let branches = &sys.problem.cons.branches;
         let ret = &sys.problem.retraction;
@@ -100,10 +113,11 @@ impl Guard<'_> {
                 continue;
             };
             let g0 = unilateral::limit_gap(reading.theta, bound, value);
-            if dimensionless(model, u, g0) <= self.tol {
+            let touching = dimensionless(model, u, g0) <= self.tol;
+            if touching && !at_boundary {
                 continue;
             }
-            if reading.unreachable(g0, value, alpha_max) {
+            if !touching && reading.unreachable(g0, value, alpha_max) {
                 continue;
             }
             let qp = probe.get_or_insert_with(|| ret.point(q, dq, PROBE));
@@ -111,11 +125,17 @@ impl Guard<'_> {
                 continue;
             };
             let rate = (unilateral::limit_gap(t1, bound, value) - g0) / PROBE;
-            if rate < 0.0 && g0 > 0.0 {
+            if rate < 0.0 && g0 > 0.0 && !touching {
                 out.push(Stop {
                     k,
                     body,
                     alpha: -g0 / rate,
+                });
+            } else if rate < 0.0 && touching {
+                out.push(Stop {
+                    k,
+                    body,
+                    alpha: 0.0,
                 });
             }
         }

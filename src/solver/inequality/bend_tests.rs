@@ -126,3 +126,89 @@ fn skips_only_stops_the_line_search_cannot_read() {
     // The shortcut is taken (else this test would check nothing).
     assert!(kept < full / 2, "{kept} of {full} stops kept");
 }
+
+/// [`Guard::stops_from`] with `at_boundary` (the valley correction's path, module
+/// `solver::valley`): a joint at a stop (within the tolerance) that the path closes is held
+/// from `α = 0`, one that the path opens is not listed, and every other stop is listed as by
+/// [`Guard::stops`], bit for bit; without `at_boundary` a stop at its boundary is never listed.
+#[test]
+fn a_stop_at_its_boundary_that_the_path_closes_is_held_from_the_start() {
+    let options = Options::default();
+    let limit = 1.2;
+    let model = load_str(
+        &limited_chain(6, limit),
+        "limited.urdf",
+        &ImportOptions::default(),
+    )
+    .unwrap()
+    .model;
+    let all = inequalities(&model, &options);
+    let mut lcg = crate::lcg::Lcg::new(5);
+    let (mut closing, mut opening) = (0, 0);
+    for trial in 0..16 {
+        // joint1 on its upper stop (within 10⁻¹² rad), the others inside.
+        let values = model
+            .joints
+            .iter()
+            .filter(|j| j.limits.is_some())
+            .map(|j| {
+                let v = if j.name == "joint1" {
+                    limit - 1e-12
+                } else {
+                    0.5 * limit * lcg.signed()
+                };
+                (j.name.clone(), vec![v])
+            })
+            .collect();
+        let start = State::from_joint_values(&model, &values);
+        let q = start.q;
+        let cons = Constraints::new(&model, &[]).on_branches(start.branches);
+        let mut sys = System::new(&model, cons, Backend::of(&model, &options));
+        let part = sys.partition(&q);
+        let eval = sys.evaluate(&q, &part).unwrap();
+        let d = DVector::from_fn(part.independent.len(), |_, _| lcg.signed());
+        let dq = sys.tangent_step(&part, &eval, &d);
+        let guard = Guard::new(&model, &options, all.clone(), &[], 1e-9, &q);
+        let upper = all
+            .iter()
+            .position(|u| {
+                matches!(u, Unilateral::Limit { joint, bound: unilateral::Bound::Upper, .. }
+                    if model.joints[joint.0].name == "joint1")
+            })
+            .unwrap();
+        let plain = guard.stops(&sys, &q, &dq, f64::INFINITY);
+        let held = guard.stops_from(&sys, &q, &dq, f64::INFINITY, true);
+        assert!(plain.iter().all(|s| s.k != upper), "trial {trial}");
+        let key = |s: &Stop| (s.k, s.body, s.alpha.to_bits());
+        let others: Vec<_> = held.iter().filter(|s| s.k != upper).map(key).collect();
+        assert_eq!(
+            others,
+            plain.iter().map(key).collect::<Vec<_>>(),
+            "trial {trial}"
+        );
+        // Whether the path closes joint1's upper stop: its angle rises along the probe.
+        let branches = &sys.problem.cons.branches;
+        let joint = model
+            .joints
+            .iter()
+            .position(|j| j.name == "joint1")
+            .unwrap();
+        let angle = |x: &DVector<f64>| {
+            unilateral::limit_angle(&model, JointId(joint), x, branches).unwrap()
+        };
+        let qp = sys.problem.retraction.point(&q, &dq, PROBE);
+        let at = held.iter().find(|s| s.k == upper);
+        if angle(&qp) > angle(&q) {
+            closing += 1;
+            assert_eq!(at.map(|s| s.alpha), Some(0.0), "trial {trial}");
+        } else {
+            opening += 1;
+            assert!(at.is_none(), "trial {trial}");
+        }
+    }
+    // Both cases were met.
+    assert!(
+        closing > 0 && opening > 0,
+        "{closing} closing, {opening} opening"
+    );
+}

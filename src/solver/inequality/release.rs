@@ -43,8 +43,9 @@
 //!
 //! Both apply to a row once per solve: a row released before (early or at a stationary point)
 //! that a later step pushes back into its bound is re-added by the guard, and then leaves only
-//! alone, the most negative at a stationary point, as in the classic method; so the set cannot
-//! zigzag between several rows leaving together and coming back.
+//! at a stationary point: alone, the most negative, as in the classic method, unless the step
+//! with all the pulling ones released moves off every one of them (module `release_trial`);
+//! so the set cannot zigzag between several rows leaving together and coming back.
 //!
 //! A row that leaves again alone at a stationary point and that the next round's first step
 //! meets again at once, the energy falling by less than `RETURN_DECREASE · F L` (`F` the

@@ -16,7 +16,8 @@
 //! the point where the first one reaches its boundary, accepted if it does not raise `f`
 //! beyond rounding; with the projected search, first by its projection onto the frictionless
 //! contacts it pushes into a ground (module `inequality::hold`), accepted by Armijo's test on
-//! the change actually made.
+//! the change actually made. A trial point brought to a valley's floor (module `valley`) is
+//! judged likewise where that correction held stops, which then join with the trial point's.
 //!
 //! ## References
 //! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §3.1, §3.5.
@@ -181,15 +182,16 @@ pub(crate) fn line_search(
             continue;
         };
         diag.function_evaluations += 1;
+        let mut held = Vec::new();
         let (qt, et) = match line.valley {
-            Some(v) => v.correct(sys, part, (options, guard), diag, (qt, et)),
+            Some(v) => v.correct(sys, part, (options, guard), diag, (qt, et), &mut held),
             None => (qt, et),
         };
         let ft = et.merit;
         // Rounding error of V: relative to the size of its terms, not of their sum.
         let roundoff = 1e-12 * eval.energy.magnitude.max(et.energy.magnitude) + f64::MIN_POSITIVE;
         // Along a bent path: Armijo on the change actually taken (the projected Armijo rule).
-        let armijo = if caps.is_empty() {
+        let armijo = if caps.is_empty() && held.is_empty() {
             ft <= f + 1e-4 * alpha * slope
         } else {
             let columns = &sys.problem.scaling.columns;
@@ -206,7 +208,10 @@ pub(crate) fn line_search(
                     .valley
                     .is_some_and(|v| v.closer(&eval.grad_v, &et.grad_v)));
         if ft.is_finite() && (armijo || flat) {
-            let reached = guard.map_or_else(Vec::new, |g| g.reached(sys, &caps, &qt));
+            let all: Vec<Stop> = caps.iter().chain(&held).copied().collect();
+            let mut reached = guard.map_or_else(Vec::new, |g| g.reached(sys, &all, &qt));
+            reached.sort_unstable();
+            reached.dedup();
             return Some(Trial {
                 q: qt,
                 eval: et,

@@ -11,6 +11,7 @@ mod issue_21_falls_found_at_once;
 mod issue_21_fingers_fall_together;
 mod issue_21_free_arm_converges_directly;
 mod issue_21_ground_start;
+mod issue_21_icub_neck_stop_kept;
 mod issue_21_knees_on_both_stops;
 mod issue_21_legs_up_fall_at_once;
 mod issue_21_neutral_base_wrist_valley;

@@ -96,6 +96,25 @@ def analyze(urdf, extra):
         return json.load(open(out)), "", dt
 
 
+def analyze_checked(urdf, extra, line=-1):
+    """`analyze`, and whether restpose crashed (a panic, a signal, a timeout: not an honest
+    refusal); the error is stderr's last non-blank line (`line`: which one)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "r.json")
+        cmd = [RESTPOSE, "analyze", "-q", urdf, "--load-steps", "1", "--json", out] + extra
+        t0 = time.time()
+        try:
+            p = subprocess.run(cmd, capture_output=True, text=True, timeout=TIMEOUT)
+        except subprocess.TimeoutExpired:
+            return None, f"timeout after {TIMEOUT:.0f} s", time.time() - t0, True
+        dt = time.time() - t0
+        crashed = p.returncode not in (0, 1, 3) or "panicked" in p.stderr
+        lines = [x for x in p.stderr.splitlines() if x.strip()]
+        if not os.path.exists(out):
+            return None, (lines[line] if lines else f"exit {p.returncode}"), dt, crashed
+        return json.load(open(out)), "", dt, crashed
+
+
 def mimics(urdf):
     """{mimic joint: (master, multiplier)} from the URDF."""
     out = {}

@@ -42,10 +42,8 @@ import json
 import math
 import os
 import re
-import subprocess
 import sys
 import tempfile
-import time
 
 import numpy as np
 import pinocchio as pin
@@ -126,20 +124,7 @@ PIVOT_R, PIVOT_L = (0.0, 0.005, 0.2), (0.0, 0.01, 0.2)
 def analyze(urdf, extra):
     """pinocchio_corpus.analyze, and whether restpose crashed (a panic, a signal: not an
     honest refusal)."""
-    with tempfile.TemporaryDirectory() as tmp:
-        out = os.path.join(tmp, "r.json")
-        cmd = [pc.RESTPOSE, "analyze", "-q", urdf, "--load-steps", "1", "--json", out] + extra
-        t0 = time.time()
-        try:
-            p = subprocess.run(cmd, capture_output=True, text=True, timeout=pc.TIMEOUT)
-        except subprocess.TimeoutExpired:
-            return None, f"timeout after {pc.TIMEOUT:.0f} s", time.time() - t0, True
-        dt = time.time() - t0
-        crashed = p.returncode not in (0, 1, 3) or "panicked" in p.stderr
-        lines = [line for line in p.stderr.splitlines() if line.strip()]
-        if not os.path.exists(out):
-            return None, (lines[-1] if lines else f"exit {p.returncode}"), dt, crashed
-        return json.load(open(out)), "", dt, crashed
+    return pc.analyze_checked(urdf, extra)
 
 
 def minitaur_loops(src, out):

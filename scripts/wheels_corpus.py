@@ -49,7 +49,6 @@ import struct
 import subprocess
 import sys
 import tempfile
-import time
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -284,22 +283,9 @@ def rtb_options(rtb):
 
 
 def run_restpose(path, options):
-    """(result or None, error line, seconds, crashed)."""
+    """(result or None, the error's first line, seconds, crashed)."""
     import pinocchio_corpus as pc
-    with tempfile.TemporaryDirectory() as tmp:
-        out = os.path.join(tmp, "r.json")
-        cmd = [pc.RESTPOSE, "analyze", "-q", path, "--load-steps", "1", "--json", out] + options
-        t0 = time.time()
-        try:
-            p = subprocess.run(cmd, capture_output=True, text=True, timeout=pc.TIMEOUT)
-        except subprocess.TimeoutExpired:
-            return None, f"timeout after {pc.TIMEOUT:.0f} s", time.time() - t0, True
-        dt = time.time() - t0
-        crashed = p.returncode not in (0, 1, 3) or "panicked" in p.stderr
-        lines = [line for line in p.stderr.splitlines() if line.strip()]
-        if not os.path.exists(out):
-            return None, (lines[0] if lines else f"exit {p.returncode}"), dt, crashed
-        return json.load(open(out)), "", dt, crashed
+    return pc.analyze_checked(path, options, line=0)
 
 
 def open_mesh_warnings(path, options):

@@ -44,9 +44,10 @@
 //! fewer at rest, the same energy), iCub (27 → 28) and iCub reduced (26 → 25). Such a
 //! valley's corrections cross no inactive inequality (the line search's guard judged the
 //! trial point before them): otherwise they carried the PincherX 100 of rtb-data past a stop,
-//! whose next round started 0.03 J higher (7 → 9 iterations). Applied to every valley, that
-//! test moved iCub reduced's rest 8.4·10⁻⁴ J up (26 → 19 iterations) and took iCub 27 → 28, so
-//! the valleys of `Ĥ` keep main's corrections.
+//! whose next round started 0.03 J higher (7 → 9 iterations). Every valley's corrections are
+//! now guarded so, bent at the stops they reach (below, "Stops"); the test alone, without the
+//! bend, took iCub 27 → 28, and with it iCub takes 26 and iCub reduced rests at the
+//! quasi-static release's rest, 8.4·10⁻⁴ J above the one main reached across a stop.
 //!
 //! In such a valley the gradient test alone does not place the soft coordinate (a curvature of
 //! 10⁻⁹ N m/rad and a tolerance of 10⁻⁸ J leave it free over radians), so a point that passes
@@ -110,7 +111,8 @@ pub(crate) const CORRECTIONS: usize = 3;
 pub(crate) struct Valley {
     soft: Vec<(DVector<f64>, f64)>,
     /// Read from the Hessian along the path beside a neutral direction
-    /// ([`Valley::along_path`]): its corrections cross no inactive inequality.
+    /// ([`Valley::along_path`]): its corrections are checked against the inactive
+    /// inequalities before they are evaluated (every valley's are, after).
     guarded: bool,
 }
 

@@ -38,6 +38,7 @@ use crate::constraints::unilateral::{self, Active};
 use crate::constraints::Constraints;
 use crate::model::Model;
 use crate::solver::report::{Stability, Verdict};
+use crate::solver::step::path_hessian::{path_curvature, path_keeps_rows};
 use crate::solver::system::{Backend, System};
 use crate::State;
 use nalgebra::{DMatrix, DVector};
@@ -157,9 +158,20 @@ pub(crate) fn stability_touching(
         return crate::solver::stability_on(model, state, strong, backend, eigenvalues);
     }
     let eval = sys.evaluate(q, &part)?;
-    let h = sys.reduced_hessian(q, &part, &eval);
-    let (vals, _) = symmetric_eigen(&h);
-    let tol = 1e-10 * vals.amax().max(1.0);
+    let reduced = sys.reduced_hessian(q, &part, &eval);
+    // The tolerance from `Ĥ`'s spectrum, as on the tangent space of every row; the cone judged
+    // on the Hessian along the search path where the path keeps every row (module docs).
+    let (reduced_vals, _) = symmetric_eigen(&reduced);
+    let tol = 1e-10 * reduced_vals.amax().max(1.0);
+    let (h, vals) = if path_keeps_rows(&sys) {
+        let h = crate::solver::system::symmetric_part(
+            reduced + path_curvature(&sys, q, &part, &eval, None),
+        );
+        let (vals, _) = symmetric_eigen(&h);
+        (h, vals)
+    } else {
+        (reduced, reduced_vals)
+    };
     let n = model.coordinate_count();
     let mut rows = Vec::with_capacity(weak.len());
     for a in weak {

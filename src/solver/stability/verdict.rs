@@ -18,6 +18,7 @@ use crate::constraints::unilateral::Active;
 use crate::constraints::Constraints;
 use crate::model::Model;
 use crate::solver::partition::Partition;
+use crate::solver::step::path_hessian::{along_path, path_keeps_rows};
 use crate::solver::system::{Backend, System};
 use crate::solver::{lock_values, Mode, Stability, Verdict};
 use crate::state::State;
@@ -33,10 +34,19 @@ pub(crate) fn from_spectrum(
 ) -> Stability {
     let (vals, vecs) = (&spectrum.values, &spectrum.vectors);
     let tol = spectrum.tolerance();
+    // Judged on the Hessian along the search path where the path keeps every row (for a
+    // tree, the Hessian in the joint coordinates): without the chart's share of the residual
+    // gradient, which puts a neutral direction's eigenvalue of `Ĥ` anywhere within about
+    // `‖∂V/∂v‖` of zero (module docs). The eigenvalues and modes reported stay `Ĥ`'s.
+    let lowest = if spectrum.exact && path_keeps_rows(sys) {
+        along_path(sys, q, part, eval, spectrum).values[0]
+    } else {
+        vals[0]
+    };
     let negative_by_inertia = spectrum.negative_by_inertia.unwrap_or(0) > 0;
-    let verdict = if vals[0] < -tol || negative_by_inertia {
+    let verdict = if lowest < -tol || negative_by_inertia {
         Verdict::Unstable
-    } else if vals[0] <= tol {
+    } else if lowest <= tol {
         Verdict::Neutral
     } else {
         Verdict::Stable

@@ -190,6 +190,7 @@ pub(crate) fn stability_touching(
         }
         rows.push(m);
     }
+    let tol = tol.max(eval.grad_v.amax());
     let lowest = if vals[0] > tol {
         vals[0]
     } else {

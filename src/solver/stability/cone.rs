@@ -28,16 +28,31 @@
 //! is repeated and no basis vector of its eigenspace lies in `C`, the face counts anyway
 //! (conservative: the verdict may then say unstable or neutral where the cone is stable).
 //!
+//! Where the search path keeps every row, the cone is judged on the Hessian along that path
+//! `Ĥ + C` (module `step::path_hessian`; for a tree, the Hessian in the joint coordinates)
+//! rather than on `Ĥ`: at a point stationary to `‖∂V/∂v‖ = g`, `Ĥ` reads a direction whose
+//! energy is exactly flat (a vertical waist, a finger whose energy is linear in its slide) as
+//! `−g·a`, `a` that direction's acceleration in the chart, of either sign and above the
+//! tolerance; `Ĥ + C` reads it at rounding. The weak rows leave a reduced gradient `g` on the
+//! tangent space of the strong ones (their efforts, of either sign, below the active set's
+//! threshold: unresolved): along a unit direction `d` the energy changes by
+//! `g·d s + ½ κ s²`, and a curvature `|κ| ≤ ‖g‖∞` decides the sign of that change only beyond
+//! `s = 2`, outside the quadratic model. The tolerance here is therefore
+//! `t = max(10⁻¹⁰ max(λ_max, 1), ‖g‖∞)` (`λ_max` of `Ĥ`), and that is the `tolerance`
+//! reported. (`C` is formed only where `Ĥ`'s smallest eigenvalue is below `t + 10 ‖g‖∞`, the
+//! Hessian's error: above, the cone is stable either way.)
+//!
 //! ## References
 //! - J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §12.5
 //!   (second-order conditions, the critical cone).
 
 use super::eigen::symmetric_eigen;
-use super::spectrum::EXACT_UP_TO;
+use super::spectrum::{Spectrum, EXACT_UP_TO};
 use crate::constraints::unilateral::{self, Active};
 use crate::constraints::Constraints;
 use crate::model::Model;
 use crate::solver::report::{Stability, Verdict};
+use crate::solver::step::path_hessian::{path_curvature, path_keeps_rows};
 use crate::solver::system::{Backend, System};
 use crate::State;
 use nalgebra::{DMatrix, DVector};
@@ -157,9 +172,21 @@ pub(crate) fn stability_touching(
         return crate::solver::stability_on(model, state, strong, backend, eigenvalues);
     }
     let eval = sys.evaluate(q, &part)?;
-    let h = sys.reduced_hessian(q, &part, &eval);
-    let (vals, _) = symmetric_eigen(&h);
-    let tol = 1e-10 * vals.amax().max(1.0);
+    let reduced = sys.reduced_hessian(q, &part, &eval);
+    // The tolerance from `Ĥ`'s spectrum, as on the tangent space of every row; the cone judged
+    // on the Hessian along the search path where the path keeps every row (module docs).
+    let (reduced_vals, _) = symmetric_eigen(&reduced);
+    let tol = 1e-10 * reduced_vals.amax().max(1.0);
+    let unresolved = reduced_vals[0] <= tol + Spectrum::error(eval.grad_v.amax());
+    let (h, vals) = if unresolved && path_keeps_rows(&sys) {
+        let h = crate::solver::system::symmetric_part(
+            reduced + path_curvature(&sys, q, &part, &eval, None),
+        );
+        let (vals, _) = symmetric_eigen(&h);
+        (h, vals)
+    } else {
+        (reduced, reduced_vals)
+    };
     let n = model.coordinate_count();
     let mut rows = Vec::with_capacity(weak.len());
     for a in weak {
@@ -178,6 +205,8 @@ pub(crate) fn stability_touching(
         }
         rows.push(m);
     }
+    // What the weak rows' unresolved efforts leave undecided (module docs).
+    let tol = tol.max(eval.grad_v.amax());
     let lowest = if vals[0] > tol {
         vals[0]
     } else {

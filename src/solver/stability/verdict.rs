@@ -4,7 +4,14 @@
 //! eigenvalues as joint-coordinate changes. Where the whole spectrum is known the eigenvalues
 //! and modes are reported in joint coordinates (module `joint_space`): physical units,
 //! independent of the start; `stable` where stops or contacts carrying a force leave no
-//! feasible motion.
+//! feasible motion. The verdict reads the smallest eigenvalue of the Hessian along the search
+//! path `Ĥ + C` where the path keeps every row (module `step::path_hessian`; for a tree, the
+//! Hessian in the joint coordinates), `Ĥ`'s elsewhere: at a point stationary only to
+//! `‖∂V/∂v‖ = g`, `Ĥ` reads an exactly flat direction (a vertical base yaw) as `−g·a`, `a`
+//! that direction's acceleration in the chart, of either sign and above `t`; `Ĥ + C` reads it
+//! at rounding. `C` is formed only where `Ĥ`'s smallest eigenvalue is within the Hessian's
+//! error `10 g` of `±t` (`Spectrum::error`): elsewhere `C` cannot move it across `±t`. The
+//! eigenvalues, modes and `t` reported stay `Ĥ`'s.
 //!
 //! The entry point is [`stability_verdict`] (stops and contacts that carry a force and those
 //! that touch without one, or none); [`stability_on`] holds every given row, and
@@ -18,6 +25,7 @@ use crate::constraints::unilateral::Active;
 use crate::constraints::Constraints;
 use crate::model::Model;
 use crate::solver::partition::Partition;
+use crate::solver::step::path_hessian::{along_path, path_keeps_rows};
 use crate::solver::system::{Backend, System};
 use crate::solver::{lock_values, Mode, Stability, Verdict};
 use crate::state::State;
@@ -33,10 +41,17 @@ pub(crate) fn from_spectrum(
 ) -> Stability {
     let (vals, vecs) = (&spectrum.values, &spectrum.vectors);
     let tol = spectrum.tolerance();
+    // On the Hessian along the search path where the path keeps every row (module docs).
+    let unresolved = vals[0].abs() <= tol + Spectrum::error(eval.grad_v.amax());
+    let lowest = if unresolved && spectrum.exact && path_keeps_rows(sys) {
+        along_path(sys, q, part, eval, spectrum).values[0]
+    } else {
+        vals[0]
+    };
     let negative_by_inertia = spectrum.negative_by_inertia.unwrap_or(0) > 0;
-    let verdict = if vals[0] < -tol || negative_by_inertia {
+    let verdict = if lowest < -tol || negative_by_inertia {
         Verdict::Unstable
-    } else if vals[0] <= tol {
+    } else if lowest <= tol {
         Verdict::Neutral
     } else {
         Verdict::Stable

@@ -15,6 +15,7 @@ mod issue_21_icub_neck_stop_kept;
 mod issue_21_knees_on_both_stops;
 mod issue_21_legs_up_fall_at_once;
 mod issue_21_neutral_base_wrist_valley;
+mod issue_21_neutral_verdict_beside_stops;
 mod issue_21_neutral_yaw_converges;
 mod issue_21_newton_along_the_path;
 mod issue_21_release_decided_by_step;

@@ -81,19 +81,9 @@ def disagreements(fk, de, res, scale, converged):
 
 
 def analyze(urdf, extra):
-    with tempfile.TemporaryDirectory() as tmp:
-        out = os.path.join(tmp, "r.json")
-        cmd = [RESTPOSE, "analyze", "-q", urdf, "--load-steps", "1", "--json", out] + extra
-        t0 = time.time()
-        try:
-            p = subprocess.run(cmd, capture_output=True, text=True, timeout=TIMEOUT)
-        except subprocess.TimeoutExpired:
-            return None, f"timeout after {TIMEOUT:.0f} s", time.time() - t0
-        dt = time.time() - t0
-        lines = [line for line in p.stderr.splitlines() if line.strip()]
-        if not os.path.exists(out):
-            return None, (lines[-1] if lines else f"exit {p.returncode}"), dt
-        return json.load(open(out)), "", dt
+    """`restpose analyze -q URDF --load-steps 1 --json`: (result or None, error, seconds)."""
+    r, err, dt, _ = analyze_checked(urdf, extra)
+    return r, err, dt
 
 
 def analyze_checked(urdf, extra, line=-1):

@@ -31,8 +31,9 @@ For every `*.urdf` and `*.xacro` file of rtb-data (outside `meshes/`):
      depends on the point the tetrahedra are summed from by more than 1e-6 of it): the script
      lists such links; both sides sum from the mesh's vertex centroid, as parry3d does.
 
-A disagreement, a crash (a panic, a signal, a timeout) or a refusal by one expansion that the
-other does not share fails. Prints a table and the iteration-count distribution of the
+A disagreement, a crash (a panic, a signal, a timeout), a refusal by one expansion that the
+other does not share, or a converged rest whose stability verdict is `unstable` (the minimizer
+leaves maxima and saddles, so a converged rest is a minimum: stable or neutral) fails. Prints a table and the iteration-count distribution of the
 converged solves per wheel; exits 1 on any failure.
 
 Environment: RESTPOSE (the binary), RTB_DATA (the `rtbdata` folder), ICUB_MODELS (the
@@ -395,7 +396,13 @@ def main():
                 continue
             row.update(termination=r["termination"], iterations=r["iterations"],
                        energy_total=r["energy"]["total"],
-                       corrector_failures=r["diagnostics"]["corrector_failures"])
+                       corrector_failures=r["diagnostics"]["corrector_failures"],
+                       verdict=(r.get("stability") or {}).get("verdict"))
+            # A converged descent without --allow-unstable ends at a minimum (the minimizer
+            # leaves maxima and saddles): an `unstable` verdict there is a wrong verdict (the
+            # hanging arms' flat directions read at the gradient's size, session 33).
+            if r["termination"] == "converged" and row["verdict"] == "unstable":
+                failures.append(f"{name}: converged, but the verdict says unstable")
             pin_file, why, open_links = urdf, "", []
             if geometry:
                 pin_file, why, open_links = with_masses(urdf, os.path.join(tmp, f"{k}.pin.urdf"),

@@ -9,9 +9,10 @@ os.environ['ERD_ROBOTS'] = glob.glob(V + '/lib/python*/site-packages/cmeel.prefi
 import pybullet_data
 os.environ['PYBULLET_DATA'] = pybullet_data.getDataPath()
 os.environ['RESTPOSE'] = 'x'
-os.environ['RTB_DATA'] = V + '/lib/python3.11/site-packages/rtbdata'
+SITE = glob.glob(V + '/lib/python*/site-packages')[0]
+os.environ['RTB_DATA'] = SITE + '/rtbdata'
 os.environ['ICUB_MODELS'] = V + '/share/iCub'
-os.environ['GYM_IGNITION_MODELS'] = V + '/lib/python3.11/site-packages/gym_ignition_models'
+os.environ['GYM_IGNITION_MODELS'] = SITE + '/gym_ignition_models'
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import pinocchio_corpus as pc, pybullet_corpus as pb, wheels_corpus as wc
 

@@ -16,7 +16,8 @@ direct solve), and for the legged robots with an SRDF standing state, standing o
        (a mimic joint's row folded into its master's with the multiplier), to 1e-6 of the
        largest term (the rest pose is converged to a reduced gradient of 1e-8 J).
 Poses that restpose did not report converged are checked for kinematics and energy only, and
-counted. Prints a table, the iteration-count distribution and corrector failures of the
+counted; a converged rest whose verdict is `unstable` fails (the minimizer leaves maxima and
+saddles). Prints a table, the iteration-count distribution and corrector failures of the
 converged solves, and exits 1 if any check fails.
 
 Environment: RESTPOSE (the binary), ERD_ROBOTS (the corpus's robots folder), CORPUS_SERVO
@@ -78,6 +79,16 @@ def disagreements(fk, de, res, scale, converged):
     if converged and res > 1e-6 * scale:
         bad.append(f"g(q) − τ held = {res:.1e} (scale {scale:.1e})")
     return bad
+
+
+def unstable_rest(r):
+    """Why a result is not a rest the solver may report as found: `converged` with the verdict
+    `unstable` (without --allow-unstable the minimizer leaves maxima and saddles, those that
+    only the critical cone shows included), or "" if it is not that."""
+    verdict = (r.get("stability") or {}).get("verdict")
+    if r["termination"] == "converged" and verdict == "unstable":
+        return "converged, but the verdict says unstable"
+    return ""
 
 
 def analyze(urdf, extra):
@@ -210,6 +221,8 @@ def main():
         bad = disagreements(fk, de, res, scale, converged)
         if bad:
             failures.append(f"{name}: " + "; ".join(bad))
+        if unstable_rest(r):
+            failures.append(f"{name}: {unstable_rest(r)}")
         print(f"{name:66s} {r['termination']:18s} {r['iterations']:4d} {row['rounds']:6d} "
               f"{d['corrector_failures']:6d} {fk:8.1e} {de:8.1e} "
               f"{res if converged else float('nan'):8.1e} {dt:6.2f}" + ("  FAIL" if bad else ""))

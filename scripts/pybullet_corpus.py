@@ -306,6 +306,8 @@ def main():
                        corrector_failures=d["corrector_failures"],
                        energy_total=r["energy"]["total"], dof=len(r.get("q_pinocchio", [])))
             converged = r["termination"] == "converged"
+            if pc.unstable_rest(r):
+                failures.append(f"{name}: {pc.unstable_rest(r)}")
             head = (f"{name:58s} {r['termination']:18s} {r['iterations']:4d} {row['rounds']:6d} "
                     f"{d['corrector_failures']:6d}")
             if rel in PINOCCHIO_REFUSES:

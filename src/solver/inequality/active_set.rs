@@ -209,6 +209,8 @@ pub(crate) fn solve(
     // the round after it (module `roll_on`).
     let mut roll_on = super::roll_on::RollOn::default();
     let mut carry = None;
+    // Converged points left along the critical cone's direction of negative curvature.
+    let mut cone_leaves = 0;
     loop {
         let mut branches = state.branches.clone();
         let q = super::guard::project_past_false_hits(
@@ -461,6 +463,24 @@ pub(crate) fn solve(
             );
         }
         report.diagnostics.timings.stability += judging + judged.elapsed().as_secs_f64();
+        // A converged point that the critical cone judges unstable is left, the weak rows its
+        // direction opens released, and the search goes on (module `stability::leave`).
+        if crate::solver::stability::leave::should_leave(&report, options, &weak, cone_leaves) {
+            let backend = Backend::of(model, options);
+            let left = crate::solver::stability::leave::leave(
+                model, &state, &strong, &weak, backend, options,
+            );
+            if let Some((q, opened)) = left {
+                cone_leaves += 1;
+                state.q = q;
+                active.retain(|a| !opened.contains(a));
+                changes += opened.len();
+                history = std::mem::take(&mut report.history);
+                iterates = std::mem::take(&mut report.iterates);
+                counters = std::mem::take(&mut report.diagnostics);
+                continue;
+            }
+        }
         return Ok((state, report));
     }
 }

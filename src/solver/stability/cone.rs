@@ -62,16 +62,28 @@ use nalgebra::{DMatrix, DVector};
 pub(crate) const MAX_WEAK: usize = 10;
 
 /// Relative tolerance of `a_w · d ≥ 0` for an eigenvector `d`.
-const CONE_TOLERANCE: f64 = 1e-9;
+pub(super) const CONE_TOLERANCE: f64 = 1e-9;
 
 /// The smallest Rayleigh quotient of `h` over the cone `{ d : weak[w].row(0) · d ≥ 0 }`, where
 /// a weak inequality held at zero also holds its other rows (`weak[w]`: rows × dof).
 /// `eig_tol` separates repeated eigenvalues.
 pub(crate) fn minimum(h: &DMatrix<f64>, weak: &[DMatrix<f64>], eig_tol: f64) -> f64 {
+    minimum_with_direction(h, weak, eig_tol).0
+}
+
+/// [`minimum`], and a unit direction of the cone that attains it (signed into the cone), where
+/// an eigenvector of the minimizing face lies in it (`None` where the face counted only
+/// because its eigenvalue is repeated).
+pub(crate) fn minimum_with_direction(
+    h: &DMatrix<f64>,
+    weak: &[DMatrix<f64>],
+    eig_tol: f64,
+) -> (f64, Option<DVector<f64>>) {
     let dof = h.nrows();
     let k = weak.len();
     let shift = 4.0 * h.amax() + 1.0;
     let mut best = f64::INFINITY;
+    let mut direction = None;
     for mask in 0usize..(1 << k) {
         let held: Vec<usize> = (0..k).filter(|w| mask >> w & 1 == 1).collect();
         let rows: usize = held.iter().map(|&w| weak[w].nrows()).sum();
@@ -117,15 +129,22 @@ pub(crate) fn minimum(h: &DMatrix<f64>, weak: &[DMatrix<f64>], eig_tol: f64) -> 
             })
         };
         let repeated: Vec<usize> = (0..dof).take_while(|&i| vals[i] <= lam + eig_tol).collect();
-        let feasible = repeated.iter().any(|&i| {
+        let feasible = repeated.iter().find_map(|&i| {
             let d = vecs.column(i).into_owned();
-            in_cone(&d) || in_cone(&-d)
+            if in_cone(&d) {
+                Some(d)
+            } else if in_cone(&-&d) {
+                Some(-d)
+            } else {
+                None
+            }
         });
-        if feasible || repeated.len() > 1 {
+        if feasible.is_some() || repeated.len() > 1 {
             best = lam;
+            direction = feasible;
         }
     }
-    best
+    (best, direction)
 }
 
 /// The stability verdict at a balanced rest where the stops and contacts `strong` carry a
@@ -172,41 +191,8 @@ pub(crate) fn stability_touching(
         return crate::solver::stability_on(model, state, strong, backend, eigenvalues);
     }
     let eval = sys.evaluate(q, &part)?;
-    let reduced = sys.reduced_hessian(q, &part, &eval);
-    // The tolerance from `Ĥ`'s spectrum, as on the tangent space of every row; the cone judged
-    // on the Hessian along the search path where the path keeps every row (module docs).
-    let (reduced_vals, _) = symmetric_eigen(&reduced);
-    let tol = 1e-10 * reduced_vals.amax().max(1.0);
-    let unresolved = reduced_vals[0] <= tol + Spectrum::error(eval.grad_v.amax());
-    let (h, vals) = if unresolved && path_keeps_rows(&sys) {
-        let h = crate::solver::system::symmetric_part(
-            reduced + path_curvature(&sys, q, &part, &eval, None),
-        );
-        let (vals, _) = symmetric_eigen(&h);
-        (h, vals)
-    } else {
-        (reduced, reduced_vals)
-    };
-    let n = model.coordinate_count();
-    let mut rows = Vec::with_capacity(weak.len());
-    for a in weak {
-        let bodies = unilateral::bodies(model, &a.row);
-        let pair = crate::jet::pair_of(&bodies, q, false);
-        let jets = unilateral::rows(model, a, &pair, &state.branches)?;
-        let mut m = DMatrix::zeros(jets.len(), dof);
-        for (r, s) in jets.iter().enumerate() {
-            let mut y = DVector::zeros(n);
-            for i in 0..crate::jet::NL {
-                if let Some(g) = crate::jet::global_index(&bodies, i) {
-                    y[g] += s.g[i];
-                }
-            }
-            m.set_row(r, &sys.tangent_transpose(&part, &eval, &y).transpose());
-        }
-        rows.push(m);
-    }
-    // What the weak rows' unresolved efforts leave undecided (module docs).
-    let tol = tol.max(eval.grad_v.amax());
+    let (h, vals, tol) = judged_hessian(&mut sys, q, &part, &eval);
+    let rows = weak_rows(model, state, &sys, &part, &eval, weak)?;
     let lowest = if vals[0] > tol {
         vals[0]
     } else {
@@ -229,6 +215,62 @@ pub(crate) fn stability_touching(
     })
 }
 
+/// The Hessian the cone is judged on, its eigenvalues and the tolerance: the tolerance from
+/// `Ĥ`'s spectrum, as on the tangent space of every row, floored at what the weak rows'
+/// unresolved efforts leave undecided; the Hessian along the search path where the path keeps
+/// every row and `Ĥ`'s smallest eigenvalue is within its error (module docs).
+pub(super) fn judged_hessian(
+    sys: &mut System,
+    q: &DVector<f64>,
+    part: &crate::solver::partition::Partition,
+    eval: &crate::solver::system::Eval,
+) -> (DMatrix<f64>, DVector<f64>, f64) {
+    let reduced = sys.reduced_hessian(q, part, eval);
+    let (reduced_vals, _) = symmetric_eigen(&reduced);
+    let tol = 1e-10 * reduced_vals.amax().max(1.0);
+    let unresolved = reduced_vals[0] <= tol + Spectrum::error(eval.grad_v.amax());
+    let (h, vals) = if unresolved && path_keeps_rows(sys) {
+        let h = crate::solver::system::symmetric_part(
+            reduced + path_curvature(sys, q, part, eval, None),
+        );
+        let (vals, _) = symmetric_eigen(&h);
+        (h, vals)
+    } else {
+        (reduced, reduced_vals)
+    };
+    (h, vals, tol.max(eval.grad_v.amax()))
+}
+
+/// Each weak inequality's rows in the independent coordinates (`Zᵀ ∇g`: rows × dof).
+pub(super) fn weak_rows(
+    model: &Model,
+    state: &State,
+    sys: &System,
+    part: &crate::solver::partition::Partition,
+    eval: &crate::solver::system::Eval,
+    weak: &[Active],
+) -> Option<Vec<DMatrix<f64>>> {
+    let (q, n, dof) = (&state.q, model.coordinate_count(), part.independent.len());
+    let mut rows = Vec::with_capacity(weak.len());
+    for a in weak {
+        let bodies = unilateral::bodies(model, &a.row);
+        let pair = crate::jet::pair_of(&bodies, q, false);
+        let jets = unilateral::rows(model, a, &pair, &state.branches)?;
+        let mut m = DMatrix::zeros(jets.len(), dof);
+        for (r, s) in jets.iter().enumerate() {
+            let mut y = DVector::zeros(n);
+            for i in 0..crate::jet::NL {
+                if let Some(g) = crate::jet::global_index(&bodies, i) {
+                    y[g] += s.g[i];
+                }
+            }
+            m.set_row(r, &sys.tangent_transpose(part, eval, &y).transpose());
+        }
+        rows.push(m);
+    }
+    Some(rows)
+}
+
 /// Whether [`stability_touching`] judges `strong` and `weak` without `all_held`: more than
 /// [`MAX_WEAK`] weak rows are left once the stops whose other stop touches too are held
 /// (Romeo's 24 fingers), and the verdict is the strong rows' alone. An active-set round that
@@ -244,7 +286,7 @@ pub(crate) fn ignores_all_held(strong: &[Active], weak: &[Active]) -> bool {
 /// Returns the strong list with those rows and the weak ones left. Without this, the eight
 /// knees' sixteen weak stops exceed [`MAX_WEAK`] and the verdict fell back to the tangent space
 /// of the strong rows alone, where the knees were free: "neutral" with six zero eigenvalues.
-fn both_stops_held(strong: &[Active], weak: &[Active]) -> (Vec<Active>, Vec<Active>) {
+pub(super) fn both_stops_held(strong: &[Active], weak: &[Active]) -> (Vec<Active>, Vec<Active>) {
     let stop = |a: &Active| match a.row {
         unilateral::Unilateral::Limit { joint, bound, .. } => Some((joint, bound)),
         unilateral::Unilateral::Contact { .. } => None,

@@ -8,6 +8,8 @@
 //!   (sparse, many degrees of freedom); also used by the minimizer to leave saddles.
 //! - `inertia`: the verdict from the inertia of the shifted KKT matrix, without eigenvalues.
 //! - `cone`: the verdict on the critical cone, where stops and contacts touch without force.
+//! - `leave`: a converged point only the cone shows unstable, left along its direction of
+//!   negative curvature with the stops and contacts it opens released.
 //! - `at_rest`: what the minimizer computes at a point: the exact spectrum where cheap, else
 //!   the inertia verdict, and Lanczos only to leave a saddle.
 //! - `verdict`: the verdict and mode shapes from the eigenpairs, and the entry points.
@@ -21,5 +23,6 @@ pub(crate) mod eigen;
 pub(crate) mod inertia;
 pub(crate) mod joint_space;
 pub(crate) mod largest;
+pub(crate) mod leave;
 pub(crate) mod spectrum;
 pub(crate) mod verdict;

@@ -6,6 +6,7 @@ mod issue_13_floating_base_start;
 mod issue_21_a1_falls_without_servos;
 mod issue_21_bolt_rolls_over;
 mod issue_21_chain_on_its_stops;
+mod issue_21_cone_saddle_left;
 mod issue_21_curved_valley;
 mod issue_21_falls_found_at_once;
 mod issue_21_fingers_fall_together;

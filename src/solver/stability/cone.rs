@@ -178,11 +178,7 @@ pub(crate) fn stability_touching(
     }
     let all: Vec<Active> = strong.iter().chain(weak).copied().collect();
     let q = &state.q;
-    let cons = Constraints::new(model, &crate::solver::lock_values(model))
-        .with_active(model, strong)
-        .on_branches(state.branches.clone());
-    let mut sys = System::new(model, cons, backend);
-    let part = sys.partition(q);
+    let (mut sys, part) = strong_system(model, state, strong, backend);
     let dof = part.independent.len();
     if dof == 0 {
         return crate::solver::stability_on(model, state, &all, backend, eigenvalues);
@@ -213,6 +209,21 @@ pub(crate) fn stability_touching(
         s.tolerance = tol;
         s
     })
+}
+
+/// The system holding the rows that carry a force (`strong`) at `state`, partitioned there.
+pub(super) fn strong_system<'m>(
+    model: &'m Model,
+    state: &State,
+    strong: &[Active],
+    backend: Backend,
+) -> (System<'m>, crate::solver::partition::Partition) {
+    let cons = Constraints::new(model, &crate::solver::lock_values(model))
+        .with_active(model, strong)
+        .on_branches(state.branches.clone());
+    let mut sys = System::new(model, cons, backend);
+    let part = sys.partition(&state.q);
+    (sys, part)
 }
 
 /// The Hessian the cone is judged on, its eigenvalues and the tolerance: the tolerance from

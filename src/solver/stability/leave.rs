@@ -19,14 +19,14 @@
 //! (−2.871693 J, stable, 26 iterations, four leaves).
 
 use super::cone::{
-    both_stops_held, judged_hessian, minimum_with_direction, weak_rows, CONE_TOLERANCE, MAX_WEAK,
+    both_stops_held, judged_hessian, minimum_with_direction, strong_system, weak_rows,
+    CONE_TOLERANCE, MAX_WEAK,
 };
 use super::spectrum::EXACT_UP_TO;
 use crate::constraints::unilateral::Active;
-use crate::constraints::Constraints;
 use crate::model::Model;
 use crate::solver::report::{Report, Verdict};
-use crate::solver::system::{Backend, System};
+use crate::solver::system::Backend;
 use crate::solver::Options;
 use crate::State;
 use nalgebra::DVector;
@@ -80,11 +80,7 @@ pub(crate) fn leave(
         return None;
     }
     let q = &state.q;
-    let cons = Constraints::new(model, &crate::solver::lock_values(model))
-        .with_active(model, strong)
-        .on_branches(state.branches.clone());
-    let mut sys = System::new(model, cons, backend);
-    let part = sys.partition(q);
+    let (mut sys, part) = strong_system(model, state, strong, backend);
     let dof = part.independent.len();
     if dof == 0 || dof > EXACT_UP_TO {
         return None;

@@ -131,16 +131,15 @@ def read_dae(path):
     return v.astype(np.float32).astype(np.float64)
 
 
-def openness(tris):
+def openness(tris, vol):
     """How far the mesh is from closed: the relative uncertainty of its enclosed volume. The
     signed volume summed from a reference point moves by `−d · S / 3` when the point moves by
     `d`, `S = Σ (b − a) × (c − a) / 2` the mesh's net vector area, zero for a closed surface;
-    over the mesh's bounding box that is `|S| D / 3` against the volume `V`."""
+    over the mesh's bounding box that is `|S| D / 3` against its volume `vol`."""
     a, b, c = tris[:, 0], tris[:, 1], tris[:, 2]
     s = np.cross(b - a, c - a).sum(axis=0) / 2.0
     pts = tris.reshape(-1, 3)
     diag = np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))
-    vol = mesh_mass(tris)[0]
     return np.linalg.norm(s) * diag / 3.0 / vol if vol > 0 else float("inf")
 
 
@@ -199,7 +198,7 @@ def shape_mass(geometry, resolve):
         scale = floats(g.get("scale"), 3, [1.0, 1.0, 1.0])
         tris = readers[ext](path) * np.array(scale)
         v, com, inertia = mesh_mass(tris)
-        return v, com, inertia, openness(tris) <= OPEN_MESH
+        return v, com, inertia, openness(tris, v) <= OPEN_MESH
     return f"geometry <{g.tag}>"
 
 

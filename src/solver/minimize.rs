@@ -10,9 +10,7 @@
 //! 3. **Reduced step** ([`reduced_step`]): Newton `d = −Ĥ⁻¹ ∇f` with the exact reduced Hessian
 //!    along the search path (`Ĥ + C`, module `step::path_hessian`), its eigenvalues replaced by
 //!    their magnitudes, floored (dense, module `step::newton`), near a maximum or saddle at
-//!    least a saddle step along every direction of negative curvature (module `step::escape`;
-//!    on a small tree away from a stationary point by Cholesky where `Ĥ + C` is positive
-//!    definite, `Ĥ` formed and not decomposed, module `step::path_cholesky`),
+//!    least a saddle step along every direction of negative curvature (module `step::escape`),
 //!    or the KKT direction (sparse); BFGS / DFP `d = −B ∇f` (module `step::quasi_newton`);
 //!    steepest descent when `d` is not a descent direction (an escape excepted).
 //! 4. **Step cap** (module `step::step_cap`): the tangent step `δq = Z d` limited on the motion of the
@@ -52,7 +50,6 @@ use super::stability::{at_rest::for_minimizer, inertia::ByInertia};
 use super::step::direction::{direction, Direction};
 use super::step::line_search::{line_search, Line, Trial};
 use super::step::newton::Settle;
-use super::step::path_cholesky::{self, Formed};
 use super::step::quasi_newton::QuasiNewton;
 use super::step::retraction::independent_change;
 use super::step::step_cap::{cap_step, Step};
@@ -204,8 +201,8 @@ pub(crate) fn minimize(
         }
         let judging = std::time::Instant::now(); // the verdict at a rest: `timings.stability`
         let mut reused = First::taken(&mut first, (&s.q, &s.part, &s.eval), gtol, &mut s.diag);
-        let (eig, formed, test) = match reused.as_mut() {
-            Some((e, _)) => (e.take(), None, Test::Continue),
+        let (eig, test) = match reused.as_mut() {
+            Some((e, _)) => (e.take(), Test::Continue),
             None => convergence_test(sys, &mut s, gtol, options),
         };
         let saddle = match test {
@@ -231,9 +228,7 @@ pub(crate) fn minimize(
         let (d, kkt, along_path) = match (rolled, reused) {
             (Some(d), _) => (d, false, None),
             (None, Some((_, d))) => (d, false, None),
-            (None, None) => {
-                reduced_step(sys, &mut s, (eig.as_ref(), formed), saddle, guard, options)
-            }
+            (None, None) => reduced_step(sys, &mut s, eig.as_ref(), saddle, guard, options),
         };
         let step = cap_step(sys, &s.part, &s.eval, &s.q, d, options);
         let slope = s.eval.grad_v.dot(&step.d);
@@ -356,24 +351,17 @@ fn record(s: &mut Search, options: &Options, report: bool) {
     }
 }
 
-/// Stage 2: the convergence test (module docs), with the spectrum where it was needed, or on a
-/// small tree away from a stationary point `Ĥ` formed and not decomposed (module
-/// `step::path_cholesky`).
+/// Stage 2: the convergence test (module docs), with the spectrum where it was needed.
 fn convergence_test(
     sys: &mut System,
     s: &mut Search,
     gtol: f64,
     options: &Options,
-) -> (Option<Spectrum>, Option<Formed>, Test) {
+) -> (Option<Spectrum>, Test) {
     let gnorm = s.eval.grad_v.amax();
     let dof = s.part.independent.len();
     let dense_newton = options.method == Method::Newton
         && (sys.backend == Backend::Dense || dof <= EXACT_NEWTON_DOF);
-    if dof > 0 && path_cholesky::applies(sys, dense_newton, gnorm, gtol, s.valley.looks(&s.history))
-    {
-        let formed = path_cholesky::formed(sys, &s.q, &s.part, &s.eval);
-        return (None, Some(formed), Test::Continue);
-    }
     // On the Lanczos path the inertia verdict, and the spectrum only to leave a saddle
     // (module `stability::at_rest`).
     let mut verdict = None;
@@ -390,7 +378,7 @@ fn convergence_test(
         })
         .flatten();
     if gnorm > gtol {
-        return (eig, None, Test::Continue);
+        return (eig, Test::Continue);
     }
     let rounding = GRADIENT_FLOOR * s.eval.energy.magnitude;
     let test = match &eig {
@@ -407,7 +395,7 @@ fn convergence_test(
         },
         _ => Test::Converged(eig.clone(), verdict),
     };
-    (eig, None, test)
+    (eig, test)
 }
 
 /// Stage 3: the reduced step `d` (module docs, module `step::direction`); steepest descent
@@ -416,7 +404,7 @@ fn convergence_test(
 fn reduced_step(
     sys: &mut System,
     s: &mut Search,
-    (eig, formed): (Option<&Spectrum>, Option<Formed>),
+    eig: Option<&Spectrum>,
     negative_curvature: Option<DVector<f64>>,
     guard: Option<&Guard>,
     options: &Options,
@@ -432,7 +420,7 @@ fn reduced_step(
     } = direction(
         sys,
         (&s.q, &s.part, &s.eval),
-        (eig, formed),
+        eig,
         negative_curvature.as_ref(),
         settle,
         &s.qn.binv,

@@ -44,6 +44,9 @@ pub(crate) const MAX_STEPS: usize = 10_000;
 /// The support tolerance `ε` relative to the group's size `D` (module docs).
 const SUPPORT_TOLERANCE: f64 = 1e-9;
 
+/// The settling height `δ` relative to the group's size `D` (module docs).
+const SETTLING: f64 = 1e-2;
+
 /// A floating group that could not stand on its ground start and toppled (module
 /// `solver::topple`).
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -235,8 +238,28 @@ impl Group<'_> {
             let c2 = flat(&projection);
             let hull = super::balance::convex_hull(touching);
             let margin = super::balance::signed_distance(&hull, &c2);
+            if before.is_none() && std::env::var_os("TOPPLE_TRACE").is_some() {
+                let mut hs: Vec<f64> = gaps.iter().map(|g| g.1).collect();
+                hs.sort_by(f64::total_cmp);
+                hs.dedup();
+                for &h in &hs {
+                    let pts: Vec<Vector2<f64>> = (0..gaps.len()).filter(|&i| gaps[i].1 <= h).map(|i| flat(&(gaps[i].0 - n * self.model.contact_points[self.points[i]].radius))).collect();
+                    let hull = super::balance::convex_hull(pts);
+                    if super::balance::signed_distance(&hull, &c2) >= -eps {
+                        eprintln!("size {size:.4}: inside the hull of the points within {h:.3e} m ({:.3e} D)", h / size);
+                        break;
+                    }
+                }
+            }
             if before.is_none() {
-                if margin >= -eps {
+                // The hull of the points within `δ` of the ground: the support the solve's
+                // settling can reach.
+                let near: Vec<Vector2<f64>> = (0..gaps.len())
+                    .filter(|&i| gaps[i].1 <= SETTLING * size)
+                    .map(|i| flat(&(gaps[i].0 - n * self.model.contact_points[self.points[i]].radius)))
+                    .collect();
+                let hull = super::balance::convex_hull(near);
+                if super::balance::signed_distance(&hull, &c2) >= -eps {
                     return None;
                 }
                 before = Some(self.links(&support));
@@ -295,6 +318,9 @@ impl Group<'_> {
                     p.x, p.y, p.z
                 ));
                 break;
+            }
+            if std::env::var_os("TOPPLE_TRACE").is_some() {
+                eprintln!("step {steps}: support {} pts hull {} margin {margin:.6} pivot {} pts at {:?} d {:?} angle {angle:.6} links {:?}", support.len(), hull.len(), pivot.len(), p.as_slice(), d.as_slice(), self.links(&support));
             }
             self.turn(q, &a, &centre, angle, a.cross(&n) * (rho * angle));
             steps += 1;

@@ -42,10 +42,8 @@ mod unbounded;
 pub(crate) mod valley;
 
 pub use mode_animation::mode_animation;
-pub use topple::Toppled;
 pub use options::{
-    ContactPolicy, Limits, LinearAlgebra, Method, Options, Progress, ProgressFn, StopSearch,
-    Topple,
+    ContactPolicy, Limits, LinearAlgebra, Method, Options, Progress, ProgressFn, StopSearch, Topple,
 };
 pub use report::{
     ActiveLimit, Contact, ContactState, Diagnostics, FrictionVerdict, Iterate, Mode, Reaction,
@@ -55,6 +53,7 @@ pub(crate) use stability::eigen;
 pub(crate) use stability::verdict::{
     stability_of, stability_on, stability_verdict, stability_verdict_after_round,
 };
+pub use topple::Toppled;
 
 use crate::constraints::unilateral::Active;
 use crate::constraints::Constraints;

@@ -75,7 +75,10 @@ pub struct Toppled {
 /// the start's).
 pub(crate) struct Path {
     pub(crate) toppled: Toppled,
-    #[cfg_attr(not(test), expect(dead_code, reason = "the unit tests check the descent"))]
+    #[cfg_attr(
+        not(test),
+        expect(dead_code, reason = "the unit tests check the descent")
+    )]
     pub(crate) energies: Vec<f64>,
 }
 
@@ -202,7 +205,10 @@ impl Group<'_> {
         let n = self.normal;
         let start = self.gaps(q);
         let (lo, hi) = start.iter().fold(
-            (Vector3::repeat(f64::INFINITY), Vector3::repeat(f64::NEG_INFINITY)),
+            (
+                Vector3::repeat(f64::INFINITY),
+                Vector3::repeat(f64::NEG_INFINITY),
+            ),
             |(lo, hi), (x, _)| (lo.inf(x), hi.sup(x)),
         );
         let size = (hi - lo).norm().max(self.model.length_scale);
@@ -218,7 +224,8 @@ impl Group<'_> {
             Vector3::y().cross(&n).normalize()
         };
         let e2 = n.cross(&e1);
-        let flat = |x: &Vector3<f64>| Vector2::new((x - self.origin).dot(&e1), (x - self.origin).dot(&e2));
+        let flat =
+            |x: &Vector3<f64>| Vector2::new((x - self.origin).dot(&e1), (x - self.origin).dot(&e2));
         let lift = |p: &Vector2<f64>| self.origin + e1 * p.x + e2 * p.y;
         let rotation0: Vec<Vector4<f64>> = self.bodies.iter().map(|&b| pose(q, b).1).collect();
         let mut energies = vec![self.energy(q)];
@@ -238,25 +245,14 @@ impl Group<'_> {
             let c2 = flat(&projection);
             let hull = super::balance::convex_hull(touching);
             let margin = super::balance::signed_distance(&hull, &c2);
-            if before.is_none() && std::env::var_os("TOPPLE_TRACE").is_some() {
-                let mut hs: Vec<f64> = gaps.iter().map(|g| g.1).collect();
-                hs.sort_by(f64::total_cmp);
-                hs.dedup();
-                for &h in &hs {
-                    let pts: Vec<Vector2<f64>> = (0..gaps.len()).filter(|&i| gaps[i].1 <= h).map(|i| flat(&(gaps[i].0 - n * self.model.contact_points[self.points[i]].radius))).collect();
-                    let hull = super::balance::convex_hull(pts);
-                    if super::balance::signed_distance(&hull, &c2) >= -eps {
-                        eprintln!("size {size:.4}: inside the hull of the points within {h:.3e} m ({:.3e} D)", h / size);
-                        break;
-                    }
-                }
-            }
             if before.is_none() {
                 // The hull of the points within `δ` of the ground: the support the solve's
                 // settling can reach.
                 let near: Vec<Vector2<f64>> = (0..gaps.len())
                     .filter(|&i| gaps[i].1 <= SETTLING * size)
-                    .map(|i| flat(&(gaps[i].0 - n * self.model.contact_points[self.points[i]].radius)))
+                    .map(|i| {
+                        flat(&(gaps[i].0 - n * self.model.contact_points[self.points[i]].radius))
+                    })
                     .collect();
                 let hull = super::balance::convex_hull(near);
                 if super::balance::signed_distance(&hull, &c2) >= -eps {
@@ -318,9 +314,6 @@ impl Group<'_> {
                     p.x, p.y, p.z
                 ));
                 break;
-            }
-            if std::env::var_os("TOPPLE_TRACE").is_some() {
-                eprintln!("step {steps}: support {} pts hull {} margin {margin:.6} pivot {} pts at {:?} d {:?} angle {angle:.6} links {:?}", support.len(), hull.len(), pivot.len(), p.as_slice(), d.as_slice(), self.links(&support));
             }
             self.turn(q, &a, &centre, angle, a.cross(&n) * (rho * angle));
             steps += 1;

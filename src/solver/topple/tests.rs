@@ -94,16 +94,27 @@ fn random_bodies_topple_downhill_onto_a_support_that_holds_them() {
         let paths = paths(&model, &mut q, &sticking());
         let Some(path) = paths.first() else { continue };
         toppled += 1;
-        assert!(path.toppled.stopped.is_none(), "case {case}: {:?}", path.toppled);
+        assert!(
+            path.toppled.stopped.is_none(),
+            "case {case}: {:?}",
+            path.toppled
+        );
         for w in path.energies.windows(2) {
             assert!(w[1] < w[0], "case {case}: {:?}", path.energies);
         }
         for k in 0..model.contact_points.len() {
             let x = crate::constraints::unilateral::point_world(&model, k, &q);
-            assert!(x.z - radius >= -1e-12, "case {case}: point {k} at {}", x.z - radius);
+            assert!(
+                x.z - radius >= -1e-12,
+                "case {case}: point {k} at {}",
+                x.z - radius
+            );
         }
         // Toppled again, it stands.
-        assert!(super::paths(&model, &mut q.clone(), &sticking()).is_empty(), "case {case}");
+        assert!(
+            super::paths(&model, &mut q.clone(), &sticking()).is_empty(),
+            "case {case}"
+        );
     }
     assert!(toppled > 100, "{toppled} of 200 toppled");
 }

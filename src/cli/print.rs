@@ -120,17 +120,7 @@ pub(crate) fn analysis(r: &AnalysisResult) {
         r.independent_coordinates.join(", ")
     );
     for t in &r.topple {
-        out!(
-            "  toppled at the start: `{}` cannot stand on {} (centre of mass {:.6} m outside); turned {:.6} rad in {} steps onto {}, {:.6} J lower{}",
-            t.body,
-            t.support_before.join(", "),
-            t.com_outside,
-            t.angle,
-            t.steps,
-            t.support_after.join(", "),
-            t.energy_released,
-            t.stopped.as_ref().map_or(String::new(), |s| format!(" ({s})"))
-        );
+        out!("  {}", t.describe());
     }
     out!();
     // Load steps and active-set rounds get their own columns when there is more than one.

@@ -20,7 +20,8 @@
 //!   line; at a corner or a single point: the point), `d̂ = (c' − p)/|c' − p|`, and the group
 //!   turns about the axis `a = n × d̂` through `p + ρ_p n` (`ρ_p` the radius shared by the
 //!   contact points on the pivot: 0 for mesh vertices and box corners; a sphere rolls, its
-//!   centre moving by `ρ_p θ (a × n)`), which lowers `c`: `dV/dθ = m |g| |c' − p| (n·ĝ) < 0`;
+//!   centre moving by `ρ_p θ (a × n)`, on a level ground only), which lowers `c`:
+//!   `dV/dθ = m |g| |c' − p| (n·ĝ) < 0`;
 //! - each other contact point's gap is, with `r = x_k − p − ρ_p n` and `r⊥ = r − (a·r) a`,
 //!   `h_k(θ) = ρ_p − ρ_k + n·r⊥ cos θ + n·(a × r⊥) sin θ`, and the group turns by the smallest
 //!   `θ ∈ (0, π]` at which one of them reaches the ground descending (a closed form per
@@ -74,6 +75,26 @@ pub struct Toppled {
     /// Why the topple stopped before the centre of mass was over the support, if it did.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stopped: Option<String>,
+}
+
+impl Toppled {
+    /// The summary's line: what could not stand, how far it turned, onto what.
+    pub fn describe(&self) -> String {
+        format!(
+            "toppled at the start: `{}` cannot stand on {} (centre of mass {:.6} m outside); \
+             turned {:.6} rad in {} steps onto {}, {:.6} J lower{}",
+            self.body,
+            self.support_before.join(", "),
+            self.com_outside,
+            self.angle,
+            self.steps,
+            self.support_after.join(", "),
+            self.energy_released,
+            self.stopped
+                .as_ref()
+                .map_or(String::new(), |s| format!(" ({s})"))
+        )
+    }
 }
 
 /// One group's topple: the report and the gravity energy after each step (the first entry
@@ -239,7 +260,7 @@ impl Group<'_> {
         let flat =
             |x: &Vector3<f64>| Vector2::new((x - self.origin).dot(&e1), (x - self.origin).dot(&e2));
         let lift = |p: &Vector2<f64>| self.origin + e1 * p.x + e2 * p.y;
-        let rotation0: Vec<Vector4<f64>> = self.bodies.iter().map(|&b| pose(q, b).1).collect();
+        let p0 = pose(q, self.bodies[0]).1;
         let mut energies = vec![self.energy(q)];
         let mut before = None;
         let mut outside = 0.0;
@@ -307,6 +328,13 @@ impl Group<'_> {
                 ));
                 break;
             }
+            if rho > 0.0 && n.dot(&self.down) > -1.0 + 1e-12 {
+                stopped = Some(format!(
+                    "the pivot is a contact sphere (radius {rho:.6} m) on a ground that is not \
+                     level: rolling it would move the centre of mass along the slope too"
+                ));
+                break;
+            }
             let centre = p + n * rho;
             // The angle at which the centre of mass is lowest.
             let (ac, bc) = components(&(c - centre), &a, &-self.down);
@@ -337,7 +365,6 @@ impl Group<'_> {
             self.links(&support)
         };
         // The net rotation: the first body's orientation now relative to its start.
-        let p0 = rotation0[0];
         let p1 = pose(q, self.bodies[0]).1;
         let relative = crate::math::compose(&p1, &Vector4::new(p0[0], -p0[1], -p0[2], -p0[3]));
         let half = Vector3::new(relative[1], relative[2], relative[3]).norm();
@@ -439,4 +466,5 @@ fn nearest(hull: &[Vector2<f64>], p: &Vector2<f64>) -> Vector2<f64> {
 }
 
 #[cfg(test)]
+#[path = "topple_tests.rs"]
 mod tests;

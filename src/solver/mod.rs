@@ -3,7 +3,8 @@
 //!
 //! 1. Initial state by forward kinematics with the initial joint values; loop joints are closed
 //!    by a damped Newton iteration that holds the joints given initial values where it can
-//!    (module `assemble`).
+//!    (module `assemble`). A floating group set on the ground by the ground start that cannot
+//!    stand there topples first, as a rigid body (module `topple`).
 //! 2. Partition `q = [u; v]` by full pivoting of `Φ_q` (module `partition`).
 //! 3. Minimize `f(v) = V(u(v), v)` (module `minimize`; its direction, step limit and line
 //!    search in folder `step`), with the corrector keeping `Φ = 0`.
@@ -108,7 +109,8 @@ pub(crate) fn assemble_only(
 
 /// Finds the stable static equilibrium of `model` from its initial guess (a floating
 /// mechanism with grounds and no base pose given starts with its lowest contact point on the
-/// grounds, module `assemble`).
+/// grounds, module `assemble`, and topples first if it cannot stand there: [`Options::topple`],
+/// [`Report::toppled`]).
 ///
 /// # Errors
 /// [`Error::Assembly`] if the loops cannot be closed from the initial guess,

@@ -50,5 +50,6 @@ pub use error::{Error, Result};
 pub use model::Model;
 pub use solver::{
     solve, solve_from, Limits, LinearAlgebra, Method, Options, Report, StopSearch, Termination,
+    Topple,
 };
 pub use state::State;

@@ -3,7 +3,7 @@
 //! `clap::ValueEnum` themselves (feature `cli`).
 
 use super::parse;
-use super::values::{Family, Friction, Limits, LinearAlgebra, Method, StopSearch};
+use super::values::{Family, Friction, Limits, LinearAlgebra, Method, StopSearch, Topple};
 use anyhow::{bail, Context};
 use clap::{Parser, Subcommand, ValueEnum};
 use restpose::solver::ContactPolicy;
@@ -306,6 +306,12 @@ pub(crate) struct AnalyzeArgs {
     /// moving on; every stop reached joins at once). See docs/method.md, "The search path".
     #[arg(long, value_enum, default_value_t = StopSearch::from(Options::default().stop_search))]
     pub(crate) stop_search: StopSearch,
+    /// A floating base placed on the ground (no base position given) whose centre of mass is
+    /// not over its support there: topple it as a rigid body over its support's edges onto the
+    /// points it lands on first (the JSON's `topple`), or solve from where it was placed.
+    /// Only with one ground, sticking contacts and no loads on it. See docs/servo.md.
+    #[arg(long, value_enum, default_value_t = Topple::from(Options::default().topple))]
+    pub(crate) topple: Topple,
     /// Stop at an unstable stationary point instead of leaving it.
     #[arg(long)]
     pub(crate) allow_unstable: bool,
@@ -373,6 +379,7 @@ impl AnalyzeArgs {
             eigenvalues: self.eigenvalues,
             load_steps: self.load_steps,
             stop_search: self.stop_search.into(),
+            topple: self.topple.into(),
             ..Default::default()
         }
         .with_contact(self.contact.policy())

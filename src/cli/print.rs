@@ -119,6 +119,9 @@ pub(crate) fn analysis(r: &AnalysisResult) {
         "  independent coordinates: {}",
         r.independent_coordinates.join(", ")
     );
+    for t in &r.topple {
+        out!("  {}", t.describe());
+    }
     out!();
     // Load steps and active-set rounds get their own columns when there is more than one.
     let staged = r.history.iter().any(|h| h.load_step != 1 || h.round != 1);

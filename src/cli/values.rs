@@ -7,7 +7,7 @@ use restpose::generate::Family as LibFamily;
 use restpose::model::Friction as LibFriction;
 use restpose::{
     Limits as LibLimits, LinearAlgebra as LibLinearAlgebra, Method as LibMethod,
-    StopSearch as LibStopSearch,
+    StopSearch as LibStopSearch, Topple as LibTopple,
 };
 
 /// A `ValueEnum` mirror of the library enum `$lib` with the same variants.
@@ -78,6 +78,18 @@ mirror! {
         /// search of bound-constrained Newton methods): every stop reached joins at once; the
         /// step is limited per joint instead of per body.
         Projected,
+    }
+}
+
+mirror! {
+    /// Whether a floating group that cannot stand on its ground start topples first
+    /// (`restpose::Topple`).
+    Topple = LibTopple {
+        /// Turn it as a rigid body over the edges of its support, onto the points it lands
+        /// on, until its centre of mass is over its support; then solve (default).
+        On,
+        /// Solve from the ground start as placed.
+        Off,
     }
 }
 

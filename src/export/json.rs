@@ -178,6 +178,11 @@ pub struct AnalysisResult {
     /// [`super::buried`]).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub buried_bodies: Vec<super::buried::BuriedBody>,
+    /// The floating groups that could not stand on their ground start and toppled before the
+    /// solve: `{body, steps, angle, support_before, support_after, com_outside,
+    /// energy_released, stopped}` (absent when none did; `restpose::solver::Toppled`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub topple: Vec<crate::solver::Toppled>,
 }
 
 impl AnalysisResult {
@@ -276,6 +281,7 @@ impl AnalysisResult {
             constraints: report.sizes.constraint_rows,
             servos: servo_results(model, state),
             buried_bodies: super::buried::buried_bodies(model, state),
+            topple: report.toppled.clone(),
         }
     }
 

@@ -106,8 +106,7 @@ fn newton(
 /// identity, turned as `--base-rpy` says), until its lowest contact point touches the grounds
 /// that face that way: `t = max_{c,g} −g_gap(c) / (n_g·û)`. It then settles from there.
 pub(crate) fn grounded_start(model: &Model, mut start: crate::State) -> crate::State {
-    let placed = model.base_pose.is_some() && !model.base_on_ground;
-    if placed || model.grounds.is_empty() || model.contact_points.is_empty() {
+    if !ground_start(model) {
         return start;
     }
     let up = if model.gravity.norm() > 0.0 {
@@ -137,6 +136,13 @@ pub(crate) fn grounded_start(model: &Model, mut start: crate::State) -> crate::S
         }
     }
     start
+}
+
+/// Whether the start is a ground start: grounds and contact points, and no base position
+/// given.
+pub(crate) fn ground_start(model: &Model) -> bool {
+    let placed = model.base_pose.is_some() && !model.base_on_ground;
+    !placed && !model.grounds.is_empty() && !model.contact_points.is_empty()
 }
 
 /// Assembles `q` (closes loops, applies locks and normalizes) or explains why it cannot.

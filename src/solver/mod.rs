@@ -3,7 +3,8 @@
 //!
 //! 1. Initial state by forward kinematics with the initial joint values; loop joints are closed
 //!    by a damped Newton iteration that holds the joints given initial values where it can
-//!    (module `assemble`).
+//!    (module `assemble`). A floating group set on the ground by the ground start that cannot
+//!    stand there topples first, as a rigid body (module `topple`).
 //! 2. Partition `q = [u; v]` by full pivoting of `Φ_q` (module `partition`).
 //! 3. Minimize `f(v) = V(u(v), v)` (module `minimize`; its direction, step limit and line
 //!    search in folder `step`), with the corrector keeping `Φ = 0`.
@@ -36,13 +37,14 @@ pub(crate) mod sparse;
 mod stability;
 mod step;
 pub(crate) mod system;
+mod topple;
 pub(crate) mod tree;
 mod unbounded;
 pub(crate) mod valley;
 
 pub use mode_animation::mode_animation;
 pub use options::{
-    ContactPolicy, Limits, LinearAlgebra, Method, Options, Progress, ProgressFn, StopSearch,
+    ContactPolicy, Limits, LinearAlgebra, Method, Options, Progress, ProgressFn, StopSearch, Topple,
 };
 pub use report::{
     ActiveLimit, Contact, ContactState, Diagnostics, FrictionVerdict, Iterate, Mode, Reaction,
@@ -52,6 +54,7 @@ pub(crate) use stability::eigen;
 pub(crate) use stability::verdict::{
     stability_of, stability_on, stability_verdict, stability_verdict_after_round,
 };
+pub use topple::Toppled;
 
 use crate::constraints::unilateral::Active;
 use crate::constraints::Constraints;
@@ -106,7 +109,8 @@ pub(crate) fn assemble_only(
 
 /// Finds the stable static equilibrium of `model` from its initial guess (a floating
 /// mechanism with grounds and no base pose given starts with its lowest contact point on the
-/// grounds, module `assemble`).
+/// grounds, module `assemble`, and topples first if it cannot stand there: [`Options::topple`],
+/// [`Report::toppled`]).
 ///
 /// # Errors
 /// [`Error::Assembly`] if the loops cannot be closed from the initial guess,
@@ -127,7 +131,7 @@ pub(crate) fn assemble_only(
 /// ```
 pub fn solve(model: &Model, options: &Options) -> Result<(State, Report)> {
     let start = assemble::grounded_start(model, initial_state(model));
-    solve_from(model, start, options)
+    solve_started(model, start, options, assemble::ground_start(model))
 }
 
 /// Like [`solve`], from a given (not necessarily assembled) state.
@@ -135,10 +139,29 @@ pub fn solve(model: &Model, options: &Options) -> Result<(State, Report)> {
 /// # Errors
 /// As [`solve`].
 pub fn solve_from(model: &Model, start: State, options: &Options) -> Result<(State, Report)> {
+    solve_started(model, start, options, false)
+}
+
+/// [`solve_from`]; a ground start (`grounded`) first topples the floating groups that cannot
+/// stand on it (module `topple`).
+fn solve_started(
+    model: &Model,
+    start: State,
+    options: &Options,
+    grounded: bool,
+) -> Result<(State, Report)> {
     let started = std::time::Instant::now();
     let locks = lock_values(model);
     let mut branches = start.branches;
-    let q = assemble::assemble(model, start.q, &mut branches, &locks, options)?;
+    let mut q = assemble::assemble(model, start.q, &mut branches, &locks, options)?;
+    let toppled = if grounded {
+        topple::topple(model, &mut q, options)
+    } else {
+        Vec::new()
+    };
+    if !toppled.is_empty() {
+        branches.follow(model, &q);
+    }
     let q = State { q, branches };
     let assembly = started.elapsed().as_secs_f64();
     let (state, mut report) =
@@ -149,6 +172,7 @@ pub fn solve_from(model: &Model, start: State, options: &Options) -> Result<(Sta
         };
     // Everything after the assembly that is not the final stability is iterations (load
     // stages and a direct attempt before a ramp included).
+    report.toppled = toppled;
     let t = &mut report.diagnostics.timings;
     t.assembly = assembly;
     t.iterations = (started.elapsed().as_secs_f64() - assembly - t.stability).max(0.0);
@@ -365,6 +389,7 @@ pub(crate) fn solve_round(
         active_set_changes: 0,
         friction: None,
         balance: None,
+        toppled: Vec::new(),
     };
     Ok(Round {
         state,

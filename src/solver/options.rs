@@ -51,6 +51,19 @@ pub enum StopSearch {
     Projected,
 }
 
+/// Whether a floating group that cannot stand on its ground start topples first (module
+/// `solver::topple`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Topple {
+    /// Turn it as a rigid body over the edges of its support, onto the points it lands on,
+    /// until its centre of mass is over its support, then solve from there (default).
+    #[default]
+    On,
+    /// Solve from the ground start as placed.
+    Off,
+}
+
 /// Whether URDF joint limits hold the joints (part of a [`ContactPolicy`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -176,6 +189,9 @@ pub struct Options {
     pub force_tolerance: f64,
     /// How a step that reaches inactive joint stops is searched (default: the projected search).
     pub stop_search: StopSearch,
+    /// Whether a floating group whose centre of mass is not over its support at the ground
+    /// start topples as a rigid body before the solve (default: on).
+    pub topple: Topple,
     /// Called after every iteration (default: none).
     pub progress: Progress,
 }
@@ -222,6 +238,7 @@ impl Default for Options {
             gap_tolerance: 1e-9,
             force_tolerance: 1e-9,
             stop_search: StopSearch::Projected,
+            topple: Topple::On,
             progress: Progress::default(),
         }
     }

@@ -394,6 +394,9 @@ pub struct Report {
     /// Support polygon, centre of mass and stability margin of a free mechanism standing on
     /// its contacts.
     pub balance: Option<crate::solver::balance::Balance>,
+    /// The floating groups that could not stand on their ground start and toppled before the
+    /// solve (module `solver::topple`; empty when none did).
+    pub toppled: Vec<crate::solver::Toppled>,
 }
 
 impl Report {

@@ -24,6 +24,7 @@ mod issue_21_sparse_chart_fold;
 mod issue_21_stand_from_reference;
 mod issue_21_stops_leave_together;
 mod issue_21_stops_met_together;
+mod issue_21_topple;
 mod issue_21_verify_forces_and_stability;
 mod issue_21_vision60_flat;
 mod issue_21_yaw_near_vertical;

@@ -48,6 +48,7 @@ from restpose._records import (
     LimitViolation,
     Reaction,
     Stability,
+    Toppled,
     Verification,
 )
 
@@ -67,6 +68,7 @@ __all__ = [
     "ActiveLimit",
     "LimitViolation",
     "BuriedBody",
+    "Toppled",
     "Iterate",
     "Diagnostics",
     "Imbalance",
@@ -102,6 +104,6 @@ def analyze(path: Union[str, "PathLike[str]"], **options: Any) -> Result:
     ``base_xyz``, ``base_rpy``, ``inertia_from_geometry``, ``locks``, ``initial``) and solves
     it with the solver options of :meth:`restpose.Model.solve` (``method``,
     ``linear_algebra``, ``tolerance``, ``constraint_tolerance``, ``max_iterations``,
-    ``load_steps``, ``allow_unstable``, ``limits``, ``friction``, ``mu``)."""
+    ``load_steps``, ``allow_unstable``, ``limits``, ``friction``, ``mu``, ``topple``)."""
     load_options = {k: options.pop(k) for k in _LOAD_OPTIONS if k in options}
     return load(path, **load_options).solve(**options)

@@ -17,6 +17,7 @@ from restpose._records import (
     LimitViolation,
     Reaction,
     Stability,
+    Toppled,
     Verification,
 )
 
@@ -86,6 +87,7 @@ class Model:
         limits: str = "enforce",
         friction: str = "none",
         mu: Optional[float] = None,
+        topple: bool = True,
     ) -> Result: ...
     def verify(
         self,
@@ -153,6 +155,8 @@ class Result:
     def limit_violations(self) -> List[LimitViolation]: ...
     @property
     def buried_bodies(self) -> List[BuriedBody]: ...
+    @property
+    def topple(self) -> List[Toppled]: ...
     @property
     def redundant_constraints(self) -> List[str]: ...
     @property

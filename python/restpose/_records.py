@@ -18,6 +18,7 @@ __all__ = [
     "ActiveLimit",
     "LimitViolation",
     "BuriedBody",
+    "Toppled",
     "Iterate",
     "Diagnostics",
     "Imbalance",
@@ -147,6 +148,22 @@ class BuriedBody(Record):
     depth: float
 
 
+class Toppled(Record):
+    """A floating group that could not stand on its ground start and toppled as a rigid body
+    before the solve: ``body`` (its first link), ``steps`` (turns over a support edge or
+    point), ``angle`` [rad] (its net rotation), ``support_before`` and ``support_after`` (links
+    touching the ground), ``com_outside`` [m] (the centre of mass's projection outside the
+    start support), ``energy_released`` [J], ``stopped`` (why it stopped early, or absent)."""
+
+    body: str
+    steps: int
+    angle: float
+    support_before: List[str]
+    support_after: List[str]
+    com_outside: float
+    energy_released: float
+
+
 class Iterate(Record):
     """One minimizer iteration: ``iteration``, ``potential_energy`` [J], ``gradient_norm``."""
 
@@ -265,6 +282,7 @@ _SECTIONS = {
     "active_limits": ActiveLimit,
     "limit_violations": LimitViolation,
     "buried_bodies": BuriedBody,
+    "topple": Toppled,
     "history": Iterate,
     "diagnostics": Diagnostics,
 }

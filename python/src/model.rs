@@ -215,7 +215,9 @@ impl Model {
     /// ``"bfgs"``, ``"dfp"``), ``linear_algebra`` (``"auto"``, ``"dense"``, ``"sparse"``, ``"tree"``),
     /// ``tolerance`` (scaled reduced gradient [J]), ``constraint_tolerance`` (‖DΦ‖∞, dimensionless),
     /// ``max_iterations``, ``load_steps`` (0: automatic), ``allow_unstable``, ``limits``
-    /// (``"enforce"``, ``"ignore"``), ``friction`` (``"none"``, ``"stick"``), ``mu``.
+    /// (``"enforce"``, ``"ignore"``), ``friction`` (``"none"``, ``"stick"``), ``mu``, ``topple``
+    /// (a floating group that cannot stand on its ground start topples as a rigid body before
+    /// the solve, ``--topple on|off``: see ``Result.topple``).
     ///
     /// Not converging is not an exception: see ``Result.converged``. Raises
     /// ``restpose.AssemblyError`` if the initial guess cannot be assembled,
@@ -223,7 +225,7 @@ impl Model {
     /// for the other failures.
     #[pyo3(signature = (*, method="newton", linear_algebra="auto", tolerance=1e-8,
         constraint_tolerance=1e-10, max_iterations=200, load_steps=0, allow_unstable=false,
-        limits="enforce", friction="none", mu=None))]
+        limits="enforce", friction="none", mu=None, topple=true))]
     fn solve(
         slf: &Bound<'_, Self>,
         method: &str,
@@ -236,6 +238,7 @@ impl Model {
         limits: &str,
         friction: &str,
         mu: Option<f64>,
+        topple: bool,
     ) -> PyResult<PyResult_> {
         let opts = options::solver_options(
             method,
@@ -248,6 +251,7 @@ impl Model {
             limits,
             friction,
             mu,
+            topple,
         )?;
         let this = slf.get();
         let loaded = this.loaded.clone();

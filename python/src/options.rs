@@ -192,6 +192,7 @@ pub(crate) fn solver_options(
     limits_name: &str,
     friction_name: &str,
     mu: Option<f64>,
+    topple: bool,
 ) -> PyResult<Options> {
     positive(Some(tolerance), "tolerance")?;
     positive(Some(constraint_tolerance), "constraint_tolerance")?;
@@ -211,6 +212,11 @@ pub(crate) fn solver_options(
         limits: limits(limits_name)?,
         friction: friction(friction_name)?,
         mu: positive(mu, "mu")?,
+        topple: if topple {
+            restpose::Topple::On
+        } else {
+            restpose::Topple::Off
+        },
         ..Default::default()
     })
 }

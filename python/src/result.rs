@@ -278,6 +278,13 @@ impl Result {
         section(py, "buried_bodies", &self.result.buried_bodies)
     }
 
+    /// Floating groups that could not stand on their ground start and toppled as rigid bodies
+    /// before the solve (``restpose.Toppled`` list; empty when none did).
+    #[getter]
+    fn topple<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        section(py, "topple", &self.result.topple)
+    }
+
     /// Constraint rows dropped as redundant.
     #[getter]
     fn redundant_constraints(&self) -> Vec<String> {

@@ -201,6 +201,35 @@ def test_floating_base_on_the_ground(robots):
     assert all(c.gap > -1e-6 for c in result.contacts)
 
 
+PLANK = """<robot name="plank">
+  <link name="plank"><inertial><origin xyz="0.45 0 0.125"/><mass value="3"/>
+    <inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>
+    <collision><origin xyz="0.45 0 0.125"/><geometry><box size="1.0 0.2 0.05"/></geometry></collision></link>
+  <link name="foot"><collision><origin xyz="0 0 0.05"/><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
+  <joint name="weld" type="fixed"><parent link="plank"/><child link="foot"/></joint>
+</robot>"""
+
+
+def test_a_body_that_cannot_stand_topples_at_the_ground_start():
+    # A plank on a foot under its end (docs/servo.md, the topple): its centre of mass 0.40 m
+    # beyond the foot's edge, it turns about that edge until the plank's far corners (0.9 m
+    # out, 0.1 m up) touch, tan(angle) = 1/9, and rests with its centre of mass at 0.725/sqrt(82).
+    model = restpose.load_string(PLANK, floating_base=True, ground=True)
+    result = model.solve(friction="stick")
+    assert result.converged
+    [t] = result.topple
+    assert isinstance(t, restpose.Toppled)
+    assert (t.body, t.steps) == ("plank", 1)
+    assert t.angle == pytest.approx(math.atan(1 / 9), abs=1e-12)
+    assert t.com_outside == pytest.approx(0.40, abs=1e-12)
+    assert (t.support_before, t.support_after) == (["foot"], ["plank", "foot"])
+    assert result.potential_energy == pytest.approx(3 * 9.81 * 0.725 / math.sqrt(82), abs=1e-9)
+    assert json.loads(result.to_json())["topple"] == [t.to_dict()]
+    # off: no topple, the field absent; the solve itself lets it fall from the foot
+    off = model.solve(friction="stick", topple=False)
+    assert off.topple == [] and "topple" not in json.loads(off.to_json())
+
+
 def test_buried_bodies_name_bodies_resting_inside_a_ground():
     # The arm without collision geometry under a ground at z = 1: its point mass at
     # (cos θ, 0, −sin θ) rests 1 + sin θ inside it (docs/contact.md).

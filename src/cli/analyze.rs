@@ -115,12 +115,16 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
     if result.converged {
         if let Some(path) = &a.write_urdf {
             let text = restpose::urdf::read_urdf_text(&a.file, &opts)?;
-            let out = restpose::urdf::with_initial_pose(
-                &text,
-                &a.file.display().to_string(),
-                model,
-                &state,
-            )?;
+            let name = a.file.display().to_string();
+            let mut out = restpose::urdf::with_initial_pose(&text, &name, model, &state)?;
+            // Relative mesh names resolve from the written file's folder as from the input's.
+            if path.as_os_str() != "-" {
+                let folder = |p: &std::path::Path| match p.parent() {
+                    Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+                    _ => std::path::PathBuf::from("."),
+                };
+                out = restpose::urdf::relocated(&out, &name, &folder(&a.file), &folder(path))?;
+            }
             print::write_output(path, &out)?;
         }
         if let Some(path) = &a.write_joint_states {

@@ -24,6 +24,7 @@ mod lines;
 mod links;
 mod mimic;
 mod number;
+mod relocate;
 mod schema;
 mod servo;
 mod text;
@@ -33,6 +34,7 @@ mod write_back;
 pub mod xacro;
 mod xml;
 
+pub use relocate::relocated;
 pub use servo::{srdf_state, ServoRequest};
 pub use text::{read_file as read_text, MAX_DEPTH, MAX_FILE_BYTES};
 pub use write_back::with_initial_pose;
@@ -72,8 +74,9 @@ pub struct ImportOptions {
     pub servos: Vec<ServoRequest>,
     /// Reference pose of the servos `(joint, value)` (`--servo-reference`, an SRDF
     /// `group_state`): a servo without its own reference holds its joint at this value, and
-    /// the joint starts there (overriding `mech:initial`; [`ImportOptions::initial`] overrides
-    /// it).
+    /// the joint starts there unless the file gives it a `mech:initial` (the file's start is
+    /// kept: a rest pose written by `--write-urdf` starts at that rest);
+    /// [`ImportOptions::initial`] overrides both.
     pub servo_reference: Vec<(String, f64)>,
     /// `--xacro-arg NAME:=VALUE`: arguments of a xacro file (feature `xacro`).
     pub xacro_args: Vec<(String, String)>,

@@ -131,6 +131,46 @@ fn a_servo_reference_is_also_the_start() {
     assert_eq!(start(&bar(vec![all], Vec::new())), 0.0);
 }
 
+/// A joint the file starts by `mech:initial` keeps that start under a reference pose (so that
+/// a rest written back by `--write-urdf` and analysed again with the same options starts at
+/// that rest); the servo's reference is still the reference pose's, and `--initial` overrides
+/// both.
+#[test]
+fn a_files_initial_value_keeps_its_start_under_a_reference_pose() {
+    let text = BAR
+        .replace(
+            "</robot>",
+            r#"<mech:initial joint="pivot" value="0.4"/></robot>"#,
+        )
+        .replacen("<robot ", r#"<robot xmlns:mech="urn:urdf-mech:1" "#, 1);
+    let load = |initial: Vec<(String, usize, f64)>| {
+        let options = ImportOptions {
+            servos: vec![ServoRequest {
+                joint: None,
+                stiffness: 100.0,
+                reference: None,
+            }],
+            servo_reference: vec![("pivot".into(), 0.25)],
+            initial,
+            ..Default::default()
+        };
+        load_str(&text, "bar.urdf", &options).unwrap().model
+    };
+    let start = |m: &restpose::Model| restpose::State::initial(m).joint(m, "pivot").unwrap()[0];
+    let m = load(Vec::new());
+    assert!((start(&m) - 0.4).abs() < 1e-15, "{}", start(&m));
+    assert_eq!(m.servos()[0].reference, 0.25);
+    let m = load(vec![("pivot".into(), 0, 0.1)]);
+    assert!((start(&m) - 0.1).abs() < 1e-15);
+    // Without the file's value the reference pose starts it, as before.
+    let options = ImportOptions {
+        servo_reference: vec![("pivot".into(), 0.25)],
+        ..Default::default()
+    };
+    let m = load_str(BAR, "bar.urdf", &options).unwrap().model;
+    assert!((start(&m) - 0.25).abs() < 1e-15);
+}
+
 #[test]
 fn an_unknown_servo_joint_is_named_with_a_suggestion() {
     let options = ImportOptions {

@@ -123,7 +123,13 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
                     Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
                     _ => std::path::PathBuf::from("."),
                 };
-                out = restpose::urdf::relocated(&out, &name, &folder(&a.file), &folder(path))?;
+                out = restpose::urdf::relocated(
+                    &out,
+                    &name,
+                    &folder(&a.file),
+                    &folder(path),
+                    &opts.packages,
+                )?;
             }
             print::write_output(path, &out)?;
         }

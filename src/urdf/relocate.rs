@@ -4,21 +4,32 @@
 //! a file that is not there (re-analysing the written rest then fails with "mesh … was not
 //! found").
 //!
-//! Each `filename` of a `<mesh>` or `<texture>` element that is a relative path (no URI scheme
-//! such as `package://` or `file://`, not absolute) is replaced by the path from the output's
-//! folder `O` to the file it named from the input's folder `I`: `relative(I/f, O)`, both
-//! folders taken as absolute canonical paths, and `I/f` itself (absolute) where they share no
-//! prefix (another drive). The text is edited in place, as `write_back` edits it: only those
-//! attribute values change.
+//! Each `filename` of a `<mesh>` or `<texture>` element that is a relative path (no URI scheme,
+//! not absolute) is replaced by the path from the output's folder `O` to the file it named from
+//! the input's folder `I`: `relative(I/f, O)`, both folders taken as absolute canonical paths,
+//! and `I/f` itself (absolute) where they share no prefix (another drive). A `package://` or
+//! `model://` name is kept where it resolves from `O` as well (the package directories given,
+//! the environment's, or a package folder above `O`: module `geometry::package`), and replaced
+//! the same way by the file it resolves to from `I` where only the walk up from `I` finds it
+//! (example-robot-data's `talos_full_v2.urdf` names its meshes `package:///example-robot-data/…`,
+//! an empty package name that only the folders above the file resolve). The text is edited in
+//! place, as `write_back` edits it: only those attribute values change.
 
 use std::path::{Component, Path, PathBuf};
 
-/// `text` (parsed as the URDF file `file`) with the relative `filename`s of its `<mesh>` and
-/// `<texture>` elements rewritten to resolve from the folder `to` as they did from `from`.
+/// `text` (parsed as the URDF file `file`) with the `filename`s of its `<mesh>` and `<texture>`
+/// elements that resolved from the folder `from` only (module docs) rewritten to resolve from
+/// the folder `to`; `packages` are the package directories given (`--package NAME=DIR`).
 ///
 /// # Errors
 /// [`crate::Error::Input`] if `text` is not well-formed XML.
-pub fn relocated(text: &str, file: &str, from: &Path, to: &Path) -> crate::Result<String> {
+pub fn relocated(
+    text: &str,
+    file: &str,
+    from: &Path,
+    to: &Path,
+    packages: &[(String, PathBuf)],
+) -> crate::Result<String> {
     let (Ok(from), Ok(to)) = (from.canonicalize(), to.canonicalize()) else {
         return Ok(text.to_string());
     };
@@ -37,13 +48,26 @@ pub fn relocated(text: &str, file: &str, from: &Path, to: &Path) -> crate::Resul
         let Some(name) = node.attribute("filename") else {
             continue;
         };
-        if name.is_empty() || name.contains("://") || Path::new(name).is_absolute() {
+        let target = if name.starts_with("package://") || name.starts_with("model://") {
+            let paths = |dir: &Path| crate::geometry::PackagePaths {
+                explicit: packages.to_vec(),
+                urdf_dir: Some(dir.to_path_buf()),
+            };
+            if paths(&to).resolve(name).is_ok() {
+                continue;
+            }
+            match paths(&from).resolve(name).map(|p| p.canonicalize()) {
+                Ok(Ok(p)) => p,
+                _ => continue,
+            }
+        } else if name.is_empty() || name.contains("://") || Path::new(name).is_absolute() {
             continue;
-        }
+        } else {
+            from.join(name)
+        };
         let Some(range) = value_range(text, node.range(), name) else {
             continue;
         };
-        let target = from.join(name);
         let path = relative(&target, &to).unwrap_or(target);
         edits.push((range, escape(&path.to_string_lossy())));
     }
@@ -145,7 +169,7 @@ mod tests {
   <collision><geometry><mesh  filename = "package://p/b.stl"/></geometry></collision>
   <collision><geometry><mesh filename="/abs/c.stl"/></geometry></collision></link>
   <!-- filename="meshes/a.stl" in a comment stays --></robot>"#;
-        let out = relocated(text, "r.urdf", &input, &output).unwrap();
+        let out = relocated(text, "r.urdf", &input, &output, &[]).unwrap();
         assert!(
             out.contains(r#"<mesh filename="../robot/meshes/a.stl" scale="1 1 1"/>"#),
             "{out}"
@@ -158,7 +182,46 @@ mod tests {
         assert!(out.contains(r#"filename="/abs/c.stl""#), "{out}");
         assert!(out.contains(r#"<!-- filename="meshes/a.stl" in a comment stays -->"#));
         // The same folder: unchanged.
-        assert_eq!(relocated(text, "r.urdf", &input, &input).unwrap(), text);
+        assert_eq!(
+            relocated(text, "r.urdf", &input, &input, &[]).unwrap(),
+            text
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn package_names_found_only_above_the_input_move() {
+        let dir =
+            std::env::temp_dir().join(format!("restpose-relocate-pkg-{}", std::process::id()));
+        // share/robots/r/r.urdf names `package:///robots/m/a.stl` (empty package name: the
+        // folders above the file) and `package://m/b.stl` (package `m`, given explicitly).
+        let (input, output, m) = (
+            dir.join("share/robots/r"),
+            dir.join("out"),
+            dir.join("share/robots/m"),
+        );
+        for d in [&input, &output, &m] {
+            std::fs::create_dir_all(d).unwrap();
+        }
+        for f in ["a.stl", "b.stl"] {
+            std::fs::write(m.join(f), "solid x\nendsolid x\n").unwrap();
+        }
+        let text = r#"<robot name="r"><link name="a"><collision><geometry>
+  <mesh filename="package:///robots/m/a.stl"/></geometry></collision><collision><geometry>
+  <mesh filename="package://m/b.stl"/></geometry></collision></link></robot>"#;
+        let given = [("m".to_string(), m.clone())];
+        let out = relocated(text, "r.urdf", &input, &output, &given).unwrap();
+        assert!(
+            out.contains(r#"filename="../share/robots/m/a.stl""#),
+            "{out}"
+        );
+        assert!(out.contains(r#"filename="package://m/b.stl""#), "{out}");
+        // Without the package given, `m` is found only above the input too.
+        let out = relocated(text, "r.urdf", &input, &output, &[]).unwrap();
+        assert!(
+            out.contains(r#"filename="../share/robots/m/b.stl""#),
+            "{out}"
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

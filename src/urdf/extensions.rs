@@ -463,23 +463,15 @@ pub(super) fn read(
             value: *value,
         });
     }
-    // The reference pose (an SRDF state, a pose file, a servo's own reference) is also the
-    // start: a robot held about its standing state starts standing. It starts the joints the
-    // file gives no `mech:initial` (a file's own start, such as the rest pose
-    // `--write-urdf` wrote, is kept: the same options then start at that rest), `--initial`
-    // overrides both; joints the model lacks or with several coordinates are skipped (as by
-    // the servos).
-    let from_file: Vec<JointId> = initial
-        .iter()
-        .filter(|l| l.dof == 0)
-        .map(|l| l.joint)
-        .collect();
+    // The reference pose (SRDF state, pose file, `@REF`) starts the joints the file does not
+    // (`mech:initial`, e.g. a written rest); `--initial` overrides both; scalar joints only.
+    let from_file: Vec<JointId> = initial.iter().map(|l| l.joint).collect();
     for (name, value) in &super::servo::starts(options) {
         let Some(id) = b.model.joint_id(name) else {
             continue;
         };
-        if b.model.partial().joints[id.0].kind.scalar_coordinates() != 1 || from_file.contains(&id)
-        {
+        let scalar = b.model.partial().joints[id.0].kind.scalar_coordinates() == 1;
+        if !scalar || from_file.contains(&id) {
             continue;
         }
         initial.retain(|l| !(l.joint == id && l.dof == 0));

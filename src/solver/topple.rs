@@ -236,6 +236,7 @@ impl Group<'_> {
     /// Topples the group in `q` (module docs); `None` if it stands or is not on the ground.
     fn topple(&self, q: &mut DVector<f64>) -> Option<Path> {
         let n = self.normal;
+        let saved = q.clone();
         let start = self.gaps(q);
         let (lo, hi) = start.iter().fold(
             (
@@ -358,6 +359,14 @@ impl Group<'_> {
             self.turn(q, &a, &centre, angle, a.cross(&n) * (rho * angle));
             steps += 1;
             energies.push(self.energy(q));
+        }
+        // A group whose numbers overflow on the way (a mass or a coordinate near the largest
+        // float) is left as placed: the topple never hands the solve a non-finite start.
+        let finite = |i: &usize| (7 * i..7 * i + 7).all(|k| q[k].is_finite());
+        let numbers = energies.iter().chain([&outside]);
+        if !(self.bodies.iter().all(finite) && numbers.into_iter().all(|e| e.is_finite())) {
+            *q = saved;
+            return None;
         }
         let after = {
             let gaps = self.gaps(q);

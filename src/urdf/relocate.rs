@@ -69,7 +69,7 @@ pub fn relocated(
             continue;
         };
         let path = relative(&target, &to).unwrap_or(target);
-        edits.push((range, escape(&path.to_string_lossy())));
+        edits.push((range, super::write_back::escape(&path.to_string_lossy())));
     }
     let mut out = String::with_capacity(text.len() + 64 * edits.len());
     let mut pos = 0;
@@ -132,14 +132,6 @@ fn relative(target: &Path, base: &Path) -> Option<PathBuf> {
         out.push(c.as_os_str());
     }
     Some(out)
-}
-
-/// `s` escaped for an attribute value in either quotes.
-fn escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('"', "&quot;")
-        .replace('\'', "&apos;")
 }
 
 #[cfg(test)]

@@ -8,7 +8,7 @@
 //! (quaternion `w x y z`; `x y z w qx qy qz`), a restpose extension of the format.
 //! A floating base's pose (its root link in the world) replaces any `mech:base` as
 //! `<mech:base xyz quat_xyzw/>`, so that `--floating-base` starts there. Names are escaped
-//! (`&`, `<`, `>`, `"`) in attribute values.
+//! (`&`, `<`, `>`, `"`, `'`) in attribute values.
 
 use super::xml::MECH_NS;
 use crate::error::Result;
@@ -111,10 +111,11 @@ pub fn with_initial_pose(text: &str, file: &str, model: &Model, state: &State) -
     Ok(out)
 }
 
-/// `s` escaped for an attribute value in double quotes.
-fn escape(s: &str) -> String {
+/// `s` escaped for an attribute value in double or single quotes.
+pub(super) fn escape(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")
         .replace('"', "&quot;")
+        .replace('\'', "&apos;")
 }

@@ -177,29 +177,15 @@ fn a_servo_held_rest_written_elsewhere_reanalyses_in_zero_iterations() {
     let dir = tempfile::tempdir().unwrap();
     let bolt = format!("{}/robots/bolt", env!("CARGO_MANIFEST_DIR"));
     let urdf = format!("{bolt}/bolt.urdf");
-    let srdf = format!("{bolt}/bolt.srdf");
-    let options = [
-        "--floating-base",
-        "--ground",
-        "--friction",
-        "stick",
-        "--servo",
-        "all=1000",
-        "--srdf",
-        &srdf,
-        "--srdf-state",
-        "standing",
-        "--load-steps",
-        "1",
-    ];
     let written = dir.path().join("out").join("rest.urdf");
     std::fs::create_dir_all(written.parent().unwrap()).unwrap();
     let analyze = |file: &std::path::Path, json: &std::path::Path, extra: &[&std::ffi::OsStr]| {
         let o = Command::new(env!("CARGO_BIN_EXE_restpose"))
+            .current_dir(&bolt)
             .arg("analyze")
             .arg(file)
-            .args(options)
-            .args(["-q", "--json"])
+            .args(BOLT_STANDING)
+            .args(["--load-steps", "1", "-q", "--json"])
             .arg(json)
             .args(extra)
             .output()

@@ -10,6 +10,22 @@ use restpose::state::State;
 use restpose::urdf::{load_file, load_str, ImportOptions};
 use restpose::{Model, Options, Report};
 
+/// Bolt standing as in the Pinocchio corpus (`robots/bolt/`, files named from that folder):
+/// a floating base on the ground, sticking contacts, servos of 1000 N m/rad about its SRDF
+/// `standing` state.
+pub(crate) const BOLT_STANDING: [&str; 10] = [
+    "--floating-base",
+    "--ground",
+    "--friction",
+    "stick",
+    "--servo",
+    "all=1000",
+    "--srdf",
+    "bolt.srdf",
+    "--srdf-state",
+    "standing",
+];
+
 /// Runs `restpose analyze -q --json OUT ARGS…` in the folder `robots/DIR`: the exit code,
 /// standard error, and the result JSON (`Null` where none was written).
 pub(crate) fn analyze_in(dir: &str, args: &[String]) -> (Option<i32>, String, serde_json::Value) {

@@ -24,18 +24,7 @@ fn bolt_falls_onto_its_trunk_without_releasing_the_vertices_it_rolls_onto() {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/robots/bolt");
     let tmp = tempfile::tempdir().unwrap();
     let json = tmp.path().join("bolt.json");
-    let args = [
-        "--floating-base",
-        "--ground",
-        "--friction",
-        "stick",
-        "--servo",
-        "all=1000",
-        "--srdf",
-        "bolt.srdf",
-        "--srdf-state",
-        "standing",
-    ];
+    let args = crate::common::BOLT_STANDING;
     let out = Command::new(env!("CARGO_BIN_EXE_restpose"))
         .current_dir(dir)
         .args([

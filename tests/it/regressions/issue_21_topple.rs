@@ -135,18 +135,7 @@ fn bolt_topples_at_the_start_and_converges_in_a_few_iterations() {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/robots/bolt");
     let tmp = tempfile::tempdir().unwrap();
     let json = tmp.path().join("bolt.json");
-    let args = [
-        "--floating-base",
-        "--ground",
-        "--friction",
-        "stick",
-        "--servo",
-        "all=1000",
-        "--srdf",
-        "bolt.srdf",
-        "--srdf-state",
-        "standing",
-    ];
+    let args = crate::common::BOLT_STANDING;
     let out = Command::new(env!("CARGO_BIN_EXE_restpose"))
         .current_dir(dir)
         .args(["analyze", "bolt.urdf", "--load-steps", "1", "--json"])

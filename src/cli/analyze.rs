@@ -132,6 +132,9 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
                 )?;
             }
             print::write_output(path, &out)?;
+            if let Some(note) = super::written::moved_servo_references(&opts, model, &state) {
+                super::print::note!("{note}");
+            }
         }
         if let Some(path) = &a.write_joint_states {
             let out = restpose::export::joint_states::joint_states_yaml(model, &state);

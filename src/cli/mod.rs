@@ -16,3 +16,4 @@ pub(crate) mod report;
 pub(crate) mod values;
 pub(crate) mod verify;
 pub(crate) mod view;
+pub(crate) mod written;

@@ -218,3 +218,40 @@ fn a_servo_held_rest_written_elsewhere_reanalyses_in_zero_iterations() {
         "{energy2} vs {energy}"
     );
 }
+
+/// A servo whose reference is its joint's start would be held about the rest when the written
+/// file is analysed again (its start is now the rest): `--write-urdf` names it with the option
+/// that keeps it (`--servo JOINT=K@REF`), and says nothing where every reference is given.
+#[test]
+fn a_servo_referenced_to_the_start_is_named_when_the_rest_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let urdf = format!("{}/robots/pendulum.urdf", env!("CARGO_MANIFEST_DIR"));
+    let (out, json) = (dir.path().join("rest.urdf"), dir.path().join("r.json"));
+    let run = |servo: &str| {
+        let o = Command::new(env!("CARGO_BIN_EXE_restpose"))
+            .args(["analyze", &urdf, "-q", "--servo", servo, "--write-urdf"])
+            .arg(&out)
+            .arg("--json")
+            .arg(&json)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0));
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    let err = run("all=100");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let reference = v["servos"][0]["reference"].as_f64().unwrap();
+    let position = v["servos"][0]["position"].as_f64().unwrap();
+    assert!(
+        (reference - position).abs() > 1e-3,
+        "{reference} {position}"
+    );
+    assert!(
+        err.contains(&format!(
+            "to keep these servos add: --servo pivot=100@{reference}"
+        )),
+        "{err}"
+    );
+    assert!(!run("pivot=100@0.3").contains("servo(s) take their reference"));
+}

@@ -95,13 +95,18 @@ _LOAD_OPTIONS = (
     "inertia_from_geometry",
     "locks",
     "initial",
+    "servos",
+    "servo_reference",
+    "srdf",
+    "srdf_state",
 )
 
 
 def analyze(path: Union[str, "PathLike[str]"], **options: Any) -> Result:
     """``restpose analyze`` in one call: loads ``path`` with the input options of
     :func:`restpose.load` (``packages``, ``gravity``, ``floating_base``, ``ground``,
-    ``base_xyz``, ``base_rpy``, ``inertia_from_geometry``, ``locks``, ``initial``) and solves
+    ``base_xyz``, ``base_rpy``, ``inertia_from_geometry``, ``locks``, ``initial``, ``servos``,
+    ``servo_reference``, ``srdf``, ``srdf_state``) and solves
     it with the solver options of :meth:`restpose.Model.solve` (``method``,
     ``linear_algebra``, ``tolerance``, ``constraint_tolerance``, ``max_iterations``,
     ``load_steps``, ``allow_unstable``, ``limits``, ``friction``, ``mu``, ``topple``)."""

@@ -41,6 +41,10 @@ def load(
     inertia_from_geometry: Optional[float] = None,
     locks: Optional[_Values] = None,
     initial: Optional[_Values] = None,
+    servos: Optional[Mapping[str, Union[float, Tuple[float, float]]]] = None,
+    servo_reference: Optional[Union[Mapping[str, float], _Path]] = None,
+    srdf: Optional[_Path] = None,
+    srdf_state: Optional[str] = None,
 ) -> Model: ...
 def load_string(
     text: str,
@@ -55,6 +59,10 @@ def load_string(
     inertia_from_geometry: Optional[float] = None,
     locks: Optional[_Values] = None,
     initial: Optional[_Values] = None,
+    servos: Optional[Mapping[str, Union[float, Tuple[float, float]]]] = None,
+    servo_reference: Optional[Union[Mapping[str, float], _Path]] = None,
+    srdf: Optional[_Path] = None,
+    srdf_state: Optional[str] = None,
 ) -> Model: ...
 def run_cli(argv: List[str]) -> int: ...
 

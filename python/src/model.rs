@@ -48,14 +48,18 @@ impl Model {
 /// gives links without ``<inertial>`` the mass of their geometry at this density [kg/m³];
 /// ``locks`` holds joint coordinates and ``initial`` sets initial guesses, both as
 /// ``{"joint": value}`` (``"joint[1]"`` or a list for several coordinates; a lock of ``None``
-/// holds the initial value).
+/// holds the initial value); ``servos`` holds joints like position servos, ``{"all": K}`` or
+/// ``{"JOINT": K}`` or ``{"JOINT": (K, REF)}`` (``--servo``), about the reference pose of
+/// ``servo_reference`` (a ``{"joint": value}`` mapping or a pose file) or of ``srdf`` and
+/// ``srdf_state`` (an SRDF ``group_state``), which is also the start.
 ///
 /// Raises ``restpose.FileError`` if the file cannot be read, ``restpose.InputError`` (with
 /// ``file``, ``line``, ``column``, ``element``) if it is not a valid restpose URDF,
 /// ``restpose.UnknownJointError`` for a lock or initial value on a joint the file lacks.
 #[pyfunction]
 #[pyo3(signature = (path, *, packages=None, gravity=None, floating_base=false, ground=false,
-    base_xyz=None, base_rpy=None, inertia_from_geometry=None, locks=None, initial=None))]
+    base_xyz=None, base_rpy=None, inertia_from_geometry=None, locks=None, initial=None,
+    servos=None, servo_reference=None, srdf=None, srdf_state=None))]
 pub(crate) fn load(
     py: Python<'_>,
     path: PathBuf,
@@ -68,8 +72,12 @@ pub(crate) fn load(
     inertia_from_geometry: Option<f64>,
     locks: Option<HashMap<String, Values>>,
     initial: Option<HashMap<String, Values>>,
+    servos: Option<HashMap<String, options::Servo>>,
+    servo_reference: Option<Bound<'_, PyAny>>,
+    srdf: Option<PathBuf>,
+    srdf_state: Option<String>,
 ) -> PyResult<Model> {
-    let opts = options::import_options(
+    let mut opts = options::import_options(
         packages,
         gravity,
         floating_base,
@@ -80,6 +88,7 @@ pub(crate) fn load(
         locks,
         initial,
     )?;
+    options::add_servos(&mut opts, servos, servo_reference, srdf, srdf_state)?;
     let started = Instant::now();
     let loaded = py
         .detach(|| restpose::urdf::load_file(&path, &opts))
@@ -92,7 +101,7 @@ pub(crate) fn load(
 #[pyfunction]
 #[pyo3(signature = (text, *, file="<string>".to_string(), packages=None, gravity=None,
     floating_base=false, ground=false, base_xyz=None, base_rpy=None, inertia_from_geometry=None,
-    locks=None, initial=None))]
+    locks=None, initial=None, servos=None, servo_reference=None, srdf=None, srdf_state=None))]
 pub(crate) fn load_string(
     py: Python<'_>,
     text: String,
@@ -106,8 +115,12 @@ pub(crate) fn load_string(
     inertia_from_geometry: Option<f64>,
     locks: Option<HashMap<String, Values>>,
     initial: Option<HashMap<String, Values>>,
+    servos: Option<HashMap<String, options::Servo>>,
+    servo_reference: Option<Bound<'_, PyAny>>,
+    srdf: Option<PathBuf>,
+    srdf_state: Option<String>,
 ) -> PyResult<Model> {
-    let opts = options::import_options(
+    let mut opts = options::import_options(
         packages,
         gravity,
         floating_base,
@@ -118,6 +131,7 @@ pub(crate) fn load_string(
         locks,
         initial,
     )?;
+    options::add_servos(&mut opts, servos, servo_reference, srdf, srdf_state)?;
     let started = Instant::now();
     let loaded = py
         .detach(|| restpose::urdf::load_str(&text, &file, &opts))

@@ -113,6 +113,76 @@ pub(crate) fn import_options(
     Ok(opts)
 }
 
+/// A servo's value in `load`'s `servos`: a stiffness, or a stiffness and a reference.
+#[derive(FromPyObject)]
+pub(crate) enum Servo {
+    /// `K` [N m/rad or N/m].
+    Stiffness(f64),
+    /// `(K, REF)`.
+    About(f64, f64),
+}
+
+/// The servo options of `load` (the command line's `--servo`, `--servo-reference`, `--srdf`
+/// and `--srdf-state`) added to `opts`: `servos` maps `"all"` or a joint to a stiffness or a
+/// `(stiffness, reference)` pair (`"all"` first, then the joints, as later `--servo` options
+/// override earlier ones); `servo_reference` is a `{joint: value}` mapping or a pose file.
+pub(crate) fn add_servos(
+    opts: &mut ImportOptions,
+    servos: Option<HashMap<String, Servo>>,
+    servo_reference: Option<Bound<'_, PyAny>>,
+    srdf: Option<PathBuf>,
+    srdf_state: Option<String>,
+) -> PyResult<()> {
+    let mut servos: Vec<(String, Servo)> = servos.unwrap_or_default().into_iter().collect();
+    servos.sort_by(|a, b| (a.0 != "all", &a.0).cmp(&(b.0 != "all", &b.0)));
+    for (name, value) in servos {
+        let (stiffness, reference) = match value {
+            Servo::Stiffness(k) => (k, None),
+            Servo::About(k, r) => (k, Some(r)),
+        };
+        finite(
+            &[stiffness, reference.unwrap_or(0.0)],
+            &format!("servo `{name}`"),
+        )?;
+        opts.servos.push(restpose::urdf::ServoRequest {
+            joint: (name != "all").then_some(name),
+            stiffness,
+            reference,
+        });
+    }
+    if let Some(r) = servo_reference {
+        if let Ok(values) = r.extract::<HashMap<String, f64>>() {
+            let mut named: Vec<(String, f64)> = values.into_iter().collect();
+            named.sort_by(|a, b| a.0.cmp(&b.0));
+            finite(
+                &named.iter().map(|x| x.1).collect::<Vec<_>>(),
+                "servo_reference",
+            )?;
+            opts.servo_reference.extend(named);
+        } else {
+            let path: PathBuf = r.extract().map_err(|_| {
+                argument("servo_reference: expected a {joint: value} mapping or a pose file")
+            })?;
+            let values = restpose::verify::read_pose(&path).map_err(crate::errors::to_py_err)?;
+            let mut named: Vec<(String, f64)> = values
+                .into_iter()
+                .filter(|(_, v)| v.len() == 1)
+                .map(|(n, v)| (n, v[0]))
+                .collect();
+            named.sort_by(|a, b| a.0.cmp(&b.0));
+            opts.servo_reference.extend(named);
+        }
+    }
+    match (srdf, srdf_state) {
+        (Some(path), Some(state)) => opts
+            .servo_reference
+            .extend(restpose::urdf::srdf_state(&path, &state).map_err(crate::errors::to_py_err)?),
+        (None, None) => {}
+        _ => return Err(argument("srdf and srdf_state go together")),
+    }
+    Ok(())
+}
+
 fn finite(v: &[f64], what: &str) -> PyResult<()> {
     if v.iter().all(|x| x.is_finite()) {
         Ok(())

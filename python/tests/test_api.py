@@ -230,6 +230,44 @@ def test_a_body_that_cannot_stand_topples_at_the_ground_start():
     assert off.topple == [] and "topple" not in json.loads(off.to_json())
 
 
+def test_servos_about_an_srdf_state_are_the_command_lines(robots, tmp_path):
+    # Bolt standing as in the Pinocchio corpus (docs/servo.md): servos of 1000 N m/rad about
+    # its SRDF `standing` state, which is also the start; it topples onto its trunk, then the
+    # solve converges. The same numbers as `restpose analyze` with the same options.
+    bolt = robots / "bolt"
+    srdf = bolt / "bolt.srdf"
+    out = tmp_path / "bolt.json"
+    subprocess.run(
+        ["restpose", "analyze", "-q", str(bolt / "bolt.urdf"), "--floating-base", "--ground",
+         "--friction", "stick", "--servo", "all=1000", "--servo", "FL_KFE=500@-1.5",
+         "--srdf", str(srdf), "--srdf-state", "standing", "--load-steps", "1",
+         "--json", str(out)],
+        check=True,
+    )
+    cli = json.loads(out.read_text())
+    model = restpose.load(
+        bolt / "bolt.urdf", floating_base=True, ground=True,
+        servos={"FL_KFE": (500, -1.5), "all": 1000}, srdf=srdf, srdf_state="standing",
+    )
+    r = model.solve(friction="stick", load_steps=1)
+    assert r.converged and r.iterations == cli["iterations"]
+    assert r.potential_energy == cli["potential_energy"]
+    assert [t.to_dict() for t in r.topple] == cli["topple"]
+    servos = json.loads(r.to_json())["servos"]
+    assert servos == cli["servos"]
+    assert {s["joint"]: (s["stiffness"], s["reference"]) for s in servos}["FL_KFE"] == (500, -1.5)
+    # a mapping as the reference pose: the SRDF state's values give the same rest
+    state = {"FL_HAA": -0.3, "FL_HFE": 0.78539816, "FL_KFE": -1.57079633,
+             "FR_HAA": 0.3, "FR_HFE": 0.78539816, "FR_KFE": -1.57079633}
+    common = dict(floating_base=True, ground=True, servos={"all": 1000})
+    by_map = restpose.load(bolt / "bolt.urdf", servo_reference=state, **common)
+    by_srdf = restpose.load(bolt / "bolt.urdf", srdf=srdf, srdf_state="standing", **common)
+    a, b = (m.solve(friction="stick", load_steps=1) for m in (by_map, by_srdf))
+    assert a.converged and a.potential_energy == b.potential_energy
+    with pytest.raises(ValueError, match="srdf and srdf_state"):
+        restpose.load(bolt / "bolt.urdf", srdf=srdf)
+
+
 def test_buried_bodies_name_bodies_resting_inside_a_ground():
     # The arm without collision geometry under a ground at z = 1: its point mass at
     # (cos θ, 0, −sin θ) rests 1 + sin θ inside it (docs/contact.md).

@@ -202,6 +202,8 @@ pub(crate) fn solve(
     let mut hits: Vec<Unilateral> = Vec::new();
     // A row that leaves again alone and comes straight back (module `release`).
     let mut returns = super::release::Returns::default();
+    // The sticking contacts that came back that way and slide from then on (module `slide`).
+    let mut slid = super::slide::Slid::default();
     // Stops that the step kept held at the last release (module `release_trial`): not
     // eligible to leave early in the next round; and that round's first direction.
     let mut next = super::release_trial::Next::default();
@@ -282,7 +284,8 @@ pub(crate) fn solve(
             .collect();
         let returned =
             !met.is_empty() && returns.met(&met, energy, force_scale(model) * model.length_scale);
-        let cycling = changes - initial >= options.max_iterations || returned;
+        let slides = slid.now(returned, &mut returns);
+        let cycling = changes - initial >= options.max_iterations || (returned && !slides);
         if !round.released.is_empty() && !cycling {
             // Rows pulling hard before the round was stationary (module `release`), or rows
             // carried past an obstacle's edge by a stalled round (module `stall`: its line
@@ -317,7 +320,7 @@ pub(crate) fn solve(
             for &k in hit.iter().filter(|&&k| !guard.is_roll_limit(k)) {
                 let a =
                     super::patch::activate(model, options, &active, guard.inactive[k], &state.q);
-                active.push(a);
+                active.push(slid.joining(a));
                 hits.push(guard.inactive[k]);
                 changes += 1;
             }
@@ -394,7 +397,10 @@ pub(crate) fn solve(
                 );
                 continue;
             }
-            if super::rolling::reanchor(model, options, &mut active, &touched, &state.q) {
+            // Not after a slide (module `slide`).
+            if !slid.any()
+                && super::rolling::reanchor(model, options, &mut active, &touched, &state.q)
+            {
                 rolls += 1;
                 if rolls <= super::rolling::MAX_ROLLS {
                     continue;

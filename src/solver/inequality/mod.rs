@@ -28,6 +28,7 @@ pub(crate) mod release;
 pub(crate) mod release_trial;
 pub(crate) mod roll_on;
 pub(crate) mod rolling;
+pub(crate) mod slide;
 pub(crate) mod stall;
 pub(crate) mod together;
 #[cfg(test)]

@@ -55,7 +55,8 @@
 //! point, and the next round's Newton step (and steepest descent as well, tried) turned it back
 //! into the floor after 10⁻⁸ J, 101 times, until `max_iterations` changes of the set: 103
 //! iterations, 202 rounds. After [`RETURNS`] such returns in a row the search ends there as
-//! `active_set_cycling` (module `active_set`), with the message that names the remedy.
+//! `active_set_cycling` (module `active_set`), with the message that names the remedy, unless
+//! the row is a sticking contact that has not slid yet (module `slide`).
 //!
 //! ## References
 //! - B. A. Murtagh, M. A. Saunders, "Large-scale linearly constrained optimization",
@@ -104,6 +105,11 @@ impl Returns {
         }
         self.last = Some((row, energy));
         self.armed = true;
+    }
+
+    /// The row that left last, alone, at a stationary point.
+    pub(crate) fn row(&self) -> Option<Unilateral> {
+        self.last.map(|(r, _)| r)
     }
 
     /// A step met the inequalities `hits` at energy `energy`; `scale` is `F L` \[J\]. Whether

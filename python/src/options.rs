@@ -163,14 +163,9 @@ pub(crate) fn add_servos(
             let path: PathBuf = r.extract().map_err(|_| {
                 argument("servo_reference: expected a {joint: value} mapping or a pose file")
             })?;
-            let values = restpose::verify::read_pose(&path).map_err(crate::errors::to_py_err)?;
-            let mut named: Vec<(String, f64)> = values
-                .into_iter()
-                .filter(|(_, v)| v.len() == 1)
-                .map(|(n, v)| (n, v[0]))
-                .collect();
-            named.sort_by(|a, b| a.0.cmp(&b.0));
-            opts.servo_reference.extend(named);
+            opts.servo_reference.extend(
+                restpose::verify::read_reference_pose(&path).map_err(crate::errors::to_py_err)?,
+            );
         }
     }
     match (srdf, srdf_state) {

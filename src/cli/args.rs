@@ -134,14 +134,8 @@ impl InputArgs {
             opts.servos.push(parse::servo(s)?);
         }
         if let Some(path) = &self.servo_reference {
-            let values = restpose::verify::read_pose(path)?;
-            let mut named: Vec<(String, f64)> = values
-                .into_iter()
-                .filter(|(_, v)| v.len() == 1)
-                .map(|(n, v)| (n, v[0]))
-                .collect();
-            named.sort_by(|a, b| a.0.cmp(&b.0));
-            opts.servo_reference.extend(named);
+            opts.servo_reference
+                .extend(restpose::verify::read_reference_pose(path)?);
         }
         if let (Some(path), Some(state)) = (&self.srdf, &self.srdf_state) {
             opts.servo_reference

@@ -47,7 +47,7 @@ mod unilateral;
 use closure::closures;
 pub use closure::Closure;
 pub use initial_guess::{check, ModelCheck};
-pub use pose::{parse_pose, pose_state, pose_state_with_bodies, read_pose};
+pub use pose::{parse_pose, pose_state, pose_state_with_bodies, read_pose, read_reference_pose};
 pub use unilateral::{UnilateralCheck, Unilaterals};
 
 use crate::error::Result;

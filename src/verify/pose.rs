@@ -26,6 +26,21 @@ pub fn read_pose(path: impl AsRef<Path>) -> Result<JointValues> {
     parse_pose(&text, &path.display().to_string())
 }
 
+/// The single-coordinate joints of a pose file as a servos' reference pose
+/// (`--servo-reference FILE`), sorted by name.
+///
+/// # Errors
+/// As [`read_pose`].
+pub fn read_reference_pose(path: impl AsRef<Path>) -> Result<Vec<(String, f64)>> {
+    let mut named: Vec<(String, f64)> = read_pose(path)?
+        .into_iter()
+        .filter(|(_, v)| v.len() == 1)
+        .map(|(n, v)| (n, v[0]))
+        .collect();
+    named.sort_by(|a, b| a.0.cmp(&b.0));
+    Ok(named)
+}
+
 fn numbers(v: &serde_json::Value) -> Option<Vec<f64>> {
     match v {
         serde_json::Value::Number(n) => n.as_f64().map(|x| vec![x]),

@@ -5,7 +5,8 @@
 //! The row and column indices are `u32` (16 bytes an entry, not 24): at 10,000 bodies the
 //! Jacobian holds 740,000 entries, written at every evaluation and read by every pass over
 //! `Φ_q` (the factors of `Φ_u`, `Φ_v` products, the KKT assembly), and the passes are bound by
-//! memory traffic. Indices only: every value and every sum is the same.
+//! memory traffic. Indices only: every value and every sum is the same. A mechanism's rows and
+//! coordinates stay far below `2³²` (as many coordinates would be 32 GiB of `q` alone).
 
 use nalgebra::DMatrix;
 

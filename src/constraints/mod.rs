@@ -16,7 +16,7 @@ use crate::kinematics::{coordinate, Branches};
 use crate::model::{BodyId, JointId, Model};
 use nalgebra::{DVector, Matrix3};
 use pair_sum::PairSum;
-pub(crate) use triplets::Triplets;
+pub(crate) use triplets::{Triplet, Triplets};
 
 /// What a block of rows expresses.
 #[derive(Clone, Debug)]
@@ -345,13 +345,13 @@ impl Constraints {
                     if pattern == ALL {
                         t.entries.extend((0..crate::jet::NL).map(|i| {
                             let gi = if i < 7 { a + i } else { b + i - 7 };
-                            (row, gi, c * g[i])
+                            (row as u32, gi as u32, c * g[i])
                         }));
                     } else {
                         let kept = (0..crate::jet::NL).filter(|i| pattern & (1 << i) != 0);
                         t.entries.extend(kept.map(|i| {
                             let gi = if i < 7 { a + i } else { b + i - 7 };
-                            (row, gi, c * g[i])
+                            (row as u32, gi as u32, c * g[i])
                         }));
                     }
                     return;
@@ -361,7 +361,7 @@ impl Constraints {
                     let i = bits.trailing_zeros() as usize;
                     bits &= bits - 1;
                     if let Some(gi) = crate::jet::global_index(bodies, i) {
-                        t.entries.push((row, gi, c * g[i]));
+                        t.entries.push((row as u32, gi as u32, c * g[i]));
                     }
                 }
             }
@@ -408,7 +408,7 @@ impl Constraints {
                 phi[row] = p.dot(&p) - 1.0;
                 if let Some(t) = jac.as_deref_mut() {
                     for k in 0..4 {
-                        t.entries.push((row, i + k, 2.0 * q[i + k]));
+                        t.entries.push((row as u32, (i + k) as u32, 2.0 * q[i + k]));
                     }
                 }
             }

@@ -79,7 +79,11 @@ fn finite_rows(
     jac: &Triplets,
     at: &str,
 ) -> Result<()> {
-    let bad_entry = jac.entries.iter().find(|e| !e.2.is_finite()).map(|e| e.0);
+    let bad_entry = jac
+        .entries
+        .iter()
+        .find(|e| !e.2.is_finite())
+        .map(|e| e.0 as usize);
     if let Some(r) = phi.iter().position(|x| !x.is_finite()).or(bad_entry) {
         let row = cons.row_name(model, r);
         return Err(Error::NonFiniteConstraint {

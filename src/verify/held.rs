@@ -398,8 +398,8 @@ fn solve_once(
             dependent.iter().enumerate().map(|(d, &r)| (r, d)).collect();
         let mut grads = vec![DVector::zeros(state.q.len()); dependent.len()];
         for &(r, c, v) in &jac.entries {
-            if let Some(&d) = index.get(&r) {
-                grads[d][c] += v;
+            if let Some(&d) = index.get(&(r as usize)) {
+                grads[d][c as usize] += v;
             }
         }
         // K restricted to the rows of the two stages.

@@ -286,7 +286,8 @@ fn rows_expanded_as_the_partition_builds_them() {
     for r in 0..m {
         // Reference: sums in triplet order, zeros dropped.
         let mut sums: Vec<(usize, f64)> = Vec::new();
-        for &(_, c, v) in t.iter().filter(|e| e.0 == r) {
+        for &(_, c, v) in t.iter().filter(|e| e.0 as usize == r) {
+            let c = c as usize;
             let a = v * row_scale[r] * scale[c];
             match sums.iter_mut().find(|e| e.0 == c) {
                 Some(e) => e.1 += a,
@@ -326,7 +327,7 @@ fn rows_expanded_as_the_partition_builds_them() {
     swapped.swap(3, 4);
     assert!(Rows::new(m, n, &swapped, &row_scale, &scale).is_none());
     let mut outside = t.clone();
-    outside[2].1 = n;
+    outside[2].1 = n as u32;
     assert!(Rows::new(m, n, &outside, &row_scale, &scale).is_none());
     assert!(Rows::new(m - 1, n, &t, &row_scale, &scale).is_none());
 }

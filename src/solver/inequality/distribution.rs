@@ -150,7 +150,7 @@ fn null_space(
     let mut dense_row = vec![0.0; q.len()];
     let mut by_row: Vec<Vec<(usize, f64)>> = vec![Vec::new(); m];
     for &(i, c, v) in &jac.entries {
-        by_row[i].push((c, v));
+        by_row[i as usize].push((c as usize, v));
     }
     for (i, entries) in by_row.iter().enumerate() {
         // Duplicates summed, as in the dense Jacobian.

@@ -7,6 +7,7 @@
 //! evaluation only refills the values and refactors numerically.
 
 use super::pattern::{Ix, Pattern, NONE};
+use crate::constraints::Triplet;
 use crate::solver::partition::Partition;
 use faer::linalg::solvers::SolveCore;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
@@ -34,18 +35,13 @@ pub(crate) struct Split {
 pub(crate) struct SparseFactors {
     lu: Option<Lu<Ix, f64>>,
     /// `(row position, independent position, value)`.
-    phi_v: Vec<(usize, usize, f64)>,
+    phi_v: Vec<Triplet>,
 }
 
 impl Split {
     /// The split of the triplets `entries` under `part`; `None` if faer's symbolic analysis
     /// fails (out of memory).
-    pub(crate) fn new(
-        part: &Partition,
-        m: usize,
-        n: usize,
-        entries: &[(usize, usize, f64)],
-    ) -> Option<Self> {
+    pub(crate) fn new(part: &Partition, m: usize, n: usize, entries: &[Triplet]) -> Option<Self> {
         let mut row_pos = vec![NONE; m];
         for (k, &r) in part.rows.iter().enumerate() {
             row_pos[r] = k;
@@ -61,22 +57,22 @@ impl Split {
         let r = part.rows.len();
         let positions: Vec<(usize, usize)> = entries
             .iter()
-            .filter(|e| row_pos[e.0] != NONE && dep_pos[e.1] != NONE)
-            .map(|e| (row_pos[e.0], dep_pos[e.1]))
+            .filter(|e| row_pos[e.0 as usize] != NONE && dep_pos[e.1 as usize] != NONE)
+            .map(|e| (row_pos[e.0 as usize], dep_pos[e.1 as usize]))
             .collect();
         let pattern = Pattern::new(r, r, positions);
         let symbolic = SymbolicLu::try_new(pattern.symbolic()).ok()?;
         let mut u_slot = vec![Ix::MAX; entries.len()];
         let mut v_entries = Vec::new();
         for (k, e) in entries.iter().enumerate() {
-            let rp = row_pos[e.0];
+            let rp = row_pos[e.0 as usize];
             if rp == NONE {
                 continue;
             }
-            if dep_pos[e.1] != NONE {
-                u_slot[k] = pattern.slot(rp, dep_pos[e.1]) as Ix;
-            } else if ind_pos[e.1] != NONE {
-                v_entries.push((rp, ind_pos[e.1], k));
+            if dep_pos[e.1 as usize] != NONE {
+                u_slot[k] = pattern.slot(rp, dep_pos[e.1 as usize]) as Ix;
+            } else if ind_pos[e.1 as usize] != NONE {
+                v_entries.push((rp, ind_pos[e.1 as usize], k));
             }
         }
         let values = vec![0.0; pattern.nnz()];
@@ -98,7 +94,7 @@ impl Split {
     }
 
     /// Refills `Φ_u` from `entries` and factors it; `Φ_v` is copied.
-    pub(crate) fn factor(&mut self, entries: &[(usize, usize, f64)]) -> SparseFactors {
+    pub(crate) fn factor(&mut self, entries: &[Triplet]) -> SparseFactors {
         self.values.iter_mut().for_each(|v| *v = 0.0);
         for (k, e) in entries.iter().enumerate() {
             let s = self.u_slot[k];
@@ -116,7 +112,7 @@ impl Split {
             phi_v: self
                 .v_entries
                 .iter()
-                .map(|&(r, c, k)| (r, c, entries[k].2))
+                .map(|&(r, c, k)| (r as u32, c as u32, entries[k].2))
                 .collect(),
         }
     }
@@ -161,19 +157,19 @@ impl SparseFactors {
 
 /// `A x` for `A` given by its `(row, column, value)` triplets, `rows` long (`Φ_v x` of the
 /// sparse and the tree factors).
-pub(crate) fn triplets_mul(a: &[(usize, usize, f64)], x: &[f64], rows: usize) -> Vec<f64> {
+pub(crate) fn triplets_mul(a: &[Triplet], x: &[f64], rows: usize) -> Vec<f64> {
     let mut y = vec![0.0; rows];
     for &(i, j, v) in a {
-        y[i] += v * x[j];
+        y[i as usize] += v * x[j as usize];
     }
     y
 }
 
 /// `Aᵀ y` for `A` given by its `(row, column, value)` triplets, `columns` long.
-pub(crate) fn triplets_tr_mul(a: &[(usize, usize, f64)], y: &[f64], columns: usize) -> Vec<f64> {
+pub(crate) fn triplets_tr_mul(a: &[Triplet], y: &[f64], columns: usize) -> Vec<f64> {
     let mut x = vec![0.0; columns];
     for &(i, j, v) in a {
-        x[j] += v * y[i];
+        x[j as usize] += v * y[i as usize];
     }
     x
 }

@@ -30,6 +30,7 @@
 use super::block::{Block, Changed};
 use super::partition::elimination_order;
 use super::rows::Rows;
+use crate::constraints::Triplet;
 use crate::model::Model;
 use crate::solver::partition::{next_id, Partition, RANK_TOLERANCE};
 
@@ -43,7 +44,7 @@ pub(crate) fn free_columns(
     model: &Model,
     m: usize,
     n: usize,
-    entries: &[(usize, usize, f64)],
+    entries: &[Triplet],
     row_scale: &[f64],
     scale: &[f64],
 ) -> Option<usize> {
@@ -64,7 +65,7 @@ pub(crate) fn partition(
     model: &Model,
     m: usize,
     n: usize,
-    entries: &[(usize, usize, f64)],
+    entries: &[Triplet],
     row_scale: &[f64],
     scale: &[f64],
 ) -> Option<Partition> {
@@ -92,7 +93,7 @@ fn eliminate(
     model: &Model,
     m: usize,
     n: usize,
-    entries: &[(usize, usize, f64)],
+    entries: &[Triplet],
     row_scale: &[f64],
     scale: &[f64],
 ) -> Option<Pivots> {

@@ -28,6 +28,7 @@
 use super::hessian::BlockHessian;
 use super::pattern::{Ix, Pattern, NONE};
 use super::shifts::Shifts;
+use crate::constraints::Triplet;
 use crate::solver::partition::Partition;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
@@ -139,7 +140,7 @@ impl Kkt {
         part: &Partition,
         m: usize,
         n: usize,
-        entries: &[(usize, usize, f64)],
+        entries: &[Triplet],
         hess: &BlockHessian,
     ) -> Option<Self> {
         let mut row_pos = vec![NONE; m];
@@ -181,8 +182,8 @@ impl Kkt {
         });
         let jacobian = entries
             .iter()
-            .filter(|e| row_pos[e.0] != NONE)
-            .map(|e| upper(n + row_pos[e.0], e.1));
+            .filter(|e| row_pos[e.0 as usize] != NONE)
+            .map(|e| upper(n + row_pos[e.0 as usize], e.1 as usize));
         let pattern = Pattern::with_capacity(
             dim,
             dim,
@@ -210,10 +211,10 @@ impl Kkt {
             .collect();
         let jac_slots = entries
             .iter()
-            .map(|e| match row_pos[e.0] {
+            .map(|e| match row_pos[e.0 as usize] {
                 NONE => Ix::MAX,
                 p => {
-                    let (a, b) = upper(n + p, e.1);
+                    let (a, b) = upper(n + p, e.1 as usize);
                     pattern.slot(a, b) as Ix
                 }
             })
@@ -279,7 +280,7 @@ impl Kkt {
     /// Fills the values (scaled) from the Jacobian triplets and the Hessian blocks.
     pub(crate) fn assemble(
         &mut self,
-        entries: &[(usize, usize, f64)],
+        entries: &[Triplet],
         row_scale: &[f64],
         scale: &[f64],
         hess: &BlockHessian,
@@ -289,7 +290,7 @@ impl Kkt {
         hess.scatter_scaled(&self.block_slots, scale, &mut self.values);
         for (e, &slot) in entries.iter().zip(&self.jac_slots) {
             if slot != Ix::MAX {
-                self.values[slot as usize] += e.2 * row_scale[e.0] * scale[e.1];
+                self.values[slot as usize] += e.2 * row_scale[e.0 as usize] * scale[e.1 as usize];
             }
         }
     }

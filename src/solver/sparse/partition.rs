@@ -33,6 +33,7 @@
 //! of the loop that are eliminated after them.
 
 use super::super::partition::{Partition, RANK_TOLERANCE};
+use crate::constraints::Triplet;
 use crate::model::Model;
 
 /// Threshold of the pivot test against the largest entry of its row.
@@ -276,7 +277,7 @@ pub(crate) fn partition(
     model: &Model,
     m: usize,
     n: usize,
-    entries: &[(usize, usize, f64)],
+    entries: &[Triplet],
     row_scale: &[f64],
     scale: &[f64],
 ) -> Partition {
@@ -285,7 +286,7 @@ pub(crate) fn partition(
     // beyond: on 10,000 links the rows are tens of megabytes, first touched page by page).
     let mut count = vec![0usize; m];
     for &(r, _, _) in entries {
-        count[r] += 1;
+        count[r as usize] += 1;
     }
     let mut rows: Vec<Vec<(usize, f64)>> = count.iter().map(|&k| Vec::with_capacity(k)).collect();
     // Duplicates summed in the order they come, found through the position of each column in
@@ -294,6 +295,7 @@ pub(crate) fn partition(
     let mut pos = vec![u32::MAX; n];
     let mut current = usize::MAX;
     for &(r, c, v) in entries {
+        let (r, c) = (r as usize, c as usize);
         let a = v * row_scale[r] * scale[c];
         if r != current {
             if let Some(row) = rows.get(current) {

@@ -6,6 +6,8 @@
 //! rows touching each body, the body of each row lying on one body alone and its reach there
 //! (its largest entry in the translation columns and in the Euler-parameter columns).
 
+use crate::constraints::Triplet;
+
 /// The expanded rows: row `r` is `entries[at[r]..at[r + 1]]`.
 pub(crate) struct Rows {
     pub(crate) entries: Vec<(usize, f64)>,
@@ -31,7 +33,7 @@ impl Rows {
     pub(crate) fn new(
         m: usize,
         n: usize,
-        entries: &[(usize, usize, f64)],
+        entries: &[Triplet],
         row_scale: &[f64],
         scale: &[f64],
     ) -> Option<Self> {
@@ -52,7 +54,7 @@ impl Rows {
         let mut body_start = vec![0usize; nb + 1];
         let mut rest = entries;
         for r in 0..m {
-            let len = rest.iter().take_while(|e| e.0 == r).count();
+            let len = rest.iter().take_while(|e| e.0 as usize == r).count();
             let (seg, tail) = rest.split_at(len);
             rest = tail;
             let start = out.len();
@@ -63,6 +65,7 @@ impl Rows {
             let (mut summed, mut max) = (false, 0.0f64);
             let (mut lo, mut hi) = (usize::MAX, 0);
             for &(_, c, v) in seg {
+                let c = c as usize;
                 if c >= n {
                     return None;
                 }

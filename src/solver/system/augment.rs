@@ -13,6 +13,7 @@
 
 use super::System;
 use crate::constraints::Constraints;
+use crate::constraints::Triplet;
 use crate::jet::{HessianSink, LMat, EULER, NL};
 use crate::model::BodyId;
 use crate::solver::partition::Partition;
@@ -39,12 +40,7 @@ pub(crate) struct AugmentPlan {
 }
 
 impl AugmentPlan {
-    fn new(
-        part: &Partition,
-        cons: &Constraints,
-        m: usize,
-        entries: &[(usize, usize, f64)],
-    ) -> Self {
+    fn new(part: &Partition, cons: &Constraints, m: usize, entries: &[Triplet]) -> Self {
         let mut in_part = vec![false; m];
         for &r in &part.rows {
             in_part[r] = true;
@@ -53,9 +49,9 @@ impl AugmentPlan {
         let mut local = vec![0u8; entries.len()];
         let mut k = 0;
         while k < entries.len() {
-            let row = entries[k].0;
+            let row = entries[k].0 as usize;
             let mut end = k;
-            while end < entries.len() && entries[end].0 == row {
+            while end < entries.len() && entries[end].0 as usize == row {
                 end += 1;
             }
             let (start, group) = (k, &entries[k..end]);
@@ -66,7 +62,7 @@ impl AugmentPlan {
             let mut bodies: [Option<BodyId>; 2] = [None, None];
             let mut on_two = true;
             for e in group {
-                let b = e.1 / 7;
+                let b = e.1 as usize / 7;
                 if bodies.iter().any(|x| x.map(|y| y.0) == Some(b)) {
                     continue;
                 }
@@ -77,8 +73,9 @@ impl AugmentPlan {
             }
             if on_two {
                 for (t, e) in group.iter().enumerate() {
-                    let side = usize::from(bodies[0].map(|x| x.0) != Some(e.1 / 7));
-                    local[start + t] = (7 * side + e.1 % 7) as u8;
+                    let c = e.1 as usize;
+                    let side = usize::from(bodies[0].map(|x| x.0) != Some(c / 7));
+                    local[start + t] = (7 * side + c % 7) as u8;
                 }
             }
             groups.push(Group {
@@ -154,10 +151,10 @@ impl System<'_> {
             let group = &entries[range.clone()];
             let row_scale = self.problem.scaling.rows[g.row].powi(2);
             let Some(bodies) = g.bodies else {
-                let rho = group.iter().fold(floor, |a, e| a.max(wdiag[e.1])) * row_scale;
+                let rho = group.iter().fold(floor, |a, e| a.max(wdiag[e.1 as usize])) * row_scale;
                 for a in group {
                     for b in group {
-                        sink.add_entry(a.1, b.1, rho * a.2 * b.2);
+                        sink.add_entry(a.1 as usize, b.1 as usize, rho * a.2 * b.2);
                     }
                 }
                 continue;
@@ -173,7 +170,7 @@ impl System<'_> {
                 }
             } else {
                 for (e, &i) in group.iter().zip(&plan.local[range]) {
-                    reach = reach.max(wdiag[e.1]);
+                    reach = reach.max(wdiag[e.1 as usize]);
                     gv[usize::from(i) & 15] += e.2;
                 }
             }
@@ -292,11 +289,12 @@ mod tests {
             for &r in &part.rows {
                 let mut g = DVector::<f64>::zeros(n);
                 let mut reach = floor;
-                for e in sys.work.jac.entries.iter().filter(|e| e.0 == r) {
-                    g[e.1] += e.2;
-                    let body = e.1 - e.1 % 7;
+                for e in sys.work.jac.entries.iter().filter(|e| e.0 as usize == r) {
+                    let c = e.1 as usize;
+                    g[c] += e.2;
+                    let body = c - c % 7;
                     if sys.problem.cons.is_normalization(r) {
-                        reach = reach.max(wdiag[e.1]);
+                        reach = reach.max(wdiag[c]);
                     } else {
                         reach = wdiag[body..body + 7].iter().fold(reach, |a, &x| a.max(x));
                     }

@@ -179,11 +179,11 @@ impl System<'_> {
         let mut phi_u = DMatrix::zeros(r, r);
         let mut phi_v = DMatrix::zeros(r, dof);
         for &(i, c, v) in &work.jac.entries {
-            let a = row_pos[i];
+            let a = row_pos[i as usize];
             if a == usize::MAX {
                 continue;
             }
-            match col_pos[c] {
+            match col_pos[c as usize] {
                 (true, k) => phi_u[(a, k)] += v,
                 (false, k) => phi_v[(a, k)] += v,
             }

@@ -2,6 +2,7 @@
 //! the tree backend where the partition fits, the tree-structured one (module `tree::kkt`).
 //! Both store the same matrix in the same elimination order and answer the same calls.
 
+use crate::constraints::Triplet;
 use crate::solver::partition::Partition;
 use crate::solver::sparse::hessian::BlockHessian;
 use crate::solver::sparse::kkt::{Factored, Kkt};
@@ -33,7 +34,7 @@ impl KktMatrix {
     /// Fills the values (scaled) from the Jacobian triplets and the Hessian blocks.
     pub(crate) fn assemble(
         &mut self,
-        entries: &[(usize, usize, f64)],
+        entries: &[Triplet],
         row_scale: &[f64],
         scale: &[f64],
         hess: &BlockHessian,

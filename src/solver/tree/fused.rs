@@ -20,6 +20,7 @@
 
 use super::kkt::TreeKkt;
 use super::shape::SKIP;
+use crate::constraints::Triplet;
 use crate::jet::{add_symmetric_part, euler_to_local, HessianSink, LMat};
 use crate::model::BodyId;
 use nalgebra::SMatrix;
@@ -219,12 +220,7 @@ impl TreeKkt {
 
     /// Ends a fused assembly: `W` stored scaled into the flat blocks (`(w D_a) D_b`, as the
     /// general scatter), the Jacobian's entries stored (as [`TreeKkt::assemble`]).
-    pub(crate) fn fused_finish(
-        &mut self,
-        entries: &[(usize, usize, f64)],
-        row_scale: &[f64],
-        scale: &[f64],
-    ) {
+    pub(crate) fn fused_finish(&mut self, entries: &[Triplet], row_scale: &[f64], scale: &[f64]) {
         self.shifts.clear();
         let s = &self.shape;
         let values = &mut self.values;

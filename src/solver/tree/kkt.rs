@@ -28,6 +28,7 @@ use super::dense;
 use super::fused::BlockMap;
 use super::norm;
 use super::shape::{Shape, FIRST, SKIP};
+use crate::constraints::Triplet;
 use crate::solver::partition::Partition;
 use crate::solver::sparse::hessian::BlockHessian;
 use crate::solver::sparse::kkt::Factored;
@@ -81,7 +82,7 @@ impl TreeKkt {
         part: &Partition,
         m: usize,
         n: usize,
-        entries: &[(usize, usize, f64)],
+        entries: &[Triplet],
         hess: &BlockHessian,
     ) -> Option<Self> {
         let shape = Shape::new(part, m, n, entries, hess)?;
@@ -121,7 +122,7 @@ impl TreeKkt {
     /// Fills the values (scaled) from the Jacobian triplets and the Hessian blocks.
     pub(crate) fn assemble(
         &mut self,
-        entries: &[(usize, usize, f64)],
+        entries: &[Triplet],
         row_scale: &[f64],
         scale: &[f64],
         hess: &BlockHessian,
@@ -143,15 +144,10 @@ impl TreeKkt {
     }
 
     /// Stores the Jacobian's entries (scaled) at their slots (see [`TreeKkt::assemble`]).
-    pub(super) fn store_jacobian(
-        &mut self,
-        entries: &[(usize, usize, f64)],
-        row_scale: &[f64],
-        scale: &[f64],
-    ) {
+    pub(super) fn store_jacobian(&mut self, entries: &[Triplet], row_scale: &[f64], scale: &[f64]) {
         let values = &mut self.values;
         for (e, slots) in entries.iter().zip(&self.shape.jac_slots) {
-            let v = e.2 * row_scale[e.0] * scale[e.1];
+            let v = e.2 * row_scale[e.0 as usize] * scale[e.1 as usize];
             for &slot in slots {
                 if slot != SKIP {
                     let at = &mut values[(slot & !FIRST) as usize];

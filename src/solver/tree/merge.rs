@@ -32,6 +32,7 @@
 //! and a rung's two posts merged (27 unknowns, coupled to 7), a chain of 2 nodes per rung.
 
 use super::nodes::{Members, Pair};
+use crate::constraints::Triplet;
 use crate::solver::partition::Partition;
 
 /// Super-nodes larger than this (unknowns or pivots) are not factored here.
@@ -61,7 +62,7 @@ pub(crate) fn phi_u_runs(
     part: &Partition,
     m: usize,
     n: usize,
-    entries: &[(usize, usize, f64)],
+    entries: &[Triplet],
     max_border: usize,
 ) -> Option<(Vec<u32>, usize, Vec<bool>)> {
     let order = part.rows.len();
@@ -79,10 +80,10 @@ pub(crate) fn phi_u_runs(
     // reads `u32::MAX`, which lowers nothing).
     let mut first: Vec<u32> = (0..runs as u32).collect();
     for e in entries {
-        let rp = row_run[e.0];
+        let rp = row_run[e.0 as usize];
         if rp != u32::MAX {
             let f = &mut first[rp as usize];
-            *f = (*f).min(col_run[e.1]);
+            *f = (*f).min(col_run[e.1 as usize]);
         }
     }
     let bordered: Vec<bool> = (0..runs).map(|r| first[r] < r as u32).collect();

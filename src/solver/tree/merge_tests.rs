@@ -49,8 +49,10 @@ fn merged_runs_make_phi_u_block_triangular() {
     let below = |run_of: &[u32]| {
         entries
             .iter()
-            .filter(|e| row_pos[e.0] != u32::MAX && col_pos[e.1] != u32::MAX)
-            .filter(|e| run_of[col_pos[e.1] as usize] < run_of[row_pos[e.0] as usize])
+            .filter(|e| row_pos[e.0 as usize] != u32::MAX && col_pos[e.1 as usize] != u32::MAX)
+            .filter(|e| {
+                run_of[col_pos[e.1 as usize] as usize] < run_of[row_pos[e.0 as usize] as usize]
+            })
             .count()
     };
     // The runs alone: a border of 7 pivots per rung, above the limit.

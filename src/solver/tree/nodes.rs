@@ -11,6 +11,7 @@
 //! [`MAX_BORDER`] the same pairs make the super-nodes of module `merge` instead.
 
 use super::shape::MAX_BORDER;
+use crate::constraints::Triplet;
 
 /// Two nodes coupled by a value, `(a, b, owned)`: `owned` unless the value is a border row's.
 pub(super) type Pair = (u32, u32, bool);
@@ -66,7 +67,7 @@ impl Members {
 /// is its node's own, not a border row); a run on the row and body of the run before it (the
 /// same pair) is not listed again where `fast` (the pairs are read as sets).
 pub(super) fn runs_and_pairs(
-    entries: &[(usize, usize, f64)],
+    entries: &[Triplet],
     keys: &[(usize, usize)],
     body_node: &[u32],
     row_node: &[u32],
@@ -85,15 +86,15 @@ pub(super) fn runs_and_pairs(
     let mut last = (usize::MAX, usize::MAX);
     let mut first = 0;
     while first < entries.len() {
-        let (r, c) = (entries[first].0, entries[first].1);
+        let (r, c) = (entries[first].0 as usize, entries[first].1 as usize);
         let body = c / 7;
         let mut end = first + 1;
         if fast {
             let top = 7 * body + 6;
             while end < entries.len()
-                && entries[end].0 == r
-                && entries[end].1 == c + (end - first)
-                && entries[end].1 <= top
+                && entries[end].0 as usize == r
+                && entries[end].1 as usize == c + (end - first)
+                && entries[end].1 as usize <= top
             {
                 end += 1;
             }

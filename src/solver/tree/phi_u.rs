@@ -22,6 +22,7 @@ use super::border::Border;
 use super::dense;
 use super::segments::Segments;
 use super::shape::FIRST;
+use crate::constraints::Triplet;
 use crate::solver::partition::Partition;
 use std::sync::Arc;
 
@@ -92,7 +93,7 @@ impl TreeSplit {
     /// Refills the blocks from `entries` and factors them, in a buffer of the pool that no
     /// evaluation holds any more (a new one if all are held); with `watch`, the factors report
     /// their pivot ratio.
-    pub(crate) fn factor(&mut self, entries: &[(usize, usize, f64)], watch: bool) -> Arc<TreeLu> {
+    pub(crate) fn factor(&mut self, entries: &[Triplet], watch: bool) -> Arc<TreeLu> {
         let shape = &self.shape;
         let free = self.pool.iter().position(|f| Arc::strong_count(f) == 1);
         let mut lu = match free {

@@ -24,6 +24,7 @@
 use super::border::Border;
 use super::fused::Run;
 use super::nodes::{border_nodes, runs_and_pairs, Members};
+use crate::constraints::Triplet;
 use crate::solver::partition::Partition;
 use crate::solver::sparse::hessian::BlockHessian;
 use std::collections::HashMap;
@@ -81,7 +82,7 @@ impl Shape {
         part: &Partition,
         m: usize,
         n: usize,
-        entries: &[(usize, usize, f64)],
+        entries: &[Triplet],
         hess: &BlockHessian,
     ) -> Option<Self> {
         Self::build(part, m, n, entries, hess, true)
@@ -95,7 +96,7 @@ impl Shape {
         part: &Partition,
         m: usize,
         n: usize,
-        entries: &[(usize, usize, f64)],
+        entries: &[Triplet],
         hess: &BlockHessian,
         fast: bool,
     ) -> Option<Self> {
@@ -201,7 +202,7 @@ impl Shape {
             runs = runs
                 .iter()
                 .flat_map(|&(first, end)| {
-                    let whole = lined[entries[first].1 / 7];
+                    let whole = lined[entries[first].1 as usize / 7];
                     let cut = if whole { end - first } else { 1 };
                     (first..end)
                         .step_by(cut)
@@ -230,8 +231,8 @@ impl Shape {
         // furthest.
         for &(_, end) in &runs {
             let e = &entries[end - 1];
-            if row_pos[e.0] != u32::MAX {
-                reach(n + row_pos[e.0] as usize, e.1);
+            if row_pos[e.0 as usize] != u32::MAX {
+                reach(n + row_pos[e.0 as usize] as usize, e.1 as usize);
             }
         }
         let mut diag_at = Vec::with_capacity(kept + 1);
@@ -322,13 +323,13 @@ impl Shape {
         // or both stay the mirror of a coupling ([`SKIP`]).
         for &(first, end) in &runs {
             let e = &entries[first];
-            let k = row_pos[e.0];
+            let k = row_pos[e.0 as usize];
             if k == u32::MAX {
                 jac_slots.extend(std::iter::repeat_n([SKIP, SKIP], end - first));
                 continue;
             }
             let r = n + k as usize;
-            let (t1, t2) = (tpos[r], tpos[e.1]);
+            let (t1, t2) = (tpos[r], tpos[e.1 as usize]);
             if t1 < tree_len && t2 < tree_len {
                 let (a, b) = (node_of[t2] as usize, node_of[t1] as usize);
                 let step = if a == b { d[a] } else { w[a] } as u32;
@@ -363,7 +364,7 @@ impl Shape {
                 }
             } else {
                 for e in &entries[first..end] {
-                    let (a, b) = (locate(r, e.1)?, locate(e.1, r)?);
+                    let (a, b) = (locate(r, e.1 as usize)?, locate(e.1 as usize, r)?);
                     jac_slots.push(if fast {
                         flag_pair(&mut reached, a, b)
                     } else {

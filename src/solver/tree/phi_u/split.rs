@@ -18,6 +18,7 @@
 //! `merge`) at the first entry in an earlier node's column.
 
 use super::{Shape, TreeSplit, MAX_BORDER};
+use crate::constraints::Triplet;
 use crate::solver::partition::Partition;
 use crate::solver::tree::border::Border;
 use crate::solver::tree::segments::Segments;
@@ -32,7 +33,7 @@ impl TreeSplit {
         part: &Partition,
         m: usize,
         n: usize,
-        entries: &[(usize, usize, f64)],
+        entries: &[Triplet],
         open: bool,
     ) -> Option<Self> {
         // Positions and triplet numbers are held as `u32`.
@@ -67,7 +68,7 @@ impl TreeSplit {
         part: &Partition,
         m: usize,
         n: usize,
-        entries: &[(usize, usize, f64)],
+        entries: &[Triplet],
         run_of: &[u32],
         runs: usize,
         bordered: Option<&[bool]>,
@@ -124,7 +125,7 @@ impl TreeSplit {
         let (mut border_at, mut spare_at) = (Vec::new(), Vec::new());
         for (t, (e, slot)) in entries.iter().zip(&mut slots).enumerate() {
             let t = t as u32;
-            let (row, col) = (rows[e.0], cols[e.1]);
+            let (row, col) = (rows[e.0 as usize], cols[e.1 as usize]);
             if row.node.max(col.node) < FREE {
                 // Both in tree nodes.
                 if row.node == col.node {

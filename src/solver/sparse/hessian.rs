@@ -69,9 +69,11 @@ impl BlockHessian {
         self.values.reserve(blocks);
     }
 
-    /// Sets every block to zero, keeping the structure.
+    /// Sets every block to zero, keeping the structure (and restores values left empty by
+    /// a fused assembly, which borrows their memory: `System::assemble_fused`).
     pub(crate) fn clear(&mut self) {
-        self.values.iter_mut().for_each(|b| *b = [0.0; 49]);
+        self.values.clear();
+        self.values.resize(self.keys.len(), [0.0; 49]);
     }
 
     fn block(&mut self, a: usize, b: usize) -> &mut [f64; 49] {
@@ -94,6 +96,7 @@ impl BlockHessian {
 
     /// `y += W x`.
     pub(crate) fn mul_add(&self, x: &[f64], y: &mut [f64]) {
+        debug_assert_eq!(self.values.len(), self.keys.len(), "values lent to a fused assembly");
         for (&(a, b), blk) in self.keys.iter().zip(&self.values) {
             for i in 0..7 {
                 let mut s = 0.0;

@@ -178,16 +178,32 @@ impl HessianSink for FusedSink<'_> {
 impl TreeKkt {
     /// Starts a fused assembly: the compact blocks zeroed and the sink that adds the terms
     /// into them. `keys` are the block Hessian's (its first blocks are this structure's:
-    /// [`TreeKkt::fits`]).
-    pub(crate) fn fused_begin(&mut self, keys: &[(usize, usize)]) -> FusedSink<'_> {
+    /// [`TreeKkt::fits`]); the compact blocks are laid in `buffer`, the block Hessian's
+    /// values lent for the assembly (the fused path leaves them unused, and they hold at
+    /// least as many blocks: no memory of its own), given back by [`TreeKkt::fused_end`].
+    pub(crate) fn fused_begin(
+        &mut self,
+        keys: &[(usize, usize)],
+        buffer: Vec<[f64; 49]>,
+    ) -> FusedSink<'_> {
         if self.map.is_none() {
             let blocks = self.shape.block_slots.len();
             let map = BlockMap::new(self.shape.n / 7, &keys[..blocks], &self.shape.block_runs);
-            self.w_blocks = vec![[0.0; 49]; map.blocks.len()];
             self.map = Some(map);
         }
-        self.w_blocks.iter_mut().for_each(|b| *b = [0.0; 49]);
+        let kept = self.map.as_ref().map_or(0, |m| m.blocks.len());
+        self.w_blocks = buffer;
+        self.w_blocks.clear();
+        self.w_blocks.resize(kept, [0.0; 49]);
         self.fused_sink()
+    }
+
+    /// Ends a fused assembly (after [`TreeKkt::fused_finish`], or where a term was
+    /// `missing`): the buffer lent to [`TreeKkt::fused_begin`], emptied.
+    pub(crate) fn fused_end(&mut self) -> Vec<[f64; 49]> {
+        let mut buffer = std::mem::take(&mut self.w_blocks);
+        buffer.clear();
+        buffer
     }
 
     /// The sink of a fused assembly in progress (more terms: the augmentation); before

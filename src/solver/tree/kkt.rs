@@ -39,7 +39,8 @@ pub(crate) struct TreeKkt {
     pub(super) shape: Shape,
     /// The Hessian blocks by body pair (module `fused`; built at the first fused assembly).
     pub(super) map: Option<BlockMap>,
-    /// The fused assembly's `7 × 7` blocks of `W` (unscaled; the kept blocks of `map`).
+    /// The fused assembly's `7 × 7` blocks of `W` (unscaled; the kept blocks of `map`), in
+    /// the block Hessian's buffer during an assembly (empty between them).
     pub(super) w_blocks: Vec<[f64; 49]>,
     id: usize,
     triplets: usize,

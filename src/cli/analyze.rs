@@ -107,7 +107,7 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
     let mut result = AnalysisResult::new(model, &state, &report);
     result.diagnostics.timings.export = export_started.elapsed().as_secs_f64();
     if let Some(path) = &a.json {
-        print::write_json(path, &result.to_json_bytes())?;
+        print::write_json_with(path, |w| result.write_json(w))?;
     }
     if let Some(path) = &a.rrd {
         write_rrd(path, model, &state, &report)?;

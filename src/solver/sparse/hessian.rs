@@ -23,8 +23,8 @@ pub(crate) struct BlockHessian {
 impl BlockHessian {
     /// Adds the blocks, scaled (`D_a H_ab D_b`, `scale` the coordinate scaling), into the
     /// values of a KKT matrix at their slots (`slots[k]` for block `k`, row-major; `u32::MAX`:
-    /// an entry the matrix does not hold). The sparse and the tree KKT matrices both assemble
-    /// their `W` block this way.
+    /// an entry the matrix does not hold). The sparse KKT matrix assembles its `W` block this
+    /// way (the tree's stores each block along its run: `tree::fused::store_block`).
     pub(crate) fn scatter_scaled(&self, slots: &[[u32; 49]], scale: &[f64], values: &mut [f64]) {
         for ((&(a, b), blk), slots) in self.keys.iter().zip(&self.values).zip(slots) {
             for i in 0..7 {
@@ -33,28 +33,6 @@ impl BlockHessian {
                     if slot != u32::MAX {
                         values[slot as usize] +=
                             blk[7 * i + j] * scale[7 * a + i] * scale[7 * b + j];
-                    }
-                }
-            }
-        }
-    }
-
-    /// [`BlockHessian::scatter_scaled`] for a matrix in which every slot holds at most one
-    /// block entry (the tree KKT matrix): the scaled values are stored, not added, so that
-    /// the slots need no zeroing first. Same values as adding them to zero.
-    pub(crate) fn scatter_scaled_store(
-        &self,
-        slots: &[[u32; 49]],
-        scale: &[f64],
-        values: &mut [f64],
-    ) {
-        for ((&(a, b), blk), slots) in self.keys.iter().zip(&self.values).zip(slots) {
-            let (sa, sb) = (&scale[7 * a..7 * a + 7], &scale[7 * b..7 * b + 7]);
-            for i in 0..7 {
-                for j in 0..7 {
-                    let slot = slots[7 * i + j];
-                    if slot != u32::MAX {
-                        values[slot as usize] = blk[7 * i + j] * sa[i] * sb[j];
                     }
                 }
             }

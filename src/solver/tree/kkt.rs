@@ -139,7 +139,11 @@ impl TreeKkt {
         for &slot in &s.bare_diag {
             values[slot as usize] = 0.0;
         }
-        hess.scatter_scaled_store(&s.block_slots, scale, values);
+        let blocks = hess.keys.iter().zip(&hess.values).zip(&s.block_runs);
+        for ((&(a, b), blk), &run) in blocks {
+            let (sa, sb) = (&scale[7 * a..7 * a + 7], &scale[7 * b..7 * b + 7]);
+            super::fused::store_block(values, run, &s.scattered_slots, blk, sa, sb);
+        }
         self.store_jacobian(entries, row_scale, scale);
     }
 

@@ -30,31 +30,6 @@ pub(crate) fn is_stdout(path: Option<&std::path::PathBuf>) -> bool {
     path.is_some_and(|p| p.as_os_str() == "-")
 }
 
-/// Writes JSON text to `path` atomically, or to standard output for `-` (with a line break
-/// after it).
-pub(crate) fn write_json(path: &std::path::Path, text: &[u8]) -> anyhow::Result<()> {
-    write_json_with(path, |w| w.write_all(text))
-}
-
-/// [`write_json`] of the bytes `write` forms, streamed to the file (or standard output) as
-/// they come instead of held whole.
-pub(crate) fn write_json_with(
-    path: &std::path::Path,
-    write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
-) -> anyhow::Result<()> {
-    use std::io::Write;
-    if path.as_os_str() == "-" {
-        // Buffered in blocks, not flushed at each of the text's line breaks.
-        let mut stdout = std::io::BufWriter::with_capacity(64 * 1024, std::io::stdout().lock());
-        let _ = write(&mut stdout)
-            .and_then(|_| stdout.write_all(b"\n"))
-            .and_then(|_| stdout.flush());
-    } else {
-        restpose::export::write_atomic_with(path, write)?;
-    }
-    Ok(())
-}
-
 /// Prints an import warning on standard error, with the library's hint for a missing
 /// `package://` folder given as the `--package` option that supplies it.
 pub(crate) fn warning(w: &str) {

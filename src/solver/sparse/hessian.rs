@@ -74,7 +74,11 @@ impl BlockHessian {
 
     /// `y += W x`.
     pub(crate) fn mul_add(&self, x: &[f64], y: &mut [f64]) {
-        debug_assert_eq!(self.values.len(), self.keys.len(), "values lent to a fused assembly");
+        debug_assert_eq!(
+            self.values.len(),
+            self.keys.len(),
+            "values lent to a fused assembly"
+        );
         for (&(a, b), blk) in self.keys.iter().zip(&self.values) {
             for i in 0..7 {
                 let mut s = 0.0;

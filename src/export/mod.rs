@@ -125,4 +125,33 @@ mod tests {
         }
         std::fs::remove_dir_all(&dir).unwrap();
     }
+
+    /// A text streamed in small pieces, several times the buffer, arrives whole and in
+    /// order; a writer that fails leaves no file and names the path.
+    #[test]
+    fn a_streamed_text_arrives_whole_and_a_failure_leaves_nothing() {
+        use super::{write_atomic_with, BUFFER};
+        let dir = std::env::temp_dir().join(format!("restpose-stream-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("result.json");
+        let piece = |k: usize| format!("{k:07},").into_bytes();
+        let pieces = 3 * BUFFER / 8 + 5;
+        write_atomic_with(&file, |w| {
+            (0..pieces).try_for_each(|k| w.write_all(&piece(k)))
+        })
+        .unwrap();
+        let want: Vec<u8> = (0..pieces).flat_map(piece).collect();
+        assert!(want.len() > 3 * BUFFER);
+        assert_eq!(std::fs::read(&file).unwrap(), want);
+        let failed = dir.join("failed.json");
+        let err = write_atomic_with(&failed, |w| {
+            w.write_all(&vec![b'x'; 2 * BUFFER])?;
+            Err(std::io::Error::other("serializer gave up"))
+        })
+        .unwrap_err();
+        assert!(err.to_string().contains("failed.json"), "{err}");
+        let left: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
+        assert_eq!(left.len(), 1, "only the first file is left");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

@@ -1,7 +1,7 @@
 //! `restpose analyze`: solve for the rest pose, write the requested files, print a summary.
 
 use super::args::{coord, AnalyzeArgs};
-use super::{exit, print};
+use super::{exit, json_out, print};
 use restpose::export::json::AnalysisResult;
 use restpose::urdf::load_file;
 
@@ -107,7 +107,7 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
     let mut result = AnalysisResult::new(model, &state, &report);
     result.diagnostics.timings.export = export_started.elapsed().as_secs_f64();
     if let Some(path) = &a.json {
-        print::write_json(path, &result.to_json_bytes())?;
+        json_out::write(path, |w| result.write_json(w))?;
     }
     if let Some(path) = &a.rrd {
         write_rrd(path, model, &state, &report)?;

@@ -2,7 +2,7 @@
 
 use super::args::{CheckArgs, Format};
 use super::exit;
-use super::print;
+use super::{json_out, print};
 use restpose::export::summary::ModelSummary;
 use restpose::urdf::load_file;
 
@@ -24,13 +24,12 @@ pub(crate) fn run(a: &CheckArgs) -> anyhow::Result<u8> {
         print::model_listing(&s, &mut listing);
     }
     if let Some(path) = &a.json {
-        print::write_json(path, &restpose::export::pretty_json(&s)?)?;
+        json_out::write(path, |w| json_out::pretty(w, &s))?;
     }
     match a.format {
-        Format::Json if !stdout_json => print::write_json(
-            std::path::Path::new("-"),
-            &restpose::export::pretty_json(&s)?,
-        )?,
+        Format::Json if !stdout_json => {
+            json_out::write(std::path::Path::new("-"), |w| json_out::pretty(w, &s))?
+        }
         Format::Text if !stdout_json => print::model_with_listing(&s, &listing),
         _ => {}
     }

@@ -9,6 +9,7 @@ pub(crate) mod confirm;
 pub(crate) mod exit;
 pub(crate) mod formats;
 pub(crate) mod generate;
+pub(crate) mod json_out;
 pub(crate) mod parse;
 pub(crate) mod print;
 pub(crate) mod progress;

@@ -30,22 +30,6 @@ pub(crate) fn is_stdout(path: Option<&std::path::PathBuf>) -> bool {
     path.is_some_and(|p| p.as_os_str() == "-")
 }
 
-/// Writes JSON text to `path` atomically, or to standard output for `-` (with a line break
-/// after it).
-pub(crate) fn write_json(path: &std::path::Path, text: &[u8]) -> anyhow::Result<()> {
-    if path.as_os_str() == "-" {
-        use std::io::Write;
-        let mut stdout = std::io::stdout().lock();
-        let _ = stdout
-            .write_all(text)
-            .and_then(|_| stdout.write_all(b"\n"))
-            .and_then(|_| stdout.flush());
-    } else {
-        restpose::export::write_atomic(path, text)?;
-    }
-    Ok(())
-}
-
 /// Prints an import warning on standard error, with the library's hint for a missing
 /// `package://` folder given as the `--package` option that supplies it.
 pub(crate) fn warning(w: &str) {

@@ -3,8 +3,8 @@
 
 use super::args::{coord, VerifyArgs};
 use super::exit;
-use super::print;
 use super::report;
+use super::{json_out, print};
 use anyhow::{bail, Context};
 use restpose::urdf::load_file;
 
@@ -141,7 +141,7 @@ pub(crate) fn run(a: &VerifyArgs) -> anyhow::Result<u8> {
         eigenvalues,
     )?;
     if let Some(path) = &a.json {
-        print::write_json(path, &restpose::export::pretty_json(&v)?)?;
+        json_out::write(path, |w| json_out::pretty(w, &v))?;
     }
     if !print::is_stdout(a.json.as_ref()) {
         if a.quiet {

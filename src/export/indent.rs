@@ -108,9 +108,21 @@ impl Formatter for Indented {
 /// The serializer's error (a map key that is not a string).
 pub fn pretty_json<T: serde::Serialize + ?Sized>(value: &T) -> serde_json::Result<Vec<u8>> {
     let mut out = Vec::with_capacity(4096);
-    let mut ser = serde_json::Serializer::with_formatter(&mut out, Indented::default());
-    value.serialize(&mut ser)?;
+    pretty_json_to(&mut out, value)?;
     Ok(out)
+}
+
+/// [`pretty_json`] written to `out` as it is formed (the same bytes, without the whole text in
+/// memory: a result file is streamed through a small buffer).
+///
+/// # Errors
+/// The serializer's error (a map key that is not a string) or the writer's.
+pub fn pretty_json_to<W: io::Write, T: serde::Serialize + ?Sized>(
+    out: W,
+    value: &T,
+) -> serde_json::Result<()> {
+    let mut ser = serde_json::Serializer::with_formatter(out, Indented::default());
+    value.serialize(&mut ser)
 }
 
 #[cfg(test)]

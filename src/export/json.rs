@@ -295,4 +295,12 @@ impl AnalysisResult {
     pub fn to_json_bytes(&self) -> Vec<u8> {
         super::pretty_json(self).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}").into_bytes())
     }
+
+    /// The bytes of [`AnalysisResult::to_json_bytes`] written to `out` as they are formed.
+    ///
+    /// # Errors
+    /// The writer's error, or the serializer's as an I/O error.
+    pub fn write_json(&self, out: &mut dyn std::io::Write) -> std::io::Result<()> {
+        super::pretty_json_to(out, self).map_err(Into::into)
+    }
 }

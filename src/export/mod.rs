@@ -11,11 +11,14 @@ pub mod mujoco;
 pub mod srdf;
 pub mod summary;
 
-pub use indent::pretty_json;
+pub use indent::{pretty_json, pretty_json_to};
 
 use crate::error::{Error, Result};
 use std::io::Write;
 use std::path::Path;
+
+/// The buffer between a streamed writer and its file [bytes].
+const BUFFER: usize = 64 * 1024;
 
 /// Writes `bytes` to `path` atomically: a temporary file in the same folder, then a rename,
 /// so that a reader never sees a half-written file. A symbolic link is followed (its target
@@ -25,6 +28,18 @@ use std::path::Path;
 /// # Errors
 /// [`Error::Io`] if the folder is not writable.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_atomic_with(path, |w| w.write_all(bytes))
+}
+
+/// [`write_atomic`] of the bytes that `write` writes, passed on through a small buffer as
+/// they come (a large result is never held whole in memory).
+///
+/// # Errors
+/// [`Error::Io`] if the folder is not writable or `write` fails.
+pub fn write_atomic_with(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<()> {
     let io = |cause| Error::Io {
         path: path.display().to_string(),
         cause,
@@ -35,7 +50,11 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
             return std::fs::OpenOptions::new()
                 .write(true)
                 .open(path)
-                .and_then(|mut f| f.write_all(bytes))
+                .and_then(|f| {
+                    let mut w = std::io::BufWriter::with_capacity(BUFFER, f);
+                    write(&mut w)?;
+                    w.flush()
+                })
                 .map_err(io);
         }
         (Ok(_), Ok(link)) if link.file_type().is_symlink() => {
@@ -53,8 +72,12 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         .map(|n| n.to_string_lossy().to_string())
         .unwrap_or_default();
     let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
-    let mut f = std::fs::File::create(&tmp).map_err(io)?;
-    f.write_all(bytes).and_then(|_| f.sync_all()).map_err(|e| {
+    let f = std::fs::File::create(&tmp).map_err(io)?;
+    let mut w = std::io::BufWriter::with_capacity(BUFFER, f);
+    let written = write(&mut w)
+        .and_then(|_| w.into_inner().map_err(std::io::IntoInnerError::into_error))
+        .and_then(|f| f.sync_all());
+    written.map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
         io(e)
     })?;
@@ -100,6 +123,35 @@ mod tests {
                 .is_symlink());
             assert_eq!(std::fs::read(&file).unwrap(), b"two");
         }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A text streamed in small pieces, several times the buffer, arrives whole and in
+    /// order; a writer that fails leaves no file and names the path.
+    #[test]
+    fn a_streamed_text_arrives_whole_and_a_failure_leaves_nothing() {
+        use super::{write_atomic_with, BUFFER};
+        let dir = std::env::temp_dir().join(format!("restpose-stream-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("result.json");
+        let piece = |k: usize| format!("{k:07},").into_bytes();
+        let pieces = 3 * BUFFER / 8 + 5;
+        write_atomic_with(&file, |w| {
+            (0..pieces).try_for_each(|k| w.write_all(&piece(k)))
+        })
+        .unwrap();
+        let want: Vec<u8> = (0..pieces).flat_map(piece).collect();
+        assert!(want.len() > 3 * BUFFER);
+        assert_eq!(std::fs::read(&file).unwrap(), want);
+        let failed = dir.join("failed.json");
+        let err = write_atomic_with(&failed, |w| {
+            w.write_all(&vec![b'x'; 2 * BUFFER])?;
+            Err(std::io::Error::other("serializer gave up"))
+        })
+        .unwrap_err();
+        assert!(err.to_string().contains("failed.json"), "{err}");
+        let left: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
+        assert_eq!(left.len(), 1, "only the first file is left");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

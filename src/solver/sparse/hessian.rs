@@ -23,8 +23,8 @@ pub(crate) struct BlockHessian {
 impl BlockHessian {
     /// Adds the blocks, scaled (`D_a H_ab D_b`, `scale` the coordinate scaling), into the
     /// values of a KKT matrix at their slots (`slots[k]` for block `k`, row-major; `u32::MAX`:
-    /// an entry the matrix does not hold). The sparse and the tree KKT matrices both assemble
-    /// their `W` block this way.
+    /// an entry the matrix does not hold). The sparse KKT matrix assembles its `W` block this
+    /// way (the tree's stores each block along its run: `tree::fused::store_block`).
     pub(crate) fn scatter_scaled(&self, slots: &[[u32; 49]], scale: &[f64], values: &mut [f64]) {
         for ((&(a, b), blk), slots) in self.keys.iter().zip(&self.values).zip(slots) {
             for i in 0..7 {
@@ -39,28 +39,6 @@ impl BlockHessian {
         }
     }
 
-    /// [`BlockHessian::scatter_scaled`] for a matrix in which every slot holds at most one
-    /// block entry (the tree KKT matrix): the scaled values are stored, not added, so that
-    /// the slots need no zeroing first. Same values as adding them to zero.
-    pub(crate) fn scatter_scaled_store(
-        &self,
-        slots: &[[u32; 49]],
-        scale: &[f64],
-        values: &mut [f64],
-    ) {
-        for ((&(a, b), blk), slots) in self.keys.iter().zip(&self.values).zip(slots) {
-            let (sa, sb) = (&scale[7 * a..7 * a + 7], &scale[7 * b..7 * b + 7]);
-            for i in 0..7 {
-                for j in 0..7 {
-                    let slot = slots[7 * i + j];
-                    if slot != u32::MAX {
-                        values[slot as usize] = blk[7 * i + j] * sa[i] * sb[j];
-                    }
-                }
-            }
-        }
-    }
-
     /// Room for `blocks` blocks over `bodies` row bodies before the first are added: a large
     /// model's blocks without the regrowth copies (a hint; more still fit).
     pub(crate) fn reserve(&mut self, bodies: usize, blocks: usize) {
@@ -69,9 +47,11 @@ impl BlockHessian {
         self.values.reserve(blocks);
     }
 
-    /// Sets every block to zero, keeping the structure.
+    /// Sets every block to zero, keeping the structure (and restores values left empty by
+    /// a fused assembly, which borrows their memory: `System::assemble_fused`).
     pub(crate) fn clear(&mut self) {
-        self.values.iter_mut().for_each(|b| *b = [0.0; 49]);
+        self.values.clear();
+        self.values.resize(self.keys.len(), [0.0; 49]);
     }
 
     fn block(&mut self, a: usize, b: usize) -> &mut [f64; 49] {
@@ -94,6 +74,11 @@ impl BlockHessian {
 
     /// `y += W x`.
     pub(crate) fn mul_add(&self, x: &[f64], y: &mut [f64]) {
+        debug_assert_eq!(
+            self.values.len(),
+            self.keys.len(),
+            "values lent to a fused assembly"
+        );
         for (&(a, b), blk) in self.keys.iter().zip(&self.values) {
             for i in 0..7 {
                 let mut s = 0.0;

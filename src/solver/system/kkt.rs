@@ -44,7 +44,8 @@ impl System<'_> {
 
     /// [`System::factor_kkt`] for a Newton step: the same matrix, assembled by the fused pass
     /// where the tree structure fits (module `tree::fused`: no block Hessian, whose values
-    /// are left as they were; [`System::reduced_apply`] needs [`System::factor_kkt`]).
+    /// are left empty, their memory lent to the fused blocks; [`System::reduced_apply`] needs
+    /// [`System::factor_kkt`]).
     pub(crate) fn factor_step_kkt(
         &mut self,
         q: &DVector<f64>,
@@ -94,7 +95,10 @@ impl System<'_> {
         for (k, &row) in part.rows.iter().enumerate() {
             weights[row] = -eval.mu[k];
         }
-        let mut sink = tree.fused_begin(&self.work.hess.keys);
+        // The block Hessian's values lend their memory to the compact blocks (and get it
+        // back emptied: `BlockHessian::clear` restores them at the next general assembly).
+        let buffer = std::mem::take(&mut self.work.hess.values);
+        let mut sink = tree.fused_begin(&self.work.hess.keys, buffer);
         let _ = potential(
             model,
             &self.problem.cons.branches,
@@ -115,9 +119,11 @@ impl System<'_> {
             let complete = !sink.missing;
             let scaling = &self.problem.scaling;
             tree.fused_finish(&self.work.jac.entries, &scaling.rows, &scaling.columns);
+            self.work.hess.values = tree.fused_end();
             self.work.kkt = Some(KktMatrix::Tree(tree));
             return complete;
         }
+        self.work.hess.values = tree.fused_end();
         self.work.kkt = Some(KktMatrix::Tree(tree));
         false
     }

@@ -32,8 +32,8 @@ pub(crate) enum Run {
     Skip,
     /// Entry `(i, j)` at `start + i stride + j`.
     Dense { start: usize, stride: usize },
-    /// Entry by entry, at the block's slots (the border).
-    Scattered,
+    /// Entry by entry, at the slots `Shape::scattered_slots[at]` (the border).
+    Scattered { at: u32 },
 }
 
 /// The Hessian blocks of a structure by body pair, built at its first fused assembly.
@@ -179,16 +179,32 @@ impl HessianSink for FusedSink<'_> {
 impl TreeKkt {
     /// Starts a fused assembly: the compact blocks zeroed and the sink that adds the terms
     /// into them. `keys` are the block Hessian's (its first blocks are this structure's:
-    /// [`TreeKkt::fits`]).
-    pub(crate) fn fused_begin(&mut self, keys: &[(usize, usize)]) -> FusedSink<'_> {
+    /// [`TreeKkt::fits`]); the compact blocks are laid in `buffer`, the block Hessian's
+    /// values lent for the assembly (the fused path leaves them unused, and they hold at
+    /// least as many blocks: no memory of its own), given back by [`TreeKkt::fused_end`].
+    pub(crate) fn fused_begin(
+        &mut self,
+        keys: &[(usize, usize)],
+        buffer: Vec<[f64; 49]>,
+    ) -> FusedSink<'_> {
         if self.map.is_none() {
-            let blocks = self.shape.block_slots.len();
+            let blocks = self.shape.block_runs.len();
             let map = BlockMap::new(self.shape.n / 7, &keys[..blocks], &self.shape.block_runs);
-            self.w_blocks = vec![[0.0; 49]; map.blocks.len()];
             self.map = Some(map);
         }
-        self.w_blocks.iter_mut().for_each(|b| *b = [0.0; 49]);
+        let kept = self.map.as_ref().map_or(0, |m| m.blocks.len());
+        self.w_blocks = buffer;
+        self.w_blocks.clear();
+        self.w_blocks.resize(kept, [0.0; 49]);
         self.fused_sink()
+    }
+
+    /// Ends a fused assembly (after [`TreeKkt::fused_finish`], or where a term was
+    /// `missing`): the buffer lent to [`TreeKkt::fused_begin`], emptied.
+    pub(crate) fn fused_end(&mut self) -> Vec<[f64; 49]> {
+        let mut buffer = std::mem::take(&mut self.w_blocks);
+        buffer.clear();
+        buffer
     }
 
     /// The sink of a fused assembly in progress (more terms: the augmentation); before
@@ -232,31 +248,46 @@ impl TreeKkt {
             let k = k as usize;
             let (a, b) = map.keys[k];
             let (sa, sb) = (&scale[7 * a..7 * a + 7], &scale[7 * b..7 * b + 7]);
-            match s.block_runs[k] {
-                Run::Skip => {}
-                Run::Dense { start, stride } => {
-                    for i in 0..7 {
-                        let row = &mut values[start + i * stride..start + i * stride + 7];
-                        let src = &blk[7 * i..7 * i + 7];
-                        for ((v, &w), &d) in row.iter_mut().zip(src).zip(sb) {
-                            *v = w * sa[i] * d;
-                        }
-                    }
+            store_block(values, s.block_runs[k], &s.scattered_slots, blk, sa, sb);
+        }
+        self.store_jacobian(entries, row_scale, scale);
+    }
+}
+
+/// Stores the block `blk` of `W` (row-major, unscaled) at its `run`'s slots, scaled
+/// `(w D_a) D_b` with `sa`, `sb` the scaling of its row and column bodies (the mirror of a
+/// coupling: nothing). The general assembly and the fused one store every block this way.
+#[inline]
+pub(super) fn store_block(
+    values: &mut [f64],
+    run: Run,
+    scattered_slots: &[[u32; 49]],
+    blk: &[f64; 49],
+    sa: &[f64],
+    sb: &[f64],
+) {
+    match run {
+        Run::Skip => {}
+        Run::Dense { start, stride } => {
+            for i in 0..7 {
+                let row = &mut values[start + i * stride..start + i * stride + 7];
+                let src = &blk[7 * i..7 * i + 7];
+                for ((v, &w), &d) in row.iter_mut().zip(src).zip(sb) {
+                    *v = w * sa[i] * d;
                 }
-                Run::Scattered => {
-                    let slots = &s.block_slots[k];
-                    for i in 0..7 {
-                        for j in 0..7 {
-                            let slot = slots[7 * i + j];
-                            if slot != SKIP {
-                                values[slot as usize] = blk[7 * i + j] * sa[i] * sb[j];
-                            }
-                        }
+            }
+        }
+        Run::Scattered { at } => {
+            let slots = &scattered_slots[at as usize];
+            for i in 0..7 {
+                for j in 0..7 {
+                    let slot = slots[7 * i + j];
+                    if slot != SKIP {
+                        values[slot as usize] = blk[7 * i + j] * sa[i] * sb[j];
                     }
                 }
             }
         }
-        self.store_jacobian(entries, row_scale, scale);
     }
 }
 

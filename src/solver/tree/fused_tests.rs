@@ -94,6 +94,14 @@ fn fused_blocks_equal_the_general_assembly_bit_for_bit() {
                 k.factor(1e-3);
             }
             assert!(sys.assemble_fused(&qr, &part, &ev), "{name}: fused");
+            // The compact blocks were laid in the block Hessian's buffer, given back empty
+            // with its room (the next general assembly, below, restores the values).
+            let hess = &sys.work.hess;
+            assert!(hess.values.is_empty(), "{name}: values lent back empty");
+            assert!(
+                hess.values.capacity() >= hess.keys.len(),
+                "{name}: room kept"
+            );
             let fused = values(&sys);
             assert_eq!(general.len(), fused.len());
             let nonzero = general.iter().filter(|v| **v != 0.0).count();

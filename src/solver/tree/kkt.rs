@@ -40,7 +40,8 @@ pub(crate) struct TreeKkt {
     pub(super) shape: Shape,
     /// The Hessian blocks by body pair (module `fused`; built at the first fused assembly).
     pub(super) map: Option<BlockMap>,
-    /// The fused assembly's `7 × 7` blocks of `W` (unscaled; the kept blocks of `map`).
+    /// The fused assembly's `7 × 7` blocks of `W` (unscaled; the kept blocks of `map`), in
+    /// the block Hessian's buffer during an assembly (empty between them).
     pub(super) w_blocks: Vec<[f64; 49]>,
     id: usize,
     triplets: usize,
@@ -139,7 +140,11 @@ impl TreeKkt {
         for &slot in &s.bare_diag {
             values[slot as usize] = 0.0;
         }
-        hess.scatter_scaled_store(&s.block_slots, scale, values);
+        let blocks = hess.keys.iter().zip(&hess.values).zip(&s.block_runs);
+        for ((&(a, b), blk), &run) in blocks {
+            let (sa, sb) = (&scale[7 * a..7 * a + 7], &scale[7 * b..7 * b + 7]);
+            super::fused::store_block(values, run, &s.scattered_slots, blk, sa, sb);
+        }
         self.store_jacobian(entries, row_scale, scale);
     }
 

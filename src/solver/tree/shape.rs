@@ -62,12 +62,13 @@ pub(crate) struct Shape {
     /// The tree-space size (the border follows).
     pub(crate) tree_len: usize,
     pub(crate) border: Border,
-    /// Slots of each Hessian block's entries and of each Jacobian triplet (`(row, column)` and
-    /// its mirror; [`FIRST`] set on the first triplet to reach a slot), and of each
-    /// coordinate's diagonal.
-    pub(crate) block_slots: Vec<[u32; 49]>,
-    /// Each block's slots as a run (module `fused`).
+    /// Where each Hessian block's entries go (module `fused`): a dense run of slots, the
+    /// mirror of a coupling (nowhere), or entry by entry at its slots in `scattered_slots`
+    /// (a block that reaches the border; the dense runs keep no slot list).
     pub(crate) block_runs: Vec<Run>,
+    pub(crate) scattered_slots: Vec<[u32; 49]>,
+    /// Slots of each Jacobian triplet (`(row, column)` and its mirror; [`FIRST`] set on the
+    /// first triplet to reach a slot), and of each coordinate's diagonal.
     pub(crate) jac_slots: Vec<[u32; 2]>,
     pub(crate) diag_slots: Vec<u32>,
     /// The diagonal slots that no Hessian block writes (zeroed by each assembly: a shift of
@@ -275,10 +276,9 @@ impl Shape {
             }
             tree_slot(t1, t2)
         };
-        let mut block_slots = Vec::with_capacity(hess.keys.len());
+        let mut scattered_slots = Vec::new();
         let mut block_runs = Vec::with_capacity(hess.keys.len());
         for &(a, b) in &hess.keys {
-            let mut s = [SKIP; 49];
             // A body's 7 coordinates lead its node, in order (or all lie in the border): a
             // block between two tree nodes is one dense run of slots, or all mirrors.
             let (ta, tb) = (tpos[7 * a], tpos[7 * b]);
@@ -289,27 +289,24 @@ impl Shape {
                 } else if par[na] == nb as u32 {
                     (coup_at[na] + (ta - at[na]) * w[na] + (tb - at[nb]), w[na])
                 } else if par[nb] == na as u32 {
-                    block_slots.push(s);
                     block_runs.push(Run::Skip);
                     continue;
                 } else {
                     return None;
                 };
-                for i in 0..7 {
-                    for j in 0..7 {
-                        s[7 * i + j] = (start + i * stride + j) as u32;
-                    }
-                }
                 block_runs.push(Run::Dense { start, stride });
             } else {
+                let mut s = [SKIP; 49];
                 for i in 0..7 {
                     for j in 0..7 {
                         s[7 * i + j] = locate(7 * a + i, 7 * b + j)?;
                     }
                 }
-                block_runs.push(Run::Scattered);
+                block_runs.push(Run::Scattered {
+                    at: scattered_slots.len() as u32,
+                });
+                scattered_slots.push(s);
             }
-            block_slots.push(s);
         }
         if flat >= FIRST as usize {
             return None;
@@ -395,8 +392,10 @@ impl Shape {
                 .collect()
         } else {
             reached.resize(total, false);
-            for s in block_slots.iter().flatten().filter(|&&s| s != SKIP) {
-                reached[*s as usize] = true;
+            for run in &block_runs {
+                for s in run_slots(run, &scattered_slots).filter(|&s| s != SKIP) {
+                    reached[s as usize] = true;
+                }
             }
             diag_slots
                 .iter()
@@ -417,13 +416,25 @@ impl Shape {
             flat_len: flat,
             tree_len,
             border,
-            block_slots,
             block_runs,
+            scattered_slots,
             jac_slots,
             diag_slots,
             bare_diag,
         })
     }
+}
+
+/// The slots of a block's 49 entries, row-major, by its run ([`SKIP`]: none).
+pub(crate) fn run_slots<'a>(
+    run: &'a Run,
+    scattered_slots: &'a [[u32; 49]],
+) -> impl Iterator<Item = u32> + 'a {
+    (0..49).map(move |e| match *run {
+        Run::Skip => SKIP,
+        Run::Dense { start, stride } => (start + (e / 7) * stride + e % 7) as u32,
+        Run::Scattered { at } => scattered_slots[at as usize][e],
+    })
 }
 
 /// A triplet's slot `a` and its mirror's `b`, each flagged [`FIRST`] if no triplet before

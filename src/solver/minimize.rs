@@ -50,6 +50,7 @@ use super::stability::{at_rest::for_minimizer, inertia::ByInertia};
 use super::step::direction::{direction, Direction};
 use super::step::line_search::{line_search, Line, Trial};
 use super::step::newton::Settle;
+use super::step::path_cholesky::{self, Formed};
 use super::step::quasi_newton::QuasiNewton;
 use super::step::retraction::independent_change;
 use super::step::step_cap::{cap_step, Step};
@@ -201,8 +202,8 @@ pub(crate) fn minimize(
         }
         let judging = std::time::Instant::now(); // the verdict at a rest: `timings.stability`
         let mut reused = First::taken(&mut first, (&s.q, &s.part, &s.eval), gtol, &mut s.diag);
-        let (eig, test) = match reused.as_mut() {
-            Some((e, _)) => (e.take(), Test::Continue),
+        let (eig, formed, test) = match reused.as_mut() {
+            Some((e, _)) => (e.take(), None, Test::Continue),
             None => convergence_test(sys, &mut s, gtol, options),
         };
         let saddle = match test {
@@ -228,7 +229,9 @@ pub(crate) fn minimize(
         let (d, kkt, along_path) = match (rolled, reused) {
             (Some(d), _) => (d, false, None),
             (None, Some((_, d))) => (d, false, None),
-            (None, None) => reduced_step(sys, &mut s, eig.as_ref(), saddle, guard, options),
+            (None, None) => {
+                reduced_step(sys, &mut s, (eig.as_ref(), formed), saddle, guard, options)
+            }
         };
         let step = cap_step(sys, &s.part, &s.eval, &s.q, d, options);
         let slope = s.eval.grad_v.dot(&step.d);
@@ -351,17 +354,24 @@ fn record(s: &mut Search, options: &Options, report: bool) {
     }
 }
 
-/// Stage 2: the convergence test (module docs), with the spectrum where it was needed.
+/// Stage 2: the convergence test (module docs), with the spectrum where it was needed, or on a
+/// small tree away from a stationary point `Ĥ` formed and not decomposed (module
+/// `step::path_cholesky`).
 fn convergence_test(
     sys: &mut System,
     s: &mut Search,
     gtol: f64,
     options: &Options,
-) -> (Option<Spectrum>, Test) {
+) -> (Option<Spectrum>, Option<Formed>, Test) {
     let gnorm = s.eval.grad_v.amax();
     let dof = s.part.independent.len();
     let dense_newton = options.method == Method::Newton
         && (sys.backend == Backend::Dense || dof <= EXACT_NEWTON_DOF);
+    if dof > 0 && path_cholesky::applies(sys, dense_newton, gnorm, gtol, s.valley.looks(&s.history))
+    {
+        let formed = path_cholesky::formed(sys, &s.q, &s.part, &s.eval);
+        return (None, Some(formed), Test::Continue);
+    }
     // On the Lanczos path the inertia verdict, and the spectrum only to leave a saddle
     // (module `stability::at_rest`).
     let mut verdict = None;
@@ -378,7 +388,7 @@ fn convergence_test(
         })
         .flatten();
     if gnorm > gtol {
-        return (eig, Test::Continue);
+        return (eig, None, Test::Continue);
     }
     let rounding = GRADIENT_FLOOR * s.eval.energy.magnitude;
     let test = match &eig {
@@ -395,7 +405,7 @@ fn convergence_test(
         },
         _ => Test::Converged(eig.clone(), verdict),
     };
-    (eig, test)
+    (eig, None, test)
 }
 
 /// Stage 3: the reduced step `d` (module docs, module `step::direction`); steepest descent
@@ -404,7 +414,7 @@ fn convergence_test(
 fn reduced_step(
     sys: &mut System,
     s: &mut Search,
-    eig: Option<&Spectrum>,
+    (eig, formed): (Option<&Spectrum>, Option<Formed>),
     negative_curvature: Option<DVector<f64>>,
     guard: Option<&Guard>,
     options: &Options,
@@ -420,7 +430,7 @@ fn reduced_step(
     } = direction(
         sys,
         (&s.q, &s.part, &s.eval),
-        eig,
+        (eig, formed),
         negative_curvature.as_ref(),
         settle,
         &s.qn.binv,

@@ -6,7 +6,9 @@
 //!    along the resolved curvatures only (module `newton`);
 //! 1. where the path keeps every row (module `path_hessian`) and the Hessian is exact, the
 //!    Newton step along the path, escaping maxima and saddles along every direction of
-//!    negative curvature (module `escape`);
+//!    negative curvature (module `escape`); on a small tree away from a stationary point from
+//!    `Ĥ` formed and not decomposed, by Cholesky where `Ĥ + C` is positive definite (module
+//!    `path_cholesky`);
 //! 2. at a stationary saddle, `max_step` along the eigenvector of the most negative
 //!    eigenvalue, downhill;
 //! 3. the Newton step with the eigenvalue magnitudes (dense, module `newton`), the KKT
@@ -19,6 +21,7 @@ use crate::solver::stability::spectrum::Spectrum;
 use crate::solver::step::escape::escape_step;
 use crate::solver::step::kkt_direction::kkt_direction;
 use crate::solver::step::newton::{newton_step, settling_step};
+use crate::solver::step::path_cholesky::{path_newton_step, Formed};
 use crate::solver::step::path_hessian::path_keeps_rows;
 use crate::solver::system::{Eval, System};
 use nalgebra::{DMatrix, DVector};
@@ -49,13 +52,14 @@ impl Direction {
 }
 
 /// The reduced step at `(q, part, eval)` (module docs), `eig` the reduced Hessian's spectrum
-/// when computed, `negative_curvature` the saddle's direction when the point is stationary,
+/// when computed, `formed` the reduced Hessian formed and not decomposed (module
+/// `path_cholesky`: then `eig` is `None`), `negative_curvature` the saddle's direction when the point is stationary,
 /// `settle` the Hessian's error where the convergence test asked for the settling step,
 /// `binv` the quasi-Newton inverse Hessian.
 pub(crate) fn direction(
     sys: &mut System,
     (q, part, eval): (&DVector<f64>, &Partition, &Eval),
-    eig: Option<&Spectrum>,
+    (eig, formed): (Option<&Spectrum>, Option<Formed>),
     negative_curvature: Option<&DVector<f64>>,
     settle: Option<f64>,
     binv: &DMatrix<f64>,
@@ -63,6 +67,16 @@ pub(crate) fn direction(
     options: &Options,
 ) -> Direction {
     let g = &eval.grad_v;
+    if let Some(formed) = formed {
+        let (d, escaped, along_path) =
+            path_newton_step(sys, (q, part, eval), formed, guard, options);
+        return Direction {
+            d,
+            escaped,
+            kkt: false,
+            along_path,
+        };
+    }
     if let (Some(band), Some(e)) = (settle, eig.filter(|e| e.exact)) {
         return Direction::plain(settling_step(e, g, band), false);
     }

@@ -157,6 +157,13 @@ impl Backend {
     }
 }
 
+/// Whether `model` is one of the small trees [`Backend::choose`] gives the tree factors at the
+/// dense size (at most [`SPARSE_FROM_COORDINATES`] coordinates, [`small_tree`]): where the
+/// minimizer may step by Cholesky away from stationary points (module `step::path_cholesky`).
+pub(crate) fn is_small_tree(model: &Model) -> bool {
+    model.coordinate_count() <= SPARSE_FROM_COORDINATES && small_tree(model)
+}
+
 /// Whether `model` is small and takes the tree factors ([`TREE_FROM_BODIES`]): open, at least
 /// that many bodies, and no stop, contact, lock or mimic.
 fn small_tree(model: &Model) -> bool {

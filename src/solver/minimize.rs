@@ -10,7 +10,9 @@
 //! 3. **Reduced step** ([`reduced_step`]): Newton `d = −Ĥ⁻¹ ∇f` with the exact reduced Hessian
 //!    along the search path (`Ĥ + C`, module `step::path_hessian`), its eigenvalues replaced by
 //!    their magnitudes, floored (dense, module `step::newton`), near a maximum or saddle at
-//!    least a saddle step along every direction of negative curvature (module `step::escape`),
+//!    least a saddle step along every direction of negative curvature (module `step::escape`;
+//!    on a small tree away from a stationary point by Cholesky where `Ĥ + C` is positive
+//!    definite, `Ĥ` formed and not decomposed, module `step::path_cholesky`),
 //!    or the KKT direction (sparse); BFGS / DFP `d = −B ∇f` (module `step::quasi_newton`);
 //!    steepest descent when `d` is not a descent direction (an escape excepted).
 //! 4. **Step cap** (module `step::step_cap`): the tangent step `δq = Z d` limited on the motion of the

@@ -30,8 +30,9 @@ pub(crate) const EXACT_UP_TO: usize = 200;
 /// Up to this many degrees of freedom on the sparse and tree paths the stability verdict
 /// comes from the exact spectrum and the report lists the eigenvalues; above, from the
 /// inertia of the shifted KKT matrix unless eigenvalues are asked for ([`listed`]). It is
-/// the minimizer's `EXACT_NEWTON_DOF`: up to there every Newton step decomposes `Ĥ`, so at
-/// the rest the spectrum is at hand; above, the steps are KKT solves and forming `Ĥ` (`dof`
+/// the minimizer's `EXACT_NEWTON_DOF`: up to there every Newton step forms `Ĥ` (and
+/// decomposes it, or on a small tree away from a stationary point solves `Ĥ + C` by Cholesky,
+/// module `step::path_cholesky`), and at the rest the convergence test decomposes it; above, the steps are KKT solves and forming `Ĥ` (`dof`
 /// tangent solves and their transposes, `O(dof · N)`) and decomposing it (`O(dof³)`) would
 /// cost more than the solve (chain 100: about two thirds of it).
 pub(crate) const LISTED_UP_TO: usize = 64;

@@ -52,7 +52,7 @@ use super::stability::{at_rest::for_minimizer, inertia::ByInertia};
 use super::step::direction::{direction, Direction};
 use super::step::line_search::{line_search, Line, Trial};
 use super::step::newton::Settle;
-use super::step::path_cholesky::{self, Formed};
+use super::step::path_cholesky::{self, Plan};
 use super::step::quasi_newton::QuasiNewton;
 use super::step::retraction::independent_change;
 use super::step::step_cap::{cap_step, Step};
@@ -204,7 +204,7 @@ pub(crate) fn minimize(
         }
         let judging = std::time::Instant::now(); // the verdict at a rest: `timings.stability`
         let mut reused = First::taken(&mut first, (&s.q, &s.part, &s.eval), gtol, &mut s.diag);
-        let (eig, formed, test) = match reused.as_mut() {
+        let (eig, plan, test) = match reused.as_mut() {
             Some((e, _)) => (e.take(), None, Test::Continue),
             None => convergence_test(sys, &mut s, gtol, options),
         };
@@ -232,7 +232,7 @@ pub(crate) fn minimize(
             (Some(d), _) => (d, false, None),
             (None, Some((_, d))) => (d, false, None),
             (None, None) => {
-                reduced_step(sys, &mut s, (eig.as_ref(), formed), saddle, guard, options)
+                reduced_step(sys, &mut s, (eig.as_ref(), plan), saddle, guard, options)
             }
         };
         let step = cap_step(sys, &s.part, &s.eval, &s.q, d, options);
@@ -357,22 +357,24 @@ fn record(s: &mut Search, options: &Options, report: bool) {
 }
 
 /// Stage 2: the convergence test (module docs), with the spectrum where it was needed, or on a
-/// small tree away from a stationary point `Ĥ` formed and not decomposed (module
-/// `step::path_cholesky`).
+/// small tree away from a stationary point where the valley watch does not look the step's
+/// plan instead: the KKT direction far from the rest, else `Ĥ` formed and not decomposed
+/// (module `step::path_cholesky`).
 fn convergence_test(
     sys: &mut System,
     s: &mut Search,
     gtol: f64,
     options: &Options,
-) -> (Option<Spectrum>, Option<Formed>, Test) {
+) -> (Option<Spectrum>, Option<Plan>, Test) {
     let gnorm = s.eval.grad_v.amax();
     let dof = s.part.independent.len();
     let dense_newton = options.method == Method::Newton
         && (sys.backend == Backend::Dense || dof <= EXACT_NEWTON_DOF);
-    if dof > 0 && path_cholesky::applies(sys, dense_newton, gnorm, gtol, s.valley.looks(&s.history))
-    {
-        let formed = path_cholesky::formed(sys, &s.q, &s.part, &s.eval);
-        return (None, Some(formed), Test::Continue);
+    let small = path_cholesky::small_tree(sys, dense_newton);
+    let watched = s.valley.looks(&s.history);
+    let at = (&s.q, &s.part, &s.eval);
+    if let Some(plan) = path_cholesky::plan(sys, at, small, (gnorm, gtol), watched) {
+        return (None, Some(plan), Test::Continue);
     }
     // On the Lanczos path the inertia verdict, and the spectrum only to leave a saddle
     // (module `stability::at_rest`).
@@ -416,7 +418,7 @@ fn convergence_test(
 fn reduced_step(
     sys: &mut System,
     s: &mut Search,
-    (eig, formed): (Option<&Spectrum>, Option<Formed>),
+    (eig, plan): (Option<&Spectrum>, Option<Plan>),
     negative_curvature: Option<DVector<f64>>,
     guard: Option<&Guard>,
     options: &Options,
@@ -432,7 +434,7 @@ fn reduced_step(
     } = direction(
         sys,
         (&s.q, &s.part, &s.eval),
-        (eig, formed),
+        (eig, plan),
         negative_curvature.as_ref(),
         settle,
         &s.qn.binv,

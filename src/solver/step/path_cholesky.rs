@@ -1,31 +1,47 @@
-//! The Newton step along the path on a small tree, by Cholesky away from stationary points.
+//! The Newton step on a small tree: the KKT step far from the rest, the step along the path by
+//! Cholesky near it.
 //!
 //! On the small trees of [`Backend::choose`] (fewer than 40 bodies, open, no stop, contact,
-//! lock or mimic: `system::backend::small_tree`) the minimizer steps by the Hessian along the
-//! search path `Ĥ + C` (module `path_hessian`) and, as everywhere up to 64 degrees of freedom,
-//! decomposes it: the magnitude step `d = −Σ v_i (v_iᵀ∇f) / max(|λ_i|, ε λ_max)` and the escape
-//! along its negative curvature (module `escape`). Away from a stationary point
-//! (`‖∇f‖∞` above the gradient tolerance) and where the valley watch does not look (module
-//! `valley`), the spectrum of `Ĥ` itself is read by nothing: `Ĥ` is formed and not decomposed,
-//! `M = Ĥ + C` is summed from it, and where every eigenvalue of `M` lies above the magnitude
-//! step's floor the step is
+//! lock or mimic: `system::backend::small_tree`) the minimizer steps, as everywhere up to 64
+//! degrees of freedom, by the Hessian along the search path `M = Ĥ + C` (module
+//! `path_hessian`): the magnitude step `d = −Σ v_i (v_iᵀ∇f) / max(|λ_i|, ε λ_max)` from the
+//! spectrum of `M` and the escape along its negative curvature (module `escape`). Three
+//! shortcuts take the same steps with less work:
+//!
+//! 1. **Far from the rest** (`‖∇f‖∞ > τ Σ|V_k|`, `τ` = [`FAR`], `Σ|V_k|` the energy's terms'
+//!    magnitudes), where the valley watch does not look (module `valley`), the step is the KKT
+//!    direction of the larger trees (module `kkt_direction`: Newton on `Ĥ`, without `C`, from
+//!    the tree-structured KKT factors; `Ĥ` is not formed). Far from the rest the step is
+//!    capped or cut by the line search anyway; `C ∝ ∇f` matters near it, where Newton on `Ĥ`
+//!    converges with a larger constant (chain 20 then takes 5 iterations instead of 4).
+//! 2. **Near the rest, away from a stationary point** (`‖∇f‖∞` above the gradient tolerance),
+//!    where the valley watch does not look, the spectrum of `Ĥ` is read by nothing: `Ĥ` is
+//!    formed and not decomposed and `M` summed from it.
+//! 3. Where the spectrum of `Ĥ` is read (the valley watch looks, module `valley`), `M` is
+//!    summed from it as `V Λ Vᵀ + C`, the matrix `path_hessian::along_path` decomposes.
+//!
+//! In 2 and 3, where every eigenvalue of `M` lies above the magnitude step's floor, the step
+//! is
 //!
 //! `M d = −∇f`,   by the Cholesky factor `M = L Lᵀ`,
 //!
 //! the magnitude step itself (no eigenvalue floored, no negative one to escape along). The
 //! floor is `ε G`, `ε = EIGENVALUE_FLOOR`, `G = maxᵢ Σⱼ |M_ij| ≥ |λ|max` (Gershgorin): the
 //! Cholesky factorization of `M − ε G I` succeeds only where `λ_min > ε G ≥ ε |λ|max`. Elsewhere
-//! `M` is decomposed and the escape taken as before (module `escape`). At a stationary point
-//! the convergence test decomposes `Ĥ` (the verdict's eigenvalues are exact, module
-//! `stability::spectrum`).
+//! `M` is decomposed and the escape taken as before (module `escape`). What the valley watch
+//! reads is unchanged: the spectrum of `Ĥ` wherever it looks, and that of `M` where `M` has a
+//! neutral direction (`|λ| ≤ 10⁻¹² |λ|max`, `valley::Valley::along_path`), which a Cholesky
+//! step's `M` has not (there the watch reads `None` instead of a spectrum it would refuse). At
+//! a stationary point the convergence test decomposes `Ĥ` (the verdict's eigenvalues are
+//! exact, module `stability::spectrum`).
 //!
-//! The step is the decomposition's to rounding, not to the bit: `M` is summed from `Ĥ` instead
-//! of `V Λ Vᵀ`, and solved by substitution instead of through eigenvectors (the reason it is
-//! kept to small trees: on G1 and Romeo LAAS small, which have stops, the rounding of `Ĥ`
-//! against `V Λ Vᵀ` moved the rests; docs/benchmarks-history.md, session 27). On chains of
-//! 3 – 40 links every iteration count, rest and eigenvalue is the decomposition's (energies to
-//! 2·10⁻¹⁵ relative, joint values to 4·10⁻¹⁶ rad); a chain of 20 takes 0.83 of the
-//! instructions (docs/benchmarks-history.md, session 34).
+//! The steps are the decomposition's to rounding in 2 and 3, not to the bit (`M` summed from
+//! `Ĥ` instead of `V Λ Vᵀ` in 2, solved by substitution instead of through eigenvectors), and
+//! another direction in 1: the reason they are kept to small trees (on G1 and Romeo LAAS
+//! small, which have stops, the rounding of `Ĥ` against `V Λ Vᵀ` moved the rests;
+//! docs/benchmarks-history.md, session 27). On chains of 3 – 40 links every iteration count
+//! and verdict is the decomposition's and every rest and eigenvalue equal to rounding
+//! (docs/benchmarks-history.md, session 35).
 //!
 //! ## References
 //! - J. Nocedal and S. J. Wright, *Numerical Optimization*, 2nd ed., Springer (2006), §3.4
@@ -34,13 +50,26 @@
 use crate::solver::inequality::active_set::Guard;
 use crate::solver::options::Options;
 use crate::solver::partition::Partition;
-use crate::solver::stability::blocks::block_symmetric_eigen;
 use crate::solver::stability::spectrum::Spectrum;
 use crate::solver::step::escape::escape_along;
 use crate::solver::step::newton::EIGENVALUE_FLOOR;
-use crate::solver::step::path_hessian::{path_curvature, path_keeps_rows};
+use crate::solver::step::path_hessian::{path_curvature, path_keeps_rows, path_matrix, spectrum_of};
 use crate::solver::system::{is_small_tree, symmetric_part, Backend, Eval, System};
 use nalgebra::{DMatrix, DVector};
+
+/// Far from the rest: `‖∇f‖∞` above this fraction of `Σ|V_k|` (module docs, 1). Chain 20
+/// (`Σ|V_k|` about 150 J, gradients 149, 58, 0.87, 8·10⁻⁴) keeps its 4 iterations from 0.003 to
+/// 1 (docs/benchmarks-history.md, sessions 34 and 35).
+pub(crate) const FAR: f64 = 0.1;
+
+/// How the convergence test prepares the step on a small tree away from a stationary point
+/// where the valley watch does not look (module docs).
+pub(crate) enum Plan {
+    /// Far from the rest: the KKT direction, `Ĥ` not formed (module docs, 1).
+    Kkt,
+    /// Near it: `Ĥ` formed and not decomposed (module docs, 2).
+    Formed(Formed),
+}
 
 /// The reduced Hessian `Ĥ` formed and not decomposed, with the null-space basis `Z` it was
 /// formed with where it was kept (`System::reduced_hessian_and_basis`).
@@ -49,36 +78,39 @@ pub(crate) struct Formed {
     pub(crate) basis: Option<DMatrix<f64>>,
 }
 
-/// Whether the step at a point with reduced gradient `gnorm` (tolerance `gtol`) is taken from
-/// `Ĥ` formed and not decomposed (module docs): a small tree on its tree factors whose path
-/// keeps every row, a Newton step up to 64 degrees of freedom (`dense_newton`), away from a
-/// stationary point, the valley watch not looking (`watched`).
-pub(crate) fn applies(
-    sys: &System,
-    dense_newton: bool,
-    gnorm: f64,
-    gtol: f64,
-    watched: bool,
-) -> bool {
+/// Whether `sys` is a small tree on its tree factors whose path keeps every row, stepped by
+/// the exact Newton step (`dense_newton`: the method is Newton, at most 64 degrees of
+/// freedom): where the steps of this module are taken (module docs).
+pub(crate) fn small_tree(sys: &System, dense_newton: bool) -> bool {
     dense_newton
-        && gnorm > gtol
-        && !watched
         && sys.backend == Backend::Tree
         && is_small_tree(sys.problem.model)
         && path_keeps_rows(sys)
 }
 
-/// `Ĥ` at `q`, formed (module docs).
-pub(crate) fn formed(sys: &mut System, q: &DVector<f64>, part: &Partition, eval: &Eval) -> Formed {
+/// The step's plan at `(q, part, eval)` with reduced gradient norm `gnorm` (tolerance `gtol`)
+/// where `sys` is a small tree (`small`, [`small_tree`]) and the valley watch does not look
+/// (`watched` false): the KKT direction far from the rest, else `Ĥ` formed (module docs);
+/// `None` elsewhere (the convergence test decomposes `Ĥ` as before).
+pub(crate) fn plan(
+    sys: &mut System,
+    (q, part, eval): (&DVector<f64>, &Partition, &Eval),
+    small: bool,
+    (gnorm, gtol): (f64, f64),
+    watched: bool,
+) -> Option<Plan> {
+    if !small || gnorm <= gtol || watched || part.independent.is_empty() {
+        return None;
+    }
+    if gnorm > FAR * eval.energy.magnitude {
+        return Some(Plan::Kkt);
+    }
     let (hessian, basis) = sys.reduced_hessian_and_basis(q, part, eval);
-    Formed { hessian, basis }
+    Some(Plan::Formed(Formed { hessian, basis }))
 }
 
-/// The Newton step `d` along the path at `q` from `Ĥ` formed (module docs): by Cholesky where
-/// `Ĥ + C` is positive definite above the floor (no escape, no spectrum), else as
-/// `escape::escape_step` with the spectrum of `Ĥ + C`; whether it escaped, and that spectrum
-/// where it was computed.
-pub(crate) fn path_newton_step(
+/// The Newton step along the path at `q` from `Ĥ` formed (module docs, 2): see [`step`].
+pub(crate) fn formed_step(
     sys: &mut System,
     (q, part, eval): (&DVector<f64>, &Partition, &Eval),
     formed: Formed,
@@ -87,20 +119,37 @@ pub(crate) fn path_newton_step(
 ) -> (DVector<f64>, bool, Option<Spectrum>) {
     let mut m = formed.hessian;
     m += path_curvature(sys, q, part, eval, formed.basis.as_ref());
-    let m = symmetric_part(m);
+    step(sys, (q, part, eval), symmetric_part(m), guard, options)
+}
+
+/// The Newton step along the path at `q` from the exact spectrum `e` of `Ĥ` (module docs, 3):
+/// see [`step`].
+pub(crate) fn spectrum_step(
+    sys: &mut System,
+    (q, part, eval): (&DVector<f64>, &Partition, &Eval),
+    e: &Spectrum,
+    guard: Option<&Guard>,
+    options: &Options,
+) -> (DVector<f64>, bool, Option<Spectrum>) {
+    let m = path_matrix(sys, q, part, eval, e);
+    step(sys, (q, part, eval), m, guard, options)
+}
+
+/// The Newton step `d` along the path at `q` with the symmetric `M = Ĥ + C`: by Cholesky where
+/// `M` is positive definite above the floor (no escape, no spectrum), else as
+/// `escape::escape_step` with the spectrum of `M`; whether it escaped, and that spectrum where
+/// it was computed.
+fn step(
+    sys: &mut System,
+    (q, part, eval): (&DVector<f64>, &Partition, &Eval),
+    m: DMatrix<f64>,
+    guard: Option<&Guard>,
+    options: &Options,
+) -> (DVector<f64>, bool, Option<Spectrum>) {
     if let Some(d) = definite_step(&m, &eval.grad_v) {
         return (d, false, None);
     }
-    let (values, vectors) = block_symmetric_eigen(&m);
-    let path = Spectrum {
-        largest: values.amax(),
-        values,
-        vectors,
-        exact: true,
-        negative_by_inertia: None,
-        basis: None,
-    };
-    let (d, escaped, path) = escape_along(sys, q, part, eval, path, guard, options);
+    let (d, escaped, path) = escape_along(sys, q, part, eval, spectrum_of(&m), guard, options);
     (d, escaped, Some(path))
 }
 
@@ -126,6 +175,7 @@ mod tests {
     use crate::solver::step::path_hessian::along_path;
     use crate::solver::step::retraction::tests::ARM;
     use crate::solver::system::Backend;
+    use crate::solver::valley::Valley;
     use crate::state::State;
     use crate::urdf::{load_str, ImportOptions};
 
@@ -142,8 +192,16 @@ mod tests {
         (model, q)
     }
 
-    /// Away from the rest, where `Ĥ + C` is positive definite, the Cholesky step equals the
-    /// decomposition's magnitude step (module `escape`, from the spectrum of `Ĥ`) to rounding.
+    /// `(Ĥ, Z)` formed at `q` (module docs, 2).
+    fn formed(sys: &mut System, q: &DVector<f64>, part: &Partition, eval: &Eval) -> Formed {
+        let (hessian, basis) = sys.reduced_hessian_and_basis(q, part, eval);
+        Formed { hessian, basis }
+    }
+
+    /// Away from the rest, where `Ĥ + C` is positive definite, the Cholesky step (from `Ĥ`
+    /// formed, and from the spectrum of `Ĥ`) equals the decomposition's magnitude step (module
+    /// `escape`, from the spectrum of `Ĥ`) to 10⁻¹²; the spectrum of `Ĥ + C` it does not
+    /// compute would give the valley watch nothing (no neutral direction).
     #[test]
     fn cholesky_step_is_the_magnitude_step_where_definite() {
         let (model, q) = chain_at(|i| 0.3 * (i as f64).sin() - 1.2);
@@ -152,24 +210,32 @@ mod tests {
         let eval = sys.evaluate(&q, &part).unwrap();
         let options = Options::default();
         assert!(eval.grad_v.amax() > 1.0, "a point away from the rest");
-        assert!(applies(sys, true, eval.grad_v.amax(), 1e-8, false));
+        assert!(small_tree(sys, true));
         let e = crate::solver::stability::spectrum::spectrum(sys, &q, &part, &eval);
         let path = along_path(sys, &q, &part, &eval, &e);
         assert!(path.values.min() > 0.0, "Ĥ + C positive definite here");
+        assert!(Valley::along_path(&path).is_none());
         let (by_spectrum, escaped, _) = escape_step(sys, &q, &part, &eval, &e, None, &options);
         assert!(!escaped);
         let f = formed(sys, &q, &part, &eval);
-        let (d, escaped, spectrum) = path_newton_step(sys, (&q, &part, &eval), f, None, &options);
+        let at = (&q, &part, &eval);
+        let (d, escaped, spectrum) = formed_step(sys, at, f, None, &options);
         assert!(!escaped && spectrum.is_none(), "taken by Cholesky");
         let err = (&d - &by_spectrum).amax() / by_spectrum.amax();
-        assert!(err < 1e-12, "relative difference {err:e}");
+        assert!(err < 1e-12, "from Ĥ formed: relative difference {err:e}");
+        let (d, escaped, spectrum) = spectrum_step(sys, at, &e, None, &options);
+        assert!(!escaped && spectrum.is_none(), "taken by Cholesky");
+        let err = (&d - &by_spectrum).amax() / by_spectrum.amax();
+        assert!(err < 1e-12, "from the spectrum: relative difference {err:e}");
     }
 
     /// Where `Ĥ + C` has negative curvature (the branched arm of module `retraction`'s tests,
     /// its lift raised), the step falls back to the spectrum of `Ĥ + C` and is the
     /// decomposition's to rounding along every resolved eigen-direction. (The arm has three
     /// neutral ones, `λ` at 0 and 10⁻¹⁶: the magnitude step divides their slopes, at rounding
-    /// level, by the floor, so there the two steps differ by their rounding.)
+    /// level, by the floor, so there the two steps differ by their rounding.) From the spectrum
+    /// of `Ĥ` it is the decomposition's step to the bit, and hands the valley watch the same
+    /// spectrum of `Ĥ + C`.
     #[test]
     fn indefinite_path_hessian_falls_back_to_the_spectrum() {
         let model = load_str(ARM, "arm.urdf", &ImportOptions::default())
@@ -192,9 +258,13 @@ mod tests {
             "negative curvature along the path"
         );
         let (by_spectrum, escaped, _) = escape_step(sys, &q, &part, &eval, &e, None, &options);
+        let at = (&q, &part, &eval);
+        let (d, escaped_here, spectrum) = spectrum_step(sys, at, &e, None, &options);
+        assert_eq!((d.clone(), escaped_here), (by_spectrum.clone(), escaped));
+        let spectrum = spectrum.expect("decomposed where indefinite");
+        assert_eq!((&spectrum.values, &spectrum.vectors), (&path.values, &path.vectors));
         let f = formed(sys, &q, &part, &eval);
-        let (d, escaped_here, spectrum) =
-            path_newton_step(sys, (&q, &part, &eval), f, None, &options);
+        let (d, escaped_here, spectrum) = formed_step(sys, at, f, None, &options);
         let spectrum = spectrum.expect("decomposed where indefinite");
         assert_eq!(escaped_here, escaped);
         let lambda = (&spectrum.values - &path.values).amax() / path.values.amax();
@@ -215,36 +285,51 @@ mod tests {
         }
     }
 
-    /// Only small trees on their tree factors: not a long chain (tree factors, sparse size),
-    /// not a chain with stops, not the dense path.
+    /// The plan: the KKT direction far from the rest, `Ĥ` formed near it, none at a
+    /// stationary point or where the valley watch looks.
+    #[test]
+    fn far_from_the_rest_the_kkt_direction() {
+        let (model, q) = chain_at(|_| 0.5);
+        let sys = &mut System::new(&model, Constraints::new(&model, &[]), Backend::Tree);
+        let part = sys.partition(&q);
+        let eval = sys.evaluate(&q, &part).unwrap();
+        let at = (&q, &part, &eval);
+        let far = FAR * eval.energy.magnitude;
+        assert!(far > 1.0);
+        let gtol = 1e-8;
+        let kkt = plan(sys, at, true, (2.0 * far, gtol), false);
+        assert!(matches!(kkt, Some(Plan::Kkt)));
+        let near = plan(sys, at, true, (0.5 * far, gtol), false);
+        let Some(Plan::Formed(f)) = near else {
+            panic!("Ĥ formed near the rest");
+        };
+        assert_eq!(f.hessian, formed(sys, &q, &part, &eval).hessian);
+        assert!(plan(sys, at, true, (1e-9, gtol), false).is_none(), "stationary");
+        assert!(plan(sys, at, true, (2.0 * far, gtol), true).is_none(), "watched");
+        assert!(plan(sys, at, false, (2.0 * far, gtol), false).is_none(), "no small tree");
+    }
+
+    /// Only small trees on their tree factors with the exact Newton step: not a long chain
+    /// (tree factors, sparse size), not a chain with stops, not the dense path, not BFGS.
     #[test]
     fn applies_to_small_trees_only() {
-        let (model, q) = chain_at(|_| 0.5);
+        let (model, _) = chain_at(|_| 0.5);
         let tree = System::new(&model, Constraints::new(&model, &[]), Backend::Tree);
-        assert!(applies(&tree, true, 1.0, 1e-8, false));
-        assert!(!applies(&tree, true, 1e-9, 1e-8, false), "stationary");
-        assert!(
-            !applies(&tree, true, 1.0, 1e-8, true),
-            "the valley watch looks"
-        );
-        assert!(
-            !applies(&tree, false, 1.0, 1e-8, false),
-            "no exact Newton step"
-        );
+        assert!(small_tree(&tree, true));
+        assert!(!small_tree(&tree, false), "no exact Newton step");
         let dense = System::new(&model, Constraints::new(&model, &[]), Backend::Dense);
-        assert!(!applies(&dense, true, 1.0, 1e-8, false));
+        assert!(!small_tree(&dense, true));
         let long = crate::generate::chain(41, false);
         let long = load_str(&long, "c.urdf", &ImportOptions::default())
             .unwrap()
             .model;
         let sys = System::new(&long, Constraints::new(&long, &[]), Backend::Tree);
-        assert!(!applies(&sys, true, 1.0, 1e-8, false), "41 bodies");
+        assert!(!small_tree(&sys, true), "41 bodies");
         let limited = include_str!("../../../robots/panda_class.urdf");
         let limited = load_str(limited, "panda.urdf", &ImportOptions::default())
             .unwrap()
             .model;
         let sys = System::new(&limited, Constraints::new(&limited, &[]), Backend::Tree);
-        assert!(!applies(&sys, true, 1.0, 1e-8, false), "stops");
-        assert!(q.iter().all(|x| x.is_finite()));
+        assert!(!small_tree(&sys, true), "stops");
     }
 }

@@ -395,21 +395,25 @@ fn convergence_test(
         return (eig, None, Test::Continue);
     }
     let rounding = GRADIENT_FLOOR * s.eval.energy.magnitude;
-    let test = match &eig {
+    let verdict = match &eig {
         Some(e) if !options.allow_unstable => match e.lowest() {
             Some((_, lmin)) if e.unresolved(lmin, gnorm, rounding) => {
                 s.settle.ask(gnorm);
-                Test::Continue
+                return (eig, None, Test::Continue);
             }
             Some((imin, lmin)) if lmin < -e.tolerance() => {
-                Test::Saddle(e.vectors.column(imin).into_owned())
+                let v = e.vectors.column(imin).into_owned();
+                return (eig, None, Test::Saddle(v));
             }
-            _ if s.valley.unsettled(e, &s.eval.grad_v, rounding) => Test::Continue, // valley floor
-            _ => Test::Converged(Some(e.clone()), None),
+            _ if s.valley.unsettled(e, &s.eval.grad_v, rounding) => {
+                return (eig, None, Test::Continue); // valley floor
+            }
+            _ => None,
         },
-        _ => Test::Converged(eig.clone(), verdict),
+        _ => verdict,
     };
-    (eig, None, test)
+    // Converged: the spectrum moves into the test (the search stops here).
+    (None, None, Test::Converged(eig, verdict))
 }
 
 /// Stage 3: the reduced step `d` (module docs, module `step::direction`); steepest descent

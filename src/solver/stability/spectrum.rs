@@ -132,16 +132,7 @@ pub(crate) fn spectrum_knowing(
     let dof = part.independent.len();
     if exact(sys.backend, dof) {
         let (h, basis) = sys.reduced_hessian_and_basis(q, part, eval);
-        let (values, vectors) = block_symmetric_eigen(&h);
-        let largest = values.amax();
-        return Spectrum {
-            values,
-            vectors,
-            largest,
-            exact: true,
-            negative_by_inertia: None,
-            basis,
-        };
+        return exact_spectrum(&h, basis);
     }
     lanczos(sys, q, part, eval, largest).unwrap_or_else(|| Spectrum {
         // A singular reduced Hessian (the KKT matrix cannot be factored): neutral.
@@ -152,6 +143,21 @@ pub(crate) fn spectrum_knowing(
         negative_by_inertia: None,
         basis: None,
     })
+}
+
+/// The exact spectrum of the reduced Hessian `h`, formed with the null-space basis `basis`
+/// (kept where `System::reduced_hessian_and_basis` kept it).
+pub(crate) fn exact_spectrum(h: &DMatrix<f64>, basis: Option<DMatrix<f64>>) -> Spectrum {
+    let (values, vectors) = block_symmetric_eigen(h);
+    let largest = values.amax();
+    Spectrum {
+        values,
+        vectors,
+        largest,
+        exact: true,
+        negative_by_inertia: None,
+        basis,
+    }
 }
 
 fn lanczos(

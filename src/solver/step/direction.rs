@@ -8,7 +8,7 @@
 //!    Newton step along the path, escaping maxima and saddles along every direction of
 //!    negative curvature (module `escape`); on a small tree by Cholesky where `Ĥ + C` is
 //!    positive definite, from `Ĥ` formed and not decomposed where no one reads its spectrum,
-//!    and far from the rest the KKT direction instead (module `path_cholesky`);
+//!    and far from the rest Newton on `Ĥ` (module `path_cholesky`);
 //! 2. at a stationary saddle, `max_step` along the eigenvector of the most negative
 //!    eigenvalue, downhill;
 //! 3. the Newton step with the eigenvalue magnitudes (dense, module `newton`), the KKT
@@ -22,7 +22,7 @@ use crate::solver::step::escape::escape_step;
 use crate::solver::step::kkt_direction::kkt_direction;
 use crate::solver::step::newton::{newton_step, settling_step};
 use crate::solver::minimize::EXACT_NEWTON_DOF;
-use crate::solver::step::path_cholesky::{self, formed_step, spectrum_step, Plan};
+use crate::solver::step::path_cholesky::{self, spectrum_step, Plan};
 use crate::solver::step::path_hessian::path_keeps_rows;
 use crate::solver::system::{Eval, System};
 use nalgebra::{DMatrix, DVector};
@@ -75,15 +75,8 @@ pub(crate) fn direction(
         kkt: false,
         along_path,
     };
-    match plan {
-        Some(Plan::Kkt) => {
-            let (d, kkt) = kkt_direction(sys, q, part, eval);
-            return Direction::plain(d, kkt);
-        }
-        Some(Plan::Formed(formed)) => {
-            return along(formed_step(sys, (q, part, eval), formed, guard, options))
-        }
-        None => {}
+    if let Some(plan) = plan {
+        return along(path_cholesky::planned_step(sys, (q, part, eval), plan, guard, options));
     }
     if let (Some(band), Some(e)) = (settle, eig.filter(|e| e.exact)) {
         return Direction::plain(settling_step(e, g, band), false);

@@ -1,4 +1,4 @@
-//! The Newton step on a small tree: the KKT step far from the rest, the step along the path by
+//! The Newton step on a small tree: Newton on `Ĥ` far from the rest, the step along the path by
 //! Cholesky near it.
 //!
 //! On the small trees of [`Backend::choose`] (fewer than 40 bodies, open, no stop, contact,
@@ -9,11 +9,14 @@
 //! shortcuts take the same steps with less work:
 //!
 //! 1. **Far from the rest** (`‖∇f‖∞ > τ Σ|V_k|`, `τ` = [`FAR`], `Σ|V_k|` the energy's terms'
-//!    magnitudes), where the valley watch does not look (module `valley`), the step is the KKT
-//!    direction of the larger trees (module `kkt_direction`: Newton on `Ĥ`, without `C`, from
-//!    the tree-structured KKT factors; `Ĥ` is not formed). Far from the rest the step is
-//!    capped or cut by the line search anyway; `C ∝ ∇f` matters near it, where Newton on `Ĥ`
-//!    converges with a larger constant (chain 20 then takes 5 iterations instead of 4).
+//!    magnitudes), where the valley watch does not look (module `valley`), the step is Newton
+//!    on `Ĥ` alone, `Ĥ d = −∇f` by Cholesky where `Ĥ` is positive definite above the floor
+//!    (below), without `C`: the reduced Newton step of the KKT direction of the larger trees
+//!    (module `kkt_direction`), which a small tree forms more cheaply than it builds the KKT
+//!    structure for. Far from the rest the step is capped or cut by the line search anyway;
+//!    `C ∝ ∇f` matters near it, where Newton on `Ĥ` converges with a larger constant (chain
+//!    20 then takes 5 iterations instead of 4). Where `Ĥ` is not positive definite above the
+//!    floor, `Ĥ` is decomposed and the step taken as in 3.
 //! 2. **Near the rest, away from a stationary point** (`‖∇f‖∞` above the gradient tolerance),
 //!    where the valley watch does not look, the spectrum of `Ĥ` is read by nothing: `Ĥ` is
 //!    formed and not decomposed and `M` summed from it.
@@ -37,7 +40,7 @@
 //!
 //! The steps are the decomposition's to rounding in 2 and 3, not to the bit (`M` summed from
 //! `Ĥ` instead of `V Λ Vᵀ` in 2, solved by substitution instead of through eigenvectors), and
-//! another direction in 1: the reason they are kept to small trees (on G1 and Romeo LAAS
+//! another direction in 1 (without `C`): the reason they are kept to small trees (on G1 and Romeo LAAS
 //! small, which have stops, the rounding of `Ĥ` against `V Λ Vᵀ` moved the rests;
 //! docs/benchmarks-history.md, session 27). On chains of 3 – 40 links every iteration count
 //! and verdict is the decomposition's and every rest and eigenvalue equal to rounding
@@ -50,25 +53,27 @@
 use crate::solver::inequality::active_set::Guard;
 use crate::solver::options::Options;
 use crate::solver::partition::Partition;
-use crate::solver::stability::spectrum::Spectrum;
+use crate::solver::stability::spectrum::{exact_spectrum, Spectrum};
 use crate::solver::step::escape::escape_along;
 use crate::solver::step::newton::EIGENVALUE_FLOOR;
 use crate::solver::step::path_hessian::{path_curvature, path_keeps_rows, path_matrix, spectrum_of};
 use crate::solver::system::{is_small_tree, symmetric_part, Backend, Eval, System};
 use nalgebra::{DMatrix, DVector};
 
-/// Far from the rest: `‖∇f‖∞` above this fraction of `Σ|V_k|` (module docs, 1). Chain 20
-/// (`Σ|V_k|` about 150 J, gradients 149, 58, 0.87, 8·10⁻⁴) keeps its 4 iterations from 0.003 to
-/// 1 (docs/benchmarks-history.md, sessions 34 and 35).
-pub(crate) const FAR: f64 = 0.1;
+/// Far from the rest: `‖∇f‖∞` above this fraction of `Σ|V_k|` (module docs, 1). The
+/// generated chains of 2 – 40 links keep every iteration count and rest (to 10⁻¹² relative)
+/// from 0.1 to 1; at 0.03 chains 5 – 9 rest 3·10⁻¹² … 4·10⁻¹⁰ apart and chain 9 takes 4
+/// iterations instead of 3 (docs/benchmarks-history.md, session 35).
+pub(crate) const FAR: f64 = 0.3;
 
 /// How the convergence test prepares the step on a small tree away from a stationary point
-/// where the valley watch does not look (module docs).
+/// where the valley watch does not look (module docs): `Ĥ` formed and not decomposed, for
+/// Newton on `Ĥ` far from the rest (1) or along the path near it (2).
 pub(crate) enum Plan {
-    /// Far from the rest: the KKT direction, `Ĥ` not formed (module docs, 1).
-    Kkt,
-    /// Near it: `Ĥ` formed and not decomposed (module docs, 2).
-    Formed(Formed),
+    /// Far from the rest (module docs, 1).
+    Far(Formed),
+    /// Near it (module docs, 2).
+    Near(Formed),
 }
 
 /// The reduced Hessian `Ĥ` formed and not decomposed, with the null-space basis `Z` it was
@@ -90,8 +95,8 @@ pub(crate) fn small_tree(sys: &System, dense_newton: bool) -> bool {
 
 /// The step's plan at `(q, part, eval)` with reduced gradient norm `gnorm` (tolerance `gtol`)
 /// where `sys` is a small tree (`small`, [`small_tree`]) and the valley watch does not look
-/// (`watched` false): the KKT direction far from the rest, else `Ĥ` formed (module docs);
-/// `None` elsewhere (the convergence test decomposes `Ĥ` as before).
+/// (`watched` false): `Ĥ` formed, far from the rest or near it (module docs); `None`
+/// elsewhere (the convergence test decomposes `Ĥ` as before).
 pub(crate) fn plan(
     sys: &mut System,
     (q, part, eval): (&DVector<f64>, &Partition, &Eval),
@@ -102,11 +107,35 @@ pub(crate) fn plan(
     if !small || gnorm <= gtol || watched || part.independent.is_empty() {
         return None;
     }
-    if gnorm > FAR * eval.energy.magnitude {
-        return Some(Plan::Kkt);
-    }
     let (hessian, basis) = sys.reduced_hessian_and_basis(q, part, eval);
-    Some(Plan::Formed(Formed { hessian, basis }))
+    let formed = Formed { hessian, basis };
+    Some(match gnorm > FAR * eval.energy.magnitude {
+        true => Plan::Far(formed),
+        false => Plan::Near(formed),
+    })
+}
+
+/// The step of `plan` at `q` (module docs): far from the rest Newton on `Ĥ` by Cholesky, or
+/// where `Ĥ` is not positive definite above the floor the step along the path from its
+/// spectrum ([`spectrum_step`]); near it [`formed_step`]. The step, whether it escaped along
+/// a direction of negative curvature, and the spectrum of `Ĥ + C` where it was computed.
+pub(crate) fn planned_step(
+    sys: &mut System,
+    at: (&DVector<f64>, &Partition, &Eval),
+    plan: Plan,
+    guard: Option<&Guard>,
+    options: &Options,
+) -> (DVector<f64>, bool, Option<Spectrum>) {
+    match plan {
+        Plan::Far(formed) => match definite_step(&formed.hessian, &at.2.grad_v) {
+            Some(d) => (d, false, None),
+            None => {
+                let e = exact_spectrum(&formed.hessian, formed.basis);
+                spectrum_step(sys, at, &e, guard, options)
+            }
+        },
+        Plan::Near(formed) => formed_step(sys, at, formed, guard, options),
+    }
 }
 
 /// The Newton step along the path at `q` from `Ĥ` formed (module docs, 2): see [`step`].
@@ -172,6 +201,7 @@ mod tests {
     use super::*;
     use crate::constraints::Constraints;
     use crate::solver::step::escape::escape_step;
+    use crate::solver::step::kkt_direction::kkt_direction;
     use crate::solver::step::path_hessian::along_path;
     use crate::solver::step::retraction::tests::ARM;
     use crate::solver::system::Backend;
@@ -285,25 +315,37 @@ mod tests {
         }
     }
 
-    /// The plan: the KKT direction far from the rest, `Ĥ` formed near it, none at a
-    /// stationary point or where the valley watch looks.
+    /// The plan: far from the rest Newton on `Ĥ` (the reduced KKT step, module
+    /// `kkt_direction`, to 10⁻¹²), near it the step along the path; none at a stationary
+    /// point or where the valley watch looks.
     #[test]
-    fn far_from_the_rest_the_kkt_direction() {
+    fn far_from_the_rest_newton_on_the_reduced_hessian() {
         let (model, q) = chain_at(|_| 0.5);
         let sys = &mut System::new(&model, Constraints::new(&model, &[]), Backend::Tree);
         let part = sys.partition(&q);
         let eval = sys.evaluate(&q, &part).unwrap();
+        let options = Options::default();
         let at = (&q, &part, &eval);
         let far = FAR * eval.energy.magnitude;
         assert!(far > 1.0);
         let gtol = 1e-8;
-        let kkt = plan(sys, at, true, (2.0 * far, gtol), false);
-        assert!(matches!(kkt, Some(Plan::Kkt)));
-        let near = plan(sys, at, true, (0.5 * far, gtol), false);
-        let Some(Plan::Formed(f)) = near else {
-            panic!("Ĥ formed near the rest");
+        let Some(Plan::Far(f)) = plan(sys, at, true, (2.0 * far, gtol), false) else {
+            panic!("far from the rest");
         };
         assert_eq!(f.hessian, formed(sys, &q, &part, &eval).hessian);
+        let (d, escaped, spectrum) = planned_step(sys, at, Plan::Far(f), None, &options);
+        assert!(!escaped && spectrum.is_none(), "taken by Cholesky");
+        let (by_kkt, definite) = kkt_direction(sys, &q, &part, &eval);
+        assert!(definite, "Ĥ positive definite here");
+        let err = (&d - &by_kkt).amax() / by_kkt.amax();
+        assert!(err < 1e-12, "relative difference {err:e}");
+        let Some(Plan::Near(f)) = plan(sys, at, true, (0.5 * far, gtol), false) else {
+            panic!("near the rest");
+        };
+        let (d, _, _) = planned_step(sys, at, Plan::Near(f), None, &options);
+        let (by_path, _, _) = formed_step(sys, at, formed(sys, &q, &part, &eval), None, &options);
+        assert_eq!(d, by_path);
+        assert!((&d - &by_kkt).amax() > 1e-6 * by_kkt.amax(), "C changes the step");
         assert!(plan(sys, at, true, (1e-9, gtol), false).is_none(), "stationary");
         assert!(plan(sys, at, true, (2.0 * far, gtol), true).is_none(), "watched");
         assert!(plan(sys, at, false, (2.0 * far, gtol), false).is_none(), "no small tree");

@@ -11,8 +11,8 @@
 //!    along the search path (`Ĥ + C`, module `step::path_hessian`), its eigenvalues replaced by
 //!    their magnitudes, floored (dense, module `step::newton`), near a maximum or saddle at
 //!    least a saddle step along every direction of negative curvature (module `step::escape`;
-//!    on a small tree away from a stationary point by Cholesky where `Ĥ + C` is positive
-//!    definite, `Ĥ` formed and not decomposed, module `step::path_cholesky`),
+//!    on a small tree by Cholesky where `Ĥ + C` is positive definite, far from the rest
+//!    Newton on `Ĥ` alone, module `step::path_cholesky`),
 //!    or the KKT direction (sparse); BFGS / DFP `d = −B ∇f` (module `step::quasi_newton`);
 //!    steepest descent when `d` is not a descent direction (an escape excepted).
 //! 4. **Step cap** (module `step::step_cap`): the tangent step `δq = Z d` limited on the motion of the
@@ -231,9 +231,7 @@ pub(crate) fn minimize(
         let (d, kkt, along_path) = match (rolled, reused) {
             (Some(d), _) => (d, false, None),
             (None, Some((_, d))) => (d, false, None),
-            (None, None) => {
-                reduced_step(sys, &mut s, (eig.as_ref(), plan), saddle, guard, options)
-            }
+            (None, None) => reduced_step(sys, &mut s, (eig.as_ref(), plan), saddle, guard, options),
         };
         let step = cap_step(sys, &s.part, &s.eval, &s.q, d, options);
         let slope = s.eval.grad_v.dot(&step.d);

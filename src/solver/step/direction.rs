@@ -15,13 +15,13 @@
 //!    direction (sparse, module `kkt_direction`), or `−B ∇f` (module `quasi_newton`).
 
 use crate::solver::inequality::active_set::Guard;
+use crate::solver::minimize::EXACT_NEWTON_DOF;
 use crate::solver::options::{Method, Options};
 use crate::solver::partition::Partition;
 use crate::solver::stability::spectrum::Spectrum;
 use crate::solver::step::escape::escape_step;
 use crate::solver::step::kkt_direction::kkt_direction;
 use crate::solver::step::newton::{newton_step, settling_step};
-use crate::solver::minimize::EXACT_NEWTON_DOF;
 use crate::solver::step::path_cholesky::{self, spectrum_step, Plan};
 use crate::solver::step::path_hessian::path_keeps_rows;
 use crate::solver::system::{Eval, System};
@@ -76,13 +76,20 @@ pub(crate) fn direction(
         along_path,
     };
     if let Some(plan) = plan {
-        return along(path_cholesky::planned_step(sys, (q, part, eval), plan, guard, options));
+        return along(path_cholesky::planned_step(
+            sys,
+            (q, part, eval),
+            plan,
+            guard,
+            options,
+        ));
     }
     if let (Some(band), Some(e)) = (settle, eig.filter(|e| e.exact)) {
         return Direction::plain(settling_step(e, g, band), false);
     }
     let newton = options.method == Method::Newton;
-    let small = path_cholesky::small_tree(sys, newton && part.independent.len() <= EXACT_NEWTON_DOF);
+    let small =
+        path_cholesky::small_tree(sys, newton && part.independent.len() <= EXACT_NEWTON_DOF);
     let path_step = eig
         .filter(|e| e.exact && newton && path_keeps_rows(sys))
         .map(|e| match small {

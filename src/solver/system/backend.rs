@@ -28,8 +28,8 @@ const SPARSE_FROM_COORDINATES: usize = 7 * 40;
 /// steps on both by the exact Newton step along the search path (module
 /// `step::path_hessian`), so the Newton steps are the same up to the partition's choice of
 /// independent coordinates and rounding (on the tree factors, away from stationary points,
-/// by Cholesky where the Hessian along the path is positive definite, module
-/// `step::path_cholesky`).
+/// by Cholesky where the Hessian along the path is positive definite, and far from the rest
+/// Newton on `Ĥ` alone, module `step::path_cholesky`).
 const TREE_FROM_BODIES: usize = 3;
 
 /// The linear algebra of a system.

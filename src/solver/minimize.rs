@@ -10,7 +10,9 @@
 //! 3. **Reduced step** ([`reduced_step`]): Newton `d = −Ĥ⁻¹ ∇f` with the exact reduced Hessian
 //!    along the search path (`Ĥ + C`, module `step::path_hessian`), its eigenvalues replaced by
 //!    their magnitudes, floored (dense, module `step::newton`), near a maximum or saddle at
-//!    least a saddle step along every direction of negative curvature (module `step::escape`),
+//!    least a saddle step along every direction of negative curvature (module `step::escape`;
+//!    on a small tree by Cholesky where `Ĥ + C` is positive definite, far from the rest
+//!    Newton on `Ĥ` alone, module `step::path_cholesky`),
 //!    or the KKT direction (sparse); BFGS / DFP `d = −B ∇f` (module `step::quasi_newton`);
 //!    steepest descent when `d` is not a descent direction (an escape excepted).
 //! 4. **Step cap** (module `step::step_cap`): the tangent step `δq = Z d` limited on the motion of the
@@ -50,6 +52,7 @@ use super::stability::{at_rest::for_minimizer, inertia::ByInertia};
 use super::step::direction::{direction, Direction};
 use super::step::line_search::{line_search, Line, Trial};
 use super::step::newton::Settle;
+use super::step::path_cholesky::{self, Plan};
 use super::step::quasi_newton::QuasiNewton;
 use super::step::retraction::independent_change;
 use super::step::step_cap::{cap_step, Step};
@@ -201,8 +204,8 @@ pub(crate) fn minimize(
         }
         let judging = std::time::Instant::now(); // the verdict at a rest: `timings.stability`
         let mut reused = First::taken(&mut first, (&s.q, &s.part, &s.eval), gtol, &mut s.diag);
-        let (eig, test) = match reused.as_mut() {
-            Some((e, _)) => (e.take(), Test::Continue),
+        let (eig, plan, test) = match reused.as_mut() {
+            Some((e, _)) => (e.take(), None, Test::Continue),
             None => convergence_test(sys, &mut s, gtol, options),
         };
         let saddle = match test {
@@ -228,7 +231,7 @@ pub(crate) fn minimize(
         let (d, kkt, along_path) = match (rolled, reused) {
             (Some(d), _) => (d, false, None),
             (None, Some((_, d))) => (d, false, None),
-            (None, None) => reduced_step(sys, &mut s, eig.as_ref(), saddle, guard, options),
+            (None, None) => reduced_step(sys, &mut s, (eig.as_ref(), plan), saddle, guard, options),
         };
         let step = cap_step(sys, &s.part, &s.eval, &s.q, d, options);
         let slope = s.eval.grad_v.dot(&step.d);
@@ -351,17 +354,26 @@ fn record(s: &mut Search, options: &Options, report: bool) {
     }
 }
 
-/// Stage 2: the convergence test (module docs), with the spectrum where it was needed.
+/// Stage 2: the convergence test (module docs), with the spectrum where it was needed, or on a
+/// small tree away from a stationary point where the valley watch does not look the step's
+/// plan instead: the KKT direction far from the rest, else `Ĥ` formed and not decomposed
+/// (module `step::path_cholesky`).
 fn convergence_test(
     sys: &mut System,
     s: &mut Search,
     gtol: f64,
     options: &Options,
-) -> (Option<Spectrum>, Test) {
+) -> (Option<Spectrum>, Option<Plan>, Test) {
     let gnorm = s.eval.grad_v.amax();
     let dof = s.part.independent.len();
     let dense_newton = options.method == Method::Newton
         && (sys.backend == Backend::Dense || dof <= EXACT_NEWTON_DOF);
+    let small = path_cholesky::small_tree(sys, dense_newton);
+    let watched = s.valley.looks(&s.history);
+    let at = (&s.q, &s.part, &s.eval);
+    if let Some(plan) = path_cholesky::plan(sys, at, small, (gnorm, gtol), watched) {
+        return (None, Some(plan), Test::Continue);
+    }
     // On the Lanczos path the inertia verdict, and the spectrum only to leave a saddle
     // (module `stability::at_rest`).
     let mut verdict = None;
@@ -378,24 +390,28 @@ fn convergence_test(
         })
         .flatten();
     if gnorm > gtol {
-        return (eig, Test::Continue);
+        return (eig, None, Test::Continue);
     }
     let rounding = GRADIENT_FLOOR * s.eval.energy.magnitude;
-    let test = match &eig {
+    let verdict = match &eig {
         Some(e) if !options.allow_unstable => match e.lowest() {
             Some((_, lmin)) if e.unresolved(lmin, gnorm, rounding) => {
                 s.settle.ask(gnorm);
-                Test::Continue
+                return (eig, None, Test::Continue);
             }
             Some((imin, lmin)) if lmin < -e.tolerance() => {
-                Test::Saddle(e.vectors.column(imin).into_owned())
+                let v = e.vectors.column(imin).into_owned();
+                return (eig, None, Test::Saddle(v));
             }
-            _ if s.valley.unsettled(e, &s.eval.grad_v, rounding) => Test::Continue, // valley floor
-            _ => Test::Converged(Some(e.clone()), None),
+            _ if s.valley.unsettled(e, &s.eval.grad_v, rounding) => {
+                return (eig, None, Test::Continue); // valley floor
+            }
+            _ => None,
         },
-        _ => Test::Converged(eig.clone(), verdict),
+        _ => verdict,
     };
-    (eig, test)
+    // Converged: the spectrum moves into the test (the search stops here).
+    (None, None, Test::Converged(eig, verdict))
 }
 
 /// Stage 3: the reduced step `d` (module docs, module `step::direction`); steepest descent
@@ -404,7 +420,7 @@ fn convergence_test(
 fn reduced_step(
     sys: &mut System,
     s: &mut Search,
-    eig: Option<&Spectrum>,
+    (eig, plan): (Option<&Spectrum>, Option<Plan>),
     negative_curvature: Option<DVector<f64>>,
     guard: Option<&Guard>,
     options: &Options,
@@ -420,7 +436,7 @@ fn reduced_step(
     } = direction(
         sys,
         (&s.q, &s.part, &s.eval),
-        eig,
+        (eig, plan),
         negative_curvature.as_ref(),
         settle,
         &s.qn.binv,

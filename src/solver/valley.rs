@@ -125,6 +125,15 @@ pub(crate) struct Watch {
     settling: usize,
 }
 
+/// Whether the last step of the round (`history`, its iterates so far) stalled: its gradient
+/// norm above [`STALL`] times the one before.
+fn stalled(history: &[Iterate]) -> bool {
+    match history {
+        [.., a, b] => b.gradient_norm > STALL * a.gradient_norm,
+        _ => false,
+    }
+}
+
 impl Watch {
     /// The valley of the spectrum `e` of `Ĥ` for this step, else of the spectrum `path` of the
     /// Hessian along the path with its neutral directions set aside ([`Valley::along_path`]),
@@ -136,10 +145,7 @@ impl Watch {
         path: Option<&Spectrum>,
         history: &[Iterate],
     ) -> Option<Valley> {
-        let stalled = match history {
-            [.., a, b] => b.gradient_norm > STALL * a.gradient_norm,
-            _ => false,
-        };
+        let stalled = stalled(history);
         if !(self.on || stalled) {
             return None;
         }
@@ -148,6 +154,12 @@ impl Watch {
             .or_else(|| path.and_then(Valley::along_path));
         self.on |= stalled && valley.is_some();
         valley.filter(|_| self.on)
+    }
+
+    /// Whether [`Watch::step`] reads the spectra at this step (on, or the last step stalled):
+    /// elsewhere they need not be computed for it (module `step::path_cholesky`).
+    pub(crate) fn looks(&self, history: &[Iterate]) -> bool {
+        self.on || stalled(history)
     }
 
     /// Whether a point that passed the gradient test is still far from the lowest point of

@@ -305,7 +305,7 @@ fn pushed_back(
     } = crate::solver::step::direction::direction(
         &mut sys,
         (q, &part, &eval),
-        eig.as_ref(),
+        (eig.as_ref(), None),
         None,
         None,
         &binv,

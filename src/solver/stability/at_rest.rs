@@ -3,7 +3,8 @@
 //! The dense Newton direction uses the whole spectrum of `Ĥ`, and a small spectrum is exact
 //! and cheap (module `spectrum`): those are computed as before (the dense path, and up to
 //! `spectrum::LISTED_UP_TO` degrees of freedom on the sparse and tree paths, where the Newton
-//! step decomposes `Ĥ` anyway). Above, at a stationary point the minimizer only needs to know
+//! step forms `Ĥ` anyway; on a small tree away from a stationary point the minimizer asks
+//! for `Ĥ` formed and not decomposed instead, module `step::path_cholesky`). Above, at a stationary point the minimizer only needs to know
 //! whether the point is a saddle or a maximum it must leave: the inertia of the shifted KKT
 //! matrix answers that (module `inertia`: `#{λ < −t}`, `t = 10⁻¹⁰ max(λ_max, 1)`) with one or
 //! two LDLᵀ factorizations, and the spectrum (exact up to `spectrum::EXACT_UP_TO`, Lanczos

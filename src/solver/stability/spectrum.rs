@@ -30,8 +30,9 @@ pub(crate) const EXACT_UP_TO: usize = 200;
 /// Up to this many degrees of freedom on the sparse and tree paths the stability verdict
 /// comes from the exact spectrum and the report lists the eigenvalues; above, from the
 /// inertia of the shifted KKT matrix unless eigenvalues are asked for ([`listed`]). It is
-/// the minimizer's `EXACT_NEWTON_DOF`: up to there every Newton step decomposes `Ĥ`, so at
-/// the rest the spectrum is at hand; above, the steps are KKT solves and forming `Ĥ` (`dof`
+/// the minimizer's `EXACT_NEWTON_DOF`: up to there every Newton step forms `Ĥ` (and
+/// decomposes it, or on a small tree away from a stationary point solves `Ĥ + C` by Cholesky,
+/// module `step::path_cholesky`), and at the rest the convergence test decomposes it; above, the steps are KKT solves and forming `Ĥ` (`dof`
 /// tangent solves and their transposes, `O(dof · N)`) and decomposing it (`O(dof³)`) would
 /// cost more than the solve (chain 100: about two thirds of it).
 pub(crate) const LISTED_UP_TO: usize = 64;
@@ -131,16 +132,7 @@ pub(crate) fn spectrum_knowing(
     let dof = part.independent.len();
     if exact(sys.backend, dof) {
         let (h, basis) = sys.reduced_hessian_and_basis(q, part, eval);
-        let (values, vectors) = block_symmetric_eigen(&h);
-        let largest = values.amax();
-        return Spectrum {
-            values,
-            vectors,
-            largest,
-            exact: true,
-            negative_by_inertia: None,
-            basis,
-        };
+        return exact_spectrum(&h, basis);
     }
     lanczos(sys, q, part, eval, largest).unwrap_or_else(|| Spectrum {
         // A singular reduced Hessian (the KKT matrix cannot be factored): neutral.
@@ -151,6 +143,21 @@ pub(crate) fn spectrum_knowing(
         negative_by_inertia: None,
         basis: None,
     })
+}
+
+/// The exact spectrum of the reduced Hessian `h`, formed with the null-space basis `basis`
+/// (kept where `System::reduced_hessian_and_basis` kept it).
+pub(crate) fn exact_spectrum(h: &DMatrix<f64>, basis: Option<DMatrix<f64>>) -> Spectrum {
+    let (values, vectors) = block_symmetric_eigen(h);
+    let largest = values.amax();
+    Spectrum {
+        values,
+        vectors,
+        largest,
+        exact: true,
+        negative_by_inertia: None,
+        basis,
+    }
 }
 
 fn lanczos(

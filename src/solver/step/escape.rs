@@ -43,7 +43,28 @@ pub(crate) fn escape_step(
     guard: Option<&Guard>,
     options: &Options,
 ) -> (DVector<f64>, bool, Spectrum) {
-    let path = along_path(sys, q, part, eval, e);
+    escape_along(
+        sys,
+        q,
+        part,
+        eval,
+        along_path(sys, q, part, eval, e),
+        guard,
+        options,
+    )
+}
+
+/// [`escape_step`] with the spectrum `path` of `Ĥ + C` at hand (module `path_cholesky`, where
+/// `Ĥ + C` was summed from `Ĥ` itself): the step, whether it escaped, and `path`.
+pub(crate) fn escape_along(
+    sys: &mut System,
+    q: &DVector<f64>,
+    part: &Partition,
+    eval: &Eval,
+    path: Spectrum,
+    guard: Option<&Guard>,
+    options: &Options,
+) -> (DVector<f64>, bool, Spectrum) {
     let e = &path;
     // Near a stationary point; anywhere after a release decided by the step (module docs).
     let near = if guard.is_some_and(|g| g.falling) {

@@ -8,6 +8,8 @@
 //!   direction of negative curvature.
 //! - `newton`: the dense Newton step from the eigen-decomposition of the Hessian along the
 //!   search path.
+//! - `path_cholesky`: on small trees away from stationary points, the Newton step along the
+//!   path by Cholesky of `Ĥ + C` summed from `Ĥ` formed and not decomposed.
 //! - `path_hessian`: that Hessian, `Ĥ + C`, `C` the search path's curvature times `∇f`;
 //!   `tr_product`: its per-edge products `aᵀ b` over the columns that are not zero.
 //! - `quasi_newton`: the BFGS / DFP inverse-Hessian approximation `B ≈ Ĥ⁻¹`.
@@ -23,6 +25,7 @@ pub(super) mod escape;
 pub(super) mod kkt_direction;
 pub(super) mod line_search;
 pub(super) mod newton;
+pub(super) mod path_cholesky;
 pub(super) mod path_hessian;
 pub(super) mod quasi_newton;
 pub(super) mod retraction;

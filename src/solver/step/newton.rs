@@ -53,7 +53,7 @@ use nalgebra::{DMatrix, DVector};
 /// The dense Newton step's floor on the eigenvalue magnitudes, a fraction of the largest. At
 /// 10⁻⁸ it cut the steps along near-neutral directions (iCub's hip yaws, 1.2·10⁻¹⁰ of the
 /// largest) 80-fold and the solve crawled at the rate `1 − λ/floor`.
-const EIGENVALUE_FLOOR: f64 = 1e-12;
+pub(crate) const EIGENVALUE_FLOOR: f64 = 1e-12;
 
 /// The escape is taken where the magnitude step is shorter than this fraction of the saddle
 /// step `c`: near a stationary point. At 1 (escaping in the middle of falls too, without the

@@ -279,11 +279,27 @@ pub(crate) fn along_path(
     eval: &Eval,
     e: &Spectrum,
 ) -> Spectrum {
+    spectrum_of(&path_matrix(sys, q, part, eval, e))
+}
+
+/// `Ĥ + C` at `q`, `Ĥ` as `V Λ Vᵀ` from its exact spectrum `e`, symmetrized: the matrix
+/// [`along_path`] decomposes.
+pub(crate) fn path_matrix(
+    sys: &System,
+    q: &DVector<f64>,
+    part: &Partition,
+    eval: &Eval,
+    e: &Spectrum,
+) -> DMatrix<f64> {
     let mut h = &e.vectors * DMatrix::from_diagonal(&e.values) * e.vectors.transpose();
     h += path_curvature(sys, q, part, eval, e.basis.as_ref());
-    let h = symmetric_part(h);
+    symmetric_part(h)
+}
+
+/// The exact spectrum of the symmetric `Ĥ + C`.
+pub(crate) fn spectrum_of(h: &DMatrix<f64>) -> Spectrum {
     // Per decoupled block (fingers, legs): each eigenvector on one of them.
-    let (values, vectors) = block_symmetric_eigen(&h);
+    let (values, vectors) = block_symmetric_eigen(h);
     Spectrum {
         largest: values.amax(),
         values,

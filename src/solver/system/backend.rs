@@ -25,9 +25,11 @@ const SPARSE_FROM_COORDINATES: usize = 7 * 40;
 /// from this many bodies on (automatic choice): they cost the same as the dense path at 1 – 2
 /// bodies and less from 3 (chain 3: 0.073 against 0.084 ms; chain 5: 0.13 / 0.18; chain 20:
 /// 1.4 / 3.4; chain 40: 10 / 61; BENCHMARKS.md). Up to 64 degrees of freedom the minimizer
-/// steps on both by the same exact eigen-decomposition of the Hessian along the search path
-/// (module `step::path_hessian`), so the Newton steps are the same up to the partition's
-/// choice of independent coordinates.
+/// steps on both by the exact Newton step along the search path (module
+/// `step::path_hessian`), so the Newton steps are the same up to the partition's choice of
+/// independent coordinates and rounding (on the tree factors, away from stationary points,
+/// by Cholesky where the Hessian along the path is positive definite, and far from the rest
+/// Newton on `Ĥ` alone, module `step::path_cholesky`).
 const TREE_FROM_BODIES: usize = 3;
 
 /// The linear algebra of a system.
@@ -155,6 +157,13 @@ impl Backend {
             Backend::Dense => partition(&jac.to_dense(), &scaling.rows, &scaling.columns),
         }
     }
+}
+
+/// Whether `model` is one of the small trees [`Backend::choose`] gives the tree factors at the
+/// dense size (at most [`SPARSE_FROM_COORDINATES`] coordinates, [`small_tree`]): where the
+/// minimizer may step by Cholesky away from stationary points (module `step::path_cholesky`).
+pub(crate) fn is_small_tree(model: &Model) -> bool {
+    model.coordinate_count() <= SPARSE_FROM_COORDINATES && small_tree(model)
 }
 
 /// Whether `model` is small and takes the tree factors ([`TREE_FROM_BODIES`]): open, at least

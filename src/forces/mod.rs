@@ -64,23 +64,6 @@ pub(crate) fn potential(
     grad: &mut DVector<f64>,
     hess: Option<&mut dyn crate::jet::HessianSink>,
 ) -> Option<Energy> {
-    potential_on(model, [branches, branches], q, grad, hess).map(|(e, _)| e)
-}
-
-/// [`potential`] with `V` and `V_q` on `branches[0]` and `V_qq` on `branches[1]` (the
-/// branches followed to `q` once it is accepted: the Hessian the Newton step from `q` forms,
-/// computed ahead by the same call). Each term's Hessian is the one [`potential`] forms on
-/// `branches[1]`, to the last bit, where the second flag is true: every joint spring on a
-/// revolute angle (the stacked terms) or on branches that agree, its law defined there.
-pub(crate) fn potential_on(
-    model: &Model,
-    branches: [&Branches; 2],
-    q: &DVector<f64>,
-    grad: &mut DVector<f64>,
-    hess: Option<&mut dyn crate::jet::HessianSink>,
-) -> Option<(Energy, bool)> {
-    let [branches, followed] = branches;
-    let mut exact = true;
     let want_h = hess.is_some();
     // `A(p)` of every body once (gravity and the joint angles on each side read each body's),
     // the identity for the ground, as `pair_of` gives it.
@@ -143,16 +126,7 @@ pub(crate) fn potential_on(
         {
             let v = on_branch(theta.v, reference);
             let (u, f, k) = law::evaluate(&js.law, SpringMode::Both, v - js.reference)?;
-            let ahead = followed.get(js.joint, js.dof);
-            let curvature = if ahead.to_bits() == reference.to_bits() {
-                Some((f, k))
-            } else {
-                let vh = on_branch(theta.v, ahead);
-                law::evaluate(&js.law, SpringMode::Both, vh - js.reference).map(|(_, f, k)| (f, k))
-            };
-            exact &= curvature.is_some();
-            let curvature = curvature.unwrap_or((f, k));
-            stacked::scatter_angle_on(&j.bodies, &theta, Some((f, k)), Some(curvature), 1.0, g, h);
+            stacked::scatter_angle(&j.bodies, &theta, Some((f, k)), 1.0, g, h);
             add.value(u, 1.0, &mut e.joint_springs);
             continue;
         }
@@ -164,7 +138,6 @@ pub(crate) fn potential_on(
             add.value(u, 1.0, &mut e.joint_springs);
             continue;
         }
-        exact &= followed.get(js.joint, js.dof).to_bits() == reference.to_bits();
         let theta = joint_coordinate(j, &pair, js.dof, reference)?;
         let (u, f, k) = law::evaluate(&js.law, SpringMode::Both, theta.v - js.reference)?;
         add.term(
@@ -199,7 +172,7 @@ pub(crate) fn potential_on(
     }
     e.total = e.gravity + e.springs + e.joint_springs + e.loads;
     e.magnitude += add.magnitude;
-    Some((e, exact))
+    Some(e)
 }
 
 /// The sums of [`potential`]: `Σ |c V_k|`, the gradient and the Hessian sink.

@@ -263,21 +263,7 @@ pub(crate) fn scatter_angle(
     grad: &mut DVector<f64>,
     hess: &mut dyn HessianSink,
 ) {
-    scatter_angle_on(bodies, theta, law, law, c, grad, hess);
-}
-
-/// [`scatter_angle`] with the gradient's `U'` from `law` and the Hessian's `(U', U'')`
-/// from `curvature` (the same law read on another branch of `θ`: `forces::potential_on`).
-pub(crate) fn scatter_angle_on(
-    bodies: &[Option<BodyId>; 2],
-    theta: &Angle,
-    law: Option<(f64, f64)>,
-    curvature: Option<(f64, f64)>,
-    c: f64,
-    grad: &mut DVector<f64>,
-    hess: &mut dyn HessianSink,
-) {
-    let (Some((du, _)), Some((hdu, ddu))) = (law, curvature) else {
+    let Some((du, ddu)) = law else {
         scatter(bodies, &theta.g, &theta.h, c, grad, hess);
         return;
     };
@@ -289,7 +275,7 @@ pub(crate) fn scatter_angle_on(
     let (hm, th) = (h.as_mut_slice(), theta.h.as_slice());
     for b in 0..8 {
         for a in b..8 {
-            let v = pg[a] * pg[b] * ddu + th[8 * b + a] * hdu;
+            let v = pg[a] * pg[b] * ddu + th[8 * b + a] * du;
             hm[8 * b + a] = v;
             hm[8 * a + b] = v;
         }

@@ -250,8 +250,6 @@ pub(crate) fn minimize(
             slope,
             valley: valley.as_ref(),
             second_order: kkt,
-            // A Newton step from the trial point follows unless it is stationary.
-            ahead: kkt && !predicted_stationary(&s.history, gtol),
         };
         let trial = line_search(sys, &line, alpha, guard, options, &mut s.diag);
         match trial {
@@ -351,18 +349,6 @@ fn record(s: &mut Search, options: &Options, report: bool) {
             progress(s.iteration, s.eval.energy.total, gnorm);
         }
     }
-}
-
-/// Whether Newton's quadratic rate predicts the next iterate stationary: `g_{k+1} ≈ C g_k²`
-/// with `C = g_k / g_{k−1}²` from the last two gradient norms of `history`, at most `gtol`
-/// (false with fewer than two). It decides only whether the trial point's energy Hessian is
-/// formed ahead ([`Line::ahead`]), never the iterates.
-fn predicted_stationary(history: &[Iterate], gtol: f64) -> bool {
-    let [.., before, last] = history else {
-        return false;
-    };
-    let (g, gp) = (last.gradient_norm, before.gradient_norm);
-    gp > 0.0 && g * (g / gp) * (g / gp) <= gtol
 }
 
 /// Stage 2: the convergence test (module docs), with the spectrum where it was needed.
@@ -487,7 +473,7 @@ fn accept_step(
     // A linear descent toward an inequality may end on it.
     let may_be_stopped = guard.is_some_and(|g| g.approaching(sys, &s.q, &t.q));
     s.q = t.q;
-    sys.follow_branches(&s.q);
+    sys.problem.cons.branches.follow(sys.problem.model, &s.q);
     s.eval = t.eval;
     s.iteration += 1;
     s.just_repartitioned = false;

@@ -50,10 +50,6 @@ pub(crate) struct Line<'a> {
     /// Hessian, are in `sys`: trial points get the second-order correction (module
     /// `second_order`).
     pub(crate) second_order: bool,
-    /// The trial point of the full step (`α = 1`) is evaluated with its energy Hessian, for
-    /// the Newton step from it (module `tree::fused`; where it is accepted and not
-    /// stationary).
-    pub(crate) ahead: bool,
 }
 
 /// A point the line search accepted.
@@ -180,12 +176,7 @@ pub(crate) fn line_search(
             alpha *= 0.5;
             continue;
         }
-        let evaluated = if line.ahead && alpha == 1.0 {
-            sys.evaluate_ahead(&qt, part)
-        } else {
-            sys.evaluate(&qt, part)
-        };
-        let Some(et) = evaluated else {
+        let Some(et) = sys.evaluate(&qt, part) else {
             diag.step_halvings += 1;
             alpha *= 0.5;
             continue;

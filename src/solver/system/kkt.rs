@@ -3,11 +3,9 @@
 //! LDLᵀ with a shift `δ` or by LU as a fall-back (module `sparse::kkt`).
 
 use super::kkt_matrix::KktMatrix;
-use super::reduced::refill;
-use super::workspace::Ahead;
 use super::Backend;
 use super::{Eval, System};
-use crate::forces::{potential, potential_on, Energy};
+use crate::forces::potential;
 use crate::solver::partition::Partition;
 use crate::solver::sparse::kkt::{Factored, Kkt};
 use crate::solver::tree::kkt::TreeKkt;
@@ -83,37 +81,30 @@ impl System<'_> {
         let Some(KktMatrix::Tree(mut tree)) = self.work.kkt.take() else {
             return false;
         };
-        let model = self.problem.model;
+        let (model, n) = (self.problem.model, q.len());
+        let mut g = std::mem::take(&mut self.work.grad);
+        if g.len() == n {
+            g.fill(0.0);
+        } else {
+            g = DVector::zeros(n);
+        }
         let mut weights = std::mem::take(&mut self.work.weights);
         weights.fill(0.0);
         weights.resize_vertically_mut(self.problem.cons.len(), 0.0);
         for (k, &row) in part.rows.iter().enumerate() {
             weights[row] = -eval.mu[k];
         }
-        // `V_qq` preloaded at this point's evaluation (module `tree::fused`), or added now.
-        let preloaded =
-            tree.take_preloaded()
-                && self.work.ahead.as_ref().is_some_and(|a| {
-                    same_bits(&a.q, q) && a.followed == self.problem.cons.branches
-                });
-        let mut sink = if preloaded {
-            tree.fused_sink()
-        } else {
-            let mut g = std::mem::take(&mut self.work.grad);
-            refill(&mut g, q.len());
-            let mut sink = tree.fused_begin(&self.work.hess.keys);
-            let _ = potential(
-                model,
-                &self.problem.cons.branches,
-                q,
-                &mut g,
-                Some(&mut sink),
-            );
-            self.work.grad = g;
-            sink
-        };
+        let mut sink = tree.fused_begin(&self.work.hess.keys);
+        let _ = potential(
+            model,
+            &self.problem.cons.branches,
+            q,
+            &mut g,
+            Some(&mut sink),
+        );
         self.problem.cons.add_hessian(model, q, &weights, &mut sink);
         let complete = !sink.missing;
+        self.work.grad = g;
         self.work.weights = weights;
         if complete {
             let columns = &self.problem.scaling.columns;
@@ -129,58 +120,6 @@ impl System<'_> {
         }
         self.work.kkt = Some(KktMatrix::Tree(tree));
         false
-    }
-
-    /// `V` and `∇V` at `q` (`∇V` added into `grad`, zero on entry), and, with `ahead` where
-    /// the tree KKT structure in place fits `part`, `V_qq` into its fused blocks for the
-    /// Newton step from `q` (module `tree::fused`): by the same call of
-    /// `forces::potential_on`, `V` and `∇V` on the joint branches in place and `V_qq` on
-    /// those followed to `q` (as the step will find them once `q` is accepted: kept for
-    /// [`System::follow_branches`]), each the number `forces::potential` gives to the last
-    /// bit. `None` where `V` is undefined.
-    pub(crate) fn energy_ahead(
-        &mut self,
-        q: &DVector<f64>,
-        part: &Partition,
-        grad: &mut DVector<f64>,
-        ahead: bool,
-    ) -> Option<Energy> {
-        let (model, branches) = (self.problem.model, &self.problem.cons.branches);
-        let (triplets, blocks) = (self.work.jac.entries.len(), self.work.hess.keys.len());
-        let tree = match self.work.kkt.as_mut() {
-            Some(KktMatrix::Tree(t)) if ahead && t.fits(part, triplets, blocks) => t,
-            _ => return potential(model, branches, q, grad, None),
-        };
-        let Some(mut sink) = tree.fused_preload() else {
-            return potential(model, branches, q, grad, None);
-        };
-        let mut followed = branches.clone();
-        followed.follow(model, q);
-        let (energy, exact) = potential_on(model, [branches, &followed], q, grad, Some(&mut sink))?;
-        if sink.missing || !exact {
-            tree.unmark_preloaded();
-            self.work.ahead = None;
-        } else {
-            self.work.ahead = Some(Ahead {
-                q: q.clone(),
-                branches: branches.clone(),
-                followed,
-            });
-        }
-        Some(energy)
-    }
-
-    /// Follows the joint branches to the accepted point `q` (`Branches::follow`), taking
-    /// those [`System::energy_ahead`] followed there from the same branches: the same
-    /// numbers.
-    pub(crate) fn follow_branches(&mut self, q: &DVector<f64>) {
-        let branches = &mut self.problem.cons.branches;
-        match &self.work.ahead {
-            Some(a) if same_bits(&a.q, q) && a.branches == *branches => {
-                branches.clone_from(&a.followed);
-            }
-            _ => branches.follow(self.problem.model, q),
-        }
     }
 
     /// Assembles `W` at `q` and the KKT matrix (as [`System::factor_kkt`]) without factoring
@@ -261,12 +200,4 @@ impl System<'_> {
         kkt.solve(&mut rhs, target)
             .then(|| DVector::from_column_slice(&rhs[..n]))
     }
-}
-
-/// Whether `a` and `b` hold the same numbers to the last bit.
-fn same_bits(a: &DVector<f64>, b: &DVector<f64>) -> bool {
-    a.len() == b.len()
-        && a.iter()
-            .zip(b.iter())
-            .all(|(x, y)| x.to_bits() == y.to_bits())
 }

@@ -34,13 +34,6 @@ impl System<'_> {
         self.evaluate_knowing(q, part, None)
     }
 
-    /// [`System::evaluate`], with the energy Hessian `V_qq` formed by the same call as `V`
-    /// and `∇V` for the Newton step from `q` (where the tree KKT structure in place fits:
-    /// [`System::energy_ahead`]); the same numbers.
-    pub(crate) fn evaluate_ahead(&mut self, q: &DVector<f64>, part: &Partition) -> Option<Eval> {
-        self.evaluate_at(q, part, None, true)
-    }
-
     /// [`System::evaluate`] with `V(q)` and `∇V(q)` given where the caller has evaluated them
     /// already (`forces::potential` at `q` on this system's branches: `verify`'s finiteness
     /// guard), instead of evaluating them again: the same numbers.
@@ -50,24 +43,18 @@ impl System<'_> {
         part: &Partition,
         known: Option<(Energy, DVector<f64>)>,
     ) -> Option<Eval> {
-        self.evaluate_at(q, part, known, false)
-    }
-
-    /// [`System::evaluate_knowing`], with `V_qq` formed ahead where `ahead` is set and `V`
-    /// is not `known` ([`System::evaluate_ahead`]).
-    fn evaluate_at(
-        &mut self,
-        q: &DVector<f64>,
-        part: &Partition,
-        known: Option<(Energy, DVector<f64>)>,
-        ahead: bool,
-    ) -> Option<Eval> {
         self.triplets(q);
         let (energy, grad_q) = match known {
             Some(known) => known,
             None => {
                 let mut grad_q = DVector::zeros(q.len());
-                let energy = self.energy_ahead(q, part, &mut grad_q, ahead)?;
+                let energy = potential(
+                    self.problem.model,
+                    &self.problem.cons.branches,
+                    q,
+                    &mut grad_q,
+                    None,
+                )?;
                 (energy, grad_q)
             }
         };
@@ -414,7 +401,7 @@ pub(crate) fn symmetric_part(mut a: DMatrix<f64>) -> DMatrix<f64> {
 }
 
 /// `v` as `len` zeros, in place when it has that length already.
-pub(super) fn refill(v: &mut DVector<f64>, len: usize) {
+fn refill(v: &mut DVector<f64>, len: usize) {
     if v.len() == len {
         v.fill(0.0);
     } else {

@@ -5,7 +5,6 @@
 use super::augment::AugmentPlan;
 use super::kkt_matrix::KktMatrix;
 use crate::constraints::Triplets;
-use crate::kinematics::Branches;
 use crate::solver::sparse::factor::Split;
 use crate::solver::sparse::hessian::BlockHessian;
 use crate::solver::tree::phi_u::TreeSplit;
@@ -42,10 +41,6 @@ pub(crate) struct Workspace {
     pub(crate) weights: DVector<f64>,
     pub(crate) wdiag: Vec<f64>,
     pub(crate) body_max: Vec<f64>,
-    /// The energy Hessian preloaded into the tree KKT matrix's fused blocks at an evaluation
-    /// (module `tree::fused`): its point, the joint branches it was evaluated on and those
-    /// followed to it (the Hessian's).
-    pub(crate) ahead: Option<Ahead>,
 }
 
 impl Workspace {
@@ -67,15 +62,6 @@ impl Workspace {
             weights: DVector::zeros(0),
             wdiag: Vec::new(),
             body_max: Vec::new(),
-            ahead: None,
         }
     }
-}
-
-/// The point of an energy Hessian formed ahead (`Workspace::ahead`), the joint branches its
-/// evaluation read and the branches followed to the point.
-pub(crate) struct Ahead {
-    pub(crate) q: DVector<f64>,
-    pub(crate) branches: Branches,
-    pub(crate) followed: Branches,
 }

@@ -17,12 +17,6 @@
 //! instructions saved). A term on a body pair that the structure does not hold (`missing`)
 //! leaves the values incomplete: the caller assembles by the general path instead, which
 //! rebuilds the structure.
-//!
-//! The energy's part `V_qq` may be added ahead, at the evaluation of the point (the line
-//! search's trial point that the next Newton step starts from), by the same call that gives
-//! `V` and `∇V` there ([`TreeKkt::fused_preload`]): the same terms at the same point in the
-//! same order from `+0`, so the step adds only `−Σ_k μ_k Φ_k,qq` and the augmentation to
-//! them, and the values are the same to the last bit.
 
 use super::kkt::TreeKkt;
 use super::shape::SKIP;
@@ -194,29 +188,7 @@ impl TreeKkt {
             self.map = Some(map);
         }
         self.w_blocks.iter_mut().for_each(|b| *b = [0.0; 49]);
-        self.preloaded = false;
         self.fused_sink()
-    }
-
-    /// Starts a fused assembly ahead, for the energy's terms alone (module docs): the compact
-    /// blocks zeroed and marked preloaded, and their sink; `None` before this structure's
-    /// first fused assembly (no map yet). The caller unmarks them if a term is `missing`.
-    pub(crate) fn fused_preload(&mut self) -> Option<FusedSink<'_>> {
-        self.map.as_ref()?;
-        self.w_blocks.iter_mut().for_each(|b| *b = [0.0; 49]);
-        self.preloaded = true;
-        Some(self.fused_sink())
-    }
-
-    /// Whether the blocks hold a preloaded energy Hessian ([`TreeKkt::fused_preload`]); the
-    /// mark is taken, as the terms added next change the blocks.
-    pub(crate) fn take_preloaded(&mut self) -> bool {
-        std::mem::take(&mut self.preloaded)
-    }
-
-    /// Drops the mark of [`TreeKkt::fused_preload`] (a term did not fit the blocks).
-    pub(crate) fn unmark_preloaded(&mut self) {
-        self.preloaded = false;
     }
 
     /// The sink of a fused assembly in progress (more terms: the augmentation); before

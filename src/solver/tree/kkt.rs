@@ -42,9 +42,6 @@ pub(crate) struct TreeKkt {
     pub(super) map: Option<BlockMap>,
     /// The fused assembly's `7 × 7` blocks of `W` (unscaled; the kept blocks of `map`).
     pub(super) w_blocks: Vec<[f64; 49]>,
-    /// `w_blocks` hold an energy Hessian `V_qq` alone, added at an evaluation ahead of the
-    /// assembly (module `fused`, [`TreeKkt::fused_preload`]).
-    pub(super) preloaded: bool,
     id: usize,
     triplets: usize,
     blocks: usize,
@@ -94,7 +91,6 @@ impl TreeKkt {
         Some(TreeKkt {
             map: None,
             w_blocks: Vec::new(),
-            preloaded: false,
             id: part.id,
             triplets: entries.len(),
             blocks: hess.keys.len(),

@@ -34,8 +34,7 @@ use crate::solver::stability::spectrum::Spectrum;
 use crate::solver::step::retraction::angular_velocity;
 use crate::solver::step::tr_product::add_tr_product;
 use crate::solver::system::{symmetric_part, Eval, System};
-use nalgebra::{DMatrix, DVector, Matrix3, Vector3, Vector4};
-use std::collections::BTreeMap;
+use nalgebra::{DMatrix, DVector, Matrix3, MatrixView3xX, Vector3, Vector4};
 
 /// The per-edge sums `(G_l, M_l, s_l, R_l)` of [`path_curvature`].
 type EdgeSums = (Vector3<f64>, Matrix3<f64>, f64, Vector4<f64>);
@@ -81,9 +80,9 @@ fn curvature_of(
     let parents = sys.problem.retraction.parents();
     let bodies = parents.len();
     // Each edge's relative twist (ω_l, w_l at the child's origin) per unit step along e_i:
-    // column i of `omega[l]` and `vel[l]`.
-    let mut omega = vec![nalgebra::Matrix3xX::<f64>::zeros(dof); bodies];
-    let mut vel = vec![nalgebra::Matrix3xX::<f64>::zeros(dof); bodies];
+    // column `l dof + i` of `omega` and `vel` (edge `l`'s block of `dof` columns, `edge`).
+    let mut omega = nalgebra::Matrix3xX::<f64>::zeros(dof * bodies);
+    let mut vel = nalgebra::Matrix3xX::<f64>::zeros(dof * bodies);
     let solved;
     let z = match basis {
         Some(z) => z,
@@ -114,18 +113,20 @@ fn curvature_of(
                 continue;
             }
             let (w, v) = twist_of(q, &dq, &spin, b, parents[b]);
-            omega[b].set_column(i, &w);
-            vel[b].set_column(i, &v);
+            omega.set_column(dof * b + i, &w);
+            vel.set_column(dof * b + i, &v);
         }
     }
     // The gradient's weight on each coordinate of the bodies with independent coordinates.
-    let mut weights: BTreeMap<usize, [f64; 7]> = BTreeMap::new();
+    // Per body, in the order of the bodies (as the sums below are taken).
+    let mut weights: Vec<Option<[f64; 7]>> = vec![None; bodies];
     for (k, &c) in part.independent.iter().enumerate() {
-        weights.entry(c / 7).or_insert([0.0; 7])[c % 7] += eval.grad_v[k] / columns[c];
+        weights[c / 7].get_or_insert([0.0; 7])[c % 7] += eval.grad_v[k] / columns[c];
     }
     // Per edge l: (G_l, M_l, s_l, R_l) over the weighted bodies below it (module docs).
-    let mut sums: BTreeMap<usize, EdgeSums> = BTreeMap::new();
-    for (&b, w) in &weights {
+    let mut sums: Vec<Option<EdgeSums>> = vec![None; bodies];
+    for (b, w) in weights.iter().enumerate() {
+        let Some(w) = w else { continue };
         let y = position(q, b);
         let p = Vector4::new(q[7 * b + 3], q[7 * b + 4], q[7 * b + 5], q[7 * b + 6]);
         // wᵀ(P ⊗ p) = P · ρ.
@@ -139,12 +140,8 @@ fn curvature_of(
         let mut l = Some(b);
         while let Some(at) = l {
             let r = y - position(q, at);
-            let e = sums.entry(at).or_insert((
-                Vector3::zeros(),
-                Matrix3::zeros(),
-                0.0,
-                Vector4::zeros(),
-            ));
+            let e =
+                sums[at].get_or_insert((Vector3::zeros(), Matrix3::zeros(), 0.0, Vector4::zeros()));
             e.0 += wy;
             e.1 += wy * r.transpose();
             e.2 += wy.dot(&r);
@@ -152,57 +149,96 @@ fn curvature_of(
             l = parents[at];
         }
     }
-    // a_i = ω_i + 2 Σ_{k above l} ω_k, the sum taken from the root down.
-    let mut above: Vec<Option<nalgebra::Matrix3xX<f64>>> = vec![None; bodies];
+    // a_i = ω_i + 2 Σ_{k above l} ω_k, the sum taken from the root down. The buffers are
+    // the call's, reused from edge to edge: `above` (edge `k`'s block: `Σ ω` over `k` and
+    // the edges above it, once `summed[k]`), `a`, `kt` and the second product `kv`.
+    let mut above = nalgebra::Matrix3xX::<f64>::zeros(dof * bodies);
+    let mut summed = vec![false; bodies];
+    let mut chain = Vec::new();
+    let mut a = nalgebra::Matrix3xX::<f64>::zeros(dof);
+    let mut kt = nalgebra::Matrix3xX::<f64>::zeros(dof);
+    let mut kv = nalgebra::Matrix3xX::<f64>::zeros(dof);
     let mut m = DMatrix::zeros(dof, dof);
-    for (&l, (g, mm, s, r)) in &sums {
-        let before = sum_above(l, &parents, &omega, &mut above, dof);
-        let a = &omega[l] + 2.0 * &before;
+    for (l, sum) in sums.iter().enumerate() {
+        let Some((g, mm, s, r)) = sum else { continue };
+        let before = sum_above(l, &parents, &omega, &mut above, &mut summed, &mut chain);
+        let span = 3 * dof * l..3 * dof * (l + 1);
+        let (a_s, omega_l) = (a.as_mut_slice(), &omega.as_slice()[span]);
+        match before {
+            Some(k) => {
+                let before = &above.as_slice()[3 * dof * k..3 * dof * (k + 1)];
+                for ((a, &w), &b) in a_s.iter_mut().zip(omega_l).zip(before) {
+                    *a = w + 2.0 * b;
+                }
+            }
+            // Nothing above: `ω + 2 · 0`, which turns a `−0` of `ω` into `+0` like any zero sum.
+            None => a_s
+                .iter_mut()
+                .zip(omega_l)
+                .for_each(|(a, &w)| *a = w + 2.0 * 0.0),
+        }
         let rv = Vector3::new(r[1], r[2], r[3]);
         let k_omega =
             mm.transpose() - Matrix3::identity() * (s + 0.25 * r[0]) - 0.25 * rv.cross_matrix();
         let k_vel = -g.cross_matrix();
-        let kt = k_omega * &omega[l] + k_vel * &vel[l];
+        // `K_ω ω_l + K_v w_l`: nalgebra's products (`gemm` with β = 0 is `*`), then the sum.
+        kt.gemm(1.0, &k_omega, &edge(&omega, l, dof), 0.0);
+        kv.gemm(1.0, &k_vel, &edge(&vel, l, dof), 0.0);
+        kt += &kv;
         add_tr_product(&mut m, &a, &kt);
     }
     symmetric_part(m)
 }
 
-/// `Σ ω_k` over the edges `k` above `l` (nearer the root), summed from the root down and kept
-/// per body in `memo`.
+/// Edge `l`'s block of `dof` columns in `per_edge` (`3 × dof · bodies`).
+fn edge(per_edge: &nalgebra::Matrix3xX<f64>, l: usize, dof: usize) -> MatrixView3xX<'_, f64> {
+    per_edge.columns(dof * l, dof)
+}
+
+/// The edge whose block of `memo` holds `Σ ω_k` over the edges `k` above `l` (nearer the
+/// root; `None` where there are none, the sum zero): `l`'s parent edge. The running sums are
+/// taken from the root down, `memo`'s block of `k` set to its parent's plus `ω_k` (to zero
+/// plus `ω_k` at the root) and `summed[k]` raised; `chain` is scratch.
 fn sum_above(
     l: usize,
     parents: &[Option<usize>],
-    omega: &[nalgebra::Matrix3xX<f64>],
-    memo: &mut [Option<nalgebra::Matrix3xX<f64>>],
-    dof: usize,
-) -> nalgebra::Matrix3xX<f64> {
-    let Some(a) = parents[l] else {
-        return nalgebra::Matrix3xX::zeros(dof);
-    };
-    if let Some(s) = &memo[a] {
-        return s.clone();
+    omega: &nalgebra::Matrix3xX<f64>,
+    memo: &mut nalgebra::Matrix3xX<f64>,
+    summed: &mut [bool],
+    chain: &mut Vec<usize>,
+) -> Option<usize> {
+    let a = parents[l]?;
+    if summed[a] {
+        return Some(a);
     }
+    let dof = omega.ncols() / parents.len();
     // The chain above `l`, root first, then the running sums down to `a`.
-    let mut chain = vec![a];
+    chain.clear();
+    chain.push(a);
     while let Some(p) = parents[*chain.last().unwrap_or(&a)] {
-        if memo[p].is_some() {
+        if summed[p] {
             break;
         }
         chain.push(p);
     }
     let top = *chain.last().unwrap_or(&a);
-    let mut run = match parents[top] {
-        Some(p) => memo[p]
-            .clone()
-            .unwrap_or_else(|| nalgebra::Matrix3xX::zeros(dof)),
-        None => nalgebra::Matrix3xX::zeros(dof),
-    };
+    let mut from = parents[top].filter(|&p| summed[p]);
     for &k in chain.iter().rev() {
-        run += &omega[k];
-        memo[k] = Some(run.clone());
+        let (o, m) = (omega.as_slice(), memo.as_mut_slice());
+        let span = 3 * dof * k..3 * dof * (k + 1);
+        match from {
+            Some(p) => {
+                let start = 3 * dof * p;
+                for (i, c) in span.enumerate() {
+                    m[c] = m[start + i] + o[c];
+                }
+            }
+            None => span.for_each(|c| m[c] = 0.0 + o[c]),
+        }
+        summed[k] = true;
+        from = Some(k);
     }
-    run
+    Some(a)
 }
 
 /// The relative twist of body `b`'s tree edge for the tangent `dq` (module `retraction`):
@@ -311,182 +347,5 @@ pub(crate) fn spectrum_of(h: &DMatrix<f64>) -> Spectrum {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::constraints::Constraints;
-    use crate::solver::system::Backend;
-    use crate::state::State;
-    use crate::urdf::{load_str, ImportOptions};
-
-    use crate::solver::step::retraction::tests::ARM;
-
-    /// `C` with the twists of unmoved edges left at zero equals `C` with every twist
-    /// computed, bit for bit, on a chain (the tree path: `Z`'s blocks above each joint zero)
-    /// and on the branched arm, fixed and floating.
-    #[test]
-    fn still_edges_skipped_change_no_bit() {
-        let chain = crate::generate::chain(12, false);
-        let cases = [
-            (chain.as_str(), Backend::Tree, false),
-            (ARM, Backend::Dense, false),
-            (ARM, Backend::Tree, true),
-        ];
-        for (text, backend, floating) in cases {
-            let options = ImportOptions {
-                floating_base: floating,
-                ..ImportOptions::default()
-            };
-            let model = load_str(text, "m.urdf", &options).unwrap().model;
-            let values: crate::state::JointValues = if text == ARM {
-                [("pan", 0.4), ("slide", 0.1), ("roll", -0.7), ("lift", 1.1)]
-                    .iter()
-                    .map(|(n, v)| (n.to_string(), vec![*v]))
-                    .collect()
-            } else {
-                (0..12)
-                    .map(|i| (format!("joint{i}"), vec![0.3 * (i as f64).sin()]))
-                    .collect()
-            };
-            let q = State::from_joint_values(&model, &values).q;
-            let sys = &mut System::new(&model, Constraints::new(&model, &[]), backend);
-            let part = sys.partition(&q);
-            let eval = sys.evaluate(&q, &part).unwrap();
-            let z = sys.null_basis(&part, &eval);
-            let still = z
-                .as_slice()
-                .chunks_exact(7)
-                .filter(|blk| blk.iter().all(|&v| v == 0.0))
-                .count();
-            if matches!(backend, Backend::Tree) && !floating {
-                assert!(still > 0, "the chain's columns leave bodies still");
-            }
-            let fast = curvature_of(sys, &q, &part, &eval, Some(&z), true);
-            let full = curvature_of(sys, &q, &part, &eval, Some(&z), false);
-            assert!(fast.amax() > 0.0);
-            for (x, y) in fast.iter().zip(full.iter()) {
-                assert_eq!(x.to_bits(), y.to_bits(), "{backend:?}: {x:e} against {y:e}");
-            }
-        }
-    }
-
-    /// `C` equals the central second differences of `∇fᵀ v̂` along the search path, on a
-    /// fixed and a floating base, away from equilibrium.
-    #[test]
-    fn path_curvature_is_the_second_derivative_along_the_path() {
-        for floating in [false, true] {
-            let options = ImportOptions {
-                floating_base: floating,
-                ..ImportOptions::default()
-            };
-            let model = load_str(ARM, "arm.urdf", &options).unwrap().model;
-            let values = [("pan", 0.4), ("slide", 0.1), ("roll", -0.7), ("lift", 1.1)]
-                .iter()
-                .map(|(n, v)| (n.to_string(), vec![*v]))
-                .collect();
-            let q = State::from_joint_values(&model, &values).q;
-            let sys = &mut System::new(&model, Constraints::new(&model, &[]), Backend::Dense);
-            let part = sys.partition(&q);
-            let eval = sys.evaluate(&q, &part).unwrap();
-            assert!(eval.grad_v.amax() > 0.1, "away from equilibrium");
-            let c = path_curvature(sys, &q, &part, &eval, None);
-            let dof = part.independent.len();
-            let columns = &sys.problem.scaling.columns;
-            let h = 1e-4;
-            let second = |d: &DVector<f64>| -> f64 {
-                let dq = sys.tangent_step(&part, &eval, d);
-                let plus = sys.problem.retraction.point(&q, &dq, h);
-                let minus = sys.problem.retraction.point(&q, &dq, -h);
-                part.independent
-                    .iter()
-                    .enumerate()
-                    .map(|(k, &i)| eval.grad_v[k] * (plus[i] + minus[i] - 2.0 * q[i]) / columns[i])
-                    .sum::<f64>()
-                    / (h * h)
-            };
-            for trial in 0..4 {
-                let d = DVector::from_fn(dof, |i, _| ((1 + i + 3 * trial) as f64).sin());
-                let fd = second(&d);
-                let exact = d.dot(&(&c * &d));
-                assert!(
-                    (fd - exact).abs() < 1e-5 * (1.0 + exact.abs()),
-                    "floating {floating}, trial {trial}: {exact} against {fd}"
-                );
-            }
-            assert!(c.amax() > 1e-3, "the path is curved in v̂");
-        }
-    }
-
-    /// The per-edge sums give the direct sum over bodies and edges of the module docs
-    /// (`C_ij = Σ_b Σ_l wy_b·(a_i × ξ_j(y_b)) + ¼ (a_i ⊗ ω_j)·ρ_b`, written out here) to
-    /// rounding, on a branched tree on the dense and the tree path.
-    #[test]
-    fn per_edge_sums_equal_the_direct_sum() {
-        let model = load_str(ARM, "arm.urdf", &ImportOptions::default())
-            .unwrap()
-            .model;
-        let values = [("pan", 0.4), ("slide", 0.1), ("roll", -0.7), ("lift", 1.1)]
-            .iter()
-            .map(|(n, v)| (n.to_string(), vec![*v]))
-            .collect();
-        let q = State::from_joint_values(&model, &values).q;
-        for backend in [Backend::Dense, Backend::Tree] {
-            let sys = &mut System::new(&model, Constraints::new(&model, &[]), backend);
-            let part = sys.partition(&q);
-            let eval = sys.evaluate(&q, &part).unwrap();
-            let c = path_curvature(sys, &q, &part, &eval, None);
-            let dof = part.independent.len();
-            let columns = &sys.problem.scaling.columns;
-            let parents = sys.problem.retraction.parents();
-            let twists: Vec<Vec<(Vector3<f64>, Vector3<f64>)>> = (0..dof)
-                .map(|i| {
-                    let mut e = DVector::zeros(dof);
-                    e[i] = 1.0;
-                    let dq = sys.tangent_step(&part, &eval, &e);
-                    (0..parents.len())
-                        .map(|b| relative_twist(&q, &dq, b, parents[b]))
-                        .collect()
-                })
-                .collect();
-            let mut direct = DMatrix::<f64>::zeros(dof, dof);
-            for (k, &col) in part.independent.iter().enumerate() {
-                let b = col / 7;
-                let mut w = [0.0; 7];
-                w[col % 7] = eval.grad_v[k] / columns[col];
-                let y = position(&q, b);
-                let p = Vector4::new(q[7 * b + 3], q[7 * b + 4], q[7 * b + 5], q[7 * b + 6]);
-                let wy = Vector3::new(w[0], w[1], w[2]);
-                let wp = Vector4::new(w[3], w[4], w[5], w[6]);
-                let mut chain = vec![b];
-                while let Some(a) = parents[*chain.last().unwrap_or(&b)] {
-                    chain.push(a);
-                }
-                let mut before = vec![Vector3::<f64>::zeros(); dof];
-                for &l in chain.iter().rev() {
-                    let xl = position(&q, l);
-                    for i in 0..dof {
-                        let a = twists[i][l].0 + 2.0 * before[i];
-                        for j in 0..dof {
-                            let (omega, vl) = twists[j][l];
-                            let xi = omega.cross(&(y - xl)) + vl;
-                            let ao = a.cross(&omega);
-                            let pq = Vector4::new(-a.dot(&omega), ao.x, ao.y, ao.z);
-                            // wᵀ ¼ (pq ⊗ p), the second derivative of p written out.
-                            direct[(i, j)] +=
-                                wy.dot(&a.cross(&xi)) + 0.25 * wp.dot(&compose(&pq, &p));
-                        }
-                    }
-                    for (i, bi) in before.iter_mut().enumerate() {
-                        *bi += twists[i][l].0;
-                    }
-                }
-            }
-            let direct = (&direct + direct.transpose()) * 0.5;
-            let scale = direct.amax();
-            assert!(scale > 1e-3);
-            assert!(
-                (&c - &direct).amax() <= 1e-12 * scale,
-                "{backend:?}: {c} against {direct}"
-            );
-        }
-    }
-}
+#[path = "path_hessian_tests.rs"]
+mod tests;

@@ -356,8 +356,7 @@ fn record(s: &mut Search, options: &Options, report: bool) {
 
 /// Stage 2: the convergence test (module docs), with the spectrum where it was needed, or on a
 /// small tree away from a stationary point where the valley watch does not look the step's
-/// plan instead: the KKT direction far from the rest, else `Ĥ` formed and not decomposed
-/// (module `step::path_cholesky`).
+/// plan instead: `Ĥ` formed, not decomposed (module `step::path_cholesky`).
 fn convergence_test(
     sys: &mut System,
     s: &mut Search,

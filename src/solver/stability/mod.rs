@@ -24,5 +24,6 @@ pub(crate) mod inertia;
 pub(crate) mod joint_space;
 pub(crate) mod largest;
 pub(crate) mod leave;
+pub(crate) mod product;
 pub(crate) mod spectrum;
 pub(crate) mod verdict;

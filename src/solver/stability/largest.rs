@@ -27,7 +27,6 @@
 //!   §12.4 (Kaniel–Paige convergence of the extreme Ritz values).
 
 use super::eigen::symmetric_eigen;
-use super::product::ReducedProduct;
 use crate::solver::partition::Partition;
 use crate::solver::system::{Eval, System};
 use nalgebra::{DMatrix, DVector};
@@ -40,23 +39,19 @@ const RESOLVED: f64 = 0.1;
 /// `λ̃`, the estimate of `|λ|max` of `Ĥ` at the point of `eval` with the `W` of the last block
 /// assembly (module doc): at most [`STEPS`] products `Ĥ x`, fewer once resolved.
 pub(crate) fn largest_eigenvalue(sys: &System, part: &Partition, eval: &Eval) -> f64 {
-    let mut product = ReducedProduct::new(sys, part, eval);
-    largest_magnitude(part.independent.len(), |x| product.apply(x))
+    largest_magnitude(part.independent.len(), |x| sys.reduced_apply(part, eval, x))
 }
 
 /// `λ̃` of the symmetric operator `apply` on `dof` coordinates (module doc). A non-finite
 /// product gives a non-finite `λ̃` (the caller has no tolerance then).
-pub(crate) fn largest_magnitude(
-    dof: usize,
-    apply: impl FnMut(&DVector<f64>) -> DVector<f64>,
-) -> f64 {
+pub(crate) fn largest_magnitude(dof: usize, apply: impl Fn(&DVector<f64>) -> DVector<f64>) -> f64 {
     lanczos_largest(dof, apply, STEPS, RESOLVED)
 }
 
 /// [`largest_magnitude`] with at most `steps` products, stopping at `r ≤ resolved |θ|`.
 fn lanczos_largest(
     dof: usize,
-    mut apply: impl FnMut(&DVector<f64>) -> DVector<f64>,
+    apply: impl Fn(&DVector<f64>) -> DVector<f64>,
     steps: usize,
     resolved: f64,
 ) -> f64 {

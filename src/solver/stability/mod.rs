@@ -24,6 +24,5 @@ pub(crate) mod inertia;
 pub(crate) mod joint_space;
 pub(crate) mod largest;
 pub(crate) mod leave;
-pub(crate) mod product;
 pub(crate) mod spectrum;
 pub(crate) mod verdict;

@@ -172,14 +172,8 @@ pub(super) fn import(
             .insert(name.to_string(), (link, f * src.frame(Some(n))?));
     }
 
-    // The joint graph, URDF and Drake joints first. Sized for every edge element (the
-    // `mech:loop_joint`s and Drake's too: no regrowth copy of the edges read before them).
-    let mech_loops = ext
-        .iter()
-        .filter(|n| n.tag_name().name() == "loop_joint")
-        .count();
-    let mut edges: Vec<Edge> =
-        Vec::with_capacity(joint_nodes.len() + loop_nodes.len() + mech_loops + drake_nodes.len());
+    // The joint graph, URDF and Drake joints first.
+    let mut edges: Vec<Edge> = Vec::with_capacity(joint_nodes.len() + loop_nodes.len());
     for &n in &joint_nodes {
         edges.push(edges::urdf_joint(&src, n, &frames, &mut warnings)?);
     }

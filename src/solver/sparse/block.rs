@@ -165,12 +165,6 @@ impl Block {
             }
             let r = self.rows[i];
             if changed.slot[r] == u32::MAX {
-                if changed.copies.len() == changed.copies.capacity() {
-                    // A row has one copy at most: room for all at the first (untouched room
-                    // costs no page; no regrowth copies of the copies kept).
-                    let rows_left = changed.slot.len() - changed.copies.len();
-                    changed.copies.reserve_exact(rows_left);
-                }
                 changed.slot[r] = changed.copies.len() as u32;
                 changed.copies.push((Vec::new(), Vec::new(), 0.0));
             }

@@ -137,6 +137,7 @@ pub(super) fn held(
                 backend,
                 None,
                 given,
+                true,
             )?;
             return Ok(Held {
                 efforts: row_of.iter().map(|&k| r.locks[k]).collect(),
@@ -158,6 +159,7 @@ pub(super) fn held(
                 backend,
                 None,
                 None,
+                false,
             )
         })?,
     };
@@ -175,6 +177,7 @@ pub(super) fn held(
                 backend,
                 None,
                 None,
+                false,
             )
         })?;
         // Too many dependent rows to choose among (a rope on the ground with its joints
@@ -200,6 +203,7 @@ pub(super) fn held(
                 backend,
                 Some(&carried),
                 given,
+                false,
             )?;
             (efforts, free.1)
         }
@@ -301,7 +305,11 @@ pub(super) fn free_of(sys: &System, part: &Partition, eval: &Eval) -> Multiplier
 }
 
 /// The multipliers of the model's rows, the locks `all` (the first `model_locks` the model's
-/// own) and the inequalities of `list` with `on`, made unique as the module docs say.
+/// own) and the inequalities of `list` with `on`, made unique as the module docs say; with
+/// `by_bodies` (`analyze`'s self-check, whose verdict reads them against a tolerance) and the
+/// tree factors on the partition by bodies where the system is a locked tree (module
+/// `tree_partition`: the general partition's rows and columns per body, the multipliers to
+/// rounding).
 fn solve_once(
     model: &Model,
     state: &State,
@@ -312,6 +320,7 @@ fn solve_once(
     backend: Backend,
     carried: Option<&DVector<f64>>,
     given: Option<ModelRows>,
+    by_bodies: bool,
 ) -> Result<Multipliers> {
     let kept: Vec<usize> = (0..list.len()).filter(|&i| on[i]).collect();
     let active: Vec<_> = kept.iter().map(|&i| list[i].active).collect();
@@ -348,10 +357,28 @@ fn solve_once(
     // The model's rows from the balance check where they are this system's first ones, and
     // with them the guard's `V` and `∇V` (the same pose and branches).
     let known = given.and_then(|rows| rows.install(&mut sys, &state.q));
-    let part = sys.partition(&state.q);
-    let mut eval = sys
-        .evaluate_knowing(&state.q, &part, known)
-        .ok_or_else(|| singular(part.rows.len()))?;
+    // By bodies where that applies and its blocks factor; otherwise (and then) the general
+    // partition.
+    let by_bodies = if by_bodies && backend == Backend::Tree {
+        sys.triplets(&state.q);
+        super::tree_partition::partition(model, m, state.q.len(), &sys.work.jac.entries)
+    } else {
+        None
+    };
+    let tree = by_bodies.and_then(|part| {
+        let eval = sys.evaluate_knowing(&state.q, &part, known.clone())?;
+        Some((part, eval))
+    });
+    let (part, mut eval) = match tree {
+        Some(solved) => solved,
+        None => {
+            let part = sys.partition(&state.q);
+            let eval = sys
+                .evaluate_knowing(&state.q, &part, known)
+                .ok_or_else(|| singular(part.rows.len()))?;
+            (part, eval)
+        }
+    };
     if let Some(c) = carried {
         // The multipliers and the reduced gradient are linear in ∇V: with `c` taken off it,
         // `Φ_uᵀ δμ = −c_u` and `δ(∂V/∂v) = S (−c_v − Φ_vᵀ δμ)` (one more solve).

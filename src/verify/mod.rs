@@ -41,6 +41,7 @@ mod pose;
 #[cfg(test)]
 mod rank_tests;
 mod reduced;
+mod tree_partition;
 mod run;
 mod unilateral;
 

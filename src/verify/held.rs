@@ -12,7 +12,8 @@
 //! `a` and the forces `λ` alone; what they cannot balance is the `unassigned` force. The
 //! unknowns are found as the multipliers of one system: the model's rows, a lock row
 //! `θ_k(q) − θ_k = 0` on every joint coordinate and the touching rows, partitioned (dense or
-//! sparse: the same partition the solver uses) so that it keeps every model row it can (lock
+//! sparse: the same partition the solver uses; `analyze`'s self-check on a locked tree: by
+//! bodies, module `tree_partition`) so that it keeps every model row it can (lock
 //! and touching rows scaled down by [`PREFERENCE`] in the pivot choice). `Φ_uᵀ μ = ∇_u V` gives
 //! the basic multipliers `μ_b`; the reduced gradient that remains is the unassigned force.
 //!
@@ -306,10 +307,8 @@ pub(super) fn free_of(sys: &System, part: &Partition, eval: &Eval) -> Multiplier
 
 /// The multipliers of the model's rows, the locks `all` (the first `model_locks` the model's
 /// own) and the inequalities of `list` with `on`, made unique as the module docs say; with
-/// `by_bodies` (`analyze`'s self-check, whose verdict reads them against a tolerance) and the
-/// tree factors on the partition by bodies where the system is a locked tree (module
-/// `tree_partition`: the general partition's rows and columns per body, the multipliers to
-/// rounding).
+/// `by_bodies` and the tree factors, partitioned by bodies where that applies (module
+/// `tree_partition`: `analyze`'s self-check, the multipliers to rounding).
 fn solve_once(
     model: &Model,
     state: &State,
@@ -357,28 +356,9 @@ fn solve_once(
     // The model's rows from the balance check where they are this system's first ones, and
     // with them the guard's `V` and `∇V` (the same pose and branches).
     let known = given.and_then(|rows| rows.install(&mut sys, &state.q));
-    // By bodies where that applies and its blocks factor; otherwise (and then) the general
-    // partition.
-    let by_bodies = if by_bodies && backend == Backend::Tree {
-        sys.triplets(&state.q);
-        super::tree_partition::partition(model, m, state.q.len(), &sys.work.jac.entries)
-    } else {
-        None
-    };
-    let tree = by_bodies.and_then(|part| {
-        let eval = sys.evaluate_knowing(&state.q, &part, known.clone())?;
-        Some((part, eval))
-    });
-    let (part, mut eval) = match tree {
-        Some(solved) => solved,
-        None => {
-            let part = sys.partition(&state.q);
-            let eval = sys
-                .evaluate_knowing(&state.q, &part, known)
-                .ok_or_else(|| singular(part.rows.len()))?;
-            (part, eval)
-        }
-    };
+    let by_bodies = by_bodies && backend == Backend::Tree;
+    let (part, mut eval) =
+        super::tree_partition::evaluated(&mut sys, &state.q, known, by_bodies).map_err(singular)?;
     if let Some(c) = carried {
         // The multipliers and the reduced gradient are linear in ∇V: with `c` taken off it,
         // `Φ_uᵀ δμ = −c_u` and `δ(∂V/∂v) = S (−c_v − Φ_vᵀ δμ)` (one more solve).

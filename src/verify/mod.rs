@@ -41,8 +41,8 @@ mod pose;
 #[cfg(test)]
 mod rank_tests;
 mod reduced;
-mod tree_partition;
 mod run;
+mod tree_partition;
 mod unilateral;
 
 use closure::closures;

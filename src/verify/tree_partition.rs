@@ -24,8 +24,11 @@
 //! where a block is singular (the caller's evaluation fails and it partitions again).
 
 use crate::constraints::Triplet;
+use crate::forces::Energy;
 use crate::model::Model;
 use crate::solver::partition::{next_id, Partition};
+use crate::solver::system::{Eval, System};
+use nalgebra::DVector;
 
 /// The locked system's partition by bodies (module docs) for the `m` rows with Jacobian
 /// triplets `entries` on the `n` coordinates of `model`, or `None` where some body is not home
@@ -36,8 +39,10 @@ pub(super) fn partition(
     n: usize,
     entries: &[Triplet],
 ) -> Option<Partition> {
+    // Seven rows a body: as many rows as coordinates (the ladder's loop rows, a floating
+    // base's missing joint rows fail this before any work).
     let nb = model.bodies.len();
-    if n != 7 * nb {
+    if n != 7 * nb || m != n {
         return None;
     }
     let order = crate::solver::sparse::partition::elimination_order(model);
@@ -85,12 +90,43 @@ pub(super) fn partition(
     })
 }
 
+/// The partition of `sys` at `q` and its evaluation with `known` `V`, `∇V` (module
+/// `model_rows`): with `by_bodies`, by bodies where that applies (as many rows as
+/// coordinates first) and its blocks factor; otherwise (and then) the general partition.
+///
+/// # Errors
+/// The general partition's rank where its `Φ_u` is singular.
+pub(super) fn evaluated(
+    sys: &mut System,
+    q: &DVector<f64>,
+    known: Option<(Energy, DVector<f64>)>,
+    by_bodies: bool,
+) -> Result<(Partition, Eval), usize> {
+    let (m, n) = (sys.problem.cons.len(), q.len());
+    if by_bodies && m == n {
+        // Installed rows are the triplets at `q` already.
+        if known.is_none() {
+            sys.triplets(q);
+        }
+        let model = sys.problem.model;
+        if let Some(part) = partition(model, m, n, &sys.work.jac.entries) {
+            if let Some(eval) = sys.evaluate_knowing(q, &part, known.clone()) {
+                return Ok((part, eval));
+            }
+        }
+    }
+    let part = sys.partition(q);
+    match sys.evaluate_knowing(q, &part, known) {
+        Some(eval) => Ok((part, eval)),
+        None => Err(part.rows.len()),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::constraints::Constraints;
-    use crate::solver::system::{Backend, System};
-    use nalgebra::DVector;
+    use crate::solver::system::Backend;
 
     fn model(text: &str, floating: bool) -> Model {
         let options = crate::urdf::ImportOptions {
@@ -158,7 +194,12 @@ mod tests {
                     s.sort_unstable();
                     s
                 };
-                assert_eq!(set(&ours.rows), set(&general.rows), "{} node {k}", model.name);
+                assert_eq!(
+                    set(&ours.rows),
+                    set(&general.rows),
+                    "{} node {k}",
+                    model.name
+                );
                 assert_eq!(
                     set(&ours.dependent),
                     set(&general.dependent),

@@ -20,8 +20,9 @@
 //! triplets in one pass instead of chosen by magnitude: the pivots' order inside a node differs,
 //! so the multipliers agree with that partition's to rounding. Anything else (a floating
 //! base, whose root owns one row; loops, mimics, stops or contacts, which give a body more than
-//! seven rows; a row without entries) is left to the general partition (`None`), as is a pose
-//! where a block is singular (the caller's evaluation fails and it partitions again).
+//! seven rows; a row without entries; a joint of two or three coordinates) is left to the
+//! general partition (`None`), as is a pose where a block is singular (the caller's evaluation
+//! fails and it partitions again).
 
 use crate::constraints::Triplet;
 use crate::forces::Energy;
@@ -41,8 +42,17 @@ pub(super) fn partition(
 ) -> Option<Partition> {
     // Seven rows a body: as many rows as coordinates (the ladder's loop rows, a floating
     // base's missing joint rows fail this before any work).
+    // And one coordinate a joint: the lock of an angle about an axis or a length along it
+    // never depends on the joint's rows, where two or three coordinates of a joint (universal,
+    // cylindrical, planar) have configurations at which their locks do.
     let nb = model.bodies.len();
-    if n != 7 * nb || m != n {
+    if n != 7 * nb
+        || m != n
+        || model
+            .joints
+            .iter()
+            .any(|j| j.tree && !j.merged && j.kind.scalar_coordinates() != 1)
+    {
         return None;
     }
     let order = crate::solver::sparse::partition::elimination_order(model);

@@ -12,7 +12,8 @@
 //! `a` and the forces `λ` alone; what they cannot balance is the `unassigned` force. The
 //! unknowns are found as the multipliers of one system: the model's rows, a lock row
 //! `θ_k(q) − θ_k = 0` on every joint coordinate and the touching rows, partitioned (dense or
-//! sparse: the same partition the solver uses) so that it keeps every model row it can (lock
+//! sparse: the same partition the solver uses; `analyze`'s self-check on a locked tree: by
+//! bodies, module `tree_partition`) so that it keeps every model row it can (lock
 //! and touching rows scaled down by [`PREFERENCE`] in the pivot choice). `Φ_uᵀ μ = ∇_u V` gives
 //! the basic multipliers `μ_b`; the reduced gradient that remains is the unassigned force.
 //!
@@ -137,6 +138,7 @@ pub(super) fn held(
                 backend,
                 None,
                 given,
+                true,
             )?;
             return Ok(Held {
                 efforts: row_of.iter().map(|&k| r.locks[k]).collect(),
@@ -158,6 +160,7 @@ pub(super) fn held(
                 backend,
                 None,
                 None,
+                false,
             )
         })?,
     };
@@ -175,6 +178,7 @@ pub(super) fn held(
                 backend,
                 None,
                 None,
+                false,
             )
         })?;
         // Too many dependent rows to choose among (a rope on the ground with its joints
@@ -200,6 +204,7 @@ pub(super) fn held(
                 backend,
                 Some(&carried),
                 given,
+                false,
             )?;
             (efforts, free.1)
         }
@@ -301,7 +306,9 @@ pub(super) fn free_of(sys: &System, part: &Partition, eval: &Eval) -> Multiplier
 }
 
 /// The multipliers of the model's rows, the locks `all` (the first `model_locks` the model's
-/// own) and the inequalities of `list` with `on`, made unique as the module docs say.
+/// own) and the inequalities of `list` with `on`, made unique as the module docs say; with
+/// `by_bodies` and the tree factors, partitioned by bodies where that applies (module
+/// `tree_partition`: `analyze`'s self-check, the multipliers to rounding).
 fn solve_once(
     model: &Model,
     state: &State,
@@ -312,6 +319,7 @@ fn solve_once(
     backend: Backend,
     carried: Option<&DVector<f64>>,
     given: Option<ModelRows>,
+    by_bodies: bool,
 ) -> Result<Multipliers> {
     let kept: Vec<usize> = (0..list.len()).filter(|&i| on[i]).collect();
     let active: Vec<_> = kept.iter().map(|&i| list[i].active).collect();
@@ -348,10 +356,9 @@ fn solve_once(
     // The model's rows from the balance check where they are this system's first ones, and
     // with them the guard's `V` and `∇V` (the same pose and branches).
     let known = given.and_then(|rows| rows.install(&mut sys, &state.q));
-    let part = sys.partition(&state.q);
-    let mut eval = sys
-        .evaluate_knowing(&state.q, &part, known)
-        .ok_or_else(|| singular(part.rows.len()))?;
+    let by_bodies = by_bodies && backend == Backend::Tree;
+    let (part, mut eval) =
+        super::tree_partition::evaluated(&mut sys, &state.q, known, by_bodies).map_err(singular)?;
     if let Some(c) = carried {
         // The multipliers and the reduced gradient are linear in ∇V: with `c` taken off it,
         // `Φ_uᵀ δμ = −c_u` and `δ(∂V/∂v) = S (−c_v − Φ_vᵀ δμ)` (one more solve).

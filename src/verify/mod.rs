@@ -42,6 +42,7 @@ mod pose;
 mod rank_tests;
 mod reduced;
 mod run;
+mod tree_partition;
 mod unilateral;
 
 use closure::closures;

@@ -321,3 +321,57 @@ fn the_self_check_on_the_dense_path_reports_what_verify_reports() {
         "{passed} {failed} {touching}"
     );
 }
+
+/// `analyze`'s self-check on the tree path, where the locked system is partitioned by bodies
+/// (module `tree_partition`), reports what `verify` reports there to rounding: the same pass
+/// and failures, the residuals, force scale, unassigned force and energy `==`, every effort
+/// within 1e-12 of the force scale; on a chain of 60 bodies and the same chain with locks of
+/// its own, at rest and bent.
+#[test]
+fn the_self_check_on_the_tree_path_reports_what_verify_reports() {
+    use crate::solver::system::Backend;
+    let locked = crate::generate::chain(60, false).replace(
+        "</robot>",
+        "<mech:lock joint=\"joint3\" value=\"0.2\"/><mech:lock joint=\"joint17\"/></robot>",
+    );
+    let (mut passed, mut failed) = (0, 0);
+    for text in [crate::generate::chain(60, false), locked] {
+        let model = load(&text);
+        let (rest, _) = crate::solver::solve(&model, &Default::default()).unwrap();
+        let bent = crate::verify::assemble(&model, &bent(&model)).unwrap();
+        for state in [rest, bent] {
+            let tol = Tolerances::default();
+            let uni = Unilaterals::default();
+            let run = |e| super::run::verify_on(&model, &state, &tol, &uni, Backend::Tree, e);
+            let v = run(super::Eigenvalues::WhenCheap).unwrap();
+            let s = run(super::Eigenvalues::Skip).unwrap();
+            let what = &model.name;
+            assert_eq!(v.passed, s.passed, "{what}");
+            assert_eq!(v.unilateral, s.unilateral, "{what}");
+            assert_eq!(
+                v.scaled_constraint_residual, s.scaled_constraint_residual,
+                "{what}"
+            );
+            assert_eq!(v.force_scale, s.force_scale, "{what}");
+            assert_eq!(v.unassigned, s.unassigned, "{what}");
+            assert_eq!(v.potential_energy, s.potential_energy, "{what}");
+            assert_eq!(v.imbalance.len(), s.imbalance.len(), "{what}");
+            let mut worst = 0.0f64;
+            for (a, b) in v.imbalance.iter().zip(&s.imbalance) {
+                assert_eq!((&a.joint, a.dof, a.locked), (&b.joint, b.dof, b.locked));
+                worst = worst.max((a.effort - b.effort).abs());
+            }
+            assert!(
+                worst <= 1e-12 * v.force_scale,
+                "{what}: {worst:e} of {:e}",
+                v.force_scale
+            );
+            if v.passed {
+                passed += 1;
+            } else {
+                failed += 1;
+            }
+        }
+    }
+    assert!(passed >= 2 && failed >= 2, "{passed} {failed}");
+}

@@ -5,6 +5,7 @@
 //! normalization `p_iᵀ p_i − 1 = 0` per body, locks `θ(q) − θ̄ = 0` and mimic couplings
 //! `θ_a(q) − m θ_b(q) − c = 0`.
 
+mod closed_rows;
 pub(crate) mod joint;
 mod pair_sum;
 mod triplets;
@@ -388,19 +389,10 @@ impl Constraints {
                 }
             }
             Term::Closed(j, pair, rots) => {
-                let layout = j.kind.spec().rows;
-                crate::jet::closed::rows_each(j, pair, rots, |k, v, g| {
-                    let pattern = layout[k].pattern();
-                    push(
-                        phi,
-                        jac.as_deref_mut(),
-                        row + k,
-                        &j.bodies,
-                        (v, g),
-                        1.0,
-                        pattern,
-                    );
-                });
+                if let Some(t) = jac.as_deref_mut() {
+                    let (layout, phi) = (j.kind.spec().rows, phi.as_mut_slice());
+                    closed_rows::write(j, layout, pair, rots, row, phi, &mut t.entries);
+                }
             }
             Term::Normalization(b) => {
                 let i = 7 * b.0 + 3;

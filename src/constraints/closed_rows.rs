@@ -9,44 +9,46 @@
 //!
 //! so a component row `d_m` has the gradient `t_k e_m` over `r_k` and row `m` of `B(p_k, s_k)`
 //! over `p_k`, and a dot product `aᵀb` has `t^a_k b + t^b_k a` over `r_k` and
-//! `B^a_kᵀ b + B^b_kᵀ a` over `p_k`. Each vector a row reads is formed once per joint (a
-//! revolute's `z₀` serves two rows), with `B` only for the sides it reads; each side's
-//! entries of a row's [`crate::joint::Row::pattern`] go into the triplets as one fixed-size
-//! run (a side's `r_m` and `p`, or its `p`, or all seven). The values and gradients are
-//! [`crate::jet::closed::rows_each`]'s and the triplets `Constraints::evaluate`'s general
-//! `push`'s, to the last bit and in the same order (the unit test `closed_rows_equal_push`).
+//! `B(p_k, s^a_k)ᵀ b + B(p_k, s^b_k)ᵀ a` over `p_k`, each product taken as `2 M(s, w) p_k`
+//! without forming `B` ([`crate::math::b_transpose_mul`]). Each vector a row reads is formed
+//! once per joint (a revolute's `z₀` serves two rows), `B(p_k, ±o_k)` of `d` only where a
+//! component row reads it; each side's entries of a row's [`crate::joint::Row::pattern`] go
+//! into the triplets as one fixed-size run (a side's `r_m` and `p`, or its `p`, or all
+//! seven). The values and the component rows' gradients are
+//! [`crate::jet::closed::rows_each`]'s to the last bit, the dot products' gradients equal to
+//! rounding, and the triplets are those the general `push` of `Constraints::evaluate`
+//! writes, in the same order (the unit test `closed_rows_equal_push`).
 
 use super::Triplet;
 use crate::jet::closed::JointRotations;
 use crate::jet::{Pair, NL};
 use crate::joint::{Row, V};
-use crate::math::b_matrix;
+use crate::math::{b_matrix, b_transpose_mul};
 use crate::model::{BodyId, Joint};
 use nalgebra::{Matrix3x4, Vector3};
 
-/// `u = Σ_k t_k r_k + A(p_k) s_k` with `B_k = B(p_k, s_k)` on the sides it reads (`on`).
+/// `u = Σ_k t_k r_k + A(p_k) s_k` on the sides it reads (`on`).
 #[derive(Clone, Copy)]
 struct Lean {
     v: Vector3<f64>,
     t: [f64; 2],
-    b: [Matrix3x4<f64>; 2],
+    s: [Vector3<f64>; 2],
     on: [bool; 2],
 }
 
 impl Lean {
     /// The world direction `A(p_k) R_k e_i` of axis `i` of side `k`'s frame.
-    fn axis(pair: &Pair, rots: &JointRotations, k: usize, i: usize) -> Lean {
+    fn axis(rots: &JointRotations, k: usize, i: usize) -> Lean {
         let s = rots.r[k].column(i).into_owned();
-        let mut b = [Matrix3x4::zeros(); 2];
-        b[k] = b_matrix(&pair.p[k], &s);
-        let mut on = [false; 2];
-        on[k] = true;
-        Lean {
+        let mut l = Lean {
             v: rots.a[k] * s,
             t: [0.0; 2],
-            b,
-            on,
-        }
+            s: [Vector3::zeros(); 2],
+            on: [false; 2],
+        };
+        l.s[k] = s;
+        l.on[k] = true;
+        l
     }
 
     /// `d = o₁ − o₀` of the joint's frame origins.
@@ -56,14 +58,15 @@ impl Lean {
         Lean {
             v: point(1) - point(0),
             t: [-1.0, 1.0],
-            b: [-b_matrix(&pair.p[0], o(0)), b_matrix(&pair.p[1], o(1))],
+            s: [-o(0), *o(1)],
             on: [true; 2],
         }
     }
 }
 
-/// `∇(aᵀb)` into the zero `g`, in [`crate::jet::closed::dot_gradient`]'s order.
-fn dot_gradient(a: &Lean, b: &Lean, g: &mut [f64; NL]) {
+/// `∇(aᵀb)` into the zero `g`: `t^a_k b + t^b_k a` over `r_k`, `B(p_k, s^a_k)ᵀ b +
+/// B(p_k, s^b_k)ᵀ a` over `p_k` ([`b_transpose_mul`]).
+fn dot_gradient(a: &Lean, b: &Lean, pair: &Pair, g: &mut [f64; NL]) {
     for k in 0..2 {
         let o = 7 * k;
         for (x, y) in [(a, b), (b, a)] {
@@ -73,7 +76,7 @@ fn dot_gradient(a: &Lean, b: &Lean, g: &mut [f64; NL]) {
                         g[o + i] += x.t[k] * y.v[i];
                     }
                 }
-                let gp = x.b[k].tr_mul(&y.v);
+                let gp = b_transpose_mul(&pair.p[k], &x.s[k], &y.v);
                 for i in 0..4 {
                     g[o + 3 + i] += gp[i];
                 }
@@ -93,17 +96,26 @@ pub(super) fn write(
     phi: &mut [f64],
     entries: &mut Vec<Triplet>,
 ) {
-    // Every vector the rows read, formed once, before any row reads it.
+    // Every vector the rows read, formed once, before any row reads it; `∂d/∂p_k` only if a
+    // component row reads its rows.
     let mut memo: [Option<Lean>; 7] = [None; 7];
+    let mut d_b: Option<[Matrix3x4<f64>; 2]> = None;
     for r in layout {
         let (a, b) = match *r {
-            Row::Component(_) | Row::Length | Row::Thread => (V::D, V::D),
+            Row::Component(_) => {
+                let o = |k: usize| &joint.body_from_joint[k].translation.vector;
+                d_b.get_or_insert_with(|| {
+                    [-b_matrix(&pair.p[0], o(0)), b_matrix(&pair.p[1], o(1))]
+                });
+                (V::D, V::D)
+            }
+            Row::Length | Row::Thread => (V::D, V::D),
             Row::Dot(a, b) => (a, b),
         };
         for v in [a, b] {
             memo[v as usize].get_or_insert_with(|| match v {
                 V::D => Lean::origins(joint, pair, rots),
-                _ => Lean::axis(pair, rots, (v as usize - 1) / 3, (v as usize - 1) % 3),
+                _ => Lean::axis(rots, (v as usize - 1) / 3, (v as usize - 1) % 3),
             });
         }
     }
@@ -115,29 +127,32 @@ pub(super) fn write(
     };
     for (k, r) in layout.iter().enumerate() {
         let mut g = [0.0; NL];
-        let value = match *r {
-            Row::Component(m) => {
+        let value = match (*r, &d_b) {
+            (Row::Component(m), Some(db)) => {
                 let d = vector(V::D);
                 for s in 0..2 {
                     g[7 * s + m] += d.t[s];
                     for i in 0..4 {
-                        g[7 * s + 3 + i] += d.b[s][(m, i)];
+                        g[7 * s + 3 + i] += db[s][(m, i)];
                     }
                 }
                 d.v[m]
             }
-            Row::Dot(a, b) => {
+            (Row::Dot(a, b), _) => {
                 let (a, b) = (vector(a), vector(b));
-                dot_gradient(a, b, &mut g);
+                dot_gradient(a, b, pair, &mut g);
                 a.v.dot(&b.v)
             }
-            Row::Length => {
+            (Row::Length, _) => {
                 let d = vector(V::D);
-                dot_gradient(d, d, &mut g);
+                dot_gradient(d, d, pair, &mut g);
                 let length = joint.kind.parameter();
                 d.v.dot(&d.v) - length * length
             }
-            Row::Thread => unreachable!("a thread row has no closed form (Spec::closed_form)"),
+            (Row::Component(_), None) => unreachable!("`∂d/∂p` is formed for a component row"),
+            (Row::Thread, _) => {
+                unreachable!("a thread row has no closed form (Spec::closed_form)")
+            }
         };
         phi[row + k] += value;
         append(entries, (row + k) as u32, &joint.bodies, &g, r.pattern());
@@ -178,10 +193,10 @@ mod tests {
     use crate::jet::closed::{self, OwnedRotations};
     use crate::jet::testing::{every_kind, sample_joint, sample_pair};
 
-    /// [`write`] gives [`closed::rows_each`]'s values and, of each row, the entries of its
-    /// pattern on the sides with a body in local order (what the general `push` appends), to
-    /// the last bit: every closed-form kind, between two bodies and with either side the
-    /// ground.
+    /// [`write`] gives [`closed::rows_each`]'s values to the last bit and, of each row, the
+    /// entries of its pattern on the sides with a body in local order (what the general
+    /// `push` appends), their values equal to rounding (`1e-14` of the row's largest): every
+    /// closed-form kind, between two bodies and with either side the ground.
     #[test]
     fn closed_rows_equal_push() {
         let (a, b) = (Some(BodyId(0)), Some(BodyId(1)));
@@ -197,13 +212,13 @@ mod tests {
                 for seed in 0..4 {
                     let what = format!("{} {bodies:?} seed {seed}", kind.name());
                     let pair = sample_pair(seed);
-                    let owned = OwnedRotations::of(&j, &pair);
-                    let rots = owned.view();
-                    let (mut phi, mut entries) = (vec![0.5; 2 + layout.len()], Vec::new());
-                    write(&j, layout, &pair, &rots, 2, &mut phi, &mut entries);
+                    let (phi, entries) = evaluate(&j, &pair);
                     let (mut phi_ref, mut entries_ref) = (vec![0.5; 2 + layout.len()], Vec::new());
-                    closed::rows_each(&j, &pair, &rots, |k, v, g| {
+                    let owned = OwnedRotations::of(&j, &pair);
+                    let mut scale = vec![0.0f64; 2 + layout.len()];
+                    closed::rows_each(&j, &pair, &owned.view(), |k, v, g| {
                         phi_ref[2 + k] += v;
+                        scale[2 + k] = g.amax();
                         for i in 0..NL {
                             let global = crate::jet::global_index(&j.bodies, i);
                             if let Some(c) = global.filter(|_| layout[k].pattern() & (1 << i) != 0) {
@@ -213,16 +228,63 @@ mod tests {
                     });
                     let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
                     assert_eq!(bits(&phi), bits(&phi_ref), "{what}");
-                    let key = |e: &[Triplet]| {
-                        e.iter()
-                            .map(|&(r, c, v)| (r, c, v.to_bits()))
-                            .collect::<Vec<_>>()
-                    };
-                    assert_eq!(key(&entries), key(&entries_ref), "{what}");
+                    assert_eq!(entries.len(), entries_ref.len(), "{what}");
+                    for (x, y) in entries.iter().zip(&entries_ref) {
+                        assert_eq!((x.0, x.1), (y.0, y.1), "{what}");
+                        let tol = 1e-14 * scale[x.0 as usize];
+                        assert!((x.2 - y.2).abs() <= tol, "{what}: {x:?} {y:?}");
+                    }
                     checked += 1;
                 }
             }
         }
         assert!(checked >= 24, "{checked} cases");
+    }
+
+    /// `Φ` and its triplets of one joint at `pair` (rows from 2 on, `Φ` starting at 0.5).
+    fn evaluate(j: &Joint, pair: &Pair) -> (Vec<f64>, Vec<Triplet>) {
+        let layout = j.kind.spec().rows;
+        let owned = OwnedRotations::of(j, pair);
+        let (mut phi, mut entries) = (vec![0.5; 2 + layout.len()], Vec::new());
+        write(j, layout, pair, &owned.view(), 2, &mut phi, &mut entries);
+        (phi, entries)
+    }
+
+    /// Every triplet of [`write`] is the central difference of its row's value in its
+    /// coordinate (bodies 0 and 1: the column is the local index), and every coordinate a
+    /// row's value moves with has a triplet.
+    #[test]
+    fn closed_rows_match_central_differences() {
+        for kind in every_kind() {
+            let j = sample_joint(kind);
+            if !closed::supports(&j) {
+                continue;
+            }
+            for seed in 0..4 {
+                let pair = sample_pair(seed);
+                let (_, entries) = evaluate(&j, &pair);
+                let h = 1e-6;
+                for i in 0..NL {
+                    let shifted = |step: f64| {
+                        let mut out = pair;
+                        let (k, c) = (i / 7, i % 7);
+                        if c < 3 {
+                            out.r[k][c] += step;
+                        } else {
+                            out.p[k][c - 3] += step;
+                        }
+                        evaluate(&j, &out).0
+                    };
+                    let (fp, fm) = (shifted(h), shifted(-h));
+                    for row in 2..fp.len() {
+                        let fd = (fp[row] - fm[row]) / (2.0 * h);
+                        let at = |e: &&Triplet| e.0 as usize == row && e.1 as usize == i;
+                        let got = entries.iter().find(at).map_or(0.0, |e| e.2);
+                        let what = format!("{} seed {seed} row {row} coordinate {i}", kind.name());
+                        assert!((fd - got).abs() < 1e-7 * (1.0 + got.abs()), "{what}: {fd} {got}");
+                    }
+                }
+            }
+        }
     }
 }

@@ -13,8 +13,8 @@ pub(crate) mod unilateral;
 
 use crate::jet::{closed, pair_of, HessianSink, Scalar};
 use crate::joint::{Pattern, ALL};
-use crate::kinematics::{coordinate, Branches};
-use crate::model::{BodyId, JointId, Model};
+use crate::kinematics::{coordinate, on_branch, revolute_first_order, Branches};
+use crate::model::{BodyId, JointId, JointKind, Model};
 use nalgebra::{DVector, Matrix3};
 use pair_sum::PairSum;
 pub(crate) use triplets::{Triplet, Triplets};
@@ -240,7 +240,24 @@ impl Constraints {
                 } => {
                     let j = &model.joints[id.0];
                     let pair = pair_of(&j.bodies, q, hess);
-                    if let Some(s) = coordinate(j, &pair, *dof, self.branches.get(*id, *dof)) {
+                    let branch = self.branches.get(*id, *dof);
+                    // A revolute angle without its Hessian in closed form (module
+                    // `kinematics::revolute_angle`), any other coordinate by the jets.
+                    let closed_angle = !hess
+                        && self.closed_form
+                        && *dof == 0
+                        && matches!(j.kind, JointKind::Revolute | JointKind::Continuous);
+                    let angle = closed_angle.then(|| {
+                        let rots = [side(j.bodies[0]), side(j.bodies[1])];
+                        let f = revolute_first_order(&pair, rots, &self.frame_rotations[id.0]);
+                        let s = Scalar {
+                            v: f.v,
+                            g: f.g,
+                            h: None,
+                        };
+                        on_branch(s, branch)
+                    });
+                    if let Some(s) = angle.or_else(|| coordinate(j, &pair, *dof, branch)) {
                         visit(
                             block.first,
                             Term::Jet(&j.bodies, &s.minus(*value), 1.0, ALL),

@@ -22,6 +22,7 @@
 
 use crate::jet::closed::quadratic_form;
 use crate::jet::{HessianSink, LVec, Pair};
+use crate::kinematics::{revolute_first_order as first_order, RevoluteFirstOrder as FirstOrder};
 use crate::math::{b_matrix, b_transpose_mul};
 use crate::model::{BodyId, Joint};
 use nalgebra::{DVector, Matrix3, SMatrix, Vector3, Vector4};
@@ -149,7 +150,7 @@ pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair, a: [&Matrix3<f64>; 2]) 
         wb,
         cr,
         sr,
-    } = first_order(joint, pair, a);
+    } = first_order(pair, a, &crate::jet::closed::frame_rotations(joint));
     let (bw, b1x) = (b_matrix(&pair.p[0], &wb), b_matrix(&pair.p[1], &bx1));
     let mut h = SMatrix::<f64, 8, 8>::zeros();
     h.fixed_view_mut::<4, 4>(0, 0)
@@ -167,10 +168,14 @@ pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair, a: [&Matrix3<f64>; 2]) 
         pn[a] = n[i];
     }
     let pd = [d0[0], d0[1], d0[2], d0[3], d1[0], d1[1], d1[2], d1[3]];
+    // On and below the diagonal, mirrored: the blocks above are symmetric to the last bit,
+    // and each entry and its mirror subtract the same products summed in swapped order.
     let hm = h.as_mut_slice();
     for b in 0..8 {
-        for a in 0..8 {
-            hm[8 * b + a] -= pn[a] * pd[b] + pd[a] * pn[b];
+        for a in b..8 {
+            let x = hm[8 * b + a] - (pn[a] * pd[b] + pd[a] * pn[b]);
+            hm[8 * b + a] = x;
+            hm[8 * a + b] = x;
         }
     }
     Angle { v, g: n, h }
@@ -183,62 +188,8 @@ pub(crate) fn revolute_angle_gradient(
     pair: &Pair,
     a: [&Matrix3<f64>; 2],
 ) -> (f64, LVec) {
-    let f = first_order(joint, pair, a);
+    let f = first_order(pair, a, &crate::jet::closed::frame_rotations(joint));
     (f.v, f.g)
-}
-
-/// `θ`, `∇θ` and the vectors and factors they are formed from, which the Hessian reuses.
-struct FirstOrder {
-    v: f64,
-    g: LVec,
-    x0: Vector3<f64>,
-    y0: Vector3<f64>,
-    x1: Vector3<f64>,
-    bx0: Vector3<f64>,
-    by0: Vector3<f64>,
-    bx1: Vector3<f64>,
-    /// `w = A(p₀) ŵ` and `ŵ = (C ŷ₀ − S x̂₀) / ρ`.
-    w: Vector3<f64>,
-    wb: Vector3<f64>,
-    /// `C / ρ`, `S / ρ`.
-    cr: f64,
-    sr: f64,
-}
-
-/// `θ = atan2(S, C)` and `∇θ = (C ∇S − S ∇C) / ρ = ∇(w · x₁)` with `ρ` frozen: over `p₀`
-/// `B(p₀, ŵ)ᵀ x₁`, over `p₁` `B(p₁, x̂₁)ᵀ w` ([`b_transpose_mul`]), zero on the positions.
-#[inline(always)]
-fn first_order(joint: &Joint, pair: &Pair, a: [&Matrix3<f64>; 2]) -> FirstOrder {
-    let (p0, p1) = (&pair.p[0], &pair.p[1]);
-    let (a0, a1) = (a[0], a[1]);
-    let [r0, r1] = crate::jet::closed::frame_rotations(joint);
-    let (bx0, by0) = (r0.column(0).into_owned(), r0.column(1).into_owned());
-    let bx1 = r1.column(0).into_owned();
-    let (x0, y0, x1) = (a0 * bx0, a0 * by0, a1 * bx1);
-    let (s, c) = (y0.dot(&x1), x0.dot(&x1));
-    let rho = s * s + c * c;
-    let (cr, sr) = (c / rho, s / rho);
-    let (wb, w) = (by0 * cr - bx0 * sr, y0 * cr - x0 * sr);
-    let (g0, g1) = (b_transpose_mul(p0, &wb, &x1), b_transpose_mul(p1, &bx1, &w));
-    let mut g = LVec::zeros();
-    for i in 0..4 {
-        g[3 + i] = g0[i];
-        g[10 + i] = g1[i];
-    }
-    FirstOrder {
-        v: s.atan2(c),
-        g,
-        x0,
-        y0,
-        x1,
-        bx0,
-        by0,
-        bx1,
-        w,
-        wb,
-        cr,
-        sr,
-    }
 }
 
 /// `c U(θ)` for `U` given by `(u, du, ddu)` at `θ` (`Scalar::compose`; `None`: `U = θ`):

@@ -159,6 +159,55 @@ pub(super) fn write(
     }
 }
 
+/// The values alone of the rows of `joint` (`layout`) from `row` on, added into `phi`: each
+/// vector formed once, by the same arithmetic as [`write`] (the same numbers).
+pub(super) fn values(
+    joint: &Joint,
+    layout: &[Row],
+    pair: &Pair,
+    rots: &JointRotations,
+    row: usize,
+    phi: &mut [f64],
+) {
+    let mut memo: [Option<Vector3<f64>>; 7] = [None; 7];
+    for r in layout {
+        let (a, b) = match *r {
+            Row::Component(_) | Row::Length | Row::Thread => (V::D, V::D),
+            Row::Dot(a, b) => (a, b),
+        };
+        for v in [a, b] {
+            memo[v as usize].get_or_insert_with(|| match v {
+                V::D => {
+                    let o = |k: usize| &joint.body_from_joint[k].translation.vector;
+                    let point = |k: usize| rots.a[k] * o(k) + pair.r[k];
+                    point(1) - point(0)
+                }
+                _ => {
+                    let (k, i) = ((v as usize - 1) / 3, (v as usize - 1) % 3);
+                    rots.a[k] * rots.r[k].column(i).into_owned()
+                }
+            });
+        }
+    }
+    let vector = |v: V| -> &Vector3<f64> {
+        match &memo[v as usize] {
+            Some(x) => x,
+            None => unreachable!("every vector of the layout is formed above"),
+        }
+    };
+    for (k, r) in layout.iter().enumerate() {
+        phi[row + k] += match *r {
+            Row::Component(m) => vector(V::D)[m],
+            Row::Dot(a, b) => vector(a).dot(vector(b)),
+            Row::Length => {
+                let length = joint.kind.parameter();
+                vector(V::D).dot(vector(V::D)) - length * length
+            }
+            Row::Thread => unreachable!("a thread row has no closed form (Spec::closed_form)"),
+        };
+    }
+}
+
 /// The entries of `g` in `pattern`, side by side, each side's as one fixed-size run.
 #[inline(always)]
 fn append(
@@ -193,7 +242,8 @@ mod tests {
     use crate::jet::closed::{self, OwnedRotations};
     use crate::jet::testing::{every_kind, sample_joint, sample_pair};
 
-    /// [`write`] gives [`closed::rows_each`]'s values to the last bit and, of each row, the
+    /// [`write`] and [`values`] give [`closed::rows_each`]'s values to the last bit and, of
+    /// each row, the
     /// entries of its pattern on the sides with a body in local order (what the general
     /// `push` appends), their values equal to rounding (`1e-14` of the row's largest): every
     /// closed-form kind, between two bodies and with either side the ground.
@@ -228,6 +278,9 @@ mod tests {
                     });
                     let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
                     assert_eq!(bits(&phi), bits(&phi_ref), "{what}");
+                    let mut alone = vec![0.5; 2 + layout.len()];
+                    values(&j, layout, &pair, &owned.view(), 2, &mut alone);
+                    assert_eq!(bits(&alone), bits(&phi_ref), "{what}");
                     assert_eq!(entries.len(), entries_ref.len(), "{what}");
                     for (x, y) in entries.iter().zip(&entries_ref) {
                         assert_eq!((x.0, x.1), (y.0, y.1), "{what}");

@@ -343,7 +343,6 @@ impl Constraints {
                 t.entries.reserve_exact(self.triplet_bound(model));
             }
         }
-        let mut closed_values = Vec::with_capacity(6);
         fn push(
             phi: &mut DVector<f64>,
             jac: Option<&mut Triplets>,
@@ -399,16 +398,11 @@ impl Constraints {
             }
             // `push`'s `phi[row] += 1.0 · v`.
             Term::Value(v) => phi[row] += 1.0 * v,
-            Term::Closed(j, pair, rots) if jac.is_none() => {
-                crate::jet::closed::values(j, pair, rots, &mut closed_values);
-                for (k, v) in closed_values.iter().enumerate() {
-                    phi[row + k] += v;
-                }
-            }
             Term::Closed(j, pair, rots) => {
-                if let Some(t) = jac.as_deref_mut() {
-                    let (layout, phi) = (j.kind.spec().rows, phi.as_mut_slice());
-                    closed_rows::write(j, layout, pair, rots, row, phi, &mut t.entries);
+                let (layout, phi) = (j.kind.spec().rows, phi.as_mut_slice());
+                match jac.as_deref_mut() {
+                    Some(t) => closed_rows::write(j, layout, pair, rots, row, phi, &mut t.entries),
+                    None => closed_rows::values(j, layout, pair, rots, row, phi),
                 }
             }
             Term::Normalization(b) => {

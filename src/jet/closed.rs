@@ -400,7 +400,8 @@ pub(crate) fn rows_each(
 }
 
 /// Values of the rows of `joint` into `out` (cleared first): the vectors alone, without
-/// derivatives.
+/// derivatives (the tests' reference; `constraints::closed_rows` writes them into `Φ`).
+#[cfg(test)]
 pub(crate) fn values(joint: &Joint, pair: &Pair, rots: &JointRotations, out: &mut Vec<f64>) {
     out.clear();
     let Some(layout) = layout(joint) else {

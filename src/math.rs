@@ -55,22 +55,6 @@ pub fn b_matrix(p: &Vector4<f64>, a: &Vector3<f64>) -> Matrix3x4<f64> {
     b
 }
 
-/// `B(p, a)ᵀ w = ∂(wᵀ A(p) a)/∂p` without forming `B`: `wᵀ A(p) a = pᵀ M(a, w) p` is a
-/// quadratic form in `p` (homogeneous `A(p)`), so the product is `2 M(a, w) p` with
-///
-/// `M(a, w) = [ wᵀa      (a × w)ᵀ          ]`
-/// `          [ a × w    w aᵀ + a wᵀ − wᵀa I ]`:
-///
-/// `2 [ wᵀa e0 + (a × w)ᵀ e ,  (a × w) e0 + w (aᵀe) + a (wᵀe) − (wᵀa) e ]`, about a third of
-/// the operations of forming `B` and multiplying (equal to rounding).
-pub fn b_transpose_mul(p: &Vector4<f64>, a: &Vector3<f64>, w: &Vector3<f64>) -> Vector4<f64> {
-    let (e0, e) = (p[0], Vector3::new(p[1], p[2], p[3]));
-    let (wa, c) = (w.dot(a), a.cross(w));
-    let (ae, we) = (a.dot(&e), w.dot(&e));
-    let v = c * e0 + w * ae + a * we - e * wa;
-    2.0 * Vector4::new(wa * e0 + c.dot(&e), v.x, v.y, v.z)
-}
-
 /// The former `b_matrix` through nalgebra's products (the reference of the tests).
 #[cfg(test)]
 fn b_matrix_products(p: &Vector4<f64>, a: &Vector3<f64>) -> Matrix3x4<f64> {
@@ -170,29 +154,6 @@ mod tests {
             let (x, y) = (b_matrix(&p, &a), b_matrix_products(&p, &a));
             for k in 0..12 {
                 assert!(x[k] == y[k], "{p} {a}: {} != {}", x[k], y[k]);
-            }
-        }
-    }
-
-    /// `b_transpose_mul` is `B(p, a)ᵀ w` to rounding and the gradient of `wᵀ A(p) a` by
-    /// central differences.
-    #[test]
-    fn b_transpose_mul_is_the_gradient_of_the_projection() {
-        let mut lcg = crate::lcg::Lcg::new(11);
-        let mut rnd = || lcg.unit() * 4.0 - 2.0;
-        for _ in 0..2_000 {
-            let p = Vector4::new(rnd(), rnd(), rnd(), rnd());
-            let a = Vector3::new(rnd(), rnd(), rnd());
-            let w = Vector3::new(rnd(), rnd(), rnd());
-            let (x, y) = (b_transpose_mul(&p, &a, &w), b_matrix(&p, &a).tr_mul(&w));
-            assert!((x - y).norm() <= 1e-14 * (1.0 + y.norm()), "{p} {a} {w}: {x} {y}");
-            let h = 1e-6;
-            for m in 0..4 {
-                let (mut pp, mut pm) = (p, p);
-                pp[m] += h;
-                pm[m] -= h;
-                let fd = (w.dot(&(rotation(&pp) * a)) - w.dot(&(rotation(&pm) * a))) / (2.0 * h);
-                assert!((fd - x[m]).abs() < 1e-7 * (1.0 + x[m].abs()), "{m}: {fd} {}", x[m]);
             }
         }
     }

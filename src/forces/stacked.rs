@@ -3,10 +3,9 @@
 //! loads `wᵀ (r + A(p) s)`, and joint springs and efforts on revolute angles
 //! `θ = atan2(y₀ · x₁, x₀ · x₁)`.
 //!
-//! Values are those of the generic path to the last bit (the same operations in the same
-//! order), and so is the weighted point's Hessian; the gradients over the Euler parameters are
-//! `B(p, a)ᵀ w` taken as `2 M(a, w) p` ([`crate::math::b_transpose_mul`]), equal to rounding,
-//! and the angle's Hessian is the generic `∇²θ = sym(m)`,
+//! Values and gradients are those of the generic path to the last bit (the same operations in
+//! the same order). The weighted point's Hessian is too; the angle's is the generic
+//! `∇²θ = sym(m)`,
 //!
 //! `m = (∇S ∇Cᵀ − ∇C ∇Sᵀ + C ∇²S − S ∇²C) / ρ − ∇θ ∇ρᵀ / ρ`,   `ρ = S² + C²`,
 //!
@@ -17,14 +16,14 @@
 //! Where no Hessian is asked for (every evaluation of the line search and of the reduced
 //! gradient), the same terms give their value and gradient alone: `θ` and
 //! `∇θ = (C ∇S − S ∇C) / ρ` by the first half of [`revolute_angle`]
-//! ([`revolute_angle_gradient`]: the gradient of [`revolute_angle`] to the last bit), a
-//! weighted point by its side 0 alone ([`weighted_point_gradient`]).
+//! ([`revolute_angle_gradient`]), a weighted point by its side 0 alone
+//! ([`weighted_point_gradient`]); both to the last bit the generic path's.
 
 use crate::jet::closed::quadratic_form;
 use crate::jet::{HessianSink, LVec, Pair};
 use crate::kinematics::{revolute_first_order as first_order, RevoluteFirstOrder as FirstOrder};
-use crate::math::{b_matrix, b_transpose_mul};
 use crate::model::{BodyId, Joint};
+use crate::math::b_matrix;
 use nalgebra::{DVector, Matrix3, SMatrix, Vector3, Vector4};
 
 /// The Euler-parameter coordinates of a body pair (local indices).
@@ -104,7 +103,7 @@ pub(crate) fn weighted_point_gradient(
 ) -> f64 {
     let x = &q.as_slice()[7 * body.0..7 * body.0 + 7];
     let v = a0 * s + Vector3::new(x[0], x[1], x[2]);
-    let gp = b_transpose_mul(&Vector4::new(x[3], x[4], x[5], x[6]), s, w);
+    let gp = b_matrix(&Vector4::new(x[3], x[4], x[5], x[6]), s).tr_mul(w);
     let out = &mut grad.as_mut_slice()[7 * body.0..7 * body.0 + 7];
     // `linear_gradient` into zeros (`t = 1` on the position), then `scatter`'s `1 · g`.
     for i in 0..3 {
@@ -123,19 +122,17 @@ pub(crate) struct Angle {
     pub(crate) h: SMatrix<f64, 8, 8>,
 }
 
-/// `θ` of the revolute `joint` at `pair` (as [`crate::jet::closed::revolute_angle`], to
-/// rounding), over plain arrays. With `S = y₀ · x₁`, `C = x₀ · x₁`, `ρ = S² + C²` frozen, the
-/// body-0 direction `w = A(p₀) ŵ`, `ŵ = (C ŷ₀ − S x̂₀) / ρ`, has `∇θ = ∇(w · x₁)` and
-/// `∇²(w · x₁) = (C ∇²S − S ∇²C) / ρ` (`w` is linear in `ŷ₀`, `x̂₀`), and the antisymmetric
-/// `∇S ∇Cᵀ − ∇C ∇Sᵀ` drops out of `sym(m)`, so
+/// `θ` of the revolute `joint` at `pair` (as [`crate::jet::closed::revolute_angle`]; the
+/// value and gradient to the last bit, the Hessian regrouped), over plain arrays. With
+/// `S = y₀ · x₁`, `C = x₀ · x₁`, `ρ = S² + C²` frozen, the body-0 direction
+/// `w = A(p₀) (C ŷ₀ − S x̂₀) / ρ` has `∇²(w · x₁) = (C ∇²S − S ∇²C) / ρ` (`w` is linear in
+/// `ŷ₀`, `x̂₀`), and the antisymmetric `∇S ∇Cᵀ − ∇C ∇Sᵀ` drops out of `sym(m)`, so
 ///
-/// `∇²θ = ∇²(w · x₁) − ∇θ ∇ρᵀ / 2ρ − ∇ρ ∇θᵀ / 2ρ`,   `∇ρ / 2ρ = ∇(u · x₁)`,
+/// `∇²θ = ∇²(w · x₁) − ∇θ ∇ρᵀ / 2ρ − ∇ρ ∇θᵀ / 2ρ`,   `∇ρ / 2ρ = (S ∇S + C ∇C) / ρ`,
 ///
-/// `u = A(p₀) û`, `û = (S ŷ₀ + C x̂₀) / ρ`, with `∇²(w · x₁)` as
-/// [`crate::jet::closed::dot_hessian_euler`] forms it: `B(p₀, ŵ)ᵀ B(p₁, x̂₁)` on the `p₀ p₁`
-/// block (and its transpose), `2 M(ŵ, x₁)` on `p₀ p₀`, `2 M(x̂₁, w)` on `p₁ p₁`. One
-/// dot-product Hessian instead of two, two `B` matrices instead of three, no division per
-/// entry.
+/// with `∇²(w · x₁)` as [`crate::jet::closed::dot_hessian_euler`] forms it: `B_wᵀ B_x₁` on
+/// the `p₀ p₁` block (and its transpose), `2 M(ŵ, x₁)` on `p₀ p₀`, `2 M(x̂₁, w)` on `p₁ p₁`.
+/// One dot-product Hessian instead of two, no division per entry.
 pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair, a: [&Matrix3<f64>; 2]) -> Angle {
     let FirstOrder {
         v,
@@ -146,12 +143,17 @@ pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair, a: [&Matrix3<f64>; 2]) 
         bx0,
         by0,
         bx1,
-        w,
-        wb,
-        cr,
-        sr,
+        b0x,
+        b0y,
+        b1x,
+        gs,
+        gc,
+        s,
+        c,
+        rho,
     } = first_order(pair, a, &crate::jet::closed::frame_rotations(joint));
-    let (bw, b1x) = (b_matrix(&pair.p[0], &wb), b_matrix(&pair.p[1], &bx1));
+    let (cr, sr) = (c / rho, s / rho);
+    let (wb, w, bw) = (by0 * cr - bx0 * sr, y0 * cr - x0 * sr, b0y * cr - b0x * sr);
     let mut h = SMatrix::<f64, 8, 8>::zeros();
     h.fixed_view_mut::<4, 4>(0, 0)
         .copy_from(&(quadratic_form(&wb, &x1) * 2.0));
@@ -160,16 +162,13 @@ pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair, a: [&Matrix3<f64>; 2]) 
     let pp = bw.tr_mul(&b1x);
     h.fixed_view_mut::<4, 4>(0, 4).copy_from(&pp);
     h.fixed_view_mut::<4, 4>(4, 0).copy_from(&pp.transpose());
-    // `∇ρ / 2ρ = ∇(u · x₁)` over the Euler parameters.
-    let (ub, u) = (by0 * sr + bx0 * cr, y0 * sr + x0 * cr);
-    let (d0, d1) = (b_transpose_mul(&pair.p[0], &ub, &x1), b1x.tr_mul(&u));
-    let mut pn = [0.0f64; 8];
+    let (mut pn, mut pd) = ([0.0f64; 8], [0.0f64; 8]);
     for (a, &i) in P.iter().enumerate() {
-        pn[a] = n[i];
+        (pn[a], pd[a]) = (n[i], (gs[i] * s + gc[i] * c) / rho);
     }
-    let pd = [d0[0], d0[1], d0[2], d0[3], d1[0], d1[1], d1[2], d1[3]];
     // On and below the diagonal, mirrored: the blocks above are symmetric to the last bit,
-    // and each entry and its mirror subtract the same products summed in swapped order.
+    // and each entry and its mirror subtract the same products summed in swapped order (the
+    // same numbers as forming both).
     let hm = h.as_mut_slice();
     for b in 0..8 {
         for a in b..8 {
@@ -250,10 +249,9 @@ mod tests {
         (g, h)
     }
 
-    /// The stacked terms equal the boxed generic path: bit for bit the angle's value and a
-    /// weighted point's value and Hessian, to rounding the gradients (`1e-14` of their largest
-    /// entry: `B(p, a)ᵀ w` by [`b_transpose_mul`]) and the angle's regrouped Hessian (spring
-    /// `U(θ)`, effort `−τ θ`; `1e-13`).
+    /// The stacked terms equal the boxed generic path: bit for bit the angle's value and
+    /// gradient and all of a weighted point, the angle's regrouped Hessian (spring `U(θ)`,
+    /// effort `−τ θ`) to rounding (`1e-13` of its largest entry).
     #[test]
     fn stacked_terms_equal_the_boxed_path() {
         let j = sample_joint(crate::model::JointKind::Revolute);
@@ -288,8 +286,8 @@ mod tests {
             let (g1, h1) = hessian_of(|g, h| {
                 scatter_angle(&bodies, &stacked, Some((du, ddu)), 1.0, g, h);
             });
-            assert!((stacked.g - theta.g).amax() <= 1e-14 * theta.g.amax(), "seed {seed}");
-            assert!((&g0 - &g1).amax() <= 1e-14 * g0.amax(), "seed {seed}");
+            assert_eq!(stacked.g, theta.g, "seed {seed}");
+            assert_eq!(g0, g1, "seed {seed}");
             assert!((&h0 - &h1).amax() <= 1e-13 * h0.amax(), "seed {seed}");
             assert!(h1.amax() > 0.0);
             // Effort: `−τ θ`.
@@ -300,7 +298,7 @@ mod tests {
             let (g1, h1) = hessian_of(|g, h| {
                 scatter_angle(&bodies, &stacked, None, tau, g, h);
             });
-            assert!((&g0 - &g1).amax() <= 1e-14 * g0.amax(), "seed {seed}");
+            assert_eq!(g0, g1, "seed {seed}");
             assert!((&h0 - &h1).amax() <= 1e-13 * h0.amax(), "seed {seed}");
             // Weighted point.
             let one = [Some(BodyId(1)), None];
@@ -326,17 +324,16 @@ mod tests {
                 (g, h)
             };
             assert_eq!(v, boxed.v);
-            assert!((&g0 - &g1).amax() <= 1e-14 * g0.amax(), "seed {seed}");
-            assert_eq!(h0, h1, "seed {seed}");
+            assert_eq!((g0, h0), (g1, h1), "seed {seed}");
         }
     }
 
-    /// Without the Hessian: the angle's value and gradient are those of the stacked term with
-    /// its Hessian to the last bit (compared as bits, so that a zero's sign counts), and with
-    /// the weighted point's value and gradient, added into a vector, the boxed generic path's
-    /// (the values to the last bit, the gradients to `1e-14` of their largest entry).
+    /// Without the Hessian: the angle's value and gradient and the weighted point's value and
+    /// gradient, added into a vector, are the boxed generic path's to the last bit (compared
+    /// as bits, so that a zero's sign counts).
     #[test]
-    fn gradient_only_terms_equal_the_boxed_path() {
+    fn gradient_only_terms_equal_the_boxed_path_bit_for_bit() {
+        let bits = |g: &DVector<f64>| g.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         let j = sample_joint(crate::model::JointKind::Revolute);
         for seed in 0..6 {
             let pair = sample_pair(seed);
@@ -346,9 +343,6 @@ mod tests {
             let a = [&rot.0[0], &rot.0[1]];
             let (v, g) = revolute_angle_gradient(&j, &pair, a);
             assert_eq!(v.to_bits(), theta.v.to_bits(), "seed {seed}");
-            let with_hessian = revolute_angle(&j, &pair, a);
-            let same = |x: &LVec, y: &LVec| x.iter().zip(y).all(|(a, b)| a.to_bits() == b.to_bits());
-            assert!(same(&g, &with_hessian.g), "seed {seed}");
             // A spring `U(θ)` (`Scalar::compose`, scattered with `c = 1`) and an effort.
             for (c, du) in [(1.0, du), (-2.5, 1.0)] {
                 let boxed = theta.clone().scale(du);
@@ -356,7 +350,7 @@ mod tests {
                 crate::jet::scatter(&j.bodies, &boxed, c, &mut g0, None);
                 let mut g1 = DVector::zeros(21);
                 scatter_gradient(&j.bodies, &(g * du), c, &mut g1);
-                assert!((&g0 - &g1).amax() <= 1e-14 * g0.amax(), "seed {seed}");
+                assert_eq!(bits(&g0), bits(&g1), "seed {seed}");
                 assert!(g1.amax() > 0.0);
             }
             let (s, w) = (Vector3::new(0.3, -0.1, 0.25), Vector3::new(1.0, -2.0, 9.81));
@@ -368,7 +362,7 @@ mod tests {
             let q = coordinates(2, &pair);
             let v = weighted_point_gradient(BodyId(2), &q, a[0], &s, &w, &mut g1);
             assert_eq!(v.to_bits(), boxed.v.to_bits(), "seed {seed}");
-            assert!((&g0 - &g1).amax() <= 1e-14 * g0.amax(), "seed {seed}");
+            assert_eq!(bits(&g0), bits(&g1), "seed {seed}");
         }
     }
 

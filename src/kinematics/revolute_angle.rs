@@ -1,20 +1,20 @@
 //! The revolute angle `θ = atan2(S, C)`, `S = y₀ · x₁`, `C = x₀ · x₁` (the child's `x` axis
 //! in the parent's joint frame, about `z₀`; as [`crate::kinematics::angle`], in (−π, π]), and
-//! its gradient in closed form: with `ρ = S² + C²` frozen,
+//! its gradient in closed form, `Pair::atan2`'s
 //!
-//! `∇θ = (C ∇S − S ∇C) / ρ = ∇(w · x₁)`,   `w = A(p₀) ŵ`,   `ŵ = (C ŷ₀ − S x̂₀) / ρ`,
+//! `∇θ = (C ∇S − S ∇C) / ρ`,   `ρ = S² + C²`,
 //!
-//! zero over the positions, `B(p₀, ŵ)ᵀ x₁` over `p₀` and `B(p₁, x̂₁)ᵀ w` over `p₁`
-//! ([`crate::math::b_transpose_mul`]; `x̂₀, ŷ₀, x̂₁` the frame axes in their bodies). The
-//! joint springs' and efforts' terms (`forces`) and the lock rows of a revolute angle
-//! (`constraints`) read it; the vectors and factors it is formed from are kept for the
-//! Hessian of the forces' terms.
+//! with `∇S = [B(p₀, ŷ₀)ᵀ x₁, B(p₁, x̂₁)ᵀ y₀]`, `∇C = [B(p₀, x̂₀)ᵀ x₁, B(p₁, x̂₁)ᵀ x₀]` over the
+//! Euler parameters and zero over the positions (`x̂₀, ŷ₀, x̂₁` the frame axes in their
+//! bodies). The joint springs' and efforts' terms (`forces`, whose Hessians reuse the vectors
+//! and factors kept here) and the lock rows of a revolute angle (`constraints`) read it.
 
 use crate::jet::{LVec, Pair};
-use crate::math::b_transpose_mul;
-use nalgebra::{Matrix3, Vector3};
+use crate::math::b_matrix;
+use nalgebra::{Matrix3, Matrix3x4, Vector3, Vector4};
 
-/// `θ`, `∇θ` and the vectors and factors they are formed from, which the Hessian reuses.
+/// `θ`, `∇θ` (`Pair::atan2`'s) and the vectors and factors they are formed from, which the
+/// Hessian reuses.
 pub(crate) struct RevoluteFirstOrder {
     pub(crate) v: f64,
     pub(crate) g: LVec,
@@ -24,16 +24,16 @@ pub(crate) struct RevoluteFirstOrder {
     pub(crate) bx0: Vector3<f64>,
     pub(crate) by0: Vector3<f64>,
     pub(crate) bx1: Vector3<f64>,
-    /// `w = A(p₀) ŵ` and `ŵ = (C ŷ₀ − S x̂₀) / ρ`.
-    pub(crate) w: Vector3<f64>,
-    pub(crate) wb: Vector3<f64>,
-    /// `C / ρ`, `S / ρ`.
-    pub(crate) cr: f64,
-    pub(crate) sr: f64,
+    pub(crate) b0x: Matrix3x4<f64>,
+    pub(crate) b0y: Matrix3x4<f64>,
+    pub(crate) b1x: Matrix3x4<f64>,
+    pub(crate) gs: LVec,
+    pub(crate) gc: LVec,
+    pub(crate) s: f64,
+    pub(crate) c: f64,
+    pub(crate) rho: f64,
 }
 
-/// `θ = atan2(S, C)` and `∇θ = (C ∇S − S ∇C) / ρ = ∇(w · x₁)` with `ρ` frozen: over `p₀`
-/// `B(p₀, ŵ)ᵀ x₁`, over `p₁` `B(p₁, x̂₁)ᵀ w` ([`b_transpose_mul`]), zero on the positions.
 #[inline(always)]
 pub(crate) fn revolute_first_order(
     pair: &Pair,
@@ -46,28 +46,82 @@ pub(crate) fn revolute_first_order(
     let (bx0, by0) = (r0.column(0).into_owned(), r0.column(1).into_owned());
     let bx1 = r1.column(0).into_owned();
     let (x0, y0, x1) = (a0 * bx0, a0 * by0, a1 * bx1);
+    let (b0x, b0y, b1x) = (b_matrix(p0, &bx0), b_matrix(p0, &by0), b_matrix(p1, &bx1));
+    // `∇S`, `∇C` (as `dot_gradient`: zero on the positions).
+    let side = |g0: Vector4<f64>, g1: Vector4<f64>| {
+        let mut g = LVec::zeros();
+        for i in 0..4 {
+            g[3 + i] += g0[i];
+            g[10 + i] += g1[i];
+        }
+        g
+    };
+    let gs = side(b0y.tr_mul(&x1), b1x.tr_mul(&y0));
+    let gc = side(b0x.tr_mul(&x1), b1x.tr_mul(&x0));
     let (s, c) = (y0.dot(&x1), x0.dot(&x1));
+    // `Pair::atan2`'s gradient.
     let rho = s * s + c * c;
-    let (cr, sr) = (c / rho, s / rho);
-    let (wb, w) = (by0 * cr - bx0 * sr, y0 * cr - x0 * sr);
-    let (g0, g1) = (b_transpose_mul(p0, &wb, &x1), b_transpose_mul(p1, &bx1, &w));
-    let mut g = LVec::zeros();
-    for i in 0..4 {
-        g[3 + i] = g0[i];
-        g[10 + i] = g1[i];
-    }
+    let n = gs * (c / rho) - gc * (s / rho);
     RevoluteFirstOrder {
         v: s.atan2(c),
-        g,
+        g: n,
         x0,
         y0,
         x1,
         bx0,
         by0,
         bx1,
-        w,
-        wb,
-        cr,
-        sr,
+        b0x,
+        b0y,
+        b1x,
+        gs,
+        gc,
+        s,
+        c,
+        rho,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::jet::closed::{frame_rotations, Rotations};
+    use crate::jet::testing::{sample_joint, sample_pair};
+    use crate::model::JointKind;
+
+    /// `θ` and `∇θ` equal the generic jets' coordinate ([`crate::kinematics::coordinate`]) to
+    /// rounding and `∇θ` matches central differences, on random pairs off the unit sphere.
+    #[test]
+    fn revolute_angle_equals_the_jets_and_central_differences() {
+        let joint = sample_joint(JointKind::Revolute);
+        let r = frame_rotations(&joint);
+        let first = |pair: &Pair| {
+            let rot = Rotations::of(pair);
+            revolute_first_order(pair, [&rot.0[0], &rot.0[1]], &r)
+        };
+        for seed in 0..8 {
+            let mut pair = sample_pair(seed);
+            pair.hess = false;
+            let f = first(&pair);
+            let jet = crate::kinematics::coordinate(&joint, &pair, 0, f64::NAN).unwrap();
+            assert!((f.v - jet.v).abs() <= 1e-15, "seed {seed}: {} {}", f.v, jet.v);
+            let scale = jet.g.amax();
+            assert!((f.g - jet.g).amax() <= 1e-14 * scale, "seed {seed}");
+            let h = 1e-6;
+            for i in 0..crate::jet::NL {
+                let shifted = |step: f64| {
+                    let mut out = pair;
+                    let (k, c) = (i / 7, i % 7);
+                    if c < 3 {
+                        out.r[k][c] += step;
+                    } else {
+                        out.p[k][c - 3] += step;
+                    }
+                    first(&out).v
+                };
+                let fd = (shifted(h) - shifted(-h)) / (2.0 * h);
+                assert!((fd - f.g[i]).abs() < 1e-7 * (1.0 + scale), "seed {seed} {i}: {fd}");
+            }
+        }
     }
 }

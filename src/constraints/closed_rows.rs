@@ -254,7 +254,8 @@ mod tests {
                         phi_ref[2 + k] += v;
                         for i in 0..NL {
                             let global = crate::jet::global_index(&j.bodies, i);
-                            if let Some(c) = global.filter(|_| layout[k].pattern() & (1 << i) != 0) {
+                            if let Some(c) = global.filter(|_| layout[k].pattern() & (1 << i) != 0)
+                            {
                                 entries_ref.push(((2 + k) as u32, c as u32, 1.0 * g[i]));
                             }
                         }
@@ -317,7 +318,10 @@ mod tests {
                         let at = |e: &&Triplet| e.0 as usize == row && e.1 as usize == i;
                         let got = entries.iter().find(at).map_or(0.0, |e| e.2);
                         let what = format!("{} seed {seed} row {row} coordinate {i}", kind.name());
-                        assert!((fd - got).abs() < 1e-7 * (1.0 + got.abs()), "{what}: {fd} {got}");
+                        assert!(
+                            (fd - got).abs() < 1e-7 * (1.0 + got.abs()),
+                            "{what}: {fd} {got}"
+                        );
                     }
                 }
             }

@@ -103,7 +103,10 @@ fn closed_forms_equal_the_jets_in_evaluate() {
         assert_eq!(t0.len(), t1.len());
         for (x, y) in t0.iter().zip(&t1) {
             assert_eq!((x.0, x.1), (y.0, y.1));
-            assert!((x.2 - y.2).abs() <= 1e-14 * (1.0 + y.2.abs()), "{x:?} {y:?}");
+            assert!(
+                (x.2 - y.2).abs() <= 1e-14 * (1.0 + y.2.abs()),
+                "{x:?} {y:?}"
+            );
         }
     }
 }

@@ -22,8 +22,8 @@
 use crate::jet::closed::quadratic_form;
 use crate::jet::{HessianSink, LVec, Pair};
 use crate::kinematics::{revolute_first_order as first_order, RevoluteFirstOrder as FirstOrder};
-use crate::model::{BodyId, Joint};
 use crate::math::b_matrix;
+use crate::model::{BodyId, Joint};
 use nalgebra::{DVector, Matrix3, SMatrix, Vector3, Vector4};
 
 /// The Euler-parameter coordinates of a body pair (local indices).

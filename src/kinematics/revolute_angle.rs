@@ -104,7 +104,12 @@ mod tests {
             pair.hess = false;
             let f = first(&pair);
             let jet = crate::kinematics::coordinate(&joint, &pair, 0, f64::NAN).unwrap();
-            assert!((f.v - jet.v).abs() <= 4e-15, "seed {seed}: {} {}", f.v, jet.v);
+            assert!(
+                (f.v - jet.v).abs() <= 4e-15,
+                "seed {seed}: {} {}",
+                f.v,
+                jet.v
+            );
             let scale = jet.g.amax();
             assert!((f.g - jet.g).amax() <= 1e-14 * scale, "seed {seed}");
             let h = 1e-6;
@@ -120,7 +125,10 @@ mod tests {
                     first(&out).v
                 };
                 let fd = (shifted(h) - shifted(-h)) / (2.0 * h);
-                assert!((fd - f.g[i]).abs() < 1e-7 * (1.0 + scale), "seed {seed} {i}: {fd}");
+                assert!(
+                    (fd - f.g[i]).abs() < 1e-7 * (1.0 + scale),
+                    "seed {seed} {i}: {fd}"
+                );
             }
         }
     }

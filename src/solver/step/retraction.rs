@@ -43,8 +43,8 @@ pub(crate) struct Retraction {
     moves: Vec<Option<usize>>,
 }
 
-/// The rigid displacement `y ↦ A(r) y + t` of the world that a body has undergone.
-/// A body's rigid displacement along the path: Euler parameters, shift and rotation matrix.
+/// The rigid displacement `y ↦ A(r) y + t` of the world that a body has undergone: `r`, `t`
+/// and `A(r)`.
 type Moved = (Vector4<f64>, Vector3<f64>, Matrix3<f64>);
 
 impl Retraction {

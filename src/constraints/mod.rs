@@ -5,6 +5,7 @@
 //! normalization `p_iᵀ p_i − 1 = 0` per body, locks `θ(q) − θ̄ = 0` and mimic couplings
 //! `θ_a(q) − m θ_b(q) − c = 0`.
 
+mod closed_rows;
 pub(crate) mod joint;
 mod pair_sum;
 mod triplets;
@@ -12,8 +13,8 @@ pub(crate) mod unilateral;
 
 use crate::jet::{closed, pair_of, HessianSink, Scalar};
 use crate::joint::{Pattern, ALL};
-use crate::kinematics::{coordinate, Branches};
-use crate::model::{BodyId, JointId, Model};
+use crate::kinematics::{coordinate, on_branch, revolute_first_order, Branches};
+use crate::model::{BodyId, JointId, JointKind, Model};
 use nalgebra::{DVector, Matrix3};
 use pair_sum::PairSum;
 pub(crate) use triplets::{Triplet, Triplets};
@@ -239,7 +240,24 @@ impl Constraints {
                 } => {
                     let j = &model.joints[id.0];
                     let pair = pair_of(&j.bodies, q, hess);
-                    if let Some(s) = coordinate(j, &pair, *dof, self.branches.get(*id, *dof)) {
+                    let branch = self.branches.get(*id, *dof);
+                    // A revolute angle without its Hessian in closed form (module
+                    // `kinematics::revolute_angle`), any other coordinate by the jets.
+                    let closed_angle = !hess
+                        && self.closed_form
+                        && *dof == 0
+                        && matches!(j.kind, JointKind::Revolute | JointKind::Continuous);
+                    let angle = closed_angle.then(|| {
+                        let rots = [side(j.bodies[0]), side(j.bodies[1])];
+                        let f = revolute_first_order(&pair, rots, &self.frame_rotations[id.0]);
+                        let s = Scalar {
+                            v: f.v,
+                            g: f.g,
+                            h: None,
+                        };
+                        on_branch(s, branch)
+                    });
+                    if let Some(s) = angle.or_else(|| coordinate(j, &pair, *dof, branch)) {
                         visit(
                             block.first,
                             Term::Jet(&j.bodies, &s.minus(*value), 1.0, ALL),
@@ -325,7 +343,6 @@ impl Constraints {
                 t.entries.reserve_exact(self.triplet_bound(model));
             }
         }
-        let mut closed_values = Vec::with_capacity(6);
         fn push(
             phi: &mut DVector<f64>,
             jac: Option<&mut Triplets>,
@@ -381,26 +398,12 @@ impl Constraints {
             }
             // `push`'s `phi[row] += 1.0 · v`.
             Term::Value(v) => phi[row] += 1.0 * v,
-            Term::Closed(j, pair, rots) if jac.is_none() => {
-                crate::jet::closed::values(j, pair, rots, &mut closed_values);
-                for (k, v) in closed_values.iter().enumerate() {
-                    phi[row + k] += v;
-                }
-            }
             Term::Closed(j, pair, rots) => {
-                let layout = j.kind.spec().rows;
-                crate::jet::closed::rows_each(j, pair, rots, |k, v, g| {
-                    let pattern = layout[k].pattern();
-                    push(
-                        phi,
-                        jac.as_deref_mut(),
-                        row + k,
-                        &j.bodies,
-                        (v, g),
-                        1.0,
-                        pattern,
-                    );
-                });
+                let (layout, phi) = (j.kind.spec().rows, phi.as_mut_slice());
+                match jac.as_deref_mut() {
+                    Some(t) => closed_rows::write(j, layout, pair, rots, row, phi, &mut t.entries),
+                    None => closed_rows::values(j, layout, pair, rots, row, phi),
+                }
             }
             Term::Normalization(b) => {
                 let i = 7 * b.0 + 3;

@@ -21,9 +21,10 @@
 
 use crate::jet::closed::quadratic_form;
 use crate::jet::{HessianSink, LVec, Pair};
+use crate::kinematics::{revolute_first_order as first_order, RevoluteFirstOrder as FirstOrder};
 use crate::math::b_matrix;
 use crate::model::{BodyId, Joint};
-use nalgebra::{DVector, Matrix3, Matrix3x4, SMatrix, Vector3, Vector4};
+use nalgebra::{DVector, Matrix3, SMatrix, Vector3, Vector4};
 
 /// The Euler-parameter coordinates of a body pair (local indices).
 const P: [usize; 8] = crate::jet::EULER;
@@ -150,7 +151,7 @@ pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair, a: [&Matrix3<f64>; 2]) 
         s,
         c,
         rho,
-    } = first_order(joint, pair, a);
+    } = first_order(pair, a, &crate::jet::closed::frame_rotations(joint));
     let (cr, sr) = (c / rho, s / rho);
     let (wb, w, bw) = (by0 * cr - bx0 * sr, y0 * cr - x0 * sr, b0y * cr - b0x * sr);
     let mut h = SMatrix::<f64, 8, 8>::zeros();
@@ -165,10 +166,15 @@ pub(crate) fn revolute_angle(joint: &Joint, pair: &Pair, a: [&Matrix3<f64>; 2]) 
     for (a, &i) in P.iter().enumerate() {
         (pn[a], pd[a]) = (n[i], (gs[i] * s + gc[i] * c) / rho);
     }
+    // On and below the diagonal, mirrored: the blocks above are symmetric to the last bit,
+    // and each entry and its mirror subtract the same products summed in swapped order (the
+    // same numbers as forming both).
     let hm = h.as_mut_slice();
     for b in 0..8 {
-        for a in 0..8 {
-            hm[8 * b + a] -= pn[a] * pd[b] + pd[a] * pn[b];
+        for a in b..8 {
+            let x = hm[8 * b + a] - (pn[a] * pd[b] + pd[a] * pn[b]);
+            hm[8 * b + a] = x;
+            hm[8 * a + b] = x;
         }
     }
     Angle { v, g: n, h }
@@ -181,73 +187,8 @@ pub(crate) fn revolute_angle_gradient(
     pair: &Pair,
     a: [&Matrix3<f64>; 2],
 ) -> (f64, LVec) {
-    let f = first_order(joint, pair, a);
+    let f = first_order(pair, a, &crate::jet::closed::frame_rotations(joint));
     (f.v, f.g)
-}
-
-/// `θ`, `∇θ` (`Pair::atan2`'s) and the vectors and factors they are formed from, which the
-/// Hessian reuses.
-struct FirstOrder {
-    v: f64,
-    g: LVec,
-    x0: Vector3<f64>,
-    y0: Vector3<f64>,
-    x1: Vector3<f64>,
-    bx0: Vector3<f64>,
-    by0: Vector3<f64>,
-    bx1: Vector3<f64>,
-    b0x: Matrix3x4<f64>,
-    b0y: Matrix3x4<f64>,
-    b1x: Matrix3x4<f64>,
-    gs: LVec,
-    gc: LVec,
-    s: f64,
-    c: f64,
-    rho: f64,
-}
-
-#[inline(always)]
-fn first_order(joint: &Joint, pair: &Pair, a: [&Matrix3<f64>; 2]) -> FirstOrder {
-    let (p0, p1) = (&pair.p[0], &pair.p[1]);
-    let (a0, a1) = (a[0], a[1]);
-    let [r0, r1] = crate::jet::closed::frame_rotations(joint);
-    let (bx0, by0) = (r0.column(0).into_owned(), r0.column(1).into_owned());
-    let bx1 = r1.column(0).into_owned();
-    let (x0, y0, x1) = (a0 * bx0, a0 * by0, a1 * bx1);
-    let (b0x, b0y, b1x) = (b_matrix(p0, &bx0), b_matrix(p0, &by0), b_matrix(p1, &bx1));
-    // `∇S`, `∇C` (as `dot_gradient`: zero on the positions).
-    let side = |g0: Vector4<f64>, g1: Vector4<f64>| {
-        let mut g = LVec::zeros();
-        for i in 0..4 {
-            g[3 + i] += g0[i];
-            g[10 + i] += g1[i];
-        }
-        g
-    };
-    let gs = side(b0y.tr_mul(&x1), b1x.tr_mul(&y0));
-    let gc = side(b0x.tr_mul(&x1), b1x.tr_mul(&x0));
-    let (s, c) = (y0.dot(&x1), x0.dot(&x1));
-    // `Pair::atan2`'s gradient.
-    let rho = s * s + c * c;
-    let n = gs * (c / rho) - gc * (s / rho);
-    FirstOrder {
-        v: s.atan2(c),
-        g: n,
-        x0,
-        y0,
-        x1,
-        bx0,
-        by0,
-        bx1,
-        b0x,
-        b0y,
-        b1x,
-        gs,
-        gc,
-        s,
-        c,
-        rho,
-    }
 }
 
 /// `c U(θ)` for `U` given by `(u, du, ddu)` at `θ` (`Scalar::compose`; `None`: `U = θ`):

@@ -165,6 +165,7 @@ pub(crate) fn linear_gradient(a: &Lin, w: &Vector3<f64>, g: &mut LVec) {
 /// are zeros, which leave a finite sum unchanged but for the sign of a zero result, and each
 /// sum enters `g` by an addition (to the zero `g` starts from, in [`rows_each`]), which
 /// clears that sign: the same numbers to the last bit.
+#[cfg(test)]
 fn component_gradient(a: &Lin, m: usize, g: &mut LVec) {
     for k in 0..2 {
         if a.on[k] {
@@ -361,8 +362,9 @@ pub(crate) fn supports(joint: &Joint) -> bool {
 }
 
 /// Values and gradients of the rows of `joint` (no Hessians), handed to `emit(k, Φ_k, ∇Φ_k)`
-/// in row order: nothing collected, nothing copied.
-#[inline(always)]
+/// in row order: nothing collected, nothing copied. The reference of
+/// `constraints::closed_rows`, which writes them into `Φ` and the triplets.
+#[cfg(test)]
 pub(crate) fn rows_each(
     joint: &Joint,
     pair: &Pair,
@@ -398,7 +400,8 @@ pub(crate) fn rows_each(
 }
 
 /// Values of the rows of `joint` into `out` (cleared first): the vectors alone, without
-/// derivatives.
+/// derivatives (the tests' reference; `constraints::closed_rows` writes them into `Φ`).
+#[cfg(test)]
 pub(crate) fn values(joint: &Joint, pair: &Pair, rots: &JointRotations, out: &mut Vec<f64>) {
     out.clear();
     let Some(layout) = layout(joint) else {

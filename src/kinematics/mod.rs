@@ -12,6 +12,7 @@ mod branches;
 mod coordinate;
 mod frames;
 mod motion;
+mod revolute_angle;
 
 pub use branches::Branches;
 pub(crate) use coordinate::{
@@ -19,3 +20,4 @@ pub(crate) use coordinate::{
 };
 pub(crate) use frames::{angle, frames};
 pub(crate) use motion::motion;
+pub(crate) use revolute_angle::{revolute_first_order, RevoluteFirstOrder};

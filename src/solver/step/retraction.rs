@@ -43,8 +43,9 @@ pub(crate) struct Retraction {
     moves: Vec<Option<usize>>,
 }
 
-/// The rigid displacement `y ↦ A(r) y + t` of the world that a body has undergone.
-type Displacement = (Vector4<f64>, Vector3<f64>);
+/// The rigid displacement `y ↦ A(r) y + t` of the world that a body has undergone: `r`, `t`
+/// and `A(r)`.
+type Moved = (Vector4<f64>, Vector3<f64>, Matrix3<f64>);
 
 impl Retraction {
     /// The walk of `model`'s spanning tree.
@@ -131,21 +132,24 @@ impl Retraction {
         caps: &[(usize, f64)],
     ) -> DVector<f64> {
         let mut out = q.clone();
-        let identity: Displacement = (Vector4::new(1.0, 0.0, 0.0, 0.0), Vector3::zeros());
-        let mut moved = vec![identity; q.len() / 7];
+        // Each body's displacement with its rotation matrix, and its angular velocity, formed
+        // once and read by its children (the same numbers as forming them again).
+        let identity = (Vector4::new(1.0, 0.0, 0.0, 0.0), Vector3::zeros());
+        let identity: Moved = (identity.0, identity.1, rotation(&identity.0));
+        let n = q.len() / 7;
+        let mut moved = vec![identity; n];
+        let mut omega = vec![Vector3::zeros(); n];
         for &(b, a) in &self.order {
             let xb = position(q, b);
-            let (wr, w, (ra, ta)) = match a {
+            let wb = angular_velocity(q, dq, b);
+            omega[b] = wb;
+            let (wr, w, (ra, ta, rot_a)) = match a {
                 Some(a) => {
-                    let wa = angular_velocity(q, dq, a);
+                    let wa = omega[a];
                     let va = position(dq, a) + wa.cross(&(xb - position(q, a)));
-                    (
-                        angular_velocity(q, dq, b) - wa,
-                        position(dq, b) - va,
-                        moved[a],
-                    )
+                    (wb - wa, position(dq, b) - va, moved[a])
                 }
-                None => (angular_velocity(q, dq, b), position(dq, b), identity),
+                None => (wb, position(dq, b), identity),
             };
             let ab = caps
                 .iter()
@@ -155,10 +159,11 @@ impl Retraction {
             // E_b(y) = x_b + A(r_e)(y − x_b) + shift, M_b = M_a ∘ E_b.
             let te = xb - rotation(&re) * xb + shift;
             let rb = compose(&ra, &re);
-            let tb = rotation(&ra) * te + ta;
-            moved[b] = (rb, tb);
+            let tb = rot_a * te + ta;
+            let rot_b = rotation(&rb);
+            moved[b] = (rb, tb, rot_b);
             let i = 7 * b;
-            let xn = rotation(&rb) * xb + tb;
+            let xn = rot_b * xb + tb;
             let pn = compose(&rb, &Vector4::new(q[i + 3], q[i + 4], q[i + 5], q[i + 6]));
             out.fixed_rows_mut::<3>(i).copy_from(&xn);
             out.fixed_rows_mut::<4>(i + 3).copy_from(&pn);

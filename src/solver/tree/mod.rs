@@ -31,6 +31,7 @@ mod merge;
 mod merge_tests;
 mod nodes;
 mod norm;
+mod original;
 pub(crate) mod phi_u;
 mod segments;
 mod shape;

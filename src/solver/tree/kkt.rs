@@ -15,12 +15,8 @@
 //! accurate, each block is factored by LU with partial pivoting instead. A solve runs
 //! `y_i = K_i⁻¹ r_i`, `r_p −= C_iᵀ y_i` from the leaves and `x_i = y_i − X_i x_p` back from
 //! the root, then the border (module `border`), then iterative refinement like the sparse
-//! path's. The factors overwrite the flat blocks in place; the values as assembled, which the
-//! solves (`C_i`) and the refinement's residual read, are kept compactly beside them (module
-//! `original`: the coordinates' rows of each `K_i` and `C_i`, saved as each block is first
-//! touched) and written back where a factorization follows another without an assembly.
-//! Values, the kept values and scratch are allocated once per structure (the kept values at
-//! its first factorization).
+//! path's. Values, factors and scratch are allocated once per structure (the factors at its
+//! first factorization).
 //!
 //! Assembly writes every slot once per Newton step without clearing the values first: a `W`
 //! entry stores its (scaled) Hessian block entry, a Jacobian entry stores its first triplet
@@ -31,7 +27,6 @@
 use super::dense;
 use super::fused::BlockMap;
 use super::norm;
-use super::original::Original;
 use super::shape::{Shape, FIRST, SKIP};
 use crate::constraints::Triplet;
 use crate::solver::partition::Partition;
@@ -51,23 +46,21 @@ pub(crate) struct TreeKkt {
     id: usize,
     triplets: usize,
     blocks: usize,
-    /// Assembled values (shifted): the flat blocks, then the border entries; after a
-    /// factorization (`spent`), the flat blocks hold the factors (`L D` or `L U` in place,
-    /// `X_i = K_i⁻¹ C_i` in the coupling slots) of the nodes saved in `original`.
+    /// Assembled values (shifted): the flat blocks, then the border entries.
     pub(super) values: Vec<f64>,
-    spent: bool,
     /// The shifts `δ` and `−σ` now in `values`.
     pub(super) shifts: Shifts,
-    /// The flat blocks' values as assembled (built at the first factorization, so that
-    /// memory freed between the assembly and it, such as the verdict's block Hessian, is
-    /// reused); the border's values and `S`, the pivots of LU.
-    original: Option<Original>,
+    /// Factors: the flat blocks (`L D` or `L U` in place; `X_i` in the coupling slots; empty
+    /// until the first factorization, so that memory freed between the assembly and it, such
+    /// as the verdict's block Hessian, is reused), the border's values and `S`, the pivots of
+    /// LU.
+    factors: Vec<f64>,
     border: Vec<f64>,
     piv: Vec<u16>,
     border_piv: Vec<u16>,
     kind: Factored,
     lu_only: bool,
-    /// Nodes not yet saved in `original` by this factorization (scratch).
+    /// Blocks not yet copied from the values in this factorization (scratch).
     fresh: Vec<bool>,
     /// Row sums of `|K|` in tree-space order (scratch).
     row_sums: Vec<f64>,
@@ -103,9 +96,8 @@ impl TreeKkt {
             triplets: entries.len(),
             blocks: hess.keys.len(),
             values: vec![0.0; total],
-            spent: false,
             shifts: Shifts::default(),
-            original: None,
+            factors: Vec::new(),
             border: vec![0.0; shape.border.len()],
             piv: vec![0; shape.tree_len],
             border_piv: vec![0; shape.border.size()],
@@ -158,11 +150,6 @@ impl TreeKkt {
 
     /// Stores the Jacobian's entries (scaled) at their slots (see [`TreeKkt::assemble`]).
     pub(super) fn store_jacobian(&mut self, entries: &[Triplet], row_scale: &[f64], scale: &[f64]) {
-        if std::mem::take(&mut self.spent) {
-            if let Some(o) = &self.original {
-                o.clear_unwritten(&mut self.values);
-            }
-        }
         let values = &mut self.values;
         for (e, slots) in entries.iter().zip(&self.shape.jac_slots) {
             let v = e.2 * row_scale[e.0 as usize] * scale[e.1 as usize];
@@ -181,39 +168,13 @@ impl TreeKkt {
 
     /// The largest diagonal entry of the (scaled) `W` block.
     pub(crate) fn max_diagonal(&self) -> f64 {
-        if !self.spent {
-            return self
-                .shifts
-                .max_diagonal(&self.shape.diag_slots, &self.values);
-        }
-        let saved = |i: usize| !self.fresh[i];
-        let diagonal = self.original().diagonal(&self.shape, &self.values, saved);
-        let slots: Vec<usize> = (0..diagonal.len()).collect();
-        self.shifts.max_diagonal(&slots, &diagonal)
-    }
-
-    /// Writes the saved values back over the factors (see module `original`).
-    fn unspend(&mut self) {
-        if std::mem::take(&mut self.spent) {
-            let mut values = std::mem::take(&mut self.values);
-            self.restore_into(&mut values);
-            self.values = values;
-        }
-    }
-
-    /// The saved nodes' values written into `values` (a factorization's flat blocks).
-    fn restore_into(&self, values: &mut [f64]) {
-        if let Some(o) = &self.original {
-            for i in (0..self.fresh.len()).filter(|&i| !self.fresh[i]) {
-                o.restore(&self.shape, i, values);
-            }
-        }
+        self.shifts
+            .max_diagonal(&self.shape.diag_slots, &self.values)
     }
 
     /// Subtracts `σ` from the diagonal of the independent coordinates `columns` in place of
     /// the last such shift (see `sparse::kkt::Kkt::shift_independent`).
     pub(crate) fn shift_independent(&mut self, columns: &[usize], sigma: f64) {
-        self.unspend();
         self.shifts
             .shift_independent(&self.shape.diag_slots, &mut self.values, columns, sigma);
     }
@@ -222,7 +183,6 @@ impl TreeKkt {
     /// number of negative pivots), or block LU with partial pivoting where LDLᵀ meets a zero
     /// pivot or after [`TreeKkt::fall_back_to_lu`].
     pub(crate) fn factor(&mut self, delta: f64) -> Factored {
-        self.unspend();
         self.shifts
             .shift_all(&self.shape.diag_slots, &mut self.values, delta);
         self.kind = Factored::None;
@@ -257,19 +217,19 @@ impl TreeKkt {
         self.factor_border(lu, negative)
     }
 
-    /// The tree part of [`TreeKkt::factor_blocks`] (and the row sums), in place.
+    /// The tree part of [`TreeKkt::factor_blocks`] (and the row sums).
     fn factor_tree(&mut self, lu: bool) -> Option<usize> {
-        self.unspend();
         let s = &self.shape;
-        let original = self.original.get_or_insert_with(|| Original::new(s));
-        // Each node is saved when first touched (its own turn, or its first child's update),
-        // before anything overwrites it; from then on the factors replace it.
+        if self.factors.len() != s.flat_len {
+            self.factors = vec![0.0; s.flat_len];
+        }
+        // Each block is copied from the values when first touched (its own turn, or its first
+        // child's update), so that a body's values are read once, while in cache.
         let fresh = &mut self.fresh;
         fresh.iter_mut().for_each(|f| *f = true);
-        self.spent = true;
-        let values = &mut self.values;
+        let (values, factors) = (&self.values, &mut self.factors);
         // ‖K‖∞ (for the backward error of solves; every factorization is solved), row sums
-        // taken node by node (module `norm`'s order).
+        // taken while the blocks are in cache (module `norm`).
         let sums = &mut self.row_sums;
         sums.iter_mut().for_each(|x| *x = 0.0);
         s.border.add_row_sums(&values[s.flat_len..], sums);
@@ -277,44 +237,52 @@ impl TreeKkt {
         for i in 0..s.at.len() {
             let (at, d, w) = (s.at[i], s.d[i], s.w[i]);
             if std::mem::take(&mut fresh[i]) {
-                original.save(s, i, values);
+                let r = s.diag_at[i]..s.diag_at[i] + d * d;
+                factors[r.clone()].copy_from_slice(&values[r]);
             }
-            let coupled = s.parent[i] != u32::MAX && w > 0;
-            if coupled {
+            let blk = &values[s.diag_at[i]..s.diag_at[i] + d * d];
+            if s.parent[i] != u32::MAX && w > 0 {
                 // The parent's unknowns come after the node's own in tree-space order.
                 let pa = s.at[s.parent[i] as usize];
                 let (head, tail) = sums.split_at_mut(pa);
-                original.add_row_sums(s, i, &mut head[at..at + d], tail);
+                let c = &values[s.coup_at[i]..s.coup_at[i] + d * w];
+                norm::add_node(blk, c, &mut head[at..at + d], tail, (d, w));
             } else {
-                original.add_row_sums(s, i, &mut sums[at..at + d], &mut []);
+                norm::add_node(blk, &[], &mut sums[at..at + d], &mut [], (d, 0));
             }
-            let diag = s.diag_at[i]..s.diag_at[i] + d * d;
-            let piv = &mut self.piv[at..at + d];
+            let (fd, rest) = factors.split_at_mut(s.diag_at[i] + d * d);
+            let blk = &mut fd[s.diag_at[i]..];
+            let piv = &mut self.piv[s.at[i]..s.at[i] + d];
             if lu {
-                if !dense::lu(&mut values[diag.clone()], d, piv) {
+                if !dense::lu(blk, d, piv) {
                     return None;
                 }
             } else {
-                negative += dense::ldlt(&mut values[diag.clone()], d)?;
+                negative += dense::ldlt(blk, d)?;
             }
-            if !coupled {
+            let p = s.parent[i];
+            if p == u32::MAX || w == 0 {
                 continue;
             }
-            // X_i = K_i⁻¹ C_i over C_i; K_p −= C_iᵀ X_i.
-            let coup = s.coup_at[i]..s.coup_at[i] + d * w;
-            let (blk, x) = two_mut(values, diag, coup.clone());
+            // X_i = K_i⁻¹ C_i in the coupling slot; K_p −= C_iᵀ X_i.
+            let base = s.diag_at[i] + d * d;
+            let (before, after) = rest.split_at_mut(s.coup_at[i] - base);
+            let x = &mut after[..d * w];
+            let c = &values[s.coup_at[i]..s.coup_at[i] + d * w];
+            x.copy_from_slice(c);
             if lu {
                 dense::lu_solve(blk, piv, d, x, w);
             } else {
                 dense::ldlt_solve(blk, d, x, w);
             }
-            let p = s.parent[i] as usize;
-            if std::mem::take(&mut fresh[p]) {
-                original.save(s, p, values);
-            }
+            let p = p as usize;
             let dp = s.d[p];
-            let (x, pblk) = two_mut(values, coup, s.diag_at[p]..s.diag_at[p] + dp * dp);
-            let c = original.coupling(s, i);
+            if fresh[p] {
+                fresh[p] = false;
+                let r = s.diag_at[p]..s.diag_at[p] + dp * dp;
+                before[r.start - base..r.end - base].copy_from_slice(&values[r]);
+            }
+            let pblk = &mut before[s.diag_at[p] - base..s.diag_at[p] - base + dp * dp];
             dense::sub_tr_mul_block(c, x, pblk, (d, w, dp), !lu);
         }
         Some(negative)
@@ -359,7 +327,7 @@ impl TreeKkt {
         let first = s.at.partition_point(|&a| a <= lo).saturating_sub(1);
         for i in first..nodes {
             let (at, d, w) = (s.at[i], s.d[i], s.w[i]);
-            let blk = &self.values[s.diag_at[i]..s.diag_at[i] + d * d];
+            let blk = &self.factors[s.diag_at[i]..s.diag_at[i] + d * d];
             let (head, tail) = x.split_at_mut(at + d);
             let y = &mut head[at..];
             if lu {
@@ -373,7 +341,7 @@ impl TreeKkt {
             }
             // r_p −= C_iᵀ y_i (the coupling's original values).
             let pa = s.at[p as usize] - at - d;
-            let c = self.original().coupling(s, i);
+            let c = &self.values[s.coup_at[i]..s.coup_at[i] + d * w];
             dense::sub_tr_mul(c, y, &mut tail[pa..pa + w], d, w);
         }
         let last = s.at.partition_point(|&a| a <= need).saturating_sub(1);
@@ -384,7 +352,7 @@ impl TreeKkt {
             }
             let (at, d, w) = (s.at[i], s.d[i], s.w[i]);
             let pa = s.at[p as usize];
-            let xm = &self.values[s.coup_at[i]..s.coup_at[i] + d * w];
+            let xm = &self.factors[s.coup_at[i]..s.coup_at[i] + d * w];
             let (head, tail) = x.split_at_mut(pa);
             dense::sub_mul(xm, &tail[..w], &mut head[at..at + d], d, w);
         }
@@ -405,16 +373,21 @@ impl TreeKkt {
         }
     }
 
-    /// `r −= K x` in tree-space order from the kept values.
+    /// `r −= K x` in tree-space order from the stored values.
     fn residual(&self, x: &[f64], r: &mut [f64]) {
         let s = &self.shape;
-        self.original().sub_product(s, x, r);
+        for i in 0..s.at.len() {
+            let (at, d, w) = (s.at[i], s.d[i], s.w[i]);
+            let blk = &self.values[s.diag_at[i]..s.diag_at[i] + d * d];
+            dense::sub_mul(blk, &x[at..at + d], &mut r[at..at + d], d, d);
+            if s.parent[i] != u32::MAX {
+                let pa = s.at[s.parent[i] as usize];
+                let c = &self.values[s.coup_at[i]..s.coup_at[i] + d * w];
+                dense::sub_mul(c, &x[pa..pa + w], &mut r[at..at + d], d, w);
+                dense::sub_tr_mul(c, &x[at..at + d], &mut r[pa..pa + w], d, w);
+            }
+        }
         s.border.sub_product(&self.values[s.flat_len..], x, r);
-    }
-
-    /// The kept values (after a factorization).
-    fn original(&self) -> &Original {
-        self.original.as_ref().expect("the tree KKT matrix is solved after a factorization")
     }
 
     /// Solves with the last factors in place (`rhs` of length `n + rows`), with iterative
@@ -466,21 +439,5 @@ impl TreeKkt {
     #[cfg(test)]
     pub(crate) fn border_size(&self) -> usize {
         self.shape.border.size()
-    }
-}
-
-/// Two disjoint ranges of `v`, mutably.
-fn two_mut(
-    v: &mut [f64],
-    a: std::ops::Range<usize>,
-    b: std::ops::Range<usize>,
-) -> (&mut [f64], &mut [f64]) {
-    if a.end <= b.start {
-        let (lo, hi) = v.split_at_mut(b.start);
-        (&mut lo[a], &mut hi[..b.end - b.start])
-    } else {
-        assert!(b.end <= a.start, "overlapping blocks {a:?} and {b:?}");
-        let (lo, hi) = v.split_at_mut(a.start);
-        (&mut hi[..a.end - a.start], &mut lo[b])
     }
 }

@@ -31,7 +31,6 @@ mod merge;
 mod merge_tests;
 mod nodes;
 mod norm;
-mod original;
 pub(crate) mod phi_u;
 mod segments;
 mod shape;

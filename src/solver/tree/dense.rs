@@ -80,60 +80,6 @@ pub(crate) fn ldlt_solve(f: &[f64], d: usize, x: &mut [f64], w: usize) {
     }
 }
 
-/// `x ← L⁻¹ x` for the factors of [`ldlt`] (the first half of [`ldlt_solve`]).
-pub(crate) fn ldlt_forward(f: &[f64], d: usize, x: &mut [f64], w: usize) {
-    match (d, w) {
-        (13, 1) => fixed::ldlt_forward::<13, 1>(f, x),
-        (13, 7) => fixed::ldlt_forward::<13, 7>(f, x),
-        (14, 1) => fixed::ldlt_forward::<14, 1>(f, x),
-        (14, 7) => fixed::ldlt_forward::<14, 7>(f, x),
-        (27, 1) => fixed::ldlt_forward::<27, 1>(f, x),
-        (27, 7) => fixed::ldlt_forward::<27, 7>(f, x),
-        (14, 18) => fixed::ldlt_forward::<14, 18>(f, x),
-        _ => {
-            let (f, x) = (&f[..d * d], &mut x[..d * w]);
-            for i in 0..d {
-                for k in 0..i {
-                    let l = f[i * d + k];
-                    if l != 0.0 {
-                        for c in 0..w {
-                            x[i * w + c] -= l * x[k * w + c];
-                        }
-                    }
-                }
-            }
-        }
-    }
-}
-
-/// `x ← L⁻ᵀ D⁻¹ x` for the factors of [`ldlt`] (the second half of [`ldlt_solve`]).
-pub(crate) fn ldlt_backward(f: &[f64], d: usize, x: &mut [f64], w: usize) {
-    match (d, w) {
-        (13, 1) => fixed::ldlt_backward::<13, 1>(f, x),
-        (14, 1) => fixed::ldlt_backward::<14, 1>(f, x),
-        (27, 1) => fixed::ldlt_backward::<27, 1>(f, x),
-        _ => {
-            let (f, x) = (&f[..d * d], &mut x[..d * w]);
-            for i in 0..d {
-                let p = 1.0 / f[i * d + i];
-                for c in 0..w {
-                    x[i * w + c] *= p;
-                }
-            }
-            for i in (0..d).rev() {
-                for k in i + 1..d {
-                    let l = f[k * d + i];
-                    if l != 0.0 {
-                        for c in 0..w {
-                            x[i * w + c] -= l * x[k * w + c];
-                        }
-                    }
-                }
-            }
-        }
-    }
-}
-
 #[inline(always)]
 fn ldlt_solve_impl(f: &[f64], d: usize, x: &mut [f64], w: usize) {
     let (f, x) = (&f[..d * d], &mut x[..d * w]);

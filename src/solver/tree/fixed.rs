@@ -99,40 +99,6 @@ pub(super) fn ldlt_solve<const D: usize, const W: usize>(f: &[f64], x: &mut [f64
     each_row!(backward: 26 25 24 23 22 21 20 19 18 17 16 15 14 13 12 11 10 9 8 7 6 5 4 3 2 1 0);
 }
 
-/// `x ← L⁻¹ x` (the first half of [`ldlt_solve`]).
-#[inline(never)]
-pub(super) fn ldlt_forward<const D: usize, const W: usize>(f: &[f64], x: &mut [f64]) {
-    const { assert!(D <= 27) };
-    let (f, x) = (&f[..D * D], &mut x[..D * W]);
-    macro_rules! each_row {
-        ($($i:literal)*) => {
-            $(
-                if $i < D {
-                    forward::<D, W, $i>(f, x);
-                }
-            )*
-        };
-    }
-    each_row!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26);
-}
-
-/// `x ← L⁻ᵀ D⁻¹ x` (the second half of [`ldlt_solve`]).
-#[inline(never)]
-pub(super) fn ldlt_backward<const D: usize, const W: usize>(f: &[f64], x: &mut [f64]) {
-    const { assert!(D <= 27) };
-    let (f, x) = (&f[..D * D], &mut x[..D * W]);
-    macro_rules! each_row {
-        ($($i:literal)*) => {
-            $(
-                if $i < D {
-                    backward::<D, W, $i>(f, x);
-                }
-            )*
-        };
-    }
-    each_row!(26 25 24 23 22 21 20 19 18 17 16 15 14 13 12 11 10 9 8 7 6 5 4 3 2 1 0);
-}
-
 /// Row `I` of `L y = x` (`f` is `D × D`, `x` is `D × W`, both row-major).
 #[inline(always)]
 fn forward<const D: usize, const W: usize, const I: usize>(f: &[f64], x: &mut [f64]) {

@@ -64,8 +64,6 @@ pub(crate) struct TreeKkt {
     fresh: Vec<bool>,
     /// Row sums of `|K|` in tree-space order (scratch).
     row_sums: Vec<f64>,
-    /// `D_i⁻¹ Y_i` of the node being eliminated (scratch).
-    scaled: Vec<f64>,
     knorm: f64,
     scratch: RefCell<Scratch>,
 }
@@ -107,7 +105,6 @@ impl TreeKkt {
             lu_only: false,
             fresh: vec![true; shape.at.len()],
             row_sums: vec![0.0; dim],
-            scaled: Vec::new(),
             knorm: 0.0,
             scratch: RefCell::new(Scratch {
                 x: Vec::with_capacity(dim),
@@ -267,23 +264,16 @@ impl TreeKkt {
             if p == u32::MAX || w == 0 {
                 continue;
             }
-            // LU: X_i = K_i⁻¹ C_i in the coupling slot, K_p −= C_iᵀ X_i. LDLᵀ: Y_i = L_i⁻¹ C_i
-            // there, K_p −= (D_i⁻¹ Y_i)ᵀ Y_i (the same `C_iᵀ K_i⁻¹ C_i`).
+            // X_i = K_i⁻¹ C_i in the coupling slot; K_p −= C_iᵀ X_i.
             let base = s.diag_at[i] + d * d;
             let (before, after) = rest.split_at_mut(s.coup_at[i] - base);
             let x = &mut after[..d * w];
             let c = &values[s.coup_at[i]..s.coup_at[i] + d * w];
             x.copy_from_slice(c);
-            let scaled = &mut self.scaled;
             if lu {
                 dense::lu_solve(blk, piv, d, x, w);
             } else {
-                dense::ldlt_forward(blk, d, x, w);
-                scaled.clear();
-                for a in 0..d {
-                    let p = 1.0 / blk[a * d + a];
-                    scaled.extend(x[a * w..a * w + w].iter().map(|&y| y * p));
-                }
+                dense::ldlt_solve(blk, d, x, w);
             }
             let p = p as usize;
             let dp = s.d[p];
@@ -293,11 +283,7 @@ impl TreeKkt {
                 before[r.start - base..r.end - base].copy_from_slice(&values[r]);
             }
             let pblk = &mut before[s.diag_at[p] - base..s.diag_at[p] - base + dp * dp];
-            if lu {
-                dense::sub_tr_mul_block(c, x, pblk, (d, w, dp), false);
-            } else {
-                dense::sub_tr_mul_block(scaled, x, pblk, (d, w, dp), true);
-            }
+            dense::sub_tr_mul_block(c, x, pblk, (d, w, dp), !lu);
         }
         Some(negative)
     }
@@ -336,13 +322,9 @@ impl TreeKkt {
     /// right side is zero, would pass zeros on); the backward pass (each node from its
     /// parent) ends at the node holding `need`, below which `x` is not read.
     fn tree_solve_from(&self, x: &mut [f64], lu: bool, lo: usize, need: usize) {
-        // LU: `y_i = K_i⁻¹ r_i`, `r_p −= C_iᵀ y_i` up, `x_i = y_i − X_i x_p` down. LDLᵀ:
-        // `v_i = L_i⁻¹ r_i`, `r_p −= Y_iᵀ D_i⁻¹ v_i` up, `x_i = L_i⁻ᵀ D_i⁻¹ (v_i − Y_i x_p)` down.
         let s = &self.shape;
         let nodes = s.at.len();
         let first = s.at.partition_point(|&a| a <= lo).saturating_sub(1);
-        let mut stack = [0.0; 32];
-        let mut heap = Vec::new();
         for i in first..nodes {
             let (at, d, w) = (s.at[i], s.d[i], s.w[i]);
             let blk = &self.factors[s.diag_at[i]..s.diag_at[i] + d * d];
@@ -351,45 +333,28 @@ impl TreeKkt {
             if lu {
                 dense::lu_solve(blk, &self.piv[at..at + d], d, y, 1);
             } else {
-                dense::ldlt_forward(blk, d, y, 1);
+                dense::ldlt_solve(blk, d, y, 1);
             }
             let p = s.parent[i];
             if p == u32::MAX {
                 continue;
             }
+            // r_p −= C_iᵀ y_i (the coupling's original values).
             let pa = s.at[p as usize] - at - d;
-            if lu {
-                // r_p −= C_iᵀ y_i (the coupling's original values).
-                let c = &self.values[s.coup_at[i]..s.coup_at[i] + d * w];
-                dense::sub_tr_mul(c, y, &mut tail[pa..pa + w], d, w);
-            } else {
-                let t = if d <= stack.len() {
-                    &mut stack[..d]
-                } else {
-                    heap.resize(d, 0.0);
-                    &mut heap[..]
-                };
-                for (k, (t, &v)) in t.iter_mut().zip(y.iter()).enumerate() {
-                    *t = v * (1.0 / blk[k * d + k]);
-                }
-                let ym = &self.factors[s.coup_at[i]..s.coup_at[i] + d * w];
-                dense::sub_tr_mul(ym, t, &mut tail[pa..pa + w], d, w);
-            }
+            let c = &self.values[s.coup_at[i]..s.coup_at[i] + d * w];
+            dense::sub_tr_mul(c, y, &mut tail[pa..pa + w], d, w);
         }
         let last = s.at.partition_point(|&a| a <= need).saturating_sub(1);
         for i in (last..nodes).rev() {
-            let (at, d, w) = (s.at[i], s.d[i], s.w[i]);
             let p = s.parent[i];
-            if p != u32::MAX {
-                let pa = s.at[p as usize];
-                let xm = &self.factors[s.coup_at[i]..s.coup_at[i] + d * w];
-                let (head, tail) = x.split_at_mut(pa);
-                dense::sub_mul(xm, &tail[..w], &mut head[at..at + d], d, w);
+            if p == u32::MAX {
+                continue;
             }
-            if !lu {
-                let blk = &self.factors[s.diag_at[i]..s.diag_at[i] + d * d];
-                dense::ldlt_backward(blk, d, &mut x[at..at + d], 1);
-            }
+            let (at, d, w) = (s.at[i], s.d[i], s.w[i]);
+            let pa = s.at[p as usize];
+            let xm = &self.factors[s.coup_at[i]..s.coup_at[i] + d * w];
+            let (head, tail) = x.split_at_mut(pa);
+            dense::sub_mul(xm, &tail[..w], &mut head[at..at + d], d, w);
         }
     }
 

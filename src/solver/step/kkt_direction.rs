@@ -14,12 +14,18 @@ use nalgebra::DVector;
 /// descent direction if no shift works. Also returns whether the step came from KKT factors
 /// with a positive definite reduced Hessian (LDLᵀ with one negative pivot per row), which then
 /// stay in `sys` for the step's second-order correction (module `second_order`).
+///
+/// Also returns the KKT solution's tangent step `δq = S δq̂` (all coordinates, unscaled)
+/// where the step came from the KKT system: `Z d` to the solve's rounding (its
+/// independent part is `Z d`'s to the last bit, its dependent part solves
+/// `Φ_u δq_u = −Φ_v δq_v` to the KKT solve's backward error), handed to the step cap
+/// (`step_cap::cap_tangent`) in place of a product `Z d`.
 pub(crate) fn kkt_direction(
     sys: &mut System,
     q: &DVector<f64>,
     part: &Partition,
     eval: &Eval,
-) -> (DVector<f64>, bool) {
+) -> (DVector<f64>, bool, Option<DVector<f64>>) {
     let g = &eval.grad_v;
     // Right side `−S (V_qᵀ − Φ_qᵀ μ)`: zero on the dependent coordinates (`Φ_uᵀ μ = V_uᵀ`) and
     // `−∇f` on the independent ones. It has the same projection `Zᵀ b = −∇f` as `−S V_qᵀ`,
@@ -54,7 +60,11 @@ pub(crate) fn kkt_direction(
                     == Factored::Ldlt {
                         negative: part.rows.len(),
                     };
-                return (d, definite);
+                let mut dq = dq;
+                for (x, &c) in dq.iter_mut().zip(&sys.problem.scaling.columns) {
+                    *x *= c;
+                }
+                return (d, definite, Some(dq));
             }
         }
         delta = if delta == 0.0 {
@@ -63,5 +73,5 @@ pub(crate) fn kkt_direction(
             delta * 100.0
         };
     }
-    (-g.clone(), false)
+    (-g.clone(), false, None)
 }

@@ -44,10 +44,24 @@ pub(crate) fn cap_step(
     part: &Partition,
     eval: &Eval,
     q: &DVector<f64>,
-    mut d: DVector<f64>,
+    d: DVector<f64>,
     options: &Options,
 ) -> Step {
-    let mut dq = sys.tangent_step(part, eval, &d);
+    let dq = sys.tangent_step(part, eval, &d);
+    cap_tangent(sys, q, d, dq, options)
+}
+
+/// [`cap_step`] of a reduced step `d` whose tangent step `δq` is known: the KKT direction's
+/// `δq` (module `kkt_direction`), which is `Z d` to the KKT solve's rounding (its dependent
+/// part satisfies `Φ_u δq_u = −Φ_v δq_v` to the solve's backward error, as `Z d`'s does to
+/// that of `Φ_u`'s factors), so no second solve with `Φ_u` forms it again.
+pub(crate) fn cap_tangent(
+    sys: &System,
+    q: &DVector<f64>,
+    mut d: DVector<f64>,
+    mut dq: DVector<f64>,
+    options: &Options,
+) -> Step {
     let l = sys.problem.model.length_scale.max(extent(q));
     let (mut rot, mut pos) = (0.0f64, 0.0f64);
     for (i, x) in dq.iter().enumerate() {

@@ -7,11 +7,9 @@
 //! axes `aᵀb` adds `B^a_kᵀ B^b_l` (and its transpose) and the curvatures `2 M(s^a_k, b)`,
 //! `2 M(s^b_l, a)`. Only the axes the rows read are formed (their `A(p_k) s`, `B(p_k, s)`);
 //! `d` enters by its body-frame offsets `s` alone (its curvature does not depend on `p`'s
-//! value), so its factors are not formed. The dot rows that share their first axis `a` are
-//! summed before the product: `Σ_r c_r aᵀb_r = aᵀu` with `u = Σ_r c_r b_r` (one direction
-//! per side of the `b_r`, its body-frame vector `Σ_r c_r s_r`), so a revolute's two axis
-//! rows form one `B` matrix and one product fewer. The entries are those of
-//! [`super::add_weighted_hessian`] restricted to [`crate::jet::EULER`] up to rounding.
+//! value), so its factors are not formed. The entries are those of
+//! [`super::add_weighted_hessian`] restricted to [`crate::jet::EULER`], added in the same
+//! order from the same operands: the same numbers to the last bit.
 
 #[cfg(test)]
 use super::OwnedRotations;
@@ -45,11 +43,22 @@ pub(crate) fn add_weighted_hessian_euler(
     let Some(layout) = layout(joint).filter(|_| euler_only(joint)) else {
         return;
     };
-    // The dot rows `Σ_r c_r a_rᵀ b_r` summed by their first axis and the side of their second:
-    // `Σ c aᵀb_r = aᵀ(Σ c b_r)`, and `Σ c b_r = A(p_k) Σ c s_r` is one direction of side `k`
-    // (a revolute's two rows `z₀ᵀx₁`, `z₀ᵀy₁` are `z₀ᵀu₁`, `u₁ = A(p₁)(c₁ x + c₂ y)`): one
-    // product `aᵀu` in place of one per row (the same Hessian up to rounding).
-    let mut combined: [[Option<Vector3<f64>>; 2]; 7] = [[None; 2]; 7];
+    // The axes the rows read, each formed once in place as `Frames::of` forms it.
+    let mut need = [false; 7];
+    for (row, &c) in layout.iter().zip(w) {
+        if let (Row::Dot(a, b), true) = (*row, c != 0.0) {
+            need[a as usize] = true;
+            need[b as usize] = true;
+        }
+    }
+    let mut axes: [Option<Lin>; 7] = [None; 7];
+    for (v, slot) in axes.iter_mut().enumerate().skip(1) {
+        if need[v] {
+            let (k, i) = ((v - 1) / 3, (v - 1) % 3);
+            let axis = rots.r[k].column(i).into_owned();
+            slot.insert(Lin::ZERO).set_vector(pair, rots.a[k], k, &axis);
+        }
+    }
     let mut wd = Vector3::zeros();
     for (row, &c) in layout.iter().zip(w) {
         if c == 0.0 {
@@ -58,25 +67,11 @@ pub(crate) fn add_weighted_hessian_euler(
         match *row {
             Row::Component(m) => wd[m] += c,
             Row::Dot(a, b) => {
-                let (k, i) = ((b as usize - 1) / 3, (b as usize - 1) % 3);
-                let s = rots.r[k].column(i) * c;
-                let slot = &mut combined[a as usize][k];
-                *slot = Some(slot.map_or(s, |x| x + s));
+                if let (Some(a), Some(b)) = (&axes[a as usize], &axes[b as usize]) {
+                    dot_hessian_euler(a, b, c, hp);
+                }
             }
             Row::Length | Row::Thread => unreachable!("not euler_only"),
-        }
-    }
-    for (v, sides) in combined.iter().enumerate().skip(1) {
-        if sides.iter().all(Option::is_none) {
-            continue;
-        }
-        let (k, i) = ((v - 1) / 3, (v - 1) % 3);
-        let a = Lin::vector(pair, rots.a[k], k, &rots.r[k].column(i).into_owned());
-        for (l, s) in sides.iter().enumerate() {
-            if let Some(s) = s {
-                let u = Lin::vector(pair, rots.a[l], l, s);
-                dot_hessian_euler(&a, &u, 1.0, hp);
-            }
         }
     }
     if wd != Vector3::zeros() {
@@ -104,11 +99,11 @@ mod tests {
     use crate::jet::testing::{check_scalar, every_kind, sample_joint, sample_pair};
     use crate::jet::{euler_to_local, LMat, Scalar, EULER};
 
-    /// The Euler-parameter Hessian equals the full one on its entries to 1e-12 of the largest
-    /// (the dot rows summed before their product), the full one is zero elsewhere, and each row's Hessian so formed matches central differences of the
+    /// The Euler-parameter Hessian equals the full one bit for bit on its entries, the full one
+    /// is zero elsewhere, and each row's Hessian so formed matches central differences of the
     /// row's gradient.
     #[test]
-    fn euler_hessian_is_the_full_one_restricted() {
+    fn euler_hessian_is_the_full_one_restricted_bit_for_bit() {
         let mut seen = 0;
         for kind in every_kind() {
             let j = sample_joint(kind);
@@ -127,20 +122,13 @@ mod tests {
                 let mut hp = SMatrix::<f64, 8, 8>::zeros();
                 add_weighted_hessian_euler(&j, &pair, &rots, &w, &mut hp);
                 assert!(hp.amax() > 0.0, "{}", kind.name());
-                // The general Hessian to rounding (the dot rows summed first), zero outside
-                // the Euler parameters.
                 let back = euler_to_local(&hp);
-                let scale = full.amax();
                 for (x, y) in full.iter().zip(back.iter()) {
-                    assert!(
-                        (x - y).abs() <= 1e-12 * scale,
-                        "{} seed {seed}: {x} against {y}",
-                        kind.name()
-                    );
+                    assert_eq!(x.to_bits(), y.to_bits(), "{} seed {seed}", kind.name());
                 }
                 for (a, &i) in EULER.iter().enumerate() {
                     for (b, &k) in EULER.iter().enumerate() {
-                        assert!((full[(i, k)] - hp[(a, b)]).abs() <= 1e-12 * scale);
+                        assert_eq!(full[(i, k)].to_bits(), hp[(a, b)].to_bits());
                     }
                 }
                 // Each row against central differences of its closed-form gradient.

@@ -102,8 +102,9 @@ mod tests {
                 .model;
             let start = crate::State::initial(&model);
             let mut branches = start.branches.clone();
-            let q = crate::solver::assemble::assemble(&model, start.q, &mut branches, &[], &options)
-                .expect("assembles");
+            let q =
+                crate::solver::assemble::assemble(&model, start.q, &mut branches, &[], &options)
+                    .expect("assembles");
             for backend in [Backend::Tree, Backend::Sparse] {
                 let cons = Constraints::new(&model, &[]).on_branches(branches.clone());
                 let mut sys = System::new(&model, cons, backend);

@@ -55,7 +55,7 @@ use super::step::newton::Settle;
 use super::step::path_cholesky::{self, Plan};
 use super::step::quasi_newton::QuasiNewton;
 use super::step::retraction::independent_change;
-use super::step::step_cap::{cap_step, cap_tangent, Step};
+use super::step::step_cap::{cap_known_step, Step};
 use super::system::{Backend, Eval, System};
 use super::unbounded::LinearDescent;
 use super::valley::Watch;
@@ -233,10 +233,7 @@ pub(crate) fn minimize(
             (None, Some((_, d))) => (d, false, None, None),
             (None, None) => reduced_step(sys, &mut s, (eig.as_ref(), plan), saddle, guard, options),
         };
-        let step = match tangent {
-            Some(dq) => cap_tangent(sys, &s.q, d, dq, options),
-            None => cap_step(sys, &s.part, &s.eval, &s.q, d, options),
-        };
+        let step = cap_known_step(sys, (&s.part, &s.eval), &s.q, (d, tangent), options);
         let slope = s.eval.grad_v.dot(&step.d);
         let failures_before = s.diag.corrector_failures;
         // From the step length the corrector last managed (with second-pass choices in the

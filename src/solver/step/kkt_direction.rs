@@ -19,7 +19,7 @@ use nalgebra::DVector;
 /// where the step came from the KKT system: `Z d` to the solve's rounding (its
 /// independent part is `Z d`'s to the last bit, its dependent part solves
 /// `Φ_u δq_u = −Φ_v δq_v` to the KKT solve's backward error), handed to the step cap
-/// (`step_cap::cap_tangent`) in place of a product `Z d`.
+/// (`step_cap::cap_known_step`) in place of a product `Z d`.
 pub(crate) fn kkt_direction(
     sys: &mut System,
     q: &DVector<f64>,

@@ -55,7 +55,7 @@ use super::step::newton::Settle;
 use super::step::path_cholesky::{self, Plan};
 use super::step::quasi_newton::QuasiNewton;
 use super::step::retraction::independent_change;
-use super::step::step_cap::{cap_known_step, Step};
+use super::step::step_cap::{cap_step, Step};
 use super::system::{Backend, Eval, System};
 use super::unbounded::LinearDescent;
 use super::valley::Watch;
@@ -228,12 +228,12 @@ pub(crate) fn minimize(
             (s.iteration == 0 && s.eval.grad_v.dot(&d) < 0.0).then_some(d)
         });
         let carried = rolled.is_some();
-        let (d, kkt, along_path, tangent) = match (rolled, reused) {
-            (Some(d), _) => (d, false, None, None),
-            (None, Some((_, d))) => (d, false, None, None),
+        let (d, kkt, along_path) = match (rolled, reused) {
+            (Some(d), _) => (d, false, None),
+            (None, Some((_, d))) => (d, false, None),
             (None, None) => reduced_step(sys, &mut s, (eig.as_ref(), plan), saddle, guard, options),
         };
-        let step = cap_known_step(sys, (&s.part, &s.eval), &s.q, (d, tangent), options);
+        let step = cap_step(sys, &s.part, &s.eval, &s.q, d, options);
         let slope = s.eval.grad_v.dot(&step.d);
         let failures_before = s.diag.corrector_failures;
         // From the step length the corrector last managed (with second-pass choices in the
@@ -423,7 +423,7 @@ fn reduced_step(
     negative_curvature: Option<DVector<f64>>,
     guard: Option<&Guard>,
     options: &Options,
-) -> (DVector<f64>, bool, Option<Spectrum>, Option<DVector<f64>>) {
+) -> (DVector<f64>, bool, Option<Spectrum>) {
     let dof = s.part.independent.len();
     let settle = s.settle.take(s.eval.grad_v.amax());
     let g = &s.eval.grad_v;
@@ -432,7 +432,6 @@ fn reduced_step(
         escaped,
         kkt,
         along_path,
-        tangent,
     } = direction(
         sys,
         (&s.q, &s.part, &s.eval),
@@ -446,9 +445,9 @@ fn reduced_step(
     s.diag.negative_curvature_steps += usize::from(escaped || negative_curvature.is_some());
     if d.dot(g) > 0.0 && !escaped {
         s.qn = QuasiNewton::new(dof, options.method);
-        return (-g.clone(), kkt, along_path, None);
+        return (-g.clone(), kkt, along_path);
     }
-    (d, kkt, along_path, tangent)
+    (d, kkt, along_path)
 }
 
 /// Stage 6: moves to the accepted trial point: the line search's next start, the quasi-Newton

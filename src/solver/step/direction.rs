@@ -39,9 +39,6 @@ pub(crate) struct Direction {
     /// The spectrum of the Hessian along the path `Ĥ + C` where the step was taken with it
     /// (item 1; module `path_hessian`), for the valley watch (module `valley`).
     pub(crate) along_path: Option<Spectrum>,
-    /// The tangent step `δq = Z d` where the direction came with it (the KKT direction's
-    /// `δq`, to the solve's rounding: module `kkt_direction`), for the step cap.
-    pub(crate) tangent: Option<DVector<f64>>,
 }
 
 impl Direction {
@@ -51,7 +48,6 @@ impl Direction {
             escaped: false,
             kkt,
             along_path: None,
-            tangent: None,
         }
     }
 }
@@ -78,7 +74,6 @@ pub(crate) fn direction(
         escaped,
         kkt: false,
         along_path,
-        tangent: None,
     };
     if let Some(plan) = plan {
         return along(path_cholesky::planned_step(
@@ -116,11 +111,8 @@ pub(crate) fn direction(
                 Direction::plain(newton_step(e, g, None).0, false)
             }
             (_, Method::Newton) => {
-                let (d, kkt, tangent) = kkt_direction(sys, q, part, eval);
-                Direction {
-                    tangent,
-                    ..Direction::plain(d, kkt)
-                }
+                let (d, kkt) = kkt_direction(sys, q, part, eval);
+                Direction::plain(d, kkt)
             }
             _ => Direction::plain(-(binv * g), false),
         },

@@ -14,18 +14,12 @@ use nalgebra::DVector;
 /// descent direction if no shift works. Also returns whether the step came from KKT factors
 /// with a positive definite reduced Hessian (LDLᵀ with one negative pivot per row), which then
 /// stay in `sys` for the step's second-order correction (module `second_order`).
-///
-/// Also returns the KKT solution's tangent step `δq = S δq̂` (all coordinates, unscaled)
-/// where the step came from the KKT system: `Z d` to the solve's rounding (its
-/// independent part is `Z d`'s to the last bit, its dependent part solves
-/// `Φ_u δq_u = −Φ_v δq_v` to the KKT solve's backward error), handed to the step cap
-/// (`step_cap::cap_known_step`) in place of a product `Z d`.
 pub(crate) fn kkt_direction(
     sys: &mut System,
     q: &DVector<f64>,
     part: &Partition,
     eval: &Eval,
-) -> (DVector<f64>, bool, Option<DVector<f64>>) {
+) -> (DVector<f64>, bool) {
     let g = &eval.grad_v;
     // Right side `−S (V_qᵀ − Φ_qᵀ μ)`: zero on the dependent coordinates (`Φ_uᵀ μ = V_uᵀ`) and
     // `−∇f` on the independent ones. It has the same projection `Zᵀ b = −∇f` as `−S V_qᵀ`,
@@ -60,11 +54,7 @@ pub(crate) fn kkt_direction(
                     == Factored::Ldlt {
                         negative: part.rows.len(),
                     };
-                let mut dq = dq;
-                for (x, &c) in dq.iter_mut().zip(&sys.problem.scaling.columns) {
-                    *x *= c;
-                }
-                return (d, definite, Some(dq));
+                return (d, definite);
             }
         }
         delta = if delta == 0.0 {
@@ -73,53 +63,5 @@ pub(crate) fn kkt_direction(
             delta * 100.0
         };
     }
-    (-g.clone(), false, None)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::kkt_direction;
-    use crate::constraints::Constraints;
-    use crate::solver::options::Options;
-    use crate::solver::system::{Backend, System};
-    use crate::urdf::{load_str, ImportOptions};
-
-    /// The KKT solution's tangent step is `Z d` of its reduced step to rounding, at the
-    /// assembled start of a chain, a ladder (loops) and the spatial four-bar, on the tree and
-    /// the sparse backends: its independent part to the last bit, all of it to 10⁻¹² of its
-    /// largest entry.
-    #[test]
-    fn the_kkt_tangent_step_is_z_d() {
-        let texts = [
-            crate::generate::chain(30, false),
-            crate::generate::ladder(6),
-            include_str!("../../../robots/four_bar_spatial.urdf").to_string(),
-        ];
-        let options = Options::default();
-        for text in &texts {
-            let model = load_str(text, "m.urdf", &ImportOptions::default())
-                .expect("model loads")
-                .model;
-            let start = crate::State::initial(&model);
-            let mut branches = start.branches.clone();
-            let q =
-                crate::solver::assemble::assemble(&model, start.q, &mut branches, &[], &options)
-                    .expect("assembles");
-            for backend in [Backend::Tree, Backend::Sparse] {
-                let cons = Constraints::new(&model, &[]).on_branches(branches.clone());
-                let mut sys = System::new(&model, cons, backend);
-                let part = sys.partition(&q);
-                let eval = sys.evaluate(&q, &part).expect("evaluates");
-                let (d, _, tangent) = kkt_direction(&mut sys, &q, &part, &eval);
-                let tangent = tangent.expect("the step came from the KKT system");
-                let z_d = sys.tangent_step(&part, &eval, &d);
-                for &c in &part.independent {
-                    assert_eq!(tangent[c].to_bits(), z_d[c].to_bits(), "{backend:?}");
-                }
-                let err = (&tangent - &z_d).amax() / z_d.amax();
-                assert!(err <= 1e-12, "{backend:?}: relative difference {err:e}");
-                assert!(z_d.amax() > 0.0);
-            }
-        }
-    }
+    (-g.clone(), false)
 }

@@ -344,7 +344,7 @@ mod tests {
         assert_eq!(f.hessian, formed(sys, &q, &part, &eval).hessian);
         let (d, escaped, spectrum) = planned_step(sys, at, Plan::Far(f), None, &options);
         assert!(!escaped && spectrum.is_none(), "taken by Cholesky");
-        let (by_kkt, definite, _) = kkt_direction(sys, &q, &part, &eval);
+        let (by_kkt, definite) = kkt_direction(sys, &q, &part, &eval);
         assert!(definite, "Ĥ positive definite here");
         let err = (&d - &by_kkt).amax() / by_kkt.amax();
         assert!(err < 1e-12, "relative difference {err:e}");

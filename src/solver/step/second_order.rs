@@ -126,7 +126,7 @@ mod tests {
         let mut sys = System::new(&model, cons, Backend::Sparse);
         let part = sys.partition(&q);
         let eval = sys.evaluate(&q, &part).unwrap();
-        let (d, _, _) = kkt_direction(&mut sys, &q, &part, &eval);
+        let (d, _) = kkt_direction(&mut sys, &q, &part, &eval);
         let dq = sys.tangent_step(&part, &eval, &d);
         let dq = &dq * (0.5 / dq.amax());
         let mut plain = Vec::new();

@@ -1,6 +1,5 @@
 //! The step limit of the minimizer (stage 4 of module `minimize`): the tangent step
-//! `δq = Z d` of a reduced step `d` (formed here, or the KKT direction's own `δq`, which is
-//! `Z d` to rounding: module `kkt_direction`) is shortened, with `d`, so that every body's Euler
+//! `δq = Z d` of a reduced step `d` is shortened, with `d`, so that every body's Euler
 //! parameters change by at most `max_step` and its origin by at most `10 max_step ℓ`,
 //! `ℓ = max(L, extent)`: `L` the characteristic length, the extent the diagonal of the
 //! bounding box of the body origins.
@@ -45,24 +44,10 @@ pub(crate) fn cap_step(
     part: &Partition,
     eval: &Eval,
     q: &DVector<f64>,
-    d: DVector<f64>,
+    mut d: DVector<f64>,
     options: &Options,
 ) -> Step {
-    cap_known_step(sys, (part, eval), q, (d, None), options)
-}
-
-/// [`cap_step`] of a reduced step `d` whose tangent step `δq` may be known: the KKT
-/// direction's `δq` (module `kkt_direction`), which is `Z d` to the KKT solve's rounding (its
-/// dependent part satisfies `Φ_u δq_u = −Φ_v δq_v` to the solve's backward error, as `Z d`'s
-/// does to that of `Φ_u`'s factors), so that no second solve with `Φ_u` forms it again.
-pub(crate) fn cap_known_step(
-    sys: &System,
-    (part, eval): (&Partition, &Eval),
-    q: &DVector<f64>,
-    (mut d, tangent): (DVector<f64>, Option<DVector<f64>>),
-    options: &Options,
-) -> Step {
-    let mut dq = tangent.unwrap_or_else(|| sys.tangent_step(part, eval, &d));
+    let mut dq = sys.tangent_step(part, eval, &d);
     let l = sys.problem.model.length_scale.max(extent(q));
     let (mut rot, mut pos) = (0.0f64, 0.0f64);
     for (i, x) in dq.iter().enumerate() {

@@ -96,9 +96,6 @@ pub(crate) struct FusedSink<'a> {
     blocks: &'a mut [[f64; 49]],
     /// A term reached a body pair the structure does not hold.
     pub(crate) missing: bool,
-    /// The body pair of the last [`HessianSink::add_entry`] and its compact block (a
-    /// normalization row adds its four entries to one block in turn).
-    last_entry: Option<((usize, usize), Option<usize>)>,
 }
 
 impl FusedSink<'_> {
@@ -150,16 +147,7 @@ impl HessianSink for FusedSink<'_> {
     }
 
     fn add_entry(&mut self, i: usize, j: usize, v: f64) {
-        let pair = (i / 7, j / 7);
-        let k = match self.last_entry {
-            Some((last, k)) if last == pair => k,
-            _ => {
-                let k = self.block(BodyId(pair.0), BodyId(pair.1));
-                self.last_entry = Some((pair, k));
-                k
-            }
-        };
-        if let Some(k) = k {
+        if let Some(k) = self.block(BodyId(i / 7), BodyId(j / 7)) {
             self.blocks[k][7 * (i % 7) + j % 7] += v;
         }
     }
@@ -226,7 +214,6 @@ impl TreeKkt {
             map: self.map.get_or_insert_with(|| BlockMap::new(0, &[], &[])),
             blocks: &mut self.w_blocks,
             missing: false,
-            last_entry: None,
         }
     }
 

@@ -16,8 +16,11 @@
 //! entry before their own (the rows closing a loop, pivoted last) form a **border** `B`; with
 //! `T` the rest, `Φ_u = [T C; R D]` is solved through the dense Schur complement
 //! `S = D − R T⁻¹ C` (module `border`). Where each Jacobian triplet goes in the factor buffer
-//! is laid out once per partition (module `split`).
+//! is laid out once per partition (module `split`). A node's entries `A_ij` (`j ≠ i`) are taken
+//! as one small dense block where they fit one (module `blocks`: a chain body's joint rows on
+//! its parent), else as the segments of module `segments`.
 
+use super::blocks::Blocks;
 use super::border::Border;
 use super::dense;
 use super::segments::Segments;
@@ -46,6 +49,8 @@ pub(crate) struct Shape {
     off_at: Vec<usize>,
     /// The same entries as dense segments (the solves' updates, module `segments`).
     segments: Segments,
+    /// The nodes' entries as dense blocks, for the nodes whose entries fit one.
+    blocks: Blocks,
     border: Border,
     /// `(row position, independent position)` of the `Φ_v` entries.
     v_at: Vec<(u32, u32)>,
@@ -77,6 +82,8 @@ pub(crate) struct TreeLu {
     /// The diagonal blocks (factored in place), the off-diagonal entries, the border, the
     /// `Φ_v` entries and the spare slot, laid out as [`Shape`] says.
     vals: Vec<f64>,
+    /// The off-diagonal values gathered into the nodes' blocks (module `blocks`).
+    packed: Vec<f64>,
     piv: Vec<u16>,
     border_piv: Vec<u16>,
     ok: bool,
@@ -101,6 +108,7 @@ impl TreeSplit {
             None => Arc::new(TreeLu {
                 shape: shape.clone(),
                 vals: vec![0.0; shape.len],
+                packed: vec![0.0; shape.blocks.len()],
                 piv: vec![0; shape.order],
                 border_piv: vec![0; shape.border.size()],
                 ok: false,
@@ -123,6 +131,9 @@ impl TreeSplit {
                     *at += e.2;
                 }
             }
+            shape
+                .blocks
+                .pack(&f.vals[shape.off0..shape.border0], &mut f.packed);
             f.ok = f.factor_blocks();
             f.watch = watch;
         }
@@ -183,7 +194,11 @@ impl TreeLu {
             let (a, b) = s.span[i];
             let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];
             dense::lu_solve_transpose(blk, &self.piv[a..b], b - a, &mut x[a..b]);
-            s.segments.transposed(i, off, x);
+            if s.blocks.has(i) {
+                s.blocks.transposed(i, &self.packed, x);
+            } else {
+                s.segments.transposed(i, off, x);
+            }
         }
     }
 
@@ -204,7 +219,11 @@ impl TreeLu {
         let (diag, rest) = self.vals.split_at(s.off0);
         let off = &rest[..s.border0 - s.off0];
         for i in (first..nodes).rev() {
-            s.segments.forward(i, off, x);
+            if s.blocks.has(i) {
+                s.blocks.forward(i, &self.packed, x);
+            } else {
+                s.segments.forward(i, off, x);
+            }
             let (a, b) = s.span[i];
             let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];
             dense::lu_solve(blk, &self.piv[a..b], b - a, &mut x[a..b], 1);
@@ -230,7 +249,8 @@ impl TreeLu {
                 |y, t| self.tree_solve(y, t),
             );
         }
-        x.iter().all(|v| v.is_finite())
+        // Without a short cut: vector lanes.
+        !x.iter().fold(false, |bad, v| bad | !v.is_finite())
     }
 
     /// The smallest pivot of the diagonal blocks' `U` (and of the border's `S`) over the

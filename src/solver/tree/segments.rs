@@ -42,8 +42,9 @@ const GATHER: usize = 32;
 
 impl Segments {
     /// The segments of the entries `off` (grouped by node: node `i`'s are
-    /// `off[off_at[i] .. off_at[i + 1]]`, in the triplets' order).
-    pub(crate) fn new(off: &[(u32, u32)], off_at: &[usize]) -> Self {
+    /// `off[off_at[i] .. off_at[i + 1]]`, in the triplets' order) of the nodes `i` that `take`
+    /// (the others have none).
+    pub(crate) fn new(off: &[(u32, u32)], off_at: &[usize], take: impl Fn(usize) -> bool) -> Self {
         // Sized for the most a segment list can hold (a row's one row and its columns per
         // entry; untouched capacity costs no page): no regrowth copies.
         let mut s = Segments {
@@ -52,9 +53,9 @@ impl Segments {
             idx: Vec::with_capacity(2 * off.len()),
         };
         s.at.push(0);
-        for w in off_at.windows(2) {
+        for (i, w) in off_at.windows(2).enumerate() {
             let mut k = w[0];
-            while k < w[1] {
+            while take(i) && k < w[1] {
                 // The row starting at `k`.
                 let p = off[k].0;
                 let end = (k..w[1]).find(|&j| off[j].0 != p).unwrap_or(w[1]);
@@ -270,7 +271,7 @@ mod tests {
         }
         let vals: Vec<f64> = off.iter().map(|_| rnd()).collect();
         let x0: Vec<f64> = (0..n).map(|_| rnd()).collect();
-        let seg = Segments::new(&off, &off_at);
+        let seg = Segments::new(&off, &off_at, |_| true);
         assert_eq!(seg.at.len(), nodes.len() + 1);
         // Distinct columns: near each other or far apart, a repeat either way.
         let row = |cols: &[u32]| cols.iter().map(|&q| (0, q)).collect::<Vec<_>>();

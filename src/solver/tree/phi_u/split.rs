@@ -20,6 +20,7 @@
 use super::{Shape, TreeSplit, MAX_BORDER};
 use crate::constraints::Triplet;
 use crate::solver::partition::Partition;
+use crate::solver::tree::blocks::Blocks;
 use crate::solver::tree::border::Border;
 use crate::solver::tree::segments::Segments;
 use crate::solver::tree::shape::FIRST;
@@ -189,6 +190,7 @@ impl TreeSplit {
         if spare_at.is_empty() {
             bare.push(spare);
         }
+        let blocks = Blocks::new(&off, &off_at);
         Some(Built::Split(TreeSplit {
             id: part.id,
             triplets: entries.len(),
@@ -196,7 +198,8 @@ impl TreeSplit {
                 order,
                 span,
                 diag_at,
-                segments: Segments::new(&off, &off_at),
+                segments: Segments::new(&off, &off_at, |i| !blocks.has(i)),
+                blocks,
                 off,
                 off_at,
                 border,

@@ -17,16 +17,15 @@
 //! for the sign of a zero (`−0 − 0 · y = +0`) and a non-finite `y` (then the solve fails
 //! either way). A node gets a block when each side is at most [`MAX`], the block holds at most
 //! [`FILL`] times its entries, each row's entries are one run without a repeated column, and
-//! the rows' column orders agree. The values are gathered into the blocks once per
-//! factorization ([`Blocks::pack`]); the zeros are written when the buffer is made and never
-//! touched again.
+//! the rows' column orders agree. [`Blocks::new`] also lays out the off-diagonal values of the
+//! factor buffer: node after node, a block (its zeros written when the buffer is made, never
+//! reached by a triplet after), or a node's entries in their order (the segments'); the
+//! Jacobian's triplets are scattered straight there (`Blocks::to`, module `phi_u::split`).
 
 /// The largest side of a block.
 pub(crate) const MAX: usize = 16;
 /// A block holds at most this many times its node's entries.
 const FILL: usize = 3;
-/// [`Blocks::to`]'s mark for an entry of a node without a block.
-const NONE: u32 = u32::MAX;
 
 /// The blocks of the nodes that have one.
 #[derive(Default)]
@@ -35,13 +34,14 @@ pub(crate) struct Blocks {
     node: Vec<Block>,
     /// Each block's row positions, then its column positions.
     idx: Vec<u32>,
-    /// The index of each off-diagonal entry in the packed values ([`NONE`]: its node has none).
+    /// The index of each off-diagonal entry in the off-diagonal values.
     to: Vec<u32>,
-    /// The packed values' length.
+    /// The off-diagonal values' length.
     len: usize,
 }
 
-/// An `r × c` block, its rows and columns from `idx`, its values row-major from `at`.
+/// An `r × c` block, its rows and columns from `idx`, its values row-major from `at` (`r == 0`:
+/// no block, the node's entries' values from `at` in their order).
 #[derive(Clone, Copy, Default)]
 struct Block {
     r: u8,
@@ -52,12 +52,14 @@ struct Block {
 
 impl Blocks {
     /// The blocks of the entries `off` (grouped by node: node `i`'s are
-    /// `off[off_at[i] .. off_at[i + 1]]`, in the triplets' order).
+    /// `off[off_at[i] .. off_at[i + 1]]`, in the triplets' order), and the layout of the
+    /// off-diagonal values: node after node, a block node's `r × c` block (row-major, zero
+    /// where no entry lies), another node's entries in their order.
     pub(crate) fn new(off: &[(u32, u32)], off_at: &[usize]) -> Self {
         let mut b = Blocks {
             node: Vec::with_capacity(off_at.len().saturating_sub(1)),
             idx: Vec::new(),
-            to: vec![NONE; off.len()],
+            to: vec![0; off.len()],
             len: 0,
         };
         let mut o = Order::default();
@@ -73,8 +75,15 @@ impl Blocks {
             }
             let to = &mut b.to[w[0]..w[1]];
             if !o.of(e, to) {
-                to.fill(NONE);
-                b.node.push(Block::default());
+                // The entries in their order.
+                for (k, t) in to.iter_mut().enumerate() {
+                    *t = (b.len + k) as u32;
+                }
+                b.node.push(Block {
+                    at: b.len as u32,
+                    ..Block::default()
+                });
+                b.len += e.len();
                 continue;
             }
             let (r, c) = (o.r, o.c);
@@ -143,20 +152,20 @@ impl Blocks {
         true
     }
 
-    /// The packed values' length (a buffer of zeros this long is what [`Blocks::pack`] fills).
+    /// The off-diagonal values' length.
     pub(crate) fn len(&self) -> usize {
         self.len
     }
 
-    /// Gathers the off-diagonal values `off` into the blocks `packed` (made zero once: the
-    /// entries always reach the same places).
-    pub(crate) fn pack(&self, off: &[f64], packed: &mut [f64]) {
-        for (&t, &v) in self.to.iter().zip(off) {
-            // `NONE` lies outside.
-            if let Some(at) = packed.get_mut(t as usize) {
-                *at = v;
-            }
-        }
+    /// Where the off-diagonal entry `k` goes in the off-diagonal values.
+    pub(crate) fn to(&self, k: usize) -> usize {
+        self.to[k] as usize
+    }
+
+    /// Where node `i`'s values start, if it has no block (its entries in their order).
+    pub(crate) fn base(&self, i: usize) -> Option<usize> {
+        let b = self.node[i];
+        (b.r == 0).then_some(b.at as usize)
     }
 
     /// Whether node `i` has a block (else its entries are the segments').
@@ -165,16 +174,16 @@ impl Blocks {
     }
 
     /// Node `i`'s block: its rows, its columns and its values.
-    fn parts<'a>(&'a self, i: usize, packed: &'a [f64]) -> (&'a [u32], &'a [u32], &'a [f64]) {
+    fn parts<'a>(&'a self, i: usize, vals: &'a [f64]) -> (&'a [u32], &'a [u32], &'a [f64]) {
         let b = self.node[i];
         let (r, c) = (b.r as usize, b.c as usize);
         let (rows, cols) = self.idx[b.idx as usize..b.idx as usize + r + c].split_at(r);
-        (rows, cols, &packed[b.at as usize..b.at as usize + r * c])
+        (rows, cols, &vals[b.at as usize..b.at as usize + r * c])
     }
 
-    /// `x_p −= Σ_q C_pq x_q` over node `i`'s block (`packed`: the blocks' values).
-    pub(crate) fn forward(&self, i: usize, packed: &[f64], x: &mut [f64]) {
-        let (rows, cols, v) = self.parts(i, packed);
+    /// `x_p −= Σ_q C_pq x_q` over node `i`'s block (`vals`: the off-diagonal values).
+    pub(crate) fn forward(&self, i: usize, vals: &[f64], x: &mut [f64]) {
+        let (rows, cols, v) = self.parts(i, vals);
         match (rows.len(), cols.len()) {
             (5, 5) => forward_fixed::<5, 5>(rows, cols, v, x),
             (5, 6) => forward_fixed::<5, 6>(rows, cols, v, x),
@@ -183,14 +192,30 @@ impl Blocks {
         }
     }
 
-    /// `x_q −= Σ_p C_pq x_p` over node `i`'s block (`packed`: the blocks' values).
-    pub(crate) fn transposed(&self, i: usize, packed: &[f64], x: &mut [f64]) {
-        let (rows, cols, v) = self.parts(i, packed);
+    /// `x_q −= Σ_p C_pq x_p` over node `i`'s block (`vals`: the off-diagonal values).
+    pub(crate) fn transposed(&self, i: usize, vals: &[f64], x: &mut [f64]) {
+        let (rows, cols, v) = self.parts(i, vals);
         match (rows.len(), cols.len()) {
             (5, 5) => transposed_fixed::<5, 5>(rows, cols, v, x),
             (5, 6) => transposed_fixed::<5, 6>(rows, cols, v, x),
             (6, 6) => transposed_fixed::<6, 6>(rows, cols, v, x),
             _ => transposed_any(rows, cols, v, x),
+        }
+    }
+
+    /// [`Blocks::forward`] on the `w` columns of the row-major `x` (`order × w`): each
+    /// column's terms as one column's.
+    pub(crate) fn forward_columns(&self, i: usize, vals: &[f64], x: &mut [f64], w: usize) {
+        let (rows, cols, v) = self.parts(i, vals);
+        for (&p, vr) in rows.iter().zip(v.chunks_exact(cols.len())) {
+            let p = p as usize * w;
+            for c in 0..w {
+                let mut s = x[p + c];
+                for (&u, &q) in vr.iter().zip(cols) {
+                    s -= u * x[q as usize * w + c];
+                }
+                x[p + c] = s;
+            }
         }
     }
 }
@@ -401,9 +426,20 @@ mod tests {
         let vals: Vec<f64> = off.iter().map(|_| rnd()).collect();
         let x0: Vec<f64> = (0..n).map(|_| rnd()).collect();
         let blocks = Blocks::new(&off, &off_at);
-        assert_eq!(blocks.len(), 30 + 30 + 9 + 4);
+        // The blocks, then the other nodes' entries one by one.
+        assert_eq!(blocks.len(), 30 + 30 + 9 + 4 + 21 + 40 + 4 + 2 + 3 + 2 + 4);
         let mut packed = vec![0.0; blocks.len()];
-        blocks.pack(&vals, &mut packed);
+        for (k, &v) in vals.iter().enumerate() {
+            packed[blocks.to(k)] = v;
+        }
+        for (i, (_, has)) in nodes.iter().enumerate() {
+            let at = blocks.base(i);
+            assert_eq!(at.is_none(), *has, "node {i}");
+            if let Some(at) = at {
+                let r = off_at[i]..off_at[i + 1];
+                assert_eq!(&packed[at..at + r.len()], &vals[r], "node {i} in order");
+            }
+        }
         let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
         for (i, (_, has)) in nodes.iter().enumerate() {
             assert_eq!(blocks.has(i), *has, "node {i}");
@@ -424,6 +460,17 @@ mod tests {
             }
             blocks.transposed(i, &packed, &mut b);
             assert_eq!(bits(&a), bits(&b), "transposed, node {i}");
+            // Three columns at once: each column's forward update.
+            let w = 3;
+            let cols: Vec<Vec<f64>> = (0..w).map(|_| (0..n).map(|_| rnd()).collect()).collect();
+            let mut wide: Vec<f64> = (0..n as usize * w).map(|k| cols[k % w][k / w]).collect();
+            blocks.forward_columns(i, &packed, &mut wide, w);
+            for (c, col) in cols.iter().enumerate() {
+                let mut one = col.clone();
+                blocks.forward(i, &packed, &mut one);
+                let got: Vec<f64> = (0..n as usize).map(|k| wide[k * w + c]).collect();
+                assert_eq!(bits(&got), bits(&one), "forward, {w} columns, node {i}");
+            }
         }
     }
 }

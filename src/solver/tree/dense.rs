@@ -185,25 +185,21 @@ fn lu_solve_impl(f: &[f64], piv: &[u16], d: usize, x: &mut [f64], w: usize) {
             }
         }
     }
-    // A single right side takes every term (straight code: `x − 0 · y` is `x` but in the
-    // sign of a zero); several skip a zero factor's row operation.
+    // Every term, a zero factor's too (straight code: `x − 0 · y` is `x` but in the sign of a
+    // zero), so that `w` right sides give each one's values to the bit.
     for i in 0..d {
         for k in 0..i {
             let l = f[i * d + k];
-            if w == 1 || l != 0.0 {
-                for c in 0..w {
-                    x[i * w + c] -= l * x[k * w + c];
-                }
+            for c in 0..w {
+                x[i * w + c] -= l * x[k * w + c];
             }
         }
     }
     for i in (0..d).rev() {
         for k in i + 1..d {
             let u = f[i * d + k];
-            if w == 1 || u != 0.0 {
-                for c in 0..w {
-                    x[i * w + c] -= u * x[k * w + c];
-                }
+            for c in 0..w {
+                x[i * w + c] -= u * x[k * w + c];
             }
         }
         let p = 1.0 / f[i * d + i];

@@ -82,8 +82,6 @@ pub(crate) struct TreeLu {
     /// The diagonal blocks (factored in place), the off-diagonal entries, the border, the
     /// `Φ_v` entries and the spare slot, laid out as [`Shape`] says.
     vals: Vec<f64>,
-    /// The off-diagonal values gathered into the nodes' blocks (module `blocks`).
-    packed: Vec<f64>,
     piv: Vec<u16>,
     border_piv: Vec<u16>,
     ok: bool,
@@ -108,7 +106,6 @@ impl TreeSplit {
             None => Arc::new(TreeLu {
                 shape: shape.clone(),
                 vals: vec![0.0; shape.len],
-                packed: vec![0.0; shape.blocks.len()],
                 piv: vec![0; shape.order],
                 border_piv: vec![0; shape.border.size()],
                 ok: false,
@@ -131,9 +128,6 @@ impl TreeSplit {
                     *at += e.2;
                 }
             }
-            shape
-                .blocks
-                .pack(&f.vals[shape.off0..shape.border0], &mut f.packed);
             f.ok = f.factor_blocks();
             f.watch = watch;
         }
@@ -195,7 +189,7 @@ impl TreeLu {
             let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];
             dense::lu_solve_transpose(blk, &self.piv[a..b], b - a, &mut x[a..b]);
             if s.blocks.has(i) {
-                s.blocks.transposed(i, &self.packed, x);
+                s.blocks.transposed(i, off, x);
             } else {
                 s.segments.transposed(i, off, x);
             }
@@ -220,7 +214,7 @@ impl TreeLu {
         let off = &rest[..s.border0 - s.off0];
         for i in (first..nodes).rev() {
             if s.blocks.has(i) {
-                s.blocks.forward(i, &self.packed, x);
+                s.blocks.forward(i, off, x);
             } else {
                 s.segments.forward(i, off, x);
             }
@@ -333,10 +327,14 @@ impl TreeLu {
         }
         let (diag, off) = self.vals[..s.border0].split_at(s.off0);
         for i in (0..s.span.len()).rev() {
-            let r = s.off_at[i]..s.off_at[i + 1];
-            for (&(p, q), &v) in s.off[r.clone()].iter().zip(&off[r]) {
-                let (p, q) = (p as usize * w, q as usize * w);
-                (0..w).for_each(|c| x[p + c] -= v * x[q + c]);
+            if let Some(at) = s.blocks.base(i) {
+                let e = &s.off[s.off_at[i]..s.off_at[i + 1]];
+                for (&(p, q), &v) in e.iter().zip(&off[at..at + e.len()]) {
+                    let (p, q) = (p as usize * w, q as usize * w);
+                    (0..w).for_each(|c| x[p + c] -= v * x[q + c]);
+                }
+            } else {
+                s.blocks.forward_columns(i, off, x, w);
             }
             let (a, b) = s.span[i];
             let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];

@@ -160,9 +160,6 @@ fn lu_impl(a: &mut [f64], d: usize, piv: &mut [u16]) -> bool {
     true
 }
 
-/// Blocks up to this order are solved without skipping zero factors ([`lu_solve`]).
-const STRAIGHT: usize = 7;
-
 /// `x ← A⁻¹ x` for the factors of [`lu`]; `x` is `d × w` row-major.
 pub(crate) fn lu_solve(f: &[f64], piv: &[u16], d: usize, x: &mut [f64], w: usize) {
     match (d, w) {
@@ -188,15 +185,10 @@ fn lu_solve_impl(f: &[f64], piv: &[u16], d: usize, x: &mut [f64], w: usize) {
             }
         }
     }
-    // A small block takes every term, zero factors' too (straight code: `x − 0 · y` is `x` but
-    // in the sign of a zero); a larger one (a ladder's super-nodes, sparse factors) skips a
-    // zero factor's row operation. Either way for any `w`: `w` right sides give each one's
-    // values to the bit.
-    let every = d <= STRAIGHT;
     for i in 0..d {
         for k in 0..i {
             let l = f[i * d + k];
-            if every || l != 0.0 {
+            if l != 0.0 {
                 for c in 0..w {
                     x[i * w + c] -= l * x[k * w + c];
                 }
@@ -206,7 +198,7 @@ fn lu_solve_impl(f: &[f64], piv: &[u16], d: usize, x: &mut [f64], w: usize) {
     for i in (0..d).rev() {
         for k in i + 1..d {
             let u = f[i * d + k];
-            if every || u != 0.0 {
+            if u != 0.0 {
                 for c in 0..w {
                     x[i * w + c] -= u * x[k * w + c];
                 }

@@ -9,7 +9,6 @@
 //!   ladder's block sizes;
 //! - `phi_u`: `Φ_u` as a block upper triangular matrix (corrector, multipliers, tangent steps);
 //! - `segments`: its off-diagonal entries as dense row × column segments for the solves;
-//! - `blocks`: a node's off-diagonal entries as one small dense block where they fit one;
 //! - `shape`: the KKT matrix's nodes, parents, border and value slots, once per partition;
 //! - `nodes`: its nodes' unknowns, the pairs of nodes coupled by a value, the bordered tree;
 //! - `fused`: the Newton step's assembly of `W`, its terms added into the tree's body-pair
@@ -22,7 +21,6 @@
 //! The sparse path (module `sparse`) stays the reference and the fallback: where a partition's
 //! structure does not fit (a super-node above its limit), the system uses it instead.
 
-mod blocks;
 mod border;
 pub(crate) mod dense;
 mod fixed;

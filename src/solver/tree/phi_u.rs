@@ -16,11 +16,8 @@
 //! entry before their own (the rows closing a loop, pivoted last) form a **border** `B`; with
 //! `T` the rest, `Φ_u = [T C; R D]` is solved through the dense Schur complement
 //! `S = D − R T⁻¹ C` (module `border`). Where each Jacobian triplet goes in the factor buffer
-//! is laid out once per partition (module `split`). A node's entries `A_ij` (`j ≠ i`) are taken
-//! as one small dense block where they fit one (module `blocks`: a chain body's joint rows on
-//! its parent), else as the segments of module `segments`.
+//! is laid out once per partition (module `split`).
 
-use super::blocks::Blocks;
 use super::border::Border;
 use super::dense;
 use super::segments::Segments;
@@ -49,8 +46,6 @@ pub(crate) struct Shape {
     off_at: Vec<usize>,
     /// The same entries as dense segments (the solves' updates, module `segments`).
     segments: Segments,
-    /// The nodes' entries as dense blocks, for the nodes whose entries fit one.
-    blocks: Blocks,
     border: Border,
     /// `(row position, independent position)` of the `Φ_v` entries.
     v_at: Vec<(u32, u32)>,
@@ -188,11 +183,7 @@ impl TreeLu {
             let (a, b) = s.span[i];
             let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];
             dense::lu_solve_transpose(blk, &self.piv[a..b], b - a, &mut x[a..b]);
-            if s.blocks.has(i) {
-                s.blocks.transposed(i, off, x);
-            } else {
-                s.segments.transposed(i, off, x);
-            }
+            s.segments.transposed(i, off, x);
         }
     }
 
@@ -213,11 +204,7 @@ impl TreeLu {
         let (diag, rest) = self.vals.split_at(s.off0);
         let off = &rest[..s.border0 - s.off0];
         for i in (first..nodes).rev() {
-            if s.blocks.has(i) {
-                s.blocks.forward(i, off, x);
-            } else {
-                s.segments.forward(i, off, x);
-            }
+            s.segments.forward(i, off, x);
             let (a, b) = s.span[i];
             let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];
             dense::lu_solve(blk, &self.piv[a..b], b - a, &mut x[a..b], 1);
@@ -243,8 +230,7 @@ impl TreeLu {
                 |y, t| self.tree_solve(y, t),
             );
         }
-        // Without a short cut: vector lanes.
-        !x.iter().fold(false, |bad, v| bad | !v.is_finite())
+        x.iter().all(|v| v.is_finite())
     }
 
     /// The smallest pivot of the diagonal blocks' `U` (and of the border's `S`) over the
@@ -327,14 +313,10 @@ impl TreeLu {
         }
         let (diag, off) = self.vals[..s.border0].split_at(s.off0);
         for i in (0..s.span.len()).rev() {
-            if let Some(at) = s.blocks.base(i) {
-                let e = &s.off[s.off_at[i]..s.off_at[i + 1]];
-                for (&(p, q), &v) in e.iter().zip(&off[at..at + e.len()]) {
-                    let (p, q) = (p as usize * w, q as usize * w);
-                    (0..w).for_each(|c| x[p + c] -= v * x[q + c]);
-                }
-            } else {
-                s.blocks.forward_columns(i, off, x, w);
+            let r = s.off_at[i]..s.off_at[i + 1];
+            for (&(p, q), &v) in s.off[r.clone()].iter().zip(&off[r]) {
+                let (p, q) = (p as usize * w, q as usize * w);
+                (0..w).for_each(|c| x[p + c] -= v * x[q + c]);
             }
             let (a, b) = s.span[i];
             let blk = &diag[s.diag_at[i]..s.diag_at[i + 1]];

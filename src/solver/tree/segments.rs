@@ -42,13 +42,8 @@ const GATHER: usize = 32;
 
 impl Segments {
     /// The segments of the entries `off` (grouped by node: node `i`'s are
-    /// `off[off_at[i] .. off_at[i + 1]]`, in the triplets' order) of the nodes `i` whose values
-    /// start at `base(i)` in the off-diagonal values (the others, `None`, have none).
-    pub(crate) fn new(
-        off: &[(u32, u32)],
-        off_at: &[usize],
-        base: impl Fn(usize) -> Option<usize>,
-    ) -> Self {
+    /// `off[off_at[i] .. off_at[i + 1]]`, in the triplets' order).
+    pub(crate) fn new(off: &[(u32, u32)], off_at: &[usize]) -> Self {
         // Sized for the most a segment list can hold (a row's one row and its columns per
         // entry; untouched capacity costs no page): no regrowth copies.
         let mut s = Segments {
@@ -57,11 +52,9 @@ impl Segments {
             idx: Vec::with_capacity(2 * off.len()),
         };
         s.at.push(0);
-        for (i, w) in off_at.windows(2).enumerate() {
+        for w in off_at.windows(2) {
             let mut k = w[0];
-            // Entry `k`'s value is at `k + shift`.
-            let shift = base(i).map(|b| b.wrapping_sub(w[0]));
-            while let (Some(shift), true) = (shift, k < w[1]) {
+            while k < w[1] {
                 // The row starting at `k`.
                 let p = off[k].0;
                 let end = (k..w[1]).find(|&j| off[j].0 != p).unwrap_or(w[1]);
@@ -86,7 +79,7 @@ impl Segments {
                     rows: (s.idx.len() - at) as u32,
                     cols: c as u32,
                     idx: at as u32,
-                    v: k.wrapping_add(shift) as u32,
+                    v: k as u32,
                     distinct,
                 });
                 s.idx.extend(cols.iter().map(|e| e.1));
@@ -277,7 +270,7 @@ mod tests {
         }
         let vals: Vec<f64> = off.iter().map(|_| rnd()).collect();
         let x0: Vec<f64> = (0..n).map(|_| rnd()).collect();
-        let seg = Segments::new(&off, &off_at, |i| Some(off_at[i]));
+        let seg = Segments::new(&off, &off_at);
         assert_eq!(seg.at.len(), nodes.len() + 1);
         // Distinct columns: near each other or far apart, a repeat either way.
         let row = |cols: &[u32]| cols.iter().map(|&q| (0, q)).collect::<Vec<_>>();

@@ -7,7 +7,7 @@
 //!
 //! ```text
 //! node(p) = node(q) = i:   diag_at[i] + (p − a_i) d_i + (q − a_i)    (diagonal block)
-//! node(p) < node(q):       the off-diagonal entries of T, node by node (module `blocks`)
+//! node(p) < node(q):       the off-diagonal entries of T, grouped by row node
 //! p or q in the border:    the border's entries;   q independent: the Φ_v entries
 //! ```
 //!
@@ -20,7 +20,6 @@
 use super::{Shape, TreeSplit, MAX_BORDER};
 use crate::constraints::Triplet;
 use crate::solver::partition::Partition;
-use crate::solver::tree::blocks::Blocks;
 use crate::solver::tree::border::Border;
 use crate::solver::tree::segments::Segments;
 use crate::solver::tree::shape::FIRST;
@@ -160,16 +159,10 @@ impl TreeSplit {
             let at = count[i as usize];
             count[i as usize] += 1;
             off[at] = (p, q);
-            slots[t as usize] = at as u32;
-        }
-        // The off-diagonal values: the nodes' blocks, or their entries in order.
-        let blocks = Blocks::new(&off, &off_at);
-        for &(t, ..) in &pending {
-            let at = &mut slots[t as usize];
-            *at = (diag_len + blocks.to(*at as usize)) as u32 | FIRST;
+            slots[t as usize] = (diag_len + at) as u32 | FIRST;
         }
         let off0 = diag_len;
-        let border0 = off0 + blocks.len();
+        let border0 = off0 + off.len();
         let v0 = border0 + border.len();
         let len = v0 + v_at.len() + 1;
         let spare = u32::try_from(len - 1).ok().filter(|&s| s < FIRST)?;
@@ -203,8 +196,7 @@ impl TreeSplit {
                 order,
                 span,
                 diag_at,
-                segments: Segments::new(&off, &off_at, |i| blocks.base(i)),
-                blocks,
+                segments: Segments::new(&off, &off_at),
                 off,
                 off_at,
                 border,

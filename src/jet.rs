@@ -250,7 +250,8 @@ pub(crate) mod testing {
             .collect()
     }
 
-    fn shifted(pair: &Pair, i: usize, h: f64) -> Pair {
+    /// `pair` with its local coordinate `i` (`r₀, p₀, r₁, p₁`, 7 a side) moved by `h`.
+    pub(crate) fn shifted(pair: &Pair, i: usize, h: f64) -> Pair {
         let mut out = *pair;
         let (k, c) = (i / 7, i % 7);
         if c < 3 {

@@ -53,14 +53,28 @@ impl Lean {
     /// `d = o₁ − o₀` of the joint's frame origins.
     fn origins(joint: &Joint, pair: &Pair, rots: &JointRotations) -> Lean {
         let o = |k: usize| &joint.body_from_joint[k].translation.vector;
-        let point = |k: usize| rots.a[k] * o(k) + pair.r[k];
         Lean {
-            v: point(1) - point(0),
+            v: origin_difference(joint, pair, rots),
             t: [-1.0, 1.0],
             b: [-b_matrix(&pair.p[0], o(0)), b_matrix(&pair.p[1], o(1))],
             on: [true; 2],
         }
     }
+}
+
+/// The two vectors row `r` reads (a component or length row reads `d` twice).
+fn reads(r: &Row) -> [V; 2] {
+    match *r {
+        Row::Component(_) | Row::Length | Row::Thread => [V::D, V::D],
+        Row::Dot(a, b) => [a, b],
+    }
+}
+
+/// `d = (r₁ + A(p₁) o₁) − (r₀ + A(p₀) o₀)`, the difference of the joint's frame origins.
+fn origin_difference(joint: &Joint, pair: &Pair, rots: &JointRotations) -> Vector3<f64> {
+    let o = |k: usize| &joint.body_from_joint[k].translation.vector;
+    let point = |k: usize| rots.a[k] * o(k) + pair.r[k];
+    point(1) - point(0)
 }
 
 /// `∇(aᵀb)` into the zero `g`, in [`crate::jet::closed::dot_gradient`]'s order.
@@ -97,11 +111,7 @@ pub(super) fn write(
     // Every vector the rows read, formed once, before any row reads it.
     let mut memo: [Option<Lean>; 7] = [None; 7];
     for r in layout {
-        let (a, b) = match *r {
-            Row::Component(_) | Row::Length | Row::Thread => (V::D, V::D),
-            Row::Dot(a, b) => (a, b),
-        };
-        for v in [a, b] {
+        for v in reads(r) {
             memo[v as usize].get_or_insert_with(|| match v {
                 V::D => Lean::origins(joint, pair, rots),
                 _ => Lean::axis(pair, rots, (v as usize - 1) / 3, (v as usize - 1) % 3),
@@ -157,17 +167,9 @@ pub(super) fn values(
 ) {
     let mut memo: [Option<Vector3<f64>>; 7] = [None; 7];
     for r in layout {
-        let (a, b) = match *r {
-            Row::Component(_) | Row::Length | Row::Thread => (V::D, V::D),
-            Row::Dot(a, b) => (a, b),
-        };
-        for v in [a, b] {
+        for v in reads(r) {
             memo[v as usize].get_or_insert_with(|| match v {
-                V::D => {
-                    let o = |k: usize| &joint.body_from_joint[k].translation.vector;
-                    let point = |k: usize| rots.a[k] * o(k) + pair.r[k];
-                    point(1) - point(0)
-                }
+                V::D => origin_difference(joint, pair, rots),
                 _ => {
                     let (k, i) = ((v as usize - 1) / 3, (v as usize - 1) % 3);
                     rots.a[k] * rots.r[k].column(i).into_owned()
@@ -226,7 +228,7 @@ fn append(
 mod tests {
     use super::*;
     use crate::jet::closed::{self, OwnedRotations};
-    use crate::jet::testing::{every_kind, sample_joint, sample_pair};
+    use crate::jet::testing::{every_kind, sample_joint, sample_pair, shifted};
 
     /// [`write`] and [`values`] give [`closed::rows_each`]'s values and, of each row, the
     /// entries of its pattern on the sides with a body in local order (what the general
@@ -302,17 +304,8 @@ mod tests {
                 let (_, entries) = evaluate(&j, &pair);
                 let h = 1e-6;
                 for i in 0..NL {
-                    let shifted = |step: f64| {
-                        let mut out = pair;
-                        let (k, c) = (i / 7, i % 7);
-                        if c < 3 {
-                            out.r[k][c] += step;
-                        } else {
-                            out.p[k][c - 3] += step;
-                        }
-                        evaluate(&j, &out).0
-                    };
-                    let (fp, fm) = (shifted(h), shifted(-h));
+                    let moved = |step: f64| evaluate(&j, &shifted(&pair, i, step)).0;
+                    let (fp, fm) = (moved(h), moved(-h));
                     for row in 2..fp.len() {
                         let fd = (fp[row] - fm[row]) / (2.0 * h);
                         let at = |e: &&Triplet| e.0 as usize == row && e.1 as usize == i;

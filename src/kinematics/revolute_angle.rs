@@ -86,7 +86,7 @@ pub(crate) fn revolute_first_order(
 mod tests {
     use super::*;
     use crate::jet::closed::{frame_rotations, Rotations};
-    use crate::jet::testing::{sample_joint, sample_pair};
+    use crate::jet::testing::{sample_joint, sample_pair, shifted};
     use crate::model::JointKind;
 
     /// `θ` and `∇θ` equal the generic jets' coordinate ([`crate::kinematics::coordinate`]) to
@@ -114,17 +114,8 @@ mod tests {
             assert!((f.g - jet.g).amax() <= 1e-14 * scale, "seed {seed}");
             let h = 1e-6;
             for i in 0..crate::jet::NL {
-                let shifted = |step: f64| {
-                    let mut out = pair;
-                    let (k, c) = (i / 7, i % 7);
-                    if c < 3 {
-                        out.r[k][c] += step;
-                    } else {
-                        out.p[k][c - 3] += step;
-                    }
-                    first(&out).v
-                };
-                let fd = (shifted(h) - shifted(-h)) / (2.0 * h);
+                let at = |step: f64| first(&shifted(&pair, i, step)).v;
+                let fd = (at(h) - at(-h)) / (2.0 * h);
                 assert!(
                     (fd - f.g[i]).abs() < 1e-7 * (1.0 + scale),
                     "seed {seed} {i}: {fd}"

@@ -321,6 +321,11 @@ fn solve_once(
     given: Option<ModelRows>,
     by_bodies: bool,
 ) -> Result<Multipliers> {
+    if by_bodies && list.is_empty() && carried.is_none() {
+        if let Some(m) = in_joint_space(model, state, all, model_locks, given.as_ref()) {
+            return Ok(m);
+        }
+    }
     let kept: Vec<usize> = (0..list.len()).filter(|&i| on[i]).collect();
     let active: Vec<_> = kept.iter().map(|&i| list[i].active).collect();
     let cons = Constraints::new(model, all)
@@ -494,5 +499,29 @@ fn solve_once(
         unassigned,
         resolved,
         chosen,
+    })
+}
+
+/// The multipliers of the locked system of a tree closed by loops, nothing touching, in
+/// joint coordinates (module `joint_space`: the efforts as the general partition chooses them,
+/// the least ones up to [`MAX_DEPENDENT`] dependent rows, nothing unassigned), from the
+/// model's rows and `∇V` evaluated at the pose (`given`); `None` where that does not apply.
+fn in_joint_space(
+    model: &Model,
+    state: &State,
+    all: &[(JointId, usize, f64)],
+    model_locks: usize,
+    given: Option<&ModelRows>,
+) -> Option<Multipliers> {
+    let loops = super::joint_space::Loops::of(model, model_locks)?;
+    let (entries, grad) = given?.at(&state.q)?;
+    let least = loops.dependent() <= MAX_DEPENDENT;
+    let locks = loops.efforts(model, &state.q, all, entries, grad, least)?;
+    Some(Multipliers {
+        locks,
+        forces: Vec::new(),
+        unassigned: 0.0,
+        resolved: least,
+        chosen: None,
     })
 }

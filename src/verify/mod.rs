@@ -35,6 +35,7 @@ mod dense;
 mod friction;
 mod held;
 mod initial_guess;
+mod joint_space;
 mod lexicographic;
 mod model_rows;
 mod pose;

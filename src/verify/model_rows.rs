@@ -69,6 +69,11 @@ impl ModelRows {
         })
     }
 
+    /// The triplets of the rows' `Φ_q` and `∇V`, where they were evaluated at `q`.
+    pub(super) fn at(&self, q: &DVector<f64>) -> Option<(&[crate::constraints::Triplet], &DVector<f64>)> {
+        (self.at == *q).then_some((&self.jac.entries[..], &self.potential.1))
+    }
+
     /// Whether `cons` at `q` starts with the blocks these rows were evaluated for: the same
     /// kinds at the same rows, its next block (if any) where they end, at the same pose.
     fn fits(&self, cons: &Constraints, q: &DVector<f64>) -> bool {

@@ -61,7 +61,7 @@ use nalgebra::{DMatrix, DVector};
 pub(super) const PREFERENCE: f64 = 1e-3;
 
 /// Largest number of dependent rows whose multipliers are made least-norm.
-const MAX_DEPENDENT: usize = 200;
+pub(super) const MAX_DEPENDENT: usize = 200;
 
 /// Largest number of solves dropping the rows that pull.
 const ROUNDS: usize = 20;
@@ -125,21 +125,27 @@ pub(super) fn held(
     // Nothing touching: the caller may have these multipliers already ([`free_of`]).
     let free = match free {
         Free::Given(m) if list.is_empty() => (m, Vec::new(), Vec::new()),
-        Free::Skip if list.is_empty() => {
+        Free::Skip { joint_space } if list.is_empty() => {
             // The locked solve is what the two stages give without a touching row (both the
             // balanced and the unbalanced case solve it; the balanced one adds a zero).
-            let r = solve_once(
-                model,
-                state,
-                &[],
-                &[],
-                &all,
-                locks.len(),
-                backend,
-                None,
-                given,
-                true,
-            )?;
+            let joint_space = joint_space
+                .then(|| in_joint_space(model, state, &all, locks.len(), given.as_ref()))
+                .flatten();
+            let r = match joint_space {
+                Some(r) => r,
+                None => solve_once(
+                    model,
+                    state,
+                    &[],
+                    &[],
+                    &all,
+                    locks.len(),
+                    backend,
+                    None,
+                    given,
+                    true,
+                )?,
+            };
             return Ok(Held {
                 efforts: row_of.iter().map(|&k| r.locks[k]).collect(),
                 locked,
@@ -262,8 +268,10 @@ pub(super) enum Free {
     /// To be solved.
     Solve,
     /// Not needed where nothing touches: the efforts, forces and unassigned force are the
-    /// locked solve's (as they are after the first solve; solved where something touches).
-    Skip,
+    /// locked solve's (as they are after the first solve; solved where something touches);
+    /// with `joint_space`, on a tree closed by loops, in joint coordinates (module
+    /// `loop_efforts`) where that applies.
+    Skip { joint_space: bool },
 }
 
 /// One solve's multipliers: per lock of `all`, per inequality of `list`, and the unassigned
@@ -321,11 +329,6 @@ fn solve_once(
     given: Option<ModelRows>,
     by_bodies: bool,
 ) -> Result<Multipliers> {
-    if by_bodies && list.is_empty() && carried.is_none() {
-        if let Some(m) = in_joint_space(model, state, all, model_locks, given.as_ref()) {
-            return Ok(m);
-        }
-    }
     let kept: Vec<usize> = (0..list.len()).filter(|&i| on[i]).collect();
     let active: Vec<_> = kept.iter().map(|&i| list[i].active).collect();
     let cons = Constraints::new(model, all)
@@ -503,7 +506,7 @@ fn solve_once(
 }
 
 /// The multipliers of the locked system of a tree closed by loops, nothing touching, in
-/// joint coordinates (module `joint_space`: the efforts as the general partition chooses them,
+/// joint coordinates (module `loop_efforts`: the efforts as the general partition chooses them,
 /// the least ones up to [`MAX_DEPENDENT`] dependent rows, nothing unassigned), from the
 /// model's rows and `∇V` evaluated at the pose (`given`); `None` where that does not apply.
 fn in_joint_space(
@@ -513,7 +516,7 @@ fn in_joint_space(
     model_locks: usize,
     given: Option<&ModelRows>,
 ) -> Option<Multipliers> {
-    let loops = super::joint_space::Loops::of(model, model_locks)?;
+    let loops = super::loop_efforts::Loops::of(model, model_locks)?;
     let (entries, grad) = given?.at(&state.q)?;
     let least = loops.dependent() <= MAX_DEPENDENT;
     let locks = loops.efforts(model, &state.q, all, entries, grad, least)?;

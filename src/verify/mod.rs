@@ -35,8 +35,8 @@ mod dense;
 mod friction;
 mod held;
 mod initial_guess;
-mod joint_space;
 mod lexicographic;
+mod loop_efforts;
 mod model_rows;
 mod pose;
 #[cfg(test)]

@@ -70,7 +70,10 @@ impl ModelRows {
     }
 
     /// The triplets of the rows' `Φ_q` and `∇V`, where they were evaluated at `q`.
-    pub(super) fn at(&self, q: &DVector<f64>) -> Option<(&[crate::constraints::Triplet], &DVector<f64>)> {
+    pub(super) fn at(
+        &self,
+        q: &DVector<f64>,
+    ) -> Option<(&[crate::constraints::Triplet], &DVector<f64>)> {
         (self.at == *q).then_some((&self.jac.entries[..], &self.potential.1))
     }
 

@@ -105,7 +105,9 @@ pub(super) fn verify_on(
                 Some((part, eval)) if list.is_empty() => {
                     held::Free::Given(held::free_of(&sys, part, eval))
                 }
-                None => held::Free::Skip,
+                None => held::Free::Skip {
+                    joint_space: sparse,
+                },
                 Some(_) => held::Free::Solve,
             };
             // The verdict first, on this thread; then the balance check's memory (its

@@ -143,11 +143,11 @@ fn held_from_the_balance_checks_system_is_held_from_its_own() {
             );
             // Without the first solve (`analyze`'s self-check): the same numbers (a zero
             // added or not: `==` takes −0 for 0).
-            let skipped = held(super::held::Free::Skip, None);
+            let skipped = held(super::held::Free::Skip { joint_space: false }, None);
             let potential = r.potential.clone();
             let rows = super::held::ModelRows::take(&mut r.sys, &state.q, values.len(), potential);
             assert!(rows.is_some(), "{}: the balance check's rows", model.name);
-            let reused = held(super::held::Free::Skip, rows);
+            let reused = held(super::held::Free::Skip { joint_space: false }, rows);
             for other in [&given, &skipped, &reused] {
                 assert_eq!(own.efforts, other.efforts, "{}", model.name);
                 assert_eq!(own.unassigned, other.unassigned, "{}", model.name);

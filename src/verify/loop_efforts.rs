@@ -33,7 +33,7 @@
 use crate::constraints::{joint as joint_rows, Triplet};
 use crate::model::{JointId, JointKind, Model};
 use crate::solver::partition::RANK_TOLERANCE;
-use nalgebra::{DMatrix, DVector, Vector3, Vector4};
+use nalgebra::{DMatrix, DVector, SVector, Vector3, Vector4};
 
 /// Largest `rows × joints` of a component's dense `J_c`.
 const MAX_COMPONENT: usize = 200_000;
@@ -247,108 +247,36 @@ impl Loops {
             }
             lock_of[k] = n;
         }
-        if self.up.iter().any(|&k| {
-            coordinate_kind(model.joints[k].kind) && lock_of[k] == usize::MAX
-        }) {
+        if self
+            .up
+            .iter()
+            .any(|&k| coordinate_kind(model.joints[k].kind) && lock_of[k] == usize::MAX)
+        {
             return None;
         }
-        let axes = axes(model, q, &self.up);
-        let pose = |b: usize| {
-            let x = Vector3::new(q[7 * b], q[7 * b + 1], q[7 * b + 2]);
-            let p = Vector4::new(q[7 * b + 3], q[7 * b + 4], q[7 * b + 5], q[7 * b + 6]);
-            (x, p)
-        };
-        // ∂V/∂θ: the wrenches of ∇V summed leaves to root.
-        let mut tau = vec![0.0; nj];
-        let mut sum = vec![(Vector3::zeros(), Vector3::zeros()); model.bodies.len()];
-        for &b in &self.order {
-            let (x, p) = pose(b);
-            let gx = Vector3::new(grad[7 * b], grad[7 * b + 1], grad[7 * b + 2]);
-            let gp = Vector4::new(
-                grad[7 * b + 3],
-                grad[7 * b + 4],
-                grad[7 * b + 5],
-                grad[7 * b + 6],
-            );
-            let (f, m) = wrench(&x, &p, &gx, &gp);
-            let (f, m) = (sum[b].0 + f, sum[b].1 + m);
-            let k = self.up[b];
-            if let Some(a) = &axes[k] {
-                tau[k] = a.rate(&f, &m);
-            }
-            if let Some(parent) = model.joints[k].bodies[0] {
-                let s = &mut sum[parent.index()];
-                s.0 += f;
-                s.1 += m;
-            }
-        }
-        // The loop rows' gradients on their two bodies (14 a row), from the triplets.
-        let end = self.loops.iter().map(|l| l.first + l.powers.len());
-        let rows = entries.iter().map(|e| e.0 as usize + 1).chain(end).max();
-        let mut at_row = vec![u32::MAX; rows.unwrap_or(0)];
-        let mut offset = Vec::with_capacity(self.loops.len());
-        let mut total = 0;
-        for l in &self.loops {
-            offset.push(total);
-            for r in 0..l.powers.len() {
-                at_row[l.first + r] = (total + r) as u32;
-            }
-            total += l.powers.len();
-        }
-        let mut grads = vec![0.0; 14 * total];
-        let mut row_loop = vec![0usize; total];
-        for (i, l) in self.loops.iter().enumerate() {
-            row_loop[offset[i]..offset[i] + l.powers.len()].fill(i);
-        }
-        for &(r, c, v) in entries {
-            let at = at_row[r as usize];
-            if at == u32::MAX {
-                continue;
-            }
-            let (at, c) = (at as usize, c as usize);
-            let l = &self.loops[row_loop[at]];
-            let side = if l.bodies[0] == Some(c / 7) { 0 } else { 1 };
-            grads[14 * at + 7 * side + c % 7] += v;
-        }
-        // Per component: J_c, its pivots, the efforts.
+        let mut tau = self.rates(model, q, grad);
+        let jacobians = self.closure_jacobians(model, q, entries);
+        // Per component: its pivots, the efforts.
         let length = model.length_scale;
-        let mut column = vec![usize::MAX; nj];
-        for comp in &self.components {
-            for (n, &k) in comp.joints.iter().enumerate() {
-                column[k] = n;
-            }
-            let nr: usize = comp.loops.iter().map(|&i| self.loops[i].powers.len()).sum();
+        for (comp, jac) in self.components.iter().zip(&jacobians) {
             let nc = comp.joints.len();
-            let mut jac = DMatrix::zeros(nr, nc);
-            let mut row_scale = Vec::with_capacity(nr);
-            let mut r0 = 0;
-            for &i in &comp.loops {
-                let l = &self.loops[i];
-                for (r, &power) in l.powers.iter().enumerate() {
-                    row_scale.push(length.powi(-power));
-                    let g = &grads[14 * (offset[i] + r)..14 * (offset[i] + r + 1)];
-                    for side in 0..2 {
-                        let Some(b) = l.bodies[side] else { continue };
-                        let (x, p) = pose(b);
-                        let g = &g[7 * side..7 * side + 7];
-                        let gx = Vector3::new(g[0], g[1], g[2]);
-                        let gp = Vector4::new(g[3], g[4], g[5], g[6]);
-                        let (f, m) = wrench(&x, &p, &gx, &gp);
-                        for &k in &l.path[side] {
-                            if let Some(a) = &axes[k] {
-                                jac[(r0 + r, column[k])] += a.rate(&f, &m);
-                            }
-                        }
-                    }
-                }
-                r0 += l.powers.len();
-            }
+            let row_scale: Vec<f64> = comp
+                .loops
+                .iter()
+                .flat_map(|&i| self.loops[i].powers.iter().map(|&p| length.powi(-p)))
+                .collect();
             let col_scale: Vec<f64> = comp
                 .joints
                 .iter()
-                .map(|&k| if axes[k].is_some_and(|a| a.slide) { length } else { 1.0 })
+                .map(|&k| {
+                    if model.joints[k].kind == JointKind::Prismatic {
+                        length
+                    } else {
+                        1.0
+                    }
+                })
                 .collect();
-            let (kept, dropped) = pivots(&jac, &row_scale, &col_scale);
+            let (kept, dropped) = pivots(jac, &row_scale, &col_scale);
             let tau0 = DVector::from_iterator(nc, comp.joints.iter().map(|&k| tau[k]));
             let held = if kept.is_empty() {
                 tau0
@@ -379,7 +307,98 @@ impl Loops {
                 tau[k] = held[n];
             }
         }
-        Some(all.iter().map(|&(joint, _, _)| tau[joint.index()]).collect())
+        Some(
+            all.iter()
+                .map(|&(joint, _, _)| tau[joint.index()])
+                .collect(),
+        )
+    }
+
+    /// `∂V/∂θ_k` by joint index (zero off the coordinate joints) at `q` from `∇V` (`grad`):
+    /// the wrenches of the bodies' gradients summed leaves to root (module docs).
+    fn rates(&self, model: &Model, q: &DVector<f64>, grad: &DVector<f64>) -> Vec<f64> {
+        let axes = axes(model, q, &self.up);
+        let mut tau = vec![0.0; model.joints.len()];
+        let mut sum = vec![(Vector3::zeros(), Vector3::zeros()); model.bodies.len()];
+        for &b in &self.order {
+            let (x, p) = pose(q, b);
+            let (f, m) = wrench(&x, &p, &grad.fixed_rows::<7>(7 * b).into_owned());
+            let (f, m) = (sum[b].0 + f, sum[b].1 + m);
+            let k = self.up[b];
+            if let Some(a) = &axes[k] {
+                tau[k] = a.rate(&f, &m);
+            }
+            if let Some(parent) = model.joints[k].bodies[0] {
+                let s = &mut sum[parent.index()];
+                s.0 += f;
+                s.1 += m;
+            }
+        }
+        tau
+    }
+
+    /// Per component, `J_c = ∂Φ_L/∂θ` at `q`: its loops' rows in order, its joints' columns,
+    /// from the rows' triplets `entries` (module docs).
+    fn closure_jacobians(
+        &self,
+        model: &Model,
+        q: &DVector<f64>,
+        entries: &[Triplet],
+    ) -> Vec<DMatrix<f64>> {
+        let axes = axes(model, q, &self.up);
+        // The loop rows' gradients on their two bodies (14 a row), from the triplets.
+        let end = self.loops.iter().map(|l| l.first + l.powers.len());
+        let rows = entries.iter().map(|e| e.0 as usize + 1).chain(end).max();
+        let mut at_row = vec![u32::MAX; rows.unwrap_or(0)];
+        let mut offset = Vec::with_capacity(self.loops.len());
+        let mut row_loop = Vec::with_capacity(self.rows);
+        for (i, l) in self.loops.iter().enumerate() {
+            offset.push(row_loop.len());
+            for r in 0..l.powers.len() {
+                at_row[l.first + r] = row_loop.len() as u32;
+                row_loop.push(i);
+            }
+        }
+        let mut grads = vec![0.0; 14 * row_loop.len()];
+        for &(r, c, v) in entries {
+            let at = at_row[r as usize];
+            if at == u32::MAX {
+                continue;
+            }
+            let (at, c) = (at as usize, c as usize);
+            let side = usize::from(self.loops[row_loop[at]].bodies[0] != Some(c / 7));
+            grads[14 * at + 7 * side + c % 7] += v;
+        }
+        let mut column = vec![usize::MAX; model.joints.len()];
+        let mut jacobians = Vec::with_capacity(self.components.len());
+        for comp in &self.components {
+            for (n, &k) in comp.joints.iter().enumerate() {
+                column[k] = n;
+            }
+            let nr: usize = comp.loops.iter().map(|&i| self.loops[i].powers.len()).sum();
+            let mut jac = DMatrix::zeros(nr, comp.joints.len());
+            let mut r0 = 0;
+            for &i in &comp.loops {
+                let l = &self.loops[i];
+                for r in 0..l.powers.len() {
+                    let g = &grads[14 * (offset[i] + r)..14 * (offset[i] + r + 1)];
+                    for side in 0..2 {
+                        let Some(b) = l.bodies[side] else { continue };
+                        let (x, p) = pose(q, b);
+                        let g = SVector::<f64, 7>::from_column_slice(&g[7 * side..7 * side + 7]);
+                        let (f, m) = wrench(&x, &p, &g);
+                        for &k in &l.path[side] {
+                            if let Some(a) = &axes[k] {
+                                jac[(r0 + r, column[k])] += a.rate(&f, &m);
+                            }
+                        }
+                    }
+                }
+                r0 += l.powers.len();
+            }
+            jacobians.push(jac);
+        }
+        jacobians
     }
 
     /// The number of loop rows: the locked system's dependent rows.
@@ -442,18 +461,22 @@ fn axes(model: &Model, q: &DVector<f64>, up: &[usize]) -> Vec<Option<Axis>> {
     axes
 }
 
-/// The wrench about the world origin of a body gradient `(g_x, g_p)` at the pose `(x, p)`
-/// (module docs).
-fn wrench(
-    x: &Vector3<f64>,
-    p: &Vector4<f64>,
-    gx: &Vector3<f64>,
-    gp: &Vector4<f64>,
-) -> (Vector3<f64>, Vector3<f64>) {
+/// The position and Euler parameters of body `b` in `q`.
+fn pose(q: &DVector<f64>, b: usize) -> (Vector3<f64>, Vector4<f64>) {
+    (
+        q.fixed_rows::<3>(7 * b).into_owned(),
+        q.fixed_rows::<4>(7 * b + 3).into_owned(),
+    )
+}
+
+/// The wrench about the world origin of a body gradient `g = (g_x, g_p)` at the pose
+/// `(x, p)` (module docs).
+fn wrench(x: &Vector3<f64>, p: &Vector4<f64>, g: &SVector<f64, 7>) -> (Vector3<f64>, Vector3<f64>) {
+    let gx = Vector3::new(g[0], g[1], g[2]);
     let e = Vector3::new(p[1], p[2], p[3]);
-    let ge = Vector3::new(gp[1], gp[2], gp[3]);
-    let m = x.cross(gx) + 0.5 * (ge * p[0] - e * gp[0] + e.cross(&ge));
-    (*gx, m)
+    let ge = Vector3::new(g[4], g[5], g[6]);
+    let m = x.cross(&gx) + 0.5 * (ge * p[0] - e * g[3] + e.cross(&ge));
+    (gx, m)
 }
 
 /// Full pivoting of `jac` scaled by `row_scale` and `col_scale`: the pivot rows and columns in
@@ -493,3 +516,7 @@ fn pivots(jac: &DMatrix<f64>, row_scale: &[f64], col_scale: &[f64]) -> (Vec<usiz
     }
     (rows, cols)
 }
+
+#[cfg(test)]
+#[path = "loop_efforts_tests.rs"]
+mod tests;

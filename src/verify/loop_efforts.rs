@@ -140,8 +140,21 @@ impl Loops {
                 depth[c] = d;
             }
         }
-        let mut order: Vec<usize> = (0..nb).collect();
-        order.sort_unstable_by(|a, b| depth[*b].cmp(&depth[*a]));
+        // A counting sort by depth, deepest first.
+        let deepest = depth.iter().copied().max().unwrap_or(0);
+        let mut start = vec![0usize; deepest + 2];
+        for &d in &depth {
+            start[deepest - d + 1] += 1;
+        }
+        for k in 1..start.len() {
+            start[k] += start[k - 1];
+        }
+        let mut order = vec![0usize; nb];
+        for (b, &d) in depth.iter().enumerate() {
+            let at = &mut start[deepest - d];
+            order[*at] = b;
+            *at += 1;
+        }
         // Each loop's paths up to the common ancestor.
         let mut walked = 0;
         for l in &mut loops {
@@ -254,8 +267,9 @@ impl Loops {
         {
             return None;
         }
-        let mut tau = self.rates(model, q, grad);
-        let jacobians = self.closure_jacobians(model, q, entries);
+        let axes = axes(model, q, &self.up);
+        let mut tau = self.rates(model, q, grad, &axes);
+        let jacobians = self.closure_jacobians(model, q, entries, &axes);
         // Per component: its pivots, the efforts.
         let length = model.length_scale;
         for (comp, jac) in self.components.iter().zip(&jacobians) {
@@ -315,9 +329,15 @@ impl Loops {
     }
 
     /// `∂V/∂θ_k` by joint index (zero off the coordinate joints) at `q` from `∇V` (`grad`):
-    /// the wrenches of the bodies' gradients summed leaves to root (module docs).
-    fn rates(&self, model: &Model, q: &DVector<f64>, grad: &DVector<f64>) -> Vec<f64> {
-        let axes = axes(model, q, &self.up);
+    /// the wrenches of the bodies' gradients summed leaves to root (module docs); `axes` the
+    /// joints' at `q` ([`axes`]).
+    fn rates(
+        &self,
+        model: &Model,
+        q: &DVector<f64>,
+        grad: &DVector<f64>,
+        axes: &[Option<Axis>],
+    ) -> Vec<f64> {
         let mut tau = vec![0.0; model.joints.len()];
         let mut sum = vec![(Vector3::zeros(), Vector3::zeros()); model.bodies.len()];
         for &b in &self.order {
@@ -338,14 +358,14 @@ impl Loops {
     }
 
     /// Per component, `J_c = ∂Φ_L/∂θ` at `q`: its loops' rows in order, its joints' columns,
-    /// from the rows' triplets `entries` (module docs).
+    /// from the rows' triplets `entries` (module docs); `axes` the joints' at `q` ([`axes`]).
     fn closure_jacobians(
         &self,
         model: &Model,
         q: &DVector<f64>,
         entries: &[Triplet],
+        axes: &[Option<Axis>],
     ) -> Vec<DMatrix<f64>> {
-        let axes = axes(model, q, &self.up);
         // The loop rows' gradients on their two bodies (14 a row), from the triplets.
         let end = self.loops.iter().map(|l| l.first + l.powers.len());
         let rows = entries.iter().map(|e| e.0 as usize + 1).chain(end).max();

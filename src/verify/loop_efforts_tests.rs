@@ -74,8 +74,9 @@ fn rates_and_the_closure_jacobian_are_the_finite_differences() {
         let state = State::from_joint_values(&model, &values);
         let (_, grad) = energy(&model, &state);
         let (_, jac) = rows(&model, &state);
-        let rates = loops.rates(&model, &state.q, &grad);
-        let jacobians = loops.closure_jacobians(&model, &state.q, &jac.entries);
+        let axes = axes(&model, &state.q, &loops.up);
+        let rates = loops.rates(&model, &state.q, &grad, &axes);
+        let jacobians = loops.closure_jacobians(&model, &state.q, &jac.entries, &axes);
         let h = 1e-6;
         let at = |name: &str, d: f64| {
             let mut v = values.clone();

@@ -86,7 +86,10 @@ impl Loops {
     /// of another kind in the tree, a body without a tree joint (a floating base), no loop,
     /// mimics, `model_locks` locks of the model, or a component too large for a dense `J_c`.
     pub(super) fn of(model: &Model, model_locks: usize) -> Option<Loops> {
-        if model_locks != 0 || !model.mimics.is_empty() {
+        if model_locks != 0
+            || !model.mimics.is_empty()
+            || !model.joints.iter().any(|j| !j.tree && !j.merged)
+        {
             return None;
         }
         let nb = model.bodies.len();

@@ -13,7 +13,8 @@
 //! unknowns are found as the multipliers of one system: the model's rows, a lock row
 //! `θ_k(q) − θ_k = 0` on every joint coordinate and the touching rows, partitioned (dense or
 //! sparse: the same partition the solver uses; `analyze`'s self-check on a locked tree: by
-//! bodies, module `tree_partition`) so that it keeps every model row it can (lock
+//! bodies, module `tree_partition`; on a tree closed by loops: in joint coordinates, module
+//! `loop_efforts`) so that it keeps every model row it can (lock
 //! and touching rows scaled down by [`PREFERENCE`] in the pivot choice). `Φ_uᵀ μ = ∇_u V` gives
 //! the basic multipliers `μ_b`; the reduced gradient that remains is the unassigned force.
 //!

@@ -11,6 +11,7 @@
 mod branches;
 mod coordinate;
 mod frames;
+mod joint_rate;
 mod motion;
 mod revolute_angle;
 
@@ -19,5 +20,6 @@ pub(crate) use coordinate::{
     angle_value_and_spread, coordinate, coordinate_value, on_branch, vector,
 };
 pub(crate) use frames::{angle, frames};
+pub(crate) use joint_rate::{wrench, JointAxis};
 pub(crate) use motion::motion;
 pub(crate) use revolute_angle::{revolute_first_order, RevoluteFirstOrder};

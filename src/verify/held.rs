@@ -41,7 +41,7 @@
 //! touching rows is solved in one (the pose fails; its efforts say by how much).
 //!
 //! A normal force below `−τ` (the effort tolerance) would pull: the row is dropped and the
-//! forces are solved again, at most [`ROUNDS`] times (the rows that pull in the first solve
+//! forces are solved again, at most `rounds::ROUNDS` times (the rows that pull in the first solve
 //! without locks are named in the failures). Above [`MAX_DEPENDENT`] dependent rows the basic
 //! multipliers are kept (a ladder of many loops: at a balanced pose the basic efforts are
 //! zero too, since the partition keeps the model's rows). The cost is one or two sparse
@@ -63,9 +63,6 @@ pub(super) const PREFERENCE: f64 = 1e-3;
 
 /// Largest number of dependent rows whose multipliers are made least-norm.
 pub(super) const MAX_DEPENDENT: usize = 200;
-
-/// Largest number of solves dropping the rows that pull.
-const ROUNDS: usize = 20;
 
 /// The forces that hold a pose.
 pub(super) struct Held {
@@ -129,10 +126,10 @@ pub(super) fn held(
         Free::Skip { joint_space } if list.is_empty() => {
             // The locked solve is what the two stages give without a touching row (both the
             // balanced and the unbalanced case solve it; the balanced one adds a zero).
-            let joint_space = joint_space
-                .then(|| in_joint_space(model, state, &all, locks.len(), given.as_ref()))
-                .flatten();
-            let r = match joint_space {
+            let in_loops = joint_space.then(|| {
+                super::loop_efforts::multipliers(model, state, &all, locks.len(), given.as_ref())
+            });
+            let r = match in_loops.flatten() {
                 Some(r) => r,
                 None => solve_once(
                     model,
@@ -156,7 +153,7 @@ pub(super) fn held(
                 friction: None,
             });
         }
-        _ => with_rounds(list, tau, |on| {
+        _ => super::rounds::with_rounds(list, tau, |on| {
             solve_once(
                 model,
                 state,
@@ -174,7 +171,7 @@ pub(super) fn held(
     let locked_solve = if free.0.unassigned <= tau {
         None
     } else {
-        let (r, forces, _) = with_rounds(list, tau, |on| {
+        let (r, forces, _) = super::rounds::with_rounds(list, tau, |on| {
             solve_once(
                 model,
                 state,
@@ -226,42 +223,6 @@ pub(super) fn held(
     })
 }
 
-/// Solves with the touching rows of `list`, dropping those whose normal force would pull
-/// (below `−tau`) and solving again, at most [`ROUNDS`] times. Returns the last solve, the
-/// forces (zero on the dropped rows) and the rows that pulled in the first round.
-#[allow(clippy::type_complexity)]
-fn with_rounds(
-    list: &[Touching],
-    tau: f64,
-    mut solve: impl FnMut(&[bool]) -> Result<Multipliers>,
-) -> Result<(Multipliers, Vec<Vec<f64>>, Vec<(usize, f64)>)> {
-    let mut on = vec![true; list.len()];
-    let mut pulling = Vec::new();
-    let mut round = 0;
-    loop {
-        let r = solve(&on)?;
-        let negative: Vec<usize> = (0..list.len())
-            .filter(|&i| on[i] && r.forces[i][0] < -tau)
-            .collect();
-        if round == 0 {
-            pulling = negative.iter().map(|&i| (i, r.forces[i][0])).collect();
-        }
-        round += 1;
-        if negative.is_empty() || round == ROUNDS {
-            let mut forces = r.forces.clone();
-            for (i, f) in forces.iter_mut().enumerate() {
-                if !on[i] || f[0] < -tau {
-                    f.iter_mut().for_each(|x| *x = 0.0);
-                }
-            }
-            return Ok((r, forces, pulling));
-        }
-        for &i in &negative {
-            on[i] = false;
-        }
-    }
-}
-
 /// The first solve of [`held`] (the model's rows and the touching ones, no joint locked).
 pub(super) enum Free {
     /// Nothing touches and these are its multipliers ([`free_of`]).
@@ -278,14 +239,14 @@ pub(super) enum Free {
 /// One solve's multipliers: per lock of `all`, per inequality of `list`, and the unassigned
 /// force.
 pub(super) struct Multipliers {
-    locks: Vec<f64>,
-    forces: Vec<Vec<f64>>,
-    unassigned: f64,
+    pub(super) locks: Vec<f64>,
+    pub(super) forces: Vec<Vec<f64>>,
+    pub(super) unassigned: f64,
     /// Whether the multipliers were made unique (at most [`MAX_DEPENDENT`] dependent rows).
-    resolved: bool,
+    pub(super) resolved: bool,
     /// `(required_mu, slipping)` where sticking contacts carry the load and no effort is
     /// chosen: the distribution of module `solver::friction` (the one `analyze` reports).
-    chosen: crate::solver::friction::Chosen,
+    pub(super) chosen: crate::solver::friction::Chosen,
 }
 
 /// The multipliers of the first solve of [`held`] where nothing touches (the model's rows
@@ -503,29 +464,5 @@ fn solve_once(
         unassigned,
         resolved,
         chosen,
-    })
-}
-
-/// The multipliers of the locked system of a tree closed by loops, nothing touching, in
-/// joint coordinates (module `loop_efforts`: the efforts as the general partition chooses them,
-/// the least ones up to [`MAX_DEPENDENT`] dependent rows, nothing unassigned), from the
-/// model's rows and `∇V` evaluated at the pose (`given`); `None` where that does not apply.
-fn in_joint_space(
-    model: &Model,
-    state: &State,
-    all: &[(JointId, usize, f64)],
-    model_locks: usize,
-    given: Option<&ModelRows>,
-) -> Option<Multipliers> {
-    let loops = super::loop_efforts::Loops::of(model, model_locks)?;
-    let (entries, grad) = given?.at(&state.q)?;
-    let least = loops.dependent() <= MAX_DEPENDENT;
-    let locks = loops.efforts(model, &state.q, all, entries, grad, least)?;
-    Some(Multipliers {
-        locks,
-        forces: Vec::new(),
-        unassigned: 0.0,
-        resolved: least,
-        chosen: None,
     })
 }

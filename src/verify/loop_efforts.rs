@@ -11,17 +11,16 @@
 //!
 //! `τ = ∂V/∂θ − J_θᵀ μ`,   `J_θ = ∂Φ_L/∂θ` (the loops' closure Jacobian in joint coordinates),
 //!
-//! `μ` the loop rows' multipliers. A body's gradient `(g_x, g_p)` at `(x, p)`, `p = (e₀, e)`,
-//! acts as the wrench `F = g_x`, `M = x × g_x + ½ (e₀ g_e − g₀ e + e × g_e)` about the world
-//! origin (the world angular velocity `ω` moves `p` by `ṗ = ½ (0, ω) ⊗ p`), and
-//! `∂/∂θ_k = ω_k · (M − c_k × F)` for a revolute joint of world axis `ω_k` through `c_k`,
-//! `ω_k · F` for a prismatic one. `∂V/∂θ` sums the wrenches of `∇V` leaves to root, one pass;
+//! `μ` the loop rows' multipliers. A body's gradient acts as a wrench `(F, M)` about the world
+//! origin, and `t_kᵀ g = ω_k · (M − c_k × F)` for a revolute joint of world axis `ω_k` through
+//! `c_k`, `ω_k · F` for a prismatic one (module `kinematics::joint_rate`). `∂V/∂θ` sums the
+//! wrenches of `∇V` leaves to root, one pass;
 //! `J_θ` pairs each loop row's gradient on its two bodies with the joints between each body
 //! and their common ancestor (a joint above it moves both rigidly: its column is exactly zero).
 //!
 //! `μ` as module `held` chooses it: loops sharing a joint form one component, a small dense
 //! `J_c` (rows scaled by `L^−k`, prismatic columns by `L`), partitioned by full pivoting with
-//! the general partition's rank tolerance: the pivot rows are the loop rows kept (model rows
+//! the general partition's rank tolerance (module `full_pivoting`): the pivot rows are the loop rows kept (model rows
 //! first), the pivot columns the locks dropped. With at most `MAX_DEPENDENT` loop rows (the
 //! locked system's dependent rows) the efforts are the least ones, `τ_c = (I − Q Qᵀ) τ₀_c` with
 //! `Q` an orthonormal basis of the kept rows' patterns; above, the basic ones: the dropped
@@ -31,9 +30,9 @@
 //! ([`Loops::of`], checked before any work) the general partition decides.
 
 use crate::constraints::{joint as joint_rows, Triplet};
+use crate::kinematics::{wrench, JointAxis};
 use crate::model::{JointId, JointKind, Model};
-use crate::solver::partition::RANK_TOLERANCE;
-use nalgebra::{DMatrix, DVector, SVector, Vector3, Vector4};
+use nalgebra::{DMatrix, DVector, Vector3};
 
 /// Largest `rows × joints` of a component's dense `J_c`.
 const MAX_COMPONENT: usize = 200_000;
@@ -293,7 +292,7 @@ impl Loops {
                     }
                 })
                 .collect();
-            let (kept, dropped) = pivots(jac, &row_scale, &col_scale);
+            let (kept, dropped) = super::full_pivoting::pivots(jac, &row_scale, &col_scale);
             let tau0 = DVector::from_iterator(nc, comp.joints.iter().map(|&k| tau[k]));
             let held = if kept.is_empty() {
                 tau0
@@ -339,13 +338,12 @@ impl Loops {
         model: &Model,
         q: &DVector<f64>,
         grad: &DVector<f64>,
-        axes: &[Option<Axis>],
+        axes: &[Option<JointAxis>],
     ) -> Vec<f64> {
         let mut tau = vec![0.0; model.joints.len()];
         let mut sum = vec![(Vector3::zeros(), Vector3::zeros()); model.bodies.len()];
         for &b in &self.order {
-            let (x, p) = pose(q, b);
-            let (f, m) = wrench(&x, &p, &grad.fixed_rows::<7>(7 * b).into_owned());
+            let (f, m) = wrench(q, b, &grad.as_slice()[7 * b..7 * b + 7]);
             let (f, m) = (sum[b].0 + f, sum[b].1 + m);
             let k = self.up[b];
             if let Some(a) = &axes[k] {
@@ -367,7 +365,7 @@ impl Loops {
         model: &Model,
         q: &DVector<f64>,
         entries: &[Triplet],
-        axes: &[Option<Axis>],
+        axes: &[Option<JointAxis>],
     ) -> Vec<DMatrix<f64>> {
         // The loop rows' gradients on their two bodies (14 a row), from the triplets.
         let end = self.loops.iter().map(|l| l.first + l.powers.len());
@@ -407,9 +405,7 @@ impl Loops {
                     let g = &grads[14 * (offset[i] + r)..14 * (offset[i] + r + 1)];
                     for side in 0..2 {
                         let Some(b) = l.bodies[side] else { continue };
-                        let (x, p) = pose(q, b);
-                        let g = SVector::<f64, 7>::from_column_slice(&g[7 * side..7 * side + 7]);
-                        let (f, m) = wrench(&x, &p, &g);
+                        let (f, m) = wrench(q, b, &g[7 * side..7 * side + 7]);
                         for &k in &l.path[side] {
                             if let Some(a) = &axes[k] {
                                 jac[(r0 + r, column[k])] += a.rate(&f, &m);
@@ -430,114 +426,37 @@ impl Loops {
     }
 }
 
-/// A coordinate joint's axis `ω` and origin `c` in the world at `q`, and whether it slides.
-#[derive(Clone, Copy, Debug)]
-struct Axis {
-    w: Vector3<f64>,
-    c: Vector3<f64>,
-    slide: bool,
+/// The multipliers of `analyze`'s self-check with the locks `all` (the first `model_locks`
+/// the model's own) where the module applies: the efforts from the model's rows and `∇V`
+/// evaluated at the pose (`given`), the least ones up to `MAX_DEPENDENT` loop rows (else the
+/// basic ones), nothing touching, nothing unassigned (every coordinate is dependent).
+pub(super) fn multipliers(
+    model: &Model,
+    state: &crate::state::State,
+    all: &[(JointId, usize, f64)],
+    model_locks: usize,
+    given: Option<&super::held::ModelRows>,
+) -> Option<super::held::Multipliers> {
+    let loops = Loops::of(model, model_locks)?;
+    let (entries, grad) = given?.at(&state.q)?;
+    let least = loops.dependent() <= super::held::MAX_DEPENDENT;
+    Some(super::held::Multipliers {
+        locks: loops.efforts(model, &state.q, all, entries, grad, least)?,
+        forces: Vec::new(),
+        unassigned: 0.0,
+        resolved: least,
+        chosen: None,
+    })
 }
 
-impl Axis {
-    /// `∂/∂θ` along the joint's motion of a function whose gradient is the wrench `(f, m)`.
-    fn rate(&self, f: &Vector3<f64>, m: &Vector3<f64>) -> f64 {
-        if self.slide {
-            self.w.dot(f)
-        } else {
-            self.w.dot(&(m - self.c.cross(f)))
-        }
-    }
-}
-
-/// The axes of the tree's coordinate joints (`up`: the joint of each body), by joint index:
-/// the parent's joint frame `world_from_parent · parent_from_J`, its z axis and origin.
-fn axes(model: &Model, q: &DVector<f64>, up: &[usize]) -> Vec<Option<Axis>> {
+/// The axes of the tree's coordinate joints at `q` (`up`: the joint of each body), by joint
+/// index.
+fn axes(model: &Model, q: &DVector<f64>, up: &[usize]) -> Vec<Option<JointAxis>> {
     let mut axes = vec![None; model.joints.len()];
     for &k in up {
-        let j = &model.joints[k];
-        if !coordinate_kind(j.kind) {
-            continue;
-        }
-        let parent_from_j = &j.body_from_joint[0];
-        let z = parent_from_j.rotation * Vector3::z();
-        let o = parent_from_j.translation.vector;
-        let (w, c) = match j.bodies[0] {
-            Some(p) => {
-                let b = p.index();
-                let x = Vector3::new(q[7 * b], q[7 * b + 1], q[7 * b + 2]);
-                let r = crate::math::rotation(&Vector4::new(
-                    q[7 * b + 3],
-                    q[7 * b + 4],
-                    q[7 * b + 5],
-                    q[7 * b + 6],
-                ));
-                (r * z, x + r * o)
-            }
-            None => (z, o),
-        };
-        axes[k] = Some(Axis {
-            w,
-            c,
-            slide: j.kind == JointKind::Prismatic,
-        });
+        axes[k] = JointAxis::at(&model.joints[k], q);
     }
     axes
-}
-
-/// The position and Euler parameters of body `b` in `q`.
-fn pose(q: &DVector<f64>, b: usize) -> (Vector3<f64>, Vector4<f64>) {
-    (
-        q.fixed_rows::<3>(7 * b).into_owned(),
-        q.fixed_rows::<4>(7 * b + 3).into_owned(),
-    )
-}
-
-/// The wrench about the world origin of a body gradient `g = (g_x, g_p)` at the pose
-/// `(x, p)` (module docs).
-fn wrench(x: &Vector3<f64>, p: &Vector4<f64>, g: &SVector<f64, 7>) -> (Vector3<f64>, Vector3<f64>) {
-    let gx = Vector3::new(g[0], g[1], g[2]);
-    let e = Vector3::new(p[1], p[2], p[3]);
-    let ge = Vector3::new(g[4], g[5], g[6]);
-    let m = x.cross(&gx) + 0.5 * (ge * p[0] - e * g[3] + e.cross(&ge));
-    (gx, m)
-}
-
-/// Full pivoting of `jac` scaled by `row_scale` and `col_scale`: the pivot rows and columns in
-/// pivot order, up to the rank (pivots above `RANK_TOLERANCE` times the largest entry).
-fn pivots(jac: &DMatrix<f64>, row_scale: &[f64], col_scale: &[f64]) -> (Vec<usize>, Vec<usize>) {
-    let (nr, nc) = jac.shape();
-    let mut a = DMatrix::from_fn(nr, nc, |r, c| jac[(r, c)] * row_scale[r] * col_scale[c]);
-    let tol = (RANK_TOLERANCE * a.amax()).max(f64::MIN_POSITIVE);
-    let (mut rows, mut cols) = (Vec::new(), Vec::new());
-    let (mut row_free, mut col_free) = (vec![true; nr], vec![true; nc]);
-    for _ in 0..nr.min(nc) {
-        let mut best = (0, 0, 0.0);
-        for r in (0..nr).filter(|&r| row_free[r]) {
-            for c in (0..nc).filter(|&c| col_free[c]) {
-                if a[(r, c)].abs() > best.2 {
-                    best = (r, c, a[(r, c)].abs());
-                }
-            }
-        }
-        if best.2 <= tol {
-            break;
-        }
-        let (pr, pc) = (best.0, best.1);
-        row_free[pr] = false;
-        col_free[pc] = false;
-        rows.push(pr);
-        cols.push(pc);
-        let pivot = a[(pr, pc)];
-        for r in (0..nr).filter(|&r| row_free[r]) {
-            let f = a[(r, pc)] / pivot;
-            if f != 0.0 {
-                for c in (0..nc).filter(|&c| col_free[c]) {
-                    a[(r, c)] -= f * a[(pr, c)];
-                }
-            }
-        }
-    }
-    (rows, cols)
 }
 
 #[cfg(test)]

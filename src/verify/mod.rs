@@ -33,6 +33,7 @@
 mod closure;
 mod dense;
 mod friction;
+mod full_pivoting;
 mod held;
 mod initial_guess;
 mod lexicographic;
@@ -42,6 +43,7 @@ mod pose;
 #[cfg(test)]
 mod rank_tests;
 mod reduced;
+mod rounds;
 mod run;
 mod tree_partition;
 mod unilateral;

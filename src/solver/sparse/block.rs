@@ -133,58 +133,6 @@ impl Block {
         }
     }
 
-    /// The copies of `rows` (ascending, active, none changed by an earlier step) at body
-    /// `b`, row `r` given by its nonzero entries `expanded[at[r] .. at[r + 1]]` (each column
-    /// once, as [`Rows`] expands it) and its largest `rmax[r]`.
-    pub(crate) fn load_expanded(
-        &mut self,
-        b: usize,
-        rows: &[usize],
-        rmax: &[f64],
-        at: &[u32],
-        expanded: &[(u32, f64)],
-    ) {
-        let row = |r: usize| &expanded[at[r] as usize..at[r + 1] as usize];
-        self.rows.clear();
-        self.rows.extend_from_slice(rows);
-        self.bodies.clear();
-        self.bodies.push(b);
-        for &r in rows {
-            let mut last = usize::MAX;
-            for &(c, _) in row(r) {
-                let body = c as usize / 7;
-                if body != last {
-                    last = body;
-                    slot(&mut self.bodies, body);
-                }
-            }
-        }
-        let w = 7 * self.bodies.len();
-        self.w = w;
-        self.a.clear();
-        self.a.resize(rows.len() * w, 0.0);
-        self.rmax.clear();
-        self.live.clear();
-        for (copy, &r) in self.a.chunks_exact_mut(w).zip(rows) {
-            let (mut last, mut base) = (usize::MAX, 0);
-            for &(c, v) in row(r) {
-                let (c, body) = (c as usize, c as usize / 7);
-                if body != last {
-                    last = body;
-                    base = 7 * slot(&mut self.bodies, body);
-                }
-                copy[base + (c - 7 * body)] = v;
-            }
-            self.rmax.push(rmax[r]);
-            self.live.push(true);
-        }
-    }
-
-    /// Whether a copy is still active.
-    pub(crate) fn any_live(&self) -> bool {
-        self.live.iter().any(|&l| l)
-    }
-
     /// The number of bodies the copies span.
     pub(crate) fn bodies(&self) -> usize {
         self.bodies.len()
@@ -301,25 +249,22 @@ impl Block {
     /// `b` alone: the entry on a `free` column largest relative to the row's reach there
     /// (same kind of column), if at least `OWN_THRESHOLD` of it; a later one only if larger
     /// by a relative `1e-9`.
-    /// `own_of` and `reach`: each row's body where it lies on one body alone and its reach
-    /// there, as [`Rows`] gives them.
     pub(crate) fn best_own_pivot(
         &self,
         free: &[bool; 7],
         tol: f64,
         b: usize,
-        own_of: &[usize],
-        reach: &[[f64; 2]],
+        rows: &Rows,
     ) -> Option<(usize, usize)> {
         let (mut best, mut bar) = (None, 0.0);
         for (i, row) in self.a.chunks_exact(self.w).enumerate() {
             let r = self.rows[i];
-            if !self.live[i] || own_of[r] != b {
+            if !self.live[i] || rows.own_of[r] != b {
                 continue;
             }
             for k in 0..7 {
                 let v = row[k].abs();
-                let ratio = v / reach[r][usize::from(k >= 3)].max(f64::MIN_POSITIVE);
+                let ratio = v / rows.reach[r][usize::from(k >= 3)].max(f64::MIN_POSITIVE);
                 // `ratio ≥ OWN_THRESHOLD > 0`: the first candidate passes `ratio > bar = 0`.
                 if free[k] && v > tol && ratio >= OWN_THRESHOLD && ratio > bar {
                     best = Some((i, k));

@@ -26,10 +26,6 @@
 //! [`MAX_BODIES`] bodies in one step (a long loop's rows gather every body they pass).
 //! `verify`'s tests check that the partitions agree to the last index on every model of
 //! their set, with and without a lock on every joint coordinate.
-//!
-//! On a mechanism without loops and contacts the steps first read their rows straight from the
-//! triplets (module `tree`: no row lists, rows by body or kept copies), the same pivots where
-//! no step leaves a row active; at the first step that does, this route follows.
 
 use super::block::{Block, Changed};
 use super::partition::elimination_order;
@@ -37,11 +33,6 @@ use super::rows::Rows;
 use crate::constraints::Triplet;
 use crate::model::Model;
 use crate::solver::partition::{next_id, Partition, RANK_TOLERANCE};
-use crate::solver::system::open;
-
-mod tree;
-#[cfg(test)]
-mod tree_tests;
 
 /// The most bodies one body's step may span (beyond it the sparse partition is used).
 pub(crate) const MAX_BODIES: usize = 32;
@@ -62,7 +53,6 @@ pub(crate) fn free_columns(
 
 /// The pivots of the elimination: `(row, column)` in pivot order, and the second pass's
 /// `(row, body, true)`.
-#[cfg_attr(test, derive(Debug, PartialEq))]
 struct Pivots {
     order: Vec<(usize, usize)>,
     second: Vec<(usize, usize, bool)>,
@@ -107,31 +97,6 @@ fn eliminate(
     row_scale: &[f64],
     scale: &[f64],
 ) -> Option<Pivots> {
-    let order = elimination_order(model);
-    // A mechanism without loops and contacts resolves its rows at their first bodies where
-    // nothing degenerates: its steps read their rows straight from the triplets.
-    let contacts = !model.grounds.is_empty()
-        || !model.obstacles.is_empty()
-        || !model.contact_points.is_empty();
-    if open(model) && !contacts {
-        if let Some(pivots) = tree::eliminate(&order, m, n, entries, row_scale, scale) {
-            return Some(pivots);
-        }
-    }
-    by_rows(&order, m, n, entries, row_scale, scale)
-}
-
-/// The elimination ([`partition`]) in the body order `order` on the rows as expanded (module
-/// `rows`), with the rows an earlier step left active kept: its pivots, or `None` where this
-/// route gives up.
-fn by_rows(
-    order: &[usize],
-    m: usize,
-    n: usize,
-    entries: &[Triplet],
-    row_scale: &[f64],
-    scale: &[f64],
-) -> Option<Pivots> {
     let rows = Rows::new(m, n, entries, row_scale, scale)?;
     let amax = rows.rmax.iter().fold(0.0f64, |a, &x| a.max(x));
     let tol = (RANK_TOLERANCE * amax).max(f64::MIN_POSITIVE);
@@ -143,7 +108,7 @@ fn by_rows(
     let mut block = Block::default();
     let mut changed = Changed::new(m, n / 7);
     let mut cands = Vec::new();
-    for &b in order {
+    for b in elimination_order(model) {
         rows.touching(b, &mut cands);
         changed.touching(b, &mut cands);
         block.load(b, &cands, &active, &rows, &changed);
@@ -163,8 +128,7 @@ fn by_rows(
             taken += 1;
         }
         while taken < 7 {
-            let Some((i, k)) = block.best_own_pivot(&free, tol, b, &rows.own_of, &rows.reach)
-            else {
+            let Some((i, k)) = block.best_own_pivot(&free, tol, b, &rows) else {
                 break;
             };
             pivots.order.push((block.rows[i], 7 * b + k));

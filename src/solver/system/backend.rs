@@ -191,7 +191,7 @@ pub(crate) fn tree_watches_pivots(model: &Model) -> bool {
 }
 
 /// Whether `model` has no closed loop (every joint a tree joint or merged).
-pub(crate) fn open(model: &Model) -> bool {
+pub(super) fn open(model: &Model) -> bool {
     model.joints.iter().all(|j| j.tree || j.merged)
 }
 

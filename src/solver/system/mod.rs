@@ -34,7 +34,7 @@ mod workspace;
 #[cfg(test)]
 mod zero_weight_tests;
 
-pub(crate) use backend::{is_small_tree, open, Backend};
+pub(crate) use backend::{is_small_tree, Backend};
 pub(crate) use base::System;
 pub(crate) use factors::Factors;
 #[cfg(test)]

@@ -53,32 +53,26 @@ impl Segments {
         };
         s.at.push(0);
         for w in off_at.windows(2) {
-            let (mut k, stop) = (w[0], w[1]);
-            while k < stop {
-                // The row starting at `k`: its entries `k .. end`.
+            let mut k = w[0];
+            while k < w[1] {
+                // The row starting at `k`.
                 let p = off[k].0;
-                let mut end = k + 1;
-                while end < stop && off[end].0 == p {
-                    end += 1;
-                }
+                let end = (k..w[1]).find(|&j| off[j].0 != p).unwrap_or(w[1]);
                 let cols = &off[k..end];
                 let c = cols.len();
                 let distinct = distinct(cols);
                 let at = s.idx.len();
                 s.idx.push(p);
-                // Further rows with the same distinct columns join the segment: `c` entries of
-                // one row, on the same columns in the same order, and no more of that row.
+                // Further rows with the same distinct columns join the segment.
                 let mut next = end;
-                while distinct && next + c <= stop {
+                while distinct && next + c <= w[1] {
                     let row = &off[next..next + c];
-                    let r = row[0].0;
-                    if next + c < stop && off[next + c].0 == r {
+                    let same_row = row.iter().all(|e| e.0 == row[0].0);
+                    let ends = next + c == w[1] || off[next + c].0 != row[0].0;
+                    if !(same_row && ends && row.iter().zip(cols).all(|(e, f)| e.1 == f.1)) {
                         break;
                     }
-                    if !row.iter().zip(cols).all(|(e, f)| e.0 == r && e.1 == f.1) {
-                        break;
-                    }
-                    s.idx.push(r);
+                    s.idx.push(row[0].0);
                     next += c;
                 }
                 s.seg.push(Seg {
@@ -179,9 +173,6 @@ impl Segments {
 /// Whether the entries' columns are distinct: by a bit per column above the least where
 /// they span fewer than 64 positions (a row's entries on one body), else pair by pair.
 fn distinct(cols: &[(u32, u32)]) -> bool {
-    if cols.windows(2).all(|w| w[0].1 < w[1].1) {
-        return true;
-    }
     let lo = cols.iter().fold(u32::MAX, |a, e| a.min(e.1));
     let mut seen = 0u64;
     for e in cols {

@@ -251,16 +251,19 @@ impl Shape {
         let mut border_slot: HashMap<(usize, usize), u32> = HashMap::new();
         // The slot of the tree-space pair `(t1, t2)`, both in the tree: its node's diagonal
         // block, its coupling to the parent, `SKIP` for the mirror of a coupling, or `None`.
-        let tree = TreeSlots {
-            node_of: &node_of,
-            at: &at,
-            d: &d,
-            par: &par,
-            w: &w,
-            diag_at: &diag_at,
-            coup_at: &coup_at,
+        let tree_slot = |t1: usize, t2: usize| -> Option<u32> {
+            let (a, b) = (node_of[t1] as usize, node_of[t2] as usize);
+            let (l1, l2) = (t1 - at[a], t2 - at[b]);
+            if a == b {
+                Some((diag_at[a] + l1 * d[a] + l2) as u32)
+            } else if par[a] == b as u32 {
+                Some((coup_at[a] + l1 * w[a] + l2) as u32)
+            } else if par[b] == a as u32 {
+                Some(SKIP)
+            } else {
+                None
+            }
         };
-        let tree_slot = |t1: usize, t2: usize| tree.slot(t1, t2);
         let mut locate = |u1: usize, u2: usize| -> Option<u32> {
             let (t1, t2) = (tpos[u1], tpos[u2]);
             if t1 >= tree_len || t2 >= tree_len {
@@ -419,37 +422,6 @@ impl Shape {
             diag_slots,
             bare_diag,
         })
-    }
-}
-
-/// The tree nodes' layout (module docs): each tree-space position's node, each node's first
-/// position, size, parent, coupling width and the offsets of its blocks.
-struct TreeSlots<'a> {
-    node_of: &'a [u32],
-    at: &'a [usize],
-    d: &'a [usize],
-    par: &'a [u32],
-    w: &'a [usize],
-    diag_at: &'a [usize],
-    coup_at: &'a [usize],
-}
-
-impl TreeSlots<'_> {
-    /// The slot of the tree-space pair `(t1, t2)`, both in the tree: its node's diagonal
-    /// block, its coupling to the parent, `SKIP` for the mirror of a coupling, or `None`.
-    #[inline(always)]
-    fn slot(&self, t1: usize, t2: usize) -> Option<u32> {
-        let (a, b) = (self.node_of[t1] as usize, self.node_of[t2] as usize);
-        let (l1, l2) = (t1 - self.at[a], t2 - self.at[b]);
-        if a == b {
-            Some((self.diag_at[a] + l1 * self.d[a] + l2) as u32)
-        } else if self.par[a] == b as u32 {
-            Some((self.coup_at[a] + l1 * self.w[a] + l2) as u32)
-        } else if self.par[b] == a as u32 {
-            Some(SKIP)
-        } else {
-            None
-        }
     }
 }
 

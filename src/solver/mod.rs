@@ -51,6 +51,7 @@ pub use report::{
     Report, Sizes, Stability, Termination, Timings, Verdict,
 };
 pub(crate) use stability::eigen;
+pub(crate) use stability::svd;
 pub(crate) use stability::verdict::{
     stability_of, stability_on, stability_verdict, stability_verdict_after_round,
 };

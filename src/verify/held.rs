@@ -438,7 +438,7 @@ fn solve_once(
         if let Some(d) = super::friction::choose(model, &base, &dirs, &items) {
             if let Some((k_touch, k_all)) = &directions {
                 let step = &d.forces - &base;
-                if let Some(svd) = crate::solver::eigen::svd(k_touch.clone(), true, true) {
+                if let Some(svd) = crate::solver::svd::svd(k_touch.clone(), true, true) {
                     let eps = 1e-12 * svd.singular_values.amax().max(1e-300);
                     if let Ok(z) = svd.solve(&step, eps) {
                         mu += k_all * z;

@@ -16,7 +16,7 @@ pub(super) fn lexicographic(
     let (z1, null) = if a_mat.nrows() == 0 {
         (DVector::zeros(d), DMatrix::identity(d, d))
     } else {
-        let Some(svd) = crate::solver::eigen::svd(a_mat.clone(), true, true) else {
+        let Some(svd) = crate::solver::svd::svd(a_mat.clone(), true, true) else {
             return DVector::from_element(d, f64::NAN);
         };
         let top = svd.singular_values.max();
@@ -29,7 +29,7 @@ pub(super) fn lexicographic(
         // Complete the basis: N = I − V_r V_rᵀ, orthonormalized by its own SVD.
         let v_r = v_t.rows(0, rank).transpose();
         let proj = &full - &v_r * v_r.transpose();
-        let Some(psvd) = crate::solver::eigen::svd(proj, true, false) else {
+        let Some(psvd) = crate::solver::svd::svd(proj, true, false) else {
             return DVector::from_element(d, f64::NAN);
         };
         let u = psvd.u.unwrap_or_else(|| DMatrix::zeros(d, 0));
@@ -45,7 +45,7 @@ pub(super) fn lexicographic(
     // Stage 2: y minimizing ‖b + B z₁ + B N y‖.
     let bn = b_mat * &null;
     let rhs = -(b + b_mat * &z1);
-    let Some(svd) = crate::solver::eigen::svd(bn, true, true) else {
+    let Some(svd) = crate::solver::svd::svd(bn, true, true) else {
         return DVector::from_element(null.ncols(), f64::NAN) * 0.0 + z1;
     };
     let eps = 1e-10 * svd.singular_values.max().max(1e-300);

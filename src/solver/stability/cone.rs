@@ -98,7 +98,7 @@ pub(crate) fn minimum_with_direction(
                     r += 1;
                 }
             }
-            let Some(svd) = super::eigen::svd(a, false, true) else {
+            let Some(svd) = super::svd::svd(a, false, true) else {
                 continue;
             };
             let smax = svd.singular_values.max();

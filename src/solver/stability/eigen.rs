@@ -6,28 +6,12 @@
 //! `‖A V − V Λ‖` is checked (each `A v_i` formed once, for both); if it is still large the cyclic Jacobi method, slower but
 //! unconditionally convergent, is used instead. A matrix with non-finite entries gets NaN
 //! eigenvalues (the caller's tests then fail) rather than an endless iteration; the singular
-//! value decomposition is guarded the same way ([`svd`]: `None` rather than a panic or a hang).
+//! value decomposition is guarded the same way (module `svd`).
 //!
 //! ## References
 //! - G. H. Golub, C. F. Van Loan, *Matrix Computations*, 4th ed. (2013), §8.5 (Jacobi).
 
 use nalgebra::{DMatrix, DVector};
-
-/// The singular value decomposition of `m`, or `None` when `m` has a non-finite entry or the
-/// iteration does not converge: nalgebra's `svd` panics on NaN ("Singular value was NaN") and
-/// iterates without end on infinite or ±1e308 entries, so no matrix reaches it unchecked.
-pub(crate) fn svd(
-    m: DMatrix<f64>,
-    compute_u: bool,
-    compute_v: bool,
-) -> Option<nalgebra::SVD<f64, nalgebra::Dyn, nalgebra::Dyn>> {
-    // Entries beyond 1e150 square to overflow inside the bidiagonalization.
-    if m.iter().any(|x| !(x.is_finite() && x.abs() <= 1e150)) {
-        return None;
-    }
-    let s = nalgebra::SVD::try_new(m, compute_u, compute_v, f64::EPSILON, 10_000)?;
-    s.singular_values.iter().all(|x| x.is_finite()).then_some(s)
-}
 
 /// Eigenvalues (ascending) and matching orthonormal eigenvectors (columns) of a symmetric `a`.
 pub(crate) fn symmetric_eigen(a: &DMatrix<f64>) -> (DVector<f64>, DMatrix<f64>) {

@@ -195,7 +195,7 @@ fn well_conditioned_inverse(t: &DMatrix<f64>) -> Option<DMatrix<f64>> {
 /// rank (singular values above `RELATIVE` times the largest) is below `dof`.
 fn chosen_inverse(t: &DMatrix<f64>, selectable: &[bool]) -> Option<DMatrix<f64>> {
     let (rows, dof) = t.shape();
-    let svd = super::eigen::svd(t.clone(), true, false)?;
+    let svd = super::svd::svd(t.clone(), true, false)?;
     let top = svd.singular_values.max();
     let kept: Vec<usize> = (0..svd.singular_values.len())
         .filter(|&k| svd.singular_values[k] > RELATIVE * top)

@@ -4,6 +4,8 @@
 //! (`t = 10⁻¹⁰ max(λ_max, 1)`).
 //!
 //! - `eigen`: guarded symmetric eigendecomposition `A = V Λ Vᵀ` (dense).
+//! - `svd`: guarded singular value decomposition `A = U Σ Vᵀ` (dense; nalgebra's checked,
+//!   one-sided Jacobi where it fails).
 //! - `spectrum`: the low end of the spectrum of `Ĥ`, exact (dense) or by Lanczos on `Ĥ⁻¹`
 //!   (sparse, many degrees of freedom); also used by the minimizer to leave saddles.
 //! - `inertia`: the verdict from the inertia of the shifted KKT matrix, without eigenvalues.
@@ -25,4 +27,5 @@ pub(crate) mod joint_space;
 pub(crate) mod largest;
 pub(crate) mod leave;
 pub(crate) mod spectrum;
+pub(crate) mod svd;
 pub(crate) mod verdict;

@@ -247,11 +247,19 @@ const POINT_MASS_RADIUS: f64 = 1e-6;
 /// Why an inertia tensor is not physically valid (a principal moment negative, or one larger
 /// than the sum of the other two, beyond `max(10⁻⁹ |I|, m (1 µm)²)`), if it is not.
 fn inertia_problem(i: &Matrix3<f64>, mass: f64) -> Option<String> {
-    // The guarded decomposition (module `solver::eigen`, dimforge/nalgebra#1109).
-    let (e, _) =
-        crate::solver::eigen::symmetric_eigen(&nalgebra::DMatrix::from_fn(3, 3, |r, c| i[(r, c)]));
-    if e.iter().any(|x| !x.is_finite()) {
+    let Some(eig) = nalgebra::SymmetricEigen::try_new(*i, f64::EPSILON, 1000) else {
         return Some("its eigenvalues cannot be computed".into());
+    };
+    // nalgebra's result checked as module `solver::eigen` checks it (dimforge/nalgebra#1109;
+    // `urdf` is below `solver`): `I v_k = λ_k v_k` and `VᵀV = 1`, to 10⁻⁹ of `|I|`.
+    let (e, v) = (eig.eigenvalues, eig.eigenvectors);
+    let residual = (i * v - v * Matrix3::from_diagonal(&e)).amax();
+    let orthonormal = (v.transpose() * v - Matrix3::identity()).amax();
+    if !(residual <= 1e-9 * i.amax() && orthonormal <= 1e-9) {
+        return Some(format!(
+            "its eigendecomposition fails its check (residual {residual:.3e}, orthonormality \
+             {orthonormal:.3e})"
+        ));
     }
     let tol = (1e-9 * e.amax())
         .max(mass * POINT_MASS_RADIUS * POINT_MASS_RADIUS)

@@ -55,7 +55,8 @@ fn rayleigh(a: &DMatrix<f64>, vecs: &DMatrix<f64>) -> Option<DVector<f64>> {
     for i in 0..n {
         for j in 0..n {
             let id = if i == j { 1.0 } else { 0.0 };
-            if !((vtv[(i, j)] - id).abs() <= 1e-9) {
+            let x = (vtv[(i, j)] - id).abs();
+            if x.is_nan() || x > 1e-9 {
                 return None;
             }
         }

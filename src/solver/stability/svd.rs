@@ -31,7 +31,8 @@
 //! to a few units of rounding in `σ_i / σ₁` (Demmel and Veselić). A matrix with a non-finite
 //! entry or one beyond `10¹⁵⁰` (whose squares overflow) gets `None`, as does a Jacobi sweep
 //! limit reached: nalgebra's `svd` panics on NaN and iterates without end on infinite
-//! entries, so no matrix reaches it unchecked.
+//! entries, so no matrix reaches it unchecked. A matrix with no rows or no columns (on which
+//! nalgebra's `svd` panics) gets `k = 0`: no singular values, `U` `m × 0`, `Vᵀ` `0 × n`.
 //!
 //! ## References
 //! - J. Demmel, K. Veselić, "Jacobi's method is more accurate than QR", SIAM J. Matrix Anal.
@@ -51,14 +52,37 @@ const TIGHT: f64 = 1e-11;
 const SWEEPS: usize = 100;
 
 /// The thin SVD of `m` with `U` if `compute_u` and `Vᵀ` if `compute_v`, singular values in
-/// descending order; `None` for a non-finite or huge entry or a failed iteration.
+/// descending order; `None` for a non-finite or huge entry or a failed iteration. With neither
+/// factor asked for, `V` is computed and checked, then dropped.
 pub(crate) fn svd(m: DMatrix<f64>, compute_u: bool, compute_v: bool) -> Option<SVD<f64, Dyn, Dyn>> {
     // Entries beyond 1e150 square to overflow inside the bidiagonalization.
     if m.iter().any(|x| !(x.is_finite() && x.abs() <= 1e150)) {
         return None;
     }
-    let checked = SVD::try_new(m.clone(), compute_u, compute_v, f64::EPSILON, 10_000)
-        .filter(|s| holds(&m, s));
+    // nalgebra's `SVD` panics on a matrix with no rows or no columns: `k = 0`.
+    if m.is_empty() {
+        let (r, c) = m.shape();
+        return Some(SVD {
+            u: compute_u.then(|| DMatrix::zeros(r, 0)),
+            v_t: compute_v.then(|| DMatrix::zeros(0, c)),
+            singular_values: DVector::zeros(0),
+        });
+    }
+    // Neither factor asked for: `V` is computed all the same, for the check.
+    let checked = SVD::try_new(
+        m.clone(),
+        compute_u,
+        compute_v || !compute_u,
+        f64::EPSILON,
+        10_000,
+    )
+    .filter(|s| holds(&m, s))
+    .map(|mut s| {
+        if !compute_v {
+            s.v_t = None;
+        }
+        s
+    });
     checked.or_else(|| {
         let mut s = jacobi(&m)?;
         if !compute_u {
@@ -401,6 +425,21 @@ mod tests {
             assert!(d < 1e-12, "{d:e}");
             let (rec, ou, ov) = errors(&a, &ours);
             assert!(rec < 1e-13 && ou < 1e-13 && ov < 1e-13);
+        }
+    }
+
+    /// Shapes with no rows or no columns, and the zero matrix: no singular values (or zeros),
+    /// no panic.
+    #[test]
+    fn empty_and_zero_shapes() {
+        for (r, c) in [(0, 3), (3, 0), (0, 0), (1, 1), (2, 5)] {
+            let a = DMatrix::<f64>::zeros(r, c);
+            for (cu, cv) in [(true, true), (true, false), (false, true), (false, false)] {
+                let s = svd(a.clone(), cu, cv).unwrap();
+                assert_eq!(s.singular_values.len(), r.min(c));
+                assert!(s.singular_values.iter().all(|&x| x == 0.0));
+                assert!(holds(&a, &s));
+            }
         }
     }
 

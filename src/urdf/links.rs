@@ -247,10 +247,20 @@ const POINT_MASS_RADIUS: f64 = 1e-6;
 /// Why an inertia tensor is not physically valid (a principal moment negative, or one larger
 /// than the sum of the other two, beyond `max(10⁻⁹ |I|, m (1 µm)²)`), if it is not.
 fn inertia_problem(i: &Matrix3<f64>, mass: f64) -> Option<String> {
-    let Some(e) = nalgebra::SymmetricEigen::try_new(*i, f64::EPSILON, 1000).map(|e| e.eigenvalues)
-    else {
+    let Some(eig) = nalgebra::SymmetricEigen::try_new(*i, f64::EPSILON, 1000) else {
         return Some("its eigenvalues cannot be computed".into());
     };
+    // nalgebra's result checked as module `solver::eigen` checks it (dimforge/nalgebra#1109;
+    // `urdf` is below `solver`): `I v_k = λ_k v_k` and `VᵀV = 1`, to 10⁻⁹ of `|I|`.
+    let (e, v) = (eig.eigenvalues, eig.eigenvectors);
+    let residual = (i * v - v * Matrix3::from_diagonal(&e)).amax();
+    let orthonormal = (v.transpose() * v - Matrix3::identity()).amax();
+    if !(residual <= 1e-9 * i.amax() && orthonormal <= 1e-9) {
+        return Some(format!(
+            "its eigendecomposition fails its check (residual {residual:.3e}, orthonormality \
+             {orthonormal:.3e})"
+        ));
+    }
     let tol = (1e-9 * e.amax())
         .max(mass * POINT_MASS_RADIUS * POINT_MASS_RADIUS)
         .max(f64::MIN_POSITIVE);
@@ -266,4 +276,44 @@ fn inertia_problem(i: &Matrix3<f64>, mass: f64) -> Option<String> {
         }
     }
     None
+}
+
+#[cfg(test)]
+mod inertia_tests {
+    use super::*;
+    use nalgebra::UnitQuaternion;
+
+    /// Principal moments `d` turned by `r`: `R diag(d) Rᵀ`.
+    fn turned(d: [f64; 3], r: &UnitQuaternion<f64>) -> Matrix3<f64> {
+        let m = r.to_rotation_matrix();
+        m.matrix() * Matrix3::from_diagonal(&Vector3::from(d)) * m.matrix().transpose()
+    }
+
+    /// Tensors at the edges of validity, turned: a rod (moments 1, 1, 0), equal moments, a
+    /// point mass's rounding (10⁻²⁰ – 10⁻³⁵ of either sign), a flat plate (1, 1, 2), moments
+    /// 10⁻⁶ beside 10³; and invalid ones just beyond the tolerance.
+    #[test]
+    fn decisions_at_the_edges_hold_in_any_orientation() {
+        let turns = [
+            UnitQuaternion::identity(),
+            UnitQuaternion::from_euler_angles(0.3, -1.1, 2.0),
+            UnitQuaternion::from_euler_angles(1e-9, 0.0, 0.7),
+        ];
+        for r in &turns {
+            for (d, mass, valid) in [
+                ([1.0, 1.0, 0.0], 1.0, true),
+                ([1.0, 1.0, 1.0], 1.0, true),
+                ([1e-20, -1e-35, 3e-21], 1.0, true),
+                ([1.0, 1.0, 2.0], 1.0, true),
+                ([1e3, 1e-6, 1e3], 1.0, true),
+                ([1.0, 1.0, 2.0 + 1e-6], 1.0, false),
+                ([1.0, 1.0, -1e-6], 1.0, false),
+                ([1e3, 1e3, 2e3 * (1.0 + 1e-6)], 1.0, false),
+            ] {
+                let got = inertia_problem(&turned(d, r), mass);
+                assert_eq!(got.is_none(), valid, "{d:?} turned {r}: {got:?}");
+            }
+        }
+        assert!(inertia_problem(&Matrix3::from_element(f64::NAN), 1.0).is_some());
+    }
 }

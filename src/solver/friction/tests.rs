@@ -60,12 +60,16 @@ fn support(touches: &[Touch], w: f64, tilt: f64, mu: Option<f64>) -> (DMatrix<f6
     let g = DMatrix::from_columns(&cols);
     let weight = Vector3::new(-w * tilt.sin(), 0.0, -w * tilt.cos());
     let rhs = DVector::from_vec(vec![-weight.x, -weight.y, -weight.z, 0.0, 0.0, 0.0]);
-    let base = g.clone().pseudo_inverse(1e-12).unwrap() * &rhs;
-    let eig = (g.transpose() * &g).symmetric_eigen();
-    let top = eig.eigenvalues.amax();
+    // By the guarded decompositions: `G` is wide and rank deficient, nalgebra's own SVD and
+    // symmetric eigendecomposition can be wrong there (modules `solver::svd`, `eigen`).
+    let svd = crate::solver::svd::svd(g.clone(), true, true).unwrap();
+    let base = svd.solve(&rhs, 1e-12).unwrap();
+    assert!((&g * &base - &rhs).amax() <= 1e-9 * rhs.amax().max(1.0));
+    let (values, vectors) = crate::solver::eigen::symmetric_eigen(&(g.transpose() * &g));
+    let top = values.amax();
     let null: Vec<DVector<f64>> = (0..g.ncols())
-        .filter(|&i| eig.eigenvalues[i] <= 1e-10 * top)
-        .map(|i| eig.eigenvectors.column(i).into_owned())
+        .filter(|&i| values[i] <= 1e-10 * top)
+        .map(|i| vectors.column(i).into_owned())
         .collect();
     let k = g.ncols();
     // Contacts with one normal are on one plane ground (module `friction::shortcut`).

@@ -173,3 +173,95 @@ pub(crate) fn triplets_tr_mul(a: &[Triplet], y: &[f64], columns: usize) -> Vec<f
     }
     x
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The partition of an `r × (r + 1)` Jacobian: rows and the first `r` columns dependent.
+    fn partition(r: usize) -> Partition {
+        Partition {
+            id: crate::solver::partition::next_id(),
+            dependent: (0..r).collect(),
+            independent: vec![r],
+            rows: (0..r).collect(),
+            redundant: vec![],
+            second_pass: vec![],
+        }
+    }
+
+    /// `Φ_u x = b` and `Φ_uᵀ x = b` by faer's sparse LU, or `None` where refused.
+    fn solves(r: usize, entries: &[Triplet]) -> (Option<Vec<f64>>, Option<Vec<f64>>) {
+        let mut split = Split::new(&partition(r), r, r + 1, entries).unwrap();
+        let f = split.factor(entries);
+        let b: Vec<f64> = (0..r).map(|i| 1.0 + i as f64).collect();
+        let (mut x, mut y) = (b.clone(), b);
+        (
+            f.solve(&mut x).then_some(x),
+            f.solve_transpose(&mut y).then_some(y),
+        )
+    }
+
+    /// faer's sparse LU on an exactly singular `Φ_u` (two equal rows; a structural entry of
+    /// value zero; a chain's bidiagonal with a zero pivot in the middle, simplicial; a dense
+    /// block of rank one, super-nodal) gives non-finite values, which the solves refuse: no
+    /// finite wrong answer and no panic (sarah-quinones/faer-rs#232). Nonsingular ones with
+    /// entries of 10⁻¹⁸ beside 1 are solved to rounding.
+    #[test]
+    fn singular_phi_u_is_refused_and_badly_scaled_solved() {
+        let chain = |n: usize, zero: Option<usize>| {
+            let mut e = vec![];
+            for i in 0..n {
+                let d = if Some(i) == zero { 0.0 } else { 1.0 };
+                e.push((i as u32, i as u32, d));
+                if i > 0 {
+                    e.push((i as u32, i as u32 - 1, 0.5));
+                }
+                e.push((i as u32, n as u32, 1.0));
+            }
+            e
+        };
+        let rank_one = |n: usize| {
+            let mut e = vec![];
+            for i in 0..n {
+                for j in 0..n {
+                    e.push((i as u32, j as u32, (i as f64 + 1.0) * (j as f64 + 1.0)));
+                }
+            }
+            e
+        };
+        let singular: Vec<(usize, Vec<Triplet>)> = vec![
+            (2, vec![(0, 0, 1.0), (0, 1, 2.0), (1, 0, 1.0), (1, 1, 2.0)]),
+            (3, vec![(0, 0, 1.0), (1, 1, 1.0), (2, 2, 0.0), (0, 2, 0.0)]),
+            (200, chain(200, Some(100))),
+            (300, rank_one(300)),
+        ];
+        for (r, e) in &singular {
+            let (x, y) = solves(*r, e);
+            assert!(x.is_none() && y.is_none(), "r = {r}: {x:?} {y:?}");
+        }
+        let scaled: Vec<(usize, Vec<Triplet>)> = vec![
+            (
+                2,
+                vec![(0, 0, 1.0), (0, 1, 1e-18), (1, 0, 1e-18), (1, 1, 1e-18)],
+            ),
+            (200, chain(200, None)),
+        ];
+        for (r, e) in &scaled {
+            let (x, y) = solves(*r, e);
+            let (x, y) = (x.unwrap(), y.unwrap());
+            let u: Vec<Triplet> = e.iter().copied().filter(|t| (t.1 as usize) < *r).collect();
+            let ax = triplets_mul(&u, &x, *r);
+            let aty = triplets_tr_mul(&u, &y, *r);
+            for i in 0..*r {
+                let b = 1.0 + i as f64;
+                assert!((ax[i] - b).abs() <= 1e-12 * b, "r = {r}: {} vs {b}", ax[i]);
+                assert!(
+                    (aty[i] - b).abs() <= 1e-12 * b,
+                    "r = {r}: {} vs {b}",
+                    aty[i]
+                );
+            }
+        }
+    }
+}

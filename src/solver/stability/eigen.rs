@@ -19,34 +19,49 @@ pub(crate) fn symmetric_eigen(a: &DMatrix<f64>) -> (DVector<f64>, DMatrix<f64>) 
     if a.iter().any(|x| !x.is_finite()) {
         return (DVector::from_element(n, f64::NAN), DMatrix::identity(n, n));
     }
-    let scale = a.amax().max(f64::MIN_POSITIVE);
-    // Bounded iterations: nalgebra's `new` iterates without limit. Each `A v_i` is formed once,
-    // for its Rayleigh quotient and its column of the residual `A V − V Λ`.
-    let guarded =
-        nalgebra::SymmetricEigen::try_new(a.clone(), f64::EPSILON, 10_000).and_then(|e| {
-            let vecs = e.eigenvectors;
-            let mut vals = DVector::zeros(n);
-            let mut av = DVector::zeros(n);
-            for i in 0..n {
-                a.mul_to(&vecs.column(i), &mut av);
-                let v = vecs.column(i);
-                vals[i] = v.dot(&av);
-                for r in 0..n {
-                    let x = (av[r] - v[r] * vals[i]).abs();
-                    // A NaN residual fails too.
-                    if x.is_nan() || x > 1e-9 * scale {
-                        return None;
-                    }
-                }
-            }
-            Some((vals, vecs))
-        });
+    // Bounded iterations: nalgebra's `new` iterates without limit.
+    let guarded = nalgebra::SymmetricEigen::try_new(a.clone(), f64::EPSILON, 10_000)
+        .and_then(|e| Some((rayleigh(a, &e.eigenvectors)?, e.eigenvectors)));
     let (vals, vecs) = guarded.unwrap_or_else(|| jacobi(a));
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_by(|&i, &j| vals[i].total_cmp(&vals[j]));
     let sorted_vals = DVector::from_fn(n, |i, _| vals[order[i]]);
     let sorted_vecs = DMatrix::from_fn(n, n, |r, c| vecs[(r, order[c])]);
     (sorted_vals, sorted_vecs)
+}
+
+/// The Rayleigh quotients `λ_i = v_iᵀ A v_i` of the columns of `vecs` if they are eigenvectors
+/// of `a` (`‖A v_i − λ_i v_i‖∞ ≤ 10⁻⁹ ‖A‖_max`, each `A v_i` formed once) and orthonormal
+/// (`VᵀV = I` to `10⁻⁹`); `None` otherwise.
+fn rayleigh(a: &DMatrix<f64>, vecs: &DMatrix<f64>) -> Option<DVector<f64>> {
+    let n = a.nrows();
+    let scale = a.amax().max(f64::MIN_POSITIVE);
+    let mut vals = DVector::zeros(n);
+    let mut av = DVector::zeros(n);
+    for i in 0..n {
+        a.mul_to(&vecs.column(i), &mut av);
+        let v = vecs.column(i);
+        vals[i] = v.dot(&av);
+        for r in 0..n {
+            let x = (av[r] - v[r] * vals[i]).abs();
+            // A NaN residual fails too.
+            if x.is_nan() || x > 1e-9 * scale {
+                return None;
+            }
+        }
+    }
+    // Orthonormal: n eigenpairs, none repeated, so the λ_i are the whole spectrum.
+    let vtv = vecs.tr_mul(vecs);
+    for i in 0..n {
+        for j in 0..n {
+            let id = if i == j { 1.0 } else { 0.0 };
+            let x = (vtv[(i, j)] - id).abs();
+            if x.is_nan() || x > 1e-9 {
+                return None;
+            }
+        }
+    }
+    Some(vals)
 }
 
 /// Cyclic Jacobi rotations until the off-diagonal part is negligible.
@@ -124,6 +139,43 @@ mod tests {
             ],
         );
         check(&a);
+    }
+
+    /// `diag(1, 2, 3)` with `e₁` listed twice in place of `e₂`: every residual is zero (the
+    /// first guard, residuals alone, took it, and the spectrum `{1, 1, 3}`), but `V` is not
+    /// orthonormal.
+    #[test]
+    fn a_repeated_eigenpair_is_refused() {
+        let a = DMatrix::from_diagonal(&DVector::from_vec(vec![1.0, 2.0, 3.0]));
+        let v = DMatrix::from_row_slice(3, 3, &[1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
+        let vals = DVector::from_vec(vec![1.0, 1.0, 3.0]);
+        assert_eq!((&a * &v - &v * DMatrix::from_diagonal(&vals)).amax(), 0.0);
+        assert!(rayleigh(&a, &v).is_none());
+        assert_eq!(rayleigh(&a, &DMatrix::identity(3, 3)), Some(a.diagonal()));
+        check(&a);
+    }
+
+    /// Rank-deficient `JᵀJ` (wide and tall `J`, all-ones, columns scaled from `10⁻⁹` to `10⁹`,
+    /// entries of `10⁻¹⁸` beside 1): the result meets both identities (nalgebra's after its
+    /// check, or Jacobi's) and its eigenvalues sum to the trace.
+    #[test]
+    fn rank_deficient_and_badly_scaled_gram_matrices() {
+        let mut lcg = crate::lcg::Lcg::new(17);
+        for (m, n) in [(1, 4), (3, 5), (5, 3), (2, 9), (9, 9), (4, 12)] {
+            for kind in 0..4 {
+                let j = DMatrix::from_fn(m, n, |r, c| match kind {
+                    0 => 1.0,
+                    1 => (lcg.unit() - 0.5) * 10f64.powi(3 * (c as i32 % 7) - 9),
+                    2 if (r + c) % 3 == 0 => 1e-18 * (lcg.unit() - 0.5),
+                    _ => lcg.unit() - 0.5,
+                });
+                let a = j.tr_mul(&j);
+                check(&a);
+                let (vals, vecs) = symmetric_eigen(&a);
+                assert!(rayleigh(&a, &vecs).is_some(), "{m} × {n}, kind {kind}");
+                assert!((vals.sum() - a.trace()).abs() <= 1e-12 * a.amax() * n as f64);
+            }
+        }
     }
 
     #[test]

@@ -6,16 +6,23 @@
 //! `√15 = 3.87`, with orthonormal `U` and `V`; here most rank-deficient inputs of a few rows,
 //! tall or wide, reconstruct with errors of the order of `‖A‖` itself). Its result is
 //! therefore checked by identities that hold for every matrix, with whichever vectors were
-//! computed:
+//! computed (`W` = `U` with `B = AᵀU`, or `W` = `V` with `B = A V`; `b_i` the columns of `B`):
 //!
 //! ```text
-//! Σ σ_i² = ‖A‖_F²,   UᵀU = I,  (AᵀU)ᵀ(AᵀU) = Σ²   (U computed)
-//!                    VᵀV = I,  (AV)ᵀ(AV) = Σ²     (V computed)
+//! σ₁ ≥ … ≥ σ_k ≥ 0,   WᵀW = I,   A = U Bᵀ  or  A = B Vᵀ,
+//! ‖b_i‖ = σ_i,   |b_iᵀ b_j| ≤ τ ‖A‖_F max(‖b_i‖, ‖b_j‖)  (i ≠ j)
 //! ```
 //!
-//! each to `10⁻⁹` of `‖A‖_F²` (of 1 for the orthonormality). Together they make the
-//! decomposition exact to that tolerance: with `U` square or `Σ σ_i² = ‖A‖_F²`, `A = U UᵀA`,
-//! and `UᵀA = Σ Vᵀ` with `V`'s columns orthonormal wherever `σ_i > 0`. A result that fails
+//! the orthonormality to `10⁻⁹`, the others to `τ ‖A‖_F` with `τ = 10⁻¹¹` (a backward-stable
+//! SVD meets them to `k ε`). They make every `σ_i` exact to `O(k τ) ‖A‖_F`: with `W`
+//! orthonormal, `A`'s singular values are within `‖A − U Bᵀ‖₂` (`‖A − B Vᵀ‖₂`) of `B`'s, and
+//! `BᵀB = diag(‖b_i‖²) + E` with `|E_ij| ≤ τ ‖A‖_F max(‖b_i‖, ‖b_j‖)` moves `‖b_i‖` by
+//! `O(√k τ ‖A‖_F)`, a zero one included (the perturbation of a small eigenvalue of `BᵀB` is
+//! second order in `E`). The callers decide ranks at `10⁻⁹ – 10⁻¹²` of `σ₁`, so the checks
+//! are on the scale of `A`, not of `A`'s squares: identities on squares (`Σ σ_i² = ‖A‖_F²`,
+//! `BᵀB = Σ²` to `10⁻⁹ ‖A‖_F²`, this module's first guard) let a zero singular value be
+//! reported as `3·10⁻⁵ ‖A‖_F`, or a `10⁻⁵ ‖A‖_F` one as zero, and a rank be miscounted
+//! (test `square_scale_identities_miss_a_wrong_rank`). A result that fails
 //! is replaced by the one-sided Jacobi method (Hestenes): the columns of `A V` (of `Aᵀ` for
 //! a wide `A`) are rotated pairwise until orthogonal, `V` accumulating the rotations; then
 //! `σ_i = ‖(A V)_i‖` and `u_i = (A V)_i / σ_i` (a pair counts as orthogonal when
@@ -24,7 +31,8 @@
 //! to a few units of rounding in `σ_i / σ₁` (Demmel and Veselić). A matrix with a non-finite
 //! entry or one beyond `10¹⁵⁰` (whose squares overflow) gets `None`, as does a Jacobi sweep
 //! limit reached: nalgebra's `svd` panics on NaN and iterates without end on infinite
-//! entries, so no matrix reaches it unchecked.
+//! entries, so no matrix reaches it unchecked. A matrix with no rows or no columns (on which
+//! nalgebra's `svd` panics) gets `k = 0`: no singular values, `U` `m × 0`, `Vᵀ` `0 × n`.
 //!
 //! ## References
 //! - J. Demmel, K. Veselić, "Jacobi's method is more accurate than QR", SIAM J. Matrix Anal.
@@ -33,21 +41,48 @@
 
 use nalgebra::{DMatrix, DVector, Dyn, SVD};
 
-/// Relative tolerance of the identities checked on nalgebra's result (module docs).
+/// Tolerance of the orthonormality of nalgebra's `U` and `V` (module docs).
 const CHECK: f64 = 1e-9;
+
+/// Tolerance, relative to `‖A‖_F`, of the identities on the scale of `A` itself (module docs):
+/// a backward-stable SVD meets them to `k ε`, a few hundred times below.
+const TIGHT: f64 = 1e-11;
 
 /// Largest number of Jacobi sweeps.
 const SWEEPS: usize = 100;
 
 /// The thin SVD of `m` with `U` if `compute_u` and `Vᵀ` if `compute_v`, singular values in
-/// descending order; `None` for a non-finite or huge entry or a failed iteration.
+/// descending order; `None` for a non-finite or huge entry or a failed iteration. With neither
+/// factor asked for, `V` is computed and checked, then dropped.
 pub(crate) fn svd(m: DMatrix<f64>, compute_u: bool, compute_v: bool) -> Option<SVD<f64, Dyn, Dyn>> {
     // Entries beyond 1e150 square to overflow inside the bidiagonalization.
     if m.iter().any(|x| !(x.is_finite() && x.abs() <= 1e150)) {
         return None;
     }
-    let checked = SVD::try_new(m.clone(), compute_u, compute_v, f64::EPSILON, 10_000)
-        .filter(|s| holds(&m, s));
+    // nalgebra's `SVD` panics on a matrix with no rows or no columns: `k = 0`.
+    if m.is_empty() {
+        let (r, c) = m.shape();
+        return Some(SVD {
+            u: compute_u.then(|| DMatrix::zeros(r, 0)),
+            v_t: compute_v.then(|| DMatrix::zeros(0, c)),
+            singular_values: DVector::zeros(0),
+        });
+    }
+    // Neither factor asked for: `V` is computed all the same, for the check.
+    let checked = SVD::try_new(
+        m.clone(),
+        compute_u,
+        compute_v || !compute_u,
+        f64::EPSILON,
+        10_000,
+    )
+    .filter(|s| holds(&m, s))
+    .map(|mut s| {
+        if !compute_v {
+            s.v_t = None;
+        }
+        s
+    });
     checked.or_else(|| {
         let mut s = jacobi(&m)?;
         if !compute_u {
@@ -63,38 +98,40 @@ pub(crate) fn svd(m: DMatrix<f64>, compute_u: bool, compute_v: bool) -> Option<S
 /// Whether `s` is a decomposition of `a` by the identities of the module docs.
 fn holds(a: &DMatrix<f64>, s: &SVD<f64, Dyn, Dyn>) -> bool {
     let sv = &s.singular_values;
-    if sv.iter().any(|x| !x.is_finite() || *x < 0.0) {
+    if sv.iter().any(|x| !x.is_finite() || *x < 0.0) || (1..sv.len()).any(|i| sv[i - 1] < sv[i]) {
         return false;
     }
-    let frob2 = a.norm_squared();
-    let tol = CHECK * frob2.max(f64::MIN_POSITIVE);
-    if (sv.norm_squared() - frob2).abs() > tol {
-        return false;
-    }
-    // `b`'s columns `b_i` (AᵀU or AV) must be orthogonal with `‖b_i‖ = σ_i`; `w` orthonormal.
-    let images = |w: &DMatrix<f64>, b: &DMatrix<f64>| {
+    let tol = TIGHT * a.norm().max(f64::MIN_POSITIVE);
+    // `w` (U or V, `k` orthonormal columns) and `b = Aᵀ U` or `A V`: `A = U Bᵀ` or `B Vᵀ` to
+    // `tol`, and `b`'s columns orthogonal with `‖b_i‖ = σ_i`.
+    let images = |w: &DMatrix<f64>, b: &DMatrix<f64>, residual: DMatrix<f64>| {
         let k = sv.len();
-        if w.ncols() != k || b.ncols() != k {
+        if w.ncols() != k || b.ncols() != k || residual.amax() > tol {
             return false;
         }
         let wtw = w.tr_mul(w);
         let btb = b.tr_mul(b);
+        let norms: Vec<f64> = (0..k).map(|i| b.column(i).norm()).collect();
         (0..k).all(|i| {
-            (0..k).all(|j| {
-                let id = if i == j { 1.0 } else { 0.0 };
-                let sq = if i == j { sv[i] * sv[i] } else { 0.0 };
-                (wtw[(i, j)] - id).abs() <= CHECK && (btb[(i, j)] - sq).abs() <= tol
-            })
+            (norms[i] - sv[i]).abs() <= tol
+                && (0..k).all(|j| {
+                    let id = if i == j { 1.0 } else { 0.0 };
+                    (wtw[(i, j)] - id).abs() <= CHECK
+                        && (i == j || btb[(i, j)].abs() <= tol * norms[i].max(norms[j]))
+                })
         })
     };
     if let Some(u) = &s.u {
-        if !images(u, &a.tr_mul(u)) {
+        let b = a.tr_mul(u);
+        let residual = a - u * b.transpose();
+        if !images(u, &b, residual) {
             return false;
         }
     }
     if let Some(v_t) = &s.v_t {
-        let v = v_t.transpose();
-        if !images(&v, &(a * &v)) {
+        let b = a * v_t.transpose();
+        let residual = a - &b * v_t;
+        if !images(&v_t.transpose(), &b, residual) {
             return false;
         }
     }
@@ -278,6 +315,91 @@ mod tests {
         assert!(wrong > 0);
     }
 
+    /// Results wrong on the scale the callers decide ranks at, which identities on squares
+    /// (`Σ σ_i² = ‖A‖_F²`, `BᵀB = Σ²`, `WᵀW = I`, each to `10⁻⁹ ‖A‖_F²`) all accept: a zero
+    /// singular value reported as `2·10⁻⁵` (rank 2 for a rank-1 matrix at the callers'
+    /// `10⁻¹⁰` thresholds), and a `10⁻⁵` one reported as zero with `V` missing its direction
+    /// (rank 1 for rank 2). The checks on the scale of `A` refuse both, with either factor.
+    #[test]
+    fn square_scale_identities_miss_a_wrong_rank() {
+        let squares = |a: &DMatrix<f64>, s: &SVD<f64, Dyn, Dyn>| {
+            let sv = &s.singular_values;
+            let tol = 1e-9 * a.norm_squared();
+            let gram = |w: &DMatrix<f64>, b: &DMatrix<f64>| {
+                let k = sv.len();
+                let (wtw, btb) = (w.tr_mul(w), b.tr_mul(b));
+                (wtw - DMatrix::<f64>::identity(k, k)).amax() <= 1e-9
+                    && (btb - DMatrix::from_diagonal(&sv.map(|x| x * x))).amax() <= tol
+            };
+            (sv.norm_squared() - a.norm_squared()).abs() <= tol
+                && s.u.as_ref().is_none_or(|u| gram(u, &a.tr_mul(u)))
+                && s.v_t
+                    .as_ref()
+                    .is_none_or(|v_t| gram(&v_t.transpose(), &(a * v_t.transpose())))
+        };
+        let too_many = (
+            DMatrix::from_row_slice(2, 2, &[1.0, 0.0, 0.0, 0.0]),
+            SVD {
+                u: Some(DMatrix::identity(2, 2)),
+                v_t: Some(DMatrix::identity(2, 2)),
+                singular_values: DVector::from_vec(vec![1.0, 2e-5]),
+            },
+        );
+        let too_few = (
+            DMatrix::from_row_slice(2, 3, &[1.0, 0.0, 0.0, 0.0, 1e-5, 0.0]),
+            SVD {
+                u: Some(DMatrix::identity(2, 2)),
+                v_t: Some(DMatrix::from_row_slice(
+                    2,
+                    3,
+                    &[1.0, 0.0, 0.0, 0.0, 0.0, 1.0],
+                )),
+                singular_values: DVector::from_vec(vec![1.0, 0.0]),
+            },
+        );
+        for (a, s) in [too_many, too_few] {
+            let true_rank = svd(a.clone(), false, false)
+                .unwrap()
+                .singular_values
+                .iter()
+                .filter(|&&x| x > 1e-10)
+                .count();
+            let claimed = s.singular_values.iter().filter(|&&x| x > 1e-10).count();
+            assert_ne!(true_rank, claimed, "{a}");
+            for (cu, cv) in [(true, true), (true, false), (false, true)] {
+                let mut one = s.clone();
+                one.u = one.u.filter(|_| cu);
+                one.v_t = one.v_t.filter(|_| cv);
+                assert!(squares(&a, &one), "{a}: {cu} {cv}");
+                // `U` alone cannot see the `V` missing `e₂` of `too_few`: its `σ₂ = ‖Aᵀu₂‖`
+                // does.
+                assert!(!holds(&a, &one), "{a}: {cu} {cv}");
+            }
+        }
+    }
+
+    /// Every result the guard returns meets its own identities, nalgebra's or Jacobi's, on
+    /// rank-deficient, wide, tall, badly scaled and exactly singular inputs.
+    #[test]
+    fn what_is_returned_meets_the_identities() {
+        let mut lcg = crate::lcg::Lcg::new(21);
+        let mut all = cases();
+        for (r, c) in [(3, 8), (8, 3), (7, 7), (12, 4)] {
+            // Columns scaled from 1e-9 to 1e9 and rows from 1 to 1e-18.
+            all.push(DMatrix::from_fn(r, c, |i, j| {
+                (lcg.unit() - 0.5)
+                    * 10f64.powi(3 * (j as i32 % 7) - 9)
+                    * 10f64.powi(-6 * (i as i32 % 4))
+            }));
+        }
+        for a in all {
+            let s = svd(a.clone(), true, true).unwrap();
+            assert!(holds(&a, &s), "{a}");
+            let j = jacobi(&a).unwrap();
+            assert!(holds(&a, &j), "{a}");
+        }
+    }
+
     #[test]
     fn one_factor_asked_for_is_checked_too() {
         for a in cases() {
@@ -303,6 +425,21 @@ mod tests {
             assert!(d < 1e-12, "{d:e}");
             let (rec, ou, ov) = errors(&a, &ours);
             assert!(rec < 1e-13 && ou < 1e-13 && ov < 1e-13);
+        }
+    }
+
+    /// Shapes with no rows or no columns, and the zero matrix: no singular values (or zeros),
+    /// no panic.
+    #[test]
+    fn empty_and_zero_shapes() {
+        for (r, c) in [(0, 3), (3, 0), (0, 0), (1, 1), (2, 5)] {
+            let a = DMatrix::<f64>::zeros(r, c);
+            for (cu, cv) in [(true, true), (true, false), (false, true), (false, false)] {
+                let s = svd(a.clone(), cu, cv).unwrap();
+                assert_eq!(s.singular_values.len(), r.min(c));
+                assert!(s.singular_values.iter().all(|&x| x == 0.0));
+                assert!(holds(&a, &s));
+            }
         }
     }
 

@@ -335,4 +335,6 @@ pub fn assemble(model: &Model, state: &State) -> Result<State> {
 }
 
 #[cfg(test)]
+mod test_support;
+#[cfg(test)]
 mod tests;

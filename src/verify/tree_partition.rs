@@ -137,16 +137,7 @@ mod tests {
     use super::*;
     use crate::constraints::Constraints;
     use crate::solver::system::Backend;
-
-    fn model(text: &str, floating: bool) -> Model {
-        let options = crate::urdf::ImportOptions {
-            floating_base: floating,
-            ..Default::default()
-        };
-        crate::urdf::load_str(text, "t.urdf", &options)
-            .unwrap()
-            .model
-    }
+    use crate::verify::test_support::model;
 
     /// The locked system of `model` at `state` (every joint coordinate locked, as module
     /// `held` builds it), its triplets evaluated.

@@ -6,6 +6,11 @@ builds only within one series).
 
 Runs the commands in turn, N rounds; prints each one's median wall time and median CPU time
 (user + system of the child, from getrusage) and their ratios to the first command's.
+
+Round k starts with command k mod M (M commands) and keeps their cyclic order, so that each
+command follows a different one from round to round: a run can be slowed by what ran just
+before it (session 38: mimalloc 2.x right after 3.x, 1.05 of its time when run first), and a
+fixed order would charge that to the same command every round.
 """
 import resource
 import statistics
@@ -16,8 +21,8 @@ import time
 n = int(sys.argv[1])
 pairs = list(zip(sys.argv[2::2], sys.argv[3::2]))
 res = {label: ([], []) for label, _ in pairs}
-for _ in range(n):
-    for label, command in pairs:
+for k in range(n):
+    for label, command in pairs[k % len(pairs):] + pairs[:k % len(pairs)]:
         r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
         t0 = time.perf_counter()
         subprocess.run(command, shell=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)

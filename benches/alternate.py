@@ -18,9 +18,11 @@ User and system apart (session 39): on the virtual machine the figures of BENCHM
 from, a first touch of a fresh 4 KiB page costs the kernel 1.5 - 2.5 us, so a third of a
 chain's CPU time can be system time that follows the heap's peak, not the code's speed; and
 with transparent huge pages the runs split into a fast and a slow mode (system time 4 - 19 ms
-against 80 - 126 ms on the 1,000-rung ladder), which a median alone hides.
+against 80 - 126 ms on the 1,000-rung ladder), which a median alone hides. The second line also
+gives the median number of minor page faults of a run (`wait4`'s, of the shell and the command
+together: `sh -c /bin/true` alone takes about 110 here), the measure of the pages it touched.
 """
-import resource
+import os
 import statistics
 import subprocess
 import sys
@@ -28,17 +30,20 @@ import time
 
 n = int(sys.argv[1])
 pairs = list(zip(sys.argv[2::2], sys.argv[3::2]))
-# Per label: wall, CPU, user and system times [s].
-res = {label: ([], [], [], []) for label, _ in pairs}
+# Per label: wall, CPU, user and system times [s], minor page faults.
+res = {label: ([], [], [], [], []) for label, _ in pairs}
 for k in range(n):
     for label, command in pairs[k % len(pairs):] + pairs[:k % len(pairs)]:
-        r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
         t0 = time.perf_counter()
-        subprocess.run(command, shell=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        child = subprocess.Popen(command, shell=True, stdout=subprocess.DEVNULL,
+                                 stderr=subprocess.DEVNULL)
+        # The child's own usage (with its reaped children: the command under the shell).
+        _, status, usage = os.wait4(child.pid, 0)
+        child.returncode = os.waitstatus_to_exitcode(status)
         t1 = time.perf_counter()
-        r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
-        user, system = r1.ru_utime - r0.ru_utime, r1.ru_stime - r0.ru_stime
-        for series, value in zip(res[label], (t1 - t0, user + system, user, system)):
+        user, system = usage.ru_utime, usage.ru_stime
+        values = (t1 - t0, user + system, user, system, usage.ru_minflt)
+        for series, value in zip(res[label], values):
             series.append(value)
 
 
@@ -52,7 +57,7 @@ def quartiles(values):
 
 base = None
 for label, _ in pairs:
-    wall_s, cpu_s, user_s, sys_s = res[label]
+    wall_s, cpu_s, user_s, sys_s, faults = res[label]
     wall = statistics.median(wall_s) * 1e3
     cpu = statistics.median(cpu_s) * 1e3
     if base is None:
@@ -63,4 +68,4 @@ for label, _ in pairs:
     print(f"{'':28s} user {statistics.median(user_s) * 1e3:9.2f} ms  "
           f"system {statistics.median(sys_s) * 1e3:7.2f} ms   "
           f"cpu min {min(cpu_s) * 1e3:.2f} q1 {q1 * 1e3:.2f} q3 {q3 * 1e3:.2f} "
-          f"max {max(cpu_s) * 1e3:.2f} ms")
+          f"max {max(cpu_s) * 1e3:.2f} ms   faults {statistics.median(faults):.0f}")

@@ -5,7 +5,7 @@ builds only within one series).
     python3 benches/alternate.py N label1 'command 1' label2 'command 2' ...
 
 Runs the commands in turn, N rounds; prints each one's median wall time and median CPU time
-(user + system of the child, from getrusage) and their ratios to the first command's, then a
+(user + system of the run, from `wait4`) and their ratios to the first command's, then a
 second line with the medians of the user and the system time apart and the CPU time's spread
 (quartiles and extremes).
 
@@ -39,6 +39,7 @@ for k in range(n):
                                  stderr=subprocess.DEVNULL)
         # The child's own usage (with its reaped children: the command under the shell).
         _, status, usage = os.wait4(child.pid, 0)
+        # Reaped here: tell `Popen`, so that it does not wait for the child again.
         child.returncode = os.waitstatus_to_exitcode(status)
         t1 = time.perf_counter()
         user, system = usage.ru_utime, usage.ru_stime

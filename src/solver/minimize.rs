@@ -187,7 +187,18 @@ pub(crate) fn minimize(
     let mut first = release.and_then(Release::first);
     let mut carry_in = release.and_then(Release::carry);
     let mut carry_out = None;
+    // The start of the loop's last pass (`timings.steps`: each pass that continues).
+    let (mut pass, mut first_pass): (Option<std::time::Instant>, _) = (None, true);
     loop {
+        if let Some(started) = pass {
+            let took = started.elapsed().as_secs_f64();
+            let t = &mut s.diag.timings;
+            if std::mem::take(&mut first_pass) {
+                t.first_step = took;
+            }
+            t.steps += took;
+        }
+        pass = Some(std::time::Instant::now());
         // The gradient cannot be resolved below the rounding of the energy's terms.
         let gtol = options
             .gradient_tolerance

@@ -240,6 +240,16 @@ pub struct Timings {
     pub stability: f64,
     /// Building the result (joint values, link frames) \[s\].
     pub export: f64,
+    /// The minimizer's iterations proper, part of `iterations`: each from one convergence
+    /// test to the next (a step, its line search and corrector), summed over load stages and
+    /// active-set rounds. The rest of `iterations` is what each minimization does once: the
+    /// partition, the first evaluation, the final convergence test \[s\].
+    pub steps: f64,
+    /// The first iteration of each minimization, part of `steps`: the one in which the linear
+    /// algebra's structure is built and its memory first touched, so that `(steps −
+    /// first_step) / (iterations − 1)` is the time of an iteration in a steady state (one
+    /// minimization) \[s\].
+    pub first_step: f64,
 }
 
 impl Diagnostics {
@@ -254,6 +264,8 @@ impl Diagnostics {
         // The time spent judging stability (every round's and stage's rest), so that the
         // caller's `iterations` (the rest of the solve) does not count it.
         self.timings.stability += other.timings.stability;
+        self.timings.steps += other.timings.steps;
+        self.timings.first_step += other.timings.first_step;
     }
 }
 

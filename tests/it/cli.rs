@@ -626,7 +626,10 @@ fn analyze_reports_timings_of_each_phase() {
         "phases {sum} s, process {wall} s: {t}"
     );
     // Issue 26: the iterations proper and the first of them, parts of `iterations`.
-    let (steps, first) = (t["steps"].as_f64().unwrap(), t["first_step"].as_f64().unwrap());
+    let (steps, first) = (
+        t["steps"].as_f64().unwrap(),
+        t["first_step"].as_f64().unwrap(),
+    );
     assert!(v["iterations"].as_u64().unwrap() >= 2, "{v}");
     assert!(
         0.0 < first && first < steps && steps <= t["iterations"].as_f64().unwrap(),

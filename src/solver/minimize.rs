@@ -12,9 +12,9 @@
 //!    their magnitudes, floored (dense, module `step::newton`), near a maximum or saddle at
 //!    least a saddle step along every direction of negative curvature (module `step::escape`;
 //!    on a small tree by Cholesky where `Ĥ + C` is positive definite, far from the rest
-//!    Newton on `Ĥ` alone, module `step::path_cholesky`),
-//!    or the KKT direction (sparse); BFGS / DFP `d = −B ∇f` (module `step::quasi_newton`);
-//!    steepest descent when `d` is not a descent direction (an escape excepted).
+//!    Newton on `Ĥ` alone, module `step::path_cholesky`), or the KKT direction (sparse);
+//!    BFGS / DFP `d = −B ∇f` (module `step::quasi_newton`); steepest descent when `d` is not a
+//!    descent direction (an escape excepted).
 //! 4. **Step cap** (module `step::step_cap`): the tangent step `δq = Z d` limited on the motion of the
 //!    whole mechanism (every body's Euler parameters by `max_step`, its origin by
 //!    `10 max_step ℓ`, `ℓ` the larger of the length scale and the mechanism's extent).
@@ -46,7 +46,7 @@ use super::inequality::release::Release;
 use super::inequality::release_trial::First;
 use super::options::{Method, Options};
 use super::partition::Partition;
-use super::report::{Diagnostics, Iterate, Termination};
+use super::report::{Diagnostics, Iterate, Laps, Termination};
 use super::stability::spectrum::Spectrum;
 use super::stability::{at_rest::for_minimizer, inertia::ByInertia};
 use super::step::direction::{direction, Direction};
@@ -186,19 +186,9 @@ pub(crate) fn minimize(
     let (mut blocked, mut released) = (None, Vec::new());
     let mut first = release.and_then(Release::first);
     let mut carry_in = release.and_then(Release::carry);
-    let mut carry_out = None;
-    // The start of the loop's last pass (`timings.steps`: each pass that continues).
-    let (mut pass, mut first_pass): (Option<std::time::Instant>, _) = (None, true);
+    let (mut carry_out, mut laps) = (None, Laps::default()); // laps: `timings.steps`
     loop {
-        if let Some(started) = pass {
-            let took = started.elapsed().as_secs_f64();
-            let t = &mut s.diag.timings;
-            if std::mem::take(&mut first_pass) {
-                t.first_step = took;
-            }
-            t.steps += took;
-        }
-        pass = Some(std::time::Instant::now());
+        laps.lap(&mut s.diag.timings);
         // The gradient cannot be resolved below the rounding of the energy's terms.
         let gtol = options
             .gradient_tolerance

@@ -252,6 +252,30 @@ pub struct Timings {
     pub first_step: f64,
 }
 
+/// The clock of the minimizer's iterations (`Timings::steps`, `Timings::first_step`): each
+/// [`Laps::lap`] after the first adds the time since the last one.
+#[derive(Default)]
+pub(crate) struct Laps {
+    last: Option<std::time::Instant>,
+    laps: usize,
+}
+
+impl Laps {
+    /// The end of one pass of the loop and the start of the next.
+    pub(crate) fn lap(&mut self, timings: &mut Timings) {
+        let now = std::time::Instant::now();
+        if let Some(last) = self.last {
+            let took = now.duration_since(last).as_secs_f64();
+            if self.laps == 0 {
+                timings.first_step = took;
+            }
+            timings.steps += took;
+            self.laps += 1;
+        }
+        self.last = Some(now);
+    }
+}
+
 impl Diagnostics {
     /// Adds the work counters of `other` (not its final norms).
     pub(crate) fn add_counts(&mut self, other: &Diagnostics) {

@@ -27,7 +27,7 @@
 use super::dense;
 use super::fused::BlockMap;
 use super::norm;
-use super::shape::{Shape, FIRST, SKIP};
+use super::shape::{Shape, EACH, FIRST, SKIP};
 use crate::constraints::Triplet;
 use crate::solver::partition::Partition;
 use crate::solver::sparse::hessian::BlockHessian;
@@ -148,18 +148,44 @@ impl TreeKkt {
         self.store_jacobian(entries, row_scale, scale);
     }
 
-    /// Stores the Jacobian's entries (scaled) at their slots (see [`TreeKkt::assemble`]).
+    /// Stores the Jacobian's entries (scaled) at their slots (see [`TreeKkt::assemble`]), run
+    /// by run ([`JacRun`](super::shape::JacRun)): a run of first triplets at consecutive slots (and its mirror's,
+    /// `step` apart), the others each at its own.
     pub(super) fn store_jacobian(&mut self, entries: &[Triplet], row_scale: &[f64], scale: &[f64]) {
-        let values = &mut self.values;
-        for (e, slots) in entries.iter().zip(&self.shape.jac_slots) {
-            let v = e.2 * row_scale[e.0 as usize] * scale[e.1 as usize];
-            for &slot in slots {
-                if slot != SKIP {
-                    let at = &mut values[(slot & !FIRST) as usize];
-                    if slot & FIRST != 0 {
-                        *at = 0.0 + v;
-                    } else {
-                        *at += v;
+        let values = &mut self.values[..];
+        let mut each = self.shape.jac_each.iter();
+        let mut from = 0;
+        for run in &self.shape.jac_runs {
+            let es = &entries[from..from + run.len as usize];
+            from += run.len as usize;
+            if run.step == EACH {
+                for (e, slots) in es.iter().zip(each.by_ref()) {
+                    let v = e.2 * row_scale[e.0 as usize] * scale[e.1 as usize];
+                    for &slot in slots {
+                        if slot != SKIP {
+                            let at = &mut values[(slot & !FIRST) as usize];
+                            if slot & FIRST != 0 {
+                                *at = 0.0 + v;
+                            } else {
+                                *at += v;
+                            }
+                        }
+                    }
+                }
+            } else if run.slot != SKIP {
+                // One row: its scale read once (the same product, `(v r) s`, as above).
+                let rs = row_scale[es[0].0 as usize];
+                let (slot, mirror, step) = (run.slot as usize, run.mirror, run.step as usize);
+                if mirror == SKIP {
+                    let dst = &mut values[slot..slot + es.len()];
+                    for (at, e) in dst.iter_mut().zip(es) {
+                        *at = 0.0 + e.2 * rs * scale[e.1 as usize];
+                    }
+                } else {
+                    for (j, e) in es.iter().enumerate() {
+                        let v = 0.0 + e.2 * rs * scale[e.1 as usize];
+                        values[slot + j] = v;
+                        values[mirror as usize + j * step] = v;
                     }
                 }
             }

@@ -41,6 +41,24 @@ pub(crate) const SKIP: u32 = u32::MAX;
 /// `0 + v` there and adds the later triplets' values: no zeroing pass). Slots stay below it.
 pub(crate) const FIRST: u32 = 1 << 31;
 
+/// `len` consecutive Jacobian triplets (one row's entries on consecutive columns of one body)
+/// and where they go: with `step` [`EACH`], each to its own slots, the next ones of
+/// [`Shape::jac_each`]; with `slot` [`SKIP`], nowhere (a row the partition does not pivot);
+/// else the `j`-th to slot `slot + j` and its mirror to `mirror + j step` (`mirror` [`SKIP`]:
+/// the mirror of a coupling, not stored), each the first triplet to reach its slot. A run of
+/// the last kind reads no slot per triplet: its row's scale once, its values and columns'
+/// scales in order, and stores them at consecutive slots.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct JacRun {
+    pub(crate) len: u32,
+    pub(crate) slot: u32,
+    pub(crate) mirror: u32,
+    pub(crate) step: u32,
+}
+
+/// The `step` of a [`JacRun`] whose triplets take their slots from [`Shape::jac_each`].
+pub(crate) const EACH: u32 = u32::MAX;
+
 /// The structure of the tree KKT matrix.
 #[cfg_attr(test, derive(Debug, PartialEq))]
 pub(crate) struct Shape {
@@ -67,9 +85,12 @@ pub(crate) struct Shape {
     /// (a block that reaches the border; the dense runs keep no slot list).
     pub(crate) block_runs: Vec<Run>,
     pub(crate) scattered_slots: Vec<[u32; 49]>,
-    /// Slots of each Jacobian triplet (`(row, column)` and its mirror; [`FIRST`] set on the
-    /// first triplet to reach a slot), and of each coordinate's diagonal.
-    pub(crate) jac_slots: Vec<[u32; 2]>,
+    /// Where the Jacobian's triplets go, run by run in the triplets' order (see [`JacRun`]),
+    /// and the slots of the triplets placed one by one (`(row, column)` and its mirror;
+    /// [`FIRST`] set on the first triplet to reach a slot), in order.
+    pub(crate) jac_runs: Vec<JacRun>,
+    pub(crate) jac_each: Vec<[u32; 2]>,
+    /// The slot of each coordinate's diagonal.
     pub(crate) diag_slots: Vec<u32>,
     /// The diagonal slots that no Hessian block writes (zeroed by each assembly: a shift of
     /// the last factorization may be left there).
@@ -314,15 +335,17 @@ impl Shape {
         // Each slot's first triplet flagged as it is listed (`reached`: the slots listed so
         // far, the border's appended as they come).
         let mut reached = vec![false; flat];
-        let mut jac_slots: Vec<[u32; 2]> = Vec::with_capacity(entries.len());
+        let mut jac_runs: Vec<JacRun> = Vec::with_capacity(runs.len());
+        let mut jac_slots: Vec<[u32; 2]> = Vec::new();
         // Along a run in the tree, the next column's slot is the next one in the row's block,
         // and its mirror's one row further in the column's block (`step`: the block's width),
         // or both stay the mirror of a coupling ([`SKIP`]).
         for &(first, end) in &runs {
             let e = &entries[first];
             let k = row_pos[e.0 as usize];
+            let len = (end - first) as u32;
             if k == u32::MAX {
-                jac_slots.extend(std::iter::repeat_n([SKIP, SKIP], end - first));
+                push_run(&mut jac_runs, len, SKIP, SKIP, 0);
                 continue;
             }
             let r = n + k as usize;
@@ -335,15 +358,12 @@ impl Shape {
                 if fast {
                     // One test per triplet, at the pair's slot that is not the mirror of a
                     // coupling (`flag_pair`; in the tree, inside `reached`).
-                    let len = (end - first) as u32;
                     if s1 != SKIP {
                         let span = &mut reached[s1 as usize..(s1 + len) as usize];
                         if !span.contains(&true) {
-                            // No slot of the run reached before: all first.
+                            // No slot of the run reached before: all first, one run.
                             span.fill(true);
-                            for j in 0..len {
-                                jac_slots.push([(s1 + j) | FIRST, at(s2, j, step) | FIRST]);
-                            }
+                            push_run(&mut jac_runs, len, s1, s2, step);
                             continue;
                         }
                     }
@@ -354,7 +374,7 @@ impl Shape {
                         jac_slots.push([at(s1, j, 1) | first, at(s2, j, step) | first]);
                     }
                 } else {
-                    for j in 0..(end - first) as u32 {
+                    for j in 0..len {
                         let (a, b) = (at(s1, j, 1), at(s2, j, step));
                         jac_slots.push(flag_each(&mut reached, a, b));
                     }
@@ -369,6 +389,7 @@ impl Shape {
                     });
                 }
             }
+            push_run(&mut jac_runs, len, 0, 0, EACH);
         }
         let mut diag_slots = Vec::with_capacity(n);
         for c in 0..n {
@@ -418,10 +439,59 @@ impl Shape {
             border,
             block_runs,
             scattered_slots,
-            jac_slots,
+            jac_runs,
+            jac_each: jac_slots,
             diag_slots,
             bare_diag,
         })
+    }
+}
+
+/// Appends a [`JacRun`], joined to the last one where both take their slots one by one, or
+/// both go nowhere (fewer runs: the one-by-one triplets of the border come in long stretches).
+fn push_run(runs: &mut Vec<JacRun>, len: u32, slot: u32, mirror: u32, step: u32) {
+    if let Some(last) = runs.last_mut() {
+        let joined = (step == EACH && last.step == EACH)
+            || (slot == SKIP && last.slot == SKIP && step != EACH && last.step != EACH);
+        if joined {
+            last.len += len;
+            return;
+        }
+    }
+    runs.push(JacRun {
+        len,
+        slot,
+        mirror,
+        step,
+    });
+}
+
+impl Shape {
+    /// The slots of every Jacobian triplet, in order, as [`Shape::jac_runs`] and
+    /// [`Shape::jac_each`] give them (`(row, column)` and its mirror, [`FIRST`] set on the
+    /// first to reach a slot).
+    #[cfg(test)]
+    pub(crate) fn jac_slots(&self) -> Vec<[u32; 2]> {
+        let mut each = self.jac_each.iter();
+        let mut out = Vec::new();
+        for run in &self.jac_runs {
+            for j in 0..run.len {
+                out.push(if run.step == EACH {
+                    *each.next().expect("a slot for each triplet")
+                } else if run.slot == SKIP {
+                    [SKIP, SKIP]
+                } else {
+                    let mirror = if run.mirror == SKIP {
+                        SKIP
+                    } else {
+                        (run.mirror + j * run.step) | FIRST
+                    };
+                    [(run.slot + j) | FIRST, mirror]
+                });
+            }
+        }
+        assert!(each.next().is_none(), "every slot of `jac_each` is used");
+        out
     }
 }
 

@@ -38,7 +38,34 @@ fn compare(name: &str, model: &Model, locks: &[(JointId, usize, f64)]) -> (usize
     let (Some(fast), Some(slow)) = (fast, slow) else {
         panic!("{name}: no tree structure");
     };
+    // The same slot for every triplet, whether by runs or one by one.
+    assert_eq!(fast.jac_slots(), slow.jac_slots(), "{name}: Jacobian slots");
+    assert_eq!(fast.jac_slots().len(), entries.len(), "{name}");
+    let lined: u32 = fast
+        .jac_runs
+        .iter()
+        .filter(|r| r.step != super::shape::EACH && r.slot != super::shape::SKIP)
+        .map(|r| r.len)
+        .sum();
+    let (mut fast, mut slow) = (fast, slow);
+    for s in [&mut fast, &mut slow] {
+        s.jac_each = s.jac_slots();
+        s.jac_runs = vec![super::shape::JacRun {
+            len: entries.len() as u32,
+            slot: 0,
+            mirror: 0,
+            step: super::shape::EACH,
+        }];
+    }
     assert_eq!(fast, slow, "{name}");
+    // On a tree, the fast construction places almost every triplet by runs.
+    if fast.border.size() == 0 && !name.contains("ladder") {
+        assert!(
+            lined as usize * 10 >= entries.len() * 9,
+            "{name}: {lined} of {} triplets in runs",
+            entries.len()
+        );
+    }
     (fast.border.size(), fast.at.len())
 }
 

@@ -40,6 +40,9 @@ pub(crate) struct AugmentPlan {
 }
 
 impl AugmentPlan {
+    /// The plan of the triplets `entries` (a row's entries consecutive; on one body, a run of
+    /// consecutive entries) under `part`: one pass over the rows, the bodies of a row found
+    /// where its column's body changes.
     fn new(part: &Partition, cons: &Constraints, m: usize, entries: &[Triplet]) -> Self {
         let mut in_part = vec![false; m];
         for &r in &part.rows {
@@ -47,42 +50,48 @@ impl AugmentPlan {
         }
         let mut groups = Vec::with_capacity(part.rows.len());
         let mut local = vec![0u8; entries.len()];
+        let none = u32::MAX;
         let mut k = 0;
         while k < entries.len() {
-            let row = entries[k].0 as usize;
-            let mut end = k;
-            while end < entries.len() && entries[end].0 as usize == row {
-                end += 1;
+            let (start, row) = (k, entries[k].0);
+            // The row's bodies in order of first appearance (`none`: not yet), and whether
+            // there are two at most.
+            let (mut first, mut second, mut on_two, mut last) = (none, none, true, none);
+            for e in &entries[start..] {
+                if e.0 != row {
+                    break;
+                }
+                let b = e.1 / 7;
+                if b != last {
+                    last = b;
+                    if b != first && b != second {
+                        if first == none {
+                            first = b;
+                        } else if second == none {
+                            second = b;
+                        } else {
+                            on_two = false;
+                        }
+                    }
+                }
+                k += 1;
             }
-            let (start, group) = (k, &entries[k..end]);
-            k = end;
+            let row = row as usize;
             if !in_part[row] {
                 continue;
             }
-            let mut bodies: [Option<BodyId>; 2] = [None, None];
-            let mut on_two = true;
-            for e in group {
-                let b = e.1 as usize / 7;
-                if bodies.iter().any(|x| x.map(|y| y.0) == Some(b)) {
-                    continue;
-                }
-                match bodies.iter().position(|x| x.is_none()) {
-                    Some(slot) => bodies[slot] = Some(BodyId(b)),
-                    None => on_two = false,
-                }
-            }
             if on_two {
-                for (t, e) in group.iter().enumerate() {
-                    let c = e.1 as usize;
-                    let side = usize::from(bodies[0].map(|x| x.0) != Some(c / 7));
-                    local[start + t] = (7 * side + c % 7) as u8;
+                for (l, e) in local[start..k].iter_mut().zip(&entries[start..k]) {
+                    let (b, c) = (e.1 / 7, e.1 % 7);
+                    *l = (7 * u32::from(b != first) + c) as u8;
                 }
             }
+            let body = |b: u32| (b != none).then_some(BodyId(b as usize));
             groups.push(Group {
                 start,
-                end,
+                end: k,
                 row,
-                bodies: on_two.then_some(bodies),
+                bodies: on_two.then_some([body(first), body(second)]),
                 whole_bodies: on_two && !cons.is_normalization(row),
             });
         }

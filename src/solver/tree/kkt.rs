@@ -26,8 +26,9 @@
 
 use super::dense;
 use super::fused::BlockMap;
+use super::jac_runs::EACH;
 use super::norm;
-use super::shape::{Shape, EACH, FIRST, SKIP};
+use super::shape::{Shape, FIRST, SKIP};
 use crate::constraints::Triplet;
 use crate::solver::partition::Partition;
 use crate::solver::sparse::hessian::BlockHessian;
@@ -149,7 +150,7 @@ impl TreeKkt {
     }
 
     /// Stores the Jacobian's entries (scaled) at their slots (see [`TreeKkt::assemble`]), run
-    /// by run ([`JacRun`](super::shape::JacRun)): a run of first triplets at consecutive slots (and its mirror's,
+    /// by run ([`JacRun`](super::jac_runs::JacRun)): a run of first triplets at consecutive slots (and its mirror's,
     /// `step` apart), the others each at its own.
     pub(super) fn store_jacobian(&mut self, entries: &[Triplet], row_scale: &[f64], scale: &[f64]) {
         let values = &mut self.values[..];

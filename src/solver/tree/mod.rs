@@ -25,6 +25,7 @@ mod border;
 pub(crate) mod dense;
 mod fixed;
 pub(crate) mod fused;
+mod jac_runs;
 pub(crate) mod kkt;
 mod merge;
 #[cfg(test)]

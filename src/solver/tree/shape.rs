@@ -23,6 +23,7 @@
 
 use super::border::Border;
 use super::fused::Run;
+use super::jac_runs::{push_run, JacRun, EACH};
 use super::nodes::{border_nodes, runs_and_pairs, Members};
 use crate::constraints::Triplet;
 use crate::solver::partition::Partition;
@@ -40,24 +41,6 @@ pub(crate) const SKIP: u32 = u32::MAX;
 /// The flag of a Jacobian slot that the triplet is the first to reach (the assembly stores
 /// `0 + v` there and adds the later triplets' values: no zeroing pass). Slots stay below it.
 pub(crate) const FIRST: u32 = 1 << 31;
-
-/// `len` consecutive Jacobian triplets (one row's entries on consecutive columns of one body)
-/// and where they go: with `step` [`EACH`], each to its own slots, the next ones of
-/// [`Shape::jac_each`]; with `slot` [`SKIP`], nowhere (a row the partition does not pivot);
-/// else the `j`-th to slot `slot + j` and its mirror to `mirror + j step` (`mirror` [`SKIP`]:
-/// the mirror of a coupling, not stored), each the first triplet to reach its slot. A run of
-/// the last kind reads no slot per triplet: its row's scale once, its values and columns'
-/// scales in order, and stores them at consecutive slots.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct JacRun {
-    pub(crate) len: u32,
-    pub(crate) slot: u32,
-    pub(crate) mirror: u32,
-    pub(crate) step: u32,
-}
-
-/// The `step` of a [`JacRun`] whose triplets take their slots from [`Shape::jac_each`].
-pub(crate) const EACH: u32 = u32::MAX;
 
 /// The structure of the tree KKT matrix.
 #[cfg_attr(test, derive(Debug, PartialEq))]
@@ -444,54 +427,6 @@ impl Shape {
             diag_slots,
             bare_diag,
         })
-    }
-}
-
-/// Appends a [`JacRun`], joined to the last one where both take their slots one by one, or
-/// both go nowhere (fewer runs: the one-by-one triplets of the border come in long stretches).
-fn push_run(runs: &mut Vec<JacRun>, len: u32, slot: u32, mirror: u32, step: u32) {
-    if let Some(last) = runs.last_mut() {
-        let joined = (step == EACH && last.step == EACH)
-            || (slot == SKIP && last.slot == SKIP && step != EACH && last.step != EACH);
-        if joined {
-            last.len += len;
-            return;
-        }
-    }
-    runs.push(JacRun {
-        len,
-        slot,
-        mirror,
-        step,
-    });
-}
-
-impl Shape {
-    /// The slots of every Jacobian triplet, in order, as [`Shape::jac_runs`] and
-    /// [`Shape::jac_each`] give them (`(row, column)` and its mirror, [`FIRST`] set on the
-    /// first to reach a slot).
-    #[cfg(test)]
-    pub(crate) fn jac_slots(&self) -> Vec<[u32; 2]> {
-        let mut each = self.jac_each.iter();
-        let mut out = Vec::new();
-        for run in &self.jac_runs {
-            for j in 0..run.len {
-                out.push(if run.step == EACH {
-                    *each.next().expect("a slot for each triplet")
-                } else if run.slot == SKIP {
-                    [SKIP, SKIP]
-                } else {
-                    let mirror = if run.mirror == SKIP {
-                        SKIP
-                    } else {
-                        (run.mirror + j * run.step) | FIRST
-                    };
-                    [(run.slot + j) | FIRST, mirror]
-                });
-            }
-        }
-        assert!(each.next().is_none(), "every slot of `jac_each` is used");
-        out
     }
 }
 

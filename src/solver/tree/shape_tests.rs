@@ -44,17 +44,17 @@ fn compare(name: &str, model: &Model, locks: &[(JointId, usize, f64)]) -> (usize
     let lined: u32 = fast
         .jac_runs
         .iter()
-        .filter(|r| r.step != super::shape::EACH && r.slot != super::shape::SKIP)
+        .filter(|r| r.step != super::jac_runs::EACH && r.slot != super::shape::SKIP)
         .map(|r| r.len)
         .sum();
     let (mut fast, mut slow) = (fast, slow);
     for s in [&mut fast, &mut slow] {
         s.jac_each = s.jac_slots();
-        s.jac_runs = vec![super::shape::JacRun {
+        s.jac_runs = vec![super::jac_runs::JacRun {
             len: entries.len() as u32,
             slot: 0,
             mirror: 0,
-            step: super::shape::EACH,
+            step: super::jac_runs::EACH,
         }];
     }
     assert_eq!(fast, slow, "{name}");

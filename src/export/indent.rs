@@ -108,7 +108,8 @@ impl Formatter for Indented {
 /// The serializer's error (a map key that is not a string).
 pub fn pretty_json<T: serde::Serialize + ?Sized>(value: &T) -> serde_json::Result<Vec<u8>> {
     let mut out = Vec::with_capacity(4096);
-    pretty_json_to(&mut out, value)?;
+    let mut ser = serde_json::Serializer::with_formatter(&mut out, Indented::default());
+    value.serialize(&mut ser)?;
     Ok(out)
 }
 
@@ -121,8 +122,58 @@ pub fn pretty_json_to<W: io::Write, T: serde::Serialize + ?Sized>(
     out: W,
     value: &T,
 ) -> serde_json::Result<()> {
-    let mut ser = serde_json::Serializer::with_formatter(out, Indented::default());
-    value.serialize(&mut ser)
+    let mut chunks = Chunks {
+        buf: Vec::with_capacity(CHUNK),
+        out,
+    };
+    let mut ser = serde_json::Serializer::with_formatter(&mut chunks, Indented::default());
+    value.serialize(&mut ser)?;
+    chunks.pass_on().map_err(serde_json::Error::io)
+}
+
+/// The bytes gathered before they are passed on.
+const CHUNK: usize = 64 * 1024;
+
+/// The serializer's many small writes (a separator, a number, a key: half a million for a
+/// ladder of 1,000 rungs) gathered in a buffer of its own, whose test and copy inline into the
+/// formatter, and passed on to the writer (possibly behind `dyn Write`) in chunks of
+/// [`CHUNK`] bytes: the same bytes in the same order.
+struct Chunks<W: io::Write> {
+    buf: Vec<u8>,
+    out: W,
+}
+
+impl<W: io::Write> Chunks<W> {
+    /// Passes on the bytes gathered.
+    fn pass_on(&mut self) -> io::Result<()> {
+        let r = self.out.write_all(&self.buf);
+        self.buf.clear();
+        r
+    }
+}
+
+impl<W: io::Write> io::Write for Chunks<W> {
+    #[inline]
+    fn write(&mut self, data: &[u8]) -> io::Result<usize> {
+        self.write_all(data).map(|()| data.len())
+    }
+
+    #[inline]
+    fn write_all(&mut self, data: &[u8]) -> io::Result<()> {
+        if self.buf.len() + data.len() > CHUNK {
+            self.pass_on()?;
+            if data.len() > CHUNK {
+                return self.out.write_all(data);
+            }
+        }
+        self.buf.extend_from_slice(data);
+        Ok(())
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.pass_on()?;
+        self.out.flush()
+    }
 }
 
 #[cfg(test)]
@@ -152,5 +203,35 @@ mod tests {
         let floats = [f64::NAN, f64::INFINITY, 0.1, 1.0 / 3.0];
         let ours = String::from_utf8(pretty_json(&floats).unwrap()).unwrap();
         assert_eq!(ours, serde_json::to_string_pretty(&floats).unwrap());
+    }
+
+    /// Streamed through the chunks: the same bytes across chunk boundaries, with a string
+    /// longer than a chunk among them, into a writer that takes a few bytes at a time.
+    #[test]
+    fn streamed_text_is_the_same_bytes() {
+        /// A writer that takes at most 7 bytes a call.
+        struct Trickle(Vec<u8>);
+        impl io::Write for Trickle {
+            fn write(&mut self, data: &[u8]) -> io::Result<usize> {
+                let n = data.len().min(7);
+                self.0.extend_from_slice(&data[..n]);
+                Ok(n)
+            }
+            fn flush(&mut self) -> io::Result<()> {
+                Ok(())
+            }
+        }
+        let rows: Vec<serde_json::Value> = (0..20_000)
+            .map(|k| serde_json::json!({"k": k, "x": [k as f64 / 7.0, -0.5], "n": format!("j{k}")}))
+            .collect();
+        let long = "é".repeat(3 * CHUNK / 2);
+        let value = serde_json::json!({"rows": rows, "long": long, "tail": [1, 2, 3]});
+        let mut out = Trickle(Vec::new());
+        pretty_json_to(&mut out, &value).unwrap();
+        assert!(out.0.len() > 10 * CHUNK);
+        assert_eq!(out.0, serde_json::to_vec_pretty(&value).unwrap());
+        let mut plain = Vec::new();
+        pretty_json_to(&mut plain, &value).unwrap();
+        assert_eq!(plain, out.0);
     }
 }

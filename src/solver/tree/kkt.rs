@@ -247,13 +247,17 @@ impl TreeKkt {
     /// The tree part of [`TreeKkt::factor_blocks`] (and the row sums).
     fn factor_tree(&mut self, lu: bool) -> Option<usize> {
         let s = &self.shape;
-        if self.factors.len() != s.flat_len {
-            self.factors = vec![0.0; s.flat_len];
-        }
         // Each block is copied from the values when first touched (its own turn, or its first
-        // child's update), so that a body's values are read once, while in cache.
+        // child's update), so that a body's values are read once, while in cache. The first
+        // factorization copies them all at once instead, into a buffer so allocated (not
+        // zeroed first: reused memory would be cleared, fresh pages faulted in, for nothing).
         let fresh = &mut self.fresh;
-        fresh.iter_mut().for_each(|f| *f = true);
+        if self.factors.len() == s.flat_len {
+            fresh.iter_mut().for_each(|f| *f = true);
+        } else {
+            self.factors = self.values[..s.flat_len].to_vec();
+            fresh.iter_mut().for_each(|f| *f = false);
+        }
         let (values, factors) = (&self.values, &mut self.factors);
         // ‖K‖∞ (for the backward error of solves; every factorization is solved), row sums
         // taken while the blocks are in cache (module `norm`).

@@ -13,11 +13,11 @@
 
 #[cfg(test)]
 use super::shape::FIRST;
-use super::shape::SKIP;
+use super::shape::{Shape, SKIP};
 
 /// `len` consecutive Jacobian triplets (one row's entries on consecutive columns of one body)
 /// and where they go: with `step` [`EACH`], each to its own slots, the next ones of
-/// [`Shape::jac_each`](super::shape::Shape::jac_each); with `slot` [`SKIP`], nowhere (a row the partition does not pivot);
+/// [`Shape::jac_each`]; with `slot` [`SKIP`], nowhere (a row the partition does not pivot);
 /// else the `j`-th to slot `slot + j` and its mirror to `mirror + j step` (`mirror` [`SKIP`]:
 /// the mirror of a coupling, not stored), each the first triplet to reach its slot. A run of
 /// the last kind reads no slot per triplet: its row's scale once, its values and columns'
@@ -30,7 +30,7 @@ pub(crate) struct JacRun {
     pub(crate) step: u32,
 }
 
-/// The `step` of a [`JacRun`] whose triplets take their slots from [`Shape::jac_each`](super::shape::Shape::jac_each).
+/// The `step` of a [`JacRun`] whose triplets take their slots from [`Shape::jac_each`].
 pub(crate) const EACH: u32 = u32::MAX;
 
 /// Appends a [`JacRun`], joined to the last one where both take their slots one by one, or
@@ -52,10 +52,10 @@ pub(super) fn push_run(runs: &mut Vec<JacRun>, len: u32, slot: u32, mirror: u32,
     });
 }
 
-impl super::shape::Shape {
-    /// The slots of every Jacobian triplet, in order, as [`Shape::jac_runs`](super::shape::Shape::jac_runs) and
-    /// [`Shape::jac_each`](super::shape::Shape::jac_each) give them (`(row, column)` and its mirror, [`FIRST`](super::shape::FIRST) set on the
-    /// first to reach a slot).
+impl Shape {
+    /// The slots of every Jacobian triplet, in order, as [`Shape::jac_runs`] and
+    /// [`Shape::jac_each`] give them (`(row, column)` and its mirror,
+    /// [`FIRST`](super::shape::FIRST) set on the first to reach a slot).
     #[cfg(test)]
     pub(crate) fn jac_slots(&self) -> Vec<[u32; 2]> {
         let mut each = self.jac_each.iter();

@@ -150,8 +150,8 @@ impl TreeKkt {
     }
 
     /// Stores the Jacobian's entries (scaled) at their slots (see [`TreeKkt::assemble`]), run
-    /// by run ([`JacRun`](super::jac_runs::JacRun)): a run of first triplets at consecutive slots (and its mirror's,
-    /// `step` apart), the others each at its own.
+    /// by run ([`JacRun`](super::jac_runs::JacRun)): a run of first triplets at consecutive
+    /// slots (and its mirror's, `step` apart), the others each at its own.
     pub(super) fn store_jacobian(&mut self, entries: &[Triplet], row_scale: &[f64], scale: &[f64]) {
         let values = &mut self.values[..];
         let mut each = self.shape.jac_each.iter();

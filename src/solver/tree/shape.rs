@@ -319,7 +319,7 @@ impl Shape {
         // far, the border's appended as they come).
         let mut reached = vec![false; flat];
         let mut jac_runs: Vec<JacRun> = Vec::with_capacity(runs.len());
-        let mut jac_slots: Vec<[u32; 2]> = Vec::new();
+        let mut jac_each: Vec<[u32; 2]> = Vec::new();
         // Along a run in the tree, the next column's slot is the next one in the row's block,
         // and its mirror's one row further in the column's block (`step`: the block's width),
         // or both stay the mirror of a coupling ([`SKIP`]).
@@ -354,18 +354,18 @@ impl Shape {
                     for j in 0..len {
                         let seen = std::mem::replace(&mut reached[(key + j * by) as usize], true);
                         let first = if seen { 0 } else { FIRST };
-                        jac_slots.push([at(s1, j, 1) | first, at(s2, j, step) | first]);
+                        jac_each.push([at(s1, j, 1) | first, at(s2, j, step) | first]);
                     }
                 } else {
                     for j in 0..len {
                         let (a, b) = (at(s1, j, 1), at(s2, j, step));
-                        jac_slots.push(flag_each(&mut reached, a, b));
+                        jac_each.push(flag_each(&mut reached, a, b));
                     }
                 }
             } else {
                 for e in &entries[first..end] {
                     let (a, b) = (locate(r, e.1 as usize)?, locate(e.1 as usize, r)?);
-                    jac_slots.push(if fast {
+                    jac_each.push(if fast {
                         flag_pair(&mut reached, a, b)
                     } else {
                         flag_each(&mut reached, a, b)
@@ -423,7 +423,7 @@ impl Shape {
             block_runs,
             scattered_slots,
             jac_runs,
-            jac_each: jac_slots,
+            jac_each,
             diag_slots,
             bare_diag,
         })

@@ -18,16 +18,44 @@ use xacro_rs::extensions::{ExtensionHandler, FindExtension, OptEnvExtension};
 use xacro_rs::XacroProcessor;
 
 /// Whether `path` names a xacro file (`*.xacro`), or `text` declares the xacro namespace and
-/// uses it (a `xacro:` element or attribute, `${…}` or `$(…)`). A URDF that only declares it,
-/// as xacro's own output keeps it (pybullet_data's `diff_ring.urdf`), is read as URDF, with
-/// the URDF reader's leniency (a late XML declaration), and its `refuse_xacro` check.
+/// uses it outside its comments (a `xacro:` element or attribute, `${…}` or `$(…)`). A URDF
+/// that only declares it, as xacro's own output keeps it (pybullet_data's `diff_ring.urdf`),
+/// or mentions xacro only in comments (the commented-out macro calls xacro leaves in its
+/// output: Talos, PR2, TIAGo, Bolt, Solo of example-robot-data), is read as URDF, with the
+/// URDF reader's leniency (a late XML declaration), its own line numbers in messages, and its
+/// `refuse_xacro` check.
 pub fn is_xacro(path: &Path, text: &str) -> bool {
     path.extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("xacro"))
-        || (text.contains("xmlns:xacro=")
-            && ["<xacro:", " xacro:", "${", "$("]
-                .iter()
-                .any(|s| text.contains(s)))
+        || (text.contains("xmlns:xacro=") && uses_xacro(text))
+}
+
+/// Whether `text` holds a xacro construct outside its comments (`<!-- … -->`; a CDATA
+/// section is text, and `<!--` inside one starts no comment).
+fn uses_xacro(text: &str) -> bool {
+    const MARKERS: [&str; 4] = ["<xacro:", " xacro:", "${", "$("];
+    let holds = |s: &str| MARKERS.iter().any(|m| s.contains(m));
+    let mut rest = text;
+    loop {
+        let comment = rest.find("<!--");
+        let cdata = rest.find("<![CDATA[");
+        // The next comment or CDATA section, whichever opens first.
+        let (at, open, close) = match (comment, cdata) {
+            (Some(c), Some(d)) if d < c => (d, "<![CDATA[".len(), "]]>"),
+            (Some(c), _) => (c, "<!--".len(), "-->"),
+            (None, Some(d)) => (d, "<![CDATA[".len(), "]]>"),
+            (None, None) => return holds(rest),
+        };
+        if holds(&rest[..at]) {
+            return true;
+        }
+        let inner = &rest[at + open..];
+        let end = inner.find(close).unwrap_or(inner.len());
+        if close == "]]>" && holds(&inner[..end]) {
+            return true;
+        }
+        rest = inner.get(end + close.len()..).unwrap_or("");
+    }
 }
 
 /// `$(find NAME)` through the user's `NAME=DIR` list; other names go to the next handler.
@@ -239,6 +267,30 @@ mod tests {
     }
 
     const NS: &str = r#"xmlns:xacro="http://www.ros.org/wiki/xacro""#;
+
+    /// xacro constructs count outside comments only; a CDATA section is text (its `<!--`
+    /// opens no comment, its constructs count).
+    #[test]
+    fn xacro_constructs_count_outside_comments() {
+        let uses = super::uses_xacro;
+        // Talos's leftover: commented-out macro calls with `${…}`.
+        let commented = r#"<robot><!-- <xacro:gripper name="${name}_x"/> --><link name="l"/><!-- $(find p) --></robot>"#;
+        assert!(!uses(commented));
+        for text in [
+            r#"<robot><xacro:property name="a" value="1"/></robot>"#,
+            r#"<robot><!-- note --><link name="${a}"/></robot>"#,
+            r#"<robot><link name="l" xacro:if="1"/><!-- x --></robot>"#,
+            r#"<robot><![CDATA[ <!-- ]]><xacro:property name="a" value="1"/> --></robot>"#,
+            r#"<robot><![CDATA[ $(find p) ]]></robot>"#,
+        ] {
+            assert!(uses(text), "{text}");
+        }
+        // An unclosed comment hides the rest (the URDF reader then reports it).
+        assert!(!uses(
+            r#"<robot><!-- <xacro:property name="a" value="1"/></robot>"#
+        ));
+        assert!(!uses(""));
+    }
 
     #[test]
     fn only_files_without_path_bound_constructs_expand_from_their_text() {

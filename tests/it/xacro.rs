@@ -290,3 +290,34 @@ fn declared_but_unused_xacro_namespace_is_plain_urdf() {
     let l = load_file(&file, &ImportOptions::default()).unwrap();
     assert_eq!(l.model.bodies()[0].mass, 3.0);
 }
+
+/// A URDF that mentions xacro only in comments (xacro's output keeps the commented-out macro
+/// calls of its sources, `${…}` included: Talos, PR2, TIAGo, Bolt and Solo of
+/// example-robot-data) is read as URDF, without the expansion: an error names the file's own
+/// line, not the expansion's.
+#[test]
+fn xacro_in_comments_only_is_plain_urdf() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("talos_like.urdf");
+    let urdf = r#"<?xml version="1.0" ?>
+<robot name="r" xmlns:xacro="http://ros.org/wiki/xacro">
+  <!-- <xacro:gripper_virtual_transmission name="${name}_inner" reduction="1.0"/> -->
+  <link name="world"/>
+  <link name="arm"><inertial><origin xyz="0 0 -0.5"/><mass value="2"/>
+    <inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <joint name="hinge" type="continuous"><parent link="world"/><child link="arm"/>
+    <axis xyz="0 1 0"/></joint>
+</robot>
+"#;
+    std::fs::write(&file, urdf).unwrap();
+    let l = load_file(&file, &ImportOptions::default()).unwrap();
+    assert_eq!(l.model.bodies().len(), 1);
+    assert_eq!(l.model.bodies()[0].mass, 2.0);
+    // A bad joint type on line 7: the message names line 7 of the file itself.
+    std::fs::write(&file, urdf.replace("\"continuous\"", "\"hinged\"")).unwrap();
+    let e = load_file(&file, &ImportOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("talos_like.urdf:7:"), "{e}");
+    assert!(!e.contains("expanded"), "{e}");
+}

@@ -10,7 +10,7 @@
 use super::problem::Problem;
 use crate::constraints::Triplets;
 use crate::model::Model;
-use crate::solver::partition::{partition, Partition};
+use crate::solver::partition::{partition_owned, Partition};
 use crate::solver::LinearAlgebra;
 
 /// Models with more coordinates than this (40 bodies) use the sparse path when the choice is
@@ -154,7 +154,7 @@ impl Backend {
                     )
                 })
             }
-            Backend::Dense => partition(&jac.to_dense(), &scaling.rows, &scaling.columns),
+            Backend::Dense => partition_owned(jac.to_dense(), &scaling.rows, &scaling.columns),
         }
     }
 }

@@ -9,7 +9,10 @@
 //! `±0` and the update leaves `a_jk` as it is, unless `a_jk = −0` (then `−0 + +0 = +0`); the
 //! trailing entries are never `−0` (an input without `−0`, and a sum is `−0` only where both
 //! terms are), so skipping those updates changes no bit. With a non-finite factor in a step, or
-//! a `−0` in the input, every update is made as nalgebra makes it.
+//! a `−0` in the input, every update is made as nalgebra makes it. The rows `j` with
+//! `c_j ≠ 0` and the columns `k` with `a_ik ≠ 0` are listed once per step (one pass down the
+//! pivot's column, one along its row, which also test that every factor is finite), and only
+//! their products are updated: a step costs those counts' product, not the trailing matrix.
 //!
 //! The solves are nalgebra's on the packed factors (`LU::solve_mut`'s three calls).
 
@@ -31,8 +34,14 @@ impl DenseLu {
         let steps = rows.min(cols);
         let mut p = PermutationSequence::identity_generic(Dyn(steps));
         // A `−0` anywhere: every update as nalgebra makes it (module docs).
-        let signed_zero = m.iter().any(|x| *x == 0.0 && x.is_sign_negative());
+        let signed_zero = m
+            .as_slice()
+            .iter()
+            .any(|x| *x == 0.0 && x.is_sign_negative());
+        // Per step, the rows below the pivot where its column is nonzero and the columns
+        // after it where its row is: the only updates that change a bit (module docs).
         let mut nonzero: Vec<usize> = Vec::with_capacity(rows);
+        let mut row_nonzero: Vec<usize> = Vec::with_capacity(cols);
         for i in 0..steps {
             let piv = m.view_range(i.., i).icamax() + i;
             let diag = m[(piv, i)];
@@ -45,22 +54,37 @@ impl DenseLu {
                 m.swap_rows(i, piv);
             }
             let inv = 1.0 / diag;
-            for j in i + 1..rows {
-                m[(j, i)] *= inv;
+            // Column-major: column `k` at `k rows ..`; the pivot's column and the later ones.
+            let (head, tail) = m.as_mut_slice().split_at_mut((i + 1) * rows);
+            let column = &mut head[i * rows..];
+            let mut finite = !signed_zero;
+            for x in &mut column[i + 1..] {
+                *x *= inv;
+                finite &= x.is_finite();
             }
-            let finite = !signed_zero
-                && (i + 1..rows).all(|j| m[(j, i)].is_finite())
-                && (i + 1..cols).all(|k| m[(i, k)].is_finite());
+            row_nonzero.clear();
+            for (k, later) in tail.chunks_exact(rows).enumerate() {
+                let a = later[i];
+                finite &= a.is_finite();
+                if a != 0.0 {
+                    row_nonzero.push(k);
+                }
+            }
             nonzero.clear();
-            nonzero.extend((i + 1..rows).filter(|&j| !finite || m[(j, i)] != 0.0));
-            for k in i + 1..cols {
-                let a = -m[(i, k)];
-                if finite && a == 0.0 {
-                    continue;
-                }
+            nonzero.extend((i + 1..rows).filter(|&j| !finite || column[j] != 0.0));
+            let column = &*column;
+            let update = |later: &mut [f64]| {
+                let a = -later[i];
                 for &j in &nonzero {
-                    m[(j, k)] += a * m[(j, i)];
+                    later[j] += a * column[j];
                 }
+            };
+            if finite {
+                for &k in &row_nonzero {
+                    update(&mut tail[k * rows..(k + 1) * rows]);
+                }
+            } else {
+                tail.chunks_exact_mut(rows).for_each(update);
             }
         }
         DenseLu { lu: m, p }
@@ -128,7 +152,8 @@ mod tests {
                 0.0
             }
         });
-        cases.extend([zero_column, infinite, signed, rectangular]);
+        let wide = rectangular.transpose();
+        cases.extend([zero_column, infinite, signed, rectangular, wide]);
         for (c, a) in cases.iter().enumerate() {
             let theirs = a.clone().lu();
             let ours = DenseLu::new(a.clone());

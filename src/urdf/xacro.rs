@@ -31,31 +31,32 @@ pub fn is_xacro(path: &Path, text: &str) -> bool {
 }
 
 /// Whether `text` holds a xacro construct outside its comments (`<!-- … -->`; a CDATA
-/// section is text, and `<!--` inside one starts no comment).
+/// section is text, and `<!--` inside one starts no comment): one pass over the `<!`s.
 fn uses_xacro(text: &str) -> bool {
     const MARKERS: [&str; 4] = ["<xacro:", " xacro:", "${", "$("];
     let holds = |s: &str| MARKERS.iter().any(|m| s.contains(m));
-    let mut rest = text;
-    loop {
-        let comment = rest.find("<!--");
-        let cdata = rest.find("<![CDATA[");
-        // The next comment or CDATA section, whichever opens first.
-        let (at, open, close) = match (comment, cdata) {
-            (Some(c), Some(d)) if d < c => (d, "<![CDATA[".len(), "]]>"),
-            (Some(c), _) => (c, "<!--".len(), "-->"),
-            (None, Some(d)) => (d, "<![CDATA[".len(), "]]>"),
-            (None, None) => return holds(rest),
-        };
-        if holds(&rest[..at]) {
-            return true;
+    // `segment`: where the text since the last comment starts; `from`: where to look on.
+    let (mut segment, mut from) = (0, 0);
+    while let Some(i) = text[from..].find("<!") {
+        let at = from + i;
+        let rest = &text[at..];
+        if let Some(body) = rest.strip_prefix("<!--") {
+            if holds(&text[segment..at]) {
+                return true;
+            }
+            // An unclosed comment hides the rest (the URDF reader then reports it).
+            let Some(end) = body.find("-->") else {
+                return false;
+            };
+            from = at + 4 + end + 3;
+            segment = from;
+        } else if let Some(body) = rest.strip_prefix("<![CDATA[") {
+            from = body.find("]]>").map_or(text.len(), |end| at + 9 + end + 3);
+        } else {
+            from = at + 2;
         }
-        let inner = &rest[at + open..];
-        let end = inner.find(close).unwrap_or(inner.len());
-        if close == "]]>" && holds(&inner[..end]) {
-            return true;
-        }
-        rest = inner.get(end + close.len()..).unwrap_or("");
     }
+    holds(&text[segment..])
 }
 
 /// `$(find NAME)` through the user's `NAME=DIR` list; other names go to the next handler.

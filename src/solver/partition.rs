@@ -71,8 +71,9 @@ pub(crate) fn partition_owned(mut a: DMatrix<f64>, row_scale: &[f64], scale: &[f
     // multiplier leaves `x − 0 · p = x`): those rows are listed once per step, so that on a
     // sparse `Φ_q` a step costs the pivot row's nonzeros times the pivot column's. A changed
     // column's maximum is its old one or one of the changed entries where the old one sits in
-    // a row that did not change (and is not the pivot row); only otherwise is the column
-    // scanned again. The other columns keep their entries and lose a zero (the pivot row's), so
+    // a row that did not change or that now holds at least as much (and is not the pivot row);
+    // only otherwise is the column scanned again, and the pivot's own column, which leaves,
+    // not at all. The other columns keep their entries and lose a zero (the pivot row's), so
     // their maximum stands. A maximum is exact (no rounding, any order): the same as a scan.
     let mut col_max = Vec::with_capacity(n);
     let mut col_arg = Vec::with_capacity(n);
@@ -129,9 +130,14 @@ pub(crate) fn partition_owned(mut a: DMatrix<f64>, row_scale: &[f64], scale: &[f
             for &ii in &changed_rows {
                 col[ii] -= factor[ii] * p;
             }
+            if jj == k {
+                // The pivot's column leaves: its maximum is never read again.
+                continue;
+            }
             let at = col_arg[jj];
-            if at > k && !changed[at] {
-                // The old maximum stands in its row; a changed entry may exceed it.
+            // The old maximum stands in its row, or its row changed and holds at least as
+            // much: then no entry outside the changed rows exceeds it.
+            if at > k && (!changed[at] || col[at].abs() >= col_max[jj]) {
                 let (mut mx, mut arg) = (col_max[jj], at);
                 for &ii in &changed_rows {
                     let v = col[ii].abs();

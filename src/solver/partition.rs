@@ -91,12 +91,20 @@ pub(crate) fn partition_owned(mut a: DMatrix<f64>, row_scale: &[f64], scale: &[f
             break;
         }
         row_perm.swap(k, best.0);
-        a.swap_rows(k, best.0);
         col_perm.swap(k, best.1);
-        a.swap_columns(k, best.1);
         col_max.swap(k, best.1);
         col_arg.swap(k, best.1);
+        let data = a.as_mut_slice();
+        // The swaps move only what is read again: the rows from `k` of the columns from `k`
+        // (the eliminated rows and columns are not).
+        if best.1 != k {
+            let (left, right) = data.split_at_mut(best.1 * m);
+            left[k * m + k..(k + 1) * m].swap_with_slice(&mut right[k..m]);
+        }
         if best.0 != k {
+            for col in data[k * m..].chunks_exact_mut(m) {
+                col.swap(k, best.0);
+            }
             for at in col_arg.iter_mut() {
                 if *at == k {
                     *at = best.0;
@@ -105,7 +113,6 @@ pub(crate) fn partition_owned(mut a: DMatrix<f64>, row_scale: &[f64], scale: &[f
                 }
             }
         }
-        let data = a.as_mut_slice();
         let piv = data[k * m + k];
         for &ii in &changed_rows {
             changed[ii] = false;

@@ -85,6 +85,7 @@ pub(crate) fn partition_owned(mut a: DMatrix<f64>, row_scale: &[f64], scale: &[f
     let mut factor = vec![0.0; m];
     let mut changed = vec![false; m];
     let mut changed_rows: Vec<usize> = Vec::with_capacity(m);
+    let mut row_reach: Vec<usize> = Vec::with_capacity(n);
     for k in 0..m.min(n) {
         let best = search(&a, &col_max, k);
         if best.2 <= RANK_TOLERANCE * amax || best.2 == 0.0 {
@@ -101,15 +102,26 @@ pub(crate) fn partition_owned(mut a: DMatrix<f64>, row_scale: &[f64], scale: &[f
             let (left, right) = data.split_at_mut(best.1 * m);
             left[k * m + k..(k + 1) * m].swap_with_slice(&mut right[k..m]);
         }
+        // The columns the pivot row reaches (after the swaps), listed in the same pass.
+        row_reach.clear();
         if best.0 != k {
-            for col in data[k * m..].chunks_exact_mut(m) {
+            for (c, col) in data[k * m..].chunks_exact_mut(m).enumerate() {
                 col.swap(k, best.0);
+                if col[k] != 0.0 {
+                    row_reach.push(k + c);
+                }
             }
             for at in col_arg.iter_mut() {
                 if *at == k {
                     *at = best.0;
                 } else if *at == best.0 {
                     *at = k;
+                }
+            }
+        } else {
+            for (c, col) in data[k * m..].chunks_exact(m).enumerate() {
+                if col[k] != 0.0 {
+                    row_reach.push(k + c);
                 }
             }
         }
@@ -127,13 +139,10 @@ pub(crate) fn partition_owned(mut a: DMatrix<f64>, row_scale: &[f64], scale: &[f
             }
         }
         rank = k + 1;
-        for jj in k..n {
+        // Only the columns the pivot row reaches change (`x − f · 0 = x` exactly).
+        for &jj in &row_reach {
             let col = &mut data[jj * m..(jj + 1) * m];
             let p = col[k];
-            if p == 0.0 {
-                // `x − f · 0 = x` exactly: the column is unchanged.
-                continue;
-            }
             for &ii in &changed_rows {
                 col[ii] -= factor[ii] * p;
             }
@@ -196,8 +205,9 @@ fn search(a: &DMatrix<f64>, col_max: &[f64], k: usize) -> (usize, usize, f64) {
     let cut = top * (1.0 - SEARCH_WINDOW);
     let (mut best, mut threshold) = ((k, k, 0.0), 0.0);
     for jj in k..n {
-        // A column whose largest entry does not exceed the threshold changes nothing.
-        if col_max[jj] < cut || col_max[jj] == 0.0 || col_max[jj] <= threshold {
+        // A column whose largest entry does not exceed the threshold (never below 0: a zero
+        // column too) changes nothing.
+        if col_max[jj] < cut || col_max[jj] <= threshold {
             continue;
         }
         let col = &data[jj * m..(jj + 1) * m];

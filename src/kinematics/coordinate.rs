@@ -6,7 +6,7 @@
 //! within π of `θ_b` (`θ_b = 3.5` reads the pose at 3.5 − 2π as 3.5, not −2.78). The
 //! derivatives do not depend on the branch.
 
-use super::frames::{angle, frames, Frames};
+use super::frames::Frames;
 use crate::jet::{Pair, Scalar, Vec3Jet};
 use crate::joint::{Read, V};
 use crate::math::{rotation, wrap_angle};
@@ -26,18 +26,43 @@ pub(crate) fn vector(f: &Frames, v: V) -> &Vec3Jet {
     }
 }
 
+/// The vector `v` of the joint frames of `joint` for `pair`, alone: the jet
+/// [`super::frames::frames`] forms for it (`d = o₁ − o₀` from both origins).
+fn frame_vector(joint: &Joint, pair: &Pair, v: V) -> Vec3Jet {
+    let f = &joint.body_from_joint;
+    let axis = |k: usize, e: Vector3<f64>| pair.vector(k, &(f[k].rotation * e));
+    match v {
+        V::D => pair
+            .point(1, &f[1].translation.vector)
+            .sub(&pair.point(0, &f[0].translation.vector)),
+        V::X0 => axis(0, Vector3::x()),
+        V::Y0 => axis(0, Vector3::y()),
+        V::Z0 => axis(0, Vector3::z()),
+        V::X1 => axis(1, Vector3::x()),
+        V::Y1 => axis(1, Vector3::y()),
+        V::Z1 => axis(1, Vector3::z()),
+    }
+}
+
 /// Scalar joint coordinate `dof` read on the branch `reference` (used only if the
 /// coordinate is an angle), or `None` if the joint has no such coordinate (its kind's
 /// [`crate::joint::Spec::coordinates`] say how it is read).
+///
+/// Only the frame vectors the coordinate reads are formed (each as
+/// [`super::frames::frames`] forms it: the same numbers): a revolute angle's three axes of
+/// the eight jets.
 pub(crate) fn coordinate(joint: &Joint, pair: &Pair, dof: usize, reference: f64) -> Option<Scalar> {
     let c = joint.kind.spec().coordinates.get(dof)?;
-    let f = frames(joint, pair);
+    let v = |v: V| frame_vector(joint, pair, v);
     let s = match c.read {
-        Read::Angle => angle(pair, &f),
-        Read::Dot(a, b) => pair.dot(vector(&f, a), vector(&f, b)),
+        Read::Angle => {
+            let (y0, x1, x0) = (v(V::Y0), v(V::X1), v(V::X0));
+            pair.atan2(&pair.dot(&y0, &x1), &pair.dot(&x0, &x1))
+        }
+        Read::Dot(a, b) => pair.dot(&v(a), &v(b)),
         Read::Atan2([a, b], [c, e]) => {
-            let s = pair.dot(vector(&f, a), vector(&f, b));
-            let c = pair.dot(vector(&f, c), vector(&f, e));
+            let s = pair.dot(&v(a), &v(b));
+            let c = pair.dot(&v(c), &v(e));
             pair.atan2(&s, &c)
         }
     };

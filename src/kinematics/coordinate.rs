@@ -30,17 +30,24 @@ pub(crate) fn vector(f: &Frames, v: V) -> &Vec3Jet {
 /// [`super::frames::frames`] forms for it (`d = o₁ − o₀` from both origins).
 fn frame_vector(joint: &Joint, pair: &Pair, v: V) -> Vec3Jet {
     let f = &joint.body_from_joint;
-    let axis = |k: usize, e: Vector3<f64>| pair.vector(k, &(f[k].rotation * e));
-    match v {
-        V::D => pair
+    match axis_of(v) {
+        Some((k, e)) => pair.vector(k, &(f[k].rotation * e)),
+        None => pair
             .point(1, &f[1].translation.vector)
             .sub(&pair.point(0, &f[0].translation.vector)),
-        V::X0 => axis(0, Vector3::x()),
-        V::Y0 => axis(0, Vector3::y()),
-        V::Z0 => axis(0, Vector3::z()),
-        V::X1 => axis(1, Vector3::x()),
-        V::Y1 => axis(1, Vector3::y()),
-        V::Z1 => axis(1, Vector3::z()),
+    }
+}
+
+/// The side and the unit vector (in its joint frame) of an axis `v`; `None` for `d`.
+fn axis_of(v: V) -> Option<(usize, Vector3<f64>)> {
+    match v {
+        V::D => None,
+        V::X0 => Some((0, Vector3::x())),
+        V::Y0 => Some((0, Vector3::y())),
+        V::Z0 => Some((0, Vector3::z())),
+        V::X1 => Some((1, Vector3::x())),
+        V::Y1 => Some((1, Vector3::y())),
+        V::Z1 => Some((1, Vector3::z())),
     }
 }
 
@@ -80,18 +87,12 @@ pub(crate) fn coordinate_value(
     let c = joint.kind.spec().coordinates.get(dof)?;
     let a = [rotation(&pair.p[0]), rotation(&pair.p[1])];
     let f = &joint.body_from_joint;
-    let axis = |k: usize, e: Vector3<f64>| a[k] * (f[k].rotation * e);
-    let vector = |v: V| match v {
-        V::D => {
+    let vector = |v: V| match axis_of(v) {
+        Some((k, e)) => a[k] * (f[k].rotation * e),
+        None => {
             let o = |k: usize| pair.r[k] + a[k] * f[k].translation.vector;
             o(1) - o(0)
         }
-        V::X0 => axis(0, Vector3::x()),
-        V::Y0 => axis(0, Vector3::y()),
-        V::Z0 => axis(0, Vector3::z()),
-        V::X1 => axis(1, Vector3::x()),
-        V::Y1 => axis(1, Vector3::y()),
-        V::Z1 => axis(1, Vector3::z()),
     };
     let dot = |a: V, b: V| vector(a).dot(&vector(b));
     let v = match c.read {

@@ -250,15 +250,9 @@ fn cli_reads_xacro_and_names_the_file_in_errors() {
     );
 }
 
-/// A URDF that declares the xacro namespace without using it (xacro's own output keeps the
-/// declaration; pybullet_data's `diff_ring.urdf`, with a blank line before `<?xml`) is read as
-/// URDF: the late declaration is accepted with its warning, as in any URDF, where the xacro
-/// reader refused it. A file that uses xacro still goes through the expansion.
-#[test]
-fn declared_but_unused_xacro_namespace_is_plain_urdf() {
-    let tmp = tempfile::tempdir().unwrap();
-    let file = tmp.path().join("exported.urdf");
-    let urdf = r#"
+/// A one-link robot that declares the xacro namespace and uses none of it, after a blank line
+/// (pybullet_data's `diff_ring.urdf` starts so).
+const DECLARED_ONLY: &str = r#"
 <?xml version="1.0" ?>
 <robot name="r" xmlns:xacro="http://ros.org/wiki/xacro">
   <link name="world"/>
@@ -268,6 +262,16 @@ fn declared_but_unused_xacro_namespace_is_plain_urdf() {
     <axis xyz="0 1 0"/></joint>
 </robot>
 "#;
+
+/// A URDF that declares the xacro namespace without using it (xacro's own output keeps the
+/// declaration; pybullet_data's `diff_ring.urdf`, with a blank line before `<?xml`) is read as
+/// URDF: the late declaration is accepted with its warning, as in any URDF, where the xacro
+/// reader refused it. A file that uses xacro still goes through the expansion.
+#[test]
+fn declared_but_unused_xacro_namespace_is_plain_urdf() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("exported.urdf");
+    let urdf = DECLARED_ONLY;
     std::fs::write(&file, urdf).unwrap();
     let l = load_file(&file, &ImportOptions::default()).unwrap();
     assert_eq!(l.model.bodies().len(), 1);
@@ -299,17 +303,12 @@ fn declared_but_unused_xacro_namespace_is_plain_urdf() {
 fn xacro_in_comments_only_is_plain_urdf() {
     let tmp = tempfile::tempdir().unwrap();
     let file = tmp.path().join("talos_like.urdf");
-    let urdf = r#"<?xml version="1.0" ?>
-<robot name="r" xmlns:xacro="http://ros.org/wiki/xacro">
-  <!-- <xacro:gripper_virtual_transmission name="${name}_inner" reduction="1.0"/> -->
-  <link name="world"/>
-  <link name="arm"><inertial><origin xyz="0 0 -0.5"/><mass value="2"/>
-    <inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
-  <joint name="hinge" type="continuous"><parent link="world"/><child link="arm"/>
-    <axis xyz="0 1 0"/></joint>
-</robot>
-"#;
-    std::fs::write(&file, urdf).unwrap();
+    // The declared-but-unused test's robot, with a commented-out macro call on line 3.
+    let urdf = DECLARED_ONLY.trim_start().replace(
+        "  <link name=\"world\"/>",
+        "  <!-- <xacro:gripper name=\"${name}_inner\" reduction=\"1.0\"/> -->\n  <link name=\"world\"/>",
+    );
+    std::fs::write(&file, &urdf).unwrap();
     let l = load_file(&file, &ImportOptions::default()).unwrap();
     assert_eq!(l.model.bodies().len(), 1);
     assert_eq!(l.model.bodies()[0].mass, 2.0);

@@ -333,6 +333,16 @@ mod tests {
         }
     }
 
+    /// The partition of `j` (row and column scales `rows`, `cols`) is the reference's: the
+    /// same dependent columns and rows in pivot order, independent columns, redundant rows.
+    fn same_pivots(j: &DMatrix<f64>, rows: &[f64], cols: &[f64], trial: usize) {
+        let (a, b) = (partition(j, rows, cols), reference(j, rows, cols));
+        assert_eq!(a.dependent, b.dependent, "trial {trial}");
+        assert_eq!(a.independent, b.independent, "trial {trial}");
+        assert_eq!(a.rows, b.rows, "trial {trial}");
+        assert_eq!(a.redundant, b.redundant, "trial {trial}");
+    }
+
     /// The in-place, fused elimination picks exactly the pivots of the reference (same rank,
     /// same order of dependent columns and rows) on random matrices with ties, zero columns,
     /// redundant rows and scaling.
@@ -366,11 +376,7 @@ mod tests {
             let cols: Vec<f64> = (0..n)
                 .map(|_| if next() < 0.5 { 1.0 } else { 0.3 })
                 .collect();
-            let (a, b) = (partition(&j, &rows, &cols), reference(&j, &rows, &cols));
-            assert_eq!(a.dependent, b.dependent, "trial {trial}");
-            assert_eq!(a.independent, b.independent, "trial {trial}");
-            assert_eq!(a.rows, b.rows, "trial {trial}");
-            assert_eq!(a.redundant, b.redundant, "trial {trial}");
+            same_pivots(&j, &rows, &cols, trial);
         }
     }
 
@@ -413,11 +419,7 @@ mod tests {
                 .map(|_| if next() < 0.5 { 1.0 } else { 2.0 })
                 .collect();
             let cols: Vec<f64> = (0..n).map(|c| if c % 7 < 3 { 0.5 } else { 1.0 }).collect();
-            let (a, b) = (partition(&j, &rows, &cols), reference(&j, &rows, &cols));
-            assert_eq!(a.dependent, b.dependent, "trial {trial}");
-            assert_eq!(a.independent, b.independent, "trial {trial}");
-            assert_eq!(a.rows, b.rows, "trial {trial}");
-            assert_eq!(a.redundant, b.redundant, "trial {trial}");
+            same_pivots(&j, &rows, &cols, trial);
         }
     }
 }

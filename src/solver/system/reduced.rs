@@ -225,9 +225,15 @@ impl System<'_> {
                 z[(c, b)] = scale(b);
             }
             if !part.rows.is_empty() {
+                // `x (−s)` for each nonzero `x`, `+0` for the zeros (not `−0`): the solve
+                // skips its zero steps on such columns (module `dense_lu`); the signs of zero
+                // entries of the result are all it can change.
                 let mut rhs = phi_v.clone();
-                for b in 0..dof {
-                    rhs.column_mut(b).scale_mut(-scale(b));
+                for (b, mut col) in rhs.column_iter_mut().enumerate() {
+                    let s = -scale(b);
+                    for x in col.iter_mut() {
+                        *x = if *x == 0.0 { 0.0 } else { *x * s };
+                    }
                 }
                 if lu.solve_mut(&mut rhs) {
                     for (k, &c) in part.dependent.iter().enumerate() {

@@ -59,7 +59,18 @@ pub(crate) fn partition_owned(mut a: DMatrix<f64>, row_scale: &[f64], scale: &[f
     }
     let mut row_perm: Vec<usize> = (0..m).collect();
     let mut col_perm: Vec<usize> = (0..n).collect();
-    let amax = a.amax();
+    // `DMatrix::amax` on the slice (the same fold: `|x₀|`, then `a ≥ |x| ? a : |x|`).
+    let amax = match a.as_slice().split_first() {
+        None => 0.0,
+        Some((first, rest)) => rest.iter().fold(first.abs(), |mx, x| {
+            let v = x.abs();
+            if mx >= v {
+                mx
+            } else {
+                v
+            }
+        }),
+    };
     let mut rank = 0;
     // Rows and columns are swapped in place (position `i` holds row `row_perm[i]`), so that the
     // pivot search and the elimination run down contiguous columns; the search order, the
@@ -130,7 +141,11 @@ pub(crate) fn partition_owned(mut a: DMatrix<f64>, row_scale: &[f64], scale: &[f
             changed[ii] = false;
         }
         changed_rows.clear();
+        // A zero's factor (`±0`) is never read: only the changed rows' are.
         for (ii, &x) in data[k * m..(k + 1) * m].iter().enumerate().skip(k + 1) {
+            if x == 0.0 {
+                continue;
+            }
             let f = x / piv;
             factor[ii] = f;
             if f != 0.0 {
@@ -193,6 +208,9 @@ pub(crate) fn partition_owned(mut a: DMatrix<f64>, row_scale: &[f64], scale: &[f
 /// full scan's unless a column holds such a chain.
 const SEARCH_WINDOW: f64 = 1e-6;
 
+/// Entries of a column tested at once against the pivot search's threshold.
+const SEARCH_CHUNK: usize = 8;
+
 /// Pivot of step `k`: position `(row, column)` and magnitude, over rows and columns `k..`,
 /// scanning only the columns whose maximum `col_max` lies within [`SEARCH_WINDOW`] of the
 /// largest; `(k, k, 0)` when every remaining entry is zero.
@@ -210,13 +228,20 @@ fn search(a: &DMatrix<f64>, col_max: &[f64], k: usize) -> (usize, usize, f64) {
         if col_max[jj] < cut || col_max[jj] <= threshold {
             continue;
         }
-        let col = &data[jj * m..(jj + 1) * m];
-        for (ii, &x) in col.iter().enumerate().skip(k) {
-            let v = x.abs();
-            if v > threshold {
-                best = (ii, jj, v);
-                threshold = v * (1.0 + 1e-9);
+        // Chunk by chunk: one without an entry above the threshold (most of a sparse
+        // Jacobian's, zeros) changes nothing, and the threshold only rises.
+        let mut at = k;
+        for chunk in data[jj * m + k..(jj + 1) * m].chunks(SEARCH_CHUNK) {
+            if chunk.iter().fold(0.0_f64, |mx, x| mx.max(x.abs())) > threshold {
+                for (i, &x) in chunk.iter().enumerate() {
+                    let v = x.abs();
+                    if v > threshold {
+                        best = (at + i, jj, v);
+                        threshold = v * (1.0 + 1e-9);
+                    }
+                }
             }
+            at += chunk.len();
         }
     }
     best
@@ -287,7 +312,18 @@ mod tests {
         }
         let mut row_perm: Vec<usize> = (0..m).collect();
         let mut col_perm: Vec<usize> = (0..n).collect();
-        let amax = a.amax();
+        // `DMatrix::amax` on the slice (the same fold: `|x₀|`, then `a ≥ |x| ? a : |x|`).
+    let amax = match a.as_slice().split_first() {
+        None => 0.0,
+        Some((first, rest)) => rest.iter().fold(first.abs(), |mx, x| {
+            let v = x.abs();
+            if mx >= v {
+                mx
+            } else {
+                v
+            }
+        }),
+    };
         let mut rank = 0;
         for k in 0..m.min(n) {
             let mut best = (k, k, 0.0);

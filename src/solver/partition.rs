@@ -239,7 +239,7 @@ fn search(a: &DMatrix<f64>, col_max: &[f64], k: usize) -> (usize, usize, f64) {
 /// The largest magnitude in `x` and its index plus `offset` (`(0, offset)` if none is above 0;
 /// a NaN is passed over): the first entry above all before it, found chunk by chunk (a chunk
 /// whose largest magnitude does not exceed the maximum so far changes nothing).
-fn abs_max(x: &[f64], offset: usize) -> (f64, usize) {
+pub(crate) fn abs_max(x: &[f64], offset: usize) -> (f64, usize) {
     let (mut mx, mut at) = (0.0_f64, offset);
     for (c, chunk) in x.chunks(SEARCH_CHUNK).enumerate() {
         let top = chunk

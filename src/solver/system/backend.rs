@@ -7,10 +7,11 @@
 //! with faer's sparse LU. The sparse backend also forms the reduced Hessian column by column
 //! and solves Newton steps through the KKT system instead of the dense `Zᵀ W Z`.
 
+use super::partition_memo::dense_partition;
 use super::problem::Problem;
 use crate::constraints::Triplets;
 use crate::model::Model;
-use crate::solver::partition::{partition_owned, Partition};
+use crate::solver::partition::Partition;
 use crate::solver::LinearAlgebra;
 
 /// Models with more coordinates than this (40 bodies) use the sparse path when the choice is
@@ -154,7 +155,7 @@ impl Backend {
                     )
                 })
             }
-            Backend::Dense => partition_owned(jac.to_dense(), &scaling.rows, &scaling.columns),
+            Backend::Dense => dense_partition(jac, &scaling.rows, &scaling.columns),
         }
     }
 }

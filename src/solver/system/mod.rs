@@ -25,6 +25,7 @@ mod dense_lu;
 mod factors;
 mod kkt;
 mod kkt_matrix;
+mod partition_memo;
 mod problem;
 mod reduced;
 pub(crate) mod residual;

@@ -7,7 +7,7 @@
 //! with faer's sparse LU. The sparse backend also forms the reduced Hessian column by column
 //! and solves Newton steps through the KKT system instead of the dense `Zᵀ W Z`.
 
-use super::partition_memo::dense_partition;
+use super::dense_memo::dense_partition;
 use super::problem::Problem;
 use crate::constraints::Triplets;
 use crate::model::Model;

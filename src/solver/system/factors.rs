@@ -3,6 +3,7 @@
 //! (faer's sparse LU) or block triangular along the tree (module `tree::phi_u`).
 
 use super::dense_lu::DenseLu;
+use super::dense_memo::dense_factors;
 use super::{Backend, System};
 use crate::solver::partition::Partition;
 use crate::solver::sparse::factor::{SparseFactors, Split};
@@ -14,7 +15,10 @@ use std::sync::Arc;
 #[derive(Clone)]
 pub(crate) enum Factors {
     /// Dense LU with partial pivoting (small models).
-    Dense { lu: DenseLu, phi_v: DMatrix<f64> },
+    Dense {
+        lu: Arc<DenseLu>,
+        phi_v: Arc<DMatrix<f64>>,
+    },
     /// faer's sparse LU.
     Sparse(SparseFactors),
     /// Block triangular along the tree (shared with the pool that reuses its buffers).
@@ -63,7 +67,7 @@ impl Factors {
     /// `Φ_v x`.
     pub(crate) fn phi_v_mul(&self, x: &DVector<f64>, rows: usize) -> DVector<f64> {
         match self {
-            Factors::Dense { phi_v, .. } => phi_v * x,
+            Factors::Dense { phi_v, .. } => phi_v.as_ref() * x,
             Factors::Sparse(f) => DVector::from_vec(f.phi_v_mul(x.as_slice(), rows)),
             Factors::Tree(f) => DVector::from_vec(f.phi_v_mul(x.as_slice(), rows)),
         }
@@ -176,22 +180,23 @@ impl System<'_> {
         for (k, &c) in part.independent.iter().enumerate() {
             col_pos[c] = (false, k);
         }
-        let mut phi_u = DMatrix::zeros(r, r);
-        let mut phi_v = DMatrix::zeros(r, dof);
-        for &(i, c, v) in &work.jac.entries {
-            let a = row_pos[i as usize];
-            if a == usize::MAX {
-                continue;
+        let entries = &work.jac.entries;
+        let (lu, phi_v) = dense_factors(entries, part, || {
+            let mut phi_u = DMatrix::zeros(r, r);
+            let mut phi_v = DMatrix::zeros(r, dof);
+            for &(i, c, v) in entries {
+                let a = row_pos[i as usize];
+                if a == usize::MAX {
+                    continue;
+                }
+                match col_pos[c as usize] {
+                    (true, k) => phi_u[(a, k)] += v,
+                    (false, k) => phi_v[(a, k)] += v,
+                }
             }
-            match col_pos[c as usize] {
-                (true, k) => phi_u[(a, k)] += v,
-                (false, k) => phi_v[(a, k)] += v,
-            }
-        }
-        Some(Factors::Dense {
-            lu: DenseLu::new(phi_u),
-            phi_v,
-        })
+            (DenseLu::new(phi_u), phi_v)
+        });
+        Some(Factors::Dense { lu, phi_v })
     }
 }
 
@@ -220,8 +225,8 @@ mod tests {
             assert!((a.transpose() * &packed - &b).amax() < 1e-9, "n = {n}");
             let d = a.clone().lu().u().diagonal().abs();
             let dense = Factors::Dense {
-                lu,
-                phi_v: DMatrix::zeros(n, 0),
+                lu: Arc::new(lu),
+                phi_v: Arc::new(DMatrix::zeros(n, 0)),
             };
             assert_eq!(dense.pivot_ratio(), Some(d.min() / d.max()));
         }

@@ -228,7 +228,7 @@ impl System<'_> {
                 // `x (−s)` for each nonzero `x`, `+0` for the zeros (not `−0`): the solve
                 // skips its zero steps on such columns (module `dense_lu`); the signs of zero
                 // entries of the result are all it can change.
-                let mut rhs = phi_v.clone();
+                let mut rhs = phi_v.as_ref().clone();
                 for (b, mut col) in rhs.column_iter_mut().enumerate() {
                     let s = -scale(b);
                     for x in col.iter_mut() {

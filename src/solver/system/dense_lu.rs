@@ -158,7 +158,8 @@ fn icamax(x: &[f64]) -> usize {
 
 /// `L U x = b` for one column `b` of length `n` on the packed factors `t` (column-major,
 /// finite, no zero on `U`'s diagonal): nalgebra's steps `b_j ← (−c) t_ji · 1 + 1 · b_j`, the
-/// same value as `(−c) t_ji + b_j`; the steps with `c = ±0` skipped if `skip` (module docs).
+/// same value as `b_j + (−c) t_ji` (the products by 1 are exact, the sum commutes); the steps
+/// with `c = ±0` skipped if `skip` (module docs).
 fn solve_column(t: &[f64], n: usize, b: &mut [f64], skip: bool) {
     for i in 0..n.saturating_sub(1) {
         // nalgebra divides by the unit diagonal: `b_i / 1` is `b_i`.
@@ -168,7 +169,7 @@ fn solve_column(t: &[f64], n: usize, b: &mut [f64], skip: bool) {
         }
         let a = -c;
         for (y, &x) in b[i + 1..].iter_mut().zip(&t[i * n + i + 1..(i + 1) * n]) {
-            *y = a * x + *y;
+            *y += a * x;
         }
     }
     for i in (0..n).rev() {
@@ -179,7 +180,7 @@ fn solve_column(t: &[f64], n: usize, b: &mut [f64], skip: bool) {
         }
         let a = -c;
         for (y, &x) in b[..i].iter_mut().zip(&t[i * n..i * n + i]) {
-            *y = a * x + *y;
+            *y += a * x;
         }
     }
 }

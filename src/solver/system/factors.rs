@@ -20,7 +20,7 @@ pub(crate) enum Factors {
         phi_v: Arc<DMatrix<f64>>,
     },
     /// faer's sparse LU.
-    Sparse(SparseFactors),
+    Sparse(Box<SparseFactors>),
     /// Block triangular along the tree (shared with the pool that reuses its buffers).
     Tree(Arc<TreeLu>),
 }
@@ -164,7 +164,7 @@ impl System<'_> {
                 work.split = Some(Split::new(part, m, n, entries)?);
             }
             let split = work.split.as_mut()?;
-            return Some(Factors::Sparse(split.factor(entries)));
+            return Some(Factors::Sparse(Box::new(split.factor(entries))));
         }
         let r = part.rows.len();
         let dof = part.independent.len();

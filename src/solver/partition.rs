@@ -172,18 +172,7 @@ pub(crate) fn partition_owned(mut a: DMatrix<f64>, row_scale: &[f64], scale: &[f
             }
         }
     }
-    let mut independent = col_perm[rank..].to_vec();
-    independent.sort_unstable();
-    let mut redundant = row_perm[rank..].to_vec();
-    redundant.sort_unstable();
-    Partition {
-        id: next_id(),
-        dependent: col_perm[..rank].to_vec(),
-        independent,
-        rows: row_perm[..rank].to_vec(),
-        redundant,
-        second_pass: Vec::new(),
-    }
+    Partition::of_pivots(&row_perm, &col_perm, rank)
 }
 
 /// Relative window below the largest remaining magnitude in which columns are scanned for the
@@ -293,6 +282,25 @@ fn amax(x: &[f64]) -> f64 {
 }
 
 impl Partition {
+    /// The partition of an elimination that made `rank` pivots, position `k` of the permuted
+    /// rows and columns holding row `row_perm[k]` and column `col_perm[k]`: the first `rank`
+    /// are the independent rows and dependent coordinates in pivot order, the others the
+    /// redundant rows and independent coordinates, ascending.
+    pub(crate) fn of_pivots(row_perm: &[usize], col_perm: &[usize], rank: usize) -> Self {
+        let mut independent = col_perm[rank..].to_vec();
+        independent.sort_unstable();
+        let mut redundant = row_perm[rank..].to_vec();
+        redundant.sort_unstable();
+        Partition {
+            id: next_id(),
+            dependent: col_perm[..rank].to_vec(),
+            independent,
+            rows: row_perm[..rank].to_vec(),
+            redundant,
+            second_pass: Vec::new(),
+        }
+    }
+
     /// Whether two partitions choose the same dependent coordinates and rows (in any order).
     pub(crate) fn same_split(&self, other: &Partition) -> bool {
         let sorted = |x: &[usize]| {

@@ -70,18 +70,7 @@ fn reference(jac: &DMatrix<f64>, row_scale: &[f64], scale: &[f64]) -> Partition 
         }
         rank = k + 1;
     }
-    let mut independent = col_perm[rank..].to_vec();
-    independent.sort_unstable();
-    let mut redundant = row_perm[rank..].to_vec();
-    redundant.sort_unstable();
-    Partition {
-        id: next_id(),
-        dependent: col_perm[..rank].to_vec(),
-        independent,
-        rows: row_perm[..rank].to_vec(),
-        redundant,
-        second_pass: Vec::new(),
-    }
+    Partition::of_pivots(&row_perm, &col_perm, rank)
 }
 
 /// The partition of `j` (row and column scales `rows`, `cols`) is the reference's: the

@@ -20,7 +20,7 @@ use crate::solver::LinearAlgebra;
 /// branch the robot tests are written against (from a far start the tractor-trailer reaches a
 /// different, lower-energy branch on the sparse path), and its partition is checked for drift
 /// as the mechanism moves.
-const SPARSE_FROM_COORDINATES: usize = 7 * 40;
+pub(super) const SPARSE_FROM_COORDINATES: usize = 7 * 40;
 
 /// Small models without closed loops, stops, contacts, locks or mimics take the tree factors
 /// from this many bodies on (automatic choice): they cost the same as the dense path at 1 – 2

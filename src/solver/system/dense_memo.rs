@@ -8,7 +8,14 @@
 //!   bit for bit, gets the kept partition under a fresh id, as a new computation would.
 //! - `Φ_u`'s LU and `Φ_v` are functions of the triplets and the partition's rows, dependent
 //!   and independent coordinates: a second request gets the kept ones (shared, not copied).
+//!
+//! One of each is kept per thread, until the thread's next request replaces it (the factors
+//! are let go before new ones are computed, so that two are never held for the memo's sake):
+//! the triplets, one partition, and the factors of a `Φ_u` of at most [`KEPT_ROWS`] rows (the
+//! automatic dense size: under a megabyte; a larger one, `--linear-algebra dense` on a long
+//! chain, is not kept).
 
+use super::backend::SPARSE_FROM_COORDINATES;
 use super::dense_lu::DenseLu;
 use crate::constraints::{Triplet, Triplets};
 use crate::solver::partition::{next_id, partition_owned, Partition};
@@ -55,6 +62,10 @@ struct FactorsKey {
     independent: Vec<usize>,
 }
 
+/// The largest `Φ_u` (rows) whose factors are kept: the coordinates of the automatic dense
+/// path's largest model (module `backend`).
+pub(crate) const KEPT_ROWS: usize = SPARSE_FROM_COORDINATES;
+
 /// The dense factors: `Φ_u`'s LU and `Φ_v`.
 pub(crate) type DenseFactors = (Arc<DenseLu>, Arc<DMatrix<f64>>);
 
@@ -96,17 +107,16 @@ pub(crate) fn dense_factors(
         dependent: part.dependent.clone(),
         independent: part.independent.clone(),
     };
-    let kept = LAST_FACTORS.with_borrow(|last| {
-        last.as_ref()
-            .filter(|(k, _)| *k == key)
-            .map(|(_, (lu, phi_v))| (lu.clone(), phi_v.clone()))
-    });
-    if let Some(factors) = kept {
+    let kept = LAST_FACTORS.take().filter(|(k, _)| *k == key);
+    if let Some((key, factors)) = kept {
+        LAST_FACTORS.set(Some((key, factors.clone())));
         return factors;
     }
     let (lu, phi_v) = compute();
     let factors = (Arc::new(lu), Arc::new(phi_v));
-    LAST_FACTORS.set(Some((key, factors.clone())));
+    if part.rows.len() <= KEPT_ROWS {
+        LAST_FACTORS.set(Some((key, factors.clone())));
+    }
     factors
 }
 
@@ -180,5 +190,16 @@ mod tests {
         let other = dense_factors(&changed, &part(vec![0], vec![1], vec![0]), || make(1.0));
         assert!(!Arc::ptr_eq(&c.0, &other.0));
         assert_eq!(computed, 3);
+        // A `Φ_u` above the dense size is not kept: asked twice, computed twice.
+        let rows: Vec<usize> = (0..=KEPT_ROWS).collect();
+        let big = part(rows.clone(), rows, Vec::new());
+        let mut made = 0;
+        for _ in 0..2 {
+            dense_factors(&entries, &big, || {
+                made += 1;
+                (DenseLu::new(DMatrix::identity(1, 1)), DMatrix::zeros(1, 0))
+            });
+        }
+        assert_eq!(made, 2);
     }
 }

@@ -6,7 +6,7 @@
 //! within π of `θ_b` (`θ_b = 3.5` reads the pose at 3.5 − 2π as 3.5, not −2.78). The
 //! derivatives do not depend on the branch.
 
-use super::frames::Frames;
+use super::frames::{angle_of, axis_of, frame_vector, Frames};
 use crate::jet::{Pair, Scalar, Vec3Jet};
 use crate::joint::{Read, V};
 use crate::math::{rotation, wrap_angle};
@@ -26,31 +26,6 @@ pub(crate) fn vector(f: &Frames, v: V) -> &Vec3Jet {
     }
 }
 
-/// The vector `v` of the joint frames of `joint` for `pair`, alone: the jet
-/// [`super::frames::frames`] forms for it (`d = o₁ − o₀` from both origins).
-fn frame_vector(joint: &Joint, pair: &Pair, v: V) -> Vec3Jet {
-    let f = &joint.body_from_joint;
-    match axis_of(v) {
-        Some((k, e)) => pair.vector(k, &(f[k].rotation * e)),
-        None => pair
-            .point(1, &f[1].translation.vector)
-            .sub(&pair.point(0, &f[0].translation.vector)),
-    }
-}
-
-/// The side and the unit vector (in its joint frame) of an axis `v`; `None` for `d`.
-fn axis_of(v: V) -> Option<(usize, Vector3<f64>)> {
-    match v {
-        V::D => None,
-        V::X0 => Some((0, Vector3::x())),
-        V::Y0 => Some((0, Vector3::y())),
-        V::Z0 => Some((0, Vector3::z())),
-        V::X1 => Some((1, Vector3::x())),
-        V::Y1 => Some((1, Vector3::y())),
-        V::Z1 => Some((1, Vector3::z())),
-    }
-}
-
 /// Scalar joint coordinate `dof` read on the branch `reference` (used only if the
 /// coordinate is an angle), or `None` if the joint has no such coordinate (its kind's
 /// [`crate::joint::Spec::coordinates`] say how it is read).
@@ -62,10 +37,7 @@ pub(crate) fn coordinate(joint: &Joint, pair: &Pair, dof: usize, reference: f64)
     let c = joint.kind.spec().coordinates.get(dof)?;
     let v = |v: V| frame_vector(joint, pair, v);
     let s = match c.read {
-        Read::Angle => {
-            let (y0, x1, x0) = (v(V::Y0), v(V::X1), v(V::X0));
-            pair.atan2(&pair.dot(&y0, &x1), &pair.dot(&x0, &x1))
-        }
+        Read::Angle => angle_of(pair, &v(V::Y0), &v(V::X0), &v(V::X1)),
         Read::Dot(a, b) => pair.dot(&v(a), &v(b)),
         Read::Atan2([a, b], [c, e]) => {
             let s = pair.dot(&v(a), &v(b));

@@ -3,6 +3,7 @@
 //! `atan2(y_i·x_j, x_i·x_j)` in (−π, π].
 
 use crate::jet::{Pair, Scalar, Vec3Jet};
+use crate::joint::V;
 use crate::model::Joint;
 use nalgebra::Vector3;
 
@@ -16,29 +17,49 @@ pub(crate) struct Frames {
 
 /// The joint frames of both sides of `joint` for the body pair `pair`.
 pub(crate) fn frames(joint: &Joint, pair: &Pair) -> Frames {
-    let side = |k: usize| {
-        let f = &joint.body_from_joint[k];
-        (
-            pair.point(k, &f.translation.vector),
-            pair.vector(k, &(f.rotation * Vector3::x())),
-            pair.vector(k, &(f.rotation * Vector3::y())),
-            pair.vector(k, &(f.rotation * Vector3::z())),
-        )
-    };
-    let (o0, x0, y0, z0) = side(0);
-    let (o1, x1, y1, z1) = side(1);
+    let v = |v: V| frame_vector(joint, pair, v);
     Frames {
-        d: o1.sub(&o0),
-        x: [x0, x1],
-        y: [y0, y1],
-        z: [z0, z1],
+        d: v(V::D),
+        x: [v(V::X0), v(V::X1)],
+        y: [v(V::Y0), v(V::Y1)],
+        z: [v(V::Z0), v(V::Z1)],
+    }
+}
+
+/// The vector `v` of the joint frames of `joint` for `pair`, alone: the jet [`frames`] holds
+/// for it (`d = o₁ − o₀` from both origins).
+pub(crate) fn frame_vector(joint: &Joint, pair: &Pair, v: V) -> Vec3Jet {
+    let f = &joint.body_from_joint;
+    match axis_of(v) {
+        Some((k, e)) => pair.vector(k, &(f[k].rotation * e)),
+        None => pair
+            .point(1, &f[1].translation.vector)
+            .sub(&pair.point(0, &f[0].translation.vector)),
+    }
+}
+
+/// The side and the unit vector (in its joint frame) of an axis `v`; `None` for `d`.
+pub(crate) fn axis_of(v: V) -> Option<(usize, Vector3<f64>)> {
+    match v {
+        V::D => None,
+        V::X0 => Some((0, Vector3::x())),
+        V::Y0 => Some((0, Vector3::y())),
+        V::Z0 => Some((0, Vector3::z())),
+        V::X1 => Some((1, Vector3::x())),
+        V::Y1 => Some((1, Vector3::y())),
+        V::Z1 => Some((1, Vector3::z())),
     }
 }
 
 /// The rotation of the child's `x` axis about the parent's `z`: `atan2(y_i·x_j, x_i·x_j)`, in
 /// (−π, π] (see [`crate::kinematics::coordinate`] for the unwrapped joint angle).
 pub(crate) fn angle(pair: &Pair, f: &Frames) -> Scalar {
-    let s = pair.dot(&f.y[0], &f.x[1]);
-    let c = pair.dot(&f.x[0], &f.x[1]);
+    angle_of(pair, &f.y[0], &f.x[0], &f.x[1])
+}
+
+/// [`angle`] of the axes `y_i`, `x_i` and `x_j`: `atan2(y_i·x_j, x_i·x_j)`.
+pub(crate) fn angle_of(pair: &Pair, y0: &Vec3Jet, x0: &Vec3Jet, x1: &Vec3Jet) -> Scalar {
+    let s = pair.dot(y0, x1);
+    let c = pair.dot(x0, x1);
     pair.atan2(&s, &c)
 }

@@ -4,6 +4,7 @@ use super::args::{coord, AnalyzeArgs};
 use super::{exit, json_out, print};
 use restpose::export::json::AnalysisResult;
 use restpose::urdf::load_file;
+use std::mem::ManuallyDrop;
 
 /// Runs `analyze`: exit 0 when converged, 3 when not, 2 for two outputs to standard output.
 pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
@@ -20,7 +21,10 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
         opts.initial.push(coord(l, "initial")?);
     }
     let import_started = std::time::Instant::now();
-    let loaded = load_file(&a.file, &opts).map_err(|e| with_option(a, e))?;
+    // The model, the state, the report and the result live until the process ends, which
+    // returns their memory at once: they are not freed one allocation at a time (on a chain
+    // of 10,000 links that took 2 % of the run).
+    let loaded = ManuallyDrop::new(load_file(&a.file, &opts).map_err(|e| with_option(a, e))?);
     let import = import_started.elapsed().as_secs_f64();
     if !a.quiet {
         for w in &loaded.warnings {
@@ -42,7 +46,7 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
     if let Some(line) = progress {
         line.finish();
     }
-    let (state, mut report) = solved.map_err(|e| match e {
+    let (state, report) = solved.map_err(|e| match e {
         restpose::Error::ConstantEnergy { .. } if a.input.inertia_from_geometry.is_none() => {
             anyhow::anyhow!(
                 "{e}; links without <inertial> can get masses from their geometry with \
@@ -94,6 +98,7 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
         }
         e => e.into(),
     })?;
+    let (state, mut report) = (ManuallyDrop::new(state), ManuallyDrop::new(report));
     report.diagnostics.timings.import = import;
     // Never converged on a pose `verify` rejects (module `confirm`).
     let rejected = report
@@ -104,7 +109,7 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
         report.termination = restpose::solver::Termination::RejectedByVerify;
     }
     let export_started = std::time::Instant::now();
-    let mut result = AnalysisResult::new(model, &state, &report);
+    let mut result = ManuallyDrop::new(AnalysisResult::new(model, &state, &report));
     result.diagnostics.timings.export = export_started.elapsed().as_secs_f64();
     if let Some(path) = &a.json {
         json_out::write(path, |w| result.write_json(w))?;

@@ -10,7 +10,10 @@
 //! skipped.
 //!
 //! - `W Z`: per body block `(a, b)` of `W` and column `j`, `(W Z)_{a, j} += W_ab Z_{b, j}`,
-//!   the sums of [`BlockHessian::mul_add`] in its order;
+//!   the sums of [`BlockHessian::mul_add`] in its order (each row's `0 + B_i0 x_0 + … +
+//!   B_i6 x_6`), the seven rows of a block at once: the block is read by columns, padded to
+//!   eight lanes, once for all columns of `Z`, so that each step `s_i += B_ik x_k` is one
+//!   vector operation over `i` (a row's sum keeps its order; lanes do not mix);
 //! - `Zᵀ (W Z)`: each entry the dot product of nalgebra's `tr_mul` (eight running sums over
 //!   the rows in chunks of 8, `k mod 8` each, then combined as `(s₀ + s₄) + (s₁ + s₅) + …`,
 //!   then the rows after the last whole chunk), over the chunks where the column of `Z` is
@@ -97,19 +100,41 @@ pub(super) fn mul_add_columns(
     let (zs, ws) = (z.as_slice(), wz.as_mut_slice());
     for (&(a, b), blk) in hess.keys.iter().zip(&hess.values) {
         let skip = blk.iter().all(|v| v.is_finite());
+        let t = by_columns(blk);
         for (j, (x, y)) in zs.chunks_exact(n).zip(ws.chunks_exact_mut(n)).enumerate() {
             if skip && !pattern.bodies[j * blocks + b] {
                 continue;
             }
-            let (x, y) = (&x[7 * b..7 * b + 7], &mut y[7 * a..7 * a + 7]);
-            for i in 0..7 {
-                let mut s = 0.0;
-                for k in 0..7 {
-                    s += blk[7 * i + k] * x[k];
-                }
-                y[i] += s;
-            }
+            block_mul_add(&t, &x[7 * b..7 * b + 7], &mut y[7 * a..7 * a + 7]);
         }
+    }
+}
+
+/// A row-major `7 × 7` block by columns, each padded to eight lanes: `t[k][i] = B_ik`, lane 7
+/// zero.
+fn by_columns(blk: &[f64; 49]) -> [[f64; 8]; 7] {
+    let mut t = [[0.0; 8]; 7];
+    for (k, col) in t.iter_mut().enumerate() {
+        for (i, v) in col.iter_mut().take(7).enumerate() {
+            *v = blk[7 * i + k];
+        }
+    }
+    t
+}
+
+/// `y += B x` for the block `B` by columns ([`by_columns`]): each row's sum `0 + B_i0 x_0 +
+/// … + B_i6 x_6` in that order, as the plain loop forms it, the rows in eight lanes (lane 7,
+/// zero times `x`, is dropped).
+#[inline(always)]
+fn block_mul_add(t: &[[f64; 8]; 7], x: &[f64], y: &mut [f64]) {
+    let mut s = [0.0f64; 8];
+    for (col, &xk) in t.iter().zip(&x[..7]) {
+        for (si, &c) in s.iter_mut().zip(col) {
+            *si += c * xk;
+        }
+    }
+    for (yi, si) in y[..7].iter_mut().zip(&s) {
+        *yi += si;
     }
 }
 
@@ -225,6 +250,23 @@ mod tests {
             bits(&z.tr_mul(&infinite)),
             bits(&tr_mul(&z, &infinite, &pattern))
         );
+        // `W Z` with an infinite block entry (nothing skipped for that block: `∞ · 0` is a
+        // NaN) and a NaN in `Z`: the lanes give each row the plain loop's bits still.
+        let mut odd = hess.clone();
+        odd.values[4][9] = f64::INFINITY;
+        odd.values[7][48] = f64::NEG_INFINITY;
+        let mut z_nan = z.clone();
+        z_nan[(30, 5)] = f64::NAN;
+        for (h, z) in [(&odd, &z), (&hess, &z_nan), (&odd, &z_nan)] {
+            let mut plain = DMatrix::zeros(n, dof);
+            for j in 0..dof {
+                h.mul_add(z.column(j).as_slice(), plain.column_mut(j).as_mut_slice());
+            }
+            let mut lanes = DMatrix::zeros(n, dof);
+            mul_add_columns(h, z, &Pattern::of(z), &mut lanes);
+            assert_eq!(bits(&plain), bits(&lanes));
+            assert!(plain.iter().any(|v| v.is_nan()));
+        }
     }
 
     /// On the tree factors, `Ĥ` and `Z` of `reduced_hessian_and_basis` (all columns in one

@@ -170,6 +170,10 @@ pub(crate) fn lu_solve(f: &[f64], piv: &[u16], d: usize, x: &mut [f64], w: usize
         // A ladder's super-nodes of `Φ_u` (module `merge`): the model's, the self-check's.
         (14, 1) => lu_solve_impl(f, piv, 14, x, 1),
         (21, 1) => lu_solve_impl(f, piv, 21, x, 1),
+        // A body's block of `Φ_u` against all columns of `Φ_v` (the null-space basis of a
+        // small tree, `TreeLu::solve_columns`).
+        (6, _) => lu_solve_impl(f, piv, 6, x, w),
+        (7, _) => lu_solve_impl(f, piv, 7, x, w),
         _ => lu_solve_impl(f, piv, d, x, w),
     }
 }

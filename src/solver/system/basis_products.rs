@@ -139,6 +139,30 @@ fn block_mul_add(t: &[[f64; 8]; 7], x: &[f64], y: &mut [f64]) {
     }
 }
 
+/// The eight running sums of nalgebra's `tr_mul` for column `zi` of `Z` and the `K` columns
+/// `w` of `W Z` at once (`K` independent chains), over `zi`'s nonzero `chunks` that `keep`
+/// marks (a chunk where a column of `w` is zero adds `±0` products: no sum changes).
+#[inline(always)]
+fn running_sums<const K: usize>(
+    zi: &[f64],
+    chunks: &[u32],
+    keep: &[bool],
+    w: &[&[f64]; K],
+) -> [[f64; 8]; K] {
+    let mut acc = [[0.0f64; 8]; K];
+    for &c in chunks.iter().filter(|&&c| keep[c as usize]) {
+        let k = 8 * c as usize;
+        let a = &zi[k..k + 8];
+        for (acc, wt) in acc.iter_mut().zip(w) {
+            let b = &wt[k..k + 8];
+            for l in 0..8 {
+                acc[l] += a[l] * b[l];
+            }
+        }
+    }
+    acc
+}
+
 /// `Zᵀ (W Z)` (`dof × dof`): nalgebra's `z.tr_mul(wz)` to the last bit (module docs), over
 /// the chunks of 8 rows where both the column of `Z` and one of a group of four columns of
 /// `W Z` hold a nonzero (a chain: the bodies below both joints, a third of the rows on
@@ -193,33 +217,14 @@ pub(super) fn tr_mul(z: &DMatrix<f64>, wz: &DMatrix<f64>, pattern: &Pattern) -> 
         // sum (module docs: every entry is finite here).
         for g in 0..groups {
             let w: [&[f64]; 4] = std::array::from_fn(|t| &ws[(4 * g + t) * n..(4 * g + t + 1) * n]);
-            let any = &any[g * whole..(g + 1) * whole];
-            let mut acc = [[0.0f64; 8]; 4];
-            for &c in chunks.iter().filter(|&&c| any[c as usize]) {
-                let k = 8 * c as usize;
-                let a = &zi[k..k + 8];
-                for (acc, wt) in acc.iter_mut().zip(&w) {
-                    let b = &wt[k..k + 8];
-                    for l in 0..8 {
-                        acc[l] += a[l] * b[l];
-                    }
-                }
-            }
+            let acc = running_sums(zi, chunks, &any[g * whole..(g + 1) * whole], &w);
             for (t, (acc, wt)) in acc.iter().zip(&w).enumerate() {
                 out[(i, 4 * g + t)] = finish(acc, zi, wt);
             }
         }
         for j in 4 * groups..cols {
             let wj = &ws[j * n..(j + 1) * n];
-            let used = &used[j * whole..(j + 1) * whole];
-            let mut acc = [0.0f64; 8];
-            for &c in chunks.iter().filter(|&&c| used[c as usize]) {
-                let k = 8 * c as usize;
-                let (a, b) = (&zi[k..k + 8], &wj[k..k + 8]);
-                for l in 0..8 {
-                    acc[l] += a[l] * b[l];
-                }
-            }
+            let [acc] = running_sums(zi, chunks, &used[j * whole..(j + 1) * whole], &[wj]);
             out[(i, j)] = finish(&acc, zi, wj);
         }
     }

@@ -34,7 +34,7 @@
 //!   floor's are (its blocks and workspace are built and touched before it is timed).
 //!
 //! Both sides are best-of figures: the floor of 40 runs (10 above 2,000 links), restpose of 10
-//! solves (5 above 2,000; `RESTPOSE_FLOOR_RUNS=K` for K), each of its columns the best on its
+//! solves (5 above 2,000; `RESTPOSE_FLOOR_RUNS=K` for K; `RESTPOSE_FLOOR_ALGEBRA=tree` or `sparse` for that backend alone), each of its columns the best on its
 //! own.
 use nalgebra::{SMatrix, SVector};
 use restpose::{LinearAlgebra, Options};
@@ -236,6 +236,10 @@ fn main() {
             ("sparse", LinearAlgebra::Sparse),
             ("tree", LinearAlgebra::Tree),
         ] {
+            // `RESTPOSE_FLOOR_ALGEBRA=tree` (or `sparse`): that backend only (for a profile).
+            if std::env::var("RESTPOSE_FLOOR_ALGEBRA").is_ok_and(|a| a != name) {
+                continue;
+            }
             // One solve's figure swings with the machine by more than the gains measured here.
             let reps = std::env::var("RESTPOSE_FLOOR_RUNS")
                 .ok()

@@ -2,7 +2,7 @@
 //! strings copied into the document's own buffer (`roxmltree` expands references, so they are
 //! not byte ranges of the text), subtree ends and sibling links by index.
 
-use super::dom::{head, AttrData, Document, Kind, NodeData, Str, OWNED};
+use super::dom::{head, is_blank, AttrData, Document, Kind, NodeData, Str, OWNED};
 
 impl<'i> Document<'i> {
     /// `roxmltree`'s document, converted.
@@ -96,7 +96,10 @@ impl<'i> Document<'i> {
             }
             last_child.push(u32::MAX);
             out.nodes.push(data);
-            let children: Vec<_> = n.children().collect();
+            let children: Vec<_> = n
+                .children()
+                .filter(|c| !(c.is_text() && c.text().is_some_and(|t| is_blank(t.as_bytes()))))
+                .collect();
             for c in children.into_iter().rev() {
                 stack.push((c, id, depth + 1));
             }

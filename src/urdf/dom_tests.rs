@@ -192,3 +192,31 @@ fn nesting_beyond_the_limit_is_declined() {
     };
     assert!(e.to_string().contains("nested more than"), "{e}");
 }
+
+#[test]
+fn whitespace_between_tags_is_not_kept_by_either_reader() {
+    // Indentation (spaces, tabs, line feeds; carriage returns in roxmltree's reading) makes
+    // no node; a text with anything else is kept whole, its whitespace included.
+    let text =
+        "<robot name=\"r\">\n\t<link name=\"a\">  </link>\n  <x> v 1 </x><y>\n</y>\n</robot>\n";
+    let crlf = text.replace('\n', "\r\n");
+    let docs = [
+        super::lean::parse(text).expect("plain XML"),
+        roxmltree(text).expect("well-formed"),
+        roxmltree(&crlf).expect("well-formed"),
+    ];
+    for doc in &docs {
+        let texts: Vec<&str> = doc
+            .descendants()
+            .filter(|n| n.is_text())
+            .filter_map(|n| n.text())
+            .collect();
+        assert_eq!(texts, [" v 1 "]);
+        let robot = doc.root_element();
+        let kids: Vec<&str> = robot.children().map(|c| c.tag_name().name()).collect();
+        assert_eq!(kids, ["link", "x", "y"]);
+        let link = robot.children().next().expect("a child");
+        assert_eq!((link.text(), link.children().count()), (None, 0));
+    }
+    assert_same(&docs[0], &docs[1], "indented");
+}

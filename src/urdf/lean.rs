@@ -288,7 +288,11 @@ impl<'i> Reader<'i> {
                 return None;
             }
             self.i += len;
-            self.push(Self::leaf(Kind::Text, (from, self.i), (from, self.i)));
+            // Whitespace between tags is not kept (module `dom`: a document holds the texts
+            // that say something).
+            if !super::dom::is_blank(t) {
+                self.push(Self::leaf(Kind::Text, (from, self.i), (from, self.i)));
+            }
         }
         let rest = &self.b[self.i..];
         if rest.starts_with(b"</") {

@@ -34,8 +34,8 @@
 //!   floor's are (its blocks and workspace are built and touched before it is timed).
 //!
 //! Both sides are best-of figures: the floor of 40 runs (10 above 2,000 links), restpose of 10
-//! solves (5 above 2,000; `RESTPOSE_FLOOR_RUNS=K` for K; `RESTPOSE_FLOOR_ALGEBRA=tree` or `sparse` for that backend alone), each of its columns the best on its
-//! own.
+//! solves (5 above 2,000; `RESTPOSE_FLOOR_RUNS=K` for K), each of its columns the best on its
+//! own. `RESTPOSE_FLOOR_ALGEBRA=tree` (or `sparse`) runs that backend alone (for a profile).
 use nalgebra::{SMatrix, SVector};
 use restpose::{LinearAlgebra, Options};
 use std::hint::black_box;
@@ -236,7 +236,7 @@ fn main() {
             ("sparse", LinearAlgebra::Sparse),
             ("tree", LinearAlgebra::Tree),
         ] {
-            // `RESTPOSE_FLOOR_ALGEBRA=tree` (or `sparse`): that backend only (for a profile).
+            // `RESTPOSE_FLOOR_ALGEBRA`: one backend only (module docs).
             if std::env::var("RESTPOSE_FLOOR_ALGEBRA").is_ok_and(|a| a != name) {
                 continue;
             }

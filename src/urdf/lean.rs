@@ -15,7 +15,7 @@
 //! `namespaces` (`lean_namespaces.rs`).
 
 use super::byte_class::{CLASS, NAME_CHAR, NAME_START, NOT_IN_VALUE, SPACE};
-use super::dom::{head, AttrData, Document, Kind, NodeData, Str};
+use super::dom::{head, is_blank, AttrData, Document, Kind, NodeData, Str};
 use namespaces::Raw;
 
 // A child module (it reads the reader's state), kept beside this file.
@@ -290,7 +290,7 @@ impl<'i> Reader<'i> {
             self.i += len;
             // Whitespace between tags is not kept (module `dom`: a document holds the texts
             // that say something).
-            if !super::dom::is_blank(t) {
+            if !is_blank(t) {
                 self.push(Self::leaf(Kind::Text, (from, self.i), (from, self.i)));
             }
         }

@@ -225,8 +225,9 @@ pub struct Diagnostics {
 }
 
 /// Wall time of each phase of an analysis \[s\]. The solver fills `assembly`, `iterations`
-/// and `stability`; `import` and `export` are the caller's (the CLI measures reading the URDF
-/// and building the result; writing the text is not included).
+/// and `stability`; `import`, `export` and `self_check` are the caller's (the CLI measures
+/// reading the URDF, building the result and confirming the pose with `verify`'s checks;
+/// writing the text is not included).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct Timings {
     /// Reading and importing the model \[s\].
@@ -250,6 +251,10 @@ pub struct Timings {
     /// first_step) / (iterations − 1)` is the time of an iteration in a steady state (one
     /// minimization) \[s\].
     pub first_step: f64,
+    /// The CLI's confirmation of a converged pose by `verify`'s independent checks before it
+    /// exits 0 (`analyze`; 0 where nothing was confirmed: a solve that did not converge, a
+    /// library call) \[s\].
+    pub self_check: f64,
 }
 
 /// The clock of the minimizer's iterations (`Timings::steps`, `Timings::first_step`): each

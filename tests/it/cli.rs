@@ -615,12 +615,21 @@ fn analyze_reports_timings_of_each_phase() {
         serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
     let t = &v["diagnostics"]["timings"];
     let mut sum = 0.0;
-    for phase in ["import", "assembly", "iterations", "stability", "export"] {
+    for phase in [
+        "import",
+        "assembly",
+        "iterations",
+        "stability",
+        "export",
+        "self_check",
+    ] {
         let s = t[phase].as_f64().unwrap_or(-1.0);
         assert!(s.is_finite() && s >= 0.0, "{phase}: {t}");
         sum += s;
     }
     assert!(t["iterations"].as_f64().unwrap() > 0.0, "{t}");
+    // Issue 26: the self-check of a converged pose is timed too (it ran: the pose converged).
+    assert!(t["self_check"].as_f64().unwrap() > 0.0, "{t}");
     assert!(
         sum > 0.0 && sum <= wall,
         "phases {sum} s, process {wall} s: {t}"

@@ -101,14 +101,14 @@ pub(crate) fn run(a: &AnalyzeArgs) -> anyhow::Result<u8> {
     let (state, mut report) = (ManuallyDrop::new(state), ManuallyDrop::new(report));
     report.diagnostics.timings.import = import;
     // Never converged on a pose `verify` rejects (module `confirm`).
-    let confirming = std::time::Instant::now();
-    let rejected = report
-        .converged()
-        .then(|| super::confirm::rejection(a, model, &state))
-        .flatten();
-    if report.converged() {
+    let rejected = if report.converged() {
+        let confirming = std::time::Instant::now();
+        let why = super::confirm::rejection(a, model, &state);
         report.diagnostics.timings.self_check = confirming.elapsed().as_secs_f64();
-    }
+        why
+    } else {
+        None
+    };
     if rejected.is_some() {
         report.termination = restpose::solver::Termination::RejectedByVerify;
     }
